@@ -1,0 +1,379 @@
+//! The scene description: a TOML file a user writes by hand.
+//!
+//! ```toml
+//! name = "two rooms"          # optional; defaults to the file's stem
+//! up = "y"                    # "y" (default) or "z": the up axis of every coordinate in this file
+//! metres_per_unit = 1.0       # default 1.0; 0.01 for a level modelled in centimetres
+//! closed = true               # the level is meant to be sealed (the bake reports leaks)
+//!
+//! [[mesh]]
+//! path = "rooms.obj"          # OBJ, glTF or GLB, relative to this file
+//! static = true               # default true; dynamic meshes are lit but not baked
+//! translate = [0, 0, 0]       # scene units
+//! rotate_deg = [0, 90, 0]     # Euler angles in degrees, applied about X, then Y, then Z
+//! scale = 1.0                 # a number or [sx, sy, sz]
+//!
+//! [[material]]                # overrides a material of the meshes, by name
+//! name = "floor"
+//! albedo = [0.8, 0.8, 0.8]    # linear diffuse albedo in [0, 1]; replaces the texture
+//!
+//! [[light]]
+//! type = "point"
+//! position = [2, 2.7, 2]
+//! intensity = [8, 8, 8]       # radiant intensity, W/sr per RGB channel
+//!
+//! [[light]]
+//! type = "spot"
+//! position = [1, 2, 1]
+//! target = [1, 0, 1]          # or direction = [0, -1, 0]
+//! intensity = [20, 20, 20]    # W/sr on the axis
+//! cutoff_deg = 30             # half-angle where the light reaches 0
+//! beam_deg = 20               # half-angle of full intensity (<= cutoff); linear in angle between
+//!
+//! [[camera]]
+//! name = "main"
+//! eye = [0.5, 1.6, 0.5]
+//! target = [4, 1.2, 2]
+//! up = [0, 1, 0]              # default: the scene's up axis
+//! fov_deg = 70                # full horizontal angle
+//! ```
+//!
+//! Every unknown key is an error that names the key and the file. The conventions are those of
+//! Mitsuba 3 (see DESIGN.md), so that an independent renderer can check visgate's images.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::SceneError;
+
+/// The up axis that a scene file's coordinates use. visgate converts everything to +Y up.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum UpAxis {
+    /// +Y up (visgate's own convention, glTF's and most OBJ exporters').
+    #[default]
+    Y,
+    /// +Z up (Blender, Quake, 3ds Max): converted with (x, y, z) → (x, z, −y).
+    Z,
+}
+
+/// A uniform or per-axis scale.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum Scale {
+    /// The same factor on every axis.
+    Uniform(f64),
+    /// One factor per axis.
+    PerAxis([f64; 3]),
+}
+
+impl Default for Scale {
+    fn default() -> Self {
+        Scale::Uniform(1.0)
+    }
+}
+
+impl Scale {
+    /// The factor on each axis.
+    pub fn as_vec(&self) -> [f64; 3] {
+        match *self {
+            Scale::Uniform(s) => [s; 3],
+            Scale::PerAxis(v) => v,
+        }
+    }
+}
+
+fn default_true() -> bool {
+    true
+}
+
+fn default_mpu() -> f64 {
+    1.0
+}
+
+/// The whole scene description, as written in TOML.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneDesc {
+    /// Display name; defaults to the file's stem.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// Up axis of every coordinate in the file.
+    #[serde(default)]
+    pub up: UpAxis,
+    /// Metres per scene unit. [Limit: > 0, finite]
+    #[serde(default = "default_mpu")]
+    pub metres_per_unit: f64,
+    /// Whether the level is meant to be sealed: the bake reports where its empty space leaks.
+    #[serde(default)]
+    pub closed: bool,
+    /// The meshes, in order.
+    #[serde(default, rename = "mesh")]
+    pub meshes: Vec<MeshDesc>,
+    /// Material overrides, matched by material name.
+    #[serde(default, rename = "material", skip_serializing_if = "Vec::is_empty")]
+    pub materials: Vec<MaterialOverride>,
+    /// Primary lights.
+    #[serde(default, rename = "light")]
+    pub lights: Vec<LightDesc>,
+    /// Named cameras.
+    #[serde(default, rename = "camera")]
+    pub cameras: Vec<CameraDesc>,
+}
+
+/// One mesh file placed in the scene.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshDesc {
+    /// OBJ, glTF or GLB file, relative to the scene file.
+    pub path: PathBuf,
+    /// Static meshes are baked and occlude; dynamic ones are only lit.
+    #[serde(rename = "static", default = "default_true")]
+    pub is_static: bool,
+    /// Translation in scene units.
+    #[serde(default)]
+    pub translate: [f64; 3],
+    /// Euler angles in degrees, applied about X, then Y, then Z.
+    #[serde(default)]
+    pub rotate_deg: [f64; 3],
+    /// Scale applied before rotation. [Limit: finite, non-zero]
+    #[serde(default)]
+    pub scale: Scale,
+}
+
+/// Replaces a material's diffuse albedo (and drops its texture).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialOverride {
+    /// Name of the material in the mesh files.
+    pub name: String,
+    /// Linear diffuse albedo. [Limit: each channel in [0, 1]]
+    pub albedo: [f32; 3],
+}
+
+/// A primary light.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "lowercase")]
+pub enum LightDesc {
+    /// Isotropic point light.
+    Point(PointLightDesc),
+    /// Spot light with Mitsuba's linear-in-angle falloff.
+    Spot(SpotLightDesc),
+}
+
+/// An isotropic point light.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PointLightDesc {
+    /// Position in scene units.
+    pub position: [f64; 3],
+    /// Radiant intensity, W/sr per RGB channel. [Limit: >= 0, finite]
+    pub intensity: [f32; 3],
+}
+
+/// A spot light.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpotLightDesc {
+    /// Position in scene units.
+    pub position: [f64; 3],
+    /// A point the spot aims at (give this or `direction`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub target: Option<[f64; 3]>,
+    /// The axis direction (give this or `target`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub direction: Option<[f64; 3]>,
+    /// Radiant intensity on the axis, W/sr per RGB channel. [Limit: >= 0, finite]
+    pub intensity: [f32; 3],
+    /// Half-angle at which the intensity reaches 0. [Limit: (0, 90]] [Units: degrees]
+    pub cutoff_deg: f32,
+    /// Half-angle of full intensity. [Limit: (0, cutoff_deg]] [Units: degrees]
+    pub beam_deg: f32,
+}
+
+/// A named look-at camera.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CameraDesc {
+    /// Name used by `--camera`.
+    pub name: String,
+    /// Eye position in scene units.
+    pub eye: [f64; 3],
+    /// Point looked at, in scene units.
+    pub target: [f64; 3],
+    /// Up vector; defaults to the scene's up axis.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub up: Option<[f64; 3]>,
+    /// Full horizontal field of view. [Limit: (0, 180)] [Units: degrees]
+    pub fov_deg: f32,
+}
+
+impl SceneDesc {
+    /// A description of one bare mesh file: static, no lights, no cameras, open.
+    pub fn for_mesh_file(path: &Path) -> Self {
+        SceneDesc {
+            name: path.file_stem().map(|s| s.to_string_lossy().into_owned()),
+            up: UpAxis::Y,
+            metres_per_unit: 1.0,
+            closed: false,
+            meshes: vec![MeshDesc {
+                path: path.file_name().map(PathBuf::from).unwrap_or_default(),
+                is_static: true,
+                translate: [0.0; 3],
+                rotate_deg: [0.0; 3],
+                scale: Scale::Uniform(1.0),
+            }],
+            materials: vec![],
+            lights: vec![],
+            cameras: vec![],
+        }
+    }
+
+    /// Parses and validates a description from TOML text; `file` names it in errors.
+    pub fn from_toml(text: &str, file: &Path) -> Result<Self, SceneError> {
+        let desc: SceneDesc = toml::from_str(text).map_err(|e| SceneError::Parse {
+            file: file.to_path_buf(),
+            message: e.to_string(),
+        })?;
+        desc.validate(file)?;
+        Ok(desc)
+    }
+
+    /// Reads, parses and validates a scene TOML file.
+    pub fn read(file: &Path) -> Result<Self, SceneError> {
+        let text = std::fs::read_to_string(file).map_err(|source| SceneError::Io {
+            file: file.to_path_buf(),
+            source,
+        })?;
+        Self::from_toml(&text, file)
+    }
+
+    /// Writes the description as TOML.
+    pub fn to_toml(&self) -> String {
+        // Serialising plain data with string keys cannot fail.
+        toml::to_string_pretty(self).unwrap_or_else(|e| format!("# could not serialise: {e}\n"))
+    }
+
+    /// Checks every value against its documented limits; no value is clamped silently.
+    pub fn validate(&self, file: &Path) -> Result<(), SceneError> {
+        let bad = |what: String| SceneError::Invalid {
+            file: file.to_path_buf(),
+            what,
+        };
+        let finite3 = |v: &[f64; 3]| v.iter().all(|x| x.is_finite());
+        if !(self.metres_per_unit.is_finite() && self.metres_per_unit > 0.0) {
+            return Err(bad(format!(
+                "metres_per_unit = {} must be a finite number > 0",
+                self.metres_per_unit
+            )));
+        }
+        for (i, m) in self.meshes.iter().enumerate() {
+            let s = m.scale.as_vec();
+            if !finite3(&m.translate) || !finite3(&m.rotate_deg) || !finite3(&s) {
+                return Err(bad(format!(
+                    "mesh {} ({}) has a non-finite transform",
+                    i + 1,
+                    m.path.display()
+                )));
+            }
+            if s.contains(&0.0) {
+                return Err(bad(format!(
+                    "mesh {} ({}) has a zero scale, which flattens it",
+                    i + 1,
+                    m.path.display()
+                )));
+            }
+        }
+        for o in &self.materials {
+            if o.albedo.iter().any(|a| !(0.0..=1.0).contains(a)) {
+                return Err(bad(format!(
+                    "material override '{}': albedo {:?} must have every channel in [0, 1]",
+                    o.name, o.albedo
+                )));
+            }
+        }
+        for (i, l) in self.lights.iter().enumerate() {
+            let n = i + 1;
+            let (position, intensity) = match l {
+                LightDesc::Point(p) => (&p.position, &p.intensity),
+                LightDesc::Spot(s) => (&s.position, &s.intensity),
+            };
+            if !finite3(position) {
+                return Err(bad(format!("light {n}: position must be finite")));
+            }
+            if intensity.iter().any(|x| !(x.is_finite() && *x >= 0.0)) {
+                return Err(bad(format!(
+                    "light {n}: intensity {intensity:?} W/sr must be finite and >= 0"
+                )));
+            }
+            if let LightDesc::Spot(s) = l {
+                match (s.target, s.direction) {
+                    (Some(_), Some(_)) => {
+                        return Err(bad(format!(
+                            "spot light {n}: give either target or direction, not both"
+                        )));
+                    }
+                    (None, None) => {
+                        return Err(bad(format!("spot light {n}: give a target or a direction")));
+                    }
+                    (Some(t), None) => {
+                        if !finite3(&t) || t == s.position {
+                            return Err(bad(format!(
+                                "spot light {n}: target must be finite and differ from the position"
+                            )));
+                        }
+                    }
+                    (None, Some(d)) => {
+                        if !finite3(&d) || d == [0.0; 3] {
+                            return Err(bad(format!(
+                                "spot light {n}: direction must be finite and non-zero"
+                            )));
+                        }
+                    }
+                }
+                if !(s.cutoff_deg > 0.0 && s.cutoff_deg <= 90.0) {
+                    return Err(bad(format!(
+                        "spot light {n}: cutoff_deg = {} must be in (0, 90] (a half-angle)",
+                        s.cutoff_deg
+                    )));
+                }
+                if !(s.beam_deg > 0.0 && s.beam_deg <= s.cutoff_deg) {
+                    return Err(bad(format!(
+                        "spot light {n}: beam_deg = {} must be in (0, cutoff_deg = {}]",
+                        s.beam_deg, s.cutoff_deg
+                    )));
+                }
+            }
+        }
+        let mut names = std::collections::BTreeSet::new();
+        for c in &self.cameras {
+            if !names.insert(c.name.as_str()) {
+                return Err(bad(format!("two cameras are named '{}'", c.name)));
+            }
+            if !finite3(&c.eye) || !finite3(&c.target) || c.eye == c.target {
+                return Err(bad(format!(
+                    "camera '{}': eye and target must be finite and differ",
+                    c.name
+                )));
+            }
+            if let Some(up) = c.up
+                && (!finite3(&up) || up == [0.0; 3])
+            {
+                {
+                    return Err(bad(format!(
+                        "camera '{}': up must be finite and non-zero",
+                        c.name
+                    )));
+                }
+            }
+            if !(c.fov_deg > 0.0 && c.fov_deg < 180.0) {
+                return Err(bad(format!(
+                    "camera '{}': fov_deg = {} must be in (0, 180) (full horizontal angle)",
+                    c.name, c.fov_deg
+                )));
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,590 @@
+//! Mesh import: OBJ through tobj, glTF/GLB through gltf, into plain meshes in file units.
+//!
+//! Both importers check every vertex for NaN/Inf (an error naming the mesh), every index
+//! against the vertex count (an error), drop zero-area triangles (counted, and one warning per
+//! file), compute face normals where the file has none, and decode diffuse textures with the
+//! `image` crate; a texture that fails to decode is a warning and its material falls back to
+//! the albedo.
+
+use std::collections::HashMap;
+use std::io::BufRead;
+use std::path::{Path, PathBuf};
+
+use glam::{Mat4, Vec2, Vec3};
+
+use crate::error::SceneError;
+use crate::scene::{FileKind, Material, Texture};
+
+/// Albedo of a triangle with no material: Mitsuba's default diffuse reflectance.
+pub const DEFAULT_ALBEDO: f32 = 0.5;
+
+/// Import settings.
+#[derive(Debug, Clone, Copy)]
+pub struct ImportOptions {
+    /// Decode diffuse textures (the bake does not need them).
+    pub load_textures: bool,
+}
+
+impl Default for ImportOptions {
+    fn default() -> Self {
+        ImportOptions {
+            load_textures: true,
+        }
+    }
+}
+
+/// One mesh as read from a file, in the file's own units and axes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RawMesh {
+    /// Object/group or glTF mesh name.
+    pub name: String,
+    /// Positions.
+    pub positions: Vec<Vec3>,
+    /// Unit normals, one per position.
+    pub normals: Vec<Vec3>,
+    /// Texture coordinates, one per position (zero where the file has none).
+    pub uvs: Vec<Vec2>,
+    /// Non-degenerate triangles.
+    pub triangles: Vec<[u32; 3]>,
+    /// Index into the model's materials.
+    pub material: u32,
+}
+
+/// Everything one mesh file holds.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ImportedModel {
+    /// Meshes, in file order.
+    pub meshes: Vec<RawMesh>,
+    /// Materials referenced by the meshes.
+    pub materials: Vec<Material>,
+    /// Decoded textures referenced by the materials.
+    pub textures: Vec<Texture>,
+    /// Triangles in the file after fan triangulation.
+    pub triangles_read: u64,
+    /// Zero-area triangles dropped.
+    pub degenerate_dropped: u64,
+    /// Textures that failed to decode.
+    pub textures_failed: u64,
+    /// Warnings, in order.
+    pub warnings: Vec<String>,
+}
+
+/// Imports an OBJ, glTF or GLB file, chosen by its extension.
+pub fn import_file(path: &Path, options: &ImportOptions) -> Result<ImportedModel, SceneError> {
+    if !path.is_file() {
+        return Err(SceneError::Io {
+            file: path.to_path_buf(),
+            source: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
+        });
+    }
+    match FileKind::of(path) {
+        Some(FileKind::Obj) => import_obj(path, options),
+        Some(FileKind::Gltf) => import_gltf(path, options),
+        _ => Err(SceneError::UnknownFileType {
+            file: path.to_path_buf(),
+        }),
+    }
+}
+
+fn tobj_options() -> tobj::LoadOptions {
+    tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ignore_points: true,
+        ignore_lines: true,
+    }
+}
+
+/// Imports an OBJ file and its MTL libraries (relative to the OBJ).
+pub fn import_obj(path: &Path, options: &ImportOptions) -> Result<ImportedModel, SceneError> {
+    let file = std::fs::File::open(path).map_err(|source| SceneError::Io {
+        file: path.to_path_buf(),
+        source,
+    })?;
+    let dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
+    let mut reader = std::io::BufReader::with_capacity(1 << 20, file);
+    import_obj_reader(path, &mut reader, &dir, options, |mtl| {
+        tobj::load_mtl(dir.join(mtl))
+    })
+}
+
+/// Imports OBJ text from memory; `mtl` supplies the text of each material library it names.
+pub fn import_obj_str(
+    name: &Path,
+    obj: &str,
+    mtl: impl Fn(&Path) -> Option<String>,
+) -> Result<ImportedModel, SceneError> {
+    let mut reader = std::io::Cursor::new(obj.as_bytes());
+    let options = ImportOptions {
+        load_textures: false,
+    };
+    import_obj_reader(name, &mut reader, Path::new("."), &options, |lib| {
+        let text = mtl(lib).ok_or(tobj::LoadError::OpenFileFailed)?;
+        tobj::load_mtl_buf(&mut std::io::Cursor::new(text.as_bytes()))
+    })
+}
+
+fn import_obj_reader(
+    path: &Path,
+    reader: &mut impl BufRead,
+    dir: &Path,
+    options: &ImportOptions,
+    mtl_loader: impl Fn(&Path) -> tobj::MTLLoadResult,
+) -> Result<ImportedModel, SceneError> {
+    let (models, materials) =
+        tobj::load_obj_buf(reader, &tobj_options(), mtl_loader).map_err(|reason| {
+            SceneError::Obj {
+                file: path.to_path_buf(),
+                reason,
+            }
+        })?;
+    let mut out = ImportedModel::default();
+    let materials = materials.unwrap_or_else(|e| {
+        out.warnings.push(format!(
+            "{}: material library not loaded ({e}); using albedo {DEFAULT_ALBEDO}",
+            path.display()
+        ));
+        vec![]
+    });
+    let mut textures = TextureCache::new(options.load_textures);
+    for m in &materials {
+        let texture = m
+            .diffuse_texture
+            .as_deref()
+            .and_then(|t| textures.load(&dir.join(t.replace('\\', "/")), &mut out));
+        out.materials.push(Material {
+            name: m.name.clone(),
+            albedo: Vec3::from(m.diffuse.unwrap_or([DEFAULT_ALBEDO; 3])),
+            texture,
+        });
+    }
+    let mut default_material = None;
+    for model in models {
+        let mesh = &model.mesh;
+        let n = mesh.positions.len() / 3;
+        let positions: Vec<Vec3> = mesh
+            .positions
+            .chunks_exact(3)
+            .map(|c| Vec3::new(c[0], c[1], c[2]))
+            .collect();
+        let normals = if mesh.normals.len() == mesh.positions.len() {
+            Some(
+                mesh.normals
+                    .chunks_exact(3)
+                    .map(|c| Vec3::new(c[0], c[1], c[2]).normalize_or_zero())
+                    .collect(),
+            )
+        } else {
+            None
+        };
+        let uvs = if mesh.texcoords.len() == n * 2 {
+            Some(
+                mesh.texcoords
+                    .chunks_exact(2)
+                    // OBJ's v runs up the image; visgate's texture rows run down.
+                    .map(|c| Vec2::new(c[0], 1.0 - c[1]))
+                    .collect(),
+            )
+        } else {
+            None
+        };
+        let material = match mesh.material_id {
+            Some(id) if id < out.materials.len() => id as u32,
+            _ => *default_material.get_or_insert_with(|| {
+                out.materials.push(Material {
+                    name: "default".into(),
+                    albedo: Vec3::splat(DEFAULT_ALBEDO),
+                    texture: None,
+                });
+                out.materials.len() as u32 - 1
+            }),
+        };
+        let indices = mesh.indices.iter().map(|&i| i as u64);
+        let raw = build_mesh(
+            path,
+            model.name.clone(),
+            positions,
+            normals,
+            uvs,
+            indices,
+            material,
+            &mut out,
+        )?;
+        if !raw.triangles.is_empty() {
+            out.meshes.push(raw);
+        }
+    }
+    finish_warnings(path, &mut out);
+    Ok(out)
+}
+
+/// Imports a glTF 2.0 file (`.gltf` with external or embedded buffers, or `.glb`), walking
+/// the default scene's node hierarchy and applying node transforms.
+pub fn import_gltf(path: &Path, options: &ImportOptions) -> Result<ImportedModel, SceneError> {
+    let gerr = |e: gltf::Error| SceneError::Gltf {
+        file: path.to_path_buf(),
+        message: e.to_string(),
+    };
+    let gltf::Gltf { document, blob } = gltf::Gltf::open(path).map_err(gerr)?;
+    let base = path.parent().unwrap_or(Path::new("."));
+    let buffers = gltf::import_buffers(&document, Some(base), blob).map_err(gerr)?;
+    let mut out = ImportedModel::default();
+
+    // Images → textures (failures fall back to the albedo).
+    let mut image_texture: Vec<Option<u32>> = Vec::new();
+    for image in document.images() {
+        if !options.load_textures {
+            image_texture.push(None);
+            continue;
+        }
+        let name = match image.source() {
+            gltf::image::Source::Uri { uri, .. } => uri.to_string(),
+            gltf::image::Source::View { .. } => {
+                format!("image {} (embedded)", image.index())
+            }
+        };
+        match gltf::image::Data::from_source(image.source(), Some(base), &buffers)
+            .map_err(|e| e.to_string())
+            .and_then(|d| gltf_image_rgba8(&d).map(|px| (d.width, d.height, px)))
+        {
+            Ok((width, height, rgba8)) => {
+                out.textures.push(Texture {
+                    name,
+                    width,
+                    height,
+                    rgba8,
+                });
+                image_texture.push(Some(out.textures.len() as u32 - 1));
+            }
+            Err(e) => {
+                out.textures_failed += 1;
+                out.warnings.push(format!(
+                    "{}: texture '{name}' not loaded ({e}); its materials use their albedo",
+                    path.display()
+                ));
+                image_texture.push(None);
+            }
+        }
+    }
+    for m in document.materials() {
+        let pbr = m.pbr_metallic_roughness();
+        let base_color = pbr.base_color_factor();
+        let mut texture = pbr
+            .base_color_texture()
+            .map(|t| t.texture().source().index());
+        let mut albedo = Vec3::new(base_color[0], base_color[1], base_color[2]);
+        if let Some(sg) = m.pbr_specular_glossiness() {
+            let d = sg.diffuse_factor();
+            if base_color == [1.0; 4] {
+                albedo = Vec3::new(d[0], d[1], d[2]);
+            }
+            if texture.is_none() {
+                texture = sg.diffuse_texture().map(|t| t.texture().source().index());
+            }
+        }
+        out.materials.push(Material {
+            name: m
+                .name()
+                .map(str::to_string)
+                .unwrap_or_else(|| format!("material {}", m.index().unwrap_or(0))),
+            albedo,
+            texture: texture.and_then(|i| image_texture.get(i).copied().flatten()),
+        });
+    }
+    let default_material = out.materials.len() as u32;
+    let mut needs_default = false;
+
+    let scene = document
+        .default_scene()
+        .or_else(|| document.scenes().next());
+    let mut stack: Vec<(gltf::Node, Mat4)> = match &scene {
+        Some(s) => s.nodes().map(|n| (n, Mat4::IDENTITY)).collect(),
+        None => vec![],
+    };
+    while let Some((node, parent)) = stack.pop() {
+        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+        for child in node.children() {
+            stack.push((child, world));
+        }
+        let Some(mesh) = node.mesh() else { continue };
+        let normal_m = world.inverse().transpose();
+        let flip = world.determinant() < 0.0;
+        for prim in mesh.primitives() {
+            let mname = mesh
+                .name()
+                .or(node.name())
+                .map(str::to_string)
+                .unwrap_or_else(|| format!("mesh {}", mesh.index()));
+            let mode = prim.mode();
+            if !matches!(
+                mode,
+                gltf::mesh::Mode::Triangles
+                    | gltf::mesh::Mode::TriangleStrip
+                    | gltf::mesh::Mode::TriangleFan
+            ) {
+                out.warnings.push(format!(
+                    "{}: mesh '{mname}' has a {mode:?} primitive, which is not triangles; skipped",
+                    path.display()
+                ));
+                continue;
+            }
+            let reader = prim.reader(|b| buffers.get(b.index()).map(|d| d.0.as_slice()));
+            let Some(pos) = reader.read_positions() else {
+                out.warnings.push(format!(
+                    "{}: mesh '{mname}' has a primitive without positions; skipped",
+                    path.display()
+                ));
+                continue;
+            };
+            let positions: Vec<Vec3> = pos.map(|p| world.transform_point3(Vec3::from(p))).collect();
+            let normals = reader.read_normals().map(|it| {
+                it.map(|n| {
+                    normal_m
+                        .transform_vector3(Vec3::from(n))
+                        .normalize_or_zero()
+                })
+                .collect::<Vec<_>>()
+            });
+            let uvs = reader
+                .read_tex_coords(0)
+                .map(|it| it.into_f32().map(Vec2::from).collect::<Vec<_>>());
+            let list: Vec<u64> = match reader.read_indices() {
+                Some(ix) => ix.into_u32().map(u64::from).collect(),
+                None => (0..positions.len() as u64).collect(),
+            };
+            let list = match mode {
+                gltf::mesh::Mode::TriangleStrip => strip_to_list(&list),
+                gltf::mesh::Mode::TriangleFan => fan_to_list(&list),
+                _ => list,
+            };
+            let list = if flip {
+                list.chunks_exact(3)
+                    .flat_map(|t| [t[0], t[2], t[1]])
+                    .collect()
+            } else {
+                list
+            };
+            let material = match prim.material().index() {
+                Some(i) => i as u32,
+                None => {
+                    needs_default = true;
+                    default_material
+                }
+            };
+            let raw = build_mesh(
+                path,
+                mname,
+                positions,
+                normals,
+                uvs,
+                list.into_iter(),
+                material,
+                &mut out,
+            )?;
+            if !raw.triangles.is_empty() {
+                out.meshes.push(raw);
+            }
+        }
+    }
+    if needs_default {
+        out.materials.push(Material {
+            name: "default".into(),
+            albedo: Vec3::splat(DEFAULT_ALBEDO),
+            texture: None,
+        });
+    }
+    finish_warnings(path, &mut out);
+    Ok(out)
+}
+
+fn gltf_image_rgba8(d: &gltf::image::Data) -> Result<Vec<u8>, String> {
+    use gltf::image::Format;
+    let px = &d.pixels;
+    Ok(match d.format {
+        Format::R8G8B8A8 => px.clone(),
+        Format::R8G8B8 => px
+            .chunks_exact(3)
+            .flat_map(|c| [c[0], c[1], c[2], 255])
+            .collect(),
+        Format::R8G8 => px
+            .chunks_exact(2)
+            .flat_map(|c| [c[0], c[0], c[0], c[1]])
+            .collect(),
+        Format::R8 => px.iter().flat_map(|&c| [c, c, c, 255]).collect(),
+        other => return Err(format!("pixel format {other:?} is not supported")),
+    })
+}
+
+fn strip_to_list(ix: &[u64]) -> Vec<u64> {
+    let mut out = Vec::new();
+    for i in 2..ix.len() {
+        if i % 2 == 0 {
+            out.extend([ix[i - 2], ix[i - 1], ix[i]]);
+        } else {
+            out.extend([ix[i - 1], ix[i - 2], ix[i]]);
+        }
+    }
+    out
+}
+
+fn fan_to_list(ix: &[u64]) -> Vec<u64> {
+    let mut out = Vec::new();
+    for i in 2..ix.len() {
+        out.extend([ix[0], ix[i - 1], ix[i]]);
+    }
+    out
+}
+
+/// Whether a triangle has exactly zero area. The cross product is computed in f64, where the
+/// products of f32 coordinate differences are exact, so this is an exact test for collinear
+/// (or repeated) corners rather than a tolerance.
+pub fn is_degenerate(a: Vec3, b: Vec3, c: Vec3) -> bool {
+    let (a, b, c) = (a.as_dvec3(), b.as_dvec3(), c.as_dvec3());
+    (b - a).cross(c - a) == glam::DVec3::ZERO
+}
+
+/// Validates and assembles one mesh: finite vertices, indices in range, degenerate triangles
+/// dropped, face normals where the file has none.
+#[allow(clippy::too_many_arguments)]
+fn build_mesh(
+    path: &Path,
+    name: String,
+    positions: Vec<Vec3>,
+    normals: Option<Vec<Vec3>>,
+    uvs: Option<Vec<Vec2>>,
+    indices: impl Iterator<Item = u64>,
+    material: u32,
+    out: &mut ImportedModel,
+) -> Result<RawMesh, SceneError> {
+    if let Some(vertex) = positions.iter().position(|p| !p.is_finite()) {
+        return Err(SceneError::NonFinite {
+            file: path.to_path_buf(),
+            mesh: name,
+            vertex,
+        });
+    }
+    let n = positions.len();
+    let indices: Vec<u64> = indices.collect();
+    if let Some(&index) = indices.iter().find(|&&i| i >= n as u64) {
+        return Err(SceneError::IndexOutOfRange {
+            file: path.to_path_buf(),
+            mesh: name,
+            index,
+            vertices: n,
+        });
+    }
+    out.triangles_read += (indices.len() / 3) as u64;
+    let mut triangles = Vec::with_capacity(indices.len() / 3);
+    for t in indices.chunks_exact(3) {
+        let t = [t[0] as u32, t[1] as u32, t[2] as u32];
+        if is_degenerate(
+            positions[t[0] as usize],
+            positions[t[1] as usize],
+            positions[t[2] as usize],
+        ) {
+            out.degenerate_dropped += 1;
+        } else {
+            triangles.push(t);
+        }
+    }
+    let normals = normals.filter(|v| v.len() == n && v.iter().all(|x| x.is_finite()));
+    let uvs = uvs
+        .filter(|v| v.len() == n && v.iter().all(|x| x.is_finite()))
+        .unwrap_or_else(|| vec![Vec2::ZERO; n]);
+    match normals {
+        Some(normals) => Ok(RawMesh {
+            name,
+            positions,
+            normals,
+            uvs,
+            triangles,
+            material,
+        }),
+        None => {
+            // Face normals: one vertex per triangle corner.
+            let mut p = Vec::with_capacity(triangles.len() * 3);
+            let mut nn = Vec::with_capacity(triangles.len() * 3);
+            let mut uv = Vec::with_capacity(triangles.len() * 3);
+            for t in &triangles {
+                let [a, b, c] = t.map(|i| positions[i as usize]);
+                let fnorm = (b - a).cross(c - a).normalize_or_zero();
+                for &i in t {
+                    p.push(positions[i as usize]);
+                    nn.push(fnorm);
+                    uv.push(uvs[i as usize]);
+                }
+            }
+            let tris = (0..triangles.len() as u32)
+                .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+                .collect();
+            Ok(RawMesh {
+                name,
+                positions: p,
+                normals: nn,
+                uvs: uv,
+                triangles: tris,
+                material,
+            })
+        }
+    }
+}
+
+fn finish_warnings(path: &Path, out: &mut ImportedModel) {
+    if out.degenerate_dropped > 0 {
+        out.warnings.push(format!(
+            "{}: dropped {} degenerate (zero-area) triangles of {}",
+            path.display(),
+            out.degenerate_dropped,
+            out.triangles_read
+        ));
+    }
+    for w in &out.warnings {
+        tracing::warn!("{w}");
+    }
+}
+
+/// Decodes each texture file once.
+struct TextureCache {
+    enabled: bool,
+    loaded: HashMap<PathBuf, Option<u32>>,
+}
+
+impl TextureCache {
+    fn new(enabled: bool) -> Self {
+        TextureCache {
+            enabled,
+            loaded: HashMap::new(),
+        }
+    }
+
+    fn load(&mut self, path: &Path, out: &mut ImportedModel) -> Option<u32> {
+        if !self.enabled {
+            return None;
+        }
+        if let Some(&t) = self.loaded.get(path) {
+            return t;
+        }
+        let t = match image::open(path) {
+            Ok(img) => {
+                let rgba = img.to_rgba8();
+                out.textures.push(Texture {
+                    name: path.display().to_string(),
+                    width: rgba.width(),
+                    height: rgba.height(),
+                    rgba8: rgba.into_raw(),
+                });
+                Some(out.textures.len() as u32 - 1)
+            }
+            Err(e) => {
+                out.textures_failed += 1;
+                out.warnings.push(format!(
+                    "texture {} not loaded ({e}); its materials use their albedo",
+                    path.display()
+                ));
+                None
+            }
+        };
+        self.loaded.insert(path.to_path_buf(), t);
+        t
+    }
+}

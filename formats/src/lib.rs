@@ -1,0 +1,27 @@
+//! # visgate-formats
+//!
+//! Plain data and I/O shared by the bake (`visgate-preprocess`) and the runtime
+//! (`visgate-runtime`); no algorithms and no GPU:
+//!
+//! - [`desc`]: the scene description, a TOML file a user writes by hand (meshes, material
+//!   overrides, lights, cameras, up axis and units, whether the level is closed);
+//! - [`import`]: mesh import — OBJ (tobj, with MTL colours and diffuse textures) and glTF/GLB
+//!   (gltf, with base colour factor/texture and node transforms) — with every bad input turned
+//!   into a typed error or a counted warning;
+//! - [`scene`]: the in-memory scene in visgate's space (right-handed, +Y up, metres), and the
+//!   hash of its static geometry;
+//! - [`vgate`]: the baked `.vgate` file — the runtime layout of a level's skeleton, visibility
+//!   clusters and gates, and its voxel grids — with a validating reader.
+
+pub mod desc;
+pub mod error;
+pub mod export;
+pub mod import;
+pub mod scene;
+pub mod vgate;
+
+pub use desc::SceneDesc;
+pub use error::{SceneError, VgateError};
+pub use import::{ImportOptions, ImportedModel};
+pub use scene::{Camera, GeometryHash, Light, Material, Mesh, Scene, Texture};
+pub use vgate::BakedLevel;

@@ -1,0 +1,479 @@
+//! The in-memory scene: every mesh of a scene description imported, transformed and converted
+//! once to visgate's space (right-handed, +Y up, metres).
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use glam::{DMat4, DQuat, DVec3, EulerRot, Vec2, Vec3};
+use serde::Serialize;
+
+use crate::desc::{LightDesc, SceneDesc, UpAxis};
+use crate::error::SceneError;
+use crate::import::{self, ImportOptions, ImportedModel};
+
+/// A diffuse material. The effective albedo at a point is `albedo × texture(uv)` (the
+/// texture decoded from sRGB to linear), as in both MTL (`Kd` × `map_Kd`) and glTF
+/// (`baseColorFactor` × `baseColorTexture`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Material {
+    /// Name in the source file.
+    pub name: String,
+    /// Linear diffuse albedo.
+    pub albedo: Vec3,
+    /// Index into [`Scene::textures`].
+    pub texture: Option<u32>,
+}
+
+/// A decoded texture, RGBA8 with sRGB-encoded colour, row 0 at the top.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Texture {
+    /// The path it was read from (or its name in the glTF file).
+    pub name: String,
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// `width × height × 4` bytes.
+    pub rgba8: Vec<u8>,
+}
+
+/// One triangle mesh in world space.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Mesh {
+    /// Object/group name (OBJ) or node/mesh name (glTF).
+    pub name: String,
+    /// Index of the scene description's `[[mesh]]` entry it came from.
+    pub entry: usize,
+    /// Static meshes are baked and occlude; dynamic meshes are only lit.
+    pub is_static: bool,
+    /// Vertex positions, metres.
+    pub positions: Vec<Vec3>,
+    /// Unit vertex normals (face normals where the file has none).
+    pub normals: Vec<Vec3>,
+    /// Texture coordinates (zero where the file has none).
+    pub uvs: Vec<Vec2>,
+    /// Counter-clockwise vertex indices.
+    pub triangles: Vec<[u32; 3]>,
+    /// Material of each triangle, an index into [`Scene::materials`].
+    pub material: Vec<u32>,
+}
+
+/// A primary light, in world space.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "type", rename_all = "lowercase")]
+pub enum Light {
+    /// Isotropic point light.
+    Point {
+        /// Position, metres.
+        position: Vec3,
+        /// Radiant intensity, W/sr per RGB channel.
+        intensity: Vec3,
+    },
+    /// Spot light: full intensity within `beam_rad` of the axis, linear in angle to 0 at
+    /// `cutoff_rad` (Mitsuba's `spot`).
+    Spot {
+        /// Position, metres.
+        position: Vec3,
+        /// Unit axis direction.
+        direction: Vec3,
+        /// Radiant intensity on the axis, W/sr per RGB channel.
+        intensity: Vec3,
+        /// Half-angle where the intensity reaches 0, radians.
+        cutoff_rad: f32,
+        /// Half-angle of full intensity, radians.
+        beam_rad: f32,
+    },
+}
+
+/// A look-at camera, in world space.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Camera {
+    /// Name used by `--camera`.
+    pub name: String,
+    /// Eye position, metres.
+    pub eye: Vec3,
+    /// Point looked at, metres.
+    pub target: Vec3,
+    /// Unit up vector.
+    pub up: Vec3,
+    /// Full horizontal field of view, radians.
+    pub fov_x_rad: f32,
+}
+
+/// What the import saw and did, for reports.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct ImportReport {
+    /// Triangles in the files after fan triangulation of polygons.
+    pub triangles_read: u64,
+    /// Zero-area triangles dropped.
+    pub degenerate_dropped: u64,
+    /// Textures that failed to load (their materials fall back to the albedo).
+    pub textures_failed: u64,
+    /// Every warning, in order.
+    pub warnings: Vec<String>,
+    /// Wall-clock time of the whole load, seconds.
+    pub load_seconds: f64,
+}
+
+/// A scene ready for baking and rendering.
+#[derive(Debug, Clone)]
+pub struct Scene {
+    /// Display name.
+    pub name: String,
+    /// The file it was loaded from (the TOML, or the bare mesh file), if any.
+    pub source: Option<PathBuf>,
+    /// Whether the level is meant to be sealed.
+    pub closed: bool,
+    /// Meshes in world space.
+    pub meshes: Vec<Mesh>,
+    /// Materials of all meshes.
+    pub materials: Vec<Material>,
+    /// Decoded textures.
+    pub textures: Vec<Texture>,
+    /// Primary lights.
+    pub lights: Vec<Light>,
+    /// Named cameras.
+    pub cameras: Vec<Camera>,
+    /// What the import saw.
+    pub report: ImportReport,
+}
+
+/// The kind of file a scene argument names.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FileKind {
+    /// A scene description (`.toml`).
+    SceneToml,
+    /// A Wavefront OBJ mesh.
+    Obj,
+    /// A glTF 2.0 file, text (`.gltf`) or binary (`.glb`).
+    Gltf,
+    /// A baked visgate level.
+    Vgate,
+}
+
+impl FileKind {
+    /// Guesses the kind from the file extension (case-insensitive).
+    pub fn of(path: &Path) -> Option<FileKind> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        match ext.as_str() {
+            "toml" => Some(FileKind::SceneToml),
+            "obj" => Some(FileKind::Obj),
+            "gltf" | "glb" => Some(FileKind::Gltf),
+            "vgate" => Some(FileKind::Vgate),
+            _ => None,
+        }
+    }
+}
+
+impl Scene {
+    /// Loads a scene TOML, or a bare OBJ/glTF/GLB file as one static mesh with no lights.
+    pub fn load(path: &Path, options: &ImportOptions) -> Result<Scene, SceneError> {
+        let start = Instant::now();
+        let (desc, base) = match FileKind::of(path) {
+            Some(FileKind::SceneToml) => (SceneDesc::read(path)?, parent_dir(path)),
+            Some(FileKind::Obj | FileKind::Gltf) => {
+                (SceneDesc::for_mesh_file(path), parent_dir(path))
+            }
+            _ => {
+                return Err(SceneError::UnknownFileType {
+                    file: path.to_path_buf(),
+                });
+            }
+        };
+        let models = desc
+            .meshes
+            .iter()
+            .map(|m| import::import_file(&base.join(&m.path), options))
+            .collect::<Result<Vec<_>, _>>()?;
+        let mut scene = Scene::assemble(&desc, models, path)?;
+        scene.report.load_seconds = start.elapsed().as_secs_f64();
+        Ok(scene)
+    }
+
+    /// Builds a scene from a description and its already imported models (one per
+    /// `[[mesh]]`, in order); `file` names the scene in errors. Applies the mesh transforms,
+    /// the scene's up axis and units, and the material overrides.
+    pub fn assemble(
+        desc: &SceneDesc,
+        models: Vec<ImportedModel>,
+        file: &Path,
+    ) -> Result<Scene, SceneError> {
+        if models.len() != desc.meshes.len() {
+            return Err(SceneError::Invalid {
+                file: file.to_path_buf(),
+                what: format!(
+                    "{} meshes described but {} imported",
+                    desc.meshes.len(),
+                    models.len()
+                ),
+            });
+        }
+        let to_world = SceneSpace::new(desc.up, desc.metres_per_unit);
+        let mut scene = Scene {
+            name: desc.name.clone().unwrap_or_else(|| {
+                file.file_stem()
+                    .map(|s| s.to_string_lossy().into_owned())
+                    .unwrap_or_else(|| "scene".into())
+            }),
+            source: Some(file.to_path_buf()),
+            closed: desc.closed,
+            meshes: vec![],
+            materials: vec![],
+            textures: vec![],
+            lights: vec![],
+            cameras: vec![],
+            report: ImportReport::default(),
+        };
+        for (entry, (mdesc, model)) in desc.meshes.iter().zip(models).enumerate() {
+            let local = DMat4::from_scale_rotation_translation(
+                DVec3::from(mdesc.scale.as_vec()),
+                DQuat::from_euler(
+                    EulerRot::ZYX,
+                    mdesc.rotate_deg[2].to_radians(),
+                    mdesc.rotate_deg[1].to_radians(),
+                    mdesc.rotate_deg[0].to_radians(),
+                ),
+                DVec3::from(mdesc.translate),
+            );
+            let m = to_world.matrix * local;
+            let normal_m = m.inverse().transpose();
+            let flip = m.determinant() < 0.0;
+            let mat_base = scene.materials.len() as u32;
+            let tex_base = scene.textures.len() as u32;
+            scene.report.triangles_read += model.triangles_read;
+            scene.report.degenerate_dropped += model.degenerate_dropped;
+            scene.report.textures_failed += model.textures_failed;
+            scene.report.warnings.extend(model.warnings);
+            scene.textures.extend(model.textures);
+            scene
+                .materials
+                .extend(model.materials.into_iter().map(|mut mat| {
+                    mat.texture = mat.texture.map(|t| t + tex_base);
+                    mat
+                }));
+            for raw in model.meshes {
+                let positions = raw
+                    .positions
+                    .iter()
+                    .map(|p| m.transform_point3(p.as_dvec3()).as_vec3())
+                    .collect();
+                let normals = raw
+                    .normals
+                    .iter()
+                    .map(|n| {
+                        normal_m
+                            .transform_vector3(n.as_dvec3())
+                            .normalize_or_zero()
+                            .as_vec3()
+                    })
+                    .collect();
+                let triangles = raw
+                    .triangles
+                    .iter()
+                    .map(|&[a, b, c]| if flip { [a, c, b] } else { [a, b, c] })
+                    .collect::<Vec<_>>();
+                let material = vec![raw.material + mat_base; triangles.len()];
+                scene.meshes.push(Mesh {
+                    name: raw.name,
+                    entry,
+                    is_static: mdesc.is_static,
+                    positions,
+                    normals,
+                    uvs: raw.uvs,
+                    triangles,
+                    material,
+                });
+            }
+        }
+        for o in &desc.materials {
+            let mut found = false;
+            for mat in scene.materials.iter_mut().filter(|m| m.name == o.name) {
+                mat.albedo = Vec3::from(o.albedo);
+                mat.texture = None;
+                found = true;
+            }
+            if !found {
+                let mut known: Vec<&str> =
+                    scene.materials.iter().map(|m| m.name.as_str()).collect();
+                known.sort_unstable();
+                known.dedup();
+                return Err(SceneError::UnknownMaterial {
+                    file: file.to_path_buf(),
+                    name: o.name.clone(),
+                    known: known.join(", "),
+                });
+            }
+        }
+        for l in &desc.lights {
+            scene.lights.push(match l {
+                LightDesc::Point(p) => Light::Point {
+                    position: to_world.point(p.position),
+                    intensity: Vec3::from(p.intensity),
+                },
+                LightDesc::Spot(s) => {
+                    let pos = DVec3::from(s.position);
+                    let dir = match (s.target, s.direction) {
+                        (Some(t), _) => DVec3::from(t) - pos,
+                        (None, Some(d)) => DVec3::from(d),
+                        (None, None) => DVec3::NEG_Y,
+                    };
+                    Light::Spot {
+                        position: to_world.point(s.position),
+                        direction: to_world.direction(dir),
+                        intensity: Vec3::from(s.intensity),
+                        cutoff_rad: s.cutoff_deg.to_radians(),
+                        beam_rad: s.beam_deg.to_radians(),
+                    }
+                }
+            });
+        }
+        for c in &desc.cameras {
+            let up = match c.up {
+                Some(u) => DVec3::from(u),
+                None => match desc.up {
+                    UpAxis::Y => DVec3::Y,
+                    UpAxis::Z => DVec3::Z,
+                },
+            };
+            scene.cameras.push(Camera {
+                name: c.name.clone(),
+                eye: to_world.point(c.eye),
+                target: to_world.point(c.target),
+                up: to_world.direction(up),
+                fov_x_rad: c.fov_deg.to_radians(),
+            });
+        }
+        if scene.triangle_count() == 0 {
+            return Err(SceneError::Empty {
+                file: file.to_path_buf(),
+            });
+        }
+        Ok(scene)
+    }
+
+    /// Triangles of all meshes.
+    pub fn triangle_count(&self) -> u64 {
+        self.meshes.iter().map(|m| m.triangles.len() as u64).sum()
+    }
+
+    /// Triangles of the static meshes only.
+    pub fn static_triangle_count(&self) -> u64 {
+        self.meshes
+            .iter()
+            .filter(|m| m.is_static)
+            .map(|m| m.triangles.len() as u64)
+            .sum()
+    }
+
+    /// Axis-aligned bounds of all vertices, metres; `None` for a scene with no vertex.
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        bounds_of(self.meshes.iter())
+    }
+
+    /// Axis-aligned bounds of the static meshes' vertices, metres.
+    pub fn static_bounds(&self) -> Option<(Vec3, Vec3)> {
+        bounds_of(self.meshes.iter().filter(|m| m.is_static))
+    }
+
+    /// Every static triangle as three world-space corners, in scene order.
+    pub fn static_triangles(&self) -> impl Iterator<Item = [Vec3; 3]> + '_ {
+        self.meshes.iter().filter(|m| m.is_static).flat_map(|m| {
+            m.triangles.iter().map(move |t| {
+                [
+                    m.positions[t[0] as usize],
+                    m.positions[t[1] as usize],
+                    m.positions[t[2] as usize],
+                ]
+            })
+        })
+    }
+
+    /// A hash of the static geometry (world-space corners of every static triangle, in
+    /// order): a baked file records it, and the runtime refuses a file whose hash differs.
+    pub fn static_geometry_hash(&self) -> GeometryHash {
+        let mut h = xxhash_rust::xxh3::Xxh3::new();
+        let mut buf = Vec::with_capacity(36 * 1024);
+        for tri in self.static_triangles() {
+            for p in tri {
+                for c in p.to_array() {
+                    buf.extend_from_slice(&c.to_le_bytes());
+                }
+            }
+            if buf.len() >= 36 * 1024 {
+                h.update(&buf);
+                buf.clear();
+            }
+        }
+        h.update(&buf);
+        GeometryHash(h.digest128().to_le_bytes())
+    }
+
+    /// The camera with this name.
+    pub fn camera(&self, name: &str) -> Option<&Camera> {
+        self.cameras.iter().find(|c| c.name == name)
+    }
+}
+
+fn bounds_of<'a>(meshes: impl Iterator<Item = &'a Mesh>) -> Option<(Vec3, Vec3)> {
+    let mut it = meshes.flat_map(|m| m.positions.iter().copied()).peekable();
+    let first = *it.peek()?;
+    Some(it.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p))))
+}
+
+fn parent_dir(path: &Path) -> PathBuf {
+    path.parent()
+        .map(Path::to_path_buf)
+        .unwrap_or_else(|| PathBuf::from("."))
+}
+
+/// 128-bit hash of a scene's static geometry (xxh3-128, little-endian bytes).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize)]
+pub struct GeometryHash(pub [u8; 16]);
+
+impl std::fmt::Display for GeometryHash {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        for b in self.0.iter().rev() {
+            write!(f, "{b:02x}")?;
+        }
+        Ok(())
+    }
+}
+
+/// The conversion from a scene file's space (its up axis and unit) to visgate's.
+#[derive(Debug, Clone, Copy)]
+pub struct SceneSpace {
+    /// The affine map from file coordinates to metres, +Y up.
+    pub matrix: DMat4,
+}
+
+impl SceneSpace {
+    /// The conversion for a file with this up axis and metres per unit.
+    pub fn new(up: UpAxis, metres_per_unit: f64) -> Self {
+        let axes = match up {
+            UpAxis::Y => DMat4::IDENTITY,
+            // (x, y, z) → (x, z, −y): a rotation by −90° about X, so handedness is kept.
+            UpAxis::Z => DMat4::from_cols(
+                glam::DVec4::new(1.0, 0.0, 0.0, 0.0),
+                glam::DVec4::new(0.0, 0.0, -1.0, 0.0),
+                glam::DVec4::new(0.0, 1.0, 0.0, 0.0),
+                glam::DVec4::W,
+            ),
+        };
+        SceneSpace {
+            matrix: DMat4::from_scale(DVec3::splat(metres_per_unit)) * axes,
+        }
+    }
+
+    /// A point in file coordinates, in metres, +Y up.
+    pub fn point(&self, p: [f64; 3]) -> Vec3 {
+        self.matrix.transform_point3(DVec3::from(p)).as_vec3()
+    }
+
+    /// A direction in file coordinates, as a unit vector, +Y up.
+    pub fn direction(&self, d: DVec3) -> Vec3 {
+        self.matrix
+            .transform_vector3(d)
+            .normalize_or_zero()
+            .as_vec3()
+    }
+}

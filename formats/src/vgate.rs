@@ -1,0 +1,839 @@
+//! The baked `.vgate` file: the runtime layout of a level's topology.
+//!
+//! ```text
+//! offset  size        field
+//! 0       8           magic  b"VGATE\r\n\x1a"  (catches text-mode transfers, like PNG's)
+//! 8       4           format version, u32 LE
+//! 12      4           header length H, u32 LE
+//! 16      H           header: postcard(Header) = BakeInfo (params, geometry hash, grid)
+//!                     + a table of sections (kind, offset, length, element type, CRC-32)
+//! 16+H    4           CRC-32 of bytes [0, 16+H)
+//! ...                 sections, contiguous, in table order, up to the end of the file:
+//!                       topology      postcard(Topology): skeleton, segmented skeleton,
+//!                                     node→cluster, clusters, gates
+//!                       voxel_node    little-endian blob, one element per voxel (x fastest)
+//!                       voxel_cluster little-endian blob, one element per voxel
+//! ```
+//!
+//! The grids are stored in the smallest unsigned type (u8, u16, u32) that holds their largest
+//! value, with the type's maximum meaning "none". Reading checks everything — magic, version,
+//! every length against the file and each other, every checksum, every index against the
+//! array it indexes, every float — and returns a typed [`VgateError`]; it never panics.
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::VgateError;
+use crate::scene::GeometryHash;
+
+/// The first eight bytes of every `.vgate` file.
+pub const MAGIC: [u8; 8] = *b"VGATE\r\n\x1a";
+/// The format version this build writes and reads.
+pub const FORMAT_VERSION: u32 = 1;
+/// "No node / no cluster" in a grid decoded to u32.
+pub const NONE: u32 = u32::MAX;
+
+/// The voxel grid every intermediate and the file share. Voxels are cell-centred:
+/// `voxel_to_world(i) = origin_m + (i + 0.5) · voxel_size_m`; linear index
+/// `x + nx · (y + ny · z)`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct GridMeta {
+    /// World position of the grid's minimum corner, metres.
+    pub origin_m: [f32; 3],
+    /// Edge length of a voxel, metres. [Limit: > 0]
+    pub voxel_size_m: f32,
+    /// Voxels along x, y, z. [Limit: each > 0]
+    pub dims: [u32; 3],
+}
+
+impl GridMeta {
+    /// Number of voxels, or `None` if it overflows.
+    pub fn voxel_count(&self) -> Option<u64> {
+        let [x, y, z] = self.dims.map(u64::from);
+        x.checked_mul(y)?.checked_mul(z)
+    }
+
+    /// Linear index of voxel (x, y, z).
+    pub fn index(&self, v: [u32; 3]) -> usize {
+        let [nx, ny, _] = self.dims.map(|d| d as usize);
+        v[0] as usize + nx * (v[1] as usize + ny * v[2] as usize)
+    }
+
+    /// Centre of voxel `v` in world space, metres.
+    pub fn voxel_to_world(&self, v: [u32; 3]) -> [f32; 3] {
+        std::array::from_fn(|a| self.origin_m[a] + (v[a] as f32 + 0.5) * self.voxel_size_m)
+    }
+}
+
+/// How the bake's resolution was given.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum Resolution {
+    /// Voxels on the longest axis of the static bounds.
+    LongestAxisVoxels(u32),
+    /// Voxel edge length, metres.
+    VoxelSizeM(f32),
+}
+
+/// Where a gate sits on its segmented edge.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum GatePlacement {
+    /// At the narrowest point of the original skeleton line between the two nodes.
+    Narrowest,
+    /// At the middle of the segmented edge (the paper's rule, IV.C).
+    Midpoint,
+}
+
+/// The bake parameters a file was made with.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BakeParams {
+    /// Grid resolution.
+    pub resolution: Resolution,
+    /// Cluster growth tolerance α of IV.B.2. [Limit: [0, 1]]
+    pub alpha: f32,
+    /// Thinning persistence, steps. [Units: thinning steps]
+    pub persistence: u32,
+    /// Empty components smaller than this, holding no camera or light, are dropped. [Units: vx]
+    pub min_component_voxels: u64,
+    /// Gate placement rule.
+    pub gate_placement: GatePlacement,
+    /// Whether a leaking closed scene was baked anyway.
+    pub allow_leaks: bool,
+}
+
+impl Default for BakeParams {
+    fn default() -> Self {
+        BakeParams {
+            resolution: Resolution::LongestAxisVoxels(128),
+            alpha: 0.2,
+            persistence: 4,
+            min_component_voxels: 64,
+            gate_placement: GatePlacement::Narrowest,
+            allow_leaks: false,
+        }
+    }
+}
+
+/// What a file was baked from and with.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BakeInfo {
+    /// The parameters used.
+    pub params: BakeParams,
+    /// Hash of the static geometry it was baked from.
+    pub geometry_hash: GeometryHash,
+    /// The voxel grid.
+    pub grid: GridMeta,
+    /// visgate version that baked it (informative).
+    pub tool_version: String,
+}
+
+/// A skeleton voxel: a node of the curvilinear skeleton graph.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct SkeletonNode {
+    /// Its voxel.
+    pub voxel: [u32; 3],
+    /// Its centre in world space, metres.
+    pub position_m: [f32; 3],
+    /// Radius of the maximal empty ball centred there, metres. [Limit: >= 0]
+    pub radius_m: f32,
+}
+
+/// The curvilinear skeleton: nodes and undirected adjacency edges.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Skeleton {
+    /// Nodes.
+    pub nodes: Vec<SkeletonNode>,
+    /// Undirected edges `[a, b]`, node indices.
+    pub edges: Vec<[u32; 2]>,
+}
+
+/// Why a skeleton node was kept by the segmentation (IV.B.1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum SegNodeKind {
+    /// Degree ≠ 2: an end or a junction.
+    Topology,
+    /// Where the line bends (curvature > 1).
+    Curvature,
+    /// Added by recursive line splitting so the maximal balls cover the line.
+    Coverage,
+}
+
+/// A node of the segmented skeleton.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct SegNode {
+    /// The skeleton node it is.
+    pub skeleton_node: u32,
+    /// Why it was kept.
+    pub kind: SegNodeKind,
+}
+
+/// An edge of the segmented skeleton: a line of skeleton nodes between two segmented nodes.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SegEdge {
+    /// The two segmented nodes.
+    pub nodes: [u32; 2],
+    /// The skeleton nodes along the original line, from `nodes[0]` to `nodes[1]` inclusive.
+    pub path: Vec<u32>,
+}
+
+/// The segmented skeleton.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct SegmentedSkeleton {
+    /// Nodes.
+    pub nodes: Vec<SegNode>,
+    /// Edges.
+    pub edges: Vec<SegEdge>,
+}
+
+/// A visibility cluster: a quasi-convex region of empty space.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Cluster {
+    /// The segmented node the greedy construction grew it from.
+    pub seed: u32,
+    /// Minimum corner of the bounds of its empty voxels, metres.
+    pub bounds_min_m: [f32; 3],
+    /// Maximum corner, metres.
+    pub bounds_max_m: [f32; 3],
+}
+
+/// A visibility gate: a disk joining two clusters.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Gate {
+    /// Disk centre, metres.
+    pub centre_m: [f32; 3],
+    /// Unit normal of the disk (along the skeleton edge).
+    pub normal: [f32; 3],
+    /// Disk radius, metres. [Limit: >= 0]
+    pub radius_m: f32,
+    /// The two clusters it joins (distinct).
+    pub clusters: [u32; 2],
+    /// The segmented edge it sits on.
+    pub seg_edge: u32,
+}
+
+/// Everything in the topology section.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Topology {
+    /// The curvilinear skeleton.
+    pub skeleton: Skeleton,
+    /// The segmented skeleton.
+    pub segmented: SegmentedSkeleton,
+    /// Cluster of each segmented node.
+    pub node_cluster: Vec<u32>,
+    /// Visibility clusters.
+    pub clusters: Vec<Cluster>,
+    /// Visibility gates.
+    pub gates: Vec<Gate>,
+}
+
+/// One value per voxel, `None` stored as the element type's maximum.
+#[derive(Debug, Clone, PartialEq)]
+pub enum VoxelValues {
+    /// 8-bit values.
+    U8(Vec<u8>),
+    /// 16-bit values.
+    U16(Vec<u16>),
+    /// 32-bit values.
+    U32(Vec<u32>),
+}
+
+impl VoxelValues {
+    /// Packs u32 values (with [`NONE`]) into the smallest type that holds them.
+    pub fn pack(values: &[u32]) -> Self {
+        let max = values.iter().copied().filter(|&v| v != NONE).max();
+        match max {
+            Some(m) if m >= u32::from(u16::MAX) => VoxelValues::U32(values.to_vec()),
+            Some(m) if m >= u32::from(u8::MAX) => VoxelValues::U16(
+                values
+                    .iter()
+                    .map(|&v| if v == NONE { u16::MAX } else { v as u16 })
+                    .collect(),
+            ),
+            _ => VoxelValues::U8(
+                values
+                    .iter()
+                    .map(|&v| if v == NONE { u8::MAX } else { v as u8 })
+                    .collect(),
+            ),
+        }
+    }
+
+    /// Number of values.
+    pub fn len(&self) -> usize {
+        match self {
+            VoxelValues::U8(v) => v.len(),
+            VoxelValues::U16(v) => v.len(),
+            VoxelValues::U32(v) => v.len(),
+        }
+    }
+
+    /// Whether there are no values.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The value at `i` widened to u32 ([`NONE`] for none); `None` past the end.
+    pub fn get(&self, i: usize) -> Option<u32> {
+        Some(match self {
+            VoxelValues::U8(v) => widen(u32::from(*v.get(i)?), u8::MAX.into()),
+            VoxelValues::U16(v) => widen(u32::from(*v.get(i)?), u16::MAX.into()),
+            VoxelValues::U32(v) => *v.get(i)?,
+        })
+    }
+
+    /// Element type.
+    pub fn elem(&self) -> Elem {
+        match self {
+            VoxelValues::U8(_) => Elem::U8,
+            VoxelValues::U16(_) => Elem::U16,
+            VoxelValues::U32(_) => Elem::U32,
+        }
+    }
+
+    fn max_value(&self) -> Option<u32> {
+        let it: Box<dyn Iterator<Item = u32>> = match self {
+            VoxelValues::U8(v) => Box::new(v.iter().filter(|&&x| x != u8::MAX).map(|&x| x.into())),
+            VoxelValues::U16(v) => {
+                Box::new(v.iter().filter(|&&x| x != u16::MAX).map(|&x| x.into()))
+            }
+            VoxelValues::U32(v) => Box::new(v.iter().copied().filter(|&x| x != NONE)),
+        };
+        it.max()
+    }
+
+    fn to_le_bytes(&self) -> Vec<u8> {
+        match self {
+            VoxelValues::U8(v) => v.clone(),
+            VoxelValues::U16(v) => v.iter().flat_map(|x| x.to_le_bytes()).collect(),
+            VoxelValues::U32(v) => {
+                let mut out = Vec::with_capacity(v.len() * 4);
+                for x in v {
+                    out.extend_from_slice(&x.to_le_bytes());
+                }
+                out
+            }
+        }
+    }
+
+    fn from_le_bytes(elem: Elem, bytes: &[u8]) -> Self {
+        match elem {
+            Elem::U8 | Elem::Structure => VoxelValues::U8(bytes.to_vec()),
+            Elem::U16 => VoxelValues::U16(
+                bytes
+                    .chunks_exact(2)
+                    .map(|c| u16::from_le_bytes([c[0], c[1]]))
+                    .collect(),
+            ),
+            Elem::U32 => VoxelValues::U32(
+                bytes
+                    .chunks_exact(4)
+                    .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+                    .collect(),
+            ),
+        }
+    }
+}
+
+fn widen(v: u32, none: u32) -> u32 {
+    if v == none { NONE } else { v }
+}
+
+/// Element type of a blob section.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Elem {
+    /// No elements: a postcard structure.
+    Structure,
+    /// u8.
+    U8,
+    /// u16 LE.
+    U16,
+    /// u32 LE.
+    U32,
+}
+
+impl Elem {
+    fn size(self) -> u64 {
+        match self {
+            Elem::Structure | Elem::U8 => 1,
+            Elem::U16 => 2,
+            Elem::U32 => 4,
+        }
+    }
+}
+
+/// The sections a file holds, in this order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum SectionKind {
+    /// postcard(Topology).
+    Topology,
+    /// Nearest skeleton node of every empty voxel.
+    VoxelNode,
+    /// Visibility cluster of every voxel a visible surface or a VPL can fall in.
+    VoxelCluster,
+}
+
+const SECTION_ORDER: [SectionKind; 3] = [
+    SectionKind::Topology,
+    SectionKind::VoxelNode,
+    SectionKind::VoxelCluster,
+];
+
+/// An entry of the section table.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub struct SectionEntry {
+    /// Which section.
+    pub kind: SectionKind,
+    /// Absolute byte offset.
+    pub offset: u64,
+    /// Length in bytes.
+    pub len: u64,
+    /// Element type.
+    pub elem: Elem,
+    /// CRC-32 (IEEE) of its bytes.
+    pub crc32: u32,
+}
+
+/// The header after the fixed prefix.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Header {
+    /// What the file was baked from and with.
+    pub info: BakeInfo,
+    /// The section table.
+    pub sections: Vec<SectionEntry>,
+}
+
+/// A whole baked level, as the runtime uses it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BakedLevel {
+    /// Params, geometry hash, grid.
+    pub info: BakeInfo,
+    /// Skeleton, segmentation, clusters, gates.
+    pub topology: Topology,
+    /// Nearest skeleton node (through empty space) of every empty voxel; [`NONE`] elsewhere.
+    pub voxel_node: VoxelValues,
+    /// Visibility cluster of every voxel; [`NONE`] where no surface or VPL can be.
+    pub voxel_cluster: VoxelValues,
+}
+
+const PREFIX: usize = 16;
+
+impl BakedLevel {
+    /// Encodes the level after checking it, so that an invalid file is never written.
+    pub fn to_bytes(&self) -> Result<Vec<u8>, VgateError> {
+        self.validate()?;
+        Ok(self.encode_unchecked())
+    }
+
+    /// Encodes without validation (tests use it to write corrupt files).
+    #[doc(hidden)]
+    pub fn encode_unchecked(&self) -> Vec<u8> {
+        let topo = postcard::to_allocvec(&self.topology).unwrap_or_default();
+        let blobs = [
+            (SectionKind::Topology, Elem::Structure, topo),
+            (
+                SectionKind::VoxelNode,
+                self.voxel_node.elem(),
+                self.voxel_node.to_le_bytes(),
+            ),
+            (
+                SectionKind::VoxelCluster,
+                self.voxel_cluster.elem(),
+                self.voxel_cluster.to_le_bytes(),
+            ),
+        ];
+        let mut header = Header {
+            info: self.info.clone(),
+            sections: blobs
+                .iter()
+                .map(|(kind, elem, bytes)| SectionEntry {
+                    kind: *kind,
+                    offset: 0,
+                    len: bytes.len() as u64,
+                    elem: *elem,
+                    crc32: crc32fast::hash(bytes),
+                })
+                .collect(),
+        };
+        // Offsets depend on the header's length, which depends on the offsets' varint widths:
+        // iterate to the fixed point (two or three rounds).
+        let mut header_bytes = Vec::new();
+        for _ in 0..8 {
+            let mut at = (PREFIX + header_bytes.len() + 4) as u64;
+            for s in &mut header.sections {
+                s.offset = at;
+                at += s.len;
+            }
+            let next = postcard::to_allocvec(&header).unwrap_or_default();
+            if next == header_bytes {
+                break;
+            }
+            header_bytes = next;
+        }
+        let total: usize =
+            PREFIX + header_bytes.len() + 4 + blobs.iter().map(|b| b.2.len()).sum::<usize>();
+        let mut out = Vec::with_capacity(total);
+        out.extend_from_slice(&MAGIC);
+        out.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
+        out.extend_from_slice(&(header_bytes.len() as u32).to_le_bytes());
+        out.extend_from_slice(&header_bytes);
+        let crc = crc32fast::hash(&out);
+        out.extend_from_slice(&crc.to_le_bytes());
+        for (_, _, b) in &blobs {
+            out.extend_from_slice(b);
+        }
+        out
+    }
+
+    /// Writes the file (to a temporary file beside it, then renamed, so a crash never leaves
+    /// half a file under the final name).
+    pub fn write(&self, path: &Path) -> Result<(), VgateError> {
+        let bytes = self.to_bytes()?;
+        let io = |source| VgateError::Io {
+            file: path.to_path_buf(),
+            source,
+        };
+        let mut tmp = path.as_os_str().to_owned();
+        tmp.push(".partial");
+        let tmp = std::path::PathBuf::from(tmp);
+        std::fs::write(&tmp, &bytes).map_err(io)?;
+        std::fs::rename(&tmp, path).map_err(io)
+    }
+
+    /// Reads and fully validates a file.
+    pub fn read(path: &Path) -> Result<BakedLevel, VgateError> {
+        let bytes = std::fs::read(path).map_err(|source| VgateError::Io {
+            file: path.to_path_buf(),
+            source,
+        })?;
+        Self::from_bytes(&bytes)
+    }
+
+    /// Reads only the header (cheap: no section is decoded), after checking its checksum.
+    pub fn read_header(bytes: &[u8]) -> Result<Header, VgateError> {
+        let avail = bytes.len() as u64;
+        if bytes.len() < PREFIX {
+            if !MAGIC.starts_with(&bytes[..bytes.len().min(8)]) {
+                return Err(VgateError::BadMagic);
+            }
+            return Err(VgateError::Truncated {
+                what: "the fixed header",
+                needed: PREFIX as u64,
+                available: avail,
+            });
+        }
+        if bytes[..8] != MAGIC {
+            return Err(VgateError::BadMagic);
+        }
+        let version = u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]);
+        if version > FORMAT_VERSION {
+            return Err(VgateError::NewerVersion {
+                found: version,
+                supported: FORMAT_VERSION,
+            });
+        }
+        if version < FORMAT_VERSION {
+            return Err(VgateError::OldVersion {
+                found: version,
+                supported: FORMAT_VERSION,
+            });
+        }
+        let hlen = u32::from_le_bytes([bytes[12], bytes[13], bytes[14], bytes[15]]) as u64;
+        let hend = PREFIX as u64 + hlen;
+        if hend + 4 > avail {
+            return Err(VgateError::Truncated {
+                what: "the header",
+                needed: hend + 4,
+                available: avail,
+            });
+        }
+        let hend = hend as usize;
+        let expected = u32::from_le_bytes([
+            bytes[hend],
+            bytes[hend + 1],
+            bytes[hend + 2],
+            bytes[hend + 3],
+        ]);
+        let found = crc32fast::hash(&bytes[..hend]);
+        if found != expected {
+            return Err(VgateError::Checksum {
+                section: "header".into(),
+                found,
+                expected,
+            });
+        }
+        let (header, rest): (Header, &[u8]) = postcard::take_from_bytes(&bytes[PREFIX..hend])
+            .map_err(|e| VgateError::Decode {
+                what: "header",
+                message: e.to_string(),
+            })?;
+        if !rest.is_empty() {
+            return Err(VgateError::Length(format!(
+                "header declares {hlen} bytes but its contents end {} bytes earlier",
+                rest.len()
+            )));
+        }
+        Ok(header)
+    }
+
+    /// Decodes and fully validates a file's bytes.
+    pub fn from_bytes(bytes: &[u8]) -> Result<BakedLevel, VgateError> {
+        let header = Self::read_header(bytes)?;
+        let avail = bytes.len() as u64;
+        let kinds: Vec<SectionKind> = header.sections.iter().map(|s| s.kind).collect();
+        if kinds != SECTION_ORDER {
+            return Err(VgateError::Length(format!(
+                "section table lists {kinds:?}, expected {SECTION_ORDER:?}"
+            )));
+        }
+        let hlen = u32::from_le_bytes([bytes[12], bytes[13], bytes[14], bytes[15]]) as u64;
+        let mut at = PREFIX as u64 + hlen + 4;
+        let mut slices = Vec::with_capacity(3);
+        for s in &header.sections {
+            if s.offset != at {
+                return Err(VgateError::Length(format!(
+                    "section {:?} starts at byte {}, expected {at}",
+                    s.kind, s.offset
+                )));
+            }
+            let end = s.offset.checked_add(s.len).ok_or_else(|| {
+                VgateError::Length(format!("section {:?} length overflows", s.kind))
+            })?;
+            if end > avail {
+                return Err(VgateError::Truncated {
+                    what: "a section",
+                    needed: end,
+                    available: avail,
+                });
+            }
+            let data = &bytes[s.offset as usize..end as usize];
+            let found = crc32fast::hash(data);
+            if found != s.crc32 {
+                return Err(VgateError::Checksum {
+                    section: format!("{:?}", s.kind),
+                    found,
+                    expected: s.crc32,
+                });
+            }
+            if s.len % s.elem.size() != 0 {
+                return Err(VgateError::Length(format!(
+                    "section {:?} is {} bytes, not a whole number of {:?} elements",
+                    s.kind, s.len, s.elem
+                )));
+            }
+            slices.push((s, data));
+            at = end;
+        }
+        if at != avail {
+            return Err(VgateError::Length(format!(
+                "the file has {} bytes after its last section",
+                avail - at
+            )));
+        }
+        let topology: Topology = {
+            let (s, data) = slices[0];
+            if s.elem != Elem::Structure {
+                return Err(VgateError::Length(
+                    "topology section is not a structure".into(),
+                ));
+            }
+            let (t, rest) = postcard::take_from_bytes(data).map_err(|e| VgateError::Decode {
+                what: "topology",
+                message: e.to_string(),
+            })?;
+            if !rest.is_empty() {
+                return Err(VgateError::Length(format!(
+                    "topology section has {} bytes after its structure",
+                    rest.len()
+                )));
+            }
+            t
+        };
+        let grid_of = |(s, data): (&SectionEntry, &[u8])| {
+            if s.elem == Elem::Structure {
+                return Err(VgateError::Length(format!(
+                    "section {:?} must be a blob of integers",
+                    s.kind
+                )));
+            }
+            Ok(VoxelValues::from_le_bytes(s.elem, data))
+        };
+        let level = BakedLevel {
+            info: header.info,
+            topology,
+            voxel_node: grid_of(slices[1])?,
+            voxel_cluster: grid_of(slices[2])?,
+        };
+        level.validate()?;
+        Ok(level)
+    }
+
+    /// Checks every length, index and value against the format's rules.
+    pub fn validate(&self) -> Result<(), VgateError> {
+        let oob = |what: String| Err(VgateError::IndexOutOfRange(what));
+        let bad = |what: String| Err(VgateError::BadValue(what));
+        let g = &self.info.grid;
+        if !(g.voxel_size_m.is_finite() && g.voxel_size_m > 0.0) {
+            return bad(format!("voxel size {} m", g.voxel_size_m));
+        }
+        if g.origin_m.iter().any(|x| !x.is_finite()) || g.dims.contains(&0) {
+            return bad(format!("grid origin {:?} / dims {:?}", g.origin_m, g.dims));
+        }
+        let voxels = g
+            .voxel_count()
+            .ok_or_else(|| VgateError::BadValue(format!("grid dims {:?} overflow", g.dims)))?;
+        for (name, grid) in [
+            ("voxel_node", &self.voxel_node),
+            ("voxel_cluster", &self.voxel_cluster),
+        ] {
+            if grid.len() as u64 != voxels {
+                return Err(VgateError::Length(format!(
+                    "{name} grid has {} values but the grid has {voxels} voxels",
+                    grid.len()
+                )));
+            }
+        }
+        let t = &self.topology;
+        let n_nodes = t.skeleton.nodes.len();
+        let n_seg = t.segmented.nodes.len();
+        let n_clusters = t.clusters.len();
+        for (i, n) in t.skeleton.nodes.iter().enumerate() {
+            if (0..3).any(|a| n.voxel[a] >= g.dims[a]) {
+                return oob(format!(
+                    "skeleton node {i} voxel {:?} outside the grid",
+                    n.voxel
+                ));
+            }
+            if n.position_m.iter().any(|x| !x.is_finite())
+                || !(n.radius_m.is_finite() && n.radius_m >= 0.0)
+            {
+                return bad(format!("skeleton node {i} position/radius"));
+            }
+        }
+        for (i, e) in t.skeleton.edges.iter().enumerate() {
+            if e.iter().any(|&v| v as usize >= n_nodes) || e[0] == e[1] {
+                return oob(format!("skeleton edge {i} {e:?} ({n_nodes} nodes)"));
+            }
+        }
+        for (i, s) in t.segmented.nodes.iter().enumerate() {
+            if s.skeleton_node as usize >= n_nodes {
+                return oob(format!(
+                    "segmented node {i} → skeleton node {}",
+                    s.skeleton_node
+                ));
+            }
+        }
+        for (i, e) in t.segmented.edges.iter().enumerate() {
+            if e.nodes.iter().any(|&v| v as usize >= n_seg) {
+                return oob(format!("segmented edge {i} {:?} ({n_seg} nodes)", e.nodes));
+            }
+            if let Some(p) = e.path.iter().find(|&&p| p as usize >= n_nodes) {
+                return oob(format!(
+                    "segmented edge {i} path node {p} ({n_nodes} nodes)"
+                ));
+            }
+        }
+        if t.node_cluster.len() != n_seg {
+            return Err(VgateError::Length(format!(
+                "node→cluster has {} entries for {n_seg} segmented nodes",
+                t.node_cluster.len()
+            )));
+        }
+        if let Some(c) = t.node_cluster.iter().find(|&&c| c as usize >= n_clusters) {
+            return oob(format!("node→cluster value {c} ({n_clusters} clusters)"));
+        }
+        for (i, c) in t.clusters.iter().enumerate() {
+            if c.seed as usize >= n_seg {
+                return oob(format!(
+                    "cluster {i} seed {} ({n_seg} segmented nodes)",
+                    c.seed
+                ));
+            }
+            if c.bounds_min_m
+                .iter()
+                .chain(&c.bounds_max_m)
+                .any(|x| !x.is_finite())
+            {
+                return bad(format!("cluster {i} bounds"));
+            }
+        }
+        for (i, gt) in t.gates.iter().enumerate() {
+            if gt.clusters.iter().any(|&c| c as usize >= n_clusters)
+                || gt.clusters[0] == gt.clusters[1]
+            {
+                return oob(format!(
+                    "gate {i} clusters {:?} ({n_clusters} clusters)",
+                    gt.clusters
+                ));
+            }
+            if gt.seg_edge as usize >= t.segmented.edges.len() {
+                return oob(format!("gate {i} segmented edge {}", gt.seg_edge));
+            }
+            let len2: f32 = gt.normal.iter().map(|x| x * x).sum();
+            if gt.centre_m.iter().any(|x| !x.is_finite())
+                || !(gt.radius_m.is_finite() && gt.radius_m >= 0.0)
+                || (len2 - 1.0).abs().is_nan()
+                || (len2 - 1.0).abs() >= 1e-3
+            {
+                return bad(format!("gate {i} centre/normal/radius"));
+            }
+        }
+        if let Some(m) = self.voxel_node.max_value()
+            && m as usize >= n_nodes
+        {
+            {
+                return oob(format!("voxel_node value {m} ({n_nodes} skeleton nodes)"));
+            }
+        }
+        if let Some(m) = self.voxel_cluster.max_value()
+            && m as usize >= n_clusters
+        {
+            {
+                return oob(format!("voxel_cluster value {m} ({n_clusters} clusters)"));
+            }
+        }
+        Ok(())
+    }
+
+    /// Refuses a level baked from other static geometry than `scene_hash`.
+    pub fn check_geometry(&self, scene_hash: GeometryHash) -> Result<(), VgateError> {
+        if self.info.geometry_hash != scene_hash {
+            return Err(VgateError::StaleBake {
+                baked: self.info.geometry_hash.to_string(),
+                scene: scene_hash.to_string(),
+            });
+        }
+        Ok(())
+    }
+
+    /// Independent cycles of the skeleton graph: E − V + C (edges, nodes, components).
+    pub fn skeleton_cycles(&self) -> u64 {
+        let s = &self.topology.skeleton;
+        let comps = components(s.nodes.len(), &s.edges);
+        (s.edges.len() as u64 + comps as u64).saturating_sub(s.nodes.len() as u64)
+    }
+}
+
+/// Connected components of an undirected graph given as an edge list.
+pub fn components(n: usize, edges: &[[u32; 2]]) -> usize {
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn find(p: &mut [usize], mut x: usize) -> usize {
+        while p[x] != x {
+            p[x] = p[p[x]];
+            x = p[x];
+        }
+        x
+    }
+    let mut count = n;
+    for e in edges {
+        let (a, b) = (e[0] as usize, e[1] as usize);
+        if a >= n || b >= n {
+            continue;
+        }
+        let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
+        if ra != rb {
+            parent[ra] = rb;
+            count -= 1;
+        }
+    }
+    count
+}

@@ -1,0 +1,246 @@
+//! `visgate inspect`: summaries of scenes, meshes and baked levels, as text or JSON.
+
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use serde::Serialize;
+use visgate_formats::scene::FileKind;
+use visgate_formats::vgate::{BakeParams, BakedLevel, GridMeta};
+use visgate_formats::{ImportOptions, Light, Scene};
+
+/// The summary of a scene, as printed and as JSON.
+#[derive(Serialize)]
+struct SceneSummary {
+    kind: &'static str,
+    name: String,
+    source: Option<String>,
+    meshes: usize,
+    static_meshes: usize,
+    dynamic_meshes: usize,
+    triangles: u64,
+    static_triangles: u64,
+    triangles_read: u64,
+    degenerate_dropped: u64,
+    vertices: u64,
+    materials: usize,
+    textured_materials: usize,
+    textures: usize,
+    textures_failed: u64,
+    point_lights: usize,
+    spot_lights: usize,
+    lights: Vec<Light>,
+    cameras: Vec<String>,
+    bounds_min_m: Option<[f32; 3]>,
+    bounds_max_m: Option<[f32; 3]>,
+    closed: bool,
+    static_geometry_hash: String,
+    load_seconds: f64,
+    warnings: Vec<String>,
+}
+
+#[derive(Serialize)]
+struct BakedSummary {
+    kind: &'static str,
+    file: String,
+    file_bytes: u64,
+    format_version: u32,
+    tool_version: String,
+    geometry_hash: String,
+    grid: GridMeta,
+    params: BakeParams,
+    skeleton_nodes: usize,
+    skeleton_edges: usize,
+    skeleton_cycles: u64,
+    segmented_nodes: usize,
+    segmented_edges: usize,
+    clusters: usize,
+    gates: usize,
+    voxel_node_bytes_per_voxel: u32,
+    voxel_cluster_bytes_per_voxel: u32,
+    read_seconds: f64,
+}
+
+pub fn run(arg: &str, json: bool, no_textures: bool) -> Result<()> {
+    let path = Path::new(arg);
+    if !arg.starts_with("builtin:") && FileKind::of(path) == Some(FileKind::Vgate) {
+        return inspect_baked(path, json);
+    }
+    let options = ImportOptions {
+        load_textures: !no_textures,
+    };
+    let scene = crate::load_scene(arg, &options)?;
+    let s = summarise(&scene);
+    if json {
+        println!("{}", serde_json::to_string_pretty(&s)?);
+    } else {
+        print_scene(&s);
+    }
+    Ok(())
+}
+
+fn summarise(scene: &Scene) -> SceneSummary {
+    let (lo, hi) = scene.bounds().unzip();
+    SceneSummary {
+        kind: "scene",
+        name: scene.name.clone(),
+        source: scene.source.as_ref().map(|p| p.display().to_string()),
+        meshes: scene.meshes.len(),
+        static_meshes: scene.meshes.iter().filter(|m| m.is_static).count(),
+        dynamic_meshes: scene.meshes.iter().filter(|m| !m.is_static).count(),
+        triangles: scene.triangle_count(),
+        static_triangles: scene.static_triangle_count(),
+        triangles_read: scene.report.triangles_read,
+        degenerate_dropped: scene.report.degenerate_dropped,
+        vertices: scene.meshes.iter().map(|m| m.positions.len() as u64).sum(),
+        materials: scene.materials.len(),
+        textured_materials: scene
+            .materials
+            .iter()
+            .filter(|m| m.texture.is_some())
+            .count(),
+        textures: scene.textures.len(),
+        textures_failed: scene.report.textures_failed,
+        point_lights: scene
+            .lights
+            .iter()
+            .filter(|l| matches!(l, Light::Point { .. }))
+            .count(),
+        spot_lights: scene
+            .lights
+            .iter()
+            .filter(|l| matches!(l, Light::Spot { .. }))
+            .count(),
+        lights: scene.lights.clone(),
+        cameras: scene.cameras.iter().map(|c| c.name.clone()).collect(),
+        bounds_min_m: lo.map(|v| v.to_array()),
+        bounds_max_m: hi.map(|v| v.to_array()),
+        closed: scene.closed,
+        static_geometry_hash: scene.static_geometry_hash().to_string(),
+        load_seconds: scene.report.load_seconds,
+        warnings: scene.report.warnings.clone(),
+    }
+}
+
+fn v3(v: [f32; 3]) -> String {
+    format!("({:.3}, {:.3}, {:.3})", v[0], v[1], v[2])
+}
+
+fn print_scene(s: &SceneSummary) {
+    println!("scene       {}", s.name);
+    if let Some(src) = &s.source {
+        println!("source      {src}");
+    }
+    println!(
+        "meshes      {} ({} static, {} dynamic)",
+        s.meshes, s.static_meshes, s.dynamic_meshes
+    );
+    println!(
+        "triangles   {} ({} static); {} read, {} degenerate dropped",
+        s.triangles, s.static_triangles, s.triangles_read, s.degenerate_dropped
+    );
+    println!("vertices    {}", s.vertices);
+    println!(
+        "materials   {} ({} textured); textures {} loaded, {} failed",
+        s.materials, s.textured_materials, s.textures, s.textures_failed
+    );
+    println!(
+        "lights      {} point, {} spot",
+        s.point_lights, s.spot_lights
+    );
+    println!(
+        "cameras     {}",
+        if s.cameras.is_empty() {
+            "none".to_string()
+        } else {
+            s.cameras.join(", ")
+        }
+    );
+    if let (Some(lo), Some(hi)) = (s.bounds_min_m, s.bounds_max_m) {
+        let size = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
+        println!(
+            "bounds      {} .. {} m (size {} m)",
+            v3(lo),
+            v3(hi),
+            v3(size)
+        );
+    }
+    println!("closed      {}", if s.closed { "yes" } else { "no" });
+    println!("static hash {}", s.static_geometry_hash);
+    println!("load time   {:.3} s", s.load_seconds);
+    if !s.warnings.is_empty() {
+        println!("warnings    {}", s.warnings.len());
+        for w in &s.warnings {
+            println!("  - {w}");
+        }
+    }
+}
+
+fn inspect_baked(path: &Path, json: bool) -> Result<()> {
+    let start = std::time::Instant::now();
+    let bytes = std::fs::read(path).with_context(|| format!("{}: cannot read", path.display()))?;
+    let level = BakedLevel::from_bytes(&bytes)
+        .with_context(|| format!("{}: cannot load the baked level", path.display()))?;
+    let read_seconds = start.elapsed().as_secs_f64();
+    let t = &level.topology;
+    let bytes_per = |v: &visgate_formats::vgate::VoxelValues| match v.elem() {
+        visgate_formats::vgate::Elem::U16 => 2,
+        visgate_formats::vgate::Elem::U32 => 4,
+        _ => 1,
+    };
+    let s = BakedSummary {
+        kind: "baked level",
+        file: path.display().to_string(),
+        file_bytes: bytes.len() as u64,
+        format_version: visgate_formats::vgate::FORMAT_VERSION,
+        tool_version: level.info.tool_version.clone(),
+        geometry_hash: level.info.geometry_hash.to_string(),
+        grid: level.info.grid,
+        params: level.info.params.clone(),
+        skeleton_nodes: t.skeleton.nodes.len(),
+        skeleton_edges: t.skeleton.edges.len(),
+        skeleton_cycles: level.skeleton_cycles(),
+        segmented_nodes: t.segmented.nodes.len(),
+        segmented_edges: t.segmented.edges.len(),
+        clusters: t.clusters.len(),
+        gates: t.gates.len(),
+        voxel_node_bytes_per_voxel: bytes_per(&level.voxel_node),
+        voxel_cluster_bytes_per_voxel: bytes_per(&level.voxel_cluster),
+        read_seconds,
+    };
+    if json {
+        println!("{}", serde_json::to_string_pretty(&s)?);
+        return Ok(());
+    }
+    let g = &s.grid;
+    println!("baked level {}", s.file);
+    println!(
+        "file        {} bytes, format v{}, baked by visgate {}",
+        s.file_bytes, s.format_version, s.tool_version
+    );
+    println!("static hash {}", s.geometry_hash);
+    println!(
+        "grid        {} x {} x {} voxels of {} m, origin {} m",
+        g.dims[0],
+        g.dims[1],
+        g.dims[2],
+        g.voxel_size_m,
+        v3(g.origin_m)
+    );
+    println!("params      {:?}", s.params);
+    println!(
+        "skeleton    {} nodes, {} edges, {} independent cycles",
+        s.skeleton_nodes, s.skeleton_edges, s.skeleton_cycles
+    );
+    println!(
+        "segmented   {} nodes, {} edges",
+        s.segmented_nodes, s.segmented_edges
+    );
+    println!("clusters    {}", s.clusters);
+    println!("gates       {}", s.gates);
+    println!(
+        "grids       voxel→node {} B/voxel, voxel→cluster {} B/voxel",
+        s.voxel_node_bytes_per_voxel, s.voxel_cluster_bytes_per_voxel
+    );
+    println!("read time   {:.3} s", s.read_seconds);
+    Ok(())
+}

@@ -1,0 +1,146 @@
+//! `visgate`: the one command-line tool — inspect scenes, meshes and baked levels, and list or
+//! export the built-in scenes.
+
+mod inspect;
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{Context, Result, bail};
+use clap::{Parser, Subcommand};
+use visgate_formats::{ImportOptions, Scene};
+use visgate_scenes::Builtin;
+
+const AFTER_HELP: &str = "\
+A SCENE argument is any of:
+  level.toml          a scene description (meshes, lights, cameras; see README)
+  mesh.obj|.gltf|.glb a bare mesh file, taken as one static mesh with no lights
+  builtin:NAME        a built-in scene (list them with `visgate scenes`)
+
+Examples:
+  visgate inspect builtin:four-rooms
+  visgate inspect --json ../shared/scenes/crytek_sponza/sponza.glb
+  visgate scenes export two-rooms out/two-rooms
+
+Logs go to stderr; set RUST_LOG=debug for more.";
+
+#[derive(Parser)]
+#[command(
+    name = "visgate",
+    version,
+    about = "Bake level topology into visibility clusters and gates; render one-bounce GI from virtual point lights.",
+    after_help = AFTER_HELP
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Print a summary of a scene, a mesh file or a baked .vgate level.
+    Inspect {
+        /// A scene (TOML, OBJ, glTF/GLB, builtin:NAME) or a baked .vgate file.
+        file: String,
+        /// Print the summary as JSON, for scripts.
+        #[arg(long)]
+        json: bool,
+        /// Skip decoding textures (faster on large scenes).
+        #[arg(long)]
+        no_textures: bool,
+    },
+    /// List the built-in scenes, or export one as OBJ + TOML.
+    Scenes {
+        #[command(subcommand)]
+        action: Option<ScenesAction>,
+    },
+}
+
+#[derive(Subcommand)]
+enum ScenesAction {
+    /// List the built-in scenes (the default).
+    List,
+    /// Write a built-in scene as NAME.toml + its OBJ/MTL + NAME.expected.toml into DIR.
+    Export {
+        /// The scene's name (see `visgate scenes`).
+        name: String,
+        /// Output directory (created if missing).
+        dir: PathBuf,
+    },
+}
+
+fn main() -> ExitCode {
+    tracing_subscriber::fmt()
+        .with_env_filter(
+            tracing_subscriber::EnvFilter::try_from_default_env()
+                .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new("warn")),
+        )
+        .with_writer(std::io::stderr)
+        .with_target(false)
+        .init();
+    let cli = Cli::parse();
+    match run(cli) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Inspect {
+            file,
+            json,
+            no_textures,
+        } => inspect::run(&file, json, no_textures),
+        Command::Scenes { action } => match action.unwrap_or(ScenesAction::List) {
+            ScenesAction::List => {
+                println!("Built-in scenes (use as builtin:NAME wherever a scene is taken):");
+                for b in Builtin::ALL {
+                    println!("  {:<14} {}", b.name(), b.description());
+                }
+                Ok(())
+            }
+            ScenesAction::Export { name, dir } => {
+                let b = builtin_or_err(&name)?;
+                let path = b.export(&dir).with_context(|| {
+                    format!("cannot export '{}' into {}", b.name(), dir.display())
+                })?;
+                println!("wrote {}", path.display());
+                Ok(())
+            }
+        },
+    }
+}
+
+fn builtin_or_err(name: &str) -> Result<Builtin> {
+    match Builtin::from_name(name) {
+        Some(b) => Ok(b),
+        None => {
+            let names: Vec<&str> = Builtin::ALL.iter().map(|b| b.name()).collect();
+            bail!(
+                "there is no built-in scene '{name}'; the built-in scenes are: {}",
+                names.join(", ")
+            )
+        }
+    }
+}
+
+/// Loads a SCENE argument: `builtin:NAME`, a scene TOML, or a bare OBJ/glTF/GLB file.
+pub fn load_scene(arg: &str, options: &ImportOptions) -> Result<Scene> {
+    if let Some(name) = arg.strip_prefix("builtin:") {
+        let start = std::time::Instant::now();
+        let mut scene = builtin_or_err(name)?.scene()?;
+        scene.report.load_seconds = start.elapsed().as_secs_f64();
+        return Ok(scene);
+    }
+    let path = Path::new(arg);
+    if !path.exists() {
+        bail!(
+            "{arg}: no such file (a scene is a .toml, .obj, .gltf or .glb file, or builtin:NAME)"
+        );
+    }
+    Ok(Scene::load(path, options)?)
+}
