@@ -77,13 +77,37 @@ pub fn import_file(path: &Path, options: &ImportOptions) -> Result<ImportedModel
             source: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
         });
     }
-    match FileKind::of(path) {
-        Some(FileKind::Obj) => import_obj(path, options),
-        Some(FileKind::Gltf) => import_gltf(path, options),
-        _ => Err(SceneError::UnknownFileType {
-            file: path.to_path_buf(),
-        }),
-    }
+    let import = match FileKind::of(path) {
+        Some(FileKind::Obj) => import_obj,
+        Some(FileKind::Gltf) => import_gltf,
+        _ => {
+            return Err(SceneError::UnknownFileType {
+                file: path.to_path_buf(),
+            });
+        }
+    };
+    // The parsers are third-party code and some malformed files make them panic (gltf-json
+    // 1.4 indexes accessors before checking them): turn that into an error, never a crash.
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| import(path, options))).unwrap_or_else(
+        |panic| {
+            let why = panic
+                .downcast_ref::<String>()
+                .map(String::as_str)
+                .or_else(|| panic.downcast_ref::<&str>().copied())
+                .unwrap_or("unknown reason");
+            let message = format!("the file is malformed (the parser failed: {why})");
+            Err(match FileKind::of(path) {
+                Some(FileKind::Gltf) => SceneError::Gltf {
+                    file: path.to_path_buf(),
+                    message,
+                },
+                _ => SceneError::Obj {
+                    file: path.to_path_buf(),
+                    reason: tobj::LoadError::GenericFailure,
+                },
+            })
+        },
+    )
 }
 
 fn tobj_options() -> tobj::LoadOptions {

@@ -1,0 +1,329 @@
+//! Every bad mesh input gives a clear typed error or a counted warning, never a panic.
+
+use std::path::{Path, PathBuf};
+
+use visgate_formats::import::{ImportOptions, import_file};
+use visgate_formats::{Scene, SceneError};
+
+fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, bytes).expect("write");
+    p
+}
+
+fn load(path: &Path) -> Result<Scene, SceneError> {
+    Scene::load(path, &ImportOptions::default())
+}
+
+#[test]
+fn missing_files_are_io_errors_naming_the_file() {
+    for name in ["nope.obj", "nope.glb", "nope.toml"] {
+        let e = load(Path::new(name)).expect_err("missing");
+        assert!(matches!(e, SceneError::Io { .. }), "{e}");
+        assert!(e.to_string().contains(name), "{e}");
+    }
+    // A scene whose mesh is missing names the mesh file.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let toml = write(dir.path(), "s.toml", b"[[mesh]]\npath = \"gone.obj\"\n");
+    let e = load(&toml).expect_err("missing mesh").to_string();
+    assert!(e.contains("gone.obj"), "{e}");
+}
+
+#[test]
+fn unknown_extension_is_an_error_listing_what_is_read() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let p = write(dir.path(), "mesh.fbx", b"binary");
+    let e = load(&p).expect_err("unknown type").to_string();
+    assert!(e.contains(".obj") && e.contains(".glb"), "{e}");
+}
+
+#[test]
+fn broken_obj_is_an_error() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    for (i, text) in [
+        "v 0 0 zero\nf 1 2 3\n",
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 x 3\n",
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn a b c\nf 1 2 3\n",
+    ]
+    .iter()
+    .enumerate()
+    {
+        let p = write(dir.path(), &format!("b{i}.obj"), text.as_bytes());
+        let e = load(&p).expect_err("broken obj");
+        assert!(matches!(e, SceneError::Obj { .. }), "{text:?}: {e}");
+        assert!(e.to_string().contains(&format!("b{i}.obj")), "{e}");
+    }
+}
+
+#[test]
+fn obj_index_out_of_range_is_an_error() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let p = write(
+        dir.path(),
+        "oob.obj",
+        b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99\n",
+    );
+    let e = load(&p).expect_err("out of range").to_string();
+    assert!(e.contains("out of"), "{e}");
+}
+
+#[test]
+fn nan_or_inf_coordinates_are_errors_naming_the_mesh() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    for (i, bad) in ["nan", "inf", "-inf", "NaN"].iter().enumerate() {
+        let text = format!("o pillar_{i}\nv 0 0 0\nv 1 {bad} 0\nv 0 1 0\nf 1 2 3\n");
+        let p = write(dir.path(), &format!("n{i}.obj"), text.as_bytes());
+        let e = load(&p).expect_err("non-finite");
+        assert!(matches!(e, SceneError::NonFinite { .. }), "{bad}: {e}");
+        assert!(e.to_string().contains(&format!("pillar_{i}")), "{e}");
+    }
+}
+
+#[test]
+fn degenerate_triangles_are_dropped_and_counted_in_a_warning() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let text = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\n\
+                f 1 2 3\n\
+                f 1 1 2\n\
+                f 1 2 4\n\
+                f 3 3 3\n";
+    let p = write(dir.path(), "d.obj", text.as_bytes());
+    let scene = load(&p).expect("loads");
+    assert_eq!(scene.triangle_count(), 1);
+    assert_eq!(scene.report.triangles_read, 4);
+    assert_eq!(scene.report.degenerate_dropped, 3);
+    assert!(
+        scene
+            .report
+            .warnings
+            .iter()
+            .any(|w| w.contains("3 degenerate")),
+        "{:?}",
+        scene.report.warnings
+    );
+}
+
+#[test]
+fn a_texture_that_fails_to_decode_is_a_warning_and_falls_back_to_the_albedo() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    write(dir.path(), "bad.png", b"\x89PNG but not really");
+    write(
+        dir.path(),
+        "t.mtl",
+        b"newmtl m\nKd 0.3 0.6 0.9\nmap_Kd bad.png\n\nnewmtl n\nKd 1 1 1\nmap_Kd missing.png\n",
+    );
+    let p = write(
+        dir.path(),
+        "t.obj",
+        b"mtllib t.mtl\nusemtl m\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\nusemtl n\nf 1 3 2\n",
+    );
+    let scene = load(&p).expect("loads despite bad textures");
+    assert_eq!(scene.report.textures_failed, 2);
+    let m = scene
+        .materials
+        .iter()
+        .find(|m| m.name == "m")
+        .expect("material m");
+    assert_eq!(m.texture, None);
+    assert_eq!(m.albedo, glam::Vec3::new(0.3, 0.6, 0.9));
+    assert!(scene.report.warnings.iter().any(|w| w.contains("bad.png")));
+    assert!(
+        scene
+            .report
+            .warnings
+            .iter()
+            .any(|w| w.contains("missing.png"))
+    );
+}
+
+#[test]
+fn a_good_texture_is_decoded() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let img = image::RgbaImage::from_pixel(4, 2, image::Rgba([10, 20, 30, 255]));
+    img.save(dir.path().join("ok.png")).expect("save png");
+    write(dir.path(), "t.mtl", b"newmtl m\nKd 1 1 1\nmap_Kd ok.png\n");
+    let p = write(dir.path(), "t.obj", b"mtllib t.mtl\nusemtl m\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n");
+    let scene = load(&p).expect("loads");
+    assert_eq!(scene.textures.len(), 1);
+    assert_eq!((scene.textures[0].width, scene.textures[0].height), (4, 2));
+    assert_eq!(&scene.textures[0].rgba8[..4], &[10, 20, 30, 255]);
+    assert_eq!(scene.materials[0].texture, Some(0));
+}
+
+#[test]
+fn a_missing_material_library_is_a_warning() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let p = write(
+        dir.path(),
+        "t.obj",
+        b"mtllib gone.mtl\nusemtl m\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    );
+    let scene = load(&p).expect("loads");
+    assert!(
+        scene
+            .report
+            .warnings
+            .iter()
+            .any(|w| w.contains("material library"))
+    );
+    assert_eq!(scene.triangle_count(), 1);
+}
+
+#[test]
+fn an_obj_without_triangles_is_an_empty_scene() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    for (i, text) in [
+        "",
+        "# nothing\n",
+        "v 0 0 0\nv 1 0 0\n",
+        "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n",
+    ]
+    .iter()
+    .enumerate()
+    {
+        let p = write(dir.path(), &format!("e{i}.obj"), text.as_bytes());
+        let e = load(&p).expect_err("empty");
+        assert!(matches!(e, SceneError::Empty { .. }), "{text:?}: {e}");
+    }
+}
+
+#[test]
+fn face_normals_are_computed_when_the_file_has_none() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let p = write(
+        dir.path(),
+        "n.obj",
+        b"v 0 0 0\nv 1 0 0\nv 0 0 -1\nf 1 2 3\n",
+    );
+    let scene = load(&p).expect("loads");
+    for n in &scene.meshes[0].normals {
+        assert!((*n - glam::Vec3::Y).length() < 1e-6, "{n}");
+    }
+}
+
+/// A minimal glTF with an external buffer of 3 positions and the given u16 indices.
+fn gltf_with(dir: &Path, name: &str, positions: [[f32; 3]; 3], indices: &[u16]) -> PathBuf {
+    let mut bin = Vec::new();
+    for p in positions {
+        for c in p {
+            bin.extend_from_slice(&c.to_le_bytes());
+        }
+    }
+    let ioff = bin.len();
+    for i in indices {
+        bin.extend_from_slice(&i.to_le_bytes());
+    }
+    while bin.len() % 4 != 0 {
+        bin.push(0);
+    }
+    std::fs::write(dir.join(format!("{name}.bin")), &bin).expect("bin");
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],
+        "nodes":[{{"mesh":0,"name":"node","translation":[0,5,0]}}],
+        "meshes":[{{"name":"wall","primitives":[{{"attributes":{{"POSITION":0}},"indices":1}}]}}],
+        "buffers":[{{"uri":"{name}.bin","byteLength":{blen}}}],
+        "bufferViews":[{{"buffer":0,"byteOffset":0,"byteLength":36}},{{"buffer":0,"byteOffset":{ioff},"byteLength":{ilen}}}],
+        "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}},
+                     {{"bufferView":1,"componentType":5123,"count":{icount},"type":"SCALAR"}}]}}"#,
+        blen = bin.len(),
+        ilen = indices.len() * 2,
+        icount = indices.len(),
+    );
+    write(dir, &format!("{name}.gltf"), json.as_bytes())
+}
+
+#[test]
+fn gltf_node_transforms_apply_and_normals_are_computed() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let p = gltf_with(
+        dir.path(),
+        "ok",
+        [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        &[0, 1, 2],
+    );
+    let scene = load(&p).expect("loads");
+    assert_eq!(scene.triangle_count(), 1);
+    let (lo, hi) = scene.bounds().expect("bounds");
+    assert_eq!((lo.y, hi.y), (5.0, 6.0));
+    assert!((scene.meshes[0].normals[0] - glam::Vec3::Z).length() < 1e-6);
+}
+
+#[test]
+fn gltf_index_out_of_range_is_an_error() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let p = gltf_with(
+        dir.path(),
+        "oob",
+        [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        &[0, 1, 7],
+    );
+    let e = load(&p).expect_err("out of range");
+    assert!(
+        matches!(e, SceneError::IndexOutOfRange { index: 7, .. }),
+        "{e}"
+    );
+    assert!(e.to_string().contains("wall"), "{e}");
+}
+
+#[test]
+fn gltf_nan_coordinates_are_errors_naming_the_mesh() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let p = gltf_with(
+        dir.path(),
+        "nan",
+        [[0.0, 0.0, 0.0], [f32::NAN, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        &[0, 1, 2],
+    );
+    let e = load(&p).expect_err("nan");
+    assert!(matches!(e, SceneError::NonFinite { .. }), "{e}");
+    assert!(e.to_string().contains("wall"), "{e}");
+}
+
+#[test]
+fn broken_gltf_is_an_error() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    for (name, bytes) in [
+        ("a.gltf", &b"{ not json"[..]),
+        ("b.glb", &b"glTF\x02\x00\x00\x00garbage"[..]),
+        ("c.gltf", &br#"{"asset":{"version":"2.0"},"meshes":[{"primitives":[{"attributes":{"POSITION":5}}]}]}"#[..]),
+    ] {
+        let p = write(dir.path(), name, bytes);
+        let e = load(&p).expect_err("broken gltf");
+        assert!(matches!(e, SceneError::Gltf { .. }), "{name}: {e}");
+        assert!(e.to_string().contains(name), "{e}");
+    }
+    // A buffer file that is missing.
+    let p = gltf_with(
+        dir.path(),
+        "nobuf",
+        [[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        &[0, 1, 2],
+    );
+    std::fs::remove_file(dir.path().join("nobuf.bin")).expect("rm");
+    assert!(matches!(load(&p), Err(SceneError::Gltf { .. })));
+}
+
+#[test]
+fn import_file_never_panics_on_random_bytes() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let mut x: u64 = 0x9e3779b97f4a7c15;
+    for i in 0..200 {
+        let len = (i * 7) % 300;
+        let bytes: Vec<u8> = (0..len)
+            .map(|_| {
+                x ^= x << 13;
+                x ^= x >> 7;
+                x ^= x << 17;
+                if i % 2 == 0 {
+                    b"vf 0123456789./-\n"[(x % 17) as usize]
+                } else {
+                    x as u8
+                }
+            })
+            .collect();
+        for ext in ["obj", "gltf", "glb"] {
+            let p = write(dir.path(), &format!("r{i}.{ext}"), &bytes);
+            let _ = import_file(&p, &ImportOptions::default());
+        }
+    }
+}
