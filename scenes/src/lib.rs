@@ -170,6 +170,25 @@ impl Builtin {
         })
     }
 
+    /// The boxes of empty space the level is made of (rooms, corridors, doorways), metres.
+    pub fn empty_boxes_m(self) -> Vec<Opening> {
+        match self.level() {
+            Some(level) => level
+                .empty
+                .iter()
+                .map(|b| Opening {
+                    min_m: b.min.map(|c| c as f32 * CELL_M),
+                    max_m: b.max.map(|c| c as f32 * CELL_M),
+                })
+                .collect(),
+            // The inside of the Cornell box (its walls are single planes).
+            None => vec![Opening {
+                min_m: [-0.99, 0.0, -1.04],
+                max_m: [0.99, 1.99, 0.99],
+            }],
+        }
+    }
+
     /// The known answers the bake must reproduce.
     pub fn known_answers(self) -> KnownAnswers {
         let m = |b: CellBox| Opening {

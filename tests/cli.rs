@@ -1,0 +1,198 @@
+//! The `visgate` command line, run as a user runs it.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn visgate(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_visgate"))
+        .args(args)
+        .env("RUST_LOG", "error")
+        .output()
+        .expect("runs visgate")
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+#[test]
+fn help_lists_the_subcommands_that_exist() {
+    let o = visgate(&["--help"]);
+    assert!(o.status.success());
+    let out = stdout(&o);
+    for sub in ["inspect", "scenes", "builtin:NAME"] {
+        assert!(out.contains(sub), "--help does not mention {sub}:\n{out}");
+    }
+    let o = visgate(&["no-such-command"]);
+    assert!(!o.status.success());
+}
+
+#[test]
+fn scenes_lists_every_builtin() {
+    let o = visgate(&["scenes"]);
+    assert!(o.status.success());
+    for name in [
+        "empty-box",
+        "two-rooms",
+        "ring-corridor",
+        "l-corridor",
+        "four-rooms",
+        "cornell-box",
+    ] {
+        assert!(stdout(&o).contains(name), "{name} missing");
+    }
+}
+
+#[test]
+fn inspect_a_builtin_as_text_and_json() {
+    let o = visgate(&["inspect", "builtin:two-rooms"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = stdout(&o);
+    assert!(
+        out.contains("triangles") && out.contains("bounds") && out.contains("closed      yes"),
+        "{out}"
+    );
+    let o = visgate(&["inspect", "--json", "builtin:four-rooms"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("valid JSON");
+    assert_eq!(v["kind"], "scene");
+    assert_eq!(v["point_lights"], 1);
+    assert_eq!(v["spot_lights"], 1);
+    assert_eq!(v["closed"], true);
+    assert!(v["triangles"].as_u64().expect("count") > 0);
+}
+
+#[test]
+fn export_then_inspect_the_files_and_a_bare_mesh() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("cb");
+    let o = visgate(&[
+        "scenes",
+        "export",
+        "cornell-box",
+        out.to_str().expect("utf8"),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = visgate(&[
+        "inspect",
+        "--json",
+        out.join("cornell-box.toml").to_str().expect("utf8"),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("json");
+    assert_eq!(v["triangles"], 36);
+    assert_eq!(v["point_lights"], 1);
+    // The OBJ on its own: one static mesh, no lights.
+    let o = visgate(&[
+        "inspect",
+        "--json",
+        out.join("CornellBox-Original.obj").to_str().expect("utf8"),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("json");
+    assert_eq!(v["triangles"], 36);
+    assert_eq!(v["point_lights"], 0);
+    assert_eq!(v["static_triangles"], 36);
+}
+
+#[test]
+fn inspect_a_baked_file_and_refuse_a_broken_one() {
+    use visgate_formats::vgate::*;
+    let dir = tempfile::tempdir().expect("tempdir");
+    let grid = GridMeta {
+        origin_m: [0.0; 3],
+        voxel_size_m: 0.5,
+        dims: [2, 2, 2],
+    };
+    let level = BakedLevel {
+        info: BakeInfo {
+            params: BakeParams::default(),
+            geometry_hash: visgate_formats::GeometryHash([1; 16]),
+            grid,
+            tool_version: "test".into(),
+        },
+        topology: Topology {
+            skeleton: Skeleton {
+                nodes: vec![SkeletonNode {
+                    voxel: [0, 0, 0],
+                    position_m: [0.25; 3],
+                    radius_m: 0.5,
+                }],
+                edges: vec![],
+            },
+            segmented: SegmentedSkeleton {
+                nodes: vec![SegNode {
+                    skeleton_node: 0,
+                    kind: SegNodeKind::Topology,
+                }],
+                edges: vec![],
+            },
+            node_cluster: vec![0],
+            clusters: vec![Cluster {
+                seed: 0,
+                bounds_min_m: [0.0; 3],
+                bounds_max_m: [1.0; 3],
+            }],
+            gates: vec![],
+        },
+        voxel_node: VoxelValues::pack(&[0; 8]),
+        voxel_cluster: VoxelValues::pack(&[0; 8]),
+    };
+    let path = dir.path().join("l.vgate");
+    level.write(&path).expect("write");
+    let o = visgate(&["inspect", path.to_str().expect("utf8")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains("2 x 2 x 2 voxels"), "{}", stdout(&o));
+    let o = visgate(&["inspect", "--json", path.to_str().expect("utf8")]);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("json");
+    assert_eq!(v["clusters"], 1);
+    assert_eq!(v["gates"], 0);
+    // Corrupt it: a clear error, exit code 1, no panic.
+    let mut bytes = std::fs::read(&path).expect("read");
+    let last = bytes.len() - 1;
+    bytes[last] ^= 0x55;
+    std::fs::write(&path, &bytes).expect("write");
+    let o = visgate(&["inspect", path.to_str().expect("utf8")]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("corrupt") && stderr(&o).contains("l.vgate"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+#[test]
+fn bad_arguments_give_clear_errors() {
+    let o = visgate(&["inspect", "missing.toml"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("missing.toml") && stderr(&o).contains("no such file"),
+        "{}",
+        stderr(&o)
+    );
+    let o = visgate(&["inspect", "builtin:nope"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("two-rooms"),
+        "the error lists the built-ins: {}",
+        stderr(&o)
+    );
+    let o = visgate(&["scenes", "export", "nope", "out"]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(!Path::new("out").exists());
+    let dir = tempfile::tempdir().expect("tempdir");
+    let bad = dir.path().join("bad.toml");
+    std::fs::write(&bad, "[[mesh]]\npath = \"x.obj\"\nstatik = true\n").expect("write");
+    let o = visgate(&["inspect", bad.to_str().expect("utf8")]);
+    assert_eq!(o.status.code(), Some(1));
+    assert!(
+        stderr(&o).contains("statik") && stderr(&o).contains("bad.toml"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!stderr(&o).contains("panicked"));
+}

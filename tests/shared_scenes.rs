@@ -1,0 +1,108 @@
+//! The large scenes in `../shared/scenes/` (or `$VISGATE_SHARED_SCENES`). Skipped, with the
+//! reason printed, where they are absent.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use visgate_formats::{ImportOptions, Scene};
+
+fn shared_scenes() -> Option<PathBuf> {
+    let dir = std::env::var_os("VISGATE_SHARED_SCENES")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/scenes"));
+    if dir.is_dir() {
+        Some(dir)
+    } else {
+        println!(
+            "SKIPPED: {} is absent; set VISGATE_SHARED_SCENES to the folder of shared scenes",
+            dir.display()
+        );
+        None
+    }
+}
+
+fn load(path: &std::path::Path) -> Scene {
+    let start = Instant::now();
+    let scene = Scene::load(path, &ImportOptions::default())
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    println!(
+        "{}: {} triangles read, {} degenerate dropped, {} materials, {} textures ({} failed), {:.3} s",
+        path.display(),
+        scene.report.triangles_read,
+        scene.report.degenerate_dropped,
+        scene.materials.len(),
+        scene.textures.len(),
+        scene.report.textures_failed,
+        start.elapsed().as_secs_f64()
+    );
+    scene
+}
+
+/// Each triangle as its corners quantised to `q` units, rotated so the smallest corner comes
+/// first (winding kept), sorted.
+fn canonical_triangles(scene: &Scene, q: f32) -> Vec<[[i64; 3]; 3]> {
+    let mut v: Vec<[[i64; 3]; 3]> = scene
+        .static_triangles()
+        .map(|t| {
+            let t = t.map(|p| p.to_array().map(|c| (c / q).round() as i64));
+            let k = (0..3).min_by_key(|&i| t[i]).unwrap_or(0);
+            [t[k], t[(k + 1) % 3], t[(k + 2) % 3]]
+        })
+        .collect();
+    v.sort_unstable();
+    v
+}
+
+#[test]
+fn every_shared_scene_loads() {
+    let Some(dir) = shared_scenes() else { return };
+    let expect = [
+        ("cornell_box/CornellBox-Original.obj", 36, 0),
+        ("cornell_box/CornellBox-Original.gltf", 36, 0),
+        ("crytek_sponza/sponza.obj", 262_267, 232),
+        ("crytek_sponza/sponza.glb", 262_267, 232),
+        ("dabrovic_sponza/sponza.obj", 66_454, 1),
+        ("dabrovic_sponza/sponza.gltf", 66_454, 1),
+        ("librequake_e2m3/e2m3.obj", 24_610, 2_748),
+    ];
+    for (file, read, degenerate) in expect {
+        let scene = load(&dir.join(file));
+        assert_eq!(scene.report.triangles_read, read, "{file}");
+        assert_eq!(scene.report.degenerate_dropped, degenerate, "{file}");
+        assert_eq!(scene.triangle_count(), read - degenerate, "{file}");
+        assert_eq!(scene.report.textures_failed, 0, "{file}");
+        if degenerate > 0 {
+            assert!(
+                scene
+                    .report
+                    .warnings
+                    .iter()
+                    .any(|w| w.contains(&format!("{degenerate} degenerate")))
+            );
+        }
+    }
+    // The textured scenes have their textures.
+    let dab = load(&dir.join("dabrovic_sponza/sponza.obj"));
+    assert!(dab.materials.iter().filter(|m| m.texture.is_some()).count() >= 18);
+    let quake = load(&dir.join("librequake_e2m3/e2m3.obj"));
+    assert!(quake.materials.iter().any(|m| m.name.starts_with("sky_")));
+}
+
+#[test]
+fn crytek_sponza_obj_and_glb_give_the_same_triangles() {
+    let Some(dir) = shared_scenes() else { return };
+    let obj = load(&dir.join("crytek_sponza/sponza.obj"));
+    let glb = load(&dir.join("crytek_sponza/sponza.glb"));
+    assert_eq!(obj.triangle_count(), 262_035);
+    assert_eq!(glb.triangle_count(), 262_035);
+    let (a, b) = (
+        canonical_triangles(&obj, 1e-3),
+        canonical_triangles(&glb, 1e-3),
+    );
+    let differing = a.iter().zip(&b).filter(|(x, y)| x != y).count();
+    assert_eq!(
+        differing, 0,
+        "{differing} triangles differ between the OBJ and the GLB"
+    );
+    assert_eq!(obj.bounds(), glb.bounds());
+}
