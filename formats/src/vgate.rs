@@ -291,20 +291,36 @@ impl VoxelValues {
     }
 
     fn max_value(&self) -> Option<u32> {
-        let it: Box<dyn Iterator<Item = u32>> = match self {
-            VoxelValues::U8(v) => Box::new(v.iter().filter(|&&x| x != u8::MAX).map(|&x| x.into())),
-            VoxelValues::U16(v) => {
-                Box::new(v.iter().filter(|&&x| x != u16::MAX).map(|&x| x.into()))
-            }
-            VoxelValues::U32(v) => Box::new(v.iter().copied().filter(|&x| x != NONE)),
-        };
-        it.max()
+        // Plain folds per type: this runs over every voxel on each load.
+        // Shift values up by one so that "none" becomes 0: a branch-free max that vectorises.
+        fn max_of<T: Copy + Into<u32>>(v: &[T], none: u32) -> Option<u32> {
+            let m = v
+                .iter()
+                .map(|&x| {
+                    let x: u32 = x.into();
+                    if x == none { 0 } else { u64::from(x) + 1 }
+                })
+                .max()
+                .unwrap_or(0);
+            (m > 0).then(|| (m - 1) as u32)
+        }
+        match self {
+            VoxelValues::U8(v) => max_of(v, u8::MAX.into()),
+            VoxelValues::U16(v) => max_of(v, u16::MAX.into()),
+            VoxelValues::U32(v) => max_of(v, NONE),
+        }
     }
 
     fn to_le_bytes(&self) -> Vec<u8> {
         match self {
             VoxelValues::U8(v) => v.clone(),
-            VoxelValues::U16(v) => v.iter().flat_map(|x| x.to_le_bytes()).collect(),
+            VoxelValues::U16(v) => {
+                let mut out = Vec::with_capacity(v.len() * 2);
+                for x in v {
+                    out.extend_from_slice(&x.to_le_bytes());
+                }
+                out
+            }
             VoxelValues::U32(v) => {
                 let mut out = Vec::with_capacity(v.len() * 4);
                 for x in v {
