@@ -7,6 +7,33 @@
 //! → segmentation (topology, curvature and coverage nodes) → visibility clusters (greedy, α)
 //! → visibility gates → the runtime layout of `visgate_formats::vgate`.
 //!
-//! Each stage is a function from plain data to new plain data with its own params struct,
-//! timed and counted in a bake context. This crate never imports `visgate-runtime`; what the
-//! two share is a type in `visgate-formats`. (The stages land with the bake issue.)
+//! Each stage is a function from plain data to new plain data with its own params struct.
+//! This crate never imports `visgate-runtime`; what the two share is a type in
+//! `visgate-formats`.
+//!
+//! Stages that exist so far: [`voxelize`] (stage 2) and [`distance`] (stage 4). The rest, the
+//! bake context and `visgate bake` are the remainder of the bake issue.
+
+pub mod distance;
+pub mod voxelize;
+
+/// Everything that can stop a bake.
+#[derive(Debug, thiserror::Error)]
+pub enum BakeError {
+    /// A parameter is outside its documented limits.
+    #[error("invalid bake parameter: {0}")]
+    Param(String),
+    /// The grids would not fit in the memory limit; nothing was allocated.
+    #[error(
+        "a {:.0} x {:.0} x {:.0} voxel grid needs about {:.1} GiB for the bake, over the limit of {:.1} GiB; lower --resolution or raise --voxel-size",
+        dims[0], dims[1], dims[2], *bytes / f64::from(1u32 << 30), *limit as f64 / f64::from(1u32 << 30)
+    )]
+    TooLarge {
+        /// The grid's dimensions.
+        dims: [f64; 3],
+        /// Bytes it would need.
+        bytes: f64,
+        /// The limit.
+        limit: u64,
+    },
+}
