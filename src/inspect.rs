@@ -182,11 +182,7 @@ fn inspect_baked(path: &Path, json: bool) -> Result<()> {
         .with_context(|| format!("{}: cannot load the baked level", path.display()))?;
     let read_seconds = start.elapsed().as_secs_f64();
     let t = &level.topology;
-    let bytes_per = |v: &visgate_formats::vgate::VoxelValues| match v.elem() {
-        visgate_formats::vgate::Elem::U16 => 2,
-        visgate_formats::vgate::Elem::U32 => 4,
-        _ => 1,
-    };
+    let bytes_per = |v: &visgate_formats::vgate::VoxelValues| v.elem().size() as u32;
     let s = BakedSummary {
         kind: "baked level",
         file: path.display().to_string(),

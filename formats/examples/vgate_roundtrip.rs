@@ -135,7 +135,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     Ok(())
 }
 
-#[allow(dead_code)]
 fn crc_speed(bytes: &[u8]) -> f64 {
     let t = Instant::now();
     let c = crc32fast::hash(bytes);

@@ -368,7 +368,8 @@ pub enum Elem {
 }
 
 impl Elem {
-    fn size(self) -> u64 {
+    /// Bytes per element (1 for a structure, whose length is in bytes).
+    pub fn size(self) -> u64 {
         match self {
             Elem::Structure | Elem::U8 => 1,
             Elem::U16 => 2,
