@@ -1,6 +1,7 @@
 //! `visgate`: the one command-line tool — inspect scenes, meshes and baked levels, and list or
 //! export the built-in scenes.
 
+mod bake;
 mod inspect;
 
 use std::path::{Path, PathBuf};
@@ -18,6 +19,7 @@ A SCENE argument is any of:
   builtin:NAME        a built-in scene (list them with `visgate scenes`)
 
 Examples:
+  visgate bake builtin:two-rooms -o two-rooms.vgate
   visgate inspect builtin:four-rooms
   visgate inspect --json ../shared/scenes/crytek_sponza/sponza.glb
   visgate scenes export two-rooms out/two-rooms
@@ -38,6 +40,9 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Bake a scene's topology (skeleton, visibility clusters, gates) into a .vgate level.
+    #[command(after_help = bake::AFTER_HELP)]
+    Bake(bake::BakeArgs),
     /// Print a summary of a scene, a mesh file or a baked .vgate level.
     Inspect {
         /// A scene (TOML, OBJ, glTF/GLB, builtin:NAME) or a baked .vgate file.
@@ -90,6 +95,7 @@ fn main() -> ExitCode {
 
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
+        Command::Bake(args) => bake::run(args),
         Command::Inspect {
             file,
             json,

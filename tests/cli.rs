@@ -196,3 +196,96 @@ fn bad_arguments_give_clear_errors() {
     );
     assert!(!stderr(&o).contains("panicked"));
 }
+
+#[test]
+fn bake_writes_the_level_report_and_debug_exports() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("two.vgate");
+    let report = dir.path().join("bake.json");
+    let debug = dir.path().join("debug");
+    let o = visgate(&[
+        "bake",
+        "builtin:two-rooms",
+        "-o",
+        out.to_str().expect("utf-8"),
+        "--resolution",
+        "64",
+        "--threads",
+        "2",
+        "--report",
+        report.to_str().expect("utf-8"),
+        "--debug-dir",
+        debug.to_str().expect("utf-8"),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    for want in [
+        "voxelize",
+        "thin",
+        "skeleton nodes",
+        "clusters 3",
+        "gates 2",
+        "(preserved)",
+    ] {
+        assert!(text.contains(want), "missing '{want}' in:\n{text}");
+    }
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).expect("report")).expect("json");
+    assert_eq!(json["summary"]["gates"], 2);
+    assert!(json["stages"].as_array().expect("stages").len() >= 10);
+    for f in [
+        "solid.npy",
+        "skeleton.npy",
+        "solid_surface.ply",
+        "skeleton.ply",
+        "segmented.ply",
+        "clusters.ply",
+        "gates.ply",
+    ] {
+        let bytes = std::fs::read(debug.join(f)).expect(f);
+        assert!(bytes.len() > 64, "{f} is empty");
+    }
+    // The .npy files have the grid's shape and 0/1 values.
+    let npy = std::fs::read(debug.join("skeleton.npy")).expect("npy");
+    assert_eq!(&npy[..6], b"\x93NUMPY");
+    let hlen = u16::from_le_bytes([npy[8], npy[9]]) as usize;
+    let header = String::from_utf8_lossy(&npy[10..10 + hlen]);
+    let dims = &json["grid"]["dims"];
+    let shape = format!("({}, {}, {})", dims[0], dims[1], dims[2]);
+    assert!(header.contains(&shape), "{header} vs {shape}");
+    let body = &npy[10 + hlen..];
+    assert!(body.iter().all(|&b| b <= 1));
+    assert_eq!(
+        body.iter().filter(|&&b| b == 1).count() as u64,
+        json["summary"]["skeleton_nodes"].as_u64().expect("n")
+    );
+    // inspect reads it back.
+    let o = visgate(&["inspect", out.to_str().expect("utf-8")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains("gates       2"), "{}", stdout(&o));
+}
+
+#[test]
+fn bake_refuses_bad_arguments_clearly() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("x.vgate");
+    let out = out.to_str().expect("utf-8");
+    let o = visgate(&["bake", "builtin:two-rooms", "-o", out, "--alpha", "3"]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("alpha"), "{}", stderr(&o));
+    let o = visgate(&["bake", "builtin:two-rooms", "-o", out, "--resolution", "4"]);
+    assert!(stderr(&o).contains("8..=2048"), "{}", stderr(&o));
+    let o = visgate(&[
+        "bake",
+        "builtin:two-rooms",
+        "-o",
+        out,
+        "--resolution",
+        "2000",
+        "--memory-limit-gib",
+        "0.5",
+    ]);
+    assert!(stderr(&o).contains("GiB"), "{}", stderr(&o));
+    let o = visgate(&["bake", "nope.toml", "-o", out]);
+    assert!(stderr(&o).contains("no such file"), "{}", stderr(&o));
+}

@@ -156,6 +156,9 @@ pub enum SegNodeKind {
     Curvature,
     /// Added by recursive line splitting so the maximal balls cover the line.
     Coverage,
+    /// Where the line narrows well below the balls of its ends (a doorway that the two end
+    /// balls happen to cover at a coarse resolution); visgate's addition to IV.B.1.
+    Narrowing,
 }
 
 /// A node of the segmented skeleton.

@@ -11,10 +11,19 @@
 //! This crate never imports `visgate-runtime`; what the two share is a type in
 //! `visgate-formats`.
 //!
-//! Stages that exist so far: [`voxelize`] (stage 2) and [`distance`] (stage 4). The rest, the
-//! bake context and `visgate bake` are the remainder of the bake issue.
+//! Stages: [`voxelize`], [`empty`], [`distance`], [`thin`], [`graph`], [`segment`],
+//! [`clusters`] (clusters and gates); [`bake::bake`] runs them all, timed and counted, and
+//! [`debug`] writes what each produced in formats Blender and MeshLab open.
 
+pub mod bake;
+pub mod clusters;
+pub mod debug;
 pub mod distance;
+pub mod empty;
+pub mod graph;
+pub mod neighbourhood;
+pub mod segment;
+pub mod thin;
 pub mod voxelize;
 
 /// Everything that can stop a bake.
@@ -23,6 +32,17 @@ pub enum BakeError {
     /// A parameter is outside its documented limits.
     #[error("invalid bake parameter: {0}")]
     Param(String),
+    /// The scene has no empty space to bake (or none was kept).
+    #[error("no empty space: {0}")]
+    NoEmptySpace(String),
+    /// The static geometry has no triangle.
+    #[error("the scene has no static triangles to bake; mark at least one mesh `static = true`")]
+    NoGeometry,
+    /// A closed scene's empty space reaches its bounds.
+    #[error(
+        "the scene is declared closed but its empty space reaches the bounds ({0}); close the geometry there, or bake anyway with --allow-leaks"
+    )]
+    Leak(String),
     /// The grids would not fit in the memory limit; nothing was allocated.
     #[error(
         "a {:.0} x {:.0} x {:.0} voxel grid needs about {:.1} GiB for the bake, over the limit of {:.1} GiB; lower --resolution or raise --voxel-size",

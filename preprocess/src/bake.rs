@@ -1,0 +1,681 @@
+//! The whole bake: a [`Scene`] and [`BakeParams`] → a [`BakedLevel`] and a [`BakeReport`].
+//!
+//! Every stage is timed and counted in the report; a progress callback hears about the long
+//! ones. The result depends only on the scene and the parameters — not on the number of
+//! threads — so re-baking reproduces the file byte for byte.
+
+use std::time::Instant;
+
+use glam::Vec3;
+use rayon::prelude::*;
+use serde::Serialize;
+use serde_json::{Value, json};
+use visgate_formats::Scene;
+use visgate_formats::scene::Light;
+use visgate_formats::vgate::{
+    BakeInfo, BakeParams, BakedLevel, Cluster, Gate, GatePlacement, GridMeta, Resolution,
+    SegNodeKind, Skeleton, SkeletonNode, Topology, VoxelValues,
+};
+
+use crate::clusters::{ClusterParams, GateDisk, clusters, gates, skeleton_clusters};
+use crate::empty::{EmptySpace, EmptySpaceParams, Seed, empty_space};
+use crate::graph::{SkeletonGraph, nearest_node, skeleton_graph};
+use crate::neighbourhood::{Betti, betti};
+use crate::segment::{SegmentParams, Segmented, segment};
+use crate::thin::{ThinParams, Thinned, extend_ends, thin};
+use crate::voxelize::{SolidGrid, grid_for, voxelize};
+use crate::{BakeError, distance};
+
+/// What the progress callback hears.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Progress {
+    /// A stage starts; `total` is the amount of work its `Advance` counts towards (0: unknown).
+    Start {
+        /// Stage name.
+        stage: &'static str,
+        /// Units of work.
+        total: u64,
+    },
+    /// Work done so far in the current stage.
+    Advance(u64),
+    /// The current stage ended.
+    Finish,
+}
+
+/// Options of [`bake`] beyond the stored parameters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BakeOptions {
+    /// Refuse grids that would need more memory than this. [Units: bytes]
+    pub memory_limit_bytes: u64,
+    /// Persistence in thinning steps; `None` picks [`auto_persistence`] for the grid.
+    pub persistence: Option<u32>,
+}
+
+impl Default for BakeOptions {
+    fn default() -> Self {
+        BakeOptions {
+            memory_limit_bytes: 16 << 30,
+            persistence: None,
+        }
+    }
+}
+
+/// The persistence used when none is given: it grows with the grid so that wall noise of a
+/// fixed size in metres is pruned at any resolution: `2 + ceil(longest axis / 64)` steps.
+pub fn auto_persistence(dims: [u32; 3]) -> u32 {
+    2 + dims.iter().max().copied().unwrap_or(0).div_ceil(64)
+}
+
+/// One timed stage.
+#[derive(Debug, Clone, Serialize)]
+pub struct StageReport {
+    /// Stage name.
+    pub name: &'static str,
+    /// Wall time. [Units: s]
+    pub seconds: f64,
+    /// What it produced.
+    pub counts: Value,
+}
+
+/// Headline counts of a bake.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct Summary {
+    /// Grid voxels (border included).
+    pub voxels: u64,
+    /// Solid voxels after voxelization.
+    pub solid_voxels: u64,
+    /// Kept empty voxels (what the skeleton describes).
+    pub empty_voxels: u64,
+    /// Skeleton nodes.
+    pub skeleton_nodes: u64,
+    /// Segmented nodes: all, then topology / curvature / coverage / narrowing.
+    pub segmented_nodes: [u64; 5],
+    /// Visibility clusters.
+    pub clusters: u64,
+    /// Visibility gates.
+    pub gates: u64,
+    /// Independent cycles of the skeleton graph.
+    pub cycles: u64,
+    /// Components of the skeleton graph.
+    pub components: u64,
+}
+
+/// Everything a bake measured.
+#[derive(Debug, Clone, Serialize)]
+pub struct BakeReport {
+    /// Scene name.
+    pub scene: String,
+    /// Parameters used (resolved).
+    pub params: BakeParams,
+    /// The grid.
+    pub grid: GridMeta,
+    /// Rayon threads.
+    pub threads: usize,
+    /// Stages in order.
+    pub stages: Vec<StageReport>,
+    /// Total wall time. [Units: s]
+    pub total_seconds: f64,
+    /// Peak resident memory of the process, where the OS tells. [Units: bytes]
+    pub peak_memory_bytes: Option<u64>,
+    /// Headline counts.
+    pub summary: Summary,
+    /// Topology of the kept empty space, counted independently of the skeleton.
+    pub empty_topology: Betti,
+    /// Topology of the skeleton voxels, counted the same way.
+    pub skeleton_topology: Betti,
+    /// Empty components and their fate, leaks, hung objects.
+    pub empty_space: Value,
+    /// Gates under both placement rules, to compare.
+    pub gate_placements: Vec<Value>,
+}
+
+/// Intermediate grids, for debug exports.
+#[derive(Debug, Clone)]
+pub struct BakeGrids {
+    /// Solid voxels as voxelized.
+    pub solid: SolidGrid,
+    /// Kept empty voxels.
+    pub empty: Vec<bool>,
+    /// Skeleton voxels, ascending grid index.
+    pub skeleton: Vec<u32>,
+}
+
+/// A finished bake.
+#[derive(Debug, Clone)]
+pub struct Baked {
+    /// The level, ready to write.
+    pub level: BakedLevel,
+    /// What happened.
+    pub report: BakeReport,
+    /// Grids for debug exports.
+    pub grids: BakeGrids,
+}
+
+struct Clock<'a> {
+    stages: Vec<StageReport>,
+    t: Instant,
+    progress: &'a (dyn Fn(Progress) + Sync),
+}
+
+impl Clock<'_> {
+    fn start(&mut self, stage: &'static str, total: u64) {
+        (self.progress)(Progress::Start { stage, total });
+        self.t = Instant::now();
+    }
+    fn end(&mut self, name: &'static str, counts: Value) {
+        (self.progress)(Progress::Finish);
+        self.stages.push(StageReport {
+            name,
+            seconds: self.t.elapsed().as_secs_f64(),
+            counts,
+        });
+    }
+}
+
+/// Peak resident set size of this process (Linux `VmHWM`), bytes.
+pub fn peak_memory_bytes() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kb * 1024)
+}
+
+fn check_params(p: &BakeParams) -> Result<(), BakeError> {
+    if !(p.alpha.is_finite() && (0.0..=1.0).contains(&p.alpha)) {
+        return Err(BakeError::Param(format!(
+            "alpha {} must be in 0..=1 (a fraction: 0.2 = 20 %)",
+            p.alpha
+        )));
+    }
+    if p.persistence > 10_000 {
+        return Err(BakeError::Param(format!(
+            "persistence {} steps is more than any grid needs (at most 10000)",
+            p.persistence
+        )));
+    }
+    Ok(())
+}
+
+/// Seeds of the scene: camera eyes and light positions.
+pub fn scene_seeds(scene: &Scene) -> Vec<Seed> {
+    let mut seeds: Vec<Seed> = scene
+        .cameras
+        .iter()
+        .map(|c| Seed {
+            what: format!("camera '{}'", c.name),
+            position_m: c.eye.to_array(),
+        })
+        .collect();
+    for (i, l) in scene.lights.iter().enumerate() {
+        let (kind, p) = match l {
+            Light::Point { position, .. } => ("point light", position),
+            Light::Spot { position, .. } => ("spot light", position),
+        };
+        seeds.push(Seed {
+            what: format!("{kind} {i}"),
+            position_m: p.to_array(),
+        });
+    }
+    seeds
+}
+
+/// Bakes `scene` (see the crate docs for the stages).
+pub fn bake(
+    scene: &Scene,
+    params: &BakeParams,
+    options: &BakeOptions,
+    progress: &(dyn Fn(Progress) + Sync),
+) -> Result<Baked, BakeError> {
+    check_params(params)?;
+    let total = Instant::now();
+    let mut clock = Clock {
+        stages: Vec::new(),
+        t: Instant::now(),
+        progress,
+    };
+    // 1. Static triangles.
+    clock.start("load static meshes", 0);
+    let triangles: Vec<[Vec3; 3]> = scene.static_triangles().collect();
+    let bounds = scene.static_bounds().ok_or(BakeError::NoGeometry)?;
+    if triangles.is_empty() {
+        return Err(BakeError::NoGeometry);
+    }
+    let hash = scene.static_geometry_hash();
+    clock.end(
+        "load static meshes",
+        json!({ "triangles": triangles.len() }),
+    );
+
+    // 2. Voxelize.
+    let meta = grid_for(bounds, params.resolution, options.memory_limit_bytes)?;
+    clock.start("voxelize", 0);
+    let solid = voxelize(meta, &triangles);
+    let solid_voxels = solid.solid_count();
+    clock.end(
+        "voxelize",
+        json!({ "dims": meta.dims, "voxel_size_m": meta.voxel_size_m, "solid_voxels": solid_voxels }),
+    );
+    let mut params = params.clone();
+    params.persistence = options
+        .persistence
+        .unwrap_or_else(|| auto_persistence(meta.dims));
+
+    // 3. Empty space.
+    clock.start("empty space", 0);
+    let seeds = scene_seeds(scene);
+    let es: EmptySpace = empty_space(
+        &meta,
+        &solid.solid,
+        &triangles,
+        &seeds,
+        &EmptySpaceParams {
+            min_component_voxels: params.min_component_voxels,
+            closed: scene.closed,
+            allow_leaks: params.allow_leaks,
+        },
+    )?;
+    clock.end(
+        "empty space",
+        json!({
+            "empty_voxels": es.empty_voxels,
+            "components": es.components.len(),
+            "kept": es.components.iter().filter(|c| c.kept).count(),
+            "leaks": es.leaks.len(),
+            "hung_objects": es.threads.len(),
+        }),
+    );
+
+    // 4. Distance.
+    clock.start("distance", 0);
+    let not_empty: Vec<bool> = es.empty.iter().map(|&e| !e).collect();
+    let dist2 = distance::squared_distance(meta.dims, &not_empty);
+    drop(not_empty);
+    let max_r = es
+        .empty
+        .iter()
+        .zip(&dist2)
+        .filter(|(e, _)| **e)
+        .map(|(_, d)| *d)
+        .max()
+        .unwrap_or(0);
+    clock.end(
+        "distance",
+        json!({ "largest_radius_vx": (max_r as f64).sqrt() }),
+    );
+
+    // 5. Thin.
+    clock.start("thin", es.empty_voxels);
+    let mut thinned: Thinned = thin(
+        meta.dims,
+        &es.empty,
+        &dist2,
+        &ThinParams {
+            persistence: params.persistence,
+        },
+        &|done, _| progress(Progress::Advance(done)),
+    );
+    let extended = extend_ends(meta.dims, &es.empty, &dist2, &mut thinned.skeleton);
+    clock.end(
+        "thin",
+        json!({
+            "ends_extended_by": extended,
+            "skeleton_voxels": thinned.skeleton.len(),
+            "steps": thinned.steps,
+            "constrained": thinned.constrained,
+            "voxels_examined": thinned.border_visits,
+            "persistence": params.persistence,
+        }),
+    );
+
+    // 6. Skeleton graph and nearest-node grid.
+    clock.start("skeleton graph", 0);
+    let sg: SkeletonGraph = skeleton_graph(meta.dims, &thinned.skeleton);
+    let voxel_node = nearest_node(meta.dims, &es.empty, &thinned.skeleton);
+    let vs = meta.voxel_size_m;
+    let position: Vec<Vec3> = sg
+        .voxels
+        .iter()
+        .map(|&v| Vec3::from(meta.voxel_to_world(coords(v, meta.dims))))
+        .collect();
+    let radius: Vec<f32> = sg
+        .voxels
+        .iter()
+        .map(|&v| (dist2[v as usize] as f64).sqrt() as f32 * vs)
+        .collect();
+    let cycles = sg.cycles();
+    let components = petgraph::algo::connected_components(&sg.graph) as u64;
+    clock.end(
+        "skeleton graph",
+        json!({
+            "nodes": sg.voxels.len(),
+            "edges": sg.graph.edge_count(),
+            "shortcuts_dropped": sg.shortcuts_dropped,
+            "cycles": cycles,
+            "components": components,
+        }),
+    );
+    drop(dist2);
+
+    // 7. Segment.
+    clock.start("segment", 0);
+    let adjacency = sg.adjacency();
+    let seg: Segmented = segment(&adjacency, &position, &radius, &SegmentParams::default());
+    let count_kind =
+        |k: SegNodeKind| seg.skeleton.nodes.iter().filter(|n| n.kind == k).count() as u64;
+    let seg_counts = [
+        seg.skeleton.nodes.len() as u64,
+        count_kind(SegNodeKind::Topology),
+        count_kind(SegNodeKind::Curvature),
+        count_kind(SegNodeKind::Coverage),
+        count_kind(SegNodeKind::Narrowing),
+    ];
+    clock.end(
+        "segment",
+        json!({
+            "nodes": seg_counts[0], "topology": seg_counts[1], "curvature": seg_counts[2],
+            "coverage": seg_counts[3], "narrowing": seg_counts[4], "edges": seg.skeleton.edges.len(),
+        }),
+    );
+
+    // 8. Clusters.
+    clock.start("clusters", 0);
+    let (node_cluster, seeds_of) = clusters(
+        &seg.skeleton,
+        &position,
+        &radius,
+        &ClusterParams {
+            alpha: params.alpha,
+        },
+    );
+    clock.end(
+        "clusters",
+        json!({ "clusters": seeds_of.len(), "alpha": params.alpha }),
+    );
+
+    // 9. Gates (both rules; the chosen one is stored).
+    clock.start("gates", 0);
+    let both: Vec<Vec<GateDisk>> = [GatePlacement::Narrowest, GatePlacement::Midpoint]
+        .iter()
+        .map(|&p| {
+            gates(
+                &seg.skeleton,
+                &adjacency,
+                &node_cluster,
+                &position,
+                &radius,
+                p,
+            )
+        })
+        .collect();
+    let chosen = match params.gate_placement {
+        GatePlacement::Narrowest => &both[0],
+        GatePlacement::Midpoint => &both[1],
+    };
+    let gate_placements: Vec<Value> = both[0]
+        .iter()
+        .zip(&both[1])
+        .map(|(n, m)| {
+            json!({
+                "clusters": n.clusters,
+                "narrowest": { "centre_m": n.centre.to_array(), "radius_m": n.radius },
+                "midpoint": { "centre_m": m.centre.to_array(), "radius_m": m.radius },
+                "apart_m": (n.centre - m.centre).length(),
+            })
+        })
+        .collect();
+    clock.end("gates", json!({ "gates": chosen.len() }));
+
+    // 10. Flatten.
+    clock.start("flatten", 0);
+    let n_voxels = es.empty.len();
+    let skel_cluster = skeleton_clusters(&seg.skeleton, &seg.node_segment, &node_cluster, chosen);
+    // A voxel whose node lies across a gate of the node's cluster takes the gate's other
+    // cluster, so that cluster borders follow the gates' planes (a doorway node's voxels would
+    // otherwise reach sideways into the rooms).
+    let mut cluster_gates: Vec<Vec<usize>> = vec![Vec::new(); seeds_of.len()];
+    for (i, g) in chosen.iter().enumerate() {
+        for c in g.clusters {
+            cluster_gates[c as usize].push(i);
+        }
+    }
+    let voxel_cluster: Vec<u32> = voxel_node
+        .par_iter()
+        .enumerate()
+        .map(|(v, &n)| {
+            if n == u32::MAX {
+                return u32::MAX;
+            }
+            let c = skel_cluster[n as usize];
+            let p = Vec3::from(meta.voxel_to_world(coords(v as u32, meta.dims)));
+            for &gi in &cluster_gates[c as usize] {
+                let g = &chosen[gi];
+                // The normal points from clusters[0]'s side to clusters[1]'s.
+                let own_side = if g.clusters[0] == c { -1.0 } else { 1.0 };
+                let side_v = (p - g.centre).dot(g.normal) * own_side;
+                let side_n = (position[n as usize] - g.centre).dot(g.normal) * own_side;
+                // Only nodes near the gate have voxels the gate's plane cuts through.
+                if side_n > -0.5 * vs && side_n <= g.radius + vs && side_v < -0.5 * vs {
+                    return if g.clusters[0] == c {
+                        g.clusters[1]
+                    } else {
+                        g.clusters[0]
+                    };
+                }
+            }
+            c
+        })
+        .collect();
+    let mut lo = vec![[f32::INFINITY; 3]; seeds_of.len()];
+    let mut hi = vec![[f32::NEG_INFINITY; 3]; seeds_of.len()];
+    for (i, &c) in voxel_cluster.iter().enumerate() {
+        if c == u32::MAX || !es.empty[i] {
+            continue;
+        }
+        let p = meta.voxel_to_world(coords(i as u32, meta.dims));
+        for a in 0..3 {
+            lo[c as usize][a] = lo[c as usize][a].min(p[a] - 0.5 * vs);
+            hi[c as usize][a] = hi[c as usize][a].max(p[a] + 0.5 * vs);
+        }
+    }
+    let clusters_out: Vec<Cluster> = seeds_of
+        .iter()
+        .enumerate()
+        .map(|(c, &seed)| {
+            // A cluster owns at least its seed's voxel, so its bounds are finite.
+            let p = position[seg.skeleton.nodes[seed as usize].skeleton_node as usize];
+            let fix = |v: [f32; 3], d: f32| -> [f32; 3] {
+                std::array::from_fn(|a| if v[a].is_finite() { v[a] } else { p[a] + d })
+            };
+            Cluster {
+                seed,
+                bounds_min_m: fix(lo[c], -0.5 * vs),
+                bounds_max_m: fix(hi[c], 0.5 * vs),
+            }
+        })
+        .collect();
+    let skeleton = Skeleton {
+        nodes: sg
+            .voxels
+            .iter()
+            .enumerate()
+            .map(|(i, &v)| SkeletonNode {
+                voxel: coords(v, meta.dims),
+                position_m: position[i].to_array(),
+                radius_m: radius[i],
+            })
+            .collect(),
+        edges: sg.edges(),
+    };
+    let gates_out: Vec<Gate> = chosen
+        .iter()
+        .map(|g| Gate {
+            centre_m: g.centre.to_array(),
+            normal: g.normal.to_array(),
+            radius_m: g.radius,
+            clusters: g.clusters,
+            seg_edge: g.seg_edge,
+        })
+        .collect();
+    let level = BakedLevel {
+        info: BakeInfo {
+            params: params.clone(),
+            geometry_hash: hash,
+            grid: meta,
+            tool_version: env!("CARGO_PKG_VERSION").to_string(),
+        },
+        topology: Topology {
+            skeleton,
+            segmented: seg.skeleton.clone(),
+            node_cluster,
+            clusters: clusters_out,
+            gates: gates_out,
+        },
+        voxel_node: VoxelValues::pack(&voxel_node),
+        voxel_cluster: VoxelValues::pack(&voxel_cluster),
+    };
+    clock.end(
+        "flatten",
+        json!({
+            "voxel_node_bytes": level.voxel_node.elem().size() * n_voxels as u64,
+            "voxel_cluster_bytes": level.voxel_cluster.elem().size() * n_voxels as u64,
+        }),
+    );
+
+    // Topology check, counted independently of the graph.
+    clock.start("topology check", 0);
+    let empty_topology = betti(meta.dims, &es.empty);
+    let mut skel = vec![false; n_voxels];
+    thinned
+        .skeleton
+        .iter()
+        .for_each(|&i| skel[i as usize] = true);
+    let skeleton_topology = betti(meta.dims, &skel);
+    clock.end(
+        "topology check",
+        json!({ "empty": empty_topology, "skeleton": skeleton_topology }),
+    );
+
+    let summary = Summary {
+        voxels: n_voxels as u64,
+        solid_voxels,
+        empty_voxels: es.empty_voxels,
+        skeleton_nodes: sg.voxels.len() as u64,
+        segmented_nodes: seg_counts,
+        clusters: level.topology.clusters.len() as u64,
+        gates: level.topology.gates.len() as u64,
+        cycles,
+        components,
+    };
+    let report = BakeReport {
+        scene: scene.name.clone(),
+        params,
+        grid: meta,
+        threads: rayon::current_num_threads(),
+        stages: clock.stages,
+        total_seconds: total.elapsed().as_secs_f64(),
+        peak_memory_bytes: peak_memory_bytes(),
+        summary,
+        empty_topology,
+        skeleton_topology,
+        empty_space: json!({
+            "components": es.components,
+            "leaks": es.leaks,
+            "hung_objects": es.threads,
+            "seeds_outside_grid": es.seeds_outside,
+        }),
+        gate_placements,
+    };
+    Ok(Baked {
+        level,
+        report,
+        grids: BakeGrids {
+            solid,
+            empty: es.empty,
+            skeleton: thinned.skeleton,
+        },
+    })
+}
+
+/// Voxel coordinates of grid index `i`.
+pub fn coords(i: u32, dims: [u32; 3]) -> [u32; 3] {
+    let (nx, ny) = (dims[0], dims[1]);
+    [i % nx, (i / nx) % ny, i / (nx * ny)]
+}
+
+impl BakeReport {
+    /// The timing tree and summary, as printed at the end of a bake.
+    pub fn text(&self) -> String {
+        let mut s = String::new();
+        let g = &self.grid;
+        s += &format!(
+            "bake of {} — {:.2} s on {} threads, peak memory {}\n",
+            self.scene,
+            self.total_seconds,
+            self.threads,
+            self.peak_memory_bytes
+                .map(|b| format!("{:.0} MiB", b as f64 / (1 << 20) as f64))
+                .unwrap_or_else(|| "unknown".into())
+        );
+        for (i, st) in self.stages.iter().enumerate() {
+            let branch = if i + 1 == self.stages.len() {
+                "└─"
+            } else {
+                "├─"
+            };
+            s += &format!(
+                "{branch} {:<18} {:>8.3} s {:>5.1} %\n",
+                st.name,
+                st.seconds,
+                100.0 * st.seconds / self.total_seconds.max(1e-9)
+            );
+        }
+        let m = &self.summary;
+        let res = match self.params.resolution {
+            Resolution::LongestAxisVoxels(n) => format!("{n} on the longest axis"),
+            Resolution::VoxelSizeM(v) => format!("{v} m voxels"),
+        };
+        s += &format!(
+            "grid {} x {} x {} ({res}), voxel {:.4} m\n",
+            g.dims[0], g.dims[1], g.dims[2], g.voxel_size_m
+        );
+        s += &format!(
+            "voxels {}  solid {}  empty (kept) {}\n",
+            m.voxels, m.solid_voxels, m.empty_voxels
+        );
+        s += &format!(
+            "skeleton nodes {}  segmented nodes {} (topology {}, curvature {}, coverage {}, narrowing {})\n",
+            m.skeleton_nodes,
+            m.segmented_nodes[0],
+            m.segmented_nodes[1],
+            m.segmented_nodes[2],
+            m.segmented_nodes[3],
+            m.segmented_nodes[4]
+        );
+        s += &format!(
+            "clusters {}  gates {}  cycles {}  components {}  (alpha {}, persistence {}, gates at {:?})\n",
+            m.clusters,
+            m.gates,
+            m.cycles,
+            m.components,
+            self.params.alpha,
+            self.params.persistence,
+            self.params.gate_placement
+        );
+        let (e, k) = (&self.empty_topology, &self.skeleton_topology);
+        s += &format!(
+            "topology: empty space {} components / {} cycles / {} cavities, skeleton {} / {} / {}{}\n",
+            e.components,
+            e.cycles,
+            e.cavities,
+            k.components,
+            k.cycles,
+            k.cavities,
+            if (e.components, e.cycles) == (k.components, k.cycles) {
+                " (preserved)"
+            } else {
+                " (CHANGED)"
+            }
+        );
+        s
+    }
+}

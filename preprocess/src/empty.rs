@@ -1,0 +1,399 @@
+//! Stage 3, empty space: which empty voxels the skeleton must describe.
+//!
+//! The empty voxels (not solid, 26-connected) fall into components. A component that holds a
+//! camera or a light of the scene is always kept. Any other component is dropped (made solid)
+//! when it is smaller than `min_component_voxels`, or when it lies inside closed geometry —
+//! the triangles around it turn their backs to it (the inside of a thick wall or a pillar at
+//! a fine resolution). Every component and the reason it was kept or dropped is listed.
+//!
+//! A scene declared `closed` whose kept empty space reaches the grid's border (the static
+//! bounds) leaks: the bake stops and names the sides and boxes where it leaks, unless leaks
+//! are allowed.
+//!
+//! **Cavities.** A solid object floating in empty space (a lamp whose chain is thinner than a
+//! voxel, a ball) is a cavity of the empty space: a 2D hole that no curve can keep, so
+//! thinning would leave a closed surface around it. Such an object is *hung*: the shortest
+//! axis-aligned run of empty voxels from it to other solid is made solid (one voxel wide), which
+//! removes the cavity and changes neither the components nor the cycles of the empty space. The
+//! skeleton then bends around the object. Each thread is listed (object size, length).
+
+use glam::Vec3;
+use serde::Serialize;
+use visgate_formats::vgate::GridMeta;
+
+use crate::BakeError;
+use crate::neighbourhood::{Conn, label_components};
+
+/// Parameters of [`empty_space`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EmptySpaceParams {
+    /// Components smaller than this that hold no camera or light are dropped. [Units: voxels]
+    pub min_component_voxels: u64,
+    /// The scene says it is sealed: empty space reaching the bounds is a leak.
+    pub closed: bool,
+    /// Bake a leaking closed scene anyway (the leaks are still reported).
+    pub allow_leaks: bool,
+}
+
+/// A named point that must be in kept empty space (a camera's eye, a light).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Seed {
+    /// What it is, e.g. `camera 'main'`.
+    pub what: String,
+    /// Where, metres.
+    pub position_m: [f32; 3],
+}
+
+/// One empty component and what became of it.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ComponentReport {
+    /// Empty voxels in it.
+    pub voxels: u64,
+    /// Bounds of its voxels, metres.
+    pub bounds_min_m: [f32; 3],
+    /// Maximum corner, metres.
+    pub bounds_max_m: [f32; 3],
+    /// Cameras and lights inside.
+    pub seeds: Vec<String>,
+    /// Triangles that face it / turn their back to it.
+    pub faced_by: [u64; 2],
+    /// Kept for the skeleton.
+    pub kept: bool,
+    /// Why.
+    pub reason: String,
+}
+
+/// Where kept empty space of a closed scene reaches the bounds.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Leak {
+    /// The side of the bounds: `-x`, `+x`, `-y`, `+y`, `-z`, `+z`.
+    pub side: &'static str,
+    /// Empty voxels touching that side.
+    pub voxels: u64,
+    /// Box of those voxels, metres.
+    pub bounds_min_m: [f32; 3],
+    /// Maximum corner, metres.
+    pub bounds_max_m: [f32; 3],
+}
+
+/// A floating solid object hung to other solid (see the module notes).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Thread {
+    /// Solid voxels of the object.
+    pub object_voxels: u64,
+    /// Where the thread starts (on the object), metres.
+    pub from_m: [f32; 3],
+    /// Empty voxels made solid.
+    pub length_voxels: u64,
+}
+
+/// The result of [`empty_space`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct EmptySpace {
+    /// `true` for the empty voxels the skeleton describes.
+    pub empty: Vec<bool>,
+    /// Kept empty voxels.
+    pub empty_voxels: u64,
+    /// Every component, largest first.
+    pub components: Vec<ComponentReport>,
+    /// Leaks of a closed scene (empty when not closed or sealed).
+    pub leaks: Vec<Leak>,
+    /// Floating objects that were hung.
+    pub threads: Vec<Thread>,
+    /// Seeds that fell outside the grid or in solid with no empty voxel next to them.
+    pub seeds_outside: Vec<String>,
+}
+
+fn voxel_of(meta: &GridMeta, p: Vec3) -> Option<[u32; 3]> {
+    let v = (p - Vec3::from(meta.origin_m)) / meta.voxel_size_m;
+    let ok = (0..3).all(|a| v[a].is_finite() && v[a] >= 0.0 && v[a] < meta.dims[a] as f32);
+    ok.then_some([v.x as u32, v.y as u32, v.z as u32])
+}
+
+/// Finds the kept empty space of a solid grid (see the module notes).
+pub fn empty_space(
+    meta: &GridMeta,
+    solid: &[bool],
+    triangles: &[[Vec3; 3]],
+    seeds: &[Seed],
+    params: &EmptySpaceParams,
+) -> Result<EmptySpace, BakeError> {
+    let dims = meta.dims;
+    let [nx, ny, nz] = dims.map(|d| d as usize);
+    let mut empty: Vec<bool> = solid.iter().map(|&s| !s).collect();
+    let (label, count) = label_components(dims, &empty, Conn::C26);
+    if count == 0 {
+        return Err(BakeError::NoEmptySpace(format!(
+            "every voxel of the {nx} x {ny} x {nz} grid is solid; raise --resolution so the geometry's gaps are wider than a voxel"
+        )));
+    }
+    let n = count as usize;
+    let mut voxels = vec![0u64; n];
+    let mut lo = vec![[u32::MAX; 3]; n];
+    let mut hi = vec![[0u32; 3]; n];
+    let mut at_bounds = vec![false; n];
+    for z in 0..nz {
+        for y in 0..ny {
+            for x in 0..nx {
+                let l = label[x + nx * (y + ny * z)];
+                if l == u32::MAX {
+                    continue;
+                }
+                let c = l as usize;
+                voxels[c] += 1;
+                let v = [x as u32, y as u32, z as u32];
+                for a in 0..3 {
+                    lo[c][a] = lo[c][a].min(v[a]);
+                    hi[c][a] = hi[c][a].max(v[a]);
+                    at_bounds[c] |= v[a] == 1 || v[a] + 2 == dims[a];
+                }
+            }
+        }
+    }
+    // Seeds: the voxel of the point, or an empty voxel next to it.
+    let mut seeds_in: Vec<Vec<String>> = vec![Vec::new(); n];
+    let mut seeds_outside = Vec::new();
+    for s in seeds {
+        let found = voxel_of(meta, Vec3::from(s.position_m)).and_then(|v| {
+            // The voxel itself first, then its 26 neighbours in a fixed order.
+            std::iter::once(13u32)
+                .chain((0..27).filter(|&k| k != 13))
+                .find_map(|k| {
+                    let o = [k % 3, (k / 3) % 3, k / 9].map(|c| c as i64 - 1);
+                    let w: [i64; 3] = std::array::from_fn(|a| v[a] as i64 + o[a]);
+                    if (0..3).any(|a| w[a] < 0 || w[a] >= dims[a] as i64) {
+                        return None;
+                    }
+                    let i = w[0] as usize + nx * (w[1] as usize + ny * w[2] as usize);
+                    (label[i] != u32::MAX).then_some(label[i])
+                })
+        });
+        match found {
+            Some(l) => seeds_in[l as usize].push(s.what.clone()),
+            None => seeds_outside.push(s.what.clone()),
+        }
+    }
+    // Facing: which side of each triangle each component lies on.
+    let mut faced = vec![[0u64; 2]; n];
+    let step = 0.75 * meta.voxel_size_m;
+    for t in triangles {
+        let nrm = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
+        if nrm == Vec3::ZERO {
+            continue;
+        }
+        let c = (t[0] + t[1] + t[2]) / 3.0;
+        for (side, p) in [(0, c + nrm * step), (1, c - nrm * step)] {
+            if let Some(v) = voxel_of(meta, p) {
+                let l = label[meta.index(v)];
+                if l != u32::MAX {
+                    faced[l as usize][side] += 1;
+                }
+            }
+        }
+    }
+    let to_m = |v: [u32; 3], corner: f32| -> [f32; 3] {
+        std::array::from_fn(|a| meta.origin_m[a] + (v[a] as f32 + corner) * meta.voxel_size_m)
+    };
+    let mut components: Vec<ComponentReport> = (0..n)
+        .map(|c| {
+            let (kept, reason) = if !seeds_in[c].is_empty() {
+                (true, format!("holds {}", seeds_in[c].join(", ")))
+            } else if params.closed && at_bounds[c] {
+                (
+                    false,
+                    "outside the closed level: reaches the bounds and holds no camera or light"
+                        .to_string(),
+                )
+            } else if voxels[c] < params.min_component_voxels {
+                (
+                    false,
+                    format!(
+                        "no camera or light and smaller than {} voxels",
+                        params.min_component_voxels
+                    ),
+                )
+            } else if faced[c][1] > faced[c][0] {
+                (
+                    false,
+                    format!(
+                        "inside closed geometry: {} triangles turn their back to it, {} face it",
+                        faced[c][1], faced[c][0]
+                    ),
+                )
+            } else {
+                (true, "large and faced by the geometry".to_string())
+            };
+            ComponentReport {
+                voxels: voxels[c],
+                bounds_min_m: to_m(lo[c], 0.0),
+                bounds_max_m: to_m(hi[c], 1.0),
+                seeds: seeds_in[c].clone(),
+                faced_by: faced[c],
+                kept,
+                reason,
+            }
+        })
+        .collect();
+    let kept: Vec<bool> = components.iter().map(|c| c.kept).collect();
+    for (e, &l) in empty.iter_mut().zip(&label) {
+        if l != u32::MAX && !kept[l as usize] {
+            *e = false;
+        }
+    }
+    // Leaks: kept empty voxels next to the border ring.
+    let mut leaks = Vec::new();
+    if params.closed {
+        const SIDES: [&str; 6] = ["-x", "+x", "-y", "+y", "-z", "+z"];
+        let mut acc: Vec<(u64, [u32; 3], [u32; 3])> = vec![(0, [u32::MAX; 3], [0; 3]); 6];
+        for z in 1..nz - 1 {
+            for y in 1..ny - 1 {
+                for x in 1..nx - 1 {
+                    if !empty[x + nx * (y + ny * z)] {
+                        continue;
+                    }
+                    let v = [x, y, z];
+                    for a in 0..3 {
+                        for (s, edge) in [(2 * a, 1), (2 * a + 1, dims[a] as usize - 2)] {
+                            if v[a] == edge {
+                                let e = &mut acc[s];
+                                e.0 += 1;
+                                for (b, &c) in v.iter().enumerate() {
+                                    e.1[b] = e.1[b].min(c as u32);
+                                    e.2[b] = e.2[b].max(c as u32);
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        for (s, (count, l, h)) in acc.into_iter().enumerate() {
+            if count > 0 {
+                leaks.push(Leak {
+                    side: SIDES[s],
+                    voxels: count,
+                    bounds_min_m: to_m(l, 0.0),
+                    bounds_max_m: to_m(h, 1.0),
+                });
+            }
+        }
+        if !leaks.is_empty() && !params.allow_leaks {
+            let list: Vec<String> = leaks
+                .iter()
+                .map(|l| {
+                    format!(
+                        "{} side: {} voxels in [{:.2}, {:.2}, {:.2}]..[{:.2}, {:.2}, {:.2}] m",
+                        l.side,
+                        l.voxels,
+                        l.bounds_min_m[0],
+                        l.bounds_min_m[1],
+                        l.bounds_min_m[2],
+                        l.bounds_max_m[0],
+                        l.bounds_max_m[1],
+                        l.bounds_max_m[2]
+                    )
+                })
+                .collect();
+            return Err(BakeError::Leak(list.join("; ")));
+        }
+    }
+    components.sort_by_key(|c| std::cmp::Reverse(c.voxels));
+    let threads = hang_floating_objects(meta, &mut empty);
+    let empty_voxels = empty.iter().filter(|&&e| e).count() as u64;
+    if empty_voxels == 0 {
+        return Err(BakeError::NoEmptySpace(
+            "no empty component was kept: add a camera or a light inside the level, or lower the minimum component size".into(),
+        ));
+    }
+    Ok(EmptySpace {
+        empty,
+        empty_voxels,
+        components,
+        leaks,
+        threads,
+        seeds_outside,
+    })
+}
+
+/// Hangs every solid 6-component that does not reach the grid border (see module notes).
+fn hang_floating_objects(meta: &GridMeta, empty: &mut [bool]) -> Vec<Thread> {
+    let dims = meta.dims;
+    let [nx, ny, _] = dims.map(|d| d as usize);
+    let strides = [1isize, nx as isize, (nx * ny) as isize];
+    let mut threads = Vec::new();
+    loop {
+        let solid: Vec<bool> = empty.iter().map(|&e| !e).collect();
+        let (label, count) = label_components(dims, &solid, Conn::C6);
+        if count <= 1 {
+            return threads;
+        }
+        // Voxel 0 is on the border ring, which is solid: its label is the grounded one.
+        let ground = label[0];
+        let mut sizes = vec![0u64; count as usize];
+        for &l in &label {
+            if l != u32::MAX {
+                sizes[l as usize] += 1;
+            }
+        }
+        // Shortest march per floating component: (length, start, dir).
+        let mut best: Vec<Option<(usize, usize, usize)>> = vec![None; count as usize];
+        for (i, &l) in label.iter().enumerate() {
+            if l == u32::MAX || l == ground {
+                continue;
+            }
+            for dir in 0..6 {
+                let step = if dir % 2 == 0 {
+                    -strides[dir / 2]
+                } else {
+                    strides[dir / 2]
+                };
+                let mut j = i as isize + step;
+                let mut len = 0usize;
+                // Never out of the grid: the ring is solid and stops every march.
+                while empty[j as usize] {
+                    len += 1;
+                    j += step;
+                }
+                if len == 0 || label[j as usize] == l {
+                    continue;
+                }
+                let cand = (len, i, dir);
+                let b = &mut best[l as usize];
+                if b.is_none_or(|b| cand < b) {
+                    *b = Some(cand);
+                }
+            }
+        }
+        let mut hung = 0;
+        for (l, b) in best.iter().enumerate() {
+            let Some((len, start, dir)) = *b else {
+                continue;
+            };
+            let step = if dir % 2 == 0 {
+                -strides[dir / 2]
+            } else {
+                strides[dir / 2]
+            };
+            let mut j = start as isize;
+            for _ in 0..len {
+                j += step;
+                empty[j as usize] = false;
+            }
+            let v = [
+                (start % nx) as u32,
+                ((start / nx) % ny) as u32,
+                (start / (nx * ny)) as u32,
+            ];
+            threads.push(Thread {
+                object_voxels: sizes[l],
+                from_m: meta.voxel_to_world(v),
+                length_voxels: len as u64,
+            });
+            hung += 1;
+        }
+        // Relabel: a thread may have reached another floating object, which then still floats.
+        if hung == 0 {
+            return threads;
+        }
+    }
+}
