@@ -60,6 +60,20 @@ impl GridMeta {
         v[0] as usize + nx * (v[1] as usize + ny * v[2] as usize)
     }
 
+    /// The voxel holding world point `p` (metres), if it lies in the grid.
+    pub fn world_to_voxel(&self, p: [f32; 3]) -> Option<[u32; 3]> {
+        let v: [f32; 3] = std::array::from_fn(|a| (p[a] - self.origin_m[a]) / self.voxel_size_m);
+        (0..3)
+            .all(|a| v[a].is_finite() && v[a] >= 0.0 && v[a] < self.dims[a] as f32)
+            .then(|| v.map(|c| c as u32))
+    }
+
+    /// Voxel coordinates of grid index `i` (the inverse of [`GridMeta::index`]).
+    pub fn coords(&self, i: u32) -> [u32; 3] {
+        let (nx, ny) = (self.dims[0], self.dims[1]);
+        [i % nx, (i / nx) % ny, i / (nx * ny)]
+    }
+
     /// Centre of voxel `v` in world space, metres.
     pub fn voxel_to_world(&self, v: [u32; 3]) -> [f32; 3] {
         std::array::from_fn(|a| self.origin_m[a] + (v[a] as f32 + 0.5) * self.voxel_size_m)

@@ -153,6 +153,7 @@ pub struct Baked {
 
 struct Clock<'a> {
     stages: Vec<StageReport>,
+    stage: &'static str,
     t: Instant,
     progress: &'a (dyn Fn(Progress) + Sync),
 }
@@ -160,12 +161,13 @@ struct Clock<'a> {
 impl Clock<'_> {
     fn start(&mut self, stage: &'static str, total: u64) {
         (self.progress)(Progress::Start { stage, total });
+        self.stage = stage;
         self.t = Instant::now();
     }
-    fn end(&mut self, name: &'static str, counts: Value) {
+    fn end(&mut self, counts: Value) {
         (self.progress)(Progress::Finish);
         self.stages.push(StageReport {
-            name,
+            name: self.stage,
             seconds: self.t.elapsed().as_secs_f64(),
             counts,
         });
@@ -230,6 +232,7 @@ pub fn bake(
     let total = Instant::now();
     let mut clock = Clock {
         stages: Vec::new(),
+        stage: "",
         t: Instant::now(),
         progress,
     };
@@ -241,19 +244,14 @@ pub fn bake(
         return Err(BakeError::NoGeometry);
     }
     let hash = scene.static_geometry_hash();
-    clock.end(
-        "load static meshes",
-        json!({ "triangles": triangles.len() }),
-    );
+    clock.end(json!({ "triangles": triangles.len() }));
 
     // 2. Voxelize.
     let meta = grid_for(bounds, params.resolution, options.memory_limit_bytes)?;
     clock.start("voxelize", 0);
     let solid = voxelize(meta, &triangles);
     let solid_voxels = solid.solid_count();
-    clock.end(
-        "voxelize",
-        json!({ "dims": meta.dims, "voxel_size_m": meta.voxel_size_m, "solid_voxels": solid_voxels }),
+    clock.end(json!({ "dims": meta.dims, "voxel_size_m": meta.voxel_size_m, "solid_voxels": solid_voxels }),
     );
     let mut params = params.clone();
     params.persistence = options
@@ -274,16 +272,13 @@ pub fn bake(
             allow_leaks: params.allow_leaks,
         },
     )?;
-    clock.end(
-        "empty space",
-        json!({
-            "empty_voxels": es.empty_voxels,
-            "components": es.components.len(),
-            "kept": es.components.iter().filter(|c| c.kept).count(),
-            "leaks": es.leaks.len(),
-            "hung_objects": es.threads.len(),
-        }),
-    );
+    clock.end(json!({
+        "empty_voxels": es.empty_voxels,
+        "components": es.components.len(),
+        "kept": es.components.iter().filter(|c| c.kept).count(),
+        "leaks": es.leaks.len(),
+        "hung_objects": es.threads.len(),
+    }));
 
     // 4. Distance.
     clock.start("distance", 0);
@@ -298,10 +293,7 @@ pub fn bake(
         .map(|(_, d)| *d)
         .max()
         .unwrap_or(0);
-    clock.end(
-        "distance",
-        json!({ "largest_radius_vx": (max_r as f64).sqrt() }),
-    );
+    clock.end(json!({ "largest_radius_vx": (max_r as f64).sqrt() }));
 
     // 5. Thin.
     clock.start("thin", es.empty_voxels);
@@ -315,17 +307,14 @@ pub fn bake(
         &|done, _| progress(Progress::Advance(done)),
     );
     let extended = extend_ends(meta.dims, &es.empty, &dist2, &mut thinned.skeleton);
-    clock.end(
-        "thin",
-        json!({
-            "ends_extended_by": extended,
-            "skeleton_voxels": thinned.skeleton.len(),
-            "steps": thinned.steps,
-            "constrained": thinned.constrained,
-            "voxels_examined": thinned.border_visits,
-            "persistence": params.persistence,
-        }),
-    );
+    clock.end(json!({
+        "ends_extended_by": extended,
+        "skeleton_voxels": thinned.skeleton.len(),
+        "steps": thinned.steps,
+        "constrained": thinned.constrained,
+        "voxels_examined": thinned.border_visits,
+        "persistence": params.persistence,
+    }));
 
     // 6. Skeleton graph and nearest-node grid.
     clock.start("skeleton graph", 0);
@@ -335,7 +324,7 @@ pub fn bake(
     let position: Vec<Vec3> = sg
         .voxels
         .iter()
-        .map(|&v| Vec3::from(meta.voxel_to_world(coords(v, meta.dims))))
+        .map(|&v| Vec3::from(meta.voxel_to_world(meta.coords(v))))
         .collect();
     let radius: Vec<f32> = sg
         .voxels
@@ -344,16 +333,13 @@ pub fn bake(
         .collect();
     let cycles = sg.cycles();
     let components = petgraph::algo::connected_components(&sg.graph) as u64;
-    clock.end(
-        "skeleton graph",
-        json!({
-            "nodes": sg.voxels.len(),
-            "edges": sg.graph.edge_count(),
-            "shortcuts_dropped": sg.shortcuts_dropped,
-            "cycles": cycles,
-            "components": components,
-        }),
-    );
+    clock.end(json!({
+        "nodes": sg.voxels.len(),
+        "edges": sg.graph.edge_count(),
+        "shortcuts_dropped": sg.shortcuts_dropped,
+        "cycles": cycles,
+        "components": components,
+    }));
     drop(dist2);
 
     // 7. Segment.
@@ -369,13 +355,10 @@ pub fn bake(
         count_kind(SegNodeKind::Coverage),
         count_kind(SegNodeKind::Narrowing),
     ];
-    clock.end(
-        "segment",
-        json!({
-            "nodes": seg_counts[0], "topology": seg_counts[1], "curvature": seg_counts[2],
-            "coverage": seg_counts[3], "narrowing": seg_counts[4], "edges": seg.skeleton.edges.len(),
-        }),
-    );
+    clock.end(json!({
+        "nodes": seg_counts[0], "topology": seg_counts[1], "curvature": seg_counts[2],
+        "coverage": seg_counts[3], "narrowing": seg_counts[4], "edges": seg.skeleton.edges.len(),
+    }));
 
     // 8. Clusters.
     clock.start("clusters", 0);
@@ -387,10 +370,7 @@ pub fn bake(
             alpha: params.alpha,
         },
     );
-    clock.end(
-        "clusters",
-        json!({ "clusters": seeds_of.len(), "alpha": params.alpha }),
-    );
+    clock.end(json!({ "clusters": seeds_of.len(), "alpha": params.alpha }));
 
     // 9. Gates (both rules; the chosen one is stored).
     clock.start("gates", 0);
@@ -423,7 +403,7 @@ pub fn bake(
             })
         })
         .collect();
-    clock.end("gates", json!({ "gates": chosen.len() }));
+    clock.end(json!({ "gates": chosen.len() }));
 
     // 10. Flatten.
     clock.start("flatten", 0);
@@ -446,7 +426,7 @@ pub fn bake(
                 return u32::MAX;
             }
             let c = skel_cluster[n as usize];
-            let p = Vec3::from(meta.voxel_to_world(coords(v as u32, meta.dims)));
+            let p = Vec3::from(meta.voxel_to_world(meta.coords(v as u32)));
             for &gi in &cluster_gates[c as usize] {
                 let g = &chosen[gi];
                 // The normal points from clusters[0]'s side to clusters[1]'s.
@@ -471,7 +451,7 @@ pub fn bake(
         if c == u32::MAX || !es.empty[i] {
             continue;
         }
-        let p = meta.voxel_to_world(coords(i as u32, meta.dims));
+        let p = meta.voxel_to_world(meta.coords(i as u32));
         for a in 0..3 {
             lo[c as usize][a] = lo[c as usize][a].min(p[a] - 0.5 * vs);
             hi[c as usize][a] = hi[c as usize][a].max(p[a] + 0.5 * vs);
@@ -499,7 +479,7 @@ pub fn bake(
             .iter()
             .enumerate()
             .map(|(i, &v)| SkeletonNode {
-                voxel: coords(v, meta.dims),
+                voxel: meta.coords(v),
                 position_m: position[i].to_array(),
                 radius_m: radius[i],
             })
@@ -533,13 +513,10 @@ pub fn bake(
         voxel_node: VoxelValues::pack(&voxel_node),
         voxel_cluster: VoxelValues::pack(&voxel_cluster),
     };
-    clock.end(
-        "flatten",
-        json!({
-            "voxel_node_bytes": level.voxel_node.elem().size() * n_voxels as u64,
-            "voxel_cluster_bytes": level.voxel_cluster.elem().size() * n_voxels as u64,
-        }),
-    );
+    clock.end(json!({
+        "voxel_node_bytes": level.voxel_node.elem().size() * n_voxels as u64,
+        "voxel_cluster_bytes": level.voxel_cluster.elem().size() * n_voxels as u64,
+    }));
 
     // Topology check, counted independently of the graph.
     clock.start("topology check", 0);
@@ -550,10 +527,7 @@ pub fn bake(
         .iter()
         .for_each(|&i| skel[i as usize] = true);
     let skeleton_topology = betti(meta.dims, &skel);
-    clock.end(
-        "topology check",
-        json!({ "empty": empty_topology, "skeleton": skeleton_topology }),
-    );
+    clock.end(json!({ "empty": empty_topology, "skeleton": skeleton_topology }));
 
     let summary = Summary {
         voxels: n_voxels as u64,
@@ -594,12 +568,6 @@ pub fn bake(
             skeleton: thinned.skeleton,
         },
     })
-}
-
-/// Voxel coordinates of grid index `i`.
-pub fn coords(i: u32, dims: [u32; 3]) -> [u32; 3] {
-    let (nx, ny) = (dims[0], dims[1]);
-    [i % nx, (i / nx) % ny, i / (nx * ny)]
 }
 
 impl BakeReport {

@@ -16,7 +16,7 @@ use std::path::Path;
 use glam::Vec3;
 use visgate_formats::vgate::{BakedLevel, SegNodeKind};
 
-use crate::bake::{BakeGrids, coords};
+use crate::bake::BakeGrids;
 
 /// Writes every debug file into `dir` (created if missing); returns the paths written.
 pub fn write_all(dir: &Path, level: &BakedLevel, grids: &BakeGrids) -> io::Result<Vec<String>> {
@@ -86,7 +86,7 @@ pub fn write_all(dir: &Path, level: &BakedLevel, grids: &BakeGrids) -> io::Resul
     out("clusters.ply", &|w| {
         let mut pts = Vec::new();
         for (i, &e) in grids.empty.iter().enumerate() {
-            let v = coords(i as u32, dims);
+            let v = meta.coords(i as u32);
             if !e || v.iter().any(|c| c % 2 == 1) {
                 continue;
             }

@@ -104,12 +104,6 @@ pub struct EmptySpace {
     pub seeds_outside: Vec<String>,
 }
 
-fn voxel_of(meta: &GridMeta, p: Vec3) -> Option<[u32; 3]> {
-    let v = (p - Vec3::from(meta.origin_m)) / meta.voxel_size_m;
-    let ok = (0..3).all(|a| v[a].is_finite() && v[a] >= 0.0 && v[a] < meta.dims[a] as f32);
-    ok.then_some([v.x as u32, v.y as u32, v.z as u32])
-}
-
 /// Finds the kept empty space of a solid grid (see the module notes).
 pub fn empty_space(
     meta: &GridMeta,
@@ -154,7 +148,7 @@ pub fn empty_space(
     let mut seeds_in: Vec<Vec<String>> = vec![Vec::new(); n];
     let mut seeds_outside = Vec::new();
     for s in seeds {
-        let found = voxel_of(meta, Vec3::from(s.position_m)).and_then(|v| {
+        let found = meta.world_to_voxel(s.position_m).and_then(|v| {
             // The voxel itself first, then its 26 neighbours in a fixed order.
             std::iter::once(13u32)
                 .chain((0..27).filter(|&k| k != 13))
@@ -183,7 +177,7 @@ pub fn empty_space(
         }
         let c = (t[0] + t[1] + t[2]) / 3.0;
         for (side, p) in [(0, c + nrm * step), (1, c - nrm * step)] {
-            if let Some(v) = voxel_of(meta, p) {
+            if let Some(v) = meta.world_to_voxel(p.to_array()) {
                 let l = label[meta.index(v)];
                 if l != u32::MAX {
                     faced[l as usize][side] += 1;

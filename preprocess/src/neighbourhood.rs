@@ -143,60 +143,31 @@ pub fn is_simple_2d(ring: u8) -> bool {
     TABLE[ring as usize]
 }
 
+/// Adjacency within the 8-position ring of [`RING`]: consecutive positions (a corner and a
+/// side) are 4-adjacent; with `eight`, two sides two apart are adjacent too.
+const fn ring_adj(eight: bool) -> [u32; 27] {
+    let mut t = [0u32; 27];
+    let mut i = 0;
+    while i < 8 {
+        t[i] = 1 << ((i + 1) % 8) | 1 << ((i + 7) % 8);
+        if eight && i % 2 == 1 {
+            t[i] |= 1 << ((i + 2) % 8) | 1 << ((i + 6) % 8);
+        }
+        i += 1;
+    }
+    t
+}
+
+const RING_ADJ8: [u32; 27] = ring_adj(true);
+const RING_ADJ4: [u32; 27] = ring_adj(false);
+/// Ring positions 4-adjacent to the centre (the sides).
+const RING_SIDES: u32 = 0b1010_1010;
+
+/// (8, 4) simplicity: one 8-component of object in the ring, one 4-component of background
+/// touching the centre's sides.
 fn simple_2d_by_flood(ring: u8) -> bool {
-    // Object 8-components in the ring; background 4-components that touch the centre's
-    // 4-neighbours (the odd positions).
-    let obj = ring;
-    let bg = !ring;
-    let mut t8 = 0;
-    let mut t4b = 0;
-    // Consecutive ring positions are 4-adjacent (a corner and a side); two sides two apart
-    // are 8-adjacent too.
-    let adj4 = |i: u32| -> u8 { (1 << ((i + 1) % 8)) | (1 << ((i + 7) % 8)) };
-    let adj8 = |i: u32| -> u8 {
-        if i % 2 == 1 {
-            adj4(i) | (1 << ((i + 2) % 8)) | (1 << ((i + 6) % 8))
-        } else {
-            adj4(i)
-        }
-    };
-    let mut seen = 0u8;
-    for i in 0..8 {
-        if obj >> i & 1 == 1 && seen >> i & 1 == 0 {
-            t8 += 1;
-            let mut stack = vec![i];
-            seen |= 1 << i;
-            while let Some(j) = stack.pop() {
-                let next = adj8(j) & obj & !seen;
-                for k in 0..8 {
-                    if next >> k & 1 == 1 {
-                        seen |= 1 << k;
-                        stack.push(k);
-                    }
-                }
-            }
-        }
-    }
-    // Background 4-adjacency in the ring: a side (odd) is 4-adjacent to its two corners; two
-    // corners are never 4-adjacent, nor two sides (they touch only through the centre).
-    let mut seen = 0u8;
-    for i in (1..8).step_by(2) {
-        if bg >> i & 1 == 1 && seen >> i & 1 == 0 {
-            t4b += 1;
-            let mut stack = vec![i];
-            seen |= 1 << i;
-            while let Some(j) = stack.pop() {
-                let next = adj4(j) & bg & !seen;
-                for k in 0..8 {
-                    if next >> k & 1 == 1 {
-                        seen |= 1 << k;
-                        stack.push(k);
-                    }
-                }
-            }
-        }
-    }
-    t8 == 1 && t4b == 1
+    components(u32::from(ring), &RING_ADJ8, 0xff, 2) == 1
+        && components(u32::from(!ring), &RING_ADJ4, RING_SIDES, 2) == 1
 }
 
 /// The 8 ring offsets of [`is_simple_2d`], as (u, v) in the square's two axes.

@@ -438,19 +438,33 @@ mod tests {
         v
     }
 
+    fn thinned(dims: [u32; 3], obj: &[bool]) -> (Thinned, crate::neighbourhood::Betti) {
+        let solid: Vec<bool> = obj.iter().map(|&o| !o).collect();
+        let d = crate::distance::squared_distance(dims, &solid);
+        let t = thin(dims, obj, &d, &ThinParams { persistence: 0 }, &|_, _| {});
+        let mut s = vec![false; obj.len()];
+        t.skeleton.iter().for_each(|&i| s[i as usize] = true);
+        let b = crate::neighbourhood::betti(dims, &s);
+        (t, b)
+    }
+
     #[test]
     fn a_box_thins_to_a_point_and_a_bar_to_a_line() {
         let dims = [12, 12, 12];
-        let obj = grid(dims, |_, _, _| true);
-        let d =
-            crate::distance::squared_distance(dims, &obj.iter().map(|&o| !o).collect::<Vec<_>>());
-        let t = thin(dims, &obj, &d, &ThinParams { persistence: 0 }, &|_, _| {});
-        assert!(!t.skeleton.is_empty());
-        let b = crate::neighbourhood::betti(dims, &{
-            let mut s = vec![false; obj.len()];
-            t.skeleton.iter().for_each(|&i| s[i as usize] = true);
-            s
-        });
+        let (t, b) = thinned(dims, &grid(dims, |_, _, _| true));
         assert_eq!((b.components, b.cycles, b.cavities), (1, 0, 0));
+        assert!(
+            t.skeleton.len() <= 2,
+            "a cube keeps {} voxels",
+            t.skeleton.len()
+        );
+        // A 30 × 4 × 4 bar keeps a line along x, most of its length.
+        let dims = [32, 6, 6];
+        let (t, b) = thinned(dims, &grid(dims, |_, _, _| true));
+        assert_eq!((b.components, b.cycles), (1, 0));
+        let xs: Vec<u32> = t.skeleton.iter().map(|&i| i % 32).collect();
+        let span = xs.iter().max().unwrap_or(&0) - xs.iter().min().unwrap_or(&0);
+        assert!(span >= 20, "the line spans {span} voxels of 30");
+        assert_eq!(t.skeleton.len() as u32, span + 1, "one voxel thin");
     }
 }

@@ -1,11 +1,11 @@
 //! The whole bake on the built-in scenes (known answers), at the extremes of scale and
 //! resolution, on bad input, and byte-for-byte reproducibility across thread counts.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use glam::{Vec2, Vec3};
 use visgate_formats::Scene;
-use visgate_formats::desc::{CameraDesc, MeshDesc, Scale, SceneDesc, UpAxis};
+use visgate_formats::desc::{CameraDesc, SceneDesc};
 use visgate_formats::import::{ImportedModel, RawMesh};
 use visgate_formats::vgate::{BakeParams, BakedLevel, GatePlacement, Resolution};
 use visgate_preprocess::BakeError;
@@ -200,28 +200,16 @@ fn rebaking_is_byte_identical_for_any_thread_count() {
 }
 
 fn custom(name: &str, model: ImportedModel, closed: bool, eye: [f64; 3], mpu: f64) -> Scene {
-    let desc = SceneDesc {
-        name: Some(name.into()),
-        up: UpAxis::Y,
-        metres_per_unit: mpu,
-        closed,
-        meshes: vec![MeshDesc {
-            path: PathBuf::from(format!("{name}.obj")),
-            is_static: true,
-            translate: [0.0; 3],
-            rotate_deg: [0.0; 3],
-            scale: Scale::Uniform(1.0),
-        }],
-        materials: vec![],
-        lights: vec![],
-        cameras: vec![CameraDesc {
-            name: "main".into(),
-            eye,
-            target: [eye[0] + 1.0, eye[1], eye[2]],
-            up: None,
-            fov_deg: 60.0,
-        }],
-    };
+    let mut desc = SceneDesc::for_mesh_file(Path::new(&format!("{name}.obj")));
+    desc.metres_per_unit = mpu;
+    desc.closed = closed;
+    desc.cameras = vec![CameraDesc {
+        name: "main".into(),
+        eye,
+        target: [eye[0] + 1.0, eye[1], eye[2]],
+        up: None,
+        fov_deg: 60.0,
+    }];
     Scene::assemble(&desc, vec![model], Path::new(name)).expect("assemble")
 }
 
