@@ -93,7 +93,7 @@ pub fn run(args: BakeArgs) -> Result<()> {
     let params = BakeParams {
         resolution,
         alpha: args.alpha,
-        persistence: 0,
+        persistence: args.persistence,
         min_component_voxels: args.min_component_voxels,
         gate_placement: match args.gates {
             Gates::Narrowest => GatePlacement::Narrowest,
@@ -103,7 +103,6 @@ pub fn run(args: BakeArgs) -> Result<()> {
     };
     let options = BakeOptions {
         memory_limit_bytes: (args.memory_limit_gib * (1u64 << 30) as f64) as u64,
-        persistence: args.persistence,
     };
     let scene = crate::load_scene(
         &args.scene,

@@ -105,8 +105,10 @@ pub struct BakeParams {
     pub resolution: Resolution,
     /// Cluster growth tolerance α of IV.B.2. [Limit: [0, 1]]
     pub alpha: f32,
-    /// Thinning persistence, steps. [Units: thinning steps]
-    pub persistence: u32,
+    /// Thinning persistence; `None` asks the bake to pick one for the grid (2 + ⌈n/64⌉ for n
+    /// voxels on the longest axis). A baked file always stores the value used. [Units: thinning
+    /// steps]
+    pub persistence: Option<u32>,
     /// Empty components smaller than this, holding no camera or light, are dropped. [Units: vx]
     pub min_component_voxels: u64,
     /// Gate placement rule.
@@ -120,7 +122,7 @@ impl Default for BakeParams {
         BakeParams {
             resolution: Resolution::LongestAxisVoxels(128),
             alpha: 0.2,
-            persistence: 4,
+            persistence: None,
             min_component_voxels: 64,
             gate_placement: GatePlacement::Narrowest,
             allow_leaks: false,

@@ -335,7 +335,7 @@ fn arb_level() -> impl Strategy<Value = BakedLevel> {
                     info: BakeInfo {
                         params: BakeParams {
                             alpha: (seed % 100) as f32 / 100.0,
-                            persistence: (seed % 7) as u32,
+                            persistence: Some((seed % 7) as u32),
                             ..Default::default()
                         },
                         geometry_hash: GeometryHash(

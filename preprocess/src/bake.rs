@@ -47,15 +47,12 @@ pub enum Progress {
 pub struct BakeOptions {
     /// Refuse grids that would need more memory than this. [Units: bytes]
     pub memory_limit_bytes: u64,
-    /// Persistence in thinning steps; `None` picks [`auto_persistence`] for the grid.
-    pub persistence: Option<u32>,
 }
 
 impl Default for BakeOptions {
     fn default() -> Self {
         BakeOptions {
             memory_limit_bytes: 16 << 30,
-            persistence: None,
         }
     }
 }
@@ -189,10 +186,12 @@ fn check_params(p: &BakeParams) -> Result<(), BakeError> {
             p.alpha
         )));
     }
-    if p.persistence > 10_000 {
+    if let Some(persistence) = p.persistence
+        && persistence > 10_000
+    {
         return Err(BakeError::Param(format!(
             "persistence {} steps is more than any grid needs (at most 10000)",
-            p.persistence
+            persistence
         )));
     }
     Ok(())
@@ -254,9 +253,10 @@ pub fn bake(
     clock.end(json!({ "dims": meta.dims, "voxel_size_m": meta.voxel_size_m, "solid_voxels": solid_voxels }),
     );
     let mut params = params.clone();
-    params.persistence = options
+    let persistence = params
         .persistence
         .unwrap_or_else(|| auto_persistence(meta.dims));
+    params.persistence = Some(persistence);
 
     // 3. Empty space.
     clock.start("empty space", 0);
@@ -301,9 +301,7 @@ pub fn bake(
         meta.dims,
         &es.empty,
         &dist2,
-        &ThinParams {
-            persistence: params.persistence,
-        },
+        &ThinParams { persistence },
         &|done, _| progress(Progress::Advance(done)),
     );
     let extended = extend_ends(meta.dims, &es.empty, &dist2, &mut thinned.skeleton);
@@ -313,13 +311,16 @@ pub fn bake(
         "steps": thinned.steps,
         "constrained": thinned.constrained,
         "voxels_examined": thinned.border_visits,
-        "persistence": params.persistence,
+        "persistence": persistence,
     }));
 
     // 6. Skeleton graph and nearest-node grid.
     clock.start("skeleton graph", 0);
-    let sg: SkeletonGraph = skeleton_graph(meta.dims, &thinned.skeleton);
-    let voxel_node = nearest_node(meta.dims, &es.empty, &thinned.skeleton);
+    // The graph and the nearest-node search are independent: run them side by side.
+    let (sg, voxel_node): (SkeletonGraph, Vec<u32>) = rayon::join(
+        || skeleton_graph(meta.dims, &thinned.skeleton),
+        || nearest_node(meta.dims, &es.empty, &thinned.skeleton),
+    );
     let vs = meta.voxel_size_m;
     let position: Vec<Vec3> = sg
         .voxels
@@ -445,18 +446,50 @@ pub fn bake(
             c
         })
         .collect();
-    let mut lo = vec![[f32::INFINITY; 3]; seeds_of.len()];
-    let mut hi = vec![[f32::NEG_INFINITY; 3]; seeds_of.len()];
-    for (i, &c) in voxel_cluster.iter().enumerate() {
-        if c == u32::MAX || !es.empty[i] {
-            continue;
-        }
-        let p = meta.voxel_to_world(meta.coords(i as u32));
-        for a in 0..3 {
-            lo[c as usize][a] = lo[c as usize][a].min(p[a] - 0.5 * vs);
-            hi[c as usize][a] = hi[c as usize][a].max(p[a] + 0.5 * vs);
-        }
-    }
+    // Each cluster's box of empty voxels, in voxel coordinates, reduced over z slabs.
+    let nc = seeds_of.len();
+    let slab = (meta.dims[0] * meta.dims[1]) as usize;
+    let (vlo, vhi) = voxel_cluster
+        .par_chunks(slab)
+        .zip(es.empty.par_chunks(slab))
+        .enumerate()
+        .fold(
+            || (vec![[u32::MAX; 3]; nc], vec![[0u32; 3]; nc]),
+            |(mut lo, mut hi), (z, (cs, es))| {
+                for (i, (&c, &e)) in cs.iter().zip(es).enumerate() {
+                    if c == u32::MAX || !e {
+                        continue;
+                    }
+                    let v = [i as u32 % meta.dims[0], i as u32 / meta.dims[0], z as u32];
+                    for a in 0..3 {
+                        lo[c as usize][a] = lo[c as usize][a].min(v[a]);
+                        hi[c as usize][a] = hi[c as usize][a].max(v[a]);
+                    }
+                }
+                (lo, hi)
+            },
+        )
+        .reduce(
+            || (vec![[u32::MAX; 3]; nc], vec![[0u32; 3]; nc]),
+            |(mut lo, mut hi), (l2, h2)| {
+                for c in 0..nc {
+                    for a in 0..3 {
+                        lo[c][a] = lo[c][a].min(l2[c][a]);
+                        hi[c][a] = hi[c][a].max(h2[c][a]);
+                    }
+                }
+                (lo, hi)
+            },
+        );
+    let (lo, hi): (Vec<[f32; 3]>, Vec<[f32; 3]>) = (0..nc)
+        .map(|c| {
+            if vlo[c][0] == u32::MAX {
+                return ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+            }
+            let (a, b) = (meta.voxel_to_world(vlo[c]), meta.voxel_to_world(vhi[c]));
+            (a.map(|x| x - 0.5 * vs), b.map(|x| x + 0.5 * vs))
+        })
+        .unzip();
     let clusters_out: Vec<Cluster> = seeds_of
         .iter()
         .enumerate()
@@ -520,13 +553,13 @@ pub fn bake(
 
     // Topology check, counted independently of the graph.
     clock.start("topology check", 0);
-    let empty_topology = betti(meta.dims, &es.empty);
     let mut skel = vec![false; n_voxels];
     thinned
         .skeleton
         .iter()
         .for_each(|&i| skel[i as usize] = true);
-    let skeleton_topology = betti(meta.dims, &skel);
+    let (empty_topology, skeleton_topology) =
+        rayon::join(|| betti(meta.dims, &es.empty), || betti(meta.dims, &skel));
     clock.end(json!({ "empty": empty_topology, "skeleton": skeleton_topology }));
 
     let summary = Summary {
@@ -576,7 +609,7 @@ impl BakeReport {
         let mut s = String::new();
         let g = &self.grid;
         s += &format!(
-            "bake of {} — {:.2} s on {} threads, peak memory {}\n",
+            "bake of {} — {:.2} s on {} thread(s), peak memory {}\n",
             self.scene,
             self.total_seconds,
             self.threads,
@@ -626,7 +659,7 @@ impl BakeReport {
             m.cycles,
             m.components,
             self.params.alpha,
-            self.params.persistence,
+            self.params.persistence.unwrap_or(0),
             self.params.gate_placement
         );
         let (e, k) = (&self.empty_topology, &self.skeleton_topology);

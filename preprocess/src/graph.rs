@@ -14,8 +14,10 @@
 //! voxel itself) always finds the node of the empty space it faces.
 
 use std::collections::BTreeSet;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use petgraph::graph::{NodeIndex, UnGraph};
+use rayon::prelude::*;
 
 /// Chamfer weights of face, edge and corner steps (× 10 of the step length).
 const W: [u32; 4] = [0, 10, 14, 17];
@@ -185,69 +187,115 @@ pub fn skeleton_graph(dims: [u32; 3], skeleton: &[u32]) -> SkeletonGraph {
 
 /// The nearest skeleton node of every empty voxel, through the empty space, and of the solid
 /// voxels up to [`SOLID_SHELL_VOXELS`] deep; `u32::MAX` elsewhere.
+///
+/// Dial's bucket queue, each bucket relaxed in parallel: a voxel's state is one `u64`
+/// `(distance, solid depth, node)` lowered with an atomic minimum, so ties go to the shallower
+/// path and then the lower node id whatever order the threads run in — the result does not
+/// depend on the thread count.
 pub fn nearest_node(dims: [u32; 3], empty: &[bool], skeleton: &[u32]) -> Vec<u32> {
     let [nx, ny, nz] = dims.map(|d| d as i64);
     let n = empty.len();
-    let mut dist = vec![u32::MAX; n];
-    let mut node = vec![u32::MAX; n];
-    let mut depth = vec![0u8; n];
-    let offsets: Vec<([i64; 3], u32)> = (0..27)
+    const NODE_BITS: u32 = 32;
+    const DEPTH_BITS: u32 = 2;
+    let pack = |dist: u32, depth: u8, node: u32| -> u64 {
+        ((dist as u64) << (NODE_BITS + DEPTH_BITS)) | ((depth as u64) << NODE_BITS) | node as u64
+    };
+    let dist_of = |s: u64| (s >> (NODE_BITS + DEPTH_BITS)) as u32;
+    let depth_of = |s: u64| ((s >> NODE_BITS) & ((1 << DEPTH_BITS) - 1)) as u8;
+    let state: Vec<AtomicU64> = (0..n)
+        .into_par_iter()
+        .map(|_| AtomicU64::new(u64::MAX))
+        .collect();
+    // Offsets with their linear index step (valid away from the grid's edge) and weight.
+    let offsets: Vec<([i64; 3], i64, u32)> = (0..27)
         .filter(|&k| k != 13)
         .map(|k: i64| {
             let o = [k % 3 - 1, (k / 3) % 3 - 1, k / 9 - 1];
             let l = o.iter().map(|c| c.abs()).sum::<i64>() as usize;
-            (o, W[l])
+            (o, o[0] + nx * (o[1] + ny * o[2]), W[l])
         })
         .collect();
-    // Dial's bucket queue: distances grow by at most 17 per step.
+    // Distances grow by one of three weights per step, so a bucket's pushes land in three.
     const B: usize = 32;
     let mut buckets: Vec<Vec<u32>> = vec![Vec::new(); B];
     for (id, &v) in skeleton.iter().enumerate() {
-        dist[v as usize] = 0;
-        node[v as usize] = id as u32;
+        state[v as usize].store(pack(0, 0, id as u32), Ordering::Relaxed);
         buckets[0].push(v);
     }
+    let relax = |v: u32, current: u32, out: &mut [Vec<u32>; 3]| {
+        let s = state[v as usize].load(Ordering::Relaxed);
+        if dist_of(s) != current {
+            return; // stale entry
+        }
+        let node = s as u32;
+        let c = coords(v, dims);
+        let from_solid = !empty[v as usize];
+        let interior =
+            c[0] > 0 && c[1] > 0 && c[2] > 0 && c[0] + 1 < nx && c[1] + 1 < ny && c[2] + 1 < nz;
+        for &(o, fo, w) in &offsets {
+            let j = if interior {
+                (v as i64 + fo) as usize
+            } else {
+                let p = [c[0] + o[0], c[1] + o[1], c[2] + o[2]];
+                if p[0] < 0 || p[1] < 0 || p[2] < 0 || p[0] >= nx || p[1] >= ny || p[2] >= nz {
+                    continue;
+                }
+                (p[0] + nx * (p[1] + ny * p[2])) as usize
+            };
+            let d = if empty[j] {
+                if from_solid {
+                    continue;
+                }
+                0
+            } else {
+                let d = if from_solid { depth_of(s) + 1 } else { 1 };
+                if d > SOLID_SHELL_VOXELS {
+                    continue;
+                }
+                d
+            };
+            let new = pack(current + w, d, node);
+            // A plain load first: most relaxations improve nothing and need no atomic write.
+            if new < state[j].load(Ordering::Relaxed)
+                && new < state[j].fetch_min(new, Ordering::Relaxed)
+            {
+                let k = W[1..].iter().position(|&x| x == w).unwrap_or(0);
+                out[k].push(j as u32);
+            }
+        }
+    };
     let mut current = 0u32;
     let mut pending = skeleton.len();
     while pending > 0 {
         let slot = current as usize % B;
         let list = std::mem::take(&mut buckets[slot]);
         pending -= list.len();
-        for v in list {
-            if dist[v as usize] != current {
-                continue; // stale entry
-            }
-            let c = coords(v, dims);
-            let from_solid = !empty[v as usize];
-            for &(o, w) in &offsets {
-                let p = [c[0] + o[0], c[1] + o[1], c[2] + o[2]];
-                if p[0] < 0 || p[1] < 0 || p[2] < 0 || p[0] >= nx || p[1] >= ny || p[2] >= nz {
-                    continue;
-                }
-                let j = (p[0] + nx * (p[1] + ny * p[2])) as usize;
-                let d = if empty[j] {
-                    if from_solid {
-                        continue;
-                    }
-                    0
-                } else {
-                    let d = if from_solid { depth[v as usize] + 1 } else { 1 };
-                    if d > SOLID_SHELL_VOXELS {
-                        continue;
-                    }
-                    d
-                };
-                let nd = current + w;
-                if nd < dist[j] {
-                    dist[j] = nd;
-                    node[j] = node[v as usize];
-                    depth[j] = d;
-                    buckets[nd as usize % B].push(j as u32);
-                    pending += 1;
-                }
+        let pushed: Vec<[Vec<u32>; 3]> = if list.len() < 4096 {
+            let mut out: [Vec<u32>; 3] = Default::default();
+            list.iter().for_each(|&v| relax(v, current, &mut out));
+            vec![out]
+        } else {
+            list.par_chunks(2048)
+                .map(|chunk| {
+                    let mut out: [Vec<u32>; 3] = Default::default();
+                    chunk.iter().for_each(|&v| relax(v, current, &mut out));
+                    out
+                })
+                .collect()
+        };
+        for out in pushed {
+            for (k, list) in out.into_iter().enumerate() {
+                pending += list.len();
+                buckets[(current + W[k + 1]) as usize % B].extend(list);
             }
         }
         current += 1;
     }
-    node
+    state
+        .into_par_iter()
+        .map(|s| {
+            let s = s.into_inner();
+            if s == u64::MAX { u32::MAX } else { s as u32 }
+        })
+        .collect()
 }

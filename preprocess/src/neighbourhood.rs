@@ -10,6 +10,8 @@
 //! background in the 18-neighbourhood that touch the centre's faces. A voxel is simple iff
 //! both are 1; it is a 1D isthmus (a curve voxel) iff `T26 >= 2`.
 
+use rayon::prelude::*;
+
 /// Bit of the centre voxel.
 pub const CENTRE: u32 = 13;
 
@@ -208,46 +210,55 @@ pub fn betti(dims: [u32; 3], set: &[bool]) -> Betti {
     let get = |x: isize, y: isize, z: isize| -> bool {
         x >= 0 && y >= 0 && z >= 0 && at(x as usize, y as usize, z as usize)
     };
-    let mut chi: i64 = 0;
-    for z in 0..=nz as isize {
-        for y in 0..=ny as isize {
-            for x in 0..=nx as isize {
-                // Vertex at lattice point (x, y, z).
-                let mut c = [[[false; 2]; 2]; 2];
-                for (dz, cz) in c.iter_mut().enumerate() {
-                    for (dy, cy) in cz.iter_mut().enumerate() {
-                        for (dx, v) in cy.iter_mut().enumerate() {
-                            *v = get(
-                                x - 1 + dx as isize,
-                                y - 1 + dy as isize,
-                                z - 1 + dz as isize,
-                            );
+    // Slabs of constant z are independent: sum them in parallel.
+    let chi: i64 = (0..=nz as isize)
+        .into_par_iter()
+        .map(|z| {
+            let mut chi: i64 = 0;
+            for y in 0..=ny as isize {
+                for x in 0..=nx as isize {
+                    // Vertex at lattice point (x, y, z).
+                    let mut c = [[[false; 2]; 2]; 2];
+                    for (dz, cz) in c.iter_mut().enumerate() {
+                        for (dy, cy) in cz.iter_mut().enumerate() {
+                            for (dx, v) in cy.iter_mut().enumerate() {
+                                *v = get(
+                                    x - 1 + dx as isize,
+                                    y - 1 + dy as isize,
+                                    z - 1 + dz as isize,
+                                );
+                            }
                         }
                     }
+                    let any = c.iter().flatten().flatten().any(|&v| v);
+                    if !any {
+                        continue;
+                    }
+                    chi += 1;
+                    // Edges leaving this point in +x, +y, +z: the 4 voxels around each.
+                    let ex = c[0][0][1] || c[0][1][1] || c[1][0][1] || c[1][1][1];
+                    let ey = c[0][1][0] || c[0][1][1] || c[1][1][0] || c[1][1][1];
+                    let ez = c[1][0][0] || c[1][0][1] || c[1][1][0] || c[1][1][1];
+                    chi -= ex as i64 + ey as i64 + ez as i64;
+                    // Faces with this corner as minimum: xy (voxels z−1, z at x, y), xz, yz.
+                    let fxy = c[0][1][1] || c[1][1][1];
+                    let fxz = c[1][0][1] || c[1][1][1];
+                    let fyz = c[1][1][0] || c[1][1][1];
+                    chi += fxy as i64 + fxz as i64 + fyz as i64;
+                    // The cube with this corner as minimum.
+                    chi -= c[1][1][1] as i64;
                 }
-                let any = c.iter().flatten().flatten().any(|&v| v);
-                if !any {
-                    continue;
-                }
-                chi += 1;
-                // Edges leaving this point in +x, +y, +z: the 4 voxels around each.
-                let ex = c[0][0][1] || c[0][1][1] || c[1][0][1] || c[1][1][1];
-                let ey = c[0][1][0] || c[0][1][1] || c[1][1][0] || c[1][1][1];
-                let ez = c[1][0][0] || c[1][0][1] || c[1][1][0] || c[1][1][1];
-                chi -= ex as i64 + ey as i64 + ez as i64;
-                // Faces with this corner as minimum: xy (voxels z−1, z at x, y), xz, yz.
-                let fxy = c[0][1][1] || c[1][1][1];
-                let fxz = c[1][0][1] || c[1][1][1];
-                let fyz = c[1][1][0] || c[1][1][1];
-                chi += fxy as i64 + fxz as i64 + fyz as i64;
-                // The cube with this corner as minimum.
-                chi -= c[1][1][1] as i64;
             }
-        }
-    }
-    let components = label_components(dims, set, Conn::C26).1 as u64;
-    let complement: Vec<bool> = set.iter().map(|&s| !s).collect();
-    let background = label_components(dims, &complement, Conn::C6).1 as u64;
+            chi
+        })
+        .sum();
+    let (components, background) = rayon::join(
+        || label_components(dims, set, Conn::C26).1 as u64,
+        || {
+            let complement: Vec<bool> = set.par_iter().map(|&s| !s).collect();
+            label_components(dims, &complement, Conn::C6).1 as u64
+        },
+    );
     let cavities = background.saturating_sub(1);
     let cycles = (components as i64 + cavities as i64 - chi).max(0) as u64;
     Betti {
@@ -267,61 +278,112 @@ pub enum Conn {
     C26,
 }
 
-/// Labels the components of `set` (flood fill from the lowest voxel index, so deterministic):
-/// returns per-voxel labels (`u32::MAX` outside the set) and the number of components.
-/// Voxels on the grid's edge take part; neighbours outside the grid are ignored.
+/// Labels the components of `set`: returns per-voxel labels (`u32::MAX` outside the set) and
+/// the number of components. Labels are numbered in the order of each component's first voxel
+/// (lowest grid index), so they are deterministic. Voxels on the grid's edge take part;
+/// neighbours outside the grid are ignored.
+///
+/// Works on runs along x: each row's runs are joined (union-find) with the overlapping runs of
+/// the rows before it that touch it (2 rows for 6-adjacency, 4 for 26-adjacency, where runs
+/// that meet at a corner or edge overlap once widened by one voxel).
 pub fn label_components(dims: [u32; 3], set: &[bool], conn: Conn) -> (Vec<u32>, u32) {
     let [nx, ny, nz] = dims.map(|d| d as usize);
-    let mut label = vec![u32::MAX; set.len()];
-    let offsets: Vec<[i32; 3]> = (0..27)
-        .map(offset)
-        .filter(|o| {
-            let l = o[0].abs() + o[1].abs() + o[2].abs();
-            l > 0 && (conn == Conn::C26 || l == 1)
+    let rows = ny * nz;
+    // Runs of each row, in voxel order: (first x, last x).
+    let per_row: Vec<Vec<(u32, u32)>> = (0..rows)
+        .into_par_iter()
+        .map(|r| {
+            let row = &set[r * nx..(r + 1) * nx];
+            let mut runs = Vec::new();
+            let mut x = 0;
+            while x < nx {
+                if row[x] {
+                    let start = x;
+                    while x < nx && row[x] {
+                        x += 1;
+                    }
+                    runs.push((start as u32, x as u32 - 1));
+                } else {
+                    x += 1;
+                }
+            }
+            runs
         })
         .collect();
-    let fast: Vec<isize> = offsets
-        .iter()
-        .map(|o| o[0] as isize + nx as isize * (o[1] as isize + ny as isize * o[2] as isize))
-        .collect();
-    let mut count = 0u32;
-    let mut stack = Vec::new();
-    for start in 0..set.len() {
-        if !set[start] || label[start] != u32::MAX {
-            continue;
+    let mut row_start = Vec::with_capacity(rows + 1);
+    row_start.push(0usize);
+    for r in &per_row {
+        row_start.push(row_start.last().copied().unwrap_or(0) + r.len());
+    }
+    let runs: Vec<(u32, u32)> = per_row.into_iter().flatten().collect();
+    let mut parent: Vec<u32> = (0..runs.len() as u32).collect();
+    fn find(p: &mut [u32], mut x: u32) -> u32 {
+        while p[x as usize] != x {
+            p[x as usize] = p[p[x as usize] as usize];
+            x = p[x as usize];
         }
-        label[start] = count;
-        stack.push(start);
-        while let Some(i) = stack.pop() {
-            let (x, y, z) = (i % nx, (i / nx) % ny, i / (nx * ny));
-            if x > 0 && y > 0 && z > 0 && x + 1 < nx && y + 1 < ny && z + 1 < nz {
-                for &o in &fast {
-                    let j = (i as isize + o) as usize;
-                    if set[j] && label[j] == u32::MAX {
-                        label[j] = count;
-                        stack.push(j);
-                    }
-                }
+        x
+    }
+    // Earlier rows that touch row (y, z), and how far runs are widened to count as touching.
+    let (earlier, widen): (&[(isize, isize)], u32) = match conn {
+        Conn::C6 => (&[(-1, 0), (0, -1)], 0),
+        Conn::C26 => (&[(-1, 0), (-1, -1), (0, -1), (1, -1)], 1),
+    };
+    for z in 0..nz {
+        for y in 0..ny {
+            let r = y + ny * z;
+            let mine = row_start[r]..row_start[r + 1];
+            if mine.is_empty() {
                 continue;
             }
-            for o in &offsets {
-                let (a, b, c) = (
-                    x as i64 + o[0] as i64,
-                    y as i64 + o[1] as i64,
-                    z as i64 + o[2] as i64,
-                );
-                if a < 0 || b < 0 || c < 0 || a >= nx as i64 || b >= ny as i64 || c >= nz as i64 {
+            for &(dy, dz) in earlier {
+                let (oy, oz) = (y as isize + dy, z as isize + dz);
+                if oy < 0 || oz < 0 || oy >= ny as isize {
                     continue;
                 }
-                let j = a as usize + nx * (b as usize + ny * c as usize);
-                if set[j] && label[j] == u32::MAX {
-                    label[j] = count;
-                    stack.push(j);
+                let o = oy as usize + ny * oz as usize;
+                let (mut i, mut j) = (mine.start, row_start[o]);
+                let (i_end, j_end) = (mine.end, row_start[o + 1]);
+                while i < i_end && j < j_end {
+                    let (a0, a1) = runs[i];
+                    let (b0, b1) = runs[j];
+                    if b0 <= a1 + widen && a0 <= b1 + widen {
+                        let (ra, rb) = (find(&mut parent, i as u32), find(&mut parent, j as u32));
+                        if ra != rb {
+                            let (lo, hi) = (ra.min(rb), ra.max(rb));
+                            parent[hi as usize] = lo;
+                        }
+                    }
+                    // Advance whichever run ends first.
+                    if a1 < b1 {
+                        i += 1;
+                    } else {
+                        j += 1;
+                    }
                 }
             }
         }
-        count += 1;
     }
+    // Roots are each component's lowest run, so numbering roots in run order numbers the
+    // components by their first voxel.
+    let mut run_label = vec![0u32; runs.len()];
+    let mut count = 0u32;
+    for i in 0..runs.len() {
+        let root = find(&mut parent, i as u32) as usize;
+        run_label[i] = if root == i {
+            count += 1;
+            count - 1
+        } else {
+            run_label[root]
+        };
+    }
+    let mut label = vec![u32::MAX; set.len()];
+    label.par_chunks_mut(nx).enumerate().for_each(|(r, row)| {
+        for i in row_start[r]..row_start[r + 1] {
+            let (a, b) = runs[i];
+            row[a as usize..=b as usize].fill(run_label[i]);
+        }
+    });
     (label, count)
 }
 
