@@ -223,15 +223,16 @@ fn bake_writes_the_level_report_and_debug_exports() {
         "voxelize",
         "thin",
         "skeleton nodes",
-        "clusters 3",
-        "gates 2",
+        "clusters 2",
+        "gates 1",
         "(preserved)",
     ] {
         assert!(text.contains(want), "missing '{want}' in:\n{text}");
     }
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&report).expect("report")).expect("json");
-    assert_eq!(json["summary"]["gates"], 2);
+    // The doorway's own cluster is a sliver in a thin wall, merged into a room: one gate.
+    assert_eq!(json["summary"]["gates"], 1);
     assert!(json["stages"].as_array().expect("stages").len() >= 10);
     for f in [
         "solid.npy",
@@ -262,7 +263,7 @@ fn bake_writes_the_level_report_and_debug_exports() {
     // inspect reads it back.
     let o = visgate(&["inspect", out.to_str().expect("utf-8")]);
     assert!(o.status.success(), "{}", stderr(&o));
-    assert!(stdout(&o).contains("gates       2"), "{}", stdout(&o));
+    assert!(stdout(&o).contains("gates       1"), "{}", stdout(&o));
 }
 
 #[test]

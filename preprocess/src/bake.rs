@@ -17,10 +17,13 @@ use visgate_formats::vgate::{
     SegNodeKind, Skeleton, SkeletonNode, Topology, VoxelValues,
 };
 
-use crate::clusters::{ClusterParams, GateDisk, clusters, gates, skeleton_clusters};
+use crate::clusters::{
+    ClusterParams, GateDisk, cluster_radius, clusters, find_sliver, gates, merge_cluster,
+    skeleton_clusters,
+};
 use crate::empty::{EmptySpace, EmptySpaceParams, Seed, empty_space};
 use crate::graph::{SkeletonGraph, nearest_node, skeleton_graph};
-use crate::neighbourhood::{Betti, betti};
+use crate::neighbourhood::{Betti, Conn, betti, label_components};
 use crate::segment::{SegmentParams, Segmented, segment};
 use crate::thin::{ThinParams, Thinned, extend_ends, thin};
 use crate::voxelize::{SolidGrid, grid_for, voxelize};
@@ -363,7 +366,7 @@ pub fn bake(
 
     // 8. Clusters.
     clock.start("clusters", 0);
-    let (node_cluster, seeds_of) = clusters(
+    let (mut node_cluster, mut seeds_of) = clusters(
         &seg.skeleton,
         &position,
         &radius,
@@ -371,22 +374,36 @@ pub fn bake(
             alpha: params.alpha,
         },
     );
-    clock.end(json!({ "clusters": seeds_of.len(), "alpha": params.alpha }));
+    let greedy_clusters = seeds_of.len();
+    clock.end(json!({ "clusters": greedy_clusters, "alpha": params.alpha }));
 
-    // 9. Gates (both rules; the chosen one is stored).
+    // 9. Gates (both rules; the chosen one is stored), after merging slivers.
     clock.start("gates", 0);
+    let gates_by = |placement: GatePlacement, node_cluster: &[u32]| {
+        gates(
+            &seg.skeleton,
+            &adjacency,
+            node_cluster,
+            &position,
+            &radius,
+            placement,
+        )
+    };
+    let mut slivers_merged = 0u64;
+    loop {
+        // Slivers are found with the narrowest-place gates whatever rule is stored, so both
+        // rules see the same clusters.
+        let g = gates_by(GatePlacement::Narrowest, &node_cluster);
+        let cr = cluster_radius(&seg.skeleton, &node_cluster, &radius, seeds_of.len());
+        let Some((from, into)) = find_sliver(&g, &cr, params.alpha) else {
+            break;
+        };
+        merge_cluster(&mut node_cluster, &mut seeds_of, from, into);
+        slivers_merged += 1;
+    }
     let both: Vec<Vec<GateDisk>> = [GatePlacement::Narrowest, GatePlacement::Midpoint]
         .iter()
-        .map(|&p| {
-            gates(
-                &seg.skeleton,
-                &adjacency,
-                &node_cluster,
-                &position,
-                &radius,
-                p,
-            )
-        })
+        .map(|&p| gates_by(p, &node_cluster))
         .collect();
     let chosen = match params.gate_placement {
         GatePlacement::Narrowest => &both[0],
@@ -398,18 +415,27 @@ pub fn bake(
         .map(|(n, m)| {
             json!({
                 "clusters": n.clusters,
-                "narrowest": { "centre_m": n.centre.to_array(), "radius_m": n.radius },
-                "midpoint": { "centre_m": m.centre.to_array(), "radius_m": m.radius },
+                "narrowest": {
+                    "centre_m": n.centre.to_array(), "normal": n.normal.to_array(), "radius_m": n.radius,
+                },
+                "midpoint": {
+                    "centre_m": m.centre.to_array(), "normal": m.normal.to_array(), "radius_m": m.radius,
+                },
                 "apart_m": (n.centre - m.centre).length(),
             })
         })
         .collect();
-    clock.end(json!({ "gates": chosen.len() }));
+    clock.end(json!({
+        "gates": chosen.len(),
+        "slivers_merged": slivers_merged,
+        "clusters": seeds_of.len(),
+    }));
 
     // 10. Flatten.
     clock.start("flatten", 0);
     let n_voxels = es.empty.len();
-    let skel_cluster = skeleton_clusters(&seg.skeleton, &seg.node_segment, &node_cluster, chosen);
+    let mut skel_cluster =
+        skeleton_clusters(&seg.skeleton, &seg.node_segment, &node_cluster, chosen);
     // A voxel whose node lies across a gate of the node's cluster takes the gate's other
     // cluster, so that cluster borders follow the gates' planes (a doorway node's voxels would
     // otherwise reach sideways into the rooms).
@@ -419,7 +445,43 @@ pub fn bake(
             cluster_gates[c as usize].push(i);
         }
     }
-    let voxel_cluster: Vec<u32> = voxel_node
+    // A skeleton node that lies past a gate of its own cluster, within the gate's reach (a
+    // doorway's end node a little inside the next room, when the narrowest place lies beyond
+    // the segmented node), takes the cluster on the gate's other side.
+    let across = |c: u32, p: Vec3| -> Option<u32> {
+        cluster_gates[c as usize].iter().find_map(|&gi| {
+            let g = &chosen[gi];
+            let own_side = if g.clusters[0] == c { -1.0 } else { 1.0 };
+            let beyond = (p - g.centre).dot(g.normal) * own_side < -0.5 * vs;
+            let near = (p - g.centre).length() <= g.radius + vs;
+            (beyond && near).then(|| g.clusters[(g.clusters[0] == c) as usize])
+        })
+    };
+    let nodes_moved = (0..skel_cluster.len())
+        .filter_map(|n| across(skel_cluster[n], position[n]).map(|c| (n, c)))
+        .collect::<Vec<_>>();
+    for &(n, c) in &nodes_moved {
+        skel_cluster[n] = c;
+    }
+    // The gates of its cluster each node lies near, on its own side (the normal points from
+    // clusters[0]'s side to clusters[1]'s): only those can cut through its voxels.
+    let own_side = |g: &GateDisk, c: u32| if g.clusters[0] == c { -1.0 } else { 1.0 };
+    let node_gates: Vec<Vec<usize>> = (0..skel_cluster.len())
+        .into_par_iter()
+        .map(|n| {
+            let c = skel_cluster[n];
+            cluster_gates[c as usize]
+                .iter()
+                .copied()
+                .filter(|&gi| {
+                    let g = &chosen[gi];
+                    let side_n = (position[n] - g.centre).dot(g.normal) * own_side(g, c);
+                    side_n > -0.5 * vs && side_n <= g.radius + vs
+                })
+                .collect()
+        })
+        .collect();
+    let mut voxel_cluster: Vec<u32> = voxel_node
         .par_iter()
         .enumerate()
         .map(|(v, &n)| {
@@ -427,25 +489,96 @@ pub fn bake(
                 return u32::MAX;
             }
             let c = skel_cluster[n as usize];
+            let near = &node_gates[n as usize];
+            if near.is_empty() {
+                return c;
+            }
             let p = Vec3::from(meta.voxel_to_world(meta.coords(v as u32)));
-            for &gi in &cluster_gates[c as usize] {
+            for &gi in near {
                 let g = &chosen[gi];
-                // The normal points from clusters[0]'s side to clusters[1]'s.
-                let own_side = if g.clusters[0] == c { -1.0 } else { 1.0 };
-                let side_v = (p - g.centre).dot(g.normal) * own_side;
-                let side_n = (position[n as usize] - g.centre).dot(g.normal) * own_side;
-                // Only nodes near the gate have voxels the gate's plane cuts through.
-                if side_n > -0.5 * vs && side_n <= g.radius + vs && side_v < -0.5 * vs {
-                    return if g.clusters[0] == c {
-                        g.clusters[1]
-                    } else {
-                        g.clusters[0]
-                    };
+                if (p - g.centre).dot(g.normal) * own_side(g, c) < -0.5 * vs {
+                    return g.clusters[(g.clusters[0] == c) as usize];
                 }
             }
             c
         })
         .collect();
+    // Then the gates cut the empty space: its pieces (6-connected, the voxels each gate's
+    // plane passes through within 3 radii of its centre removed) whose skeleton nodes all lie
+    // in one cluster take that cluster whole, so a room's voxels that reached a doorway's
+    // node sideways join the room. Pieces that hold nodes of several clusters (a gate in open
+    // space that does not close its opening) keep the per-voxel rule.
+    let mut cut = es.empty.clone();
+    for g in chosen {
+        let reach = 3.0 * g.radius + vs;
+        let half = 0.5 * vs * g.normal.abs().element_sum();
+        // Walk the plane over its two in-plane axes; along the dominant axis only the few
+        // voxels within `half` of the plane.
+        let ax = (0..3)
+            .max_by(|&i, &j| g.normal[i].abs().total_cmp(&g.normal[j].abs()))
+            .unwrap_or(0);
+        let (u, w) = ((ax + 1) % 3, (ax + 2) % 3);
+        let o = Vec3::from(meta.origin_m);
+        let to_vx = |x: f32, a: usize| ((x - o[a]) / vs - 0.5).round();
+        let dims = meta.dims.map(|d| d as i64);
+        let range = |a: usize| {
+            let lo = (to_vx(g.centre[a] - reach, a) as i64).max(0);
+            let hi = (to_vx(g.centre[a] + reach, a) as i64).min(dims[a] - 1);
+            lo..=hi
+        };
+        let slack = (half / g.normal[ax].abs() / vs).ceil() as i64 + 1;
+        for iu in range(u) {
+            for iw in range(w) {
+                let mut v = [0i64; 3];
+                v[u] = iu;
+                v[w] = iw;
+                let pu = o[u] + (iu as f32 + 0.5) * vs - g.centre[u];
+                let pw = o[w] + (iw as f32 + 0.5) * vs - g.centre[w];
+                // Where the plane crosses this column.
+                let t = g.centre[ax] - (g.normal[u] * pu + g.normal[w] * pw) / g.normal[ax];
+                let mid = to_vx(t, ax) as i64;
+                for ia in (mid - slack).max(0)..=(mid + slack).min(dims[ax] - 1) {
+                    v[ax] = ia;
+                    let vv = v.map(|c| c as u32);
+                    let p = Vec3::from(meta.voxel_to_world(vv)) - g.centre;
+                    let along = p.dot(g.normal);
+                    if along.abs() <= half && (p - along * g.normal).length() <= reach {
+                        cut[meta.index(vv)] = false;
+                    }
+                }
+            }
+        }
+    }
+    let (piece, pieces) = label_components(meta.dims, &cut, Conn::C6);
+    drop(cut);
+    // Cluster of each piece's nodes: u32::MAX none yet, u32::MAX - 1 several.
+    let mut piece_cluster = vec![u32::MAX; pieces as usize];
+    for (n, &v) in sg.voxels.iter().enumerate() {
+        let p = piece[v as usize];
+        if p == u32::MAX {
+            continue;
+        }
+        let pc = &mut piece_cluster[p as usize];
+        *pc = match *pc {
+            u32::MAX => skel_cluster[n],
+            c if c == skel_cluster[n] => c,
+            _ => u32::MAX - 1,
+        };
+    }
+    let voxels_by_piece = voxel_cluster
+        .par_iter_mut()
+        .zip(piece.par_iter())
+        .filter(|(c, p)| **p != u32::MAX && **c != u32::MAX)
+        .map(|(c, &p)| {
+            let pc = piece_cluster[p as usize];
+            let changed = pc < u32::MAX - 1 && *c != pc;
+            if changed {
+                *c = pc;
+            }
+            changed as u64
+        })
+        .sum::<u64>();
+    drop(piece);
     // Each cluster's box of empty voxels, in voxel coordinates, reduced over z slabs.
     let nc = seeds_of.len();
     let slab = (meta.dims[0] * meta.dims[1]) as usize;
@@ -547,6 +680,10 @@ pub fn bake(
         voxel_cluster: VoxelValues::pack(&voxel_cluster),
     };
     clock.end(json!({
+        "nodes_moved_across_gates": nodes_moved.len(),
+        "voxels_moved_to_their_piece": voxels_by_piece,
+        "pieces": pieces,
+        "pieces_of_several_clusters": piece_cluster.iter().filter(|&&c| c == u32::MAX - 1).count(),
         "voxel_node_bytes": level.voxel_node.elem().size() * n_voxels as u64,
         "voxel_cluster_bytes": level.voxel_cluster.elem().size() * n_voxels as u64,
     }));

@@ -13,12 +13,20 @@
 //! to it, with the smaller of the two max-ball radii. A segmented edge is a straight shortcut
 //! of a skeleton line that may pass far from the narrow place between two rooms, so the
 //! default rule (`Narrowest`) puts the disk at the skeleton node of smallest max ball along the
-//! original line (the doorway), orthogonal to the line there, with that node's radius.
+//! original line or just past its ends (the doorway) — the middle of the run of nodes as narrow
+//! as it — orthogonal to the line over that run (or over about one radius each way), with that
+//! node's radius.
+//!
+//! **Slivers.** A cluster between two gates that face each other closer than the opening is
+//! wide (a doorway in a thin wall, or a node just before it) is a slab, and its voxels would
+//! reach sideways into the rooms; it is merged into the wider of its two neighbours when that
+//! one is wider by more than α ([`find_sliver`]), and the gates are placed again.
 //!
 //! **Voxels.** A skeleton node takes the cluster of its segmented node (the nearer end of its
 //! line), except on a line that crosses a gate: there the nodes before the gate take the
 //! first end's cluster and the others the second's, so the clusters of the voxels change
-//! where the gate is — at the doorway.
+//! where the gate is — at the doorway. The bake then settles voxels against the gates' planes
+//! (see `bake`'s flatten stage).
 
 use glam::Vec3;
 use visgate_formats::vgate::{GatePlacement, SegNodeKind, SegmentedSkeleton};
@@ -129,6 +137,12 @@ pub fn skeleton_clusters(
     out
 }
 
+/// How far past a segmented edge's ends the narrowest place is searched for, at least: also
+/// every node within the end node's max ball. [Units: nodes]
+const BEYOND_SEARCH: usize = 3;
+/// How far past the ends a run of equally narrow nodes is followed. [Units: nodes]
+const BEYOND_RUN: usize = 16;
+
 /// A gate before it is written: centre, unit normal, radius, the two clusters, its edge.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GateDisk {
@@ -189,12 +203,12 @@ pub fn gates(
                 )
             }
             GatePlacement::Narrowest => {
-                // The path, extended by up to 3 skeleton nodes past each end: when an end is
-                // a doorway node of its own cluster, the narrowest place may lie just beyond.
+                // The path, extended past each end: when an end is a doorway node of its own
+                // cluster, the narrowest place may lie just beyond.
                 let beyond = |from: u32, avoid: u32| -> Vec<u32> {
                     let (mut prev, mut cur) = (avoid, from);
                     let mut out = Vec::new();
-                    for _ in 0..3 {
+                    for _ in 0..BEYOND_RUN {
                         if adjacency[cur as usize].len() != 2 {
                             break;
                         }
@@ -227,9 +241,20 @@ pub fn gates(
                     .chain(post.iter())
                     .copied()
                     .collect();
-                // Smallest radius; among equals the one nearest the middle of the path.
+                // Smallest radius on the path or just past its ends (within the end's max
+                // ball, or 3 nodes); among equals the one nearest the middle of the path.
                 let mid = pre.len() as f32 + last as f32 * 0.5;
-                let i = (0..ext.len())
+                let within = |beyond: &[u32], end: u32| -> usize {
+                    let (p, r) = (position[end as usize], radius[end as usize]);
+                    beyond
+                        .iter()
+                        .take_while(|&&n| (position[n as usize] - p).length() <= r)
+                        .count()
+                        .max(BEYOND_SEARCH.min(beyond.len()))
+                };
+                let window = pre.len() - within(&pre, path[0])
+                    ..pre.len() + path.len() + within(&post, path[last]);
+                let i = window
                     .min_by(|&i, &j| {
                         radius[ext[i] as usize]
                             .total_cmp(&radius[ext[j] as usize])
@@ -237,9 +262,46 @@ pub fn gates(
                             .then(i.cmp(&j))
                     })
                     .unwrap_or(0);
+                // The middle of the run of nodes as narrow as it (within 2 %): the middle
+                // of a doorway's passage rather than one of its faces.
+                let r_min = radius[ext[i] as usize] * 1.02;
+                let narrow = |j: usize| radius[ext[j] as usize] <= r_min;
+                let (mut s, mut e) = (i, i);
+                while s > 0 && narrow(s - 1) {
+                    s -= 1;
+                }
+                while e + 1 < ext.len() && narrow(e + 1) {
+                    e += 1;
+                }
+                let i = (s + e) / 2;
                 let k = i.saturating_sub(pre.len()).min(path.len());
-                let lo = ext[i.saturating_sub(2)];
-                let hi = ext[(i + 2).min(ext.len() - 1)];
+                // Orthogonal to the line averaged over the disk's own size, so that a line
+                // that dips through a low doorway does not tilt the disk.
+                let (r_i, p_i) = (radius[ext[i] as usize], position[ext[i] as usize]);
+                let reach = |step: isize| -> u32 {
+                    let mut j = i as isize;
+                    loop {
+                        let next = j + step;
+                        if next < 0 || next >= ext.len() as isize {
+                            break;
+                        }
+                        j = next;
+                        let far = (position[ext[j as usize] as usize] - p_i).length() >= r_i;
+                        if far && (j - i as isize).abs() >= 2 {
+                            break;
+                        }
+                    }
+                    ext[j as usize]
+                };
+                // Along the narrow run itself where it is long enough to give a direction
+                // (a doorway's passage), else over about one radius each way.
+                let run = (position[ext[e] as usize] - p_i).length()
+                    + (position[ext[s] as usize] - p_i).length();
+                let (lo, hi) = if run >= 0.5 * r_i {
+                    (ext[s], ext[e])
+                } else {
+                    (reach(-1), reach(1))
+                };
                 let t = (position[hi as usize] - position[lo as usize]).normalize_or_zero();
                 let t = if t == Vec3::ZERO { along } else { t };
                 (position[ext[i] as usize], t, radius[ext[i] as usize], k)
@@ -260,4 +322,140 @@ pub fn gates(
         });
     }
     out
+}
+
+/// Gates of a sliver face each other within this angle's cosine (45°).
+const SLIVER_COS: f32 = std::f32::consts::FRAC_1_SQRT_2;
+
+/// A *sliver*: a cluster with two gates to two other clusters that face each other (normals
+/// within 45°), lie one behind the other along the normal (the line between their centres
+/// within 45° of it) and closer together than the smaller gate's radius — a cluster shallower than its opening is wide, as
+/// when a doorway in a thin wall, or a node just before it, makes a cluster of its own. Its
+/// voxels would be slabs reaching sideways into the rooms. Returns the first sliver (lowest
+/// cluster id) and the neighbour to merge it into: across one of those two gates, the one
+/// whose nodes have the largest max ball (the room), ties to the lower id — provided that
+/// ball is larger than the sliver's by more than `alpha` of it (the clustering tolerance).
+pub fn find_sliver(gates: &[GateDisk], cluster_radius: &[f32], alpha: f32) -> Option<(u32, u32)> {
+    let n = cluster_radius.len();
+    let mut of: Vec<Vec<(usize, u32)>> = vec![Vec::new(); n];
+    for (i, g) in gates.iter().enumerate() {
+        of[g.clusters[0] as usize].push((i, g.clusters[1]));
+        of[g.clusters[1] as usize].push((i, g.clusters[0]));
+    }
+    for (x, list) in of.iter().enumerate() {
+        for (k, &(gi, a)) in list.iter().enumerate() {
+            for &(gj, b) in &list[k + 1..] {
+                let (p, q) = (&gates[gi], &gates[gj]);
+                // Facing each other (within 45°), one behind the other along the normal (not
+                // side by side), closer than the smaller opening is wide: a slab across a
+                // doorway.
+                let d = q.centre - p.centre;
+                let facing = p.normal.dot(q.normal).abs() >= SLIVER_COS;
+                let stacked = d.dot(p.normal).abs() >= SLIVER_COS * d.length();
+                if a == b || !facing || !stacked || d.length() >= p.radius.min(q.radius) {
+                    continue;
+                }
+                let into = if cluster_radius[b as usize] > cluster_radius[a as usize]
+                    || (cluster_radius[b as usize] == cluster_radius[a as usize] && b < a)
+                {
+                    b
+                } else {
+                    a
+                };
+                // Only a slab markedly narrower than the space it joins (by more than the
+                // clustering tolerance) merges: the corner of a uniform corridor does not.
+                let (rx, ri) = (cluster_radius[x], cluster_radius[into as usize]);
+                if ri - rx > alpha * ri {
+                    return Some((x as u32, into));
+                }
+            }
+        }
+    }
+    None
+}
+
+/// Merges cluster `from` into `into`: relabels the segmented nodes, drops `from`'s seed and
+/// renumbers the clusters after it, so ids stay dense and in creation order.
+pub fn merge_cluster(node_cluster: &mut [u32], seeds: &mut Vec<u32>, from: u32, into: u32) {
+    for c in node_cluster.iter_mut() {
+        if *c == from {
+            *c = into;
+        }
+        if *c > from {
+            *c -= 1;
+        }
+    }
+    seeds.remove(from as usize);
+}
+
+/// Largest max-ball radius among each cluster's segmented nodes.
+pub fn cluster_radius(
+    seg: &SegmentedSkeleton,
+    node_cluster: &[u32],
+    radius: &[f32],
+    clusters: usize,
+) -> Vec<f32> {
+    let mut out = vec![0f32; clusters];
+    for (s, &c) in node_cluster.iter().enumerate() {
+        let r = radius[seg.nodes[s].skeleton_node as usize];
+        out[c as usize] = out[c as usize].max(r);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn gate(centre: [f32; 3], normal: [f32; 3], radius: f32, clusters: [u32; 2]) -> GateDisk {
+        GateDisk {
+            centre: Vec3::from(centre),
+            normal: Vec3::from(normal).normalize(),
+            radius,
+            clusters,
+            seg_edge: 0,
+            path_index: 0,
+        }
+    }
+
+    #[test]
+    fn a_doorway_slab_merges_into_the_wider_room_and_a_corridor_corner_does_not() {
+        // Rooms 0 (r 1.4) and 2 (r 1.5) either side of doorway cluster 1 (r 0.5), gates 0.2 m
+        // apart facing each other.
+        let gates = [
+            gate([4.0, 1.0, 2.0], [1.0, 0.0, 0.0], 0.5, [0, 1]),
+            gate([4.2, 1.0, 2.0], [1.0, 0.1, 0.0], 0.5, [1, 2]),
+        ];
+        assert_eq!(find_sliver(&gates, &[1.4, 0.5, 1.5], 0.2), Some((1, 2)));
+        // The same clusters, all as wide: nothing merges.
+        assert_eq!(find_sliver(&gates, &[0.5, 0.5, 0.5], 0.2), None);
+        // The corner of a uniform corridor (the ring's, as baked at 96): its two gates look
+        // like a slab, but the corner is as wide as the legs, so it stays.
+        let corner = [
+            gate([7.1, 1.2, 6.76], [-0.45, 0.0, 0.89], 0.67, [0, 1]),
+            gate([6.76, 1.2, 7.1], [-0.89, 0.0, 0.45], 0.67, [1, 2]),
+        ];
+        assert_eq!(find_sliver(&corner, &[0.67, 0.67, 0.67], 0.2), None);
+        // Two gates side by side in one plane are no slab, whatever the widths.
+        let side_by_side = [
+            gate([4.0, 1.0, 2.0], [1.0, 0.0, 0.0], 0.5, [0, 1]),
+            gate([4.0, 1.0, 2.3], [1.0, 0.0, 0.0], 0.5, [1, 2]),
+        ];
+        assert_eq!(find_sliver(&side_by_side, &[1.4, 0.5, 1.5], 0.2), None);
+        // Gates far apart (a corridor between rooms): nothing merges.
+        let far = [
+            gate([4.0, 1.0, 2.0], [1.0, 0.0, 0.0], 0.5, [0, 1]),
+            gate([6.0, 1.0, 2.0], [1.0, 0.0, 0.0], 0.5, [1, 2]),
+        ];
+        assert_eq!(find_sliver(&far, &[1.4, 0.5, 1.5], 0.2), None);
+    }
+
+    #[test]
+    fn merging_keeps_cluster_ids_dense() {
+        let mut node_cluster = vec![0, 1, 2, 3, 1];
+        let mut seeds = vec![10, 11, 12, 13];
+        merge_cluster(&mut node_cluster, &mut seeds, 1, 3);
+        assert_eq!(node_cluster, vec![0, 2, 1, 2, 2]);
+        assert_eq!(seeds, vec![10, 12, 13]);
+    }
 }

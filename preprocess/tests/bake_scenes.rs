@@ -169,11 +169,12 @@ fn ring_corridor_has_exactly_one_cycle() {
 
 #[test]
 fn four_rooms_cycles_equal_their_loops_and_l_corridor_is_a_tree() {
-    // Known limitation: at one of the four doorways the segmentation keeps a second node just
-    // inside a room; its cluster's nearest-node slab then crosses that room near the wall and
-    // the gate between it and the room is 1.09 m wide, so those two checks are not made here
-    // (they are for two-rooms, the ring and the L).
-    check_known_answers(Builtin::FourRooms, 96, false);
+    // Each room one cluster, gates in the doorways no wider than them. (At 200 voxels one
+    // doorway's gate comes out tilted by ~8° and its cut leaks round the floor, so one room
+    // corner keeps the per-voxel rule there: not checked.)
+    for res in [64, 96, 128, 160] {
+        check_known_answers(Builtin::FourRooms, res, true);
+    }
     check_known_answers(Builtin::LCorridor, 96, true);
     check_known_answers(Builtin::CornellBox, 64, true);
 }
