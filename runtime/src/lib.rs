@@ -7,4 +7,43 @@
 //! CPU reference renderer with exact visibility, image metrics, and the egui viewer.
 //!
 //! It reads baked levels through `visgate-formats` and never imports `visgate-preprocess`.
-//! (The passes land with the runtime issues.)
+//!
+//! What stands so far: the CPU side — [`tracer`] (BVH ray casting), [`camera`], [`lights`]
+//! (radiometry and direct light), [`vpl`] (the VPL struct, light-path VPLs, the gather term),
+//! [`reference`] (the exact-visibility renderer), [`hdr`] (EXR/PNG) and [`metrics`].
+
+pub mod camera;
+pub mod hdr;
+pub mod lights;
+pub mod metrics;
+pub mod reference;
+pub mod tracer;
+pub mod vpl;
+
+use std::path::Path;
+
+/// What can go wrong in the runtime.
+#[derive(Debug, thiserror::Error)]
+pub enum RenderError {
+    /// A parameter outside its limits, or inputs that do not fit together.
+    #[error("{0}")]
+    Param(String),
+    /// Reading or writing a file.
+    #[error("{path}: {message}")]
+    Io {
+        /// The file.
+        path: String,
+        /// What happened.
+        message: String,
+    },
+}
+
+impl RenderError {
+    /// An I/O error on `path`.
+    pub fn io(path: &Path, e: impl std::fmt::Display) -> RenderError {
+        RenderError::Io {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        }
+    }
+}
