@@ -1,8 +1,9 @@
-//! `visgate`: the one command-line tool — inspect scenes, meshes and baked levels, and list or
-//! export the built-in scenes.
+//! `visgate`: the one command-line tool — bake levels, render and compare images, inspect
+//! scenes, meshes and baked levels, and list or export the built-in scenes.
 
 mod bake;
 mod inspect;
+mod render;
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -20,6 +21,7 @@ A SCENE argument is any of:
 
 Examples:
   visgate bake builtin:two-rooms -o two-rooms.vgate
+  visgate render builtin:cornell-box --out cornell.png
   visgate inspect builtin:four-rooms
   visgate inspect --json ../shared/scenes/crytek_sponza/sponza.glb
   visgate scenes export two-rooms out/two-rooms
@@ -43,6 +45,11 @@ enum Command {
     /// Bake a scene's topology (skeleton, visibility clusters, gates) into a .vgate level.
     #[command(after_help = bake::AFTER_HELP)]
     Bake(bake::BakeArgs),
+    /// Render an image of a scene (CPU: exact reference, no indirect visibility, or direct only).
+    #[command(after_help = render::RENDER_HELP)]
+    Render(render::RenderArgs),
+    /// Compare an image with a reference: MSE, relative MSE, FLIP, and an error map.
+    Diff(render::DiffArgs),
     /// Print a summary of a scene, a mesh file or a baked .vgate level.
     Inspect {
         /// A scene (TOML, OBJ, glTF/GLB, builtin:NAME) or a baked .vgate file.
@@ -96,6 +103,8 @@ fn main() -> ExitCode {
 fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Bake(args) => bake::run(args),
+        Command::Render(args) => render::run(args),
+        Command::Diff(args) => render::diff(args),
         Command::Inspect {
             file,
             json,

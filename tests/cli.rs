@@ -290,3 +290,70 @@ fn bake_refuses_bad_arguments_clearly() {
     let o = visgate(&["bake", "nope.toml", "-o", out]);
     assert!(stderr(&o).contains("no such file"), "{}", stderr(&o));
 }
+
+#[test]
+fn render_writes_exr_and_png_and_diff_compares_them() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let p = |n: &str| dir.path().join(n).to_str().expect("utf-8").to_string();
+    for (mode, out) in [
+        ("reference", "ref.exr"),
+        ("none", "none.exr"),
+        ("direct-only", "direct.png"),
+    ] {
+        let o = visgate(&[
+            "render",
+            "builtin:cornell-box",
+            "--mode",
+            mode,
+            "--vpls",
+            "64",
+            "--size",
+            "24x16",
+            "--spp",
+            "1",
+            "--out",
+            &p(out),
+        ]);
+        assert!(o.status.success(), "{mode}: {}", stderr(&o));
+        assert!(stdout(&o).contains("wrote"), "{}", stdout(&o));
+    }
+    let o = visgate(&["diff", &p("none.exr"), &p("ref.exr"), "-o", &p("d.png")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    for want in ["MSE", "rel. MSE", "FLIP mean", "wrote"] {
+        assert!(text.contains(want), "missing {want}: {text}");
+    }
+    assert!(std::path::Path::new(&p("d.png")).exists());
+    // The same image against itself: zero error.
+    let o = visgate(&["diff", &p("ref.exr"), &p("ref.exr")]);
+    assert!(stdout(&o).contains("MSE        0.0"), "{}", stdout(&o));
+}
+
+#[test]
+fn render_and_diff_refuse_bad_arguments_clearly() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("x.exr");
+    let out = out.to_str().expect("utf-8");
+    for (args, want) in [
+        (vec!["--size", "0x10"], "1..=16384"),
+        (vec!["--size", "abc"], "WIDTHxHEIGHT"),
+        (vec!["--camera", "nope"], "no camera 'nope'"),
+        (vec!["--bounces", "0"], "bounces"),
+        (vec!["--spp", "0"], "samples per pixel"),
+        (vec!["--g-max", "0"], "clamp"),
+    ] {
+        let mut a = vec!["render", "builtin:cornell-box", "--out", out];
+        if !args.contains(&"--size") {
+            a.extend(["--size", "8x8"]);
+        }
+        a.extend(args.iter().copied());
+        let o = visgate(&a);
+        assert!(!o.status.success(), "{args:?} succeeded");
+        assert!(stderr(&o).contains(want), "{args:?}: {}", stderr(&o));
+    }
+    let o = visgate(&["render", "builtin:cornell-box", "--out", "x.jpg"]);
+    assert!(stderr(&o).contains(".exr"), "{}", stderr(&o));
+    let o = visgate(&["diff", "missing-a.exr", "missing-b.exr"]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("missing-a.exr"), "{}", stderr(&o));
+}

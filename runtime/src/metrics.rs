@@ -1,4 +1,5 @@
-//! Image error metrics against a reference: MSE, relative MSE, and per-pixel maps.
+//! Image error metrics against a reference: MSE, relative MSE, FLIP (NVIDIA's perceptual
+//! difference, LDR version, on the sRGB pictures at one exposure) and per-pixel maps.
 
 use glam::Vec3;
 
@@ -69,4 +70,21 @@ pub fn abs_error_map(a: &HdrImage, r: &HdrImage) -> Result<Vec<f32>, RenderError
         .zip(&r.pixels)
         .map(|(p, q)| ((*p - *q).abs()).dot(Vec3::ONE) / 3.0)
         .collect())
+}
+
+/// LDR-FLIP of `a` against reference `r`, both tone mapped at `exposure_stops`: the mean
+/// (FLIP's recommended single number, 0 = identical, 1 = maximal) and the per-pixel map.
+pub fn flip(
+    a: &HdrImage,
+    r: &HdrImage,
+    exposure_stops: f32,
+) -> Result<(f32, Vec<f32>), RenderError> {
+    same_size(a, r)?;
+    let to_flip = |img: &HdrImage| {
+        let rgb = img.to_srgb8(exposure_stops);
+        nv_flip::FlipImageRgb8::with_data(img.width, img.height, rgb.as_raw())
+    };
+    let map = nv_flip::flip(to_flip(r), to_flip(a), nv_flip::DEFAULT_PIXELS_PER_DEGREE);
+    let pool = nv_flip::FlipPool::from_image(&map);
+    Ok((pool.mean(), map.to_vec()))
 }

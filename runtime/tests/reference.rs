@@ -492,3 +492,28 @@ fn a_light_inside_geometry_lights_nothing_outside_it() {
     .expect("hit");
     assert_eq!(l, Vec3::ZERO);
 }
+
+#[test]
+fn metrics_are_zero_for_equal_images_and_grow_with_the_difference() {
+    use visgate_runtime::hdr::HdrImage;
+    use visgate_runtime::metrics::{errors, flip};
+    let mut a = HdrImage::new(32, 24);
+    for (i, p) in a.pixels.iter_mut().enumerate() {
+        *p = Vec3::splat((i % 7) as f32 * 0.1);
+    }
+    let e = errors(&a, &a).expect("same size");
+    assert_eq!((e.mse, e.rel_mse), (0.0, 0.0));
+    assert_eq!(flip(&a, &a, 0.0).expect("same size").0, 0.0);
+    let mut b = a.clone();
+    b.pixels.iter_mut().for_each(|p| *p *= 1.1);
+    let mut c = a.clone();
+    c.pixels.iter_mut().for_each(|p| *p *= 2.0);
+    let (eb, ec) = (errors(&b, &a).expect("ok"), errors(&c, &a).expect("ok"));
+    assert!(eb.mse > 0.0 && ec.mse > eb.mse && ec.rel_mse > eb.rel_mse);
+    let (fb, fc) = (
+        flip(&b, &a, 0.0).expect("ok").0,
+        flip(&c, &a, 0.0).expect("ok").0,
+    );
+    assert!(fb > 0.0 && fc > fb && fc <= 1.0, "{fb} {fc}");
+    assert!(errors(&HdrImage::new(3, 3), &a).is_err());
+}

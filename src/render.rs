@@ -1,0 +1,262 @@
+//! `visgate render` and `visgate diff`.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Context, Result, bail};
+use clap::{Args, ValueEnum};
+use indicatif::{ProgressBar, ProgressStyle};
+use visgate_formats::ImportOptions;
+use visgate_runtime::camera::View;
+use visgate_runtime::hdr::{HdrImage, false_colour};
+use visgate_runtime::metrics::{errors, flip};
+use visgate_runtime::reference::{ReferenceParams, render_reference};
+use visgate_runtime::tracer::Tracer;
+use visgate_runtime::vpl::{GatherParams, PathParams, path_vpls};
+
+pub const RENDER_HELP: &str = "\
+Modes (all on the CPU, with the exact ray-cast visibility of the reference where they use any):
+  reference    direct light with shadow rays + every VPL with a shadow ray per pixel sample
+  none         direct light with shadow rays + every VPL lighting every point (no indirect
+               shadows: the baseline that gates and virtual area lights improve on)
+  direct-only  direct light alone
+
+VPLs come from light paths traced from the scene's lights (--bounces generations, a VPL at every
+hit), deterministic for a --seed. Output: .exr is linear radiance (W/(m²·sr), for `visgate diff`),
+.png is sRGB at --exposure stops.
+
+Examples:
+  visgate render builtin:cornell-box --mode reference --vpls 4096 --out cornell.exr
+  visgate render builtin:four-rooms --mode none --size 320x240 --out none.png
+  visgate diff none.exr cornell.exr --out diff.png";
+
+/// Indirect-light visibility.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Mode {
+    /// Exact: a shadow ray per VPL and sample.
+    Reference,
+    /// No visibility on indirect light.
+    None,
+    /// Direct light only.
+    DirectOnly,
+}
+
+#[derive(Debug, Args)]
+pub struct RenderArgs {
+    /// The scene: a .toml, .obj, .gltf/.glb file or builtin:NAME.
+    pub scene: String,
+    /// Camera by name (default: the scene's first camera).
+    #[arg(long)]
+    pub camera: Option<String>,
+    /// Visibility of indirect light.
+    #[arg(long, value_enum, default_value_t = Mode::Reference)]
+    pub mode: Mode,
+    /// Light paths traced from the lights (VPLs: one per path and bounce that hits).
+    #[arg(long, default_value_t = 1024)]
+    pub vpls: u32,
+    /// VPL generations per path (1: one-bounce indirect light).
+    #[arg(long, default_value_t = 1)]
+    pub bounces: u32,
+    /// Seed of the VPLs' low-discrepancy sequence.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Image size, WIDTHxHEIGHT.
+    #[arg(long, default_value = "512x512")]
+    pub size: String,
+    /// Pixel samples (jittered).
+    #[arg(long, default_value_t = 4)]
+    pub spp: u32,
+    /// Upper bound of the VPL geometry term cos·cos/d², 1/m² (against spikes near VPLs).
+    #[arg(long, default_value_t = 10.0)]
+    pub g_max: f32,
+    /// Exposure of the PNG, in stops.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub exposure: f32,
+    /// Output image: .exr (linear) or .png (sRGB).
+    #[arg(long, short)]
+    pub out: PathBuf,
+    /// Rayon threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+}
+
+fn parse_size(s: &str) -> Result<[u32; 2]> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .with_context(|| format!("--size {s}: write WIDTHxHEIGHT, e.g. 512x512"))?;
+    let w: u32 = w
+        .trim()
+        .parse()
+        .with_context(|| format!("--size {s}: width is not a number"))?;
+    let h: u32 = h
+        .trim()
+        .parse()
+        .with_context(|| format!("--size {s}: height is not a number"))?;
+    Ok([w, h])
+}
+
+pub fn run(args: RenderArgs) -> Result<()> {
+    let size = parse_size(&args.size)?;
+    if !matches!(
+        args.out.extension().and_then(|e| e.to_str()),
+        Some("exr" | "png")
+    ) {
+        bail!(
+            "--out {}: write .exr (linear radiance) or .png (sRGB)",
+            args.out.display()
+        );
+    }
+    if args.threads == Some(0) {
+        bail!("--threads 0: give at least 1 thread, or leave it out to use all cores");
+    }
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(args.threads.unwrap_or(0))
+        .build()
+        .context("cannot start the thread pool")?;
+    let t = Instant::now();
+    let scene = crate::load_scene(
+        &args.scene,
+        &ImportOptions {
+            load_textures: true,
+        },
+    )?;
+    let load_s = t.elapsed().as_secs_f64();
+    let camera = match &args.camera {
+        Some(name) => scene.camera(name).cloned().with_context(|| {
+            let names: Vec<&str> = scene.cameras.iter().map(|c| c.name.as_str()).collect();
+            format!(
+                "{}: no camera '{name}'; its cameras are: {}",
+                args.scene,
+                if names.is_empty() {
+                    "none".to_string()
+                } else {
+                    names.join(", ")
+                }
+            )
+        })?,
+        None => scene.cameras.first().cloned().with_context(|| {
+            format!(
+                "{}: the scene has no camera; add a [[camera]] to its TOML (see README)",
+                args.scene
+            )
+        })?,
+    };
+    if scene.lights.is_empty() {
+        tracing::warn!(
+            "{}: the scene has no lights; the image is black",
+            args.scene
+        );
+    }
+    let view = View::new(&camera, size)?;
+    pool.install(|| -> Result<()> {
+        let t = Instant::now();
+        let tracer = Tracer::new(&scene);
+        let bvh_s = t.elapsed().as_secs_f64();
+        let t = Instant::now();
+        let vpls = if args.mode == Mode::DirectOnly {
+            Vec::new()
+        } else {
+            path_vpls(
+                &tracer,
+                &scene.lights,
+                &PathParams {
+                    paths: args.vpls,
+                    bounces: args.bounces,
+                    seed: args.seed,
+                },
+            )?
+        };
+        let vpl_s = t.elapsed().as_secs_f64();
+        let params = ReferenceParams {
+            samples_per_pixel: args.spp,
+            direct: true,
+            indirect: args.mode != Mode::DirectOnly,
+            indirect_visibility: args.mode == Mode::Reference,
+            gather: GatherParams { g_max: args.g_max },
+        };
+        let bar = ProgressBar::new(size[1] as u64).with_style(
+            ProgressStyle::with_template("render {bar:40} {pos}/{len} rows {elapsed}<{eta}")
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        let (img, stats) = render_reference(
+            &tracer,
+            &scene.lights,
+            &vpls,
+            &view,
+            &params,
+            &|done, _| bar.set_position(done as u64),
+        )?;
+        bar.finish_and_clear();
+        img.write(&args.out, args.exposure)?;
+        println!(
+            "{} {:?} {}x{} spp {}: {} triangles, {} VPLs from {} paths ({} bounce(s))",
+            scene.name,
+            args.mode,
+            size[0],
+            size[1],
+            args.spp,
+            tracer.triangle_count(),
+            vpls.len(),
+            args.vpls,
+            args.bounces
+        );
+        println!(
+            "times (CPU): load {load_s:.3} s, BVH {bvh_s:.3} s, VPL paths {vpl_s:.3} s, render {:.3} s",
+            stats.seconds
+        );
+        if stats.shadow_rays > 0 {
+            println!(
+                "shadow rays {} ({:.2} M/s), camera rays {}",
+                stats.shadow_rays,
+                stats.shadow_rays as f64 / stats.seconds.max(1e-9) / 1e6,
+                stats.camera_rays
+            );
+        }
+        let m = img.mean();
+        println!("mean radiance {:.5} {:.5} {:.5}", m.x, m.y, m.z);
+        println!("wrote {}", args.out.display());
+        Ok(())
+    })
+}
+
+#[derive(Debug, Args)]
+pub struct DiffArgs {
+    /// The image to judge (.exr).
+    pub image: PathBuf,
+    /// The reference (.exr).
+    pub reference: PathBuf,
+    /// Write the FLIP error map, false-coloured (black 0 … white 1), as a PNG.
+    #[arg(long, short)]
+    pub out: Option<PathBuf>,
+    /// Exposure both are tone mapped at for FLIP, in stops.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub exposure: f32,
+}
+
+pub fn diff(args: DiffArgs) -> Result<()> {
+    let a = HdrImage::read(&args.image)?;
+    let r = HdrImage::read(&args.reference)?;
+    let e = errors(&a, &r)?;
+    let (f, map) = flip(&a, &r, args.exposure)?;
+    println!("image      {}", args.image.display());
+    println!("reference  {}", args.reference.display());
+    println!("MSE        {:.6e}", e.mse);
+    println!("rel. MSE   {:.6e}", e.rel_mse);
+    println!(
+        "FLIP mean  {f:.5}  (LDR-FLIP at exposure {})",
+        args.exposure
+    );
+    println!(
+        "mean       {:.6e} vs {:.6e} ({:+.2} %)",
+        e.image_mean,
+        e.reference_mean,
+        100.0 * (e.image_mean / e.reference_mean.max(f64::MIN_POSITIVE) - 1.0)
+    );
+    if let Some(out) = &args.out {
+        false_colour(&map, a.width, a.height, 1.0)
+            .save(out)
+            .with_context(|| format!("cannot write {}", out.display()))?;
+        println!("wrote {}", out.display());
+    }
+    Ok(())
+}
