@@ -8,6 +8,7 @@ use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 use visgate_formats::ImportOptions;
 use visgate_runtime::camera::View;
+use visgate_runtime::gpu::{GpuContext, GpuMode, GpuParams, GpuRenderer};
 use visgate_runtime::hdr::{HdrImage, false_colour};
 use visgate_runtime::metrics::{errors, flip};
 use visgate_runtime::reference::{ReferenceParams, render_reference};
@@ -15,11 +16,13 @@ use visgate_runtime::tracer::Tracer;
 use visgate_runtime::vpl::{GatherParams, PathParams, path_vpls};
 
 pub const RENDER_HELP: &str = "\
-Modes (all on the CPU, with the exact ray-cast visibility of the reference where they use any):
-  reference    direct light with shadow rays + every VPL with a shadow ray per pixel sample
-  none         direct light with shadow rays + every VPL lighting every point (no indirect
-               shadows: the baseline that gates and virtual area lights improve on)
-  direct-only  direct light alone
+Modes:
+  reference    CPU: direct light with shadow rays + every VPL with a shadow ray per pixel
+               sample (exact visibility)
+  none         GPU: direct light with shadow maps (PCF) + every VPL lighting every point (no
+               indirect shadows: the baseline that gates and virtual area lights improve on)
+  direct-only  GPU: direct light alone
+With --cpu, none and direct-only run on the CPU twin (shadow rays for direct light).
 
 VPLs come from light paths traced from the scene's lights (--bounces generations, a VPL at every
 hit), deterministic for a --seed. Output: .exr is linear radiance (W/(m²·sr), for `visgate diff`),
@@ -28,6 +31,7 @@ hit), deterministic for a --seed. Output: .exr is linear radiance (W/(m²·sr), 
 Examples:
   visgate render builtin:cornell-box --mode reference --vpls 4096 --out cornell.exr
   visgate render builtin:four-rooms --mode none --size 320x240 --out none.png
+  visgate render builtin:four-rooms --mode none --cpu --out none-cpu.exr
   visgate diff none.exr cornell.exr --out diff.png";
 
 /// Indirect-light visibility.
@@ -75,6 +79,12 @@ pub struct RenderArgs {
     /// Output image: .exr (linear) or .png (sRGB).
     #[arg(long, short)]
     pub out: PathBuf,
+    /// Run none/direct-only on the CPU twin instead of the GPU.
+    #[arg(long)]
+    pub cpu: bool,
+    /// Shadow map size per layer (GPU), texels.
+    #[arg(long, default_value_t = 1024)]
+    pub shadow_size: u32,
     /// Rayon threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
@@ -167,6 +177,58 @@ pub fn run(args: RenderArgs) -> Result<()> {
             )?
         };
         let vpl_s = t.elapsed().as_secs_f64();
+        if args.mode != Mode::Reference && !args.cpu {
+            let t = Instant::now();
+            let ctx = GpuContext::new()?;
+            let open_s = t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            let gpu = GpuRenderer::new(&ctx, &scene)?;
+            let upload_s = t.elapsed().as_secs_f64();
+            let (img, times) = gpu.render(
+                &ctx,
+                &view,
+                &vpls,
+                &GpuParams {
+                    mode: if args.mode == Mode::None {
+                        GpuMode::None
+                    } else {
+                        GpuMode::DirectOnly
+                    },
+                    g_max: args.g_max,
+                    shadow_size: args.shadow_size,
+                    ..GpuParams::default()
+                },
+            )?;
+            img.write(&args.out, args.exposure)?;
+            println!(
+                "{} {:?} {}x{} on {} ({:?}): {} VPLs from {} paths ({} bounce(s))",
+                scene.name,
+                args.mode,
+                size[0],
+                size[1],
+                ctx.adapter_info.name,
+                ctx.adapter_info.backend,
+                vpls.len(),
+                args.vpls,
+                args.bounces
+            );
+            println!(
+                "times: load {load_s:.3} s, BVH {bvh_s:.3} s, VPL paths {vpl_s:.3} s, adapter \
+                 {open_s:.3} s, upload {upload_s:.3} s"
+            );
+            println!(
+                "passes (CPU wall, each submitted and waited for): shadow maps {:.2} ms, \
+                 G-buffer {:.2} ms, shading {:.2} ms, readback {:.2} ms",
+                times.shadows * 1e3,
+                times.gbuffer * 1e3,
+                times.shade * 1e3,
+                times.readback * 1e3
+            );
+            let m = img.mean();
+            println!("mean radiance {:.5} {:.5} {:.5}", m.x, m.y, m.z);
+            println!("wrote {}", args.out.display());
+            return Ok(());
+        }
         let params = ReferenceParams {
             samples_per_pixel: args.spp,
             direct: true,

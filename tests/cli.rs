@@ -317,6 +317,25 @@ fn render_writes_exr_and_png_and_diff_compares_them() {
         assert!(o.status.success(), "{mode}: {}", stderr(&o));
         assert!(stdout(&o).contains("wrote"), "{}", stdout(&o));
     }
+    // The CPU twin of none agrees with the GPU's none.
+    let o = visgate(&[
+        "render",
+        "builtin:cornell-box",
+        "--mode",
+        "none",
+        "--cpu",
+        "--vpls",
+        "64",
+        "--size",
+        "24x16",
+        "--spp",
+        "1",
+        "--out",
+        &p("none-cpu.exr"),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let o = visgate(&["diff", &p("none.exr"), &p("none-cpu.exr")]);
+    assert!(o.status.success(), "{}", stderr(&o));
     let o = visgate(&["diff", &p("none.exr"), &p("ref.exr"), "-o", &p("d.png")]);
     assert!(o.status.success(), "{}", stderr(&o));
     let text = stdout(&o);

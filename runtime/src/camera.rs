@@ -72,3 +72,36 @@ impl View {
         (self.forward + self.right * ndc.x * t.x + self.up * ndc.y * t.y).normalize()
     }
 }
+
+/// Right-handed view matrix looking along unit `forward` (to −z), `up` roughly up.
+pub fn look_to(eye: Vec3, forward: Vec3, up: Vec3) -> glam::Mat4 {
+    let f = forward.normalize();
+    let s = f.cross(up).normalize();
+    let u = s.cross(f);
+    glam::Mat4::from_cols(
+        glam::Vec4::new(s.x, u.x, -f.x, 0.0),
+        glam::Vec4::new(s.y, u.y, -f.y, 0.0),
+        glam::Vec4::new(s.z, u.z, -f.z, 0.0),
+        glam::Vec4::new(-s.dot(eye), -u.dot(eye), f.dot(eye), 1.0),
+    )
+}
+
+/// Perspective to wgpu clip space (depth 0 at `near`, 1 at `far`) with image-plane half
+/// extents `tan_x`, `tan_y` at distance 1.
+pub fn perspective(tan_x: f32, tan_y: f32, near: f32, far: f32) -> glam::Mat4 {
+    let a = far / (near - far);
+    glam::Mat4::from_cols(
+        glam::Vec4::new(1.0 / tan_x, 0.0, 0.0, 0.0),
+        glam::Vec4::new(0.0, 1.0 / tan_y, 0.0, 0.0),
+        glam::Vec4::new(0.0, 0.0, a, -1.0),
+        glam::Vec4::new(0.0, 0.0, near * a, 0.0),
+    )
+}
+
+impl View {
+    /// View-projection to wgpu clip space matching [`View::ray_dir`] at pixel centres.
+    pub fn view_proj(&self, near: f32, far: f32) -> glam::Mat4 {
+        let t = self.tan_half();
+        perspective(t.x, t.y, near, far) * look_to(self.eye, self.forward, self.up)
+    }
+}

@@ -13,6 +13,7 @@
 //! [`reference`] (the exact-visibility renderer), [`hdr`] (EXR/PNG) and [`metrics`].
 
 pub mod camera;
+pub mod gpu;
 pub mod hdr;
 pub mod lights;
 pub mod metrics;
@@ -28,6 +29,12 @@ pub enum RenderError {
     /// A parameter outside its limits, or inputs that do not fit together.
     #[error("{0}")]
     Param(String),
+    /// No GPU adapter, or it could not be opened.
+    #[error("no usable GPU adapter: {0}")]
+    NoAdapter(String),
+    /// The GPU failed at something it should do.
+    #[error("GPU: {0}")]
+    Gpu(String),
     /// Reading or writing a file.
     #[error("{path}: {message}")]
     Io {

@@ -1,0 +1,775 @@
+//! The wgpu renderer: G-buffer → shadow maps → deferred direct light with PCF and the VPL
+//! gather → a linear HDR texture, read back as an [`HdrImage`]. One [`GpuRenderer::render`] for
+//! any offscreen target size.
+//!
+//! Shadow maps: a 2D array of R32Float distance layers, 6 per point light (cube faces ±X, ±Y,
+//! ±Z, 90° each) and 1 per spot (its cutoff cone), `shadow_size`² each; lookups offset the
+//! point along its normal and compare with a bias, both in texels of the layer at that
+//! distance, and filter 3 × 3 (PCF).
+//!
+//! What stands: modes `none` (every VPL lights every pixel) and `direct-only`. Per-VPL shadow
+//! maps, GPU RSM VPLs and timestamp queries come next.
+
+use std::time::Instant;
+
+use bytemuck::{Pod, Zeroable};
+use glam::Vec3;
+use visgate_formats::{Light, Scene};
+use wgpu::util::DeviceExt;
+
+use crate::RenderError;
+use crate::camera::{View, look_to, perspective};
+use crate::hdr::HdrImage;
+use crate::vpl::Vpl;
+
+const GBUFFER_WGSL: &str = include_str!("shaders/gbuffer.wgsl");
+const SHADOW_WGSL: &str = include_str!("shaders/shadow.wgsl");
+const SHADE_WGSL: &str = include_str!("shaders/shade.wgsl");
+
+/// The WGSL sources, for validation without a GPU.
+pub const SHADERS: [(&str, &str); 3] = [
+    ("gbuffer.wgsl", GBUFFER_WGSL),
+    ("shadow.wgsl", SHADOW_WGSL),
+    ("shade.wgsl", SHADE_WGSL),
+];
+
+/// Per-frame constants, shared with WGSL (`Globals` in every shader). 112 bytes.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct Globals {
+    /// Camera view-projection, column-major. Written by [`GpuRenderer::render`].
+    pub view_proj: [[f32; 4]; 4],
+    /// Eye position (xyz, m), w unused.
+    pub eye: [f32; 4],
+    /// x: geometry-term clamp (1/m²), y: shadow normal offset (texels), z: shadow bias
+    /// (texels), w unused.
+    pub params: [f32; 4],
+    /// x: VPL count, y: light count, z: mode (0 none, 1 direct-only), w: shadow map size.
+    pub counts: [u32; 4],
+}
+
+/// A light, shared with WGSL (`Light` in shade.wgsl). 64 bytes.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuLight {
+    /// xyz position (m), w kind (0 point, 1 spot).
+    pub position: [f32; 4],
+    /// rgb intensity (W/sr), w beam half-angle (rad).
+    pub intensity: [f32; 4],
+    /// xyz unit axis, w cutoff half-angle (rad).
+    pub direction: [f32; 4],
+    /// x first shadow layer, y layer count.
+    pub layers: [u32; 4],
+}
+
+/// One shadow layer's view, shared with WGSL (`ShadowView` in shadow.wgsl). 80 bytes, placed
+/// at 256-byte strides.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct ShadowView {
+    /// The layer's view-projection.
+    pub view_proj: [[f32; 4]; 4],
+    /// xyz light position (m).
+    pub light: [f32; 4],
+}
+
+/// Indirect-light visibility on the GPU.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GpuMode {
+    /// Every VPL lights every pixel.
+    None,
+    /// Direct light only.
+    DirectOnly,
+}
+
+/// Rendering parameters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GpuParams {
+    /// Visibility mode.
+    pub mode: GpuMode,
+    /// Geometry-term clamp. [Units: 1/m²] [Limit: > 0]
+    pub g_max: f32,
+    /// Shadow map layer size. [Units: texels] [Limit: 16..=4096]
+    pub shadow_size: u32,
+    /// Normal offset of shadow lookups. [Units: texels]
+    pub shadow_normal_offset: f32,
+    /// Depth bias of shadow lookups. [Units: texels]
+    pub shadow_bias: f32,
+}
+
+impl Default for GpuParams {
+    fn default() -> Self {
+        GpuParams {
+            mode: GpuMode::None,
+            g_max: 10.0,
+            shadow_size: 1024,
+            shadow_normal_offset: 1.5,
+            shadow_bias: 1.0,
+        }
+    }
+}
+
+/// Wall times of the passes (CPU side, each pass submitted and waited for). [Units: s]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct PassTimes {
+    /// Shadow maps.
+    pub shadows: f64,
+    /// G-buffer.
+    pub gbuffer: f64,
+    /// Direct and indirect shading.
+    pub shade: f64,
+    /// Copy back to the CPU.
+    pub readback: f64,
+}
+
+/// A device and queue.
+pub struct GpuContext {
+    /// The device.
+    pub device: wgpu::Device,
+    /// Its queue.
+    pub queue: wgpu::Queue,
+    /// What the adapter says it is.
+    pub adapter_info: wgpu::AdapterInfo,
+}
+
+impl GpuContext {
+    /// Opens the first adapter wgpu finds (backends from `WGPU_BACKEND`, else all that are
+    /// built in); an error that says what to install when there is none.
+    pub fn new() -> Result<GpuContext, RenderError> {
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            force_fallback_adapter: false,
+            compatible_surface: None,
+            apply_limit_buckets: false,
+        }))
+        .map_err(|e| {
+            RenderError::NoAdapter(format!(
+                "{e}. Install a Vulkan driver (on Debian/Ubuntu without a GPU: apt-get install \
+                 mesa-vulkan-drivers for the software driver, lavapipe), or Metal/DX12 on macOS/Windows"
+            ))
+        })?;
+        let adapter_info = adapter.get_info();
+        let limits = wgpu::Limits {
+            max_texture_array_layers: adapter.limits().max_texture_array_layers,
+            max_storage_buffer_binding_size: adapter.limits().max_storage_buffer_binding_size,
+            ..wgpu::Limits::downlevel_defaults()
+        };
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("visgate device"),
+            required_features: wgpu::Features::empty(),
+            required_limits: limits,
+            ..Default::default()
+        }))
+        .map_err(|e| RenderError::NoAdapter(format!("cannot open {}: {e}", adapter_info.name)))?;
+        Ok(GpuContext {
+            device,
+            queue,
+            adapter_info,
+        })
+    }
+
+    fn wait(&self) {
+        let _ = self.device.poll(wgpu::PollType::wait_indefinitely());
+    }
+}
+
+/// The scene on the GPU and the pipelines.
+pub struct GpuRenderer {
+    vertices: wgpu::Buffer,
+    vertex_count: u32,
+    lights: Vec<Light>,
+    near_m: f32,
+    far_m: f32,
+    gbuffer: wgpu::RenderPipeline,
+    shadow: wgpu::RenderPipeline,
+    shade: wgpu::RenderPipeline,
+}
+
+/// Vertex layout: position, normal, albedo (f32 × 3 each).
+const VERTEX_STRIDE: u64 = 36;
+
+impl GpuRenderer {
+    /// Uploads every mesh of `scene` (albedo per vertex from its material; textures are not
+    /// sampled yet) and builds the pipelines.
+    pub fn new(ctx: &GpuContext, scene: &Scene) -> Result<GpuRenderer, RenderError> {
+        let mut data: Vec<f32> = Vec::new();
+        for m in &scene.meshes {
+            for (t, idx) in m.triangles.iter().enumerate() {
+                let albedo = m
+                    .material
+                    .get(t)
+                    .and_then(|&k| scene.materials.get(k as usize))
+                    .map(|mat| mat.albedo)
+                    .unwrap_or(Vec3::splat(0.5));
+                let p = idx.map(|i| m.positions[i as usize]);
+                if (p[1] - p[0]).cross(p[2] - p[0]).length_squared() <= 0.0 {
+                    continue;
+                }
+                for (k, &i) in idx.iter().enumerate() {
+                    let n = m.normals.get(i as usize).copied().unwrap_or(Vec3::Y);
+                    data.extend_from_slice(&p[k].to_array());
+                    data.extend_from_slice(&n.to_array());
+                    data.extend_from_slice(&albedo.to_array());
+                }
+            }
+        }
+        let vertex_count = (data.len() / 9) as u32;
+        if data.is_empty() {
+            data.resize(9, 0.0);
+        }
+        let d = &ctx.device;
+        let vertices = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("scene vertices"),
+            contents: bytemuck::cast_slice(&data),
+            usage: wgpu::BufferUsages::VERTEX,
+        });
+        let size = scene
+            .bounds()
+            .map(|(lo, hi)| (hi - lo).length())
+            .unwrap_or(1.0)
+            .max(1e-6);
+        let module = |label: &str, src: &str| {
+            d.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some(label),
+                source: wgpu::ShaderSource::Wgsl(src.into()),
+            })
+        };
+        let gb = module("gbuffer.wgsl", GBUFFER_WGSL);
+        let sh = module("shadow.wgsl", SHADOW_WGSL);
+        let sd = module("shade.wgsl", SHADE_WGSL);
+        let attrs = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3];
+        let layout = wgpu::VertexBufferLayout {
+            array_stride: VERTEX_STRIDE,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &attrs,
+        };
+        let pos_only = [wgpu::VertexAttribute {
+            format: wgpu::VertexFormat::Float32x3,
+            offset: 0,
+            shader_location: 0,
+        }];
+        let pos_layout = wgpu::VertexBufferLayout {
+            array_stride: VERTEX_STRIDE,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &pos_only,
+        };
+        let depth = Some(wgpu::DepthStencilState {
+            format: wgpu::TextureFormat::Depth32Float,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Less),
+            stencil: Default::default(),
+            bias: Default::default(),
+        });
+        let target = |f: wgpu::TextureFormat| {
+            Some(wgpu::ColorTargetState {
+                format: f,
+                blend: None,
+                write_mask: wgpu::ColorWrites::ALL,
+            })
+        };
+        let pipeline = |label: &str,
+                        m: &wgpu::ShaderModule,
+                        buffers: &[Option<wgpu::VertexBufferLayout>],
+                        targets: &[Option<wgpu::ColorTargetState>],
+                        depth: Option<wgpu::DepthStencilState>| {
+            d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: None,
+                vertex: wgpu::VertexState {
+                    module: m,
+                    entry_point: Some("vs"),
+                    buffers,
+                    compilation_options: Default::default(),
+                },
+                primitive: wgpu::PrimitiveState::default(),
+                depth_stencil: depth,
+                multisample: wgpu::MultisampleState::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: m,
+                    entry_point: Some("fs"),
+                    targets,
+                    compilation_options: Default::default(),
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let gbuffer = pipeline(
+            "gbuffer",
+            &gb,
+            &[Some(layout)],
+            &[
+                target(wgpu::TextureFormat::Rgba32Float),
+                target(wgpu::TextureFormat::Rgba16Float),
+                target(wgpu::TextureFormat::Rgba16Float),
+            ],
+            depth.clone(),
+        );
+        let shadow = pipeline(
+            "shadow",
+            &sh,
+            &[Some(pos_layout)],
+            &[target(wgpu::TextureFormat::R32Float)],
+            depth,
+        );
+        let shade = pipeline(
+            "shade",
+            &sd,
+            &[],
+            &[target(wgpu::TextureFormat::Rgba32Float)],
+            None,
+        );
+        Ok(GpuRenderer {
+            vertices,
+            vertex_count,
+            lights: scene.lights.clone(),
+            near_m: size * 1e-4,
+            far_m: size * 4.0,
+            gbuffer,
+            shadow,
+            shade,
+        })
+    }
+
+    /// The shadow layers' view-projections and the lights as the GPU sees them.
+    fn light_views(&self) -> (Vec<GpuLight>, Vec<ShadowView>) {
+        let mut lights = Vec::new();
+        let mut views = Vec::new();
+        let (near, far) = (self.near_m, self.far_m);
+        for l in &self.lights {
+            match *l {
+                Light::Point {
+                    position,
+                    intensity,
+                } => {
+                    let first = views.len() as u32;
+                    let faces = [
+                        (Vec3::X, Vec3::NEG_Y),
+                        (Vec3::NEG_X, Vec3::NEG_Y),
+                        (Vec3::Y, Vec3::Z),
+                        (Vec3::NEG_Y, Vec3::NEG_Z),
+                        (Vec3::Z, Vec3::NEG_Y),
+                        (Vec3::NEG_Z, Vec3::NEG_Y),
+                    ];
+                    for (f, up) in faces {
+                        let vp = perspective(1.0, 1.0, near, far) * look_to(position, f, up);
+                        views.push(ShadowView {
+                            view_proj: vp.to_cols_array_2d(),
+                            light: position.extend(1.0).to_array(),
+                        });
+                    }
+                    lights.push(GpuLight {
+                        position: position.extend(0.0).to_array(),
+                        intensity: intensity.extend(0.0).to_array(),
+                        direction: [0.0, -1.0, 0.0, 0.0],
+                        layers: [first, 6, 0, 0],
+                    });
+                }
+                Light::Spot {
+                    position,
+                    direction,
+                    intensity,
+                    cutoff_rad,
+                    beam_rad,
+                } => {
+                    let first = views.len() as u32;
+                    let up = if direction.y.abs() > 0.9 {
+                        Vec3::Z
+                    } else {
+                        Vec3::Y
+                    };
+                    let t = cutoff_rad.min(1.5).tan();
+                    let vp = perspective(t, t, near, far) * look_to(position, direction, up);
+                    views.push(ShadowView {
+                        view_proj: vp.to_cols_array_2d(),
+                        light: position.extend(1.0).to_array(),
+                    });
+                    lights.push(GpuLight {
+                        position: position.extend(1.0).to_array(),
+                        intensity: intensity.extend(beam_rad).to_array(),
+                        direction: direction.extend(cutoff_rad).to_array(),
+                        layers: [first, 1, 0, 0],
+                    });
+                }
+            }
+        }
+        (lights, views)
+    }
+
+    /// Renders `view` with `vpls` and returns the linear HDR image and the pass times.
+    pub fn render(
+        &self,
+        ctx: &GpuContext,
+        view: &View,
+        vpls: &[Vpl],
+        params: &GpuParams,
+    ) -> Result<(HdrImage, PassTimes), RenderError> {
+        if params.g_max.is_nan() || params.g_max <= 0.0 {
+            return Err(RenderError::Param(format!(
+                "geometry-term clamp {} must be > 0",
+                params.g_max
+            )));
+        }
+        if !(16..=4096).contains(&params.shadow_size) {
+            return Err(RenderError::Param(format!(
+                "shadow map size {} must be 16..=4096",
+                params.shadow_size
+            )));
+        }
+        let d = &ctx.device;
+        let [w, h] = view.size;
+        let mut times = PassTimes::default();
+        let (gpu_lights, shadow_views) = self.light_views();
+        let layers = shadow_views.len().max(1) as u32;
+        if layers > d.limits().max_texture_array_layers {
+            return Err(RenderError::Param(format!(
+                "{} shadow layers exceed the adapter's {}",
+                layers,
+                d.limits().max_texture_array_layers
+            )));
+        }
+        let vpl_bytes = std::mem::size_of_val(vpls) as u64;
+        if vpl_bytes > d.limits().max_storage_buffer_binding_size {
+            return Err(RenderError::Param(format!(
+                "{} VPLs need {vpl_bytes} bytes, more than the adapter's storage binding limit {}",
+                vpls.len(),
+                d.limits().max_storage_buffer_binding_size
+            )));
+        }
+        let tex = |label: &str, size: [u32; 3], format: wgpu::TextureFormat, usage| {
+            d.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size: wgpu::Extent3d {
+                    width: size[0],
+                    height: size[1],
+                    depth_or_array_layers: size[2],
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+        };
+        let rt = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+        let s = params.shadow_size;
+        let shadow_tex = tex(
+            "shadow maps",
+            [s, s, layers],
+            wgpu::TextureFormat::R32Float,
+            rt,
+        );
+        let shadow_depth = tex(
+            "shadow depth",
+            [s, s, 1],
+            wgpu::TextureFormat::Depth32Float,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        );
+        // 1. Shadow maps, one pass per layer.
+        let t0 = Instant::now();
+        let stride = 256u64;
+        let mut sv_bytes = vec![0u8; (stride as usize) * shadow_views.len().max(1)];
+        for (i, v) in shadow_views.iter().enumerate() {
+            let b = bytemuck::bytes_of(v);
+            sv_bytes[i * stride as usize..i * stride as usize + b.len()].copy_from_slice(b);
+        }
+        let sv_buf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("shadow views"),
+            contents: &sv_bytes,
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("shadow maps"),
+        });
+        let depth_view = shadow_depth.create_view(&Default::default());
+        for (i, _) in shadow_views.iter().enumerate() {
+            let layer_view = shadow_tex.create_view(&wgpu::TextureViewDescriptor {
+                label: Some("shadow layer"),
+                dimension: Some(wgpu::TextureViewDimension::D2),
+                base_array_layer: i as u32,
+                array_layer_count: Some(1),
+                ..Default::default()
+            });
+            let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("shadow view"),
+                layout: &self.shadow.get_bind_group_layout(0),
+                entries: &[wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                        buffer: &sv_buf,
+                        offset: i as u64 * stride,
+                        size: std::num::NonZeroU64::new(std::mem::size_of::<ShadowView>() as u64),
+                    }),
+                }],
+            });
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("shadow layer"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &layer_view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color {
+                            r: 1e30,
+                            g: 0.0,
+                            b: 0.0,
+                            a: 0.0,
+                        }),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &depth_view,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Discard,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&self.shadow);
+            pass.set_bind_group(0, &bg, &[]);
+            pass.set_vertex_buffer(0, self.vertices.slice(..));
+            pass.draw(0..self.vertex_count, 0..1);
+        }
+        ctx.queue.submit([enc.finish()]);
+        ctx.wait();
+        times.shadows = t0.elapsed().as_secs_f64();
+
+        // 2. G-buffer.
+        let t0 = Instant::now();
+        let globals = Globals {
+            view_proj: view.view_proj(self.near_m, self.far_m).to_cols_array_2d(),
+            eye: view.eye.extend(1.0).to_array(),
+            params: [
+                params.g_max,
+                params.shadow_normal_offset,
+                params.shadow_bias,
+                0.0,
+            ],
+            counts: [
+                vpls.len() as u32,
+                gpu_lights.len() as u32,
+                match params.mode {
+                    GpuMode::None => 0,
+                    GpuMode::DirectOnly => 1,
+                },
+                s,
+            ],
+        };
+        let globals_buf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("globals"),
+            contents: bytemuck::bytes_of(&globals),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let g_pos = tex(
+            "g position",
+            [w, h, 1],
+            wgpu::TextureFormat::Rgba32Float,
+            rt,
+        );
+        let g_nrm = tex("g normal", [w, h, 1], wgpu::TextureFormat::Rgba16Float, rt);
+        let g_alb = tex("g albedo", [w, h, 1], wgpu::TextureFormat::Rgba16Float, rt);
+        let g_depth = tex(
+            "g depth",
+            [w, h, 1],
+            wgpu::TextureFormat::Depth32Float,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        );
+        let views = [&g_pos, &g_nrm, &g_alb].map(|t| t.create_view(&Default::default()));
+        let gdepth_view = g_depth.create_view(&Default::default());
+        let gbg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("gbuffer globals"),
+            layout: &self.gbuffer.get_bind_group_layout(0),
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: globals_buf.as_entire_binding(),
+            }],
+        });
+        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("gbuffer"),
+        });
+        {
+            let clear = |v| {
+                Some(wgpu::RenderPassColorAttachment {
+                    view: v,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })
+            };
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("gbuffer"),
+                color_attachments: &[clear(&views[0]), clear(&views[1]), clear(&views[2])],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &gdepth_view,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Discard,
+                    }),
+                    stencil_ops: None,
+                }),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&self.gbuffer);
+            pass.set_bind_group(0, &gbg, &[]);
+            pass.set_vertex_buffer(0, self.vertices.slice(..));
+            pass.draw(0..self.vertex_count, 0..1);
+        }
+        ctx.queue.submit([enc.finish()]);
+        ctx.wait();
+        times.gbuffer = t0.elapsed().as_secs_f64();
+
+        // 3. Shade.
+        let t0 = Instant::now();
+        let storage = |label: &str, bytes: &[u8]| {
+            let mut v = bytes.to_vec();
+            if v.is_empty() {
+                v.resize(64, 0);
+            }
+            d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: &v,
+                usage: wgpu::BufferUsages::STORAGE,
+            })
+        };
+        let lights_buf = storage("lights", bytemuck::cast_slice(&gpu_lights));
+        let vpl_buf = storage("vpls", bytemuck::cast_slice(vpls));
+        let mats: Vec<[[f32; 4]; 4]> = shadow_views.iter().map(|v| v.view_proj).collect();
+        let mats_buf = storage("shadow matrices", bytemuck::cast_slice(&mats));
+        let shadow_array_view = shadow_tex.create_view(&wgpu::TextureViewDescriptor {
+            label: Some("shadow maps"),
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        let out = tex(
+            "hdr",
+            [w, h, 1],
+            wgpu::TextureFormat::Rgba32Float,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        );
+        let out_view = out.create_view(&Default::default());
+        let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("shade"),
+            layout: &self.shade.get_bind_group_layout(0),
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: globals_buf.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: lights_buf.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: vpl_buf.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: mats_buf.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: wgpu::BindingResource::TextureView(&shadow_array_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: wgpu::BindingResource::TextureView(&views[0]),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 6,
+                    resource: wgpu::BindingResource::TextureView(&views[1]),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 7,
+                    resource: wgpu::BindingResource::TextureView(&views[2]),
+                },
+            ],
+        });
+        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("shade"),
+        });
+        {
+            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("shade"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &out_view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            pass.set_pipeline(&self.shade);
+            pass.set_bind_group(0, &bg, &[]);
+            pass.draw(0..3, 0..1);
+        }
+        ctx.queue.submit([enc.finish()]);
+        ctx.wait();
+        times.shade = t0.elapsed().as_secs_f64();
+
+        // 4. Read back.
+        let t0 = Instant::now();
+        let row = (w as u64 * 16).div_ceil(256) * 256;
+        let read = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size: row * h as u64,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("readback"),
+        });
+        enc.copy_texture_to_buffer(
+            out.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &read,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(row as u32),
+                    rows_per_image: Some(h),
+                },
+            },
+            out.size(),
+        );
+        ctx.queue.submit([enc.finish()]);
+        let slice = read.slice(..);
+        slice.map_async(wgpu::MapMode::Read, |_| {});
+        ctx.wait();
+        let mut img = HdrImage::new(w, h);
+        {
+            let bytes = slice
+                .get_mapped_range()
+                .map_err(|e| RenderError::Gpu(format!("cannot read the image back: {e}")))?;
+            for y in 0..h {
+                let r = &bytes[(y as u64 * row) as usize..][..(w as usize * 16)];
+                let px: &[f32] = bytemuck::cast_slice(r);
+                for x in 0..w as usize {
+                    img.pixels[(y * w) as usize + x] =
+                        Vec3::new(px[4 * x], px[4 * x + 1], px[4 * x + 2]);
+                }
+            }
+        }
+        read.unmap();
+        times.readback = t0.elapsed().as_secs_f64();
+        Ok((img, times))
+    }
+}

@@ -1,0 +1,57 @@
+// G-buffer pass: world position (w = 1 where a surface is), shading normal turned towards the
+// camera (surfaces are two-sided), linear albedo. Depth test less, depth 0 near.
+
+struct Globals {
+    view_proj: mat4x4<f32>,
+    eye: vec4<f32>,
+    // x: geometry-term clamp g_max (1/m²), y: shadow normal offset in texels, z: shadow bias in
+    // texels, w: unused.
+    params: vec4<f32>,
+    // x: VPL count, y: light count, z: mode (0 none, 1 direct-only), w: shadow map size.
+    counts: vec4<u32>,
+};
+
+@group(0) @binding(0) var<uniform> globals: Globals;
+
+struct VsIn {
+    @location(0) position: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) albedo: vec3<f32>,
+};
+
+struct VsOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) albedo: vec3<f32>,
+};
+
+@vertex
+fn vs(v: VsIn) -> VsOut {
+    var o: VsOut;
+    o.clip = globals.view_proj * vec4<f32>(v.position, 1.0);
+    o.world = v.position;
+    o.normal = v.normal;
+    o.albedo = v.albedo;
+    return o;
+}
+
+struct GOut {
+    @location(0) position: vec4<f32>,
+    @location(1) normal: vec4<f32>,
+    @location(2) albedo: vec4<f32>,
+};
+
+@fragment
+fn fs(i: VsOut) -> GOut {
+    var n = normalize(i.normal);
+    // Two-sided: face the camera.
+    if dot(n, globals.eye.xyz - i.world) < 0.0 {
+        n = -n;
+    }
+    var o: GOut;
+    o.position = vec4<f32>(i.world, 1.0);
+    o.normal = vec4<f32>(n, 0.0);
+    o.albedo = vec4<f32>(i.albedo, 1.0);
+    return o;
+}

@@ -1,0 +1,175 @@
+//! The wgpu renderer against the CPU reference with the same VPLs and the same visibility
+//! choice, on whatever adapter wgpu finds (lavapipe in CI). A missing adapter fails the test.
+
+use std::f32::consts::PI;
+
+use glam::Vec3;
+use visgate_runtime::camera::View;
+use visgate_runtime::gpu::{GpuContext, GpuMode, GpuParams, GpuRenderer, SHADERS};
+use visgate_runtime::metrics::{errors, flip};
+use visgate_runtime::reference::{ReferenceParams, render_reference};
+use visgate_runtime::tracer::Tracer;
+use visgate_runtime::vpl::{GatherParams, PathParams, path_vpls};
+use visgate_scenes::Builtin;
+
+fn context() -> GpuContext {
+    match GpuContext::new() {
+        Ok(c) => c,
+        Err(e) => panic!("GPU tests need an adapter (CI installs lavapipe): {e}"),
+    }
+}
+
+#[test]
+fn every_shader_parses_and_validates_without_a_gpu() {
+    for (name, src) in SHADERS {
+        let module = naga::front::wgsl::parse_str(src)
+            .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(src)));
+        naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::all(),
+        )
+        .validate(&module)
+        .unwrap_or_else(|e| panic!("{name}: {e:?}"));
+    }
+}
+
+/// CPU (spp 1, pixel centres) and GPU images of a built-in scene's first camera.
+fn both(
+    b: Builtin,
+    size: [u32; 2],
+    paths: u32,
+    mode: GpuMode,
+) -> (
+    visgate_runtime::hdr::HdrImage,
+    visgate_runtime::hdr::HdrImage,
+) {
+    let ctx = context();
+    let scene = b.scene().expect("scene");
+    let tracer = Tracer::new(&scene);
+    let vpls = path_vpls(
+        &tracer,
+        &scene.lights,
+        &PathParams {
+            paths,
+            bounces: 1,
+            seed: 2,
+        },
+    )
+    .expect("vpls");
+    let view = View::new(scene.cameras.first().expect("camera"), size).expect("view");
+    let gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    let (img, _) = gpu
+        .render(
+            &ctx,
+            &view,
+            &vpls,
+            &GpuParams {
+                mode,
+                ..GpuParams::default()
+            },
+        )
+        .expect("render");
+    let (cpu, _) = render_reference(
+        &tracer,
+        &scene.lights,
+        &vpls,
+        &view,
+        &ReferenceParams {
+            samples_per_pixel: 1,
+            indirect: mode == GpuMode::None,
+            indirect_visibility: false,
+            gather: GatherParams::default(),
+            ..ReferenceParams::default()
+        },
+        &|_, _| {},
+    )
+    .expect("reference");
+    (img, cpu)
+}
+
+#[test]
+fn gpu_none_and_direct_only_agree_with_the_cpu_twin() {
+    for (b, mode) in [
+        (Builtin::FourRooms, GpuMode::None),
+        (Builtin::FourRooms, GpuMode::DirectOnly),
+        (Builtin::CornellBox, GpuMode::None),
+    ] {
+        let (gpu, cpu) = both(b, [64, 48], 256, mode);
+        let e = errors(&gpu, &cpu).expect("same size");
+        let (f, _) = flip(&gpu, &cpu, 0.0).expect("same size");
+        eprintln!("{} {mode:?}: {e:?}, FLIP {f}", b.name());
+        assert!(cpu.mean().x > 0.0);
+        // Shadow maps (PCF, bias) differ from shadow rays at shadow edges only.
+        assert!(e.rel_mse < 0.05, "{} {mode:?}: {e:?}", b.name());
+        assert!(f < 0.08, "{} {mode:?}: FLIP {f}", b.name());
+        assert!(
+            (e.image_mean / e.reference_mean - 1.0).abs() < 0.03,
+            "{e:?}"
+        );
+    }
+}
+
+#[test]
+fn gpu_white_plane_under_a_point_light_has_the_closed_form_radiance() {
+    use visgate_formats::scene::ImportReport;
+    use visgate_formats::{Camera, Light, Material, Mesh, Scene};
+    let (rho, i, h) = (0.8f32, 10.0f32, 2.0f32);
+    let r = 50.0;
+    let scene = Scene {
+        name: "plane".into(),
+        source: None,
+        closed: false,
+        meshes: vec![Mesh {
+            name: "floor".into(),
+            entry: 0,
+            is_static: true,
+            positions: vec![
+                Vec3::new(-r, 0.0, -r),
+                Vec3::new(-r, 0.0, r),
+                Vec3::new(r, 0.0, r),
+                Vec3::new(r, 0.0, -r),
+            ],
+            normals: vec![Vec3::Y; 4],
+            uvs: vec![glam::Vec2::ZERO; 4],
+            triangles: vec![[0, 1, 2], [0, 2, 3]],
+            material: vec![0, 0],
+        }],
+        materials: vec![Material {
+            name: "white".into(),
+            albedo: Vec3::splat(rho),
+            texture: None,
+        }],
+        textures: Vec::new(),
+        lights: vec![Light::Point {
+            position: Vec3::new(0.0, h, 0.0),
+            intensity: Vec3::splat(i),
+        }],
+        cameras: Vec::new(),
+        report: ImportReport::default(),
+    };
+    let ctx = context();
+    let gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    // Looking straight down from beside the light at the point under it.
+    let cam = Camera {
+        name: "down".into(),
+        eye: Vec3::new(0.0, 1.0, 0.0),
+        target: Vec3::ZERO,
+        up: Vec3::Z,
+        fov_x_rad: 0.2,
+    };
+    let view = View::new(&cam, [9, 9]).expect("view");
+    let (img, _) = gpu
+        .render(
+            &ctx,
+            &view,
+            &[],
+            &GpuParams {
+                mode: GpuMode::DirectOnly,
+                ..GpuParams::default()
+            },
+        )
+        .expect("render");
+    let want = rho / PI * i / (h * h);
+    let got = img.at(4, 4).x;
+    assert!((got - want).abs() / want < 1e-3, "{got} vs {want}");
+}
