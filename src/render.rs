@@ -21,8 +21,12 @@ Modes:
                sample (exact visibility)
   none         GPU: direct light with shadow maps (PCF) + every VPL lighting every point (no
                indirect shadows: the baseline that gates and virtual area lights improve on)
+  per-vpl-shadow-maps
+               GPU: one paraboloid shadow map per VPL, rendered and gathered in batches of
+               --vpl-batch (the brute-force baseline that gates and virtual area lights beat)
   direct-only  GPU: direct light alone
-With --cpu, none and direct-only run on the CPU twin (shadow rays for direct light).
+With --cpu, none and direct-only run on the CPU twin (shadow rays for direct light), and
+per-vpl-shadow-maps is the reference (exact shadow rays).
 
 VPLs come from light paths traced from the scene's lights (--bounces generations, a VPL at every
 hit), deterministic for a --seed. Output: .exr is linear radiance (W/(m²·sr), for `visgate diff`),
@@ -41,6 +45,8 @@ pub enum Mode {
     Reference,
     /// No visibility on indirect light.
     None,
+    /// One paraboloid shadow map per VPL (GPU, in batches).
+    PerVplShadowMaps,
     /// Direct light only.
     DirectOnly,
 }
@@ -85,6 +91,12 @@ pub struct RenderArgs {
     /// Shadow map size per layer (GPU), texels.
     #[arg(long, default_value_t = 1024)]
     pub shadow_size: u32,
+    /// Per-VPL paraboloid map size (GPU), texels.
+    #[arg(long, default_value_t = 128)]
+    pub vpl_map_size: u32,
+    /// Per-VPL maps rendered and gathered per batch (bounds their memory).
+    #[arg(long, default_value_t = 128)]
+    pub vpl_batch: u32,
     /// Rayon threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
@@ -189,11 +201,13 @@ pub fn run(args: RenderArgs) -> Result<()> {
                 &view,
                 &vpls,
                 &GpuParams {
-                    mode: if args.mode == Mode::None {
-                        GpuMode::None
-                    } else {
-                        GpuMode::DirectOnly
+                    mode: match args.mode {
+                        Mode::None => GpuMode::None,
+                        Mode::PerVplShadowMaps => GpuMode::PerVplShadowMaps,
+                        _ => GpuMode::DirectOnly,
                     },
+                    vpl_map_size: args.vpl_map_size,
+                    vpl_batch: args.vpl_batch,
                     g_max: args.g_max,
                     shadow_size: args.shadow_size,
                     ..GpuParams::default()
@@ -218,10 +232,13 @@ pub fn run(args: RenderArgs) -> Result<()> {
             );
             println!(
                 "passes (CPU wall, each submitted and waited for): shadow maps {:.2} ms, \
-                 G-buffer {:.2} ms, shading {:.2} ms, readback {:.2} ms",
+                 G-buffer {:.2} ms, shading {:.2} ms, VPL maps {:.2} ms, VPL gather {:.2} ms, \
+                 readback {:.2} ms",
                 times.shadows * 1e3,
                 times.gbuffer * 1e3,
                 times.shade * 1e3,
+                times.vpl_maps * 1e3,
+                times.vpl_gather * 1e3,
                 times.readback * 1e3
             );
             let m = img.mean();
@@ -233,7 +250,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
             samples_per_pixel: args.spp,
             direct: true,
             indirect: args.mode != Mode::DirectOnly,
-            indirect_visibility: args.mode == Mode::Reference,
+            indirect_visibility: matches!(args.mode, Mode::Reference | Mode::PerVplShadowMaps),
             gather: GatherParams { g_max: args.g_max },
         };
         let bar = ProgressBar::new(size[1] as u64).with_style(

@@ -7,8 +7,9 @@
 //! point along its normal and compare with a bias, both in texels of the layer at that
 //! distance, and filter 3 × 3 (PCF).
 //!
-//! What stands: modes `none` (every VPL lights every pixel) and `direct-only`. Per-VPL shadow
-//! maps, GPU RSM VPLs and timestamp queries come next.
+//! Modes: `none` (every VPL lights every pixel), `per-vpl-shadow-maps` (a paraboloid distance
+//! map per VPL, rendered and gathered in batches of `vpl_batch` so memory stays bounded) and
+//! `direct-only`. GPU RSM VPLs and timestamp queries come next.
 
 use std::time::Instant;
 
@@ -25,13 +26,46 @@ use crate::vpl::Vpl;
 const GBUFFER_WGSL: &str = include_str!("shaders/gbuffer.wgsl");
 const SHADOW_WGSL: &str = include_str!("shaders/shadow.wgsl");
 const SHADE_WGSL: &str = include_str!("shaders/shade.wgsl");
+const VPL_SHADOW_WGSL: &str = include_str!("shaders/vpl_shadow.wgsl");
+const GATHER_BATCH_WGSL: &str = include_str!("shaders/gather_batch.wgsl");
 
 /// The WGSL sources, for validation without a GPU.
-pub const SHADERS: [(&str, &str); 3] = [
+pub const SHADERS: [(&str, &str); 5] = [
     ("gbuffer.wgsl", GBUFFER_WGSL),
     ("shadow.wgsl", SHADOW_WGSL),
     ("shade.wgsl", SHADE_WGSL),
+    ("vpl_shadow.wgsl", VPL_SHADOW_WGSL),
+    ("gather_batch.wgsl", GATHER_BATCH_WGSL),
 ];
+
+/// Triangles drawn into paraboloid maps are split until no edge is longer than this fraction
+/// of the scene's diagonal: the projection bends lines, and short edges bend little.
+pub const VPL_SHADOW_MAX_EDGE: f32 = 1.0 / 24.0;
+
+/// One VPL's paraboloid view, shared with WGSL (`VplView` in vpl_shadow.wgsl). 64 bytes, at
+/// 256-byte strides.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct VplView {
+    /// xyz position (m), w far distance (m).
+    pub position: [f32; 4],
+    /// Tangent of the VPL's frame.
+    pub tangent: [f32; 4],
+    /// Bitangent of the VPL's frame.
+    pub bitangent: [f32; 4],
+    /// The VPL's normal.
+    pub normal: [f32; 4],
+}
+
+/// A batch of VPLs for the gather, shared with WGSL (`Batch` in gather_batch.wgsl). 32 bytes.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct Batch {
+    /// x first VPL, y count, z map size (texels).
+    pub range: [u32; 4],
+    /// x g_max (1/m²), y normal offset (texels), z bias (texels).
+    pub params: [f32; 4],
+}
 
 /// Per-frame constants, shared with WGSL (`Globals` in every shader). 112 bytes.
 #[repr(C)]
@@ -78,6 +112,8 @@ pub struct ShadowView {
 pub enum GpuMode {
     /// Every VPL lights every pixel.
     None,
+    /// One paraboloid shadow map per VPL, rendered in batches (the brute-force baseline).
+    PerVplShadowMaps,
     /// Direct light only.
     DirectOnly,
 }
@@ -95,6 +131,10 @@ pub struct GpuParams {
     pub shadow_normal_offset: f32,
     /// Depth bias of shadow lookups. [Units: texels]
     pub shadow_bias: f32,
+    /// Per-VPL paraboloid map size. [Units: texels] [Limit: 16..=2048]
+    pub vpl_map_size: u32,
+    /// VPL maps rendered and gathered per batch (bounds their memory). [Limit: 1..=2048]
+    pub vpl_batch: u32,
 }
 
 impl Default for GpuParams {
@@ -105,6 +145,8 @@ impl Default for GpuParams {
             shadow_size: 1024,
             shadow_normal_offset: 1.5,
             shadow_bias: 1.0,
+            vpl_map_size: 128,
+            vpl_batch: 128,
         }
     }
 }
@@ -116,8 +158,12 @@ pub struct PassTimes {
     pub shadows: f64,
     /// G-buffer.
     pub gbuffer: f64,
-    /// Direct and indirect shading.
+    /// Direct and indirect shading (direct only with per-VPL shadow maps).
     pub shade: f64,
+    /// Per-VPL paraboloid maps, all batches.
+    pub vpl_maps: f64,
+    /// Indirect gather with per-VPL maps, all batches.
+    pub vpl_gather: f64,
     /// Copy back to the CPU.
     pub readback: f64,
 }
@@ -185,6 +231,29 @@ pub struct GpuRenderer {
     gbuffer: wgpu::RenderPipeline,
     shadow: wgpu::RenderPipeline,
     shade: wgpu::RenderPipeline,
+    vpl_vertices: wgpu::Buffer,
+    vpl_vertex_count: u32,
+    vpl_shadow: wgpu::RenderPipeline,
+    gather_batch: wgpu::RenderPipeline,
+}
+
+/// Splits triangles until no edge is longer than `max_edge` (longest edge halved first).
+fn subdivide(tris: &[[Vec3; 3]], max_edge: f32) -> Vec<[Vec3; 3]> {
+    let mut out = Vec::new();
+    let mut stack: Vec<([Vec3; 3], u32)> = tris.iter().map(|&t| (t, 0)).collect();
+    while let Some((t, depth)) = stack.pop() {
+        let l = [0, 1, 2].map(|k| (t[(k + 1) % 3] - t[k]).length());
+        let k = (0..3).max_by(|&a, &b| l[a].total_cmp(&l[b])).unwrap_or(0);
+        if l[k] <= max_edge || depth >= 24 {
+            out.push(t);
+            continue;
+        }
+        let (a, b, c) = (t[k], t[(k + 1) % 3], t[(k + 2) % 3]);
+        let m = (a + b) * 0.5;
+        stack.push(([a, m, c], depth + 1));
+        stack.push(([m, b, c], depth + 1));
+    }
+    out
 }
 
 /// Vertex layout: position, normal, albedo (f32 × 3 each).
@@ -216,6 +285,23 @@ impl GpuRenderer {
             }
         }
         let vertex_count = (data.len() / 9) as u32;
+        let diag = scene
+            .bounds()
+            .map(|(lo, hi)| (hi - lo).length())
+            .unwrap_or(1.0)
+            .max(1e-6);
+        let tris: Vec<[Vec3; 3]> = data
+            .chunks_exact(27)
+            .map(|c| [0, 9, 18].map(|o| Vec3::new(c[o], c[o + 1], c[o + 2])))
+            .collect();
+        let mut vpl_data: Vec<f32> = subdivide(&tris, diag * VPL_SHADOW_MAX_EDGE)
+            .iter()
+            .flat_map(|t| t.iter().flat_map(|p| p.to_array()))
+            .collect();
+        let vpl_vertex_count = (vpl_data.len() / 3) as u32;
+        if vpl_data.is_empty() {
+            vpl_data.resize(3, 0.0);
+        }
         if data.is_empty() {
             data.resize(9, 0.0);
         }
@@ -239,6 +325,8 @@ impl GpuRenderer {
         let gb = module("gbuffer.wgsl", GBUFFER_WGSL);
         let sh = module("shadow.wgsl", SHADOW_WGSL);
         let sd = module("shade.wgsl", SHADE_WGSL);
+        let vs_mod = module("vpl_shadow.wgsl", VPL_SHADOW_WGSL);
+        let gb_mod = module("gather_batch.wgsl", GATHER_BATCH_WGSL);
         let attrs = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3];
         let layout = wgpu::VertexBufferLayout {
             array_stride: VERTEX_STRIDE,
@@ -273,6 +361,7 @@ impl GpuRenderer {
                         m: &wgpu::ShaderModule,
                         buffers: &[Option<wgpu::VertexBufferLayout>],
                         targets: &[Option<wgpu::ColorTargetState>],
+                        primitive: wgpu::PrimitiveState,
                         depth: Option<wgpu::DepthStencilState>| {
             d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(label),
@@ -283,7 +372,7 @@ impl GpuRenderer {
                     buffers,
                     compilation_options: Default::default(),
                 },
-                primitive: wgpu::PrimitiveState::default(),
+                primitive,
                 depth_stencil: depth,
                 multisample: wgpu::MultisampleState::default(),
                 fragment: Some(wgpu::FragmentState {
@@ -305,6 +394,7 @@ impl GpuRenderer {
                 target(wgpu::TextureFormat::Rgba16Float),
                 target(wgpu::TextureFormat::Rgba16Float),
             ],
+            wgpu::PrimitiveState::default(),
             depth.clone(),
         );
         let shadow = pipeline(
@@ -312,15 +402,47 @@ impl GpuRenderer {
             &sh,
             &[Some(pos_layout)],
             &[target(wgpu::TextureFormat::R32Float)],
-            depth,
+            wgpu::PrimitiveState::default(),
+            depth.clone(),
         );
         let shade = pipeline(
             "shade",
             &sd,
             &[],
             &[target(wgpu::TextureFormat::Rgba32Float)],
+            wgpu::PrimitiveState::default(),
             None,
         );
+        let pos12 = [wgpu::VertexAttribute {
+            format: wgpu::VertexFormat::Float32x3,
+            offset: 0,
+            shader_location: 0,
+        }];
+        let vpl_shadow = pipeline(
+            "vpl paraboloid maps",
+            &vs_mod,
+            &[Some(wgpu::VertexBufferLayout {
+                array_stride: 12,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &pos12,
+            })],
+            &[target(wgpu::TextureFormat::R32Float)],
+            wgpu::PrimitiveState::default(),
+            depth,
+        );
+        let gather_batch = pipeline(
+            "gather batch",
+            &gb_mod,
+            &[],
+            &[target(wgpu::TextureFormat::Rgba32Float)],
+            wgpu::PrimitiveState::default(),
+            None,
+        );
+        let vpl_vertices = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("vpl map vertices (subdivided)"),
+            contents: bytemuck::cast_slice(&vpl_data),
+            usage: wgpu::BufferUsages::VERTEX,
+        });
         Ok(GpuRenderer {
             vertices,
             vertex_count,
@@ -330,6 +452,10 @@ impl GpuRenderer {
             gbuffer,
             shadow,
             shade,
+            vpl_vertices,
+            vpl_vertex_count,
+            vpl_shadow,
+            gather_batch,
         })
     }
 
@@ -410,6 +536,12 @@ impl GpuRenderer {
             return Err(RenderError::Param(format!(
                 "geometry-term clamp {} must be > 0",
                 params.g_max
+            )));
+        }
+        if !(16..=2048).contains(&params.vpl_map_size) || !(1..=2048).contains(&params.vpl_batch) {
+            return Err(RenderError::Param(format!(
+                "VPL map size {} must be 16..=2048 and VPL batch {} 1..=2048",
+                params.vpl_map_size, params.vpl_batch
             )));
         }
         if !(16..=4096).contains(&params.shadow_size) {
@@ -558,7 +690,7 @@ impl GpuRenderer {
                 gpu_lights.len() as u32,
                 match params.mode {
                     GpuMode::None => 0,
-                    GpuMode::DirectOnly => 1,
+                    GpuMode::DirectOnly | GpuMode::PerVplShadowMaps => 1,
                 },
                 s,
             ],
@@ -657,7 +789,10 @@ impl GpuRenderer {
             "hdr",
             [w, h, 1],
             wgpu::TextureFormat::Rgba32Float,
-            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::COPY_SRC
+                | wgpu::TextureUsages::COPY_DST
+                | wgpu::TextureUsages::TEXTURE_BINDING,
         );
         let out_view = out.create_view(&Default::default());
         let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -726,6 +861,11 @@ impl GpuRenderer {
         ctx.wait();
         times.shade = t0.elapsed().as_secs_f64();
 
+        // 3b. Per-VPL paraboloid maps and their gather, batch by batch, added onto the image.
+        if params.mode == GpuMode::PerVplShadowMaps && !vpls.is_empty() {
+            self.per_vpl_batches(ctx, params, vpls, &vpl_buf, &views, &out, &mut times)?;
+        }
+
         // 4. Read back.
         let t0 = Instant::now();
         let row = (w as u64 * 16).div_ceil(256) * 256;
@@ -771,5 +911,250 @@ impl GpuRenderer {
         read.unmap();
         times.readback = t0.elapsed().as_secs_f64();
         Ok((img, times))
+    }
+
+    /// Renders the paraboloid maps of `vpls` in batches of `params.vpl_batch` and adds each
+    /// batch's gather onto `out`.
+    #[allow(clippy::too_many_arguments)]
+    fn per_vpl_batches(
+        &self,
+        ctx: &GpuContext,
+        params: &GpuParams,
+        vpls: &[Vpl],
+        vpl_buf: &wgpu::Buffer,
+        gviews: &[wgpu::TextureView; 3],
+        out: &wgpu::Texture,
+        times: &mut PassTimes,
+    ) -> Result<(), RenderError> {
+        let d = &ctx.device;
+        // Ping-pong: each batch reads the image so far and writes it plus its light.
+        let other = d.create_texture(&wgpu::TextureDescriptor {
+            label: Some("hdr (ping-pong)"),
+            size: out.size(),
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba32Float,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+                | wgpu::TextureUsages::TEXTURE_BINDING
+                | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let pair = [
+            out.create_view(&Default::default()),
+            other.create_view(&Default::default()),
+        ];
+        let mut current = 0usize;
+        let m = params.vpl_map_size;
+        let batch = params
+            .vpl_batch
+            .min(d.limits().max_texture_array_layers)
+            .max(1) as usize;
+        let far = self.far_m;
+        let maps = d.create_texture(&wgpu::TextureDescriptor {
+            label: Some("vpl paraboloid maps"),
+            size: wgpu::Extent3d {
+                width: m,
+                height: m,
+                depth_or_array_layers: batch as u32,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::R32Float,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let depth = d.create_texture(&wgpu::TextureDescriptor {
+            label: Some("vpl map depth"),
+            size: wgpu::Extent3d {
+                width: m,
+                height: m,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Depth32Float,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            view_formats: &[],
+        });
+        let depth_view = depth.create_view(&Default::default());
+        let layer_views: Vec<wgpu::TextureView> = (0..batch as u32)
+            .map(|l| {
+                maps.create_view(&wgpu::TextureViewDescriptor {
+                    label: Some("vpl map layer"),
+                    dimension: Some(wgpu::TextureViewDimension::D2),
+                    base_array_layer: l,
+                    array_layer_count: Some(1),
+                    ..Default::default()
+                })
+            })
+            .collect();
+        let array_view = maps.create_view(&wgpu::TextureViewDescriptor {
+            label: Some("vpl maps"),
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        let stride = 256usize;
+        for (bi, chunk) in vpls.chunks(batch).enumerate() {
+            let t0 = Instant::now();
+            let mut bytes = vec![0u8; stride * chunk.len()];
+            for (k, v) in chunk.iter().enumerate() {
+                let n = Vec3::from(v.normal).normalize_or(Vec3::Y);
+                let (t, b) = crate::vpl::basis(n);
+                let view = VplView {
+                    position: Vec3::from(v.position).extend(far).to_array(),
+                    tangent: t.extend(0.0).to_array(),
+                    bitangent: b.extend(0.0).to_array(),
+                    normal: n.extend(0.0).to_array(),
+                };
+                bytes[k * stride..k * stride + 64].copy_from_slice(bytemuck::bytes_of(&view));
+            }
+            let ubuf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("vpl views"),
+                contents: &bytes,
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+            let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("vpl maps"),
+            });
+            for k in 0..chunk.len() {
+                let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("vpl view"),
+                    layout: &self.vpl_shadow.get_bind_group_layout(0),
+                    entries: &[wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+                            buffer: &ubuf,
+                            offset: (k * stride) as u64,
+                            size: std::num::NonZeroU64::new(64),
+                        }),
+                    }],
+                });
+                let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("vpl map"),
+                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                        view: &layer_views[k],
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(wgpu::Color {
+                                r: 1e30,
+                                g: 0.0,
+                                b: 0.0,
+                                a: 0.0,
+                            }),
+                            store: wgpu::StoreOp::Store,
+                        },
+                    })],
+                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                        view: &depth_view,
+                        depth_ops: Some(wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(1.0),
+                            store: wgpu::StoreOp::Discard,
+                        }),
+                        stencil_ops: None,
+                    }),
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.set_pipeline(&self.vpl_shadow);
+                pass.set_bind_group(0, &bg, &[]);
+                pass.set_vertex_buffer(0, self.vpl_vertices.slice(..));
+                pass.draw(0..self.vpl_vertex_count, 0..1);
+            }
+            ctx.queue.submit([enc.finish()]);
+            ctx.wait();
+            times.vpl_maps += t0.elapsed().as_secs_f64();
+
+            let t0 = Instant::now();
+            let b = Batch {
+                range: [(bi * batch) as u32, chunk.len() as u32, m, 0],
+                params: [
+                    params.g_max,
+                    params.shadow_normal_offset,
+                    params.shadow_bias,
+                    0.0,
+                ],
+            };
+            let bbuf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("batch"),
+                contents: bytemuck::bytes_of(&b),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+            let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("gather batch"),
+                layout: &self.gather_batch.get_bind_group_layout(0),
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: bbuf.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: vpl_buf.as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: wgpu::BindingResource::TextureView(&array_view),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 3,
+                        resource: wgpu::BindingResource::TextureView(&gviews[0]),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 4,
+                        resource: wgpu::BindingResource::TextureView(&gviews[1]),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 5,
+                        resource: wgpu::BindingResource::TextureView(&gviews[2]),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 6,
+                        resource: wgpu::BindingResource::TextureView(&pair[current]),
+                    },
+                ],
+            });
+            let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("gather batch"),
+            });
+            {
+                let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("gather batch"),
+                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                        view: &pair[1 - current],
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                            store: wgpu::StoreOp::Store,
+                        },
+                    })],
+                    depth_stencil_attachment: None,
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                pass.set_pipeline(&self.gather_batch);
+                pass.set_bind_group(0, &bg, &[]);
+                pass.draw(0..3, 0..1);
+            }
+            ctx.queue.submit([enc.finish()]);
+            ctx.wait();
+            current = 1 - current;
+            times.vpl_gather += t0.elapsed().as_secs_f64();
+        }
+        if current == 1 {
+            let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("ping-pong copy"),
+            });
+            enc.copy_texture_to_texture(other.as_image_copy(), out.as_image_copy(), out.size());
+            ctx.queue.submit([enc.finish()]);
+            ctx.wait();
+        }
+        Ok(())
     }
 }

@@ -76,8 +76,8 @@ fn both(
         &view,
         &ReferenceParams {
             samples_per_pixel: 1,
-            indirect: mode == GpuMode::None,
-            indirect_visibility: false,
+            indirect: mode != GpuMode::DirectOnly,
+            indirect_visibility: mode == GpuMode::PerVplShadowMaps,
             gather: GatherParams::default(),
             ..ReferenceParams::default()
         },
@@ -88,11 +88,13 @@ fn both(
 }
 
 #[test]
-fn gpu_none_and_direct_only_agree_with_the_cpu_twin() {
+fn gpu_modes_agree_with_the_cpu_reference_with_the_same_vpls_and_visibility() {
     for (b, mode) in [
         (Builtin::FourRooms, GpuMode::None),
         (Builtin::FourRooms, GpuMode::DirectOnly),
         (Builtin::CornellBox, GpuMode::None),
+        (Builtin::FourRooms, GpuMode::PerVplShadowMaps),
+        (Builtin::CornellBox, GpuMode::PerVplShadowMaps),
     ] {
         let (gpu, cpu) = both(b, [64, 48], 256, mode);
         let e = errors(&gpu, &cpu).expect("same size");

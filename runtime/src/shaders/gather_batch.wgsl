@@ -1,0 +1,103 @@
+// Indirect light of one batch of VPLs with their paraboloid shadow maps (mode
+// per-vpl-shadow-maps), added to the image so far (`previous`, ping-pong: 32-bit float targets
+// are not blendable everywhere). Same gather term as shade.wgsl.
+
+const PI: f32 = 3.14159265358979;
+
+struct Batch {
+    // x first VPL, y count, z map size (texels), w unused.
+    range: vec4<u32>,
+    // x g_max (1/m²), y normal offset (texels), z bias (texels), w unused.
+    params: vec4<f32>,
+};
+
+struct Vpl {
+    position: vec3<f32>,
+    pad0: f32,
+    normal: vec3<f32>,
+    pad1: f32,
+    flux: vec3<f32>,
+    pad2: f32,
+};
+
+@group(0) @binding(0) var<uniform> batch: Batch;
+@group(0) @binding(1) var<storage, read> vpls: array<Vpl>;
+@group(0) @binding(2) var maps: texture_2d_array<f32>;
+@group(0) @binding(3) var g_position: texture_2d<f32>;
+@group(0) @binding(4) var g_normal: texture_2d<f32>;
+@group(0) @binding(5) var g_albedo: texture_2d<f32>;
+@group(0) @binding(6) var previous: texture_2d<f32>;
+
+@vertex
+fn vs(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
+    let uv = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
+    return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
+}
+
+// The basis of shade_basis in Rust (Duff et al. 2017).
+fn basis(n: vec3<f32>) -> mat2x3<f32> {
+    let s = select(-1.0, 1.0, n.z >= 0.0);
+    let a = -1.0 / (s + n.z);
+    let b = n.x * n.y * a;
+    return mat2x3<f32>(
+        vec3<f32>(1.0 + s * n.x * n.x * a, s * b, -s * n.x),
+        vec3<f32>(b, s + n.y * n.y * a, -n.y),
+    );
+}
+
+fn visibility(layer: u32, v: Vpl, p: vec3<f32>, n: vec3<f32>) -> f32 {
+    let size = f32(batch.range.z);
+    let tb = basis(v.normal);
+    let dist = length(p - v.position);
+    // A texel spans about 4/size rad at the map's centre.
+    let texel = dist * 4.0 / size;
+    let q = p + n * texel * batch.params.y - v.position;
+    let local = vec3<f32>(dot(q, tb[0]), dot(q, tb[1]), dot(q, v.normal));
+    let d = length(local);
+    if local.z <= 0.0 || d <= 0.0 {
+        return 0.0;
+    }
+    let dir = local / d;
+    let uv = dir.xy / (1.0 + dir.z);
+    let c = vec2<i32>(vec2<f32>(uv.x * 0.5 + 0.5, 0.5 - uv.y * 0.5) * size);
+    let ref_dist = d - texel * batch.params.z;
+    var lit = 0.0;
+    for (var dy = -1; dy <= 1; dy++) {
+        for (var dx = -1; dx <= 1; dx++) {
+            let t = clamp(c + vec2<i32>(dx, dy), vec2<i32>(0), vec2<i32>(i32(size) - 1));
+            lit += select(0.0, 1.0, textureLoad(maps, t, i32(layer), 0).x >= ref_dist);
+        }
+    }
+    return lit / 9.0;
+}
+
+@fragment
+fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
+    let px = vec2<i32>(frag.xy);
+    let before = textureLoad(previous, px, 0);
+    let pos = textureLoad(g_position, px, 0);
+    if pos.w == 0.0 {
+        return before;
+    }
+    let p = pos.xyz;
+    let n = normalize(textureLoad(g_normal, px, 0).xyz);
+    let albedo = textureLoad(g_albedo, px, 0).xyz;
+    var radiance = vec3<f32>(0.0);
+    for (var k = 0u; k < batch.range.y; k++) {
+        let v = vpls[batch.range.x + k];
+        let d = v.position - p;
+        let d2 = dot(d, d);
+        if d2 <= 0.0 {
+            continue;
+        }
+        let w = d * inverseSqrt(d2);
+        let cos_x = dot(n, w);
+        let cos_v = -dot(v.normal, w);
+        if cos_x <= 0.0 || cos_v <= 0.0 {
+            continue;
+        }
+        let g = min(cos_x * cos_v / d2, batch.params.x);
+        radiance += albedo / PI * v.flux / PI * g * visibility(k, v, p, n);
+    }
+    return vec4<f32>(before.xyz + radiance, 1.0);
+}

@@ -1,0 +1,51 @@
+// Per-VPL paraboloid shadow maps (the brute-force baseline): each layer of a 2D array holds,
+// per texel, the distance from one VPL to the nearest surface over the hemisphere around the
+// VPL's normal. Paraboloid projection (Brabec et al.): a direction d in the VPL's frame
+// (t, b, n) maps to d.xy / (1 + d.z). The projection is not linear, so a long edge would be
+// bent wrongly: the renderer splits the scene's triangles until no edge is longer than a
+// fraction of the scene (see `gpu::VPL_SHADOW_MAX_EDGE`); vertices behind the VPL's plane go to
+// the map's rim, and fragments behind or in the plane are discarded.
+
+struct VplView {
+    // xyz position, w far distance (m).
+    position: vec4<f32>,
+    tangent: vec4<f32>,
+    bitangent: vec4<f32>,
+    normal: vec4<f32>,
+};
+
+@group(0) @binding(0) var<uniform> vpl_view: VplView;
+
+struct VsOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) local: vec3<f32>,
+};
+
+@vertex
+fn vs(@location(0) position: vec3<f32>) -> VsOut {
+    let v = position - vpl_view.position.xyz;
+    let local = vec3<f32>(dot(v, vpl_view.tangent.xyz), dot(v, vpl_view.bitangent.xyz), dot(v, vpl_view.normal.xyz));
+    let d = max(length(local), 1e-12);
+    let dir = local / d;
+    var o: VsOut;
+    // A vertex behind the VPL's plane would project far outside the map and drag its
+    // triangle across it: put it on the rim instead (its fragments behind are discarded).
+    var uv = dir.xy / max(1.0 + dir.z, 1e-4);
+    if local.z < 0.0 {
+        let r = length(local.xy);
+        uv = select(vec2<f32>(1.0, 0.0), local.xy / r, r > 0.0);
+    }
+    o.clip = vec4<f32>(uv, clamp(d / vpl_view.position.w, 0.0, 1.0), 1.0);
+    o.local = local;
+    return o;
+}
+
+@fragment
+fn fs(i: VsOut) -> @location(0) f32 {
+    // Behind the VPL's plane, or in it: the surface the VPL lies on projects to the rim, but a
+    // triangle around the VPL would fill the map's middle with near distances.
+    if i.local.z <= 1e-3 * length(i.local) {
+        discard;
+    }
+    return length(i.local);
+}
