@@ -1019,7 +1019,7 @@ impl GpuRenderer {
             let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("vpl maps"),
             });
-            for k in 0..chunk.len() {
+            for (k, layer_view) in layer_views.iter().enumerate().take(chunk.len()) {
                 let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("vpl view"),
                     layout: &self.vpl_shadow.get_bind_group_layout(0),
@@ -1035,7 +1035,7 @@ impl GpuRenderer {
                 let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some("vpl map"),
                     color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                        view: &layer_views[k],
+                        view: layer_view,
                         depth_slice: None,
                         resolve_target: None,
                         ops: wgpu::Operations {

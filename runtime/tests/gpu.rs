@@ -175,3 +175,200 @@ fn gpu_white_plane_under_a_point_light_has_the_closed_form_radiance() {
     let got = img.at(4, 4).x;
     assert!((got - want).abs() / want < 1e-3, "{got} vs {want}");
 }
+
+/// Size and member offsets of struct `name` in `src`, as naga lays it out.
+fn wgsl_layout(src: &str, name: &str) -> (u32, Vec<(String, u32)>) {
+    let module = naga::front::wgsl::parse_str(src).expect("parses");
+    let mut layouter = naga::proc::Layouter::default();
+    layouter.update(module.to_ctx()).expect("layout");
+    let (h, ty) = module
+        .types
+        .iter()
+        .find(|(_, t)| t.name.as_deref() == Some(name))
+        .unwrap_or_else(|| panic!("no struct {name}"));
+    let naga::TypeInner::Struct { members, .. } = &ty.inner else {
+        panic!("{name} is not a struct");
+    };
+    (
+        layouter[h].size,
+        members
+            .iter()
+            .map(|m| (m.name.clone().unwrap_or_default(), m.offset))
+            .collect(),
+    )
+}
+
+#[test]
+fn gpu_structs_match_their_wgsl_layouts() {
+    use std::mem::{offset_of, size_of};
+    use visgate_runtime::gpu::{Batch, Globals, GpuLight, ShadowView, VplView};
+    use visgate_runtime::vpl::Vpl;
+    let shade = SHADERS[2].1;
+    let check = |src: &str, name: &str, size: usize, offsets: &[(&str, usize)]| {
+        let (s, members) = wgsl_layout(src, name);
+        assert_eq!(s as usize, size, "{name} size");
+        assert_eq!(members.len(), offsets.len(), "{name} members {members:?}");
+        for ((m, o), (want_name, want)) in members.iter().zip(offsets) {
+            assert_eq!((m.as_str(), *o as usize), (*want_name, *want), "{name}");
+        }
+    };
+    check(
+        shade,
+        "Globals",
+        size_of::<Globals>(),
+        &[
+            ("view_proj", offset_of!(Globals, view_proj)),
+            ("eye", offset_of!(Globals, eye)),
+            ("params", offset_of!(Globals, params)),
+            ("counts", offset_of!(Globals, counts)),
+        ],
+    );
+    check(
+        SHADERS[0].1,
+        "Globals",
+        size_of::<Globals>(),
+        &[
+            ("view_proj", 0),
+            ("eye", 64),
+            ("params", 80),
+            ("counts", 96),
+        ],
+    );
+    check(
+        shade,
+        "Light",
+        size_of::<GpuLight>(),
+        &[
+            ("position", offset_of!(GpuLight, position)),
+            ("intensity", offset_of!(GpuLight, intensity)),
+            ("direction", offset_of!(GpuLight, direction)),
+            ("layers", offset_of!(GpuLight, layers)),
+        ],
+    );
+    for src in [shade, SHADERS[4].1] {
+        check(
+            src,
+            "Vpl",
+            size_of::<Vpl>(),
+            &[
+                ("position", offset_of!(Vpl, position)),
+                ("pad0", offset_of!(Vpl, _pad0)),
+                ("normal", offset_of!(Vpl, normal)),
+                ("pad1", offset_of!(Vpl, _pad1)),
+                ("flux", offset_of!(Vpl, flux)),
+                ("pad2", offset_of!(Vpl, _pad2)),
+            ],
+        );
+    }
+    check(
+        SHADERS[1].1,
+        "ShadowView",
+        size_of::<ShadowView>(),
+        &[
+            ("view_proj", offset_of!(ShadowView, view_proj)),
+            ("light", offset_of!(ShadowView, light)),
+        ],
+    );
+    check(
+        SHADERS[3].1,
+        "VplView",
+        size_of::<VplView>(),
+        &[
+            ("position", offset_of!(VplView, position)),
+            ("tangent", offset_of!(VplView, tangent)),
+            ("bitangent", offset_of!(VplView, bitangent)),
+            ("normal", offset_of!(VplView, normal)),
+        ],
+    );
+    check(
+        SHADERS[4].1,
+        "Batch",
+        size_of::<Batch>(),
+        &[
+            ("range", offset_of!(Batch, range)),
+            ("params", offset_of!(Batch, params)),
+        ],
+    );
+}
+
+#[test]
+fn gpu_renders_0_1_and_65536_vpls_and_a_vpl_on_the_receiver_without_nan() {
+    let ctx = context();
+    let scene = Builtin::FourRooms.scene().expect("scene");
+    let tracer = Tracer::new(&scene);
+    let vpls = path_vpls(
+        &tracer,
+        &scene.lights,
+        &PathParams {
+            paths: 65536,
+            bounces: 1,
+            seed: 5,
+        },
+    )
+    .expect("vpls");
+    let view = View::new(scene.cameras.first().expect("camera"), [16, 12]).expect("view");
+    let gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    let mut means = Vec::new();
+    for v in [&vpls[..0], &vpls[..1], &vpls[..]] {
+        let (img, _) = gpu
+            .render(&ctx, &view, v, &GpuParams::default())
+            .expect("render");
+        assert!(
+            img.pixels
+                .iter()
+                .all(|p| p.is_finite() && p.min_element() >= 0.0)
+        );
+        means.push(img.mean().x);
+    }
+    assert!(means[2] > means[0], "{means:?}");
+    // VPLs lying on the surfaces the camera sees (every light-path VPL does): the clamp holds.
+    let (img, _) = gpu
+        .render(
+            &ctx,
+            &view,
+            &vpls[..4096],
+            &GpuParams {
+                g_max: 1.0,
+                ..GpuParams::default()
+            },
+        )
+        .expect("render");
+    assert!(img.pixels.iter().all(|p| p.is_finite()));
+    // Bad parameters are errors, not panics.
+    assert!(
+        gpu.render(
+            &ctx,
+            &view,
+            &[],
+            &GpuParams {
+                g_max: 0.0,
+                ..GpuParams::default()
+            }
+        )
+        .is_err()
+    );
+    assert!(
+        gpu.render(
+            &ctx,
+            &view,
+            &[],
+            &GpuParams {
+                shadow_size: 1,
+                ..GpuParams::default()
+            }
+        )
+        .is_err()
+    );
+    assert!(
+        gpu.render(
+            &ctx,
+            &view,
+            &[],
+            &GpuParams {
+                vpl_batch: 0,
+                ..GpuParams::default()
+            }
+        )
+        .is_err()
+    );
+}
