@@ -221,6 +221,114 @@ impl GpuContext {
     }
 }
 
+/// A 2D (array) texture of `size` = [width, height, layers].
+fn texture(
+    d: &wgpu::Device,
+    label: &str,
+    size: [u32; 3],
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
+    d.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width: size[0],
+            height: size[1],
+            depth_or_array_layers: size[2],
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    })
+}
+
+/// One layer of a distance map (shadow or paraboloid): clears `color` to "far" and the shared
+/// `depth`, then draws `vertices` with `pipeline` and its view in `bind_group`.
+#[allow(clippy::too_many_arguments)]
+fn distance_pass(
+    enc: &mut wgpu::CommandEncoder,
+    label: &str,
+    color: &wgpu::TextureView,
+    depth: &wgpu::TextureView,
+    pipeline: &wgpu::RenderPipeline,
+    bind_group: &wgpu::BindGroup,
+    vertices: &wgpu::Buffer,
+    count: u32,
+) {
+    let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: color,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(wgpu::Color {
+                    r: 1e30,
+                    g: 0.0,
+                    b: 0.0,
+                    a: 0.0,
+                }),
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: depth,
+            depth_ops: Some(wgpu::Operations {
+                load: wgpu::LoadOp::Clear(1.0),
+                store: wgpu::StoreOp::Discard,
+            }),
+            stencil_ops: None,
+        }),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    pass.set_pipeline(pipeline);
+    pass.set_bind_group(0, bind_group, &[]);
+    pass.set_vertex_buffer(0, vertices.slice(..));
+    pass.draw(0..count, 0..1);
+}
+
+/// A fullscreen triangle into `target` (cleared to black) with `pipeline` and `bind_group`,
+/// submitted and waited for.
+fn fullscreen_pass(
+    ctx: &GpuContext,
+    label: &str,
+    target: &wgpu::TextureView,
+    pipeline: &wgpu::RenderPipeline,
+    bind_group: &wgpu::BindGroup,
+) {
+    let mut enc = ctx
+        .device
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+    {
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some(label),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: target,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, bind_group, &[]);
+        pass.draw(0..3, 0..1);
+    }
+    ctx.queue.submit([enc.finish()]);
+    ctx.wait();
+}
+
 /// The scene on the GPU and the pipelines.
 pub struct GpuRenderer {
     vertices: wgpu::Buffer,
@@ -570,22 +678,7 @@ impl GpuRenderer {
                 d.limits().max_storage_buffer_binding_size
             )));
         }
-        let tex = |label: &str, size: [u32; 3], format: wgpu::TextureFormat, usage| {
-            d.create_texture(&wgpu::TextureDescriptor {
-                label: Some(label),
-                size: wgpu::Extent3d {
-                    width: size[0],
-                    height: size[1],
-                    depth_or_array_layers: size[2],
-                },
-                mip_level_count: 1,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format,
-                usage,
-                view_formats: &[],
-            })
-        };
+        let tex = |label: &str, size, format, usage| texture(d, label, size, format, usage);
         let rt = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
         let s = params.shadow_size;
         let shadow_tex = tex(
@@ -637,38 +730,16 @@ impl GpuRenderer {
                     }),
                 }],
             });
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("shadow layer"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &layer_view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color {
-                            r: 1e30,
-                            g: 0.0,
-                            b: 0.0,
-                            a: 0.0,
-                        }),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &depth_view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Discard,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.set_pipeline(&self.shadow);
-            pass.set_bind_group(0, &bg, &[]);
-            pass.set_vertex_buffer(0, self.vertices.slice(..));
-            pass.draw(0..self.vertex_count, 0..1);
+            distance_pass(
+                &mut enc,
+                "shadow layer",
+                &layer_view,
+                &depth_view,
+                &self.shadow,
+                &bg,
+                &self.vertices,
+                self.vertex_count,
+            );
         }
         ctx.queue.submit([enc.finish()]);
         ctx.wait();
@@ -833,32 +904,7 @@ impl GpuRenderer {
                 },
             ],
         });
-        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("shade"),
-        });
-        {
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("shade"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &out_view,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.set_pipeline(&self.shade);
-            pass.set_bind_group(0, &bg, &[]);
-            pass.draw(0..3, 0..1);
-        }
-        ctx.queue.submit([enc.finish()]);
-        ctx.wait();
+        fullscreen_pass(ctx, "shade", &out_view, &self.shade, &bg);
         times.shade = t0.elapsed().as_secs_f64();
 
         // 3b. Per-VPL paraboloid maps and their gather, batch by batch, added onto the image.
@@ -928,18 +974,15 @@ impl GpuRenderer {
     ) -> Result<(), RenderError> {
         let d = &ctx.device;
         // Ping-pong: each batch reads the image so far and writes it plus its light.
-        let other = d.create_texture(&wgpu::TextureDescriptor {
-            label: Some("hdr (ping-pong)"),
-            size: out.size(),
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba32Float,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT
+        let other = texture(
+            d,
+            "hdr (ping-pong)",
+            [out.width(), out.height(), 1],
+            wgpu::TextureFormat::Rgba32Float,
+            wgpu::TextureUsages::RENDER_ATTACHMENT
                 | wgpu::TextureUsages::TEXTURE_BINDING
                 | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
+        );
         let pair = [
             out.create_view(&Default::default()),
             other.create_view(&Default::default()),
@@ -951,34 +994,20 @@ impl GpuRenderer {
             .min(d.limits().max_texture_array_layers)
             .max(1) as usize;
         let far = self.far_m;
-        let maps = d.create_texture(&wgpu::TextureDescriptor {
-            label: Some("vpl paraboloid maps"),
-            size: wgpu::Extent3d {
-                width: m,
-                height: m,
-                depth_or_array_layers: batch as u32,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::R32Float,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-            view_formats: &[],
-        });
-        let depth = d.create_texture(&wgpu::TextureDescriptor {
-            label: Some("vpl map depth"),
-            size: wgpu::Extent3d {
-                width: m,
-                height: m,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Depth32Float,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-            view_formats: &[],
-        });
+        let maps = texture(
+            d,
+            "vpl paraboloid maps",
+            [m, m, batch as u32],
+            wgpu::TextureFormat::R32Float,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        );
+        let depth = texture(
+            d,
+            "vpl map depth",
+            [m, m, 1],
+            wgpu::TextureFormat::Depth32Float,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        );
         let depth_view = depth.create_view(&Default::default());
         let layer_views: Vec<wgpu::TextureView> = (0..batch as u32)
             .map(|l| {
@@ -1032,38 +1061,16 @@ impl GpuRenderer {
                         }),
                     }],
                 });
-                let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("vpl map"),
-                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                        view: layer_view,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(wgpu::Color {
-                                r: 1e30,
-                                g: 0.0,
-                                b: 0.0,
-                                a: 0.0,
-                            }),
-                            store: wgpu::StoreOp::Store,
-                        },
-                    })],
-                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                        view: &depth_view,
-                        depth_ops: Some(wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(1.0),
-                            store: wgpu::StoreOp::Discard,
-                        }),
-                        stencil_ops: None,
-                    }),
-                    timestamp_writes: None,
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
-                pass.set_pipeline(&self.vpl_shadow);
-                pass.set_bind_group(0, &bg, &[]);
-                pass.set_vertex_buffer(0, self.vpl_vertices.slice(..));
-                pass.draw(0..self.vpl_vertex_count, 0..1);
+                distance_pass(
+                    &mut enc,
+                    "vpl map",
+                    layer_view,
+                    &depth_view,
+                    &self.vpl_shadow,
+                    &bg,
+                    &self.vpl_vertices,
+                    self.vpl_vertex_count,
+                );
             }
             ctx.queue.submit([enc.finish()]);
             ctx.wait();
@@ -1118,32 +1125,13 @@ impl GpuRenderer {
                     },
                 ],
             });
-            let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                label: Some("gather batch"),
-            });
-            {
-                let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("gather batch"),
-                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                        view: &pair[1 - current],
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                            store: wgpu::StoreOp::Store,
-                        },
-                    })],
-                    depth_stencil_attachment: None,
-                    timestamp_writes: None,
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
-                pass.set_pipeline(&self.gather_batch);
-                pass.set_bind_group(0, &bg, &[]);
-                pass.draw(0..3, 0..1);
-            }
-            ctx.queue.submit([enc.finish()]);
-            ctx.wait();
+            fullscreen_pass(
+                ctx,
+                "gather batch",
+                &pair[1 - current],
+                &self.gather_batch,
+                &bg,
+            );
             current = 1 - current;
             times.vpl_gather += t0.elapsed().as_secs_f64();
         }
