@@ -33,18 +33,15 @@ fn same_size(a: &HdrImage, r: &HdrImage) -> Result<(), RenderError> {
 pub fn errors(a: &HdrImage, r: &HdrImage) -> Result<ImageErrors, RenderError> {
     same_size(a, r)?;
     let n = (a.pixels.len() * 3).max(1) as f64;
-    let mean_r = r
-        .pixels
-        .iter()
-        .map(|p| (p.x + p.y + p.z) as f64)
-        .sum::<f64>()
-        / n;
-    let mean_a = a
-        .pixels
-        .iter()
-        .map(|p| (p.x + p.y + p.z) as f64)
-        .sum::<f64>()
-        / n;
+    // Mean over pixels and channels.
+    let mean = |img: &HdrImage| {
+        img.pixels
+            .iter()
+            .map(|p| (p.x + p.y + p.z) as f64)
+            .sum::<f64>()
+            / n
+    };
+    let (mean_r, mean_a) = (mean(r), mean(a));
     let eps = 1e-2 * mean_r * mean_r + f64::MIN_POSITIVE;
     let (mut mse, mut rel) = (0f64, 0f64);
     for (p, q) in a.pixels.iter().zip(&r.pixels) {
