@@ -28,8 +28,9 @@ Modes:
 With --cpu, none and direct-only run on the CPU twin (shadow rays for direct light), and
 per-vpl-shadow-maps is the reference (exact shadow rays).
 
-VPLs come from light paths traced from the scene's lights (--bounces generations, a VPL at every
-hit), deterministic for a --seed. Output: .exr is linear radiance (W/(m²·sr), for `visgate diff`),
+VPLs come from light paths traced from the scene's lights on the CPU (--vpl-source paths:
+--bounces generations, a VPL at every hit) or from the lights' reflective shadow maps sampled at
+Halton points on the GPU (--vpl-source rsm: one bounce), deterministic for a --seed. Output: .exr is linear radiance (W/(m²·sr), for `visgate diff`),
 .png is sRGB at --exposure stops.
 
 Examples:
@@ -37,6 +38,15 @@ Examples:
   visgate render builtin:four-rooms --mode none --size 320x240 --out none.png
   visgate render builtin:four-rooms --mode none --cpu --out none-cpu.exr
   visgate diff none.exr cornell.exr --out diff.png";
+
+/// Where VPLs come from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum VplSource {
+    /// Light paths traced on the CPU (any number of bounces).
+    Paths,
+    /// Reflective shadow maps of the lights, sampled at Halton points on the GPU (one bounce).
+    Rsm,
+}
 
 /// Indirect-light visibility.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -64,6 +74,12 @@ pub struct RenderArgs {
     /// Light paths traced from the lights (VPLs: one per path and bounce that hits).
     #[arg(long, default_value_t = 1024)]
     pub vpls: u32,
+    /// Where the VPLs come from.
+    #[arg(long, value_enum, default_value_t = VplSource::Paths)]
+    pub vpl_source: VplSource,
+    /// RSM size per layer (cube face or spot), texels, for --vpl-source rsm.
+    #[arg(long, default_value_t = 256)]
+    pub rsm_size: u32,
     /// VPL generations per path (1: one-bounce indirect light).
     #[arg(long, default_value_t = 1)]
     pub bounces: u32,
@@ -175,10 +191,28 @@ pub fn run(args: RenderArgs) -> Result<()> {
         let tracer = Tracer::new(&scene);
         let bvh_s = t.elapsed().as_secs_f64();
         let t = Instant::now();
-        let vpls = if args.mode == Mode::DirectOnly {
-            Vec::new()
-        } else {
-            path_vpls(
+        if args.vpl_source == VplSource::Rsm && args.bounces != 1 {
+            bail!(
+                "--vpl-source rsm gives one bounce; use --vpl-source paths for --bounces {}",
+                args.bounces
+            );
+        }
+        let gpu_ctx =
+            if args.mode != Mode::Reference && !args.cpu || args.vpl_source == VplSource::Rsm {
+                Some(GpuContext::new()?)
+            } else {
+                None
+            };
+        let gpu = match &gpu_ctx {
+            Some(ctx) => Some(GpuRenderer::new(ctx, &scene)?),
+            None => None,
+        };
+        let vpls = match (args.mode, args.vpl_source, &gpu_ctx, &gpu) {
+            (Mode::DirectOnly, _, _, _) => Vec::new(),
+            (_, VplSource::Rsm, Some(ctx), Some(g)) => {
+                g.rsm_vpls(ctx, args.vpls, args.rsm_size, args.seed)?
+            }
+            _ => path_vpls(
                 &tracer,
                 &scene.lights,
                 &PathParams {
@@ -186,18 +220,14 @@ pub fn run(args: RenderArgs) -> Result<()> {
                     bounces: args.bounces,
                     seed: args.seed,
                 },
-            )?
+            )?,
         };
         let vpl_s = t.elapsed().as_secs_f64();
-        if args.mode != Mode::Reference && !args.cpu {
-            let t = Instant::now();
-            let ctx = GpuContext::new()?;
-            let open_s = t.elapsed().as_secs_f64();
-            let t = Instant::now();
-            let gpu = GpuRenderer::new(&ctx, &scene)?;
-            let upload_s = t.elapsed().as_secs_f64();
+        if let (true, Some(ctx), Some(gpu)) =
+            (args.mode != Mode::Reference && !args.cpu, &gpu_ctx, &gpu)
+        {
             let (img, times) = gpu.render(
-                &ctx,
+                ctx,
                 &view,
                 &vpls,
                 &GpuParams {
@@ -215,7 +245,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
             )?;
             img.write(&args.out, args.exposure)?;
             println!(
-                "{} {:?} {}x{} on {} ({:?}): {} VPLs from {} paths ({} bounce(s))",
+                "{} {:?} {}x{} on {} ({:?}): {} VPLs ({:?}, {} asked, {} bounce(s))",
                 scene.name,
                 args.mode,
                 size[0],
@@ -223,12 +253,12 @@ pub fn run(args: RenderArgs) -> Result<()> {
                 ctx.adapter_info.name,
                 ctx.adapter_info.backend,
                 vpls.len(),
+                args.vpl_source,
                 args.vpls,
                 args.bounces
             );
             println!(
-                "times: load {load_s:.3} s, BVH {bvh_s:.3} s, VPL paths {vpl_s:.3} s, adapter \
-                 {open_s:.3} s, upload {upload_s:.3} s"
+                "times: load {load_s:.3} s, BVH {bvh_s:.3} s, adapter + upload + VPLs {vpl_s:.3} s"
             );
             println!(
                 "passes (CPU wall, each submitted and waited for): shadow maps {:.2} ms, \
@@ -257,18 +287,14 @@ pub fn run(args: RenderArgs) -> Result<()> {
             ProgressStyle::with_template("render {bar:40} {pos}/{len} rows {elapsed}<{eta}")
                 .unwrap_or_else(|_| ProgressStyle::default_bar()),
         );
-        let (img, stats) = render_reference(
-            &tracer,
-            &scene.lights,
-            &vpls,
-            &view,
-            &params,
-            &|done, _| bar.set_position(done as u64),
-        )?;
+        let (img, stats) =
+            render_reference(&tracer, &scene.lights, &vpls, &view, &params, &|done, _| {
+                bar.set_position(done as u64)
+            })?;
         bar.finish_and_clear();
         img.write(&args.out, args.exposure)?;
         println!(
-            "{} {:?} {}x{} spp {}: {} triangles, {} VPLs from {} paths ({} bounce(s))",
+            "{} {:?} {}x{} spp {}: {} triangles, {} VPLs ({:?}, {} asked, {} bounce(s))",
             scene.name,
             args.mode,
             size[0],
@@ -276,11 +302,12 @@ pub fn run(args: RenderArgs) -> Result<()> {
             args.spp,
             tracer.triangle_count(),
             vpls.len(),
+            args.vpl_source,
             args.vpls,
             args.bounces
         );
         println!(
-            "times (CPU): load {load_s:.3} s, BVH {bvh_s:.3} s, VPL paths {vpl_s:.3} s, render {:.3} s",
+            "times (CPU): load {load_s:.3} s, BVH {bvh_s:.3} s, VPLs {vpl_s:.3} s, render {:.3} s",
             stats.seconds
         );
         if stats.shadow_rays > 0 {

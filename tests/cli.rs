@@ -336,6 +336,38 @@ fn render_writes_exr_and_png_and_diff_compares_them() {
     assert!(o.status.success(), "{}", stderr(&o));
     let o = visgate(&["diff", &p("none.exr"), &p("none-cpu.exr")]);
     assert!(o.status.success(), "{}", stderr(&o));
+    // RSM VPLs (GPU) in the GPU's none and in the CPU reference.
+    for mode in ["none", "reference"] {
+        let o = visgate(&[
+            "render",
+            "builtin:cornell-box",
+            "--mode",
+            mode,
+            "--vpl-source",
+            "rsm",
+            "--vpls",
+            "64",
+            "--size",
+            "24x16",
+            "--spp",
+            "1",
+            "--out",
+            &p("rsm.exr"),
+        ]);
+        assert!(o.status.success(), "{mode}: {}", stderr(&o));
+        assert!(stdout(&o).contains("Rsm"), "{}", stdout(&o));
+    }
+    let o = visgate(&[
+        "render",
+        "builtin:cornell-box",
+        "--vpl-source",
+        "rsm",
+        "--bounces",
+        "2",
+        "--out",
+        &p("x.exr"),
+    ]);
+    assert!(stderr(&o).contains("one bounce"), "{}", stderr(&o));
     let o = visgate(&["diff", &p("none.exr"), &p("ref.exr"), "-o", &p("d.png")]);
     assert!(o.status.success(), "{}", stderr(&o));
     let text = stdout(&o);

@@ -14,7 +14,7 @@
 use std::time::Instant;
 
 use bytemuck::{Pod, Zeroable};
-use glam::Vec3;
+use glam::{Mat4, Vec3};
 use visgate_formats::{Light, Scene};
 use wgpu::util::DeviceExt;
 
@@ -28,15 +28,27 @@ const SHADOW_WGSL: &str = include_str!("shaders/shadow.wgsl");
 const SHADE_WGSL: &str = include_str!("shaders/shade.wgsl");
 const VPL_SHADOW_WGSL: &str = include_str!("shaders/vpl_shadow.wgsl");
 const GATHER_BATCH_WGSL: &str = include_str!("shaders/gather_batch.wgsl");
+const RSM_VPLS_WGSL: &str = include_str!("shaders/rsm_vpls.wgsl");
 
 /// The WGSL sources, for validation without a GPU.
-pub const SHADERS: [(&str, &str); 5] = [
+pub const SHADERS: [(&str, &str); 6] = [
     ("gbuffer.wgsl", GBUFFER_WGSL),
     ("shadow.wgsl", SHADOW_WGSL),
     ("shade.wgsl", SHADE_WGSL),
     ("vpl_shadow.wgsl", VPL_SHADOW_WGSL),
     ("gather_batch.wgsl", GATHER_BATCH_WGSL),
+    ("rsm_vpls.wgsl", RSM_VPLS_WGSL),
 ];
+
+/// One RSM sample for the VPL compute pass, shared with WGSL (`Sample` in rsm_vpls.wgsl).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct RsmSample {
+    /// x layer, y texel x, z texel y.
+    pub texel: [u32; 4],
+    /// rgb power (W): intensity towards the sample × its solid angle.
+    pub power: [f32; 4],
+}
 
 /// Triangles drawn into paraboloid maps are split until no edge is longer than this fraction
 /// of the scene's diagonal: the projection bends lines, and short edges bend little.
@@ -343,6 +355,7 @@ pub struct GpuRenderer {
     vpl_vertex_count: u32,
     vpl_shadow: wgpu::RenderPipeline,
     gather_batch: wgpu::RenderPipeline,
+    rsm_vpls: wgpu::ComputePipeline,
 }
 
 /// Splits triangles until no edge is longer than `max_edge` (longest edge halved first).
@@ -546,6 +559,15 @@ impl GpuRenderer {
             wgpu::PrimitiveState::default(),
             None,
         );
+        let rsm_mod = module("rsm_vpls.wgsl", RSM_VPLS_WGSL);
+        let rsm_vpls = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("rsm vpls"),
+            layout: None,
+            module: &rsm_mod,
+            entry_point: Some("main"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
         let vpl_vertices = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("vpl map vertices (subdivided)"),
             contents: bytemuck::cast_slice(&vpl_data),
@@ -564,6 +586,7 @@ impl GpuRenderer {
             vpl_vertex_count,
             vpl_shadow,
             gather_batch,
+            rsm_vpls,
         })
     }
 
@@ -630,6 +653,302 @@ impl GpuRenderer {
             }
         }
         (lights, views)
+    }
+
+    /// VPLs from reflective shadow maps (Dong et al. §6): each light's RSM (`rsm_size`² per
+    /// layer: 6 cube faces per point light, 1 per spot) fetched at `n` Halton points in all,
+    /// shared between the lights by power, rotated by `seed`. The same lights give the same
+    /// VPLs (no flicker). Returned to the CPU so that the reference can use the very same.
+    pub fn rsm_vpls(
+        &self,
+        ctx: &GpuContext,
+        n: u32,
+        rsm_size: u32,
+        seed: u64,
+    ) -> Result<Vec<Vpl>, RenderError> {
+        if !(16..=4096).contains(&rsm_size) {
+            return Err(RenderError::Param(format!(
+                "RSM size {rsm_size} must be 16..=4096"
+            )));
+        }
+        if n > 1 << 24 {
+            return Err(RenderError::Param(format!(
+                "{n} RSM VPLs: at most {} are supported",
+                1 << 24
+            )));
+        }
+        let (gpu_lights, views) = self.light_views();
+        if n == 0 || views.is_empty() {
+            return Ok(Vec::new());
+        }
+        let d = &ctx.device;
+        let layers = views.len() as u32;
+        if layers > d.limits().max_texture_array_layers {
+            return Err(RenderError::Param(format!(
+                "{layers} RSM layers exceed the adapter's {}",
+                d.limits().max_texture_array_layers
+            )));
+        }
+        let s = rsm_size;
+        let rt = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+        let maps = [
+            texture(
+                d,
+                "rsm position",
+                [s, s, layers],
+                wgpu::TextureFormat::Rgba32Float,
+                rt,
+            ),
+            texture(
+                d,
+                "rsm normal",
+                [s, s, layers],
+                wgpu::TextureFormat::Rgba16Float,
+                rt,
+            ),
+            texture(
+                d,
+                "rsm albedo",
+                [s, s, layers],
+                wgpu::TextureFormat::Rgba16Float,
+                rt,
+            ),
+        ];
+        let depth = texture(
+            d,
+            "rsm depth",
+            [s, s, 1],
+            wgpu::TextureFormat::Depth32Float,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        );
+        let depth_view = depth.create_view(&Default::default());
+        let mut enc =
+            d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("rsm") });
+        for (i, v) in views.iter().enumerate() {
+            let globals = Globals {
+                view_proj: v.view_proj,
+                eye: v.light,
+                params: [0.0; 4],
+                counts: [0; 4],
+            };
+            let buf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("rsm globals"),
+                contents: bytemuck::bytes_of(&globals),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+            let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("rsm globals"),
+                layout: &self.gbuffer.get_bind_group_layout(0),
+                entries: &[wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: buf.as_entire_binding(),
+                }],
+            });
+            let layer_views = maps.each_ref().map(|t| {
+                t.create_view(&wgpu::TextureViewDescriptor {
+                    label: Some("rsm layer"),
+                    dimension: Some(wgpu::TextureViewDimension::D2),
+                    base_array_layer: i as u32,
+                    array_layer_count: Some(1),
+                    ..Default::default()
+                })
+            });
+            self.gbuffer_pass(&mut enc, &layer_views, &depth_view, &bg);
+        }
+        ctx.queue.submit([enc.finish()]);
+
+        // Samples: paths shared by power as for light paths, Halton points per light.
+        let lights: Vec<Light> = self.lights.clone();
+        let power: Vec<f32> = lights
+            .iter()
+            .map(|l| {
+                crate::lights::light_power(l)
+                    .dot(Vec3::new(0.2126, 0.7152, 0.0722))
+                    .max(0.0)
+            })
+            .collect();
+        let total: f32 = power.iter().sum();
+        if total <= 0.0 {
+            return Ok(Vec::new());
+        }
+        let mut share: Vec<u32> = power
+            .iter()
+            .map(|p| (n as f64 * (*p / total) as f64).floor() as u32)
+            .collect();
+        let given: u32 = share.iter().sum();
+        if let Some(best) = (0..power.len()).max_by(|&a, &b| power[a].total_cmp(&power[b])) {
+            share[best] += n - given;
+        }
+        let mut samples = Vec::with_capacity(n as usize);
+        for (li, l) in lights.iter().enumerate() {
+            let m = share[li];
+            let gl = &gpu_lights[li];
+            let first = gl.layers[0];
+            let shift = crate::vpl::seed_shift(seed ^ li as u64, 0);
+            for k in 0..m as u64 {
+                let u = crate::vpl::halton2(k, 2, 3, shift);
+                let (layer, x, y, half) = match *l {
+                    Light::Point { .. } => {
+                        let f = ((u.x * 6.0) as u32).min(5);
+                        (
+                            first + f,
+                            (u.x * 6.0 - f as f32) * 2.0 - 1.0,
+                            u.y * 2.0 - 1.0,
+                            1.0,
+                        )
+                    }
+                    Light::Spot { cutoff_rad, .. } => {
+                        let t = cutoff_rad.min(1.5).tan();
+                        (first, (u.x * 2.0 - 1.0) * t, (u.y * 2.0 - 1.0) * t, t)
+                    }
+                };
+                let faces = if matches!(l, Light::Point { .. }) {
+                    6.0
+                } else {
+                    1.0
+                };
+                // Direction through (x, y) on the layer's image plane at distance 1.
+                let view = Mat4::from_cols_array_2d(&views[layer as usize].view_proj);
+                let inv = view.inverse();
+                let ndc = glam::Vec4::new(x / half, y / half, 0.5, 1.0);
+                let w = inv * ndc;
+                let dir = (w.truncate() / w.w
+                    - Vec3::from_slice(&views[layer as usize].light[..3]))
+                .normalize_or_zero();
+                let solid = faces * 4.0 * half * half / m as f32 / (1.0 + x * x + y * y).powf(1.5);
+                let power = crate::lights::intensity_towards(l, dir) * solid;
+                let tx = (((x / half) * 0.5 + 0.5) * s as f32).clamp(0.0, s as f32 - 1.0) as u32;
+                let ty = ((0.5 - (y / half) * 0.5) * s as f32).clamp(0.0, s as f32 - 1.0) as u32;
+                samples.push(RsmSample {
+                    texel: [layer, tx, ty, 0],
+                    power: power.extend(0.0).to_array(),
+                });
+            }
+        }
+        let sample_buf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("rsm samples"),
+            contents: bytemuck::cast_slice(&samples),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let bytes = (samples.len() * std::mem::size_of::<Vpl>()) as u64;
+        let out = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("rsm vpls"),
+            size: bytes,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let read = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("rsm vpls readback"),
+            size: bytes,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        let array = |t: &wgpu::Texture| {
+            t.create_view(&wgpu::TextureViewDescriptor {
+                label: Some("rsm"),
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                ..Default::default()
+            })
+        };
+        let arrays = maps.each_ref().map(array);
+        let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("rsm vpls"),
+            layout: &self.rsm_vpls.get_bind_group_layout(0),
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: sample_buf.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: out.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::TextureView(&arrays[0]),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::TextureView(&arrays[1]),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: wgpu::BindingResource::TextureView(&arrays[2]),
+                },
+            ],
+        });
+        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("rsm vpls"),
+        });
+        {
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("rsm vpls"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.rsm_vpls);
+            pass.set_bind_group(0, &bg, &[]);
+            let groups = (samples.len() as u32).div_ceil(64);
+            let max = d.limits().max_compute_workgroups_per_dimension;
+            if groups > max {
+                return Err(RenderError::Param(format!(
+                    "{n} RSM VPLs need {groups} workgroups, more than the adapter's {max}"
+                )));
+            }
+            pass.dispatch_workgroups(groups, 1, 1);
+        }
+        enc.copy_buffer_to_buffer(&out, 0, &read, 0, bytes);
+        ctx.queue.submit([enc.finish()]);
+        let slice = read.slice(..);
+        slice.map_async(wgpu::MapMode::Read, |_| {});
+        ctx.wait();
+        let vpls: Vec<Vpl> = {
+            let mapped = slice
+                .get_mapped_range()
+                .map_err(|e| RenderError::Gpu(format!("cannot read the VPLs back: {e}")))?;
+            bytemuck::cast_slice(&mapped).to_vec()
+        };
+        read.unmap();
+        Ok(vpls)
+    }
+
+    /// The G-buffer pass into `targets` (position, normal, albedo) and `depth`.
+    fn gbuffer_pass(
+        &self,
+        enc: &mut wgpu::CommandEncoder,
+        targets: &[wgpu::TextureView; 3],
+        depth: &wgpu::TextureView,
+        bind_group: &wgpu::BindGroup,
+    ) {
+        let clear = |v| {
+            Some(wgpu::RenderPassColorAttachment {
+                view: v,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    store: wgpu::StoreOp::Store,
+                },
+            })
+        };
+        let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("gbuffer"),
+            color_attachments: &[clear(&targets[0]), clear(&targets[1]), clear(&targets[2])],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: depth,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Discard,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.gbuffer);
+        pass.set_bind_group(0, bind_group, &[]);
+        pass.set_vertex_buffer(0, self.vertices.slice(..));
+        pass.draw(0..self.vertex_count, 0..1);
     }
 
     /// Renders `view` with `vpls` and returns the linear HDR image and the pass times.
@@ -798,38 +1117,7 @@ impl GpuRenderer {
         let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("gbuffer"),
         });
-        {
-            let clear = |v| {
-                Some(wgpu::RenderPassColorAttachment {
-                    view: v,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })
-            };
-            let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("gbuffer"),
-                color_attachments: &[clear(&views[0]), clear(&views[1]), clear(&views[2])],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &gdepth_view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Discard,
-                    }),
-                    stencil_ops: None,
-                }),
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            pass.set_pipeline(&self.gbuffer);
-            pass.set_bind_group(0, &gbg, &[]);
-            pass.set_vertex_buffer(0, self.vertices.slice(..));
-            pass.draw(0..self.vertex_count, 0..1);
-        }
+        self.gbuffer_pass(&mut enc, &views, &gdepth_view, &gbg);
         ctx.queue.submit([enc.finish()]);
         ctx.wait();
         times.gbuffer = t0.elapsed().as_secs_f64();

@@ -120,8 +120,9 @@ const PRIMES: [u64; 34] = [
     101, 103, 107, 109, 113, 127, 131, 137, 139,
 ];
 
-/// Rotation of dimension pair `k` for `seed` (splitmix64).
-fn shift(seed: u64, k: u64) -> Vec2 {
+/// Rotation of dimension pair `k` for `seed` (splitmix64): a Cranley–Patterson shift of the
+/// Halton points (zero for seed 0).
+pub fn seed_shift(seed: u64, k: u64) -> Vec2 {
     let mix = |mut z: u64| {
         z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
         z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
@@ -230,7 +231,7 @@ pub fn path_vpls(
                 .into_par_iter()
                 .map(|k| {
                     let mut out = Vec::new();
-                    let u = halton2(k, 2, 3, shift(params.seed ^ li as u64, 0));
+                    let u = halton2(k, 2, 3, seed_shift(params.seed ^ li as u64, 0));
                     let mut dir = cone_dir(u, axis, max_rad);
                     let mut flux = intensity_towards(light, dir) * solid_angle / n as f32;
                     let mut from = origin;
@@ -248,7 +249,8 @@ pub fn path_vpls(
                         }
                         let pair = 1 + bounce;
                         let (b0, b1) = (PRIMES[2 * pair % 34], PRIMES[(2 * pair + 1) % 34]);
-                        let u = halton2(k, b0, b1, shift(params.seed ^ li as u64, pair as u64));
+                        let u =
+                            halton2(k, b0, b1, seed_shift(params.seed ^ li as u64, pair as u64));
                         dir = cosine_dir(u, s.normal);
                         from = s.position + s.geometric_normal * tracer.epsilon_m;
                     }

@@ -201,7 +201,7 @@ fn wgsl_layout(src: &str, name: &str) -> (u32, Vec<(String, u32)>) {
 #[test]
 fn gpu_structs_match_their_wgsl_layouts() {
     use std::mem::{offset_of, size_of};
-    use visgate_runtime::gpu::{Batch, Globals, GpuLight, ShadowView, VplView};
+    use visgate_runtime::gpu::{Batch, Globals, GpuLight, RsmSample, ShadowView, VplView};
     use visgate_runtime::vpl::Vpl;
     let shade = SHADERS[2].1;
     let check = |src: &str, name: &str, size: usize, offsets: &[(&str, usize)]| {
@@ -278,6 +278,28 @@ fn gpu_structs_match_their_wgsl_layouts() {
             ("tangent", offset_of!(VplView, tangent)),
             ("bitangent", offset_of!(VplView, bitangent)),
             ("normal", offset_of!(VplView, normal)),
+        ],
+    );
+    check(
+        SHADERS[5].1,
+        "Sample",
+        size_of::<RsmSample>(),
+        &[
+            ("texel", offset_of!(RsmSample, texel)),
+            ("power", offset_of!(RsmSample, power)),
+        ],
+    );
+    check(
+        SHADERS[5].1,
+        "Vpl",
+        size_of::<Vpl>(),
+        &[
+            ("position", 0),
+            ("pad0", 12),
+            ("normal", 16),
+            ("pad1", 28),
+            ("flux", 32),
+            ("pad2", 44),
         ],
     );
     check(
@@ -371,4 +393,60 @@ fn gpu_renders_0_1_and_65536_vpls_and_a_vpl_on_the_receiver_without_nan() {
         )
         .is_err()
     );
+}
+
+#[test]
+fn rsm_vpls_carry_the_reflected_power_and_do_not_flicker() {
+    // A point light inside a closed box: the RSM sees walls in every direction, so the VPLs
+    // hold ρ × the light's power, as the light paths do.
+    let ctx = context();
+    let scene = Builtin::EmptyBox.scene().expect("scene");
+    let gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    let tracer = Tracer::new(&scene);
+    let n = 4096;
+    let rsm = gpu.rsm_vpls(&ctx, n, 256, 1).expect("rsm vpls");
+    assert_eq!(rsm.len(), n as usize);
+    let paths = path_vpls(
+        &tracer,
+        &scene.lights,
+        &PathParams {
+            paths: n,
+            bounces: 1,
+            seed: 1,
+        },
+    )
+    .expect("paths");
+    let sum =
+        |v: &[visgate_runtime::vpl::Vpl]| -> Vec3 { v.iter().map(|v| Vec3::from(v.flux)).sum() };
+    let (a, b) = (sum(&rsm), sum(&paths));
+    eprintln!("RSM flux {a}, path flux {b}");
+    assert!(((a - b) / b).abs().max_element() < 0.02, "{a} vs {b}");
+    // The same light gives the same VPLs.
+    assert_eq!(rsm, gpu.rsm_vpls(&ctx, n, 256, 1).expect("again"));
+    // Every VPL with flux lies on a wall, its normal facing the light.
+    let light = visgate_runtime::lights::light_position(&scene.lights[0]);
+    for v in rsm.iter().filter(|v| v.flux[0] > 0.0) {
+        let p = Vec3::from(v.position);
+        assert!(Vec3::from(v.normal).dot(light - p) > 0.0, "{v:?}");
+    }
+    // And the GPU `none` image with RSM VPLs agrees with its CPU twin.
+    let view = View::new(scene.cameras.first().expect("camera"), [48, 32]).expect("view");
+    let (img, _) = gpu
+        .render(&ctx, &view, &rsm[..1024], &GpuParams::default())
+        .expect("render");
+    let (cpu, _) = render_reference(
+        &tracer,
+        &scene.lights,
+        &rsm[..1024],
+        &view,
+        &ReferenceParams {
+            samples_per_pixel: 1,
+            indirect_visibility: false,
+            ..ReferenceParams::default()
+        },
+        &|_, _| {},
+    )
+    .expect("cpu");
+    let e = errors(&img, &cpu).expect("same size");
+    assert!(e.rel_mse < 0.02, "{e:?}");
 }
