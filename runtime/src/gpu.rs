@@ -759,25 +759,9 @@ impl GpuRenderer {
 
         // Samples: paths shared by power as for light paths, Halton points per light.
         let lights: Vec<Light> = self.lights.clone();
-        let power: Vec<f32> = lights
-            .iter()
-            .map(|l| {
-                crate::lights::light_power(l)
-                    .dot(Vec3::new(0.2126, 0.7152, 0.0722))
-                    .max(0.0)
-            })
-            .collect();
-        let total: f32 = power.iter().sum();
-        if total <= 0.0 {
+        let share = crate::vpl::share_by_power(&lights, n);
+        if share.iter().all(|&k| k == 0) {
             return Ok(Vec::new());
-        }
-        let mut share: Vec<u32> = power
-            .iter()
-            .map(|p| (n as f64 * (*p / total) as f64).floor() as u32)
-            .collect();
-        let given: u32 = share.iter().sum();
-        if let Some(best) = (0..power.len()).max_by(|&a, &b| power[a].total_cmp(&power[b])) {
-            share[best] += n - given;
         }
         let mut samples = Vec::with_capacity(n as usize);
         for (li, l) in lights.iter().enumerate() {

@@ -169,6 +169,32 @@ fn cosine_dir(u: Vec2, n: Vec3) -> Vec3 {
     (t * r * phi.cos() + b * r * phi.sin() + n * (1.0 - u.x).max(0.0).sqrt()).normalize()
 }
 
+/// `n` split between `lights` by power (luminance), the rounding remainder to the strongest;
+/// all zeros when no light emits.
+pub fn share_by_power(lights: &[Light], n: u32) -> Vec<u32> {
+    let power: Vec<f32> = lights
+        .iter()
+        .map(|l| {
+            light_power(l)
+                .dot(Vec3::new(0.2126, 0.7152, 0.0722))
+                .max(0.0)
+        })
+        .collect();
+    let total: f32 = power.iter().sum();
+    if total <= 0.0 || !total.is_finite() {
+        return vec![0; lights.len()];
+    }
+    let mut share: Vec<u32> = power
+        .iter()
+        .map(|p| (n as f64 * (*p / total) as f64).floor() as u32)
+        .collect();
+    let given: u32 = share.iter().sum();
+    if let Some(best) = (0..power.len()).max_by(|&a, &b| power[a].total_cmp(&power[b])) {
+        share[best] += n - given;
+    }
+    share
+}
+
 /// Traces light paths from `lights` and returns a VPL at every hit (see the module notes).
 pub fn path_vpls(
     tracer: &Tracer,
@@ -188,26 +214,9 @@ pub fn path_vpls(
             params.bounces
         )));
     }
-    // Paths per light, by power (luminance), the rounding remainder to the strongest.
-    let power: Vec<f32> = lights
-        .iter()
-        .map(|l| {
-            light_power(l)
-                .dot(Vec3::new(0.2126, 0.7152, 0.0722))
-                .max(0.0)
-        })
-        .collect();
-    let total: f32 = power.iter().sum();
-    if lights.is_empty() || total <= 0.0 || params.paths == 0 {
+    let share = share_by_power(lights, params.paths);
+    if share.iter().all(|&n| n == 0) {
         return Ok(Vec::new());
-    }
-    let mut share: Vec<u32> = power
-        .iter()
-        .map(|p| (params.paths as f64 * (*p / total) as f64).floor() as u32)
-        .collect();
-    let given: u32 = share.iter().sum();
-    if let Some(best) = (0..power.len()).max_by(|&a, &b| power[a].total_cmp(&power[b])) {
-        share[best] += params.paths - given;
     }
     let mut vpls = Vec::new();
     for (li, light) in lights.iter().enumerate() {
