@@ -271,6 +271,18 @@ pub fn run(args: RenderArgs) -> Result<()> {
                 times.vpl_gather * 1e3,
                 times.readback * 1e3
             );
+            match times.gpu {
+                Some(g) => println!(
+                    "GPU time (timestamp queries): shadow maps {:.2} ms, G-buffer {:.2} ms, \
+                     shading {:.2} ms, VPL maps {:.2} ms, VPL gather {:.2} ms",
+                    g.shadows * 1e3,
+                    g.gbuffer * 1e3,
+                    g.shade * 1e3,
+                    g.vpl_maps * 1e3,
+                    g.vpl_gather * 1e3
+                ),
+                None => println!("GPU time: the adapter has no timestamp queries"),
+            }
             let m = img.mean();
             println!("mean radiance {:.5} {:.5} {:.5}", m.x, m.y, m.z);
             println!("wrote {}", args.out.display());

@@ -178,6 +178,133 @@ pub struct PassTimes {
     pub vpl_gather: f64,
     /// Copy back to the CPU.
     pub readback: f64,
+    /// GPU time of each stage from timestamp queries, where the adapter has them.
+    pub gpu: Option<GpuStageTimes>,
+}
+
+/// GPU time of each stage, from timestamp queries (summed over a stage's passes). [Units: s]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct GpuStageTimes {
+    /// Shadow maps.
+    pub shadows: f64,
+    /// G-buffer.
+    pub gbuffer: f64,
+    /// Shading.
+    pub shade: f64,
+    /// Per-VPL paraboloid maps.
+    pub vpl_maps: f64,
+    /// Gather with per-VPL maps.
+    pub vpl_gather: f64,
+}
+
+/// Stages a [`Timer`] tells apart, in [`GpuStageTimes`] order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Stage {
+    Shadows,
+    GBuffer,
+    Shade,
+    VplMaps,
+    VplGather,
+}
+
+/// Timestamp queries around stages: each span is the beginning of a stage's first pass and
+/// the end of its last. Inactive (all `None`) where the adapter has no timestamps.
+struct Timer {
+    set: Option<wgpu::QuerySet>,
+    used: u32,
+    spans: Vec<(Stage, u32)>,
+}
+
+impl Timer {
+    fn new(ctx: &GpuContext, spans: u32) -> Timer {
+        let set = ctx.timestamp_period.map(|_| {
+            ctx.device.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("pass timestamps"),
+                ty: wgpu::QueryType::Timestamp,
+                count: (2 * spans).clamp(2, 4096),
+            })
+        });
+        Timer {
+            set,
+            used: 0,
+            spans: Vec::new(),
+        }
+    }
+
+    /// Reserves a span for `stage`; `None` when inactive or full.
+    fn span(&mut self, stage: Stage) -> Option<u32> {
+        let set = self.set.as_ref()?;
+        if self.used + 2 > set.count() {
+            return None;
+        }
+        let b = self.used;
+        self.used += 2;
+        self.spans.push((stage, b));
+        Some(b)
+    }
+
+    /// The writes of a pass that is the `first` and/or `last` of span `b`.
+    fn writes(
+        &self,
+        b: Option<u32>,
+        first: bool,
+        last: bool,
+    ) -> Option<wgpu::RenderPassTimestampWrites<'_>> {
+        let (set, b) = (self.set.as_ref()?, b?);
+        if !first && !last {
+            return None;
+        }
+        Some(wgpu::RenderPassTimestampWrites {
+            query_set: set,
+            beginning_of_pass_write_index: first.then_some(b),
+            end_of_pass_write_index: last.then_some(b + 1),
+        })
+    }
+
+    /// Resolves, reads back and sums the spans per stage.
+    fn read(&self, ctx: &GpuContext) -> Option<GpuStageTimes> {
+        let (set, period) = (self.set.as_ref()?, ctx.timestamp_period?);
+        if self.used == 0 {
+            return Some(GpuStageTimes::default());
+        }
+        let d = &ctx.device;
+        let bytes = self.used as u64 * 8;
+        let resolve = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("timestamps"),
+            size: bytes,
+            usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let read = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("timestamps readback"),
+            size: bytes,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("timestamps"),
+        });
+        enc.resolve_query_set(set, 0..self.used, &resolve, 0);
+        enc.copy_buffer_to_buffer(&resolve, 0, &read, 0, bytes);
+        ctx.queue.submit([enc.finish()]);
+        let slice = read.slice(..);
+        slice.map_async(wgpu::MapMode::Read, |_| {});
+        ctx.wait();
+        let ticks: Vec<u64> = bytemuck::cast_slice(&slice.get_mapped_range().ok()?).to_vec();
+        read.unmap();
+        let mut t = [0f64; 5];
+        for &(stage, b) in &self.spans {
+            let (a, z) = (ticks[b as usize], ticks[b as usize + 1]);
+            t[stage as usize] += z.saturating_sub(a) as f64 * period as f64 * 1e-9;
+        }
+        Some(GpuStageTimes {
+            shadows: t[0],
+            gbuffer: t[1],
+            shade: t[2],
+            vpl_maps: t[3],
+            vpl_gather: t[4],
+        })
+    }
 }
 
 /// A device and queue.
@@ -188,6 +315,8 @@ pub struct GpuContext {
     pub queue: wgpu::Queue,
     /// What the adapter says it is.
     pub adapter_info: wgpu::AdapterInfo,
+    /// Nanoseconds per timestamp tick, where the adapter has timestamp queries.
+    pub timestamp_period: Option<f32>,
 }
 
 impl GpuContext {
@@ -216,15 +345,20 @@ impl GpuContext {
         };
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("visgate device"),
-            required_features: wgpu::Features::empty(),
+            required_features: adapter.features() & wgpu::Features::TIMESTAMP_QUERY,
             required_limits: limits,
             ..Default::default()
         }))
         .map_err(|e| RenderError::NoAdapter(format!("cannot open {}: {e}", adapter_info.name)))?;
+        let timestamp_period = device
+            .features()
+            .contains(wgpu::Features::TIMESTAMP_QUERY)
+            .then(|| queue.get_timestamp_period());
         Ok(GpuContext {
             device,
             queue,
             adapter_info,
+            timestamp_period,
         })
     }
 
@@ -269,6 +403,7 @@ fn distance_pass(
     bind_group: &wgpu::BindGroup,
     vertices: &wgpu::Buffer,
     count: u32,
+    timestamps: Option<wgpu::RenderPassTimestampWrites>,
 ) {
     let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some(label),
@@ -294,7 +429,7 @@ fn distance_pass(
             }),
             stencil_ops: None,
         }),
-        timestamp_writes: None,
+        timestamp_writes: timestamps,
         occlusion_query_set: None,
         multiview_mask: None,
     });
@@ -312,6 +447,7 @@ fn fullscreen_pass(
     target: &wgpu::TextureView,
     pipeline: &wgpu::RenderPipeline,
     bind_group: &wgpu::BindGroup,
+    timestamps: Option<wgpu::RenderPassTimestampWrites>,
 ) {
     let mut enc = ctx
         .device
@@ -329,7 +465,7 @@ fn fullscreen_pass(
                 },
             })],
             depth_stencil_attachment: None,
-            timestamp_writes: None,
+            timestamp_writes: timestamps,
             occlusion_query_set: None,
             multiview_mask: None,
         });
@@ -753,7 +889,7 @@ impl GpuRenderer {
                     ..Default::default()
                 })
             });
-            self.gbuffer_pass(&mut enc, &layer_views, &depth_view, &bg);
+            self.gbuffer_pass(&mut enc, &layer_views, &depth_view, &bg, None);
         }
         ctx.queue.submit([enc.finish()]);
 
@@ -902,6 +1038,7 @@ impl GpuRenderer {
         targets: &[wgpu::TextureView; 3],
         depth: &wgpu::TextureView,
         bind_group: &wgpu::BindGroup,
+        timestamps: Option<wgpu::RenderPassTimestampWrites>,
     ) {
         let clear = |v| {
             Some(wgpu::RenderPassColorAttachment {
@@ -925,7 +1062,7 @@ impl GpuRenderer {
                 }),
                 stencil_ops: None,
             }),
-            timestamp_writes: None,
+            timestamp_writes: timestamps,
             occlusion_query_set: None,
             multiview_mask: None,
         });
@@ -965,6 +1102,12 @@ impl GpuRenderer {
         let [w, h] = view.size;
         let mut times = PassTimes::default();
         let (gpu_lights, shadow_views) = self.light_views();
+        let batches = if params.mode == GpuMode::PerVplShadowMaps {
+            vpls.len().div_ceil(params.vpl_batch.max(1) as usize) as u32
+        } else {
+            0
+        };
+        let mut timer = Timer::new(ctx, 3 + 2 * batches);
         let layers = shadow_views.len().max(1) as u32;
         if layers > d.limits().max_texture_array_layers {
             return Err(RenderError::Param(format!(
@@ -1013,6 +1156,8 @@ impl GpuRenderer {
             label: Some("shadow maps"),
         });
         let depth_view = shadow_depth.create_view(&Default::default());
+        let span = timer.span(Stage::Shadows);
+        let last = shadow_views.len().saturating_sub(1);
         for (i, _) in shadow_views.iter().enumerate() {
             let layer_view = shadow_tex.create_view(&wgpu::TextureViewDescriptor {
                 label: Some("shadow layer"),
@@ -1042,6 +1187,7 @@ impl GpuRenderer {
                 &bg,
                 &self.vertices,
                 self.vertex_count,
+                timer.writes(span, i == 0, i == last),
             );
         }
         ctx.queue.submit([enc.finish()]);
@@ -1101,7 +1247,14 @@ impl GpuRenderer {
         let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("gbuffer"),
         });
-        self.gbuffer_pass(&mut enc, &views, &gdepth_view, &gbg);
+        let span = timer.span(Stage::GBuffer);
+        self.gbuffer_pass(
+            &mut enc,
+            &views,
+            &gdepth_view,
+            &gbg,
+            timer.writes(span, true, true),
+        );
         ctx.queue.submit([enc.finish()]);
         ctx.wait();
         times.gbuffer = t0.elapsed().as_secs_f64();
@@ -1176,12 +1329,22 @@ impl GpuRenderer {
                 },
             ],
         });
-        fullscreen_pass(ctx, "shade", &out_view, &self.shade, &bg);
+        let span = timer.span(Stage::Shade);
+        fullscreen_pass(
+            ctx,
+            "shade",
+            &out_view,
+            &self.shade,
+            &bg,
+            timer.writes(span, true, true),
+        );
         times.shade = t0.elapsed().as_secs_f64();
 
         // 3b. Per-VPL paraboloid maps and their gather, batch by batch, added onto the image.
         if params.mode == GpuMode::PerVplShadowMaps && !vpls.is_empty() {
-            self.per_vpl_batches(ctx, params, vpls, &vpl_buf, &views, &out, &mut times)?;
+            self.per_vpl_batches(
+                ctx, params, vpls, &vpl_buf, &views, &out, &mut times, &mut timer,
+            )?;
         }
 
         // 4. Read back.
@@ -1228,6 +1391,7 @@ impl GpuRenderer {
         }
         read.unmap();
         times.readback = t0.elapsed().as_secs_f64();
+        times.gpu = timer.read(ctx);
         Ok((img, times))
     }
 
@@ -1243,6 +1407,7 @@ impl GpuRenderer {
         gviews: &[wgpu::TextureView; 3],
         out: &wgpu::Texture,
         times: &mut PassTimes,
+        timer: &mut Timer,
     ) -> Result<(), RenderError> {
         let d = &ctx.device;
         // Ping-pong: each batch reads the image so far and writes it plus its light.
@@ -1320,6 +1485,7 @@ impl GpuRenderer {
             let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("vpl maps"),
             });
+            let span = timer.span(Stage::VplMaps);
             for (k, layer_view) in layer_views.iter().enumerate().take(chunk.len()) {
                 let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("vpl view"),
@@ -1342,6 +1508,7 @@ impl GpuRenderer {
                     &bg,
                     &self.vpl_vertices,
                     self.vpl_vertex_count,
+                    timer.writes(span, k == 0, k + 1 == chunk.len()),
                 );
             }
             ctx.queue.submit([enc.finish()]);
@@ -1397,12 +1564,14 @@ impl GpuRenderer {
                     },
                 ],
             });
+            let span = timer.span(Stage::VplGather);
             fullscreen_pass(
                 ctx,
                 "gather batch",
                 &pair[1 - current],
                 &self.gather_batch,
                 &bg,
+                timer.writes(span, true, true),
             );
             current = 1 - current;
             times.vpl_gather += t0.elapsed().as_secs_f64();

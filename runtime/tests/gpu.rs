@@ -343,6 +343,34 @@ fn gpu_renders_0_1_and_65536_vpls_and_a_vpl_on_the_receiver_without_nan() {
         means.push(img.mean().x);
     }
     assert!(means[2] > means[0], "{means:?}");
+    // Timestamp queries, where the adapter has them (lavapipe does): every stage that ran took
+    // GPU time, and the stages that did not run took none.
+    let (_, times) = gpu
+        .render(
+            &ctx,
+            &view,
+            &vpls[..64],
+            &GpuParams {
+                mode: GpuMode::PerVplShadowMaps,
+                vpl_batch: 16,
+                ..GpuParams::default()
+            },
+        )
+        .expect("render");
+    match (ctx.timestamp_period, times.gpu) {
+        (Some(_), Some(g)) => {
+            assert!(g.shadows > 0.0 && g.gbuffer > 0.0 && g.shade > 0.0, "{g:?}");
+            assert!(g.vpl_maps > 0.0 && g.vpl_gather > 0.0, "{g:?}");
+        }
+        (None, None) => eprintln!("adapter without timestamp queries: CPU times only"),
+        other => panic!("timestamp support and times disagree: {other:?}"),
+    }
+    let (_, times) = gpu
+        .render(&ctx, &view, &vpls[..64], &GpuParams::default())
+        .expect("render");
+    if let Some(g) = times.gpu {
+        assert_eq!((g.vpl_maps, g.vpl_gather), (0.0, 0.0));
+    }
     // VPLs lying on the surfaces the camera sees (every light-path VPL does): the clamp holds.
     let (img, _) = gpu
         .render(
