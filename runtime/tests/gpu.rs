@@ -478,3 +478,54 @@ fn rsm_vpls_carry_the_reflected_power_and_do_not_flicker() {
     let e = errors(&img, &cpu).expect("same size");
     assert!(e.rel_mse < 0.02, "{e:?}");
 }
+
+#[test]
+fn gpu_scene_scales_from_1e_minus_3_to_1e4_give_the_same_image_after_scaling_the_light() {
+    use visgate_formats::Light;
+    let ctx = context();
+    let render = |scale: f32| {
+        let mut scene = Builtin::FourRooms.scene().expect("scene");
+        for m in &mut scene.meshes {
+            m.positions.iter_mut().for_each(|p| *p *= scale);
+        }
+        for l in &mut scene.lights {
+            let (Light::Point {
+                position,
+                intensity,
+            }
+            | Light::Spot {
+                position,
+                intensity,
+                ..
+            }) = l;
+            *position *= scale;
+            *intensity *= scale * scale;
+        }
+        let mut cam = scene.cameras.first().cloned().expect("camera");
+        cam.eye *= scale;
+        cam.target *= scale;
+        let tracer = Tracer::new(&scene);
+        let vpls = path_vpls(
+            &tracer,
+            &scene.lights,
+            &PathParams {
+                paths: 256,
+                bounces: 1,
+                seed: 3,
+            },
+        )
+        .expect("vpls");
+        let gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+        let view = View::new(&cam, [32, 24]).expect("view");
+        let params = GpuParams {
+            g_max: 10.0 / (scale * scale),
+            ..GpuParams::default()
+        };
+        gpu.render(&ctx, &view, &vpls, &params).expect("render").0
+    };
+    let base = render(1.0);
+    for scale in [1e-3f32, 1e-1, 10.0, 1e4] {
+        let e = errors(&render(scale), &base).expect("same size");
+        assert!(e.rel_mse < 1e-3, "scale {scale}: {e:?}");
+    }
+}
