@@ -529,3 +529,121 @@ fn gpu_scene_scales_from_1e_minus_3_to_1e4_give_the_same_image_after_scaling_the
         assert!(e.rel_mse < 1e-3, "scale {scale}: {e:?}");
     }
 }
+
+#[test]
+fn gpu_a_light_inside_geometry_lights_nothing_outside_it() {
+    use visgate_formats::scene::ImportReport;
+    use visgate_formats::{Camera, Light, Material, Mesh, Scene};
+    // A closed 0.4 m box around a point light at 1 m, over a 20 m floor.
+    let mut positions = Vec::new();
+    let mut triangles = Vec::new();
+    let mut quad = |q: [Vec3; 4]| {
+        let b = positions.len() as u32;
+        positions.extend(q);
+        triangles.push([b, b + 1, b + 2]);
+        triangles.push([b, b + 2, b + 3]);
+    };
+    let c = |x: f32, y: f32, z: f32| Vec3::new(x * 0.2, 1.0 + y * 0.2, z * 0.2);
+    for q in [
+        [
+            c(-1., -1., -1.),
+            c(-1., -1., 1.),
+            c(1., -1., 1.),
+            c(1., -1., -1.),
+        ],
+        [
+            c(-1., 1., -1.),
+            c(1., 1., -1.),
+            c(1., 1., 1.),
+            c(-1., 1., 1.),
+        ],
+        [
+            c(-1., -1., -1.),
+            c(-1., 1., -1.),
+            c(-1., 1., 1.),
+            c(-1., -1., 1.),
+        ],
+        [
+            c(1., -1., -1.),
+            c(1., -1., 1.),
+            c(1., 1., 1.),
+            c(1., 1., -1.),
+        ],
+        [
+            c(-1., -1., -1.),
+            c(1., -1., -1.),
+            c(1., 1., -1.),
+            c(-1., 1., -1.),
+        ],
+        [
+            c(-1., -1., 1.),
+            c(-1., 1., 1.),
+            c(1., 1., 1.),
+            c(1., -1., 1.),
+        ],
+    ] {
+        quad(q);
+    }
+    let r = 10.0;
+    quad([
+        Vec3::new(-r, 0.0, -r),
+        Vec3::new(-r, 0.0, r),
+        Vec3::new(r, 0.0, r),
+        Vec3::new(r, 0.0, -r),
+    ]);
+    let n = positions.len();
+    let t = triangles.len();
+    let scene = Scene {
+        name: "boxed light".into(),
+        source: None,
+        closed: false,
+        meshes: vec![Mesh {
+            name: "all".into(),
+            entry: 0,
+            is_static: true,
+            normals: vec![Vec3::Y; n],
+            uvs: vec![glam::Vec2::ZERO; n],
+            positions,
+            triangles,
+            material: vec![0; t],
+        }],
+        materials: vec![Material {
+            name: "grey".into(),
+            albedo: Vec3::splat(0.7),
+            texture: None,
+        }],
+        textures: Vec::new(),
+        lights: vec![Light::Point {
+            position: Vec3::new(0.0, 1.0, 0.0),
+            intensity: Vec3::splat(50.0),
+        }],
+        cameras: Vec::new(),
+        report: ImportReport::default(),
+    };
+    let ctx = context();
+    let gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    let cam = Camera {
+        name: "floor".into(),
+        eye: Vec3::new(3.0, 2.0, 0.0),
+        target: Vec3::new(1.5, 0.0, 0.0),
+        up: Vec3::Y,
+        fov_x_rad: 0.5,
+    };
+    let view = View::new(&cam, [16, 12]).expect("view");
+    let (img, _) = gpu
+        .render(
+            &ctx,
+            &view,
+            &[],
+            &GpuParams {
+                mode: GpuMode::DirectOnly,
+                ..GpuParams::default()
+            },
+        )
+        .expect("render");
+    assert!(
+        img.pixels.iter().all(|p| *p == Vec3::ZERO),
+        "light leaks: {}",
+        img.mean()
+    );
+}
