@@ -477,6 +477,68 @@ fn fullscreen_pass(
     ctx.wait();
 }
 
+/// The scene's textures as layers of one sRGB array (resized, nearest, to the largest size up to
+/// [`MAX_TEXTURE_SIZE`]; one white texel when there are none), and a nearest, repeating sampler.
+fn albedo_array(ctx: &GpuContext, scene: &Scene) -> (wgpu::TextureView, wgpu::Sampler) {
+    let d = &ctx.device;
+    let size = scene
+        .textures
+        .iter()
+        .map(|t| t.width.max(t.height))
+        .max()
+        .unwrap_or(1)
+        .clamp(1, MAX_TEXTURE_SIZE.min(d.limits().max_texture_dimension_2d));
+    let layers = (scene.textures.len() as u32).clamp(1, d.limits().max_texture_array_layers);
+    let mut bytes = vec![255u8; (size * size * 4 * layers) as usize];
+    for (k, t) in scene.textures.iter().take(layers as usize).enumerate() {
+        let layer = &mut bytes[k * (size * size * 4) as usize..][..(size * size * 4) as usize];
+        if t.width == 0 || t.height == 0 || t.rgba8.len() < (t.width * t.height * 4) as usize {
+            continue;
+        }
+        for y in 0..size {
+            for x in 0..size {
+                let (sx, sy) = (x * t.width / size, y * t.height / size);
+                let s = ((sy * t.width + sx) * 4) as usize;
+                let o = ((y * size + x) * 4) as usize;
+                layer[o..o + 4].copy_from_slice(&t.rgba8[s..s + 4]);
+            }
+        }
+    }
+    let tex = d.create_texture_with_data(
+        &ctx.queue,
+        &wgpu::TextureDescriptor {
+            label: Some("albedo textures"),
+            size: wgpu::Extent3d {
+                width: size,
+                height: size,
+                depth_or_array_layers: layers,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba8UnormSrgb,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        },
+        wgpu::util::TextureDataOrder::LayerMajor,
+        &bytes,
+    );
+    let view = tex.create_view(&wgpu::TextureViewDescriptor {
+        label: Some("albedo textures"),
+        dimension: Some(wgpu::TextureViewDimension::D2Array),
+        ..Default::default()
+    });
+    let sampler = d.create_sampler(&wgpu::SamplerDescriptor {
+        label: Some("albedo (nearest, repeat)"),
+        address_mode_u: wgpu::AddressMode::Repeat,
+        address_mode_v: wgpu::AddressMode::Repeat,
+        mag_filter: wgpu::FilterMode::Nearest,
+        min_filter: wgpu::FilterMode::Nearest,
+        ..Default::default()
+    });
+    (view, sampler)
+}
+
 /// The scene on the GPU and the pipelines.
 pub struct GpuRenderer {
     vertices: wgpu::Buffer,
@@ -492,6 +554,8 @@ pub struct GpuRenderer {
     vpl_shadow: wgpu::RenderPipeline,
     gather_batch: wgpu::RenderPipeline,
     rsm_vpls: wgpu::ComputePipeline,
+    albedo_maps: wgpu::TextureView,
+    albedo_sampler: wgpu::Sampler,
 }
 
 /// Splits triangles until no edge is longer than `max_edge` (longest edge halved first).
@@ -513,22 +577,31 @@ fn subdivide(tris: &[[Vec3; 3]], max_edge: f32) -> Vec<[Vec3; 3]> {
     out
 }
 
-/// Vertex layout: position, normal, albedo (f32 × 3 each).
-const VERTEX_STRIDE: u64 = 36;
+/// Vertex layout: position, normal, albedo, (u, v, texture layer or −1) — f32 × 3 each.
+const VERTEX_STRIDE: u64 = 48;
+/// Floats per vertex.
+const VERTEX_FLOATS: usize = 12;
+/// Textures are resized (nearest) to one layer size, at most this. [Units: texels]
+pub const MAX_TEXTURE_SIZE: u32 = 1024;
 
 impl GpuRenderer {
-    /// Uploads every mesh of `scene` (albedo per vertex from its material; textures are not
-    /// sampled yet) and builds the pipelines.
+    /// Uploads every mesh of `scene` (albedo per vertex from its material, textures as layers
+    /// of one sRGB array, resized to the largest texture's size up to [`MAX_TEXTURE_SIZE`]) and
+    /// builds the pipelines.
     pub fn new(ctx: &GpuContext, scene: &Scene) -> Result<GpuRenderer, RenderError> {
         let mut data: Vec<f32> = Vec::new();
         for m in &scene.meshes {
             for (t, idx) in m.triangles.iter().enumerate() {
-                let albedo = m
+                let mat = m
                     .material
                     .get(t)
-                    .and_then(|&k| scene.materials.get(k as usize))
-                    .map(|mat| mat.albedo)
-                    .unwrap_or(Vec3::splat(0.5));
+                    .and_then(|&k| scene.materials.get(k as usize));
+                let albedo = mat.map(|mat| mat.albedo).unwrap_or(Vec3::splat(0.5));
+                let layer = mat
+                    .and_then(|mat| mat.texture)
+                    .filter(|&k| (k as usize) < scene.textures.len())
+                    .map(|k| k as f32)
+                    .unwrap_or(-1.0);
                 let p = idx.map(|i| m.positions[i as usize]);
                 if (p[1] - p[0]).cross(p[2] - p[0]).length_squared() <= 0.0 {
                     continue;
@@ -538,18 +611,22 @@ impl GpuRenderer {
                     data.extend_from_slice(&p[k].to_array());
                     data.extend_from_slice(&n.to_array());
                     data.extend_from_slice(&albedo.to_array());
+                    let uv = m.uvs.get(i as usize).copied().unwrap_or_default();
+                    data.extend_from_slice(&[uv.x, uv.y, layer]);
                 }
             }
         }
-        let vertex_count = (data.len() / 9) as u32;
+        let vertex_count = (data.len() / VERTEX_FLOATS) as u32;
         let diag = scene
             .bounds()
             .map(|(lo, hi)| (hi - lo).length())
             .unwrap_or(1.0)
             .max(1e-6);
         let tris: Vec<[Vec3; 3]> = data
-            .chunks_exact(27)
-            .map(|c| [0, 9, 18].map(|o| Vec3::new(c[o], c[o + 1], c[o + 2])))
+            .chunks_exact(3 * VERTEX_FLOATS)
+            .map(|c| {
+                [0, VERTEX_FLOATS, 2 * VERTEX_FLOATS].map(|o| Vec3::new(c[o], c[o + 1], c[o + 2]))
+            })
             .collect();
         let mut vpl_data: Vec<f32> = subdivide(&tris, diag * VPL_SHADOW_MAX_EDGE)
             .iter()
@@ -560,7 +637,7 @@ impl GpuRenderer {
             vpl_data.resize(3, 0.0);
         }
         if data.is_empty() {
-            data.resize(9, 0.0);
+            data.resize(VERTEX_FLOATS, 0.0);
         }
         let d = &ctx.device;
         let vertices = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -584,7 +661,9 @@ impl GpuRenderer {
         let sd = module("shade.wgsl", SHADE_WGSL);
         let vs_mod = module("vpl_shadow.wgsl", VPL_SHADOW_WGSL);
         let gb_mod = module("gather_batch.wgsl", GATHER_BATCH_WGSL);
-        let attrs = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x3];
+        let attrs = wgpu::vertex_attr_array![
+            0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 3 => Float32x3
+        ];
         let layout = wgpu::VertexBufferLayout {
             array_stride: VERTEX_STRIDE,
             step_mode: wgpu::VertexStepMode::Vertex,
@@ -695,6 +774,7 @@ impl GpuRenderer {
             wgpu::PrimitiveState::default(),
             None,
         );
+        let (albedo_maps, albedo_sampler) = albedo_array(ctx, scene);
         let rsm_mod = module("rsm_vpls.wgsl", RSM_VPLS_WGSL);
         let rsm_vpls = d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
             label: Some("rsm vpls"),
@@ -723,6 +803,8 @@ impl GpuRenderer {
             vpl_shadow,
             gather_batch,
             rsm_vpls,
+            albedo_maps,
+            albedo_sampler,
         })
     }
 
@@ -875,10 +957,7 @@ impl GpuRenderer {
             let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("rsm globals"),
                 layout: &self.gbuffer.get_bind_group_layout(0),
-                entries: &[wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: buf.as_entire_binding(),
-                }],
+                entries: &self.gbuffer_entries(&buf),
             });
             let layer_views = maps.each_ref().map(|t| {
                 t.create_view(&wgpu::TextureViewDescriptor {
@@ -1029,6 +1108,24 @@ impl GpuRenderer {
         };
         read.unmap();
         Ok(vpls)
+    }
+
+    /// The G-buffer's bindings: `globals`, the albedo array and its sampler.
+    fn gbuffer_entries<'a>(&'a self, globals: &'a wgpu::Buffer) -> [wgpu::BindGroupEntry<'a>; 3] {
+        [
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: globals.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: wgpu::BindingResource::TextureView(&self.albedo_maps),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: wgpu::BindingResource::Sampler(&self.albedo_sampler),
+            },
+        ]
     }
 
     /// The G-buffer pass into `targets` (position, normal, albedo) and `depth`.
@@ -1239,10 +1336,7 @@ impl GpuRenderer {
         let gbg = d.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("gbuffer globals"),
             layout: &self.gbuffer.get_bind_group_layout(0),
-            entries: &[wgpu::BindGroupEntry {
-                binding: 0,
-                resource: globals_buf.as_entire_binding(),
-            }],
+            entries: &self.gbuffer_entries(&globals_buf),
         });
         let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("gbuffer"),

@@ -647,3 +647,109 @@ fn gpu_a_light_inside_geometry_lights_nothing_outside_it() {
         img.mean()
     );
 }
+
+#[test]
+fn gpu_samples_albedo_textures_as_the_reference_does() {
+    use visgate_formats::scene::ImportReport;
+    use visgate_formats::{Camera, Light, Material, Mesh, Scene, Texture};
+    // A floor with a 4 × 4 sRGB checker of red and dark blue, repeated twice, under a light.
+    let mut rgba8 = Vec::new();
+    for y in 0..4 {
+        for x in 0..4 {
+            rgba8.extend(if (x + y) % 2 == 0 {
+                [230, 40, 40, 255]
+            } else {
+                [20, 30, 120, 255]
+            });
+        }
+    }
+    let r = 2.0;
+    let scene = Scene {
+        name: "checker".into(),
+        source: None,
+        closed: false,
+        meshes: vec![Mesh {
+            name: "floor".into(),
+            entry: 0,
+            is_static: true,
+            positions: vec![
+                Vec3::new(-r, 0.0, -r),
+                Vec3::new(-r, 0.0, r),
+                Vec3::new(r, 0.0, r),
+                Vec3::new(r, 0.0, -r),
+            ],
+            normals: vec![Vec3::Y; 4],
+            uvs: vec![
+                glam::Vec2::new(0.0, 0.0),
+                glam::Vec2::new(0.0, 2.0),
+                glam::Vec2::new(2.0, 2.0),
+                glam::Vec2::new(2.0, 0.0),
+            ],
+            triangles: vec![[0, 1, 2], [0, 2, 3]],
+            material: vec![0, 0],
+        }],
+        materials: vec![Material {
+            name: "checker".into(),
+            albedo: Vec3::splat(0.9),
+            texture: Some(0),
+        }],
+        textures: vec![Texture {
+            name: "checker".into(),
+            width: 4,
+            height: 4,
+            rgba8,
+        }],
+        lights: vec![Light::Point {
+            position: Vec3::new(0.3, 2.0, 0.2),
+            intensity: Vec3::splat(10.0),
+        }],
+        cameras: Vec::new(),
+        report: ImportReport::default(),
+    };
+    let cam = Camera {
+        name: "down".into(),
+        eye: Vec3::new(0.0, 3.0, 0.01),
+        target: Vec3::ZERO,
+        up: Vec3::Z,
+        fov_x_rad: 1.0,
+    };
+    let view = View::new(&cam, [40, 40]).expect("view");
+    let ctx = context();
+    let gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    let (img, _) = gpu
+        .render(
+            &ctx,
+            &view,
+            &[],
+            &GpuParams {
+                mode: GpuMode::DirectOnly,
+                ..GpuParams::default()
+            },
+        )
+        .expect("render");
+    let tracer = Tracer::new(&scene);
+    let (cpu, _) = render_reference(
+        &tracer,
+        &scene.lights,
+        &[],
+        &view,
+        &ReferenceParams {
+            samples_per_pixel: 1,
+            indirect: false,
+            ..ReferenceParams::default()
+        },
+        &|_, _| {},
+    )
+    .expect("cpu");
+    // Both show the checker: red and blue dominate in different pixels.
+    let red = img.pixels.iter().filter(|p| p.x > 3.0 * p.z).count();
+    let blue = img.pixels.iter().filter(|p| p.z > 2.0 * p.x).count();
+    assert!(red > 200 && blue > 200, "{red} red, {blue} blue pixels");
+    let e = errors(&img, &cpu).expect("same size");
+    // Pixels on checker edges may pick the neighbouring texel on one side only.
+    assert!(e.rel_mse < 0.02, "{e:?}");
+    assert!(
+        (e.image_mean / e.reference_mean - 1.0).abs() < 0.02,
+        "{e:?}"
+    );
+}

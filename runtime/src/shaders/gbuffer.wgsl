@@ -1,5 +1,6 @@
 // G-buffer pass: world position (w = 1 where a surface is), shading normal turned towards the
-// camera (surfaces are two-sided), linear albedo. Depth test less, depth 0 near.
+// camera (surfaces are two-sided), linear albedo (material × texture, the texture an sRGB layer
+// of one array, sampled nearest with repeat as the CPU reference does). Depth test less.
 
 struct Globals {
     view_proj: mat4x4<f32>,
@@ -12,11 +13,15 @@ struct Globals {
 };
 
 @group(0) @binding(0) var<uniform> globals: Globals;
+@group(0) @binding(1) var albedo_maps: texture_2d_array<f32>;
+@group(0) @binding(2) var albedo_sampler: sampler;
 
 struct VsIn {
     @location(0) position: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) albedo: vec3<f32>,
+    // xy texture coordinates, z texture layer (< 0: none).
+    @location(3) uv_layer: vec3<f32>,
 };
 
 struct VsOut {
@@ -24,6 +29,7 @@ struct VsOut {
     @location(0) world: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) albedo: vec3<f32>,
+    @location(3) uv_layer: vec3<f32>,
 };
 
 @vertex
@@ -33,6 +39,7 @@ fn vs(v: VsIn) -> VsOut {
     o.world = v.position;
     o.normal = v.normal;
     o.albedo = v.albedo;
+    o.uv_layer = v.uv_layer;
     return o;
 }
 
@@ -52,6 +59,11 @@ fn fs(i: VsOut) -> GOut {
     var o: GOut;
     o.position = vec4<f32>(i.world, 1.0);
     o.normal = vec4<f32>(n, 0.0);
-    o.albedo = vec4<f32>(i.albedo, 1.0);
+    var albedo = i.albedo;
+    if i.uv_layer.z >= 0.0 {
+        let layer = i32(i.uv_layer.z + 0.5);
+        albedo *= textureSampleLevel(albedo_maps, albedo_sampler, i.uv_layer.xy, layer, 0.0).xyz;
+    }
+    o.albedo = vec4<f32>(albedo, 1.0);
     return o;
 }
