@@ -113,42 +113,15 @@ fn gpu_modes_agree_with_the_cpu_reference_with_the_same_vpls_and_visibility() {
 
 #[test]
 fn gpu_white_plane_under_a_point_light_has_the_closed_form_radiance() {
-    use visgate_formats::scene::ImportReport;
-    use visgate_formats::{Camera, Light, Material, Mesh, Scene};
+    use visgate_formats::{Camera, Light};
     let (rho, i, h) = (0.8f32, 10.0f32, 2.0f32);
-    let r = 50.0;
-    let scene = Scene {
-        name: "plane".into(),
-        source: None,
-        closed: false,
-        meshes: vec![Mesh {
-            name: "floor".into(),
-            entry: 0,
-            is_static: true,
-            positions: vec![
-                Vec3::new(-r, 0.0, -r),
-                Vec3::new(-r, 0.0, r),
-                Vec3::new(r, 0.0, r),
-                Vec3::new(r, 0.0, -r),
-            ],
-            normals: vec![Vec3::Y; 4],
-            uvs: vec![glam::Vec2::ZERO; 4],
-            triangles: vec![[0, 1, 2], [0, 2, 3]],
-            material: vec![0, 0],
-        }],
-        materials: vec![Material {
-            name: "white".into(),
-            albedo: Vec3::splat(rho),
-            texture: None,
-        }],
-        textures: Vec::new(),
-        lights: vec![Light::Point {
+    let scene = floor_scene(
+        rho,
+        vec![Light::Point {
             position: Vec3::new(0.0, h, 0.0),
             intensity: Vec3::splat(i),
         }],
-        cameras: Vec::new(),
-        report: ImportReport::default(),
-    };
+    );
     let ctx = context();
     let gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
     // Looking straight down from beside the light at the point under it.
@@ -752,4 +725,117 @@ fn gpu_samples_albedo_textures_as_the_reference_does() {
         (e.image_mean / e.reference_mean - 1.0).abs() < 0.02,
         "{e:?}"
     );
+}
+
+/// A 100 m floor of albedo `rho` with `lights`, for the GPU known answers.
+fn floor_scene(rho: f32, lights: Vec<visgate_formats::Light>) -> visgate_formats::Scene {
+    use visgate_formats::scene::ImportReport;
+    use visgate_formats::{Material, Mesh, Scene};
+    let r = 50.0;
+    Scene {
+        name: "floor".into(),
+        source: None,
+        closed: false,
+        meshes: vec![Mesh {
+            name: "floor".into(),
+            entry: 0,
+            is_static: true,
+            positions: vec![
+                Vec3::new(-r, 0.0, -r),
+                Vec3::new(-r, 0.0, r),
+                Vec3::new(r, 0.0, r),
+                Vec3::new(r, 0.0, -r),
+            ],
+            normals: vec![Vec3::Y; 4],
+            uvs: vec![glam::Vec2::ZERO; 4],
+            triangles: vec![[0, 1, 2], [0, 2, 3]],
+            material: vec![0, 0],
+        }],
+        materials: vec![Material {
+            name: "white".into(),
+            albedo: Vec3::splat(rho),
+            texture: None,
+        }],
+        textures: Vec::new(),
+        lights,
+        cameras: Vec::new(),
+        report: ImportReport::default(),
+    }
+}
+
+#[test]
+fn gpu_spot_falloff_matches_the_conventions_at_beam_mid_ramp_and_cutoff() {
+    use visgate_formats::{Camera, Light};
+    use visgate_runtime::lights::spot_falloff;
+    let (beam, cutoff, h, i) = (20f32.to_radians(), 40f32.to_radians(), 2.0f32, 5.0f32);
+    let scene = floor_scene(
+        1.0,
+        vec![Light::Spot {
+            position: Vec3::new(0.0, h, 0.0),
+            direction: -Vec3::Y,
+            intensity: Vec3::splat(i),
+            cutoff_rad: cutoff,
+            beam_rad: beam,
+        }],
+    );
+    let ctx = context();
+    let gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    for angle in [0.0f32, beam * 0.95, 0.5 * (beam + cutoff), cutoff * 1.1] {
+        let x = h * angle.tan();
+        // A narrow camera straight above the point at `angle` from the spot's axis.
+        let cam = Camera {
+            name: "probe".into(),
+            eye: Vec3::new(x, 0.5, 0.0),
+            target: Vec3::new(x, 0.0, 0.0),
+            up: Vec3::Z,
+            fov_x_rad: 0.01,
+        };
+        let view = View::new(&cam, [3, 3]).expect("view");
+        let (img, _) = gpu
+            .render(
+                &ctx,
+                &view,
+                &[],
+                &GpuParams {
+                    mode: GpuMode::DirectOnly,
+                    ..GpuParams::default()
+                },
+            )
+            .expect("render");
+        let d2 = x * x + h * h;
+        let want = 1.0 / PI * i * spot_falloff(angle, beam, cutoff) * angle.cos() / d2;
+        let got = img.at(1, 1).x;
+        assert!(
+            (got - want).abs() <= 2e-3 * (1.0 + want),
+            "angle {angle}: {got} vs {want}"
+        );
+    }
+}
+
+#[test]
+fn gpu_a_closed_box_with_no_light_is_black() {
+    let ctx = context();
+    let mut scene = Builtin::EmptyBox.scene().expect("scene");
+    scene.lights.clear();
+    let gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    let view = View::new(scene.cameras.first().expect("camera"), [16, 12]).expect("view");
+    for mode in [
+        GpuMode::None,
+        GpuMode::PerVplShadowMaps,
+        GpuMode::DirectOnly,
+    ] {
+        let (img, _) = gpu
+            .render(
+                &ctx,
+                &view,
+                &[],
+                &GpuParams {
+                    mode,
+                    ..GpuParams::default()
+                },
+            )
+            .expect("render");
+        assert!(img.pixels.iter().all(|p| *p == Vec3::ZERO), "{mode:?}");
+    }
+    assert!(gpu.rsm_vpls(&ctx, 64, 64, 1).expect("rsm").is_empty());
 }
