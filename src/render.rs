@@ -8,10 +8,11 @@ use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 use visgate_formats::ImportOptions;
 use visgate_runtime::camera::View;
+use visgate_runtime::gates::{GateLevel, GateParams};
 use visgate_runtime::gpu::{GpuContext, GpuMode, GpuParams, GpuRenderer};
 use visgate_runtime::hdr::{HdrImage, false_colour};
 use visgate_runtime::metrics::{errors, flip};
-use visgate_runtime::reference::{ReferenceParams, render_reference};
+use visgate_runtime::reference::{IndirectVisibility, ReferenceParams, render_with};
 use visgate_runtime::tracer::Tracer;
 use visgate_runtime::vpl::{GatherParams, PathParams, path_vpls};
 
@@ -24,6 +25,9 @@ Modes:
   per-vpl-shadow-maps
                GPU: one paraboloid shadow map per VPL, rendered and gathered in batches of
                --vpl-batch (the brute-force baseline that gates and virtual area lights beat)
+  gates        CPU twin of gate visibility: a VPL lights a point of another visibility
+               cluster only through a chain of at most --gate-hops gate disks (× --gate-oversize)
+               of the baked --level
   direct-only  GPU: direct light alone
 With --cpu, none and direct-only run on the CPU twin (shadow rays for direct light), and
 per-vpl-shadow-maps is the reference (exact shadow rays).
@@ -57,6 +61,8 @@ pub enum Mode {
     None,
     /// One paraboloid shadow map per VPL (GPU, in batches).
     PerVplShadowMaps,
+    /// Visibility through the gates of a baked level (CPU twin for now; needs --level).
+    Gates,
     /// Direct light only.
     DirectOnly,
 }
@@ -107,6 +113,15 @@ pub struct RenderArgs {
     /// Shadow map size per layer (GPU), texels.
     #[arg(long, default_value_t = 1024)]
     pub shadow_size: u32,
+    /// The baked level (.vgate) for --mode gates; it must come from this scene's geometry.
+    #[arg(long)]
+    pub level: Option<PathBuf>,
+    /// Gate disks are this many times their baked radius (--mode gates).
+    #[arg(long, default_value_t = 1.0)]
+    pub gate_oversize: f32,
+    /// Gates a VPL's light may pass in a chain (--mode gates; the paper: 1).
+    #[arg(long, default_value_t = 2)]
+    pub gate_hops: u32,
     /// Per-VPL paraboloid map size (GPU), texels.
     #[arg(long, default_value_t = 128)]
     pub vpl_map_size: u32,
@@ -146,6 +161,19 @@ pub fn run(args: RenderArgs) -> Result<()> {
     }
     if args.threads == Some(0) {
         bail!("--threads 0: give at least 1 thread, or leave it out to use all cores");
+    }
+    if args.mode == Mode::Gates && args.level.is_none() {
+        bail!(
+            "--mode gates needs --level LEVEL.vgate (bake one with `visgate bake SCENE -o LEVEL.vgate`)"
+        );
+    }
+    let oversize_ok = args.gate_oversize > 0.0 && args.gate_oversize.is_finite();
+    if !oversize_ok || !(1..=16).contains(&args.gate_hops) {
+        bail!(
+            "--gate-oversize {} must be > 0 and --gate-hops {} 1..=16",
+            args.gate_oversize,
+            args.gate_hops
+        );
     }
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads.unwrap_or(0))
@@ -197,12 +225,12 @@ pub fn run(args: RenderArgs) -> Result<()> {
                 args.bounces
             );
         }
-        let gpu_ctx =
-            if args.mode != Mode::Reference && !args.cpu || args.vpl_source == VplSource::Rsm {
-                Some(GpuContext::new()?)
-            } else {
-                None
-            };
+        let on_gpu = !matches!(args.mode, Mode::Reference | Mode::Gates) && !args.cpu;
+        let gpu_ctx = if on_gpu || args.vpl_source == VplSource::Rsm {
+            Some(GpuContext::new()?)
+        } else {
+            None
+        };
         let gpu = match &gpu_ctx {
             Some(ctx) => Some(GpuRenderer::new(ctx, &scene)?),
             None => None,
@@ -223,9 +251,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
             )?,
         };
         let vpl_s = t.elapsed().as_secs_f64();
-        if let (true, Some(ctx), Some(gpu)) =
-            (args.mode != Mode::Reference && !args.cpu, &gpu_ctx, &gpu)
-        {
+        if let (true, Some(ctx), Some(gpu)) = (on_gpu, &gpu_ctx, &gpu) {
             let (img, times) = gpu.render(
                 ctx,
                 &view,
@@ -299,10 +325,34 @@ pub fn run(args: RenderArgs) -> Result<()> {
             ProgressStyle::with_template("render {bar:40} {pos}/{len} rows {elapsed}<{eta}")
                 .unwrap_or_else(|_| ProgressStyle::default_bar()),
         );
-        let (img, stats) =
-            render_reference(&tracer, &scene.lights, &vpls, &view, &params, &|done, _| {
-                bar.set_position(done as u64)
-            })?;
+        let gate_level = match (&args.level, args.mode) {
+            (Some(path), Mode::Gates) => {
+                let level = visgate_formats::BakedLevel::read(path)
+                    .with_context(|| format!("cannot read the level {}", path.display()))?;
+                Some(GateLevel::new(level, &scene)?)
+            }
+            _ => None,
+        };
+        let vis = match &gate_level {
+            Some(g) => IndirectVisibility::Gates(
+                g,
+                GateParams {
+                    oversize: args.gate_oversize,
+                    max_hops: args.gate_hops,
+                },
+            ),
+            None if params.indirect_visibility => IndirectVisibility::Exact,
+            None => IndirectVisibility::Unoccluded,
+        };
+        let (img, stats) = render_with(
+            &tracer,
+            &scene.lights,
+            &vpls,
+            &view,
+            &params,
+            vis,
+            &|done, _| bar.set_position(done as u64),
+        )?;
         bar.finish_and_clear();
         img.write(&args.out, args.exposure)?;
         println!(

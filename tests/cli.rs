@@ -408,3 +408,52 @@ fn render_and_diff_refuse_bad_arguments_clearly() {
     assert!(!o.status.success());
     assert!(stderr(&o).contains("missing-a.exr"), "{}", stderr(&o));
 }
+
+#[test]
+fn render_gates_uses_a_baked_level_and_refuses_a_missing_or_stale_one() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let p = |n: &str| dir.path().join(n).to_str().expect("utf-8").to_string();
+    let o = visgate(&[
+        "bake",
+        "builtin:two-rooms",
+        "-o",
+        &p("two.vgate"),
+        "--resolution",
+        "64",
+        "-q",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let base = [
+        "render", "--mode", "gates", "--vpls", "64", "--size", "16x12", "--spp", "1",
+    ];
+    let mut a: Vec<&str> = base.to_vec();
+    a.insert(1, "builtin:two-rooms");
+    let out = p("g.exr");
+    let level = p("two.vgate");
+    a.extend(["--level", &level, "--out", &out]);
+    let o = visgate(&a);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // No level: a clear message.
+    let o = visgate(&[
+        "render",
+        "builtin:two-rooms",
+        "--mode",
+        "gates",
+        "--out",
+        &out,
+    ]);
+    assert!(stderr(&o).contains("--level"), "{}", stderr(&o));
+    // A level from other geometry: re-bake.
+    let o = visgate(&[
+        "render",
+        "builtin:four-rooms",
+        "--mode",
+        "gates",
+        "--level",
+        &level,
+        "--out",
+        &out,
+    ]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("re-bake"), "{}", stderr(&o));
+}

@@ -14,6 +14,7 @@ use visgate_formats::Light;
 
 use crate::RenderError;
 use crate::camera::View;
+use crate::gates::{GateLevel, GateParams};
 use crate::hdr::HdrImage;
 use crate::lights::direct_radiance;
 use crate::tracer::Tracer;
@@ -57,6 +58,17 @@ pub struct ReferenceStats {
     pub seconds: f64,
 }
 
+/// Visibility of VPL light, for [`render_with`].
+#[derive(Clone, Copy)]
+pub enum IndirectVisibility<'a> {
+    /// A shadow ray per VPL and sample.
+    Exact,
+    /// Every VPL lights every point.
+    Unoccluded,
+    /// The gate test of a baked level (the CPU twin of the `gates` mode, per point).
+    Gates(&'a GateLevel, GateParams),
+}
+
 /// Renders the reference image of `view`. `progress(rows_done, rows)` is called as rows end.
 pub fn render_reference(
     tracer: &Tracer,
@@ -64,6 +76,25 @@ pub fn render_reference(
     vpls: &[Vpl],
     view: &View,
     params: &ReferenceParams,
+    progress: &(dyn Fn(u32, u32) + Sync),
+) -> Result<(HdrImage, ReferenceStats), RenderError> {
+    let vis = if params.indirect_visibility {
+        IndirectVisibility::Exact
+    } else {
+        IndirectVisibility::Unoccluded
+    };
+    render_with(tracer, lights, vpls, view, params, vis, progress)
+}
+
+/// [`render_reference`] with any [`IndirectVisibility`] (`params.indirect_visibility` is not
+/// read).
+pub fn render_with(
+    tracer: &Tracer,
+    lights: &[Light],
+    vpls: &[Vpl],
+    view: &View,
+    params: &ReferenceParams,
+    vis: IndirectVisibility,
     progress: &(dyn Fn(u32, u32) + Sync),
 ) -> Result<(HdrImage, ReferenceStats), RenderError> {
     if !(1..=4096).contains(&params.samples_per_pixel) {
@@ -79,6 +110,14 @@ pub fn render_reference(
         )));
     }
     let t0 = std::time::Instant::now();
+    // The visibility cluster of every VPL, for the gate test.
+    let vpl_cluster: Vec<Option<u32>> = match vis {
+        IndirectVisibility::Gates(level, _) => vpls
+            .iter()
+            .map(|v| level.cluster_at(Vec3::from(v.position), Vec3::from(v.normal)))
+            .collect(),
+        _ => Vec::new(),
+    };
     let [w, h] = view.size;
     let shadow = AtomicU64::new(0);
     let done = AtomicU64::new(0);
@@ -106,7 +145,13 @@ pub fn render_reference(
                     }
                     if params.indirect {
                         let from = surf.position + surf.geometric_normal * tracer.epsilon_m;
-                        for v in vpls {
+                        let here = match vis {
+                            IndirectVisibility::Gates(level, _) => {
+                                level.cluster_at(surf.position, surf.normal)
+                            }
+                            _ => None,
+                        };
+                        for (j, v) in vpls.iter().enumerate() {
                             let l = gather_one(
                                 v,
                                 surf.position,
@@ -117,15 +162,32 @@ pub fn render_reference(
                             if l == Vec3::ZERO {
                                 continue;
                             }
-                            if params.indirect_visibility {
-                                rays += 1;
-                                let to = Vec3::from(v.position)
-                                    + Vec3::from(v.normal) * tracer.epsilon_m;
-                                if tracer.occluded(from, to) {
-                                    continue;
+                            let lit = match vis {
+                                IndirectVisibility::Unoccluded => true,
+                                IndirectVisibility::Exact => {
+                                    rays += 1;
+                                    let to = Vec3::from(v.position)
+                                        + Vec3::from(v.normal) * tracer.epsilon_m;
+                                    !tracer.occluded(from, to)
                                 }
+                                // A point or VPL outside every cluster (in a dropped void)
+                                // meets no gate: unoccluded, as without visibility.
+                                IndirectVisibility::Gates(level, gp) => {
+                                    match (vpl_cluster[j], here) {
+                                        (Some(a), Some(b)) => level.visible(
+                                            Vec3::from(v.position),
+                                            a,
+                                            surf.position,
+                                            b,
+                                            &gp,
+                                        ),
+                                        _ => true,
+                                    }
+                                }
+                            };
+                            if lit {
+                                sum += l;
                             }
-                            sum += l;
                         }
                     }
                 }

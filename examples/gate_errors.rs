@@ -1,0 +1,130 @@
+//! An error table like Table II of the visibility-gates paper, from the CPU renderers: MSE
+//! (and relative MSE, FLIP) against the exact reference with the same VPLs, for direct light
+//! only, no visibility on indirect light, and gate visibility (the paper's 1 hop, 2 hops,
+//! oversized disks).
+//!
+//! `cargo run --release --example gate_errors -- [SCENE] [LEVEL.vgate] [CAMERA|x,y,z:tx,ty,tz]`
+//!
+//! Without arguments: the built-in four rooms, baked here at 128, seen by its camera and by a
+//! camera in the room diagonal to the light (where the light is all indirect).
+
+use glam::Vec3;
+use visgate_formats::vgate::{BakeParams, Resolution};
+use visgate_formats::{BakedLevel, Camera, ImportOptions, Scene};
+use visgate_preprocess::bake::{BakeOptions, bake};
+use visgate_runtime::camera::View;
+use visgate_runtime::gates::{GateLevel, GateParams};
+use visgate_runtime::metrics::{errors, flip};
+use visgate_runtime::reference::{IndirectVisibility, ReferenceParams, render_with};
+use visgate_runtime::tracer::Tracer;
+use visgate_runtime::vpl::{PathParams, path_vpls};
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let mut args = std::env::args().skip(1);
+    let scene_arg = args.next().unwrap_or_else(|| "builtin:four-rooms".into());
+    let scene = match scene_arg.strip_prefix("builtin:") {
+        Some(name) => visgate_scenes::Builtin::from_name(name)
+            .ok_or("no such built-in scene")?
+            .scene()?,
+        None => Scene::load(
+            std::path::Path::new(&scene_arg),
+            &ImportOptions {
+                load_textures: true,
+            },
+        )?,
+    };
+    let level = match args.next() {
+        Some(p) if p != "-" => BakedLevel::read(std::path::Path::new(&p))?,
+        _ => {
+            let params = BakeParams {
+                resolution: Resolution::LongestAxisVoxels(128),
+                ..BakeParams::default()
+            };
+            bake(&scene, &params, &BakeOptions::default(), &|_| {})?.level
+        }
+    };
+    let mut cameras: Vec<Camera> = scene.cameras.clone();
+    if let Some(c) = args.next() {
+        let parse = |s: &str| -> Option<Vec3> {
+            let v: Vec<f32> = s.split(',').filter_map(|x| x.trim().parse().ok()).collect();
+            (v.len() == 3).then(|| Vec3::new(v[0], v[1], v[2]))
+        };
+        cameras = match c.split_once(':') {
+            Some((e, t)) => vec![Camera {
+                name: "given".into(),
+                eye: parse(e).ok_or("eye x,y,z")?,
+                target: parse(t).ok_or("target x,y,z")?,
+                up: Vec3::Y,
+                fov_x_rad: 70f32.to_radians(),
+            }],
+            None => cameras.into_iter().filter(|k| k.name == c).collect(),
+        };
+    } else if scene_arg == "builtin:four-rooms" {
+        cameras.push(Camera {
+            name: "far room (indirect only)".into(),
+            eye: Vec3::new(7.6, 1.6, 7.6),
+            target: Vec3::new(4.6, 0.8, 4.6),
+            up: Vec3::Y,
+            fov_x_rad: 75f32.to_radians(),
+        });
+    }
+    let gates = GateLevel::new(level, &scene)?;
+    let tracer = Tracer::new(&scene);
+    let vpls = path_vpls(
+        &tracer,
+        &scene.lights,
+        &PathParams {
+            paths: 1024,
+            bounces: 1,
+            seed: 1,
+        },
+    )?;
+    println!(
+        "{}: {} clusters, {} gates, {} VPLs, 128×96, 1 spp",
+        scene.name,
+        gates.cluster_count(),
+        gates.gate_count(),
+        vpls.len()
+    );
+    for cam in &cameras {
+        let view = View::new(cam, [128, 96])?;
+        let p = ReferenceParams {
+            samples_per_pixel: 1,
+            ..ReferenceParams::default()
+        };
+        let run = |vis: IndirectVisibility, indirect: bool| {
+            let params = ReferenceParams { indirect, ..p };
+            render_with(
+                &tracer,
+                &scene.lights,
+                &vpls,
+                &view,
+                &params,
+                vis,
+                &|_, _| {},
+            )
+            .map(|r| r.0)
+        };
+        let reference = run(IndirectVisibility::Exact, true)?;
+        println!("\ncamera {}", cam.name);
+        println!("| method | MSE | rel. MSE | FLIP |");
+        println!("|---|---|---|---|");
+        let gp = |oversize: f32, max_hops: u32| {
+            IndirectVisibility::Gates(&gates, GateParams { oversize, max_hops })
+        };
+        for (name, vis, indirect) in [
+            ("direct only", IndirectVisibility::Unoccluded, false),
+            ("no visibility", IndirectVisibility::Unoccluded, true),
+            ("gates (paper: 1 hop)", gp(1.0, 1), true),
+            ("gates, 2 hops", gp(1.0, 2), true),
+            ("gates × 1.5, 2 hops", gp(1.5, 2), true),
+            ("gates × 2, 2 hops", gp(2.0, 2), true),
+        ] {
+            let img = run(vis, indirect)?;
+            let e = errors(&img, &reference)?;
+            let (f, _) = flip(&img, &reference, 0.0)?;
+            println!("| {name} | {:.3e} | {:.3e} | {f:.4} |", e.mse, e.rel_mse);
+        }
+    }
+    Ok(())
+}

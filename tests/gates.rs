@@ -1,0 +1,123 @@
+//! Gate visibility on baked built-in levels (the CPU twin of the `gates` mode, per point),
+//! against the exact ray-cast visibility.
+
+use glam::Vec3;
+use visgate_formats::vgate::BakeParams;
+use visgate_formats::vgate::Resolution;
+use visgate_preprocess::bake::{BakeOptions, bake};
+use visgate_runtime::gates::{GateLevel, GateParams};
+use visgate_runtime::tracer::Tracer;
+use visgate_scenes::Builtin;
+
+fn baked(b: Builtin, res: u32) -> (visgate_formats::Scene, visgate_formats::BakedLevel) {
+    let scene = b.scene().expect("scene");
+    let params = BakeParams {
+        resolution: Resolution::LongestAxisVoxels(res),
+        ..BakeParams::default()
+    };
+    let level = bake(&scene, &params, &BakeOptions::default(), &|_| {})
+        .expect("bake")
+        .level;
+    (scene, level)
+}
+
+#[test]
+fn two_rooms_a_vpl_in_a_lights_b_only_through_the_doorway_gates() {
+    let (scene, level) = baked(Builtin::TwoRooms, 96);
+    let ka = Builtin::TwoRooms.known_answers();
+    let (a_room, b_room) = (&ka.rooms[0], &ka.rooms[1]);
+    let tracer = Tracer::new(&scene);
+    let gates = GateLevel::new(level.clone(), &scene).expect("level");
+    // VPLs on room A's floor, points on room B's floor and walls seen from a grid.
+    let lerp = |lo: [f32; 3], hi: [f32; 3], t: Vec3| {
+        Vec3::from(lo) + (Vec3::from(hi) - Vec3::from(lo)) * t
+    };
+    let mut lit = 0;
+    let mut tested = 0;
+    let mut exact_lit = 0;
+    let params = GateParams::default();
+    for i in 1..6 {
+        for k in 1..6 {
+            let t = Vec3::new(i as f32 / 6.0, 0.0, k as f32 / 6.0);
+            let vpl = lerp(a_room.min_m, a_room.max_m, t) + Vec3::Y * 0.01;
+            let ca = gates.cluster_at(vpl, Vec3::Y).expect("VPL cluster");
+            for u in 1..8 {
+                for w in 1..8 {
+                    let s = Vec3::new(u as f32 / 8.0, 0.3, w as f32 / 8.0);
+                    let p = lerp(b_room.min_m, b_room.max_m, s);
+                    let cb = gates.cluster_at(p, Vec3::Y).expect("point cluster");
+                    assert_ne!(ca, cb, "rooms A and B share a cluster");
+                    tested += 1;
+                    let through = gates.visible(vpl, ca, p, cb, &params);
+                    let seen = !tracer.occluded(vpl, p);
+                    exact_lit += seen as u32;
+                    if through {
+                        lit += 1;
+                        // Light through a gate disk (no wider than the doorway) is really seen.
+                        assert!(seen, "gate lets light through a wall: {vpl} → {p}");
+                    }
+                }
+            }
+        }
+    }
+    eprintln!(
+        "two rooms: {lit} of {tested} VPL–point pairs lit through gates, {exact_lit} seen exactly; \
+         {} clusters, {} gates",
+        gates.cluster_count(),
+        gates.gate_count()
+    );
+    assert!(lit > 0 && lit <= exact_lit);
+    // Without the gates, room A lights nothing in room B.
+    let mut closed = level.clone();
+    closed.topology.gates.clear();
+    let closed = GateLevel::new(closed, &scene).expect("level");
+    let vpl = Vec3::from(a_room.min_m).lerp(Vec3::from(a_room.max_m), 0.5)
+        * Vec3::new(1.0, 0.0, 1.0)
+        + Vec3::Y * 0.01;
+    let ca = closed.cluster_at(vpl, Vec3::Y).expect("cluster");
+    let p = Vec3::from(b_room.min_m).lerp(Vec3::from(b_room.max_m), 0.5);
+    let cb = closed.cluster_at(p, Vec3::Y).expect("cluster");
+    assert!(!closed.visible(vpl, ca, p, cb, &params));
+}
+
+#[test]
+fn a_level_baked_from_other_geometry_is_refused_with_a_re_bake_message() {
+    let (mut scene, level) = baked(Builtin::TwoRooms, 48);
+    scene.meshes[0].positions[0] += Vec3::X * 0.01;
+    let e = GateLevel::new(level, &scene).err().expect("refused");
+    assert!(e.to_string().contains("re-bake"), "{e}");
+}
+
+#[test]
+fn gate_tests_are_stable_at_the_extremes() {
+    use visgate_runtime::gates::segment_crosses_disk;
+    let (c, n) = (Vec3::ZERO, Vec3::X);
+    // A VPL in the plane of a gate: the segment never crosses the plane.
+    assert!(!segment_crosses_disk(
+        Vec3::new(0.0, 0.1, 0.0),
+        Vec3::new(0.0, 0.2, 0.3),
+        c,
+        n,
+        1.0
+    ));
+    // At the gate's centre: it crosses at t = 0.
+    assert!(segment_crosses_disk(c, Vec3::new(1.0, 0.1, 0.0), c, n, 0.5));
+    // A gate of radius zero lets only the exact centre through.
+    assert!(!segment_crosses_disk(
+        Vec3::new(-1.0, 0.1, 0.0),
+        Vec3::new(1.0, 0.1, 0.0),
+        c,
+        n,
+        0.0
+    ));
+    assert!(segment_crosses_disk(
+        Vec3::new(-1.0, 0.0, 0.0),
+        Vec3::new(1.0, 0.0, 0.0),
+        c,
+        n,
+        0.0
+    ));
+    // Degenerate segments and NaN radii: no crossing, no panic.
+    assert!(!segment_crosses_disk(c, c, c, n, 1.0));
+    assert!(!segment_crosses_disk(Vec3::NEG_X, Vec3::X, c, n, f32::NAN));
+}
