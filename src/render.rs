@@ -25,9 +25,9 @@ Modes:
   per-vpl-shadow-maps
                GPU: one paraboloid shadow map per VPL, rendered and gathered in batches of
                --vpl-batch (the brute-force baseline that gates and virtual area lights beat)
-  gates        CPU twin of gate visibility: a VPL lights a point of another visibility
-               cluster only through a chain of at most --gate-hops gate disks (× --gate-oversize)
-               of the baked --level
+  gates        GPU: a VPL lights a point of another visibility cluster only through a chain
+               of at most --gate-hops gate disks (× --gate-oversize) of the baked --level
+               (brute force per pixel and VPL for now; --cpu for the CPU twin; GPU: ≤ 2 hops)
   direct-only  GPU: direct light alone
 With --cpu, none and direct-only run on the CPU twin (shadow rays for direct light), and
 per-vpl-shadow-maps is the reference (exact shadow rays).
@@ -225,13 +225,13 @@ pub fn run(args: RenderArgs) -> Result<()> {
                 args.bounces
             );
         }
-        let on_gpu = !matches!(args.mode, Mode::Reference | Mode::Gates) && !args.cpu;
+        let on_gpu = args.mode != Mode::Reference && !args.cpu;
         let gpu_ctx = if on_gpu || args.vpl_source == VplSource::Rsm {
             Some(GpuContext::new()?)
         } else {
             None
         };
-        let gpu = match &gpu_ctx {
+        let mut gpu = match &gpu_ctx {
             Some(ctx) => Some(GpuRenderer::new(ctx, &scene)?),
             None => None,
         };
@@ -251,7 +251,18 @@ pub fn run(args: RenderArgs) -> Result<()> {
             )?,
         };
         let vpl_s = t.elapsed().as_secs_f64();
-        if let (true, Some(ctx), Some(gpu)) = (on_gpu, &gpu_ctx, &gpu) {
+        let gate_level = match (&args.level, args.mode) {
+            (Some(path), Mode::Gates) => {
+                let level = visgate_formats::BakedLevel::read(path)
+                    .with_context(|| format!("cannot read the level {}", path.display()))?;
+                Some(GateLevel::new(level, &scene)?)
+            }
+            _ => None,
+        };
+        if let (true, Some(ctx), Some(gpu)) = (on_gpu, &gpu_ctx, &mut gpu) {
+            if let Some(level) = &gate_level {
+                gpu.set_level(ctx, level)?;
+            }
             let (img, times) = gpu.render(
                 ctx,
                 &view,
@@ -260,7 +271,12 @@ pub fn run(args: RenderArgs) -> Result<()> {
                     mode: match args.mode {
                         Mode::None => GpuMode::None,
                         Mode::PerVplShadowMaps => GpuMode::PerVplShadowMaps,
+                        Mode::Gates => GpuMode::Gates,
                         _ => GpuMode::DirectOnly,
+                    },
+                    gates: GateParams {
+                        oversize: args.gate_oversize,
+                        max_hops: args.gate_hops,
                     },
                     vpl_map_size: args.vpl_map_size,
                     vpl_batch: args.vpl_batch,
@@ -325,14 +341,6 @@ pub fn run(args: RenderArgs) -> Result<()> {
             ProgressStyle::with_template("render {bar:40} {pos}/{len} rows {elapsed}<{eta}")
                 .unwrap_or_else(|_| ProgressStyle::default_bar()),
         );
-        let gate_level = match (&args.level, args.mode) {
-            (Some(path), Mode::Gates) => {
-                let level = visgate_formats::BakedLevel::read(path)
-                    .with_context(|| format!("cannot read the level {}", path.display()))?;
-                Some(GateLevel::new(level, &scene)?)
-            }
-            _ => None,
-        };
         let vis = match &gate_level {
             Some(g) => IndirectVisibility::Gates(
                 g,

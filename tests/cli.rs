@@ -433,6 +433,9 @@ fn render_gates_uses_a_baked_level_and_refuses_a_missing_or_stale_one() {
     a.extend(["--level", &level, "--out", &out]);
     let o = visgate(&a);
     assert!(o.status.success(), "{}", stderr(&o));
+    a.push("--cpu");
+    let o = visgate(&a);
+    assert!(o.status.success(), "{}", stderr(&o));
     // No level: a clear message.
     let o = visgate(&[
         "render",

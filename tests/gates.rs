@@ -121,3 +121,82 @@ fn gate_tests_are_stable_at_the_extremes() {
     assert!(!segment_crosses_disk(c, c, c, n, 1.0));
     assert!(!segment_crosses_disk(Vec3::NEG_X, Vec3::X, c, n, f32::NAN));
 }
+
+#[test]
+fn gpu_gates_agree_with_the_cpu_twin() {
+    use visgate_runtime::camera::View;
+    use visgate_runtime::gpu::{GpuContext, GpuMode, GpuParams, GpuRenderer};
+    use visgate_runtime::metrics::errors;
+    use visgate_runtime::reference::{IndirectVisibility, ReferenceParams, render_with};
+    use visgate_runtime::vpl::{PathParams, path_vpls};
+    let ctx = GpuContext::new().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"));
+    for (b, res) in [(Builtin::FourRooms, 128), (Builtin::TwoRooms, 96)] {
+        let (scene, level) = baked(b, res);
+        let gates = GateLevel::new(level, &scene).expect("level");
+        let tracer = Tracer::new(&scene);
+        let vpls = path_vpls(
+            &tracer,
+            &scene.lights,
+            &PathParams {
+                paths: 256,
+                bounces: 1,
+                seed: 4,
+            },
+        )
+        .expect("vpls");
+        let view = View::new(scene.cameras.first().expect("camera"), [64, 48]).expect("view");
+        let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+        assert!(
+            gpu.render(
+                &ctx,
+                &view,
+                &vpls,
+                &GpuParams {
+                    mode: GpuMode::Gates,
+                    ..GpuParams::default()
+                }
+            )
+            .is_err(),
+            "gates without a level must be refused"
+        );
+        gpu.set_level(&ctx, &gates).expect("level upload");
+        for hops in [1, 2] {
+            let gp = GateParams {
+                oversize: 1.5,
+                max_hops: hops,
+            };
+            let (img, _) = gpu
+                .render(
+                    &ctx,
+                    &view,
+                    &vpls,
+                    &GpuParams {
+                        mode: GpuMode::Gates,
+                        gates: gp,
+                        ..GpuParams::default()
+                    },
+                )
+                .expect("render");
+            let (cpu, _) = render_with(
+                &tracer,
+                &scene.lights,
+                &vpls,
+                &view,
+                &ReferenceParams {
+                    samples_per_pixel: 1,
+                    ..ReferenceParams::default()
+                },
+                IndirectVisibility::Gates(&gates, gp),
+                &|_, _| {},
+            )
+            .expect("cpu");
+            let e = errors(&img, &cpu).expect("same size");
+            eprintln!("{} {hops} hop(s): {e:?}", b.name());
+            assert!(e.rel_mse < 0.02, "{} {hops}: {e:?}", b.name());
+            assert!(
+                (e.image_mean / e.reference_mean - 1.0).abs() < 0.01,
+                "{e:?}"
+            );
+        }
+    }
+}

@@ -157,3 +157,86 @@ pub fn segment_crosses_disk(a: Vec3, b: Vec3, centre: Vec3, normal: Vec3, radius
     }
     (a + d * t - centre).length_squared() <= radius * radius
 }
+
+/// The GPU's copy of a level's gate data: the voxel→cluster grid as little-endian words of its
+/// stored element size (u8, u16 or u32: only what the scene's cluster count needs), the gates,
+/// and each cluster's gates as offsets + indices.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GateTables {
+    /// Grid origin (xyz, m) and voxel size (w, m).
+    pub origin: [f32; 4],
+    /// Grid dims (xyz) and bytes per value (w: 1, 2 or 4).
+    pub dims: [u32; 4],
+    /// The grid's values packed into u32 words, little-endian.
+    pub voxel_words: Vec<u32>,
+    /// Per gate: centre (xyz) + radius, normal (xyz) + 0, clusters (2) + 0 + 0 as f32 bits.
+    pub gates: Vec<[u32; 12]>,
+    /// `clusters + 1` offsets into the list that follows them, then the gate indices.
+    pub cluster_gates: Vec<u32>,
+}
+
+impl GateLevel {
+    /// The tables the GPU's gate test reads.
+    pub fn tables(&self) -> GateTables {
+        use visgate_formats::vgate::VoxelValues;
+        let (bytes, words): (u32, Vec<u32>) = match &self.level.voxel_cluster {
+            VoxelValues::U8(v) => (
+                1,
+                v.chunks(4)
+                    .map(|c| {
+                        let mut b = [u8::MAX; 4];
+                        b[..c.len()].copy_from_slice(c);
+                        u32::from_le_bytes(b)
+                    })
+                    .collect(),
+            ),
+            VoxelValues::U16(v) => (
+                2,
+                v.chunks(2)
+                    .map(|c| u32::from(c[0]) | (u32::from(*c.get(1).unwrap_or(&u16::MAX)) << 16))
+                    .collect(),
+            ),
+            VoxelValues::U32(v) => (4, v.clone()),
+        };
+        let gates = self
+            .level
+            .topology
+            .gates
+            .iter()
+            .map(|g| {
+                let f = |x: f32| x.to_bits();
+                [
+                    f(g.centre_m[0]),
+                    f(g.centre_m[1]),
+                    f(g.centre_m[2]),
+                    f(g.radius_m),
+                    f(g.normal[0]),
+                    f(g.normal[1]),
+                    f(g.normal[2]),
+                    0,
+                    g.clusters[0],
+                    g.clusters[1],
+                    0,
+                    0,
+                ]
+            })
+            .collect();
+        let mut starts = Vec::with_capacity(self.cluster_gates.len() + 1);
+        let mut list = Vec::new();
+        let base = self.cluster_gates.len() as u32 + 1;
+        for l in &self.cluster_gates {
+            starts.push(base + list.len() as u32);
+            list.extend(l.iter().map(|&g| g as u32));
+        }
+        starts.push(base + list.len() as u32);
+        starts.extend(list);
+        let g = &self.grid;
+        GateTables {
+            origin: [g.origin_m[0], g.origin_m[1], g.origin_m[2], g.voxel_size_m],
+            dims: [g.dims[0], g.dims[1], g.dims[2], bytes],
+            voxel_words: words,
+            gates,
+            cluster_gates: starts,
+        }
+    }
+}

@@ -94,6 +94,18 @@ pub struct Globals {
     pub counts: [u32; 4],
 }
 
+/// The level's grid for the gate test, shared with WGSL (`Grid` in shade.wgsl). 48 bytes.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GridUniform {
+    /// xyz origin (m), w voxel size (m).
+    pub origin: [f32; 4],
+    /// xyz dims, w bytes per stored value.
+    pub dims: [u32; 4],
+    /// x disk oversize, y max hops.
+    pub params: [f32; 4],
+}
+
 /// A light, shared with WGSL (`Light` in shade.wgsl). 64 bytes.
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
@@ -128,6 +140,9 @@ pub enum GpuMode {
     PerVplShadowMaps,
     /// Direct light only.
     DirectOnly,
+    /// VPL light through the gates of the level set with [`GpuRenderer::set_level`]: brute
+    /// force per fragment and VPL (the clustered light assignment comes next); at most 2 hops.
+    Gates,
 }
 
 /// Rendering parameters.
@@ -147,6 +162,8 @@ pub struct GpuParams {
     pub vpl_map_size: u32,
     /// VPL maps rendered and gathered per batch (bounds their memory). [Limit: 1..=2048]
     pub vpl_batch: u32,
+    /// How light passes gates in mode `Gates` (`max_hops` 1 or 2 on the GPU).
+    pub gates: crate::gates::GateParams,
 }
 
 impl Default for GpuParams {
@@ -159,6 +176,7 @@ impl Default for GpuParams {
             shadow_bias: 1.0,
             vpl_map_size: 128,
             vpl_batch: 128,
+            gates: crate::gates::GateParams::default(),
         }
     }
 }
@@ -341,6 +359,10 @@ impl GpuContext {
         let limits = wgpu::Limits {
             max_texture_array_layers: adapter.limits().max_texture_array_layers,
             max_storage_buffer_binding_size: adapter.limits().max_storage_buffer_binding_size,
+            max_storage_buffers_per_shader_stage: adapter
+                .limits()
+                .max_storage_buffers_per_shader_stage
+                .min(16),
             ..wgpu::Limits::downlevel_defaults()
         };
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
@@ -556,6 +578,17 @@ pub struct GpuRenderer {
     rsm_vpls: wgpu::ComputePipeline,
     albedo_maps: wgpu::TextureView,
     albedo_sampler: wgpu::Sampler,
+    /// The level's gate tables: grid (origin, dims), voxel words, gates, cluster gates.
+    level: Option<LevelBuffers>,
+}
+
+/// A level's gate tables on the GPU.
+struct LevelBuffers {
+    origin: [f32; 4],
+    dims: [u32; 4],
+    voxel_words: wgpu::Buffer,
+    gates: wgpu::Buffer,
+    cluster_gates: wgpu::Buffer,
 }
 
 /// Splits triangles until no edge is longer than `max_edge` (longest edge halved first).
@@ -805,6 +838,7 @@ impl GpuRenderer {
             rsm_vpls,
             albedo_maps,
             albedo_sampler,
+            level: None,
         })
     }
 
@@ -871,6 +905,45 @@ impl GpuRenderer {
             }
         }
         (lights, views)
+    }
+
+    /// Uploads a baked level's gate tables for mode [`GpuMode::Gates`]; the voxel→cluster grid
+    /// keeps the smallest integer type that holds the scene's clusters.
+    pub fn set_level(
+        &mut self,
+        ctx: &GpuContext,
+        level: &crate::gates::GateLevel,
+    ) -> Result<(), RenderError> {
+        let t = level.tables();
+        let d = &ctx.device;
+        let bytes = (t.voxel_words.len() * 4) as u64;
+        if bytes > d.limits().max_storage_buffer_binding_size {
+            return Err(RenderError::Param(format!(
+                "the voxel→cluster grid needs {bytes} bytes, more than the adapter's storage \
+                 binding limit {}: bake at a lower resolution",
+                d.limits().max_storage_buffer_binding_size
+            )));
+        }
+        let buf = |label: &str, words: &[u32]| {
+            let mut w = words.to_vec();
+            if w.is_empty() {
+                w.resize(16, 0);
+            }
+            d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: bytemuck::cast_slice(&w),
+                usage: wgpu::BufferUsages::STORAGE,
+            })
+        };
+        let gates: Vec<u32> = t.gates.iter().flatten().copied().collect();
+        self.level = Some(LevelBuffers {
+            origin: t.origin,
+            dims: t.dims,
+            voxel_words: buf("voxel clusters", &t.voxel_words),
+            gates: buf("gates", &gates),
+            cluster_gates: buf("cluster gates", &t.cluster_gates),
+        });
+        Ok(())
     }
 
     /// VPLs from reflective shadow maps (Dong et al. §6): each light's RSM (`rsm_size`² per
@@ -1189,6 +1262,20 @@ impl GpuRenderer {
                 params.vpl_map_size, params.vpl_batch
             )));
         }
+        if params.mode == GpuMode::Gates {
+            if self.level.is_none() {
+                return Err(RenderError::Param(
+                    "mode gates needs a baked level (GpuRenderer::set_level, --level)".into(),
+                ));
+            }
+            let o = params.gates.oversize;
+            if !(o > 0.0 && o.is_finite() && (1..=2).contains(&params.gates.max_hops)) {
+                return Err(RenderError::Param(format!(
+                    "gate oversize {o} must be > 0 and hops {} 1 or 2 on the GPU",
+                    params.gates.max_hops
+                )));
+            }
+        }
         if !(16..=4096).contains(&params.shadow_size) {
             return Err(RenderError::Param(format!(
                 "shadow map size {} must be 16..=4096",
@@ -1308,6 +1395,7 @@ impl GpuRenderer {
                 match params.mode {
                     GpuMode::None => 0,
                     GpuMode::DirectOnly | GpuMode::PerVplShadowMaps => 1,
+                    GpuMode::Gates => 2,
                 },
                 s,
             ],
@@ -1375,6 +1463,24 @@ impl GpuRenderer {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
             ..Default::default()
         });
+        // Gate tables (mode gates), placeholders otherwise.
+        let level = self.level.as_ref();
+        let grid = GridUniform {
+            origin: level.map_or([0.0, 0.0, 0.0, 1.0], |l| l.origin),
+            dims: level.map_or([0, 0, 0, 4], |l| l.dims),
+            params: [
+                params.gates.oversize,
+                params.gates.max_hops as f32,
+                0.0,
+                0.0,
+            ],
+        };
+        let grid_buf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("grid"),
+            contents: bytemuck::bytes_of(&grid),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let dummy = storage("no level", &[]);
         let out = tex(
             "hdr",
             [w, h, 1],
@@ -1420,6 +1526,24 @@ impl GpuRenderer {
                 wgpu::BindGroupEntry {
                     binding: 7,
                     resource: wgpu::BindingResource::TextureView(&views[2]),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 8,
+                    resource: grid_buf.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 9,
+                    resource: level.map_or(&dummy, |l| &l.voxel_words).as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 10,
+                    resource: level.map_or(&dummy, |l| &l.gates).as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 11,
+                    resource: level
+                        .map_or(&dummy, |l| &l.cluster_gates)
+                        .as_entire_binding(),
                 },
             ],
         });

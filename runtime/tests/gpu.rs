@@ -174,7 +174,9 @@ fn wgsl_layout(src: &str, name: &str) -> (u32, Vec<(String, u32)>) {
 #[test]
 fn gpu_structs_match_their_wgsl_layouts() {
     use std::mem::{offset_of, size_of};
-    use visgate_runtime::gpu::{Batch, Globals, GpuLight, RsmSample, ShadowView, VplView};
+    use visgate_runtime::gpu::{
+        Batch, Globals, GpuLight, GridUniform, RsmSample, ShadowView, VplView,
+    };
     use visgate_runtime::vpl::Vpl;
     let shade = SHADERS[2].1;
     let check = |src: &str, name: &str, size: usize, offsets: &[(&str, usize)]| {
@@ -252,6 +254,23 @@ fn gpu_structs_match_their_wgsl_layouts() {
             ("bitangent", offset_of!(VplView, bitangent)),
             ("normal", offset_of!(VplView, normal)),
         ],
+    );
+    check(
+        shade,
+        "Grid",
+        size_of::<GridUniform>(),
+        &[
+            ("origin", offset_of!(GridUniform, origin)),
+            ("dims", offset_of!(GridUniform, dims)),
+            ("params", offset_of!(GridUniform, params)),
+        ],
+    );
+    // Gates go up as 12 words each (GateLevel::tables): centre + radius, normal, clusters.
+    check(
+        shade,
+        "Gate",
+        48,
+        &[("centre", 0), ("normal", 16), ("clusters", 32)],
     );
     check(
         SHADERS[5].1,

@@ -1,5 +1,6 @@
 // Deferred shading: direct light from point and spot lights with shadow-map PCF (3 × 3), and
-// the indirect sum over VPLs without visibility (mode none), into a linear HDR target.
+// the indirect sum over VPLs without visibility (mode 0, none) or through the gates of a baked
+// level (mode 2), into a linear HDR target.
 //
 // Radiometry as the CPU reference: L = ρ/π · I · falloff · cos θ / d² for lights, and
 // ρ/π · Φ/π · min(cos θ_v cos θ_x / d², g_max) for VPLs.
@@ -41,6 +42,110 @@ struct Vpl {
 @group(0) @binding(5) var g_position: texture_2d<f32>;
 @group(0) @binding(6) var g_normal: texture_2d<f32>;
 @group(0) @binding(7) var g_albedo: texture_2d<f32>;
+
+// Gate visibility (mode 2), brute force per fragment and VPL: the clusters of both through
+// their normal side, then a chain of at most 2 gate disks the segment passes through.
+struct Grid {
+    // xyz origin (m), w voxel size (m).
+    origin: vec4<f32>,
+    // xyz dims, w bytes per stored value (1, 2 or 4).
+    dims: vec4<u32>,
+    // x disk oversize factor, y max hops (1 or 2), z, w unused.
+    params: vec4<f32>,
+};
+
+struct Gate {
+    // xyz centre (m), w radius (m).
+    centre: vec4<f32>,
+    // xyz unit normal.
+    normal: vec4<f32>,
+    // xy the two clusters.
+    clusters: vec4<u32>,
+};
+
+@group(0) @binding(8) var<uniform> grid: Grid;
+@group(0) @binding(9) var<storage, read> voxel_words: array<u32>;
+@group(0) @binding(10) var<storage, read> gates: array<Gate>;
+// Offsets (clusters + 1) into this same array, then the gate indices.
+@group(0) @binding(11) var<storage, read> cluster_gates: array<u32>;
+
+const NONE: u32 = 0xffffffffu;
+
+fn cluster_of(p: vec3<f32>) -> u32 {
+    let v = (p - grid.origin.xyz) / grid.origin.w;
+    if any(v < vec3<f32>(0.0)) || any(v >= vec3<f32>(grid.dims.xyz)) {
+        return NONE;
+    }
+    let c = vec3<u32>(v);
+    let i = c.x + grid.dims.x * (c.y + grid.dims.y * c.z);
+    let bytes = grid.dims.w;
+    if bytes == 4u {
+        return voxel_words[i];
+    }
+    if bytes == 2u {
+        let x = (voxel_words[i / 2u] >> ((i % 2u) * 16u)) & 0xffffu;
+        return select(x, NONE, x == 0xffffu);
+    }
+    let x = (voxel_words[i / 4u] >> ((i % 4u) * 8u)) & 0xffu;
+    return select(x, NONE, x == 0xffu);
+}
+
+fn cluster_at(p: vec3<f32>, n: vec3<f32>) -> u32 {
+    let vs = grid.origin.w;
+    var c = cluster_of(p + n * (0.5 * vs));
+    if c == NONE {
+        c = cluster_of(p + n * (1.5 * vs));
+    }
+    if c == NONE {
+        c = cluster_of(p);
+    }
+    return c;
+}
+
+fn crosses(a: vec3<f32>, b: vec3<f32>, g: Gate) -> bool {
+    let d = b - a;
+    let den = dot(d, g.normal.xyz);
+    if abs(den) <= 1.1920929e-7 * length(d) {
+        return false;
+    }
+    let t = dot(g.centre.xyz - a, g.normal.xyz) / den;
+    if t < 0.0 || t > 1.0 {
+        return false;
+    }
+    let q = a + d * t - g.centre.xyz;
+    let r = g.centre.w * grid.params.x;
+    return dot(q, q) <= r * r;
+}
+
+fn other_side(g: Gate, c: u32) -> u32 {
+    return select(g.clusters.x, g.clusters.y, g.clusters.x == c);
+}
+
+fn through_gates(a: vec3<f32>, ca: u32, b: vec3<f32>, cb: u32) -> bool {
+    if ca == cb || ca == NONE || cb == NONE {
+        return true;
+    }
+    for (var i = cluster_gates[ca]; i < cluster_gates[ca + 1u]; i++) {
+        let g = gates[cluster_gates[i]];
+        if !crosses(a, b, g) {
+            continue;
+        }
+        let c = other_side(g, ca);
+        if c == cb {
+            return true;
+        }
+        if grid.params.y < 1.5 {
+            continue;
+        }
+        for (var j = cluster_gates[c]; j < cluster_gates[c + 1u]; j++) {
+            let h = gates[cluster_gates[j]];
+            if other_side(h, c) == cb && crosses(a, b, h) {
+                return true;
+            }
+        }
+    }
+    return false;
+}
 
 @vertex
 fn vs(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
@@ -129,8 +234,13 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
         }
         radiance += albedo / PI * intensity * cos_x / d2 * shadow(l, p, n);
     }
-    if globals.counts.z == 0u {
+    if globals.counts.z == 0u || globals.counts.z == 2u {
         let g_max = globals.params.x;
+        let gated = globals.counts.z == 2u;
+        var here = NONE;
+        if gated {
+            here = cluster_at(p, n);
+        }
         for (var j = 0u; j < globals.counts.x; j++) {
             let v = vpls[j];
             let d = v.position - p;
@@ -142,6 +252,9 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
             let cos_x = dot(n, w);
             let cos_v = -dot(v.normal, w);
             if cos_x <= 0.0 || cos_v <= 0.0 {
+                continue;
+            }
+            if gated && !through_gates(v.position, cluster_at(v.position, v.normal), p, here) {
                 continue;
             }
             let g = min(cos_x * cos_v / d2, g_max);
