@@ -200,3 +200,91 @@ fn gpu_gates_agree_with_the_cpu_twin() {
         }
     }
 }
+
+#[test]
+fn clustered_light_lists_give_exactly_the_per_point_gate_test() {
+    use glam::Vec2;
+    use visgate_runtime::camera::View;
+    use visgate_runtime::clustered::{ClusterParams, PixelSurface, assign, entry_reaches};
+    use visgate_runtime::vpl::{PathParams, path_vpls};
+    for (b, res) in [(Builtin::FourRooms, 128), (Builtin::TwoRooms, 96)] {
+        let (scene, level) = baked(b, res);
+        let gates = GateLevel::new(level, &scene).expect("level");
+        let tracer = Tracer::new(&scene);
+        let vpls = path_vpls(
+            &tracer,
+            &scene.lights,
+            &PathParams {
+                paths: 256,
+                bounces: 1,
+                seed: 4,
+            },
+        )
+        .expect("vpls");
+        let view = View::new(scene.cameras.first().expect("camera"), [64, 48]).expect("view");
+        let pixels: Vec<Option<PixelSurface>> = (0..48u32)
+            .flat_map(|y| (0..64u32).map(move |x| (x, y)))
+            .map(|(x, y)| {
+                let dir = view.ray_dir(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+                tracer.trace(view.eye, dir).map(|s| PixelSurface {
+                    position: s.position,
+                    normal: s.normal,
+                    depth: (s.position - view.eye).dot(view.forward),
+                    cluster: gates.cluster_at(s.position, s.normal),
+                })
+            })
+            .collect();
+        for gp in [
+            GateParams {
+                oversize: 1.0,
+                max_hops: 1,
+            },
+            GateParams {
+                oversize: 1.5,
+                max_hops: 2,
+            },
+        ] {
+            let c = assign(&pixels, 64, &vpls, &gates, &gp, &ClusterParams::default());
+            let vpl_cluster: Vec<_> = vpls
+                .iter()
+                .map(|v| gates.cluster_at(Vec3::from(v.position), Vec3::from(v.normal)))
+                .collect();
+            let mut lit_pairs = 0u64;
+            for (i, p) in pixels.iter().enumerate() {
+                let Some(p) = p else { continue };
+                let list = &c.lists[c.pixel_cluster[i] as usize];
+                for (j, v) in vpls.iter().enumerate() {
+                    let want = match (vpl_cluster[j], p.cluster) {
+                        (Some(a), Some(bc)) => {
+                            gates.visible(Vec3::from(v.position), a, p.position, bc, &gp)
+                        }
+                        _ => true,
+                    };
+                    let got = list
+                        .iter()
+                        .filter(|e| e.vpl == j as u32)
+                        .any(|e| entry_reaches(e, v, p.position, &gates, &gp));
+                    assert_eq!(got, want, "{} pixel {i} VPL {j} {gp:?}", b.name());
+                    lit_pairs += got as u64;
+                }
+            }
+            let covered = pixels.iter().flatten().count() as u64 * vpls.len() as u64;
+            eprintln!(
+                "{} {gp:?}: {} geometry clusters, {} list entries ({:.1} per cluster) for {} \
+                 pixel-VPL pairs, {} lit",
+                b.name(),
+                c.clusters.len(),
+                c.entries(),
+                c.entries() as f64 / c.clusters.len() as f64,
+                covered,
+                lit_pairs
+            );
+            // Every pixel of a geometry cluster shares one visibility cluster.
+            for (i, p) in pixels.iter().enumerate() {
+                if let Some(p) = p {
+                    assert_eq!(c.clusters[c.pixel_cluster[i] as usize].cluster, p.cluster);
+                }
+            }
+        }
+    }
+}

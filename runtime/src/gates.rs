@@ -97,6 +97,53 @@ impl GateLevel {
             .find_map(|&k| self.cluster_of_voxel(p + n * (k * vs)))
     }
 
+    /// Gate `i`: centre, unit normal, radius (m).
+    pub fn gate(&self, i: u32) -> (Vec3, Vec3, f32) {
+        let g = &self.level.topology.gates[i as usize];
+        (Vec3::from(g.centre_m), Vec3::from(g.normal), g.radius_m)
+    }
+
+    /// Every chain of at most `max_hops` gates leading from cluster `ca` to `cb` through
+    /// distinct clusters, in a deterministic order.
+    pub fn chains(&self, ca: u32, cb: u32, max_hops: u32) -> Vec<Vec<u32>> {
+        let gates = &self.level.topology.gates;
+        let mut out = Vec::new();
+        let mut stack: Vec<(u32, Vec<u32>, Vec<u32>)> = vec![(ca, Vec::new(), vec![ca])];
+        while let Some((c, chain, visited)) = stack.pop() {
+            if chain.len() as u32 >= max_hops {
+                continue;
+            }
+            for &gi in self
+                .cluster_gates
+                .get(c as usize)
+                .into_iter()
+                .flatten()
+                .rev()
+            {
+                let g = &gates[gi];
+                let other = if g.clusters[0] == c {
+                    g.clusters[1]
+                } else {
+                    g.clusters[0]
+                };
+                if visited.contains(&other) {
+                    continue;
+                }
+                let mut next = chain.clone();
+                next.push(gi as u32);
+                if other == cb {
+                    out.push(next);
+                } else {
+                    let mut v = visited.clone();
+                    v.push(other);
+                    stack.push((other, next, v));
+                }
+            }
+        }
+        out.sort();
+        out
+    }
+
     /// Whether light from `a` (cluster `ca`) reaches `b` (cluster `cb`) through the gates: same
     /// cluster, or the segment passes through a chain of at most `max_hops` gate disks that
     /// leads from `ca` to `cb`.

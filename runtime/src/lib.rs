@@ -13,6 +13,7 @@
 //! [`reference`] (the exact-visibility renderer), [`hdr`] (EXR/PNG) and [`metrics`].
 
 pub mod camera;
+pub mod clustered;
 pub mod gates;
 pub mod gpu;
 pub mod hdr;
