@@ -21,6 +21,36 @@ fn baked(b: Builtin, res: u32) -> (visgate_formats::Scene, visgate_formats::Bake
     (scene, level)
 }
 
+/// A built-in scene baked at `res`, its gate level, tracer, 256 path VPLs and a 64×48 view.
+fn fixture(
+    b: Builtin,
+    res: u32,
+) -> (
+    visgate_formats::Scene,
+    GateLevel,
+    Tracer,
+    Vec<visgate_runtime::vpl::Vpl>,
+    visgate_runtime::camera::View,
+) {
+    use visgate_runtime::vpl::{PathParams, path_vpls};
+    let (scene, level) = baked(b, res);
+    let gates = GateLevel::new(level, &scene).expect("level");
+    let tracer = Tracer::new(&scene);
+    let vpls = path_vpls(
+        &tracer,
+        &scene.lights,
+        &PathParams {
+            paths: 256,
+            bounces: 1,
+            seed: 4,
+        },
+    )
+    .expect("vpls");
+    let view = visgate_runtime::camera::View::new(scene.cameras.first().expect("camera"), [64, 48])
+        .expect("view");
+    (scene, gates, tracer, vpls, view)
+}
+
 #[test]
 fn two_rooms_a_vpl_in_a_lights_b_only_through_the_doorway_gates() {
     let (scene, level) = baked(Builtin::TwoRooms, 96);
@@ -124,27 +154,12 @@ fn gate_tests_are_stable_at_the_extremes() {
 
 #[test]
 fn gpu_gates_agree_with_the_cpu_twin() {
-    use visgate_runtime::camera::View;
     use visgate_runtime::gpu::{GpuContext, GpuMode, GpuParams, GpuRenderer};
     use visgate_runtime::metrics::errors;
     use visgate_runtime::reference::{IndirectVisibility, ReferenceParams, render_with};
-    use visgate_runtime::vpl::{PathParams, path_vpls};
     let ctx = GpuContext::new().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"));
     for (b, res) in [(Builtin::FourRooms, 128), (Builtin::TwoRooms, 96)] {
-        let (scene, level) = baked(b, res);
-        let gates = GateLevel::new(level, &scene).expect("level");
-        let tracer = Tracer::new(&scene);
-        let vpls = path_vpls(
-            &tracer,
-            &scene.lights,
-            &PathParams {
-                paths: 256,
-                bounces: 1,
-                seed: 4,
-            },
-        )
-        .expect("vpls");
-        let view = View::new(scene.cameras.first().expect("camera"), [64, 48]).expect("view");
+        let (scene, gates, tracer, vpls, view) = fixture(b, res);
         let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
         assert!(
             gpu.render(
@@ -204,24 +219,9 @@ fn gpu_gates_agree_with_the_cpu_twin() {
 #[test]
 fn clustered_light_lists_give_exactly_the_per_point_gate_test() {
     use glam::Vec2;
-    use visgate_runtime::camera::View;
     use visgate_runtime::clustered::{ClusterParams, PixelSurface, assign, entry_reaches};
-    use visgate_runtime::vpl::{PathParams, path_vpls};
     for (b, res) in [(Builtin::FourRooms, 128), (Builtin::TwoRooms, 96)] {
-        let (scene, level) = baked(b, res);
-        let gates = GateLevel::new(level, &scene).expect("level");
-        let tracer = Tracer::new(&scene);
-        let vpls = path_vpls(
-            &tracer,
-            &scene.lights,
-            &PathParams {
-                paths: 256,
-                bounces: 1,
-                seed: 4,
-            },
-        )
-        .expect("vpls");
-        let view = View::new(scene.cameras.first().expect("camera"), [64, 48]).expect("view");
+        let (_scene, gates, tracer, vpls, view) = fixture(b, res);
         let pixels: Vec<Option<PixelSurface>> = (0..48u32)
             .flat_map(|y| (0..64u32).map(move |x| (x, y)))
             .map(|(x, y)| {

@@ -12,6 +12,9 @@ use visgate_runtime::tracer::Tracer;
 use visgate_runtime::vpl::{GatherParams, PathParams, path_vpls};
 use visgate_scenes::Builtin;
 
+mod common;
+use common::{closed_box, floor, quads, scaled_four_rooms};
+
 fn context() -> GpuContext {
     match GpuContext::new() {
         Ok(c) => c,
@@ -377,42 +380,22 @@ fn gpu_renders_0_1_and_65536_vpls_and_a_vpl_on_the_receiver_without_nan() {
         .expect("render");
     assert!(img.pixels.iter().all(|p| p.is_finite()));
     // Bad parameters are errors, not panics.
-    assert!(
-        gpu.render(
-            &ctx,
-            &view,
-            &[],
-            &GpuParams {
-                g_max: 0.0,
-                ..GpuParams::default()
-            }
-        )
-        .is_err()
-    );
-    assert!(
-        gpu.render(
-            &ctx,
-            &view,
-            &[],
-            &GpuParams {
-                shadow_size: 1,
-                ..GpuParams::default()
-            }
-        )
-        .is_err()
-    );
-    assert!(
-        gpu.render(
-            &ctx,
-            &view,
-            &[],
-            &GpuParams {
-                vpl_batch: 0,
-                ..GpuParams::default()
-            }
-        )
-        .is_err()
-    );
+    for bad in [
+        GpuParams {
+            g_max: 0.0,
+            ..GpuParams::default()
+        },
+        GpuParams {
+            shadow_size: 1,
+            ..GpuParams::default()
+        },
+        GpuParams {
+            vpl_batch: 0,
+            ..GpuParams::default()
+        },
+    ] {
+        assert!(gpu.render(&ctx, &view, &[], &bad).is_err(), "{bad:?}");
+    }
 }
 
 #[test]
@@ -473,29 +456,9 @@ fn rsm_vpls_carry_the_reflected_power_and_do_not_flicker() {
 
 #[test]
 fn gpu_scene_scales_from_1e_minus_3_to_1e4_give_the_same_image_after_scaling_the_light() {
-    use visgate_formats::Light;
     let ctx = context();
     let render = |scale: f32| {
-        let mut scene = Builtin::FourRooms.scene().expect("scene");
-        for m in &mut scene.meshes {
-            m.positions.iter_mut().for_each(|p| *p *= scale);
-        }
-        for l in &mut scene.lights {
-            let (Light::Point {
-                position,
-                intensity,
-            }
-            | Light::Spot {
-                position,
-                intensity,
-                ..
-            }) = l;
-            *position *= scale;
-            *intensity *= scale * scale;
-        }
-        let mut cam = scene.cameras.first().cloned().expect("camera");
-        cam.eye *= scale;
-        cam.target *= scale;
+        let (scene, cam) = scaled_four_rooms(scale);
         let tracer = Tracer::new(&scene);
         let vpls = path_vpls(
             &tracer,
@@ -524,94 +487,22 @@ fn gpu_scene_scales_from_1e_minus_3_to_1e4_give_the_same_image_after_scaling_the
 
 #[test]
 fn gpu_a_light_inside_geometry_lights_nothing_outside_it() {
-    use visgate_formats::scene::ImportReport;
-    use visgate_formats::{Camera, Light, Material, Mesh, Scene};
+    use visgate_formats::{Camera, Light};
     // A closed 0.4 m box around a point light at 1 m, over a 20 m floor.
-    let mut positions = Vec::new();
-    let mut triangles = Vec::new();
-    let mut quad = |q: [Vec3; 4]| {
-        let b = positions.len() as u32;
-        positions.extend(q);
-        triangles.push([b, b + 1, b + 2]);
-        triangles.push([b, b + 2, b + 3]);
-    };
-    let c = |x: f32, y: f32, z: f32| Vec3::new(x * 0.2, 1.0 + y * 0.2, z * 0.2);
-    for q in [
-        [
-            c(-1., -1., -1.),
-            c(-1., -1., 1.),
-            c(1., -1., 1.),
-            c(1., -1., -1.),
-        ],
-        [
-            c(-1., 1., -1.),
-            c(1., 1., -1.),
-            c(1., 1., 1.),
-            c(-1., 1., 1.),
-        ],
-        [
-            c(-1., -1., -1.),
-            c(-1., 1., -1.),
-            c(-1., 1., 1.),
-            c(-1., -1., 1.),
-        ],
-        [
-            c(1., -1., -1.),
-            c(1., -1., 1.),
-            c(1., 1., 1.),
-            c(1., 1., -1.),
-        ],
-        [
-            c(-1., -1., -1.),
-            c(1., -1., -1.),
-            c(1., 1., -1.),
-            c(-1., 1., -1.),
-        ],
-        [
-            c(-1., -1., 1.),
-            c(-1., 1., 1.),
-            c(1., 1., 1.),
-            c(1., -1., 1.),
-        ],
-    ] {
-        quad(q);
-    }
-    let r = 10.0;
-    quad([
-        Vec3::new(-r, 0.0, -r),
-        Vec3::new(-r, 0.0, r),
-        Vec3::new(r, 0.0, r),
-        Vec3::new(r, 0.0, -r),
-    ]);
-    let n = positions.len();
-    let t = triangles.len();
-    let scene = Scene {
-        name: "boxed light".into(),
-        source: None,
-        closed: false,
-        meshes: vec![Mesh {
-            name: "all".into(),
-            entry: 0,
-            is_static: true,
-            normals: vec![Vec3::Y; n],
-            uvs: vec![glam::Vec2::ZERO; n],
-            positions,
-            triangles,
-            material: vec![0; t],
-        }],
-        materials: vec![Material {
-            name: "grey".into(),
-            albedo: Vec3::splat(0.7),
-            texture: None,
-        }],
-        textures: Vec::new(),
-        lights: vec![Light::Point {
+    let mut faces = closed_box(0.2);
+    faces
+        .iter_mut()
+        .flatten()
+        .for_each(|p| *p += Vec3::new(0.0, 1.0, 0.0));
+    faces.push(floor(10.0));
+    let scene = quads(
+        &faces,
+        0.7,
+        vec![Light::Point {
             position: Vec3::new(0.0, 1.0, 0.0),
             intensity: Vec3::splat(50.0),
         }],
-        cameras: Vec::new(),
-        report: ImportReport::default(),
-    };
+    );
     let ctx = context();
     let gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
     let cam = Camera {
@@ -642,8 +533,7 @@ fn gpu_a_light_inside_geometry_lights_nothing_outside_it() {
 
 #[test]
 fn gpu_samples_albedo_textures_as_the_reference_does() {
-    use visgate_formats::scene::ImportReport;
-    use visgate_formats::{Camera, Light, Material, Mesh, Scene, Texture};
+    use visgate_formats::{Camera, Light, Texture};
     // A floor with a 4 × 4 sRGB checker of red and dark blue, repeated twice, under a light.
     let mut rgba8 = Vec::new();
     for y in 0..4 {
@@ -655,49 +545,27 @@ fn gpu_samples_albedo_textures_as_the_reference_does() {
             });
         }
     }
-    let r = 2.0;
-    let scene = Scene {
-        name: "checker".into(),
-        source: None,
-        closed: false,
-        meshes: vec![Mesh {
-            name: "floor".into(),
-            entry: 0,
-            is_static: true,
-            positions: vec![
-                Vec3::new(-r, 0.0, -r),
-                Vec3::new(-r, 0.0, r),
-                Vec3::new(r, 0.0, r),
-                Vec3::new(r, 0.0, -r),
-            ],
-            normals: vec![Vec3::Y; 4],
-            uvs: vec![
-                glam::Vec2::new(0.0, 0.0),
-                glam::Vec2::new(0.0, 2.0),
-                glam::Vec2::new(2.0, 2.0),
-                glam::Vec2::new(2.0, 0.0),
-            ],
-            triangles: vec![[0, 1, 2], [0, 2, 3]],
-            material: vec![0, 0],
-        }],
-        materials: vec![Material {
-            name: "checker".into(),
-            albedo: Vec3::splat(0.9),
-            texture: Some(0),
-        }],
-        textures: vec![Texture {
-            name: "checker".into(),
-            width: 4,
-            height: 4,
-            rgba8,
-        }],
-        lights: vec![Light::Point {
+    let mut scene = quads(
+        &[floor(2.0)],
+        0.9,
+        vec![Light::Point {
             position: Vec3::new(0.3, 2.0, 0.2),
             intensity: Vec3::splat(10.0),
         }],
-        cameras: Vec::new(),
-        report: ImportReport::default(),
-    };
+    );
+    scene.meshes[0].uvs = vec![
+        glam::Vec2::new(0.0, 0.0),
+        glam::Vec2::new(0.0, 2.0),
+        glam::Vec2::new(2.0, 2.0),
+        glam::Vec2::new(2.0, 0.0),
+    ];
+    scene.materials[0].texture = Some(0);
+    scene.textures = vec![Texture {
+        name: "checker".into(),
+        width: 4,
+        height: 4,
+        rgba8,
+    }];
     let cam = Camera {
         name: "down".into(),
         eye: Vec3::new(0.0, 3.0, 0.01),
@@ -748,38 +616,7 @@ fn gpu_samples_albedo_textures_as_the_reference_does() {
 
 /// A 100 m floor of albedo `rho` with `lights`, for the GPU known answers.
 fn floor_scene(rho: f32, lights: Vec<visgate_formats::Light>) -> visgate_formats::Scene {
-    use visgate_formats::scene::ImportReport;
-    use visgate_formats::{Material, Mesh, Scene};
-    let r = 50.0;
-    Scene {
-        name: "floor".into(),
-        source: None,
-        closed: false,
-        meshes: vec![Mesh {
-            name: "floor".into(),
-            entry: 0,
-            is_static: true,
-            positions: vec![
-                Vec3::new(-r, 0.0, -r),
-                Vec3::new(-r, 0.0, r),
-                Vec3::new(r, 0.0, r),
-                Vec3::new(r, 0.0, -r),
-            ],
-            normals: vec![Vec3::Y; 4],
-            uvs: vec![glam::Vec2::ZERO; 4],
-            triangles: vec![[0, 1, 2], [0, 2, 3]],
-            material: vec![0, 0],
-        }],
-        materials: vec![Material {
-            name: "white".into(),
-            albedo: Vec3::splat(rho),
-            texture: None,
-        }],
-        textures: Vec::new(),
-        lights,
-        cameras: Vec::new(),
-        report: ImportReport::default(),
-    }
+    quads(&[floor(50.0)], rho, lights)
 }
 
 #[test]

@@ -1,110 +1,19 @@
 //! Known answers and extremes of the CPU side: direct light radiometry, spot falloff, the
 //! light-path VPLs' energy, the gather's clamp, and stability at scale extremes.
 
+mod common;
+
 use std::f32::consts::PI;
 
 use glam::{Vec2, Vec3};
-use visgate_formats::scene::ImportReport;
-use visgate_formats::{Camera, Light, Material, Mesh, Scene};
+use visgate_formats::{Camera, Light, Scene};
 use visgate_runtime::camera::View;
 use visgate_runtime::lights::{light_power, spot_falloff};
 use visgate_runtime::reference::{ReferenceParams, render_reference, shade_point};
 use visgate_runtime::tracer::Tracer;
 use visgate_runtime::vpl::{GatherParams, PathParams, Vpl, clamp_loss, gather_one, path_vpls};
-use visgate_scenes::Builtin;
 
-/// A scene of quads (each `[a, b, c, d]`, counter-clockwise) of one albedo.
-fn quads(quads: &[[Vec3; 4]], albedo: f32, lights: Vec<Light>) -> Scene {
-    let mut positions = Vec::new();
-    let mut normals = Vec::new();
-    let mut triangles = Vec::new();
-    for q in quads {
-        let n = (q[1] - q[0]).cross(q[2] - q[0]).normalize();
-        let base = positions.len() as u32;
-        positions.extend_from_slice(q);
-        normals.extend([n; 4]);
-        triangles.push([base, base + 1, base + 2]);
-        triangles.push([base, base + 2, base + 3]);
-    }
-    let material = vec![0; triangles.len()];
-    Scene {
-        name: "test".into(),
-        source: None,
-        closed: false,
-        meshes: vec![Mesh {
-            name: "quads".into(),
-            entry: 0,
-            is_static: true,
-            uvs: vec![Vec2::ZERO; positions.len()],
-            positions,
-            normals,
-            triangles,
-            material,
-        }],
-        materials: vec![Material {
-            name: "white".into(),
-            albedo: Vec3::splat(albedo),
-            texture: None,
-        }],
-        textures: Vec::new(),
-        lights,
-        cameras: Vec::new(),
-        report: ImportReport::default(),
-    }
-}
-
-/// The floor square of half-size `r` at height 0, facing +y.
-fn floor(r: f32) -> [Vec3; 4] {
-    [
-        Vec3::new(-r, 0.0, -r),
-        Vec3::new(-r, 0.0, r),
-        Vec3::new(r, 0.0, r),
-        Vec3::new(r, 0.0, -r),
-    ]
-}
-
-/// The six inner faces of the box `[-r, r]³`.
-fn closed_box(r: f32) -> Vec<[Vec3; 4]> {
-    let c = |x: f32, y: f32, z: f32| Vec3::new(x, y, z) * r;
-    vec![
-        [
-            c(-1., -1., -1.),
-            c(-1., -1., 1.),
-            c(1., -1., 1.),
-            c(1., -1., -1.),
-        ],
-        [
-            c(-1., 1., -1.),
-            c(1., 1., -1.),
-            c(1., 1., 1.),
-            c(-1., 1., 1.),
-        ],
-        [
-            c(-1., -1., -1.),
-            c(-1., 1., -1.),
-            c(-1., 1., 1.),
-            c(-1., -1., 1.),
-        ],
-        [
-            c(1., -1., -1.),
-            c(1., -1., 1.),
-            c(1., 1., 1.),
-            c(1., 1., -1.),
-        ],
-        [
-            c(-1., -1., -1.),
-            c(1., -1., -1.),
-            c(1., 1., -1.),
-            c(-1., 1., -1.),
-        ],
-        [
-            c(-1., -1., 1.),
-            c(-1., 1., 1.),
-            c(1., 1., 1.),
-            c(1., -1., 1.),
-        ],
-    ]
-}
+use common::{closed_box, floor, quads, scaled_four_rooms};
 
 fn direct_only() -> ReferenceParams {
     ReferenceParams {
@@ -358,26 +267,7 @@ fn a_vpl_on_the_receiving_surface_gives_no_nan_and_the_clamp_bounds_g() {
 
 /// The built-in four rooms seen by its first camera, with `n` path VPLs.
 fn four_rooms(n: u32, size: [u32; 2], scale: f32) -> (Scene, Vec<Vpl>, View) {
-    let mut s = Builtin::FourRooms.scene().expect("scene");
-    for m in &mut s.meshes {
-        m.positions.iter_mut().for_each(|p| *p *= scale);
-    }
-    for l in &mut s.lights {
-        let (Light::Point {
-            position,
-            intensity,
-        }
-        | Light::Spot {
-            position,
-            intensity,
-            ..
-        }) = l;
-        *position *= scale;
-        *intensity *= scale * scale;
-    }
-    let mut cam = s.cameras.first().cloned().expect("a camera");
-    cam.eye *= scale;
-    cam.target *= scale;
+    let (s, cam) = scaled_four_rooms(scale);
     let t = Tracer::new(&s);
     let vpls = path_vpls(
         &t,
