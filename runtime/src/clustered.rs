@@ -213,8 +213,14 @@ pub fn assign(
     }
 }
 
+/// Angular slack of the cone test: GPU and CPU compute asin / acos to different last bits
+/// (acos is ill-conditioned near 1), so both widen the cone by this much to stay conservative.
+/// [Units: rad]
+pub const CONE_SLACK: f32 = 1e-4;
+
 /// Whether the cone from `apex` through the sphere (`disk_centre`, `disk_radius`) — which
-/// holds the cone through the disk — meets the sphere (`centre`, `radius`).
+/// holds the cone through the disk — meets the sphere (`centre`, `radius`), within
+/// [`CONE_SLACK`].
 pub fn cone_meets_sphere(
     apex: Vec3,
     disk_centre: Vec3,
@@ -222,10 +228,23 @@ pub fn cone_meets_sphere(
     centre: Vec3,
     radius: f32,
 ) -> bool {
+    cone_margin(apex, disk_centre, disk_radius, centre, radius) <= CONE_SLACK
+}
+
+/// The angle between the cone's axis and the sphere's centre, less the cone's half-angle and
+/// the sphere's angular radius (seen from `apex`): ≤ 0 where they meet, −∞ where `apex` lies
+/// inside a sphere. [Units: rad]
+pub fn cone_margin(
+    apex: Vec3,
+    disk_centre: Vec3,
+    disk_radius: f32,
+    centre: Vec3,
+    radius: f32,
+) -> f32 {
     let axis = disk_centre - apex;
     let (la, ls) = (axis.length(), (centre - apex).length());
     if la <= disk_radius || ls <= radius || la <= 0.0 {
-        return true; // the apex is inside one of the spheres: no cone to speak of
+        return f32::NEG_INFINITY; // the apex is inside one of the spheres: no cone to speak of
     }
     let half = (disk_radius / la).clamp(0.0, 1.0).asin();
     let spread = (radius / ls).clamp(0.0, 1.0).asin();
@@ -233,7 +252,7 @@ pub fn cone_meets_sphere(
         .dot((centre - apex) / ls)
         .clamp(-1.0, 1.0)
         .acos();
-    angle <= half + spread
+    angle - (half + spread)
 }
 
 /// Step 4 for one pixel: whether entry `e`'s light reaches point `p`.

@@ -23,21 +23,39 @@ use crate::camera::{View, look_to, perspective};
 use crate::hdr::HdrImage;
 use crate::vpl::Vpl;
 
-const GBUFFER_WGSL: &str = include_str!("shaders/gbuffer.wgsl");
+#[path = "gpu_clustered.rs"]
+mod clustered;
+pub use clustered::{ClusterFrame, GpuGeometryCluster, LightListStats, MAX_CLUSTERS, MAX_GATES};
+
+// WGSL has no includes: the grid and gate code is put in front of the shaders that use it.
+const GBUFFER_WGSL: &str = concat!(
+    include_str!("shaders/grid.wgsl"),
+    include_str!("shaders/gbuffer.wgsl")
+);
 const SHADOW_WGSL: &str = include_str!("shaders/shadow.wgsl");
-const SHADE_WGSL: &str = include_str!("shaders/shade.wgsl");
+const SHADE_WGSL: &str = concat!(
+    include_str!("shaders/grid.wgsl"),
+    include_str!("shaders/gates.wgsl"),
+    include_str!("shaders/shade.wgsl")
+);
+const CLUSTERS_WGSL: &str = concat!(
+    include_str!("shaders/grid.wgsl"),
+    include_str!("shaders/gates.wgsl"),
+    include_str!("shaders/clusters.wgsl")
+);
 const VPL_SHADOW_WGSL: &str = include_str!("shaders/vpl_shadow.wgsl");
 const GATHER_BATCH_WGSL: &str = include_str!("shaders/gather_batch.wgsl");
 const RSM_VPLS_WGSL: &str = include_str!("shaders/rsm_vpls.wgsl");
 
-/// The WGSL sources, for validation without a GPU.
-pub const SHADERS: [(&str, &str); 6] = [
+/// The WGSL sources (with what is put in front of them), for validation without a GPU.
+pub const SHADERS: [(&str, &str); 7] = [
     ("gbuffer.wgsl", GBUFFER_WGSL),
     ("shadow.wgsl", SHADOW_WGSL),
     ("shade.wgsl", SHADE_WGSL),
     ("vpl_shadow.wgsl", VPL_SHADOW_WGSL),
     ("gather_batch.wgsl", GATHER_BATCH_WGSL),
     ("rsm_vpls.wgsl", RSM_VPLS_WGSL),
+    ("clusters.wgsl", CLUSTERS_WGSL),
 ];
 
 /// One RSM sample for the VPL compute pass, shared with WGSL (`Sample` in rsm_vpls.wgsl).
@@ -90,7 +108,8 @@ pub struct Globals {
     /// x: geometry-term clamp (1/m²), y: shadow normal offset (texels), z: shadow bias
     /// (texels), w unused.
     pub params: [f32; 4],
-    /// x: VPL count, y: light count, z: mode (0 none, 1 direct-only), w: shadow map size.
+    /// x: VPL count, y: light count, z: mode (0 none, 1 direct light only, 2 gates per
+    /// pixel, 3 gates by clustered light lists), w: shadow map size.
     pub counts: [u32; 4],
 }
 
@@ -140,9 +159,13 @@ pub enum GpuMode {
     PerVplShadowMaps,
     /// Direct light only.
     DirectOnly,
-    /// VPL light through the gates of the level set with [`GpuRenderer::set_level`]: brute
-    /// force per fragment and VPL (the clustered light assignment comes next); at most 2 hops.
+    /// VPL light through the gates of the level set with [`GpuRenderer::set_level`], the
+    /// paper's clustered shading: geometry clusters (tiles × depth slices × visibility
+    /// cluster), light lists of (VPL, gate chain) assigned by cones through the gates, the
+    /// gather over each pixel's list with the chain tested per fragment. At most 2 hops.
     Gates,
+    /// The same gate test, brute force: every fragment tests every VPL (for comparison).
+    GatesPerPixel,
 }
 
 /// Rendering parameters.
@@ -162,8 +185,14 @@ pub struct GpuParams {
     pub vpl_map_size: u32,
     /// VPL maps rendered and gathered per batch (bounds their memory). [Limit: 1..=2048]
     pub vpl_batch: u32,
-    /// How light passes gates in mode `Gates` (`max_hops` 1 or 2 on the GPU).
+    /// How light passes gates in modes `Gates` and `GatesPerPixel` (`max_hops` 1 or 2 on the
+    /// GPU).
     pub gates: crate::gates::GateParams,
+    /// Geometry clusters of mode `Gates` (`tile_px` 1..=16 on the GPU).
+    pub clusters: crate::clustered::ClusterParams,
+    /// Capacity of the light-list pool of mode `Gates`, in (VPL, gates) entries of 8 bytes; a
+    /// frame that needs more fails with the count it needs. [Limit: 1..=storage limit / 8]
+    pub light_entries: u32,
 }
 
 impl Default for GpuParams {
@@ -177,6 +206,8 @@ impl Default for GpuParams {
             vpl_map_size: 128,
             vpl_batch: 128,
             gates: crate::gates::GateParams::default(),
+            clusters: crate::clustered::ClusterParams::default(),
+            light_entries: 1 << 23,
         }
     }
 }
@@ -188,8 +219,13 @@ pub struct PassTimes {
     pub shadows: f64,
     /// G-buffer.
     pub gbuffer: f64,
-    /// Direct and indirect shading (direct only with per-VPL shadow maps).
+    /// Direct and indirect shading (direct only with per-VPL shadow maps); with gates the
+    /// indirect lighting, the gather over the light lists.
     pub shade: f64,
+    /// Mode gates: finding the geometry clusters in view and their boxes.
+    pub unique_clusters: f64,
+    /// Mode gates: VPL clusters and the light lists.
+    pub light_assignment: f64,
     /// Per-VPL paraboloid maps, all batches.
     pub vpl_maps: f64,
     /// Indirect gather with per-VPL maps, all batches.
@@ -198,6 +234,8 @@ pub struct PassTimes {
     pub readback: f64,
     /// GPU time of each stage from timestamp queries, where the adapter has them.
     pub gpu: Option<GpuStageTimes>,
+    /// Mode gates: how full the light lists came out.
+    pub lists: Option<LightListStats>,
 }
 
 /// GPU time of each stage, from timestamp queries (summed over a stage's passes). [Units: s]
@@ -213,6 +251,10 @@ pub struct GpuStageTimes {
     pub vpl_maps: f64,
     /// Gather with per-VPL maps.
     pub vpl_gather: f64,
+    /// Unique clusters (mode gates).
+    pub unique_clusters: f64,
+    /// Light assignment (mode gates).
+    pub light_assignment: f64,
 }
 
 /// Stages a [`Timer`] tells apart, in [`GpuStageTimes`] order.
@@ -223,6 +265,8 @@ enum Stage {
     Shade,
     VplMaps,
     VplGather,
+    UniqueClusters,
+    LightAssignment,
 }
 
 /// Timestamp queries around stages: each span is the beginning of a stage's first pass and
@@ -279,6 +323,16 @@ impl Timer {
         })
     }
 
+    /// The writes of a compute pass that is all of span `b`.
+    fn compute_writes(&self, b: Option<u32>) -> Option<wgpu::ComputePassTimestampWrites<'_>> {
+        let (set, b) = (self.set.as_ref()?, b?);
+        Some(wgpu::ComputePassTimestampWrites {
+            query_set: set,
+            beginning_of_pass_write_index: Some(b),
+            end_of_pass_write_index: Some(b + 1),
+        })
+    }
+
     /// Resolves, reads back and sums the spans per stage.
     fn read(&self, ctx: &GpuContext) -> Option<GpuStageTimes> {
         let (set, period) = (self.set.as_ref()?, ctx.timestamp_period?);
@@ -310,7 +364,7 @@ impl Timer {
         ctx.wait();
         let ticks: Vec<u64> = bytemuck::cast_slice(&slice.get_mapped_range().ok()?).to_vec();
         read.unmap();
-        let mut t = [0f64; 5];
+        let mut t = [0f64; 7];
         for &(stage, b) in &self.spans {
             let (a, z) = (ticks[b as usize], ticks[b as usize + 1]);
             t[stage as usize] += z.saturating_sub(a) as f64 * period as f64 * 1e-9;
@@ -321,6 +375,8 @@ impl Timer {
             shade: t[2],
             vpl_maps: t[3],
             vpl_gather: t[4],
+            unique_clusters: t[5],
+            light_assignment: t[6],
         })
     }
 }
@@ -387,6 +443,107 @@ impl GpuContext {
     fn wait(&self) {
         let _ = self.device.poll(wgpu::PollType::wait_indefinitely());
     }
+}
+
+/// A storage buffer holding `bytes` (64 zero bytes when empty: bindings cannot be empty).
+fn storage(d: &wgpu::Device, label: &str, bytes: &[u8]) -> wgpu::Buffer {
+    let mut v = bytes.to_vec();
+    if v.is_empty() {
+        v.resize(64, 0);
+    }
+    d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents: &v,
+        usage: wgpu::BufferUsages::STORAGE,
+    })
+}
+
+/// Copies `buf` (made with COPY_SRC) back to the CPU.
+fn read_buffer(ctx: &GpuContext, buf: &wgpu::Buffer) -> Result<Vec<u8>, RenderError> {
+    let d = &ctx.device;
+    let read = d.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size: buf.size(),
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+        label: Some("readback"),
+    });
+    enc.copy_buffer_to_buffer(buf, 0, &read, 0, buf.size());
+    ctx.queue.submit([enc.finish()]);
+    let slice = read.slice(..);
+    slice.map_async(wgpu::MapMode::Read, |_| {});
+    ctx.wait();
+    let bytes = slice
+        .get_mapped_range()
+        .map_err(|e| RenderError::Gpu(format!("cannot read a buffer back: {e}")))?
+        .to_vec();
+    read.unmap();
+    Ok(bytes)
+}
+
+/// Copies a 2D texture of 4 channels (Rgba32Float, or Rgba16Float widened) back to the CPU,
+/// row by row.
+fn read_texture(ctx: &GpuContext, tex: &wgpu::Texture) -> Result<Vec<[f32; 4]>, RenderError> {
+    let d = &ctx.device;
+    let (w, h) = (tex.width(), tex.height());
+    let half = tex.format() == wgpu::TextureFormat::Rgba16Float;
+    let texel = if half { 8u64 } else { 16 };
+    let row = (w as u64 * texel).div_ceil(256) * 256;
+    let read = d.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("texture readback"),
+        size: row * h as u64,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+        label: Some("texture readback"),
+    });
+    enc.copy_texture_to_buffer(
+        tex.as_image_copy(),
+        wgpu::TexelCopyBufferInfo {
+            buffer: &read,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(row as u32),
+                rows_per_image: Some(h),
+            },
+        },
+        tex.size(),
+    );
+    ctx.queue.submit([enc.finish()]);
+    let slice = read.slice(..);
+    slice.map_async(wgpu::MapMode::Read, |_| {});
+    ctx.wait();
+    let mut out = Vec::with_capacity((w * h) as usize);
+    {
+        let bytes = slice
+            .get_mapped_range()
+            .map_err(|e| RenderError::Gpu(format!("cannot read an image back: {e}")))?;
+        for y in 0..h as u64 {
+            let r = &bytes[(y * row) as usize..][..(w as u64 * texel) as usize];
+            if half {
+                let v: &[u16] = bytemuck::cast_slice(r);
+                out.extend(
+                    v.chunks_exact(4)
+                        .map(|c| [0, 1, 2, 3].map(|k| half::f16::from_bits(c[k]).to_f32())),
+                );
+            } else {
+                let v: &[f32] = bytemuck::cast_slice(r);
+                out.extend(v.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]));
+            }
+        }
+    }
+    read.unmap();
+    Ok(out)
+}
+
+/// The buffers every pass of a frame reads.
+struct FrameInputs {
+    globals: wgpu::Buffer,
+    grid: wgpu::Buffer,
+    vpls: wgpu::Buffer,
 }
 
 /// A 2D (array) texture of `size` = [width, height, layers].
@@ -580,6 +737,9 @@ pub struct GpuRenderer {
     albedo_sampler: wgpu::Sampler,
     /// The level's gate tables: grid (origin, dims), voxel words, gates, cluster gates.
     level: Option<LevelBuffers>,
+    /// Bound where a mode has no level or no light lists.
+    no_level: wgpu::Buffer,
+    cluster_pipelines: clustered::Pipelines,
 }
 
 /// A level's gate tables on the GPU.
@@ -839,6 +999,8 @@ impl GpuRenderer {
             albedo_maps,
             albedo_sampler,
             level: None,
+            no_level: storage(d, "no level", &[]),
+            cluster_pipelines: clustered::Pipelines::new(d, CLUSTERS_WGSL),
         })
     }
 
@@ -916,6 +1078,16 @@ impl GpuRenderer {
     ) -> Result<(), RenderError> {
         let t = level.tables();
         let d = &ctx.device;
+        if t.gates.len() > MAX_GATES || level.cluster_count() > MAX_CLUSTERS {
+            return Err(RenderError::Param(format!(
+                "the level has {} gates and {} clusters; the GPU's light lists hold at most {} \
+                 gates and {} clusters: bake at a lower resolution",
+                t.gates.len(),
+                level.cluster_count(),
+                MAX_GATES,
+                MAX_CLUSTERS
+            )));
+        }
         let bytes = (t.voxel_words.len() * 4) as u64;
         if bytes > d.limits().max_storage_buffer_binding_size {
             return Err(RenderError::Param(format!(
@@ -1013,6 +1185,16 @@ impl GpuRenderer {
             wgpu::TextureUsages::RENDER_ATTACHMENT,
         );
         let depth_view = depth.create_view(&Default::default());
+        // The light's view needs no visibility clusters: a grid of no voxels.
+        let no_grid = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("no grid"),
+            contents: bytemuck::bytes_of(&GridUniform {
+                origin: [0.0, 0.0, 0.0, 1.0],
+                dims: [0, 0, 0, 4],
+                params: [1.0, 1.0, 0.0, 0.0],
+            }),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
         let mut enc =
             d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("rsm") });
         for (i, v) in views.iter().enumerate() {
@@ -1030,7 +1212,7 @@ impl GpuRenderer {
             let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("rsm globals"),
                 layout: &self.gbuffer.get_bind_group_layout(0),
-                entries: &self.gbuffer_entries(&buf),
+                entries: &self.gbuffer_entries(&buf, &no_grid),
             });
             let layer_views = maps.each_ref().map(|t| {
                 t.create_view(&wgpu::TextureViewDescriptor {
@@ -1183,8 +1365,13 @@ impl GpuRenderer {
         Ok(vpls)
     }
 
-    /// The G-buffer's bindings: `globals`, the albedo array and its sampler.
-    fn gbuffer_entries<'a>(&'a self, globals: &'a wgpu::Buffer) -> [wgpu::BindGroupEntry<'a>; 3] {
+    /// The G-buffer's bindings: `globals`, the albedo array and its sampler, the level's
+    /// `grid` uniform and voxel→cluster words.
+    fn gbuffer_entries<'a>(
+        &'a self,
+        globals: &'a wgpu::Buffer,
+        grid: &'a wgpu::Buffer,
+    ) -> [wgpu::BindGroupEntry<'a>; 5] {
         [
             wgpu::BindGroupEntry {
                 binding: 0,
@@ -1197,6 +1384,18 @@ impl GpuRenderer {
             wgpu::BindGroupEntry {
                 binding: 2,
                 resource: wgpu::BindingResource::Sampler(&self.albedo_sampler),
+            },
+            wgpu::BindGroupEntry {
+                binding: 8,
+                resource: grid.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 9,
+                resource: self
+                    .level
+                    .as_ref()
+                    .map_or(&self.no_level, |l| &l.voxel_words)
+                    .as_entire_binding(),
             },
         ]
     }
@@ -1242,14 +1441,13 @@ impl GpuRenderer {
         pass.draw(0..self.vertex_count, 0..1);
     }
 
-    /// Renders `view` with `vpls` and returns the linear HDR image and the pass times.
-    pub fn render(
+    /// Checks `params` and the VPL count against their limits and the adapter's.
+    fn validate(
         &self,
         ctx: &GpuContext,
-        view: &View,
         vpls: &[Vpl],
         params: &GpuParams,
-    ) -> Result<(HdrImage, PassTimes), RenderError> {
+    ) -> Result<(), RenderError> {
         if params.g_max.is_nan() || params.g_max <= 0.0 {
             return Err(RenderError::Param(format!(
                 "geometry-term clamp {} must be > 0",
@@ -1262,7 +1460,7 @@ impl GpuRenderer {
                 params.vpl_map_size, params.vpl_batch
             )));
         }
-        if params.mode == GpuMode::Gates {
+        if matches!(params.mode, GpuMode::Gates | GpuMode::GatesPerPixel) {
             if self.level.is_none() {
                 return Err(RenderError::Param(
                     "mode gates needs a baked level (GpuRenderer::set_level, --level)".into(),
@@ -1283,6 +1481,138 @@ impl GpuRenderer {
             )));
         }
         let d = &ctx.device;
+        let vpl_bytes = std::mem::size_of_val(vpls) as u64;
+        if vpl_bytes > d.limits().max_storage_buffer_binding_size {
+            return Err(RenderError::Param(format!(
+                "{} VPLs need {vpl_bytes} bytes, more than the adapter's storage binding limit {}",
+                vpls.len(),
+                d.limits().max_storage_buffer_binding_size
+            )));
+        }
+        Ok(())
+    }
+
+    /// The buffers every pass of a frame reads: globals, the level's grid uniform, the VPLs.
+    fn frame_inputs(
+        &self,
+        ctx: &GpuContext,
+        view: &View,
+        vpls: &[Vpl],
+        params: &GpuParams,
+    ) -> Result<FrameInputs, RenderError> {
+        self.validate(ctx, vpls, params)?;
+        let d = &ctx.device;
+        let globals = Globals {
+            view_proj: view.view_proj(self.near_m, self.far_m).to_cols_array_2d(),
+            eye: view.eye.extend(1.0).to_array(),
+            params: [
+                params.g_max,
+                params.shadow_normal_offset,
+                params.shadow_bias,
+                0.0,
+            ],
+            counts: [
+                vpls.len() as u32,
+                self.lights.len() as u32,
+                match params.mode {
+                    GpuMode::None => 0,
+                    GpuMode::DirectOnly | GpuMode::PerVplShadowMaps => 1,
+                    GpuMode::GatesPerPixel => 2,
+                    GpuMode::Gates => 3,
+                },
+                params.shadow_size,
+            ],
+        };
+        let level = self.level.as_ref();
+        let grid = GridUniform {
+            origin: level.map_or([0.0, 0.0, 0.0, 1.0], |l| l.origin),
+            dims: level.map_or([0, 0, 0, 4], |l| l.dims),
+            params: [
+                params.gates.oversize,
+                params.gates.max_hops as f32,
+                0.0,
+                0.0,
+            ],
+        };
+        let uniform = |label: &str, bytes: &[u8]| {
+            d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: bytes,
+                usage: wgpu::BufferUsages::UNIFORM,
+            })
+        };
+        Ok(FrameInputs {
+            globals: uniform("globals", bytemuck::bytes_of(&globals)),
+            grid: uniform("grid", bytemuck::bytes_of(&grid)),
+            vpls: storage(d, "vpls", bytemuck::cast_slice(vpls)),
+        })
+    }
+
+    /// The geometry pass: the G-buffer (position with the visibility cluster in w, normal,
+    /// albedo) of `view`.
+    fn geometry_pass(
+        &self,
+        ctx: &GpuContext,
+        view: &View,
+        frame: &FrameInputs,
+        timer: &mut Timer,
+        times: &mut PassTimes,
+    ) -> ([wgpu::Texture; 3], [wgpu::TextureView; 3]) {
+        let t0 = Instant::now();
+        let d = &ctx.device;
+        let [w, h] = view.size;
+        let rt = wgpu::TextureUsages::RENDER_ATTACHMENT
+            | wgpu::TextureUsages::TEXTURE_BINDING
+            | wgpu::TextureUsages::COPY_SRC;
+        let targets = [
+            ("g position", wgpu::TextureFormat::Rgba32Float),
+            ("g normal", wgpu::TextureFormat::Rgba16Float),
+            ("g albedo", wgpu::TextureFormat::Rgba16Float),
+        ]
+        .map(|(label, format)| texture(d, label, [w, h, 1], format, rt));
+        let g_depth = texture(
+            d,
+            "g depth",
+            [w, h, 1],
+            wgpu::TextureFormat::Depth32Float,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        );
+        let views = targets
+            .each_ref()
+            .map(|t| t.create_view(&Default::default()));
+        let gdepth_view = g_depth.create_view(&Default::default());
+        let gbg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("gbuffer globals"),
+            layout: &self.gbuffer.get_bind_group_layout(0),
+            entries: &self.gbuffer_entries(&frame.globals, &frame.grid),
+        });
+        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("gbuffer"),
+        });
+        let span = timer.span(Stage::GBuffer);
+        self.gbuffer_pass(
+            &mut enc,
+            &views,
+            &gdepth_view,
+            &gbg,
+            timer.writes(span, true, true),
+        );
+        ctx.queue.submit([enc.finish()]);
+        ctx.wait();
+        times.gbuffer = t0.elapsed().as_secs_f64();
+        (targets, views)
+    }
+
+    /// Renders `view` with `vpls` and returns the linear HDR image and the pass times.
+    pub fn render(
+        &self,
+        ctx: &GpuContext,
+        view: &View,
+        vpls: &[Vpl],
+        params: &GpuParams,
+    ) -> Result<(HdrImage, PassTimes), RenderError> {
+        let frame = self.frame_inputs(ctx, view, vpls, params)?;
+        let d = &ctx.device;
         let [w, h] = view.size;
         let mut times = PassTimes::default();
         let (gpu_lights, shadow_views) = self.light_views();
@@ -1291,21 +1621,13 @@ impl GpuRenderer {
         } else {
             0
         };
-        let mut timer = Timer::new(ctx, 3 + 2 * batches);
+        let mut timer = Timer::new(ctx, 5 + 2 * batches);
         let layers = shadow_views.len().max(1) as u32;
         if layers > d.limits().max_texture_array_layers {
             return Err(RenderError::Param(format!(
                 "{} shadow layers exceed the adapter's {}",
                 layers,
                 d.limits().max_texture_array_layers
-            )));
-        }
-        let vpl_bytes = std::mem::size_of_val(vpls) as u64;
-        if vpl_bytes > d.limits().max_storage_buffer_binding_size {
-            return Err(RenderError::Param(format!(
-                "{} VPLs need {vpl_bytes} bytes, more than the adapter's storage binding limit {}",
-                vpls.len(),
-                d.limits().max_storage_buffer_binding_size
             )));
         }
         let tex = |label: &str, size, format, usage| texture(d, label, size, format, usage);
@@ -1378,109 +1700,39 @@ impl GpuRenderer {
         ctx.wait();
         times.shadows = t0.elapsed().as_secs_f64();
 
-        // 2. G-buffer.
-        let t0 = Instant::now();
-        let globals = Globals {
-            view_proj: view.view_proj(self.near_m, self.far_m).to_cols_array_2d(),
-            eye: view.eye.extend(1.0).to_array(),
-            params: [
-                params.g_max,
-                params.shadow_normal_offset,
-                params.shadow_bias,
-                0.0,
-            ],
-            counts: [
-                vpls.len() as u32,
-                gpu_lights.len() as u32,
-                match params.mode {
-                    GpuMode::None => 0,
-                    GpuMode::DirectOnly | GpuMode::PerVplShadowMaps => 1,
-                    GpuMode::Gates => 2,
-                },
-                s,
-            ],
-        };
-        let globals_buf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("globals"),
-            contents: bytemuck::bytes_of(&globals),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let g_pos = tex(
-            "g position",
-            [w, h, 1],
-            wgpu::TextureFormat::Rgba32Float,
-            rt,
-        );
-        let g_nrm = tex("g normal", [w, h, 1], wgpu::TextureFormat::Rgba16Float, rt);
-        let g_alb = tex("g albedo", [w, h, 1], wgpu::TextureFormat::Rgba16Float, rt);
-        let g_depth = tex(
-            "g depth",
-            [w, h, 1],
-            wgpu::TextureFormat::Depth32Float,
-            wgpu::TextureUsages::RENDER_ATTACHMENT,
-        );
-        let views = [&g_pos, &g_nrm, &g_alb].map(|t| t.create_view(&Default::default()));
-        let gdepth_view = g_depth.create_view(&Default::default());
-        let gbg = d.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("gbuffer globals"),
-            layout: &self.gbuffer.get_bind_group_layout(0),
-            entries: &self.gbuffer_entries(&globals_buf),
-        });
-        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("gbuffer"),
-        });
-        let span = timer.span(Stage::GBuffer);
-        self.gbuffer_pass(
-            &mut enc,
-            &views,
-            &gdepth_view,
-            &gbg,
-            timer.writes(span, true, true),
-        );
-        ctx.queue.submit([enc.finish()]);
-        ctx.wait();
-        times.gbuffer = t0.elapsed().as_secs_f64();
+        // 2. Geometry pass (G-buffer).
+        let (_targets, views) = self.geometry_pass(ctx, view, &frame, &mut timer, &mut times);
 
-        // 3. Shade.
-        let t0 = Instant::now();
-        let storage = |label: &str, bytes: &[u8]| {
-            let mut v = bytes.to_vec();
-            if v.is_empty() {
-                v.resize(64, 0);
-            }
-            d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents: &v,
-                usage: wgpu::BufferUsages::STORAGE,
-            })
+        // 2b. Mode gates: unique clusters and light assignment.
+        let lists = if params.mode == GpuMode::Gates {
+            Some(self.cluster_passes(
+                ctx,
+                view,
+                vpls,
+                &frame.vpls,
+                &frame.grid,
+                &views[0],
+                params,
+                &mut timer,
+                &mut times,
+            )?)
+        } else {
+            None
         };
-        let lights_buf = storage("lights", bytemuck::cast_slice(&gpu_lights));
-        let vpl_buf = storage("vpls", bytemuck::cast_slice(vpls));
+
+        // 3. Shade: direct light and the indirect lighting.
+        let t0 = Instant::now();
+        let lights_buf = storage(d, "lights", bytemuck::cast_slice(&gpu_lights));
         let mats: Vec<[[f32; 4]; 4]> = shadow_views.iter().map(|v| v.view_proj).collect();
-        let mats_buf = storage("shadow matrices", bytemuck::cast_slice(&mats));
+        let mats_buf = storage(d, "shadow matrices", bytemuck::cast_slice(&mats));
         let shadow_array_view = shadow_tex.create_view(&wgpu::TextureViewDescriptor {
             label: Some("shadow maps"),
             dimension: Some(wgpu::TextureViewDimension::D2Array),
             ..Default::default()
         });
-        // Gate tables (mode gates), placeholders otherwise.
+        // Gate tables and light lists where the mode has them, placeholders otherwise.
         let level = self.level.as_ref();
-        let grid = GridUniform {
-            origin: level.map_or([0.0, 0.0, 0.0, 1.0], |l| l.origin),
-            dims: level.map_or([0, 0, 0, 4], |l| l.dims),
-            params: [
-                params.gates.oversize,
-                params.gates.max_hops as f32,
-                0.0,
-                0.0,
-            ],
-        };
-        let grid_buf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("grid"),
-            contents: bytemuck::bytes_of(&grid),
-            usage: wgpu::BufferUsages::UNIFORM,
-        });
-        let dummy = storage("no level", &[]);
+        let none = &self.no_level;
         let out = tex(
             "hdr",
             [w, h, 1],
@@ -1491,61 +1743,40 @@ impl GpuRenderer {
                 | wgpu::TextureUsages::TEXTURE_BINDING,
         );
         let out_view = out.create_view(&Default::default());
+        let buffers: [(u32, &wgpu::Buffer); 11] = [
+            (0, &frame.globals),
+            (1, &lights_buf),
+            (2, &frame.vpls),
+            (3, &mats_buf),
+            (8, &frame.grid),
+            (9, level.map_or(none, |l| &l.voxel_words)),
+            (10, level.map_or(none, |l| &l.gates)),
+            (11, level.map_or(none, |l| &l.cluster_gates)),
+            (12, lists.as_ref().map_or(none, |b| &b.pixel_cluster)),
+            (13, lists.as_ref().map_or(none, |b| &b.clusters)),
+            (14, lists.as_ref().map_or(none, |b| &b.entries)),
+        ];
+        let textures = [
+            (4, &shadow_array_view),
+            (5, &views[0]),
+            (6, &views[1]),
+            (7, &views[2]),
+        ];
+        let entries: Vec<wgpu::BindGroupEntry> = buffers
+            .iter()
+            .map(|&(binding, b)| wgpu::BindGroupEntry {
+                binding,
+                resource: b.as_entire_binding(),
+            })
+            .chain(textures.iter().map(|&(binding, v)| wgpu::BindGroupEntry {
+                binding,
+                resource: wgpu::BindingResource::TextureView(v),
+            }))
+            .collect();
         let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("shade"),
             layout: &self.shade.get_bind_group_layout(0),
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: globals_buf.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: lights_buf.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: vpl_buf.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: mats_buf.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: wgpu::BindingResource::TextureView(&shadow_array_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 5,
-                    resource: wgpu::BindingResource::TextureView(&views[0]),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 6,
-                    resource: wgpu::BindingResource::TextureView(&views[1]),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 7,
-                    resource: wgpu::BindingResource::TextureView(&views[2]),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 8,
-                    resource: grid_buf.as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 9,
-                    resource: level.map_or(&dummy, |l| &l.voxel_words).as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 10,
-                    resource: level.map_or(&dummy, |l| &l.gates).as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 11,
-                    resource: level
-                        .map_or(&dummy, |l| &l.cluster_gates)
-                        .as_entire_binding(),
-                },
-            ],
+            entries: &entries,
         });
         let span = timer.span(Stage::Shade);
         fullscreen_pass(
@@ -1561,53 +1792,27 @@ impl GpuRenderer {
         // 3b. Per-VPL paraboloid maps and their gather, batch by batch, added onto the image.
         if params.mode == GpuMode::PerVplShadowMaps && !vpls.is_empty() {
             self.per_vpl_batches(
-                ctx, params, vpls, &vpl_buf, &views, &out, &mut times, &mut timer,
+                ctx,
+                params,
+                vpls,
+                &frame.vpls,
+                &views,
+                &out,
+                &mut times,
+                &mut timer,
             )?;
         }
 
         // 4. Read back.
         let t0 = Instant::now();
-        let row = (w as u64 * 16).div_ceil(256) * 256;
-        let read = d.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("readback"),
-            size: row * h as u64,
-            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            mapped_at_creation: false,
-        });
-        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("readback"),
-        });
-        enc.copy_texture_to_buffer(
-            out.as_image_copy(),
-            wgpu::TexelCopyBufferInfo {
-                buffer: &read,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(row as u32),
-                    rows_per_image: Some(h),
-                },
-            },
-            out.size(),
-        );
-        ctx.queue.submit([enc.finish()]);
-        let slice = read.slice(..);
-        slice.map_async(wgpu::MapMode::Read, |_| {});
-        ctx.wait();
-        let mut img = HdrImage::new(w, h);
-        {
-            let bytes = slice
-                .get_mapped_range()
-                .map_err(|e| RenderError::Gpu(format!("cannot read the image back: {e}")))?;
-            for y in 0..h {
-                let r = &bytes[(y as u64 * row) as usize..][..(w as usize * 16)];
-                let px: &[f32] = bytemuck::cast_slice(r);
-                for x in 0..w as usize {
-                    img.pixels[(y * w) as usize + x] =
-                        Vec3::new(px[4 * x], px[4 * x + 1], px[4 * x + 2]);
-                }
-            }
+        if let Some(b) = &lists {
+            times.lists = Some(self.list_stats(ctx, b)?);
         }
-        read.unmap();
+        let px = read_texture(ctx, &out)?;
+        let mut img = HdrImage::new(w, h);
+        for (o, p) in img.pixels.iter_mut().zip(&px) {
+            *o = Vec3::new(p[0], p[1], p[2]);
+        }
         times.readback = t0.elapsed().as_secs_f64();
         times.gpu = timer.read(ctx);
         Ok((img, times))

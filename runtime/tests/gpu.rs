@@ -178,7 +178,8 @@ fn wgsl_layout(src: &str, name: &str) -> (u32, Vec<(String, u32)>) {
 fn gpu_structs_match_their_wgsl_layouts() {
     use std::mem::{offset_of, size_of};
     use visgate_runtime::gpu::{
-        Batch, Globals, GpuLight, GridUniform, RsmSample, ShadowView, VplView,
+        Batch, ClusterFrame, Globals, GpuGeometryCluster, GpuLight, GridUniform, RsmSample,
+        ShadowView, VplView,
     };
     use visgate_runtime::vpl::Vpl;
     let shade = SHADERS[2].1;
@@ -305,6 +306,33 @@ fn gpu_structs_match_their_wgsl_layouts() {
             ("range", offset_of!(Batch, range)),
             ("params", offset_of!(Batch, params)),
         ],
+    );
+    let clusters = SHADERS[6].1;
+    check(
+        clusters,
+        "Frame",
+        size_of::<ClusterFrame>(),
+        &[
+            ("eye", offset_of!(ClusterFrame, eye)),
+            ("forward", offset_of!(ClusterFrame, forward)),
+            ("size", offset_of!(ClusterFrame, size)),
+            ("counts", offset_of!(ClusterFrame, counts)),
+        ],
+    );
+    let cluster_members = [
+        ("key", offset_of!(GpuGeometryCluster, key)),
+        ("lo", offset_of!(GpuGeometryCluster, lo)),
+        ("hi", offset_of!(GpuGeometryCluster, hi)),
+        ("list", offset_of!(GpuGeometryCluster, list)),
+    ];
+    let size = size_of::<GpuGeometryCluster>();
+    check(clusters, "GeometryCluster", size, &cluster_members);
+    check(shade, "ClusterLists", size, &cluster_members);
+    check(
+        clusters,
+        "Grid",
+        size_of::<GridUniform>(),
+        &[("origin", 0), ("dims", 16), ("params", 32)],
     );
 }
 

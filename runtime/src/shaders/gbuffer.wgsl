@@ -1,5 +1,6 @@
-// G-buffer pass: world position (w = 1 where a surface is), shading normal turned towards the
-// camera (surfaces are two-sided), linear albedo (material × texture, the texture an sRGB layer
+// G-buffer pass (grid.wgsl first): world position (w: the visibility cluster it faces, 0 where
+// no surface is, see encode_cluster), shading normal turned towards the camera (surfaces are
+// two-sided), linear albedo (material × texture, the texture an sRGB layer
 // of one array, sampled nearest with repeat as the CPU reference does). Depth test less.
 
 struct Globals {
@@ -57,7 +58,7 @@ fn fs(i: VsOut) -> GOut {
         n = -n;
     }
     var o: GOut;
-    o.position = vec4<f32>(i.world, 1.0);
+    o.position = vec4<f32>(i.world, encode_cluster(cluster_at(i.world, n)));
     o.normal = vec4<f32>(n, 0.0);
     var albedo = i.albedo;
     if i.uv_layer.z >= 0.0 {

@@ -1,6 +1,6 @@
 // Deferred shading: direct light from point and spot lights with shadow-map PCF (3 × 3), and
-// the indirect sum over VPLs without visibility (mode 0, none) or through the gates of a baked
-// level (mode 2), into a linear HDR target.
+// the indirect sum over VPLs without visibility (mode 0, none), through the gates of a baked
+// level per pixel (mode 2) or by clustered light lists (mode 3), into a linear HDR target.
 //
 // Radiometry as the CPU reference: L = ρ/π · I · falloff · cos θ / d² for lights, and
 // ρ/π · Φ/π · min(cos θ_v cos θ_x / d², g_max) for VPLs.
@@ -43,83 +43,24 @@ struct Vpl {
 @group(0) @binding(6) var g_normal: texture_2d<f32>;
 @group(0) @binding(7) var g_albedo: texture_2d<f32>;
 
-// Gate visibility (mode 2), brute force per fragment and VPL: the clusters of both through
-// their normal side, then a chain of at most 2 gate disks the segment passes through.
-struct Grid {
-    // xyz origin (m), w voxel size (m).
-    origin: vec4<f32>,
-    // xyz dims, w bytes per stored value (1, 2 or 4).
-    dims: vec4<u32>,
-    // x disk oversize factor, y max hops (1 or 2), z, w unused.
-    params: vec4<f32>,
+// Gate visibility. grid.wgsl and gates.wgsl come first (bindings 8–11); a pixel's cluster is
+// in the G-buffer (position.w). Mode 2 (gates per pixel) tests every VPL with a chain of at
+// most 2 gate disks; mode 3 (clustered) walks the light list of the pixel's geometry cluster
+// that the clusters.wgsl passes built.
+
+struct ClusterLists {
+    // x tile x, y tile y, z depth slice, w visibility cluster.
+    key: vec4<u32>,
+    lo: vec4<f32>,
+    hi: vec4<f32>,
+    // x first entry, y entries, z entries needed, w unused.
+    list: vec4<u32>,
 };
 
-struct Gate {
-    // xyz centre (m), w radius (m).
-    centre: vec4<f32>,
-    // xyz unit normal.
-    normal: vec4<f32>,
-    // xy the two clusters.
-    clusters: vec4<u32>,
-};
-
-@group(0) @binding(8) var<uniform> grid: Grid;
-@group(0) @binding(9) var<storage, read> voxel_words: array<u32>;
-@group(0) @binding(10) var<storage, read> gates: array<Gate>;
-// Offsets (clusters + 1) into this same array, then the gate indices.
-@group(0) @binding(11) var<storage, read> cluster_gates: array<u32>;
-
-const NONE: u32 = 0xffffffffu;
-
-fn cluster_of(p: vec3<f32>) -> u32 {
-    let v = (p - grid.origin.xyz) / grid.origin.w;
-    if any(v < vec3<f32>(0.0)) || any(v >= vec3<f32>(grid.dims.xyz)) {
-        return NONE;
-    }
-    let c = vec3<u32>(v);
-    let i = c.x + grid.dims.x * (c.y + grid.dims.y * c.z);
-    let bytes = grid.dims.w;
-    if bytes == 4u {
-        return voxel_words[i];
-    }
-    if bytes == 2u {
-        let x = (voxel_words[i / 2u] >> ((i % 2u) * 16u)) & 0xffffu;
-        return select(x, NONE, x == 0xffffu);
-    }
-    let x = (voxel_words[i / 4u] >> ((i % 4u) * 8u)) & 0xffu;
-    return select(x, NONE, x == 0xffu);
-}
-
-fn cluster_at(p: vec3<f32>, n: vec3<f32>) -> u32 {
-    let vs = grid.origin.w;
-    var c = cluster_of(p + n * (0.5 * vs));
-    if c == NONE {
-        c = cluster_of(p + n * (1.5 * vs));
-    }
-    if c == NONE {
-        c = cluster_of(p);
-    }
-    return c;
-}
-
-fn crosses(a: vec3<f32>, b: vec3<f32>, g: Gate) -> bool {
-    let d = b - a;
-    let den = dot(d, g.normal.xyz);
-    if abs(den) <= 1.1920929e-7 * length(d) {
-        return false;
-    }
-    let t = dot(g.centre.xyz - a, g.normal.xyz) / den;
-    if t < 0.0 || t > 1.0 {
-        return false;
-    }
-    let q = a + d * t - g.centre.xyz;
-    let r = g.centre.w * grid.params.x;
-    return dot(q, q) <= r * r;
-}
-
-fn other_side(g: Gate, c: u32) -> u32 {
-    return select(g.clusters.x, g.clusters.y, g.clusters.x == c);
-}
+@group(0) @binding(12) var<storage, read> pixel_cluster: array<u32>;
+@group(0) @binding(13) var<storage, read> geometry_clusters: array<ClusterLists>;
+// (VPL, gates): gates (g0 + 1) | (g1 + 1) << 16, 0 for none.
+@group(0) @binding(14) var<storage, read> light_entries: array<vec2<u32>>;
 
 fn through_gates(a: vec3<f32>, ca: u32, b: vec3<f32>, cb: u32) -> bool {
     if ca == cb || ca == NONE || cb == NONE {
@@ -237,10 +178,7 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     if globals.counts.z == 0u || globals.counts.z == 2u {
         let g_max = globals.params.x;
         let gated = globals.counts.z == 2u;
-        var here = NONE;
-        if gated {
-            here = cluster_at(p, n);
-        }
+        let here = decode_cluster(pos.w);
         for (var j = 0u; j < globals.counts.x; j++) {
             let v = vpls[j];
             let d = v.position - p;
@@ -261,5 +199,52 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
             radiance += albedo / PI * v.flux / PI * g;
         }
     }
+    if globals.counts.z == 3u {
+        radiance += albedo / PI * clustered_gather(px, p, n);
+    }
     return vec4<f32>(radiance, 1.0);
+}
+
+// Mode 3: the VPL light at p through its geometry cluster's list (without albedo / π). An
+// entry with gates is tested here, per fragment; a VPL whose light passes by several chains
+// counts once (a list is sorted by VPL).
+fn clustered_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    let width = textureDimensions(g_position).x;
+    let gc = pixel_cluster[u32(px.x) + u32(px.y) * width];
+    if gc == NONE {
+        return vec3<f32>(0.0);
+    }
+    let list = geometry_clusters[gc].list;
+    let g_max = globals.params.x;
+    var sum = vec3<f32>(0.0);
+    var last = NONE;
+    for (var e = list.x; e < list.x + list.y; e++) {
+        let entry = light_entries[e];
+        if entry.x == last {
+            continue;
+        }
+        let v = vpls[entry.x];
+        let d = v.position - p;
+        let d2 = dot(d, d);
+        if d2 <= 0.0 {
+            continue;
+        }
+        let w = d * inverseSqrt(d2);
+        let cos_x = dot(n, w);
+        let cos_v = -dot(v.normal, w);
+        if cos_x <= 0.0 || cos_v <= 0.0 {
+            continue;
+        }
+        let g0 = entry.y & 0xffffu;
+        if g0 != 0u && !crosses(v.position, p, gates[g0 - 1u]) {
+            continue;
+        }
+        let g1 = entry.y >> 16u;
+        if g1 != 0u && !crosses(v.position, p, gates[g1 - 1u]) {
+            continue;
+        }
+        last = entry.x;
+        sum += v.flux / PI * min(cos_x * cos_v / d2, g_max);
+    }
+    return sum;
 }
