@@ -8,8 +8,9 @@ use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 use visgate_formats::ImportOptions;
 use visgate_runtime::camera::View;
+use visgate_runtime::clustered::ClusterParams;
 use visgate_runtime::gates::{GateLevel, GateParams};
-use visgate_runtime::gpu::{GpuContext, GpuMode, GpuParams, GpuRenderer};
+use visgate_runtime::gpu::{GpuContext, GpuMode, GpuParams, GpuRenderer, PassTimes};
 use visgate_runtime::hdr::{HdrImage, false_colour};
 use visgate_runtime::metrics::{errors, flip};
 use visgate_runtime::reference::{IndirectVisibility, ReferenceParams, render_with};
@@ -26,8 +27,13 @@ Modes:
                GPU: one paraboloid shadow map per VPL, rendered and gathered in batches of
                --vpl-batch (the brute-force baseline that gates and virtual area lights beat)
   gates        GPU: a VPL lights a point of another visibility cluster only through a chain
-               of at most --gate-hops gate disks (× --gate-oversize) of the baked --level
-               (brute force per pixel and VPL for now; --cpu for the CPU twin; GPU: ≤ 2 hops)
+               of at most --gate-hops gate disks (× --gate-oversize) of the baked --level, by
+               clustered shading (the paper's Table I passes: geometry pass, unique clusters
+               of --tile-px tiles × --depth-slices slices × visibility cluster, light
+               assignment into a pool of --light-entries, indirect lighting); GPU: ≤ 2 hops;
+               --cpu: the CPU twin, per point
+  gates-per-pixel
+               GPU: the same gate test, brute force (every pixel tests every VPL)
   direct-only  GPU: direct light alone
 With --cpu, none and direct-only run on the CPU twin (shadow rays for direct light), and
 per-vpl-shadow-maps is the reference (exact shadow rays).
@@ -41,6 +47,8 @@ Examples:
   visgate render builtin:cornell-box --mode reference --vpls 4096 --out cornell.exr
   visgate render builtin:four-rooms --mode none --size 320x240 --out none.png
   visgate render builtin:four-rooms --mode none --cpu --out none-cpu.exr
+  visgate bake builtin:four-rooms -o four-rooms.vgate
+  visgate render builtin:four-rooms --mode gates --level four-rooms.vgate --out gates.png
   visgate diff none.exr cornell.exr --out diff.png";
 
 /// Where VPLs come from.
@@ -61,8 +69,10 @@ pub enum Mode {
     None,
     /// One paraboloid shadow map per VPL (GPU, in batches).
     PerVplShadowMaps,
-    /// Visibility through the gates of a baked level (CPU twin for now; needs --level).
+    /// Visibility through the gates of a baked level by clustered shading (needs --level).
     Gates,
+    /// The gate test brute force, every pixel against every VPL (GPU; needs --level).
+    GatesPerPixel,
     /// Direct light only.
     DirectOnly,
 }
@@ -122,6 +132,16 @@ pub struct RenderArgs {
     /// Gates a VPL's light may pass in a chain (--mode gates; the paper: 1).
     #[arg(long, default_value_t = 2)]
     pub gate_hops: u32,
+    /// Screen tile side of geometry clusters (--mode gates), pixels, 1..=16 on the GPU.
+    #[arg(long, default_value_t = 16)]
+    pub tile_px: u32,
+    /// Exponential depth slices of geometry clusters (--mode gates), 1..=256.
+    #[arg(long, default_value_t = 24)]
+    pub depth_slices: u32,
+    /// Capacity of the light-list pool (--mode gates), entries of 8 bytes; a frame that needs
+    /// more stops with the count it needs.
+    #[arg(long, default_value_t = 1 << 23)]
+    pub light_entries: u32,
     /// Per-VPL paraboloid map size (GPU), texels.
     #[arg(long, default_value_t = 128)]
     pub vpl_map_size: u32,
@@ -162,10 +182,19 @@ pub fn run(args: RenderArgs) -> Result<()> {
     if args.threads == Some(0) {
         bail!("--threads 0: give at least 1 thread, or leave it out to use all cores");
     }
-    if args.mode == Mode::Gates && args.level.is_none() {
+    let gated = matches!(args.mode, Mode::Gates | Mode::GatesPerPixel);
+    if gated && args.level.is_none() {
         bail!(
-            "--mode gates needs --level LEVEL.vgate (bake one with `visgate bake SCENE -o LEVEL.vgate`)"
+            "--mode {} needs --level LEVEL.vgate (bake one with `visgate bake SCENE -o LEVEL.vgate`)",
+            if args.mode == Mode::Gates {
+                "gates"
+            } else {
+                "gates-per-pixel"
+            }
         );
+    }
+    if args.mode == Mode::GatesPerPixel && args.cpu {
+        bail!("--mode gates-per-pixel runs on the GPU; the CPU twin is --mode gates --cpu");
     }
     let oversize_ok = args.gate_oversize > 0.0 && args.gate_oversize.is_finite();
     if !oversize_ok || !(1..=16).contains(&args.gate_hops) {
@@ -251,8 +280,8 @@ pub fn run(args: RenderArgs) -> Result<()> {
             )?,
         };
         let vpl_s = t.elapsed().as_secs_f64();
-        let gate_level = match (&args.level, args.mode) {
-            (Some(path), Mode::Gates) => {
+        let gate_level = match (&args.level, gated) {
+            (Some(path), true) => {
                 let level = visgate_formats::BakedLevel::read(path)
                     .with_context(|| format!("cannot read the level {}", path.display()))?;
                 Some(GateLevel::new(level, &scene)?)
@@ -272,8 +301,14 @@ pub fn run(args: RenderArgs) -> Result<()> {
                         Mode::None => GpuMode::None,
                         Mode::PerVplShadowMaps => GpuMode::PerVplShadowMaps,
                         Mode::Gates => GpuMode::Gates,
+                        Mode::GatesPerPixel => GpuMode::GatesPerPixel,
                         _ => GpuMode::DirectOnly,
                     },
+                    clusters: ClusterParams {
+                        tile_px: args.tile_px,
+                        depth_slices: args.depth_slices,
+                    },
+                    light_entries: args.light_entries,
                     gates: GateParams {
                         oversize: args.gate_oversize,
                         max_hops: args.gate_hops,
@@ -302,29 +337,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
             println!(
                 "times: load {load_s:.3} s, BVH {bvh_s:.3} s, adapter + upload + VPLs {vpl_s:.3} s"
             );
-            println!(
-                "passes (CPU wall, each submitted and waited for): shadow maps {:.2} ms, \
-                 G-buffer {:.2} ms, shading {:.2} ms, VPL maps {:.2} ms, VPL gather {:.2} ms, \
-                 readback {:.2} ms",
-                times.shadows * 1e3,
-                times.gbuffer * 1e3,
-                times.shade * 1e3,
-                times.vpl_maps * 1e3,
-                times.vpl_gather * 1e3,
-                times.readback * 1e3
-            );
-            match times.gpu {
-                Some(g) => println!(
-                    "GPU time (timestamp queries): shadow maps {:.2} ms, G-buffer {:.2} ms, \
-                     shading {:.2} ms, VPL maps {:.2} ms, VPL gather {:.2} ms",
-                    g.shadows * 1e3,
-                    g.gbuffer * 1e3,
-                    g.shade * 1e3,
-                    g.vpl_maps * 1e3,
-                    g.vpl_gather * 1e3
-                ),
-                None => println!("GPU time: the adapter has no timestamp queries"),
-            }
+            print_passes(&times, args.mode);
             let m = img.mean();
             println!("mean radiance {:.5} {:.5} {:.5}", m.x, m.y, m.z);
             println!("wrote {}", args.out.display());
@@ -393,6 +406,51 @@ pub fn run(args: RenderArgs) -> Result<()> {
         println!("wrote {}", args.out.display());
         Ok(())
     })
+}
+
+/// Prints the passes that ran (named as the paper's Table I in mode gates), each with its CPU
+/// wall time and, where the adapter has timestamp queries, its GPU time.
+fn print_passes(t: &PassTimes, mode: Mode) {
+    let g = t.gpu.unwrap_or_default();
+    let shading = match mode {
+        Mode::Gates | Mode::GatesPerPixel | Mode::None => "shading: direct + indirect lighting",
+        _ => "shading: direct lighting",
+    };
+    let mut rows = vec![
+        ("shadow maps", t.shadows, g.shadows),
+        ("geometry pass (G-buffer)", t.gbuffer, g.gbuffer),
+    ];
+    if mode == Mode::Gates {
+        rows.push(("unique clusters", t.unique_clusters, g.unique_clusters));
+        rows.push(("light assignment", t.light_assignment, g.light_assignment));
+    }
+    rows.push((shading, t.shade, g.shade));
+    if mode == Mode::PerVplShadowMaps {
+        rows.push(("VPL paraboloid maps", t.vpl_maps, g.vpl_maps));
+        rows.push(("VPL gather", t.vpl_gather, g.vpl_gather));
+    }
+    println!("pass                               CPU wall (ms)   GPU (ms)");
+    for (name, cpu, gpu) in rows {
+        match t.gpu {
+            Some(_) => println!("  {name:<33}{:>12.2}{:>11.2}", cpu * 1e3, gpu * 1e3),
+            None => println!("  {name:<33}{:>12.2}          -", cpu * 1e3),
+        }
+    }
+    println!("  {:<33}{:>12.2}", "readback", t.readback * 1e3);
+    if t.gpu.is_none() {
+        println!("(the adapter has no timestamp queries: no GPU times)");
+    }
+    if let Some(l) = t.lists {
+        println!(
+            "light lists: {} geometry clusters, {} entries ({:.1} per cluster), pool {} \
+             entries ({:.1} % used)",
+            l.geometry_clusters,
+            l.entries,
+            l.entries as f64 / l.geometry_clusters.max(1) as f64,
+            l.capacity,
+            l.entries as f64 / l.capacity.max(1) as f64 * 100.0
+        );
+    }
 }
 
 #[derive(Debug, Args)]

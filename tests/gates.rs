@@ -398,3 +398,213 @@ fn gpu_light_lists_equal_the_cpu_twin() {
         }
     }
 }
+
+// The runtime tests' scene builders; this file uses the scaled four rooms.
+#[path = "../runtime/tests/common/mod.rs"]
+mod common;
+
+/// GPU gates (clustered) and the CPU twin on `vpls`, relative MSE of the GPU image.
+fn gpu_vs_twin(
+    gpu: &visgate_runtime::gpu::GpuRenderer,
+    ctx: &visgate_runtime::gpu::GpuContext,
+    scene: &visgate_formats::Scene,
+    tracer: &Tracer,
+    gates: &GateLevel,
+    vpls: &[visgate_runtime::vpl::Vpl],
+    view: &visgate_runtime::camera::View,
+) -> (visgate_runtime::hdr::HdrImage, f64) {
+    use visgate_runtime::gpu::{GpuMode, GpuParams};
+    use visgate_runtime::metrics::errors;
+    use visgate_runtime::reference::{IndirectVisibility, ReferenceParams, render_with};
+    let (img, _) = gpu
+        .render(
+            ctx,
+            view,
+            vpls,
+            &GpuParams {
+                mode: GpuMode::Gates,
+                ..GpuParams::default()
+            },
+        )
+        .expect("gpu");
+    assert!(img.pixels.iter().all(|p| p.is_finite()), "finite");
+    let (cpu, _) = render_with(
+        tracer,
+        &scene.lights,
+        vpls,
+        view,
+        &ReferenceParams {
+            samples_per_pixel: 1,
+            ..ReferenceParams::default()
+        },
+        IndirectVisibility::Gates(gates, GateParams::default()),
+        &|_, _| {},
+    )
+    .expect("cpu");
+    let e = errors(&img, &cpu).expect("same size");
+    (img, e.rel_mse)
+}
+
+#[test]
+fn gpu_gates_stay_stable_at_the_extremes() {
+    use visgate_runtime::gpu::{GpuContext, GpuMode, GpuParams, GpuRenderer};
+    use visgate_runtime::vpl::{PathParams, Vpl, path_vpls};
+    let ctx = GpuContext::new().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"));
+    let (scene, gates, tracer, vpls, view) = fixture(Builtin::FourRooms, 128);
+    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    gpu.set_level(&ctx, &gates).expect("level");
+    let params = |mode| GpuParams {
+        mode,
+        ..GpuParams::default()
+    };
+    // No VPLs: direct light alone, empty lists.
+    let (none, t) = gpu
+        .render(&ctx, &view, &[], &params(GpuMode::Gates))
+        .expect("0 VPLs");
+    let (direct, _) = gpu
+        .render(&ctx, &view, &[], &params(GpuMode::DirectOnly))
+        .expect("direct");
+    assert_eq!(none.pixels, direct.pixels);
+    assert_eq!(t.lists.expect("lists").entries, 0);
+    // 65,536 VPLs on a small image: finite, and more light than direct alone.
+    let many = path_vpls(
+        &tracer,
+        &scene.lights,
+        &PathParams {
+            paths: 65536,
+            bounces: 1,
+            seed: 2,
+        },
+    )
+    .expect("vpls");
+    let small =
+        visgate_runtime::camera::View::new(scene.cameras.first().expect("camera"), [16, 12])
+            .expect("view");
+    let (img, t) = gpu
+        .render(&ctx, &small, &many, &params(GpuMode::Gates))
+        .expect("65536 VPLs");
+    assert!(img.pixels.iter().all(|p| p.is_finite()));
+    let (d, _) = gpu
+        .render(&ctx, &small, &[], &params(GpuMode::DirectOnly))
+        .expect("direct");
+    assert!(
+        img.mean().x > d.mean().x * 1.01,
+        "{} vs {}",
+        img.mean(),
+        d.mean()
+    );
+    eprintln!("65536 VPLs: {:?}", t.lists);
+    // A pool too small: an error naming the setting, never an image with light cut.
+    let e = gpu
+        .render(
+            &ctx,
+            &view,
+            &vpls,
+            &GpuParams {
+                light_entries: 1000,
+                ..params(GpuMode::Gates)
+            },
+        )
+        .expect_err("overflow");
+    assert!(e.to_string().contains("--light-entries"), "{e}");
+    // All VPLs in one cluster (the camera's): agrees with the twin; lists carry no gates there.
+    let home = gates
+        .cluster_at(view.eye, Vec3::ZERO)
+        .expect("camera cluster");
+    let one: Vec<Vpl> = vpls
+        .iter()
+        .filter(|v| gates.cluster_at(Vec3::from(v.position), Vec3::from(v.normal)) == Some(home))
+        .copied()
+        .collect();
+    assert!(one.len() > 20, "{} VPLs in the camera's cluster", one.len());
+    let (_, rel) = gpu_vs_twin(&gpu, &ctx, &scene, &tracer, &gates, &one, &view);
+    assert!(rel < 0.02, "one cluster: {rel}");
+    let (_, lists) = gpu
+        .light_lists(&ctx, &view, &one, &params(GpuMode::Gates))
+        .expect("lists");
+    for (c, l) in lists.clusters.iter().zip(&lists.lists) {
+        if c.cluster == Some(home) {
+            assert_eq!(l.len(), one.len());
+            assert!(l.iter().all(|e| e.gates.is_empty()));
+        }
+    }
+    // VPLs at a gate's centre and in its plane: finite, and as the twin.
+    let (c, n, r) = gates.gate(0);
+    let t = n.any_orthonormal_vector();
+    let flux = Vec3::ONE;
+    let on_gate = [
+        Vpl::new(c, n, flux),
+        Vpl::new(c, -n, flux),
+        Vpl::new(c + t * (0.5 * r), n.cross(t), flux),
+    ];
+    let (_, rel) = gpu_vs_twin(&gpu, &ctx, &scene, &tracer, &gates, &on_gate, &view);
+    assert!(rel < 0.05, "VPLs on a gate: {rel}");
+    // A camera inside a wall: finite, and as the twin.
+    let dir = (view.forward).normalize();
+    let hit = tracer.trace(view.eye, dir).expect("a wall ahead");
+    let mut cam = scene.cameras[0].clone();
+    cam.eye = hit.position + dir * 0.02;
+    cam.target = cam.eye + dir;
+    let inside = visgate_runtime::camera::View::new(&cam, [64, 48]).expect("view");
+    let (img, rel) = gpu_vs_twin(&gpu, &ctx, &scene, &tracer, &gates, &vpls, &inside);
+    eprintln!("camera in a wall: mean {}, rel. MSE {rel}", img.mean());
+    assert!(rel < 0.05, "camera in a wall: {rel}");
+}
+
+#[test]
+fn gpu_gates_give_the_same_image_at_scales_1e_3_to_1e4() {
+    use visgate_runtime::gpu::{GpuContext, GpuMode, GpuParams, GpuRenderer};
+    use visgate_runtime::metrics::errors;
+    use visgate_runtime::vpl::{PathParams, path_vpls};
+    let ctx = GpuContext::new().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"));
+    let mut images = Vec::new();
+    for s in [1e-3f32, 1.0, 1e4] {
+        let (scene, cam) = common::scaled_four_rooms(s);
+        let params = BakeParams {
+            resolution: Resolution::LongestAxisVoxels(96),
+            ..BakeParams::default()
+        };
+        let level = bake(&scene, &params, &BakeOptions::default(), &|_| {})
+            .expect("bake")
+            .level;
+        let gates = GateLevel::new(level, &scene).expect("level");
+        let tracer = Tracer::new(&scene);
+        let vpls = path_vpls(
+            &tracer,
+            &scene.lights,
+            &PathParams {
+                paths: 256,
+                bounces: 1,
+                seed: 4,
+            },
+        )
+        .expect("vpls");
+        let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+        gpu.set_level(&ctx, &gates).expect("level");
+        let view = visgate_runtime::camera::View::new(&cam, [64, 48]).expect("view");
+        let (img, t) = gpu
+            .render(
+                &ctx,
+                &view,
+                &vpls,
+                &GpuParams {
+                    mode: GpuMode::Gates,
+                    g_max: 10.0 / (s * s),
+                    ..GpuParams::default()
+                },
+            )
+            .expect("render");
+        eprintln!(
+            "scale {s}: {} clusters, {} gates, {:?}, mean {}",
+            gates.cluster_count(),
+            gates.gate_count(),
+            t.lists,
+            img.mean()
+        );
+        images.push(img);
+    }
+    for img in [&images[0], &images[2]] {
+        let e = errors(img, &images[1]).expect("same size");
+        assert!(e.rel_mse < 1e-3, "{e:?}");
+    }
+}

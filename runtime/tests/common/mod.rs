@@ -101,8 +101,9 @@ pub fn closed_box(r: f32) -> Vec<[Vec3; 4]> {
     ]
 }
 
-/// The built-in four rooms and its first camera, every length × `scale` and the lights'
-/// intensities × `scale²`, so that the image is the same at any scale.
+/// The built-in four rooms and its first camera, every length (cameras too: a bake keeps the
+/// empty space that holds them) × `scale` and the lights' intensities × `scale²`, so that the
+/// image is the same at any scale.
 pub fn scaled_four_rooms(scale: f32) -> (Scene, Camera) {
     let mut s = Builtin::FourRooms.scene().expect("scene");
     for m in &mut s.meshes {
@@ -121,8 +122,10 @@ pub fn scaled_four_rooms(scale: f32) -> (Scene, Camera) {
         *position *= scale;
         *intensity *= scale * scale;
     }
-    let mut cam = s.cameras.first().cloned().expect("a camera");
-    cam.eye *= scale;
-    cam.target *= scale;
+    for c in &mut s.cameras {
+        c.eye *= scale;
+        c.target *= scale;
+    }
+    let cam = s.cameras.first().cloned().expect("a camera");
     (s, cam)
 }

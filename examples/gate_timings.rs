@@ -1,0 +1,126 @@
+//! A timing table like Table I of the visibility-gates paper: GPU time per pass (timestamp
+//! queries) of mode gates — geometry pass, unique clusters, light assignment, indirect
+//! lighting — beside per-VPL shadow maps and no visibility, at 512 / 1024 / 2048 VPLs.
+//!
+//! `cargo run --release --example gate_timings -- [SCENE] [LEVEL.vgate|-] [WxH] [CAMERA]`
+//!
+//! Without arguments: the built-in four rooms, baked here at 128, at 1024×512. The speedup is
+//! per-VPL shadow maps' total over gates' total at the same VPLs, measured in one run.
+
+use visgate_formats::vgate::{BakeParams, Resolution};
+use visgate_formats::{BakedLevel, ImportOptions, Scene};
+use visgate_preprocess::bake::{BakeOptions, bake};
+use visgate_runtime::camera::View;
+use visgate_runtime::gates::GateLevel;
+use visgate_runtime::gpu::{GpuContext, GpuMode, GpuParams, GpuRenderer, GpuStageTimes};
+use visgate_runtime::tracer::Tracer;
+use visgate_runtime::vpl::{PathParams, path_vpls};
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let mut args = std::env::args().skip(1);
+    let scene_arg = args.next().unwrap_or_else(|| "builtin:four-rooms".into());
+    let scene = match scene_arg.strip_prefix("builtin:") {
+        Some(name) => visgate_scenes::Builtin::from_name(name)
+            .ok_or("no such built-in scene")?
+            .scene()?,
+        None => Scene::load(
+            std::path::Path::new(&scene_arg),
+            &ImportOptions {
+                load_textures: true,
+            },
+        )?,
+    };
+    let level = match args.next() {
+        Some(p) if p != "-" => BakedLevel::read(std::path::Path::new(&p))?,
+        _ => {
+            let params = BakeParams {
+                resolution: Resolution::LongestAxisVoxels(128),
+                ..BakeParams::default()
+            };
+            bake(&scene, &params, &BakeOptions::default(), &|_| {})?.level
+        }
+    };
+    let size = args.next().unwrap_or_else(|| "1024x512".into());
+    let (w, h) = size.split_once('x').ok_or("size WxH")?;
+    let size = [w.parse()?, h.parse()?];
+    let camera = match args.next() {
+        Some(name) => scene.camera(&name).ok_or("no such camera")?.clone(),
+        None => scene
+            .cameras
+            .first()
+            .ok_or("the scene has no camera")?
+            .clone(),
+    };
+    let view = View::new(&camera, size)?;
+    let gates = GateLevel::new(level, &scene)?;
+    let tracer = Tracer::new(&scene);
+    let ctx = GpuContext::new()?;
+    let mut gpu = GpuRenderer::new(&ctx, &scene)?;
+    gpu.set_level(&ctx, &gates)?;
+    println!(
+        "{} camera {} at {}x{} on {} ({:?}); GPU ms per pass from timestamp queries",
+        scene.name, camera.name, size[0], size[1], ctx.adapter_info.name, ctx.adapter_info.backend
+    );
+    let render = |mode: GpuMode, vpls: &[visgate_runtime::vpl::Vpl]| {
+        gpu.render(
+            &ctx,
+            &view,
+            vpls,
+            &GpuParams {
+                mode,
+                ..GpuParams::default()
+            },
+        )
+    };
+    // Warm-up: the first frame pays for allocations the others reuse.
+    render(GpuMode::Gates, &[])?;
+    println!(
+        "| VPLs | mode | geometry pass | unique clusters | light assignment | shading (direct + \
+         indirect) | VPL maps | VPL gather | total | per-VPL maps / this |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|---|");
+    for n in [512, 1024, 2048] {
+        let vpls = path_vpls(
+            &tracer,
+            &scene.lights,
+            &PathParams {
+                paths: n,
+                bounces: 1,
+                seed: 1,
+            },
+        )?;
+        let mut rows: Vec<(&str, GpuStageTimes, Option<u64>)> = Vec::new();
+        for (name, mode) in [
+            ("gates", GpuMode::Gates),
+            ("gates per pixel", GpuMode::GatesPerPixel),
+            ("none", GpuMode::None),
+            ("per-VPL shadow maps", GpuMode::PerVplShadowMaps),
+        ] {
+            let (_, t) = render(mode, &vpls)?;
+            let g = t.gpu.ok_or("the adapter has no timestamp queries")?;
+            rows.push((name, g, t.lists.map(|l| l.entries)));
+        }
+        let total = |g: &GpuStageTimes| {
+            g.gbuffer + g.unique_clusters + g.light_assignment + g.shade + g.vpl_maps + g.vpl_gather
+        };
+        let base = total(&rows[3].1);
+        for (name, g, entries) in &rows {
+            let ms = |x: f64| format!("{:.1}", x * 1e3);
+            let dash = |x: f64| if x > 0.0 { ms(x) } else { "–".into() };
+            println!(
+                "| {} | {name}{} | {} | {} | {} | {} | {} | {} | {} | {:.2} |",
+                vpls.len(),
+                entries.map_or(String::new(), |e| format!(" ({e} entries)")),
+                ms(g.gbuffer),
+                dash(g.unique_clusters),
+                dash(g.light_assignment),
+                ms(g.shade),
+                dash(g.vpl_maps),
+                dash(g.vpl_gather),
+                ms(total(g)),
+                base / total(g)
+            );
+        }
+    }
+    Ok(())
+}
