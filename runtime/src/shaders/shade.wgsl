@@ -175,31 +175,14 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
         }
         radiance += albedo / PI * intensity * cos_x / d2 * shadow(l, p, n);
     }
-    if globals.counts.z == 0u || globals.counts.z == 2u {
-        let g_max = globals.params.x;
-        let gated = globals.counts.z == 2u;
-        let here = decode_cluster(pos.w);
-        for (var j = 0u; j < globals.counts.x; j++) {
-            let v = vpls[j];
-            let d = v.position - p;
-            let d2 = dot(d, d);
-            if d2 <= 0.0 {
-                continue;
-            }
-            let w = d * inverseSqrt(d2);
-            let cos_x = dot(n, w);
-            let cos_v = -dot(v.normal, w);
-            if cos_x <= 0.0 || cos_v <= 0.0 {
-                continue;
-            }
-            if gated && !through_gates(v.position, cluster_at(v.position, v.normal), p, here) {
-                continue;
-            }
-            let g = min(cos_x * cos_v / d2, g_max);
-            radiance += albedo / PI * v.flux / PI * g;
-        }
-    }
-    if globals.counts.z == 3u {
+    // One loop per mode: a software rasterizer (lavapipe) runs a loop that carries another
+    // mode's branch several times slower.
+    let mode = globals.counts.z;
+    if mode == 0u {
+        radiance += albedo / PI * gather_all(p, n);
+    } else if mode == 2u {
+        radiance += albedo / PI * gather_per_pixel(p, n, decode_cluster(pos.w));
+    } else if mode == 3u {
         radiance += albedo / PI * clustered_gather(px, p, n);
     }
     return vec4<f32>(radiance, 1.0);
@@ -215,7 +198,6 @@ fn clustered_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
         return vec3<f32>(0.0);
     }
     let list = geometry_clusters[gc].list;
-    let g_max = globals.params.x;
     var sum = vec3<f32>(0.0);
     var last = NONE;
     for (var e = list.x; e < list.x + list.y; e++) {
@@ -224,15 +206,8 @@ fn clustered_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
             continue;
         }
         let v = vpls[entry.x];
-        let d = v.position - p;
-        let d2 = dot(d, d);
-        if d2 <= 0.0 {
-            continue;
-        }
-        let w = d * inverseSqrt(d2);
-        let cos_x = dot(n, w);
-        let cos_v = -dot(v.normal, w);
-        if cos_x <= 0.0 || cos_v <= 0.0 {
+        let l = vpl_light(v, p, n);
+        if all(l == vec3<f32>(0.0)) {
             continue;
         }
         let g0 = entry.y & 0xffffu;
@@ -244,7 +219,46 @@ fn clustered_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
             continue;
         }
         last = entry.x;
-        sum += v.flux / PI * min(cos_x * cos_v / d2, g_max);
+        sum += l;
+    }
+    return sum;
+}
+
+// The light of VPL v at p (normal n) without albedo / π: Φ/π · min(cos θ_v cos θ_x / d², g_max);
+// zero behind either.
+fn vpl_light(v: Vpl, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    let d = v.position - p;
+    let d2 = dot(d, d);
+    if d2 <= 0.0 {
+        return vec3<f32>(0.0);
+    }
+    let w = d * inverseSqrt(d2);
+    let cos_x = dot(n, w);
+    let cos_v = -dot(v.normal, w);
+    if cos_x <= 0.0 || cos_v <= 0.0 {
+        return vec3<f32>(0.0);
+    }
+    return v.flux / PI * min(cos_x * cos_v / d2, globals.params.x);
+}
+
+// Mode 0: every VPL, no visibility.
+fn gather_all(p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    var sum = vec3<f32>(0.0);
+    for (var j = 0u; j < globals.counts.x; j++) {
+        sum += vpl_light(vpls[j], p, n);
+    }
+    return sum;
+}
+
+// Mode 2: every VPL through the gates, brute force.
+fn gather_per_pixel(p: vec3<f32>, n: vec3<f32>, here: u32) -> vec3<f32> {
+    var sum = vec3<f32>(0.0);
+    for (var j = 0u; j < globals.counts.x; j++) {
+        let v = vpls[j];
+        let l = vpl_light(v, p, n);
+        if any(l > vec3<f32>(0.0)) && through_gates(v.position, cluster_at(v.position, v.normal), p, here) {
+            sum += l;
+        }
     }
     return sum;
 }
