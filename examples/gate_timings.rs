@@ -52,28 +52,28 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             .clone(),
     };
     let view = View::new(&camera, size)?;
+    let only = std::env::var("GATE_TIMINGS_ONLY").ok();
     let gates = GateLevel::new(level, &scene)?;
     let tracer = Tracer::new(&scene);
-    let ctx = GpuContext::new()?;
-    let mut gpu = GpuRenderer::new(&ctx, &scene)?;
-    gpu.set_level(&ctx, &gates)?;
-    println!(
-        "{} camera {} at {}x{} on {} ({:?}); GPU ms per pass from timestamp queries",
-        scene.name, camera.name, size[0], size[1], ctx.adapter_info.name, ctx.adapter_info.backend
-    );
+    // Each measurement on a fresh device (lavapipe slows a pass that follows others on the
+    // same device by up to 3×), after one warm-up frame.
     let render = |mode: GpuMode, vpls: &[visgate_runtime::vpl::Vpl]| {
-        gpu.render(
-            &ctx,
-            &view,
-            vpls,
-            &GpuParams {
-                mode,
-                ..GpuParams::default()
-            },
-        )
+        let ctx = GpuContext::new()?;
+        let mut gpu = GpuRenderer::new(&ctx, &scene)?;
+        gpu.set_level(&ctx, &gates)?;
+        let params = GpuParams {
+            mode,
+            ..GpuParams::default()
+        };
+        gpu.render(&ctx, &view, &vpls[..vpls.len().min(16)], &params)?;
+        gpu.render(&ctx, &view, vpls, &params)
+            .map(|(_, t)| (t, ctx.adapter_info.name.clone()))
     };
-    // Warm-up: the first frame pays for allocations the others reuse.
-    render(GpuMode::Gates, &[])?;
+    let (_, adapter) = render(GpuMode::DirectOnly, &[])?;
+    println!(
+        "{} camera {} at {}x{} on {adapter}; GPU ms per pass from timestamp queries",
+        scene.name, camera.name, size[0], size[1]
+    );
     println!(
         "| VPLs | mode | geometry pass | unique clusters | light assignment | shading (direct + \
          indirect) | VPL maps | VPL gather | total | per-VPL maps / this |"
@@ -90,20 +90,31 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             },
         )?;
         let mut rows: Vec<(&str, GpuStageTimes, Option<u64>)> = Vec::new();
-        for (name, mode) in [
+        let modes = [
+            ("none", GpuMode::None),
             ("gates", GpuMode::Gates),
             ("gates per pixel", GpuMode::GatesPerPixel),
-            ("none", GpuMode::None),
             ("per-VPL shadow maps", GpuMode::PerVplShadowMaps),
-        ] {
-            let (_, t) = render(mode, &vpls)?;
+        ];
+        let order: Vec<(&str, GpuMode)> = match &only {
+            Some(list) => list
+                .split(',')
+                .filter_map(|o| modes.iter().find(|m| m.0 == o).copied())
+                .collect(),
+            None => modes.to_vec(),
+        };
+        for (name, mode) in order {
+            let (t, _) = render(mode, &vpls)?;
             let g = t.gpu.ok_or("the adapter has no timestamp queries")?;
             rows.push((name, g, t.lists.map(|l| l.entries)));
         }
         let total = |g: &GpuStageTimes| {
             g.gbuffer + g.unique_clusters + g.light_assignment + g.shade + g.vpl_maps + g.vpl_gather
         };
-        let base = total(&rows[3].1);
+        let base = rows
+            .iter()
+            .find(|r| r.0 == "per-VPL shadow maps")
+            .map_or(f64::NAN, |r| total(&r.1));
         for (name, g, entries) in &rows {
             let ms = |x: f64| format!("{:.1}", x * 1e3);
             let dash = |x: f64| if x > 0.0 { ms(x) } else { "–".into() };

@@ -433,6 +433,33 @@ fn render_gates_uses_a_baked_level_and_refuses_a_missing_or_stale_one() {
     a.extend(["--level", &level, "--out", &out]);
     let o = visgate(&a);
     assert!(o.status.success(), "{}", stderr(&o));
+    // The passes are named as the paper's Table I, with the lists' fill.
+    for pass in [
+        "geometry pass",
+        "unique clusters",
+        "light assignment",
+        "indirect lighting",
+        "light lists:",
+    ] {
+        assert!(stdout(&o).contains(pass), "{pass}: {}", stdout(&o));
+    }
+    // A pool too small: the error names the setting and what it needs.
+    let mut small = a.clone();
+    small.extend(["--light-entries", "10"]);
+    let o = visgate(&small);
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("raise --light-entries"),
+        "{}",
+        stderr(&o)
+    );
+    let mut brute = a.clone();
+    brute[3] = "gates-per-pixel";
+    let o = visgate(&brute);
+    assert!(o.status.success(), "{}", stderr(&o));
+    brute.push("--cpu");
+    let o = visgate(&brute);
+    assert!(stderr(&o).contains("--mode gates --cpu"), "{}", stderr(&o));
     a.push("--cpu");
     let o = visgate(&a);
     assert!(o.status.success(), "{}", stderr(&o));
