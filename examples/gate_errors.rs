@@ -11,9 +11,7 @@
 //! diagonal to it), baked here at 128, seen by its camera and by a camera in the diagonal room.
 
 use glam::Vec3;
-use visgate_formats::vgate::{BakeParams, Resolution};
-use visgate_formats::{BakedLevel, Camera, ImportOptions, Scene};
-use visgate_preprocess::bake::{BakeOptions, bake};
+use visgate_formats::Camera;
 use visgate_runtime::camera::View;
 use visgate_runtime::gates::{GateLevel, GateParams};
 use visgate_runtime::metrics::{errors, flip};
@@ -21,30 +19,11 @@ use visgate_runtime::reference::{IndirectVisibility, ReferenceParams, render_wit
 use visgate_runtime::tracer::Tracer;
 use visgate_runtime::vpl::{PathParams, path_vpls};
 
+mod common;
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
-    let scene_arg = args.next().unwrap_or_else(|| "builtin:four-rooms".into());
-    let scene = match scene_arg.strip_prefix("builtin:") {
-        Some(name) => visgate_scenes::Builtin::from_name(name)
-            .ok_or("no such built-in scene")?
-            .scene()?,
-        None => Scene::load(
-            std::path::Path::new(&scene_arg),
-            &ImportOptions {
-                load_textures: true,
-            },
-        )?,
-    };
-    let level = match args.next() {
-        Some(p) if p != "-" => BakedLevel::read(std::path::Path::new(&p))?,
-        _ => {
-            let params = BakeParams {
-                resolution: Resolution::LongestAxisVoxels(128),
-                ..BakeParams::default()
-            };
-            bake(&scene, &params, &BakeOptions::default(), &|_| {})?.level
-        }
-    };
+    let (scene_arg, scene, level) = common::scene_and_level(&mut args)?;
     let mut cameras: Vec<Camera> = scene.cameras.clone();
     if let Some(c) = args.next() {
         let parse = |s: &str| -> Option<Vec3> {

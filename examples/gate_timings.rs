@@ -7,39 +7,17 @@
 //! Without arguments: the built-in four rooms, baked here at 128, at 1024×512. The speedup is
 //! per-VPL shadow maps' total over gates' total at the same VPLs, measured in one run.
 
-use visgate_formats::vgate::{BakeParams, Resolution};
-use visgate_formats::{BakedLevel, ImportOptions, Scene};
-use visgate_preprocess::bake::{BakeOptions, bake};
 use visgate_runtime::camera::View;
 use visgate_runtime::gates::GateLevel;
 use visgate_runtime::gpu::{GpuContext, GpuMode, GpuParams, GpuRenderer, GpuStageTimes};
 use visgate_runtime::tracer::Tracer;
 use visgate_runtime::vpl::{PathParams, path_vpls};
 
+mod common;
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
-    let scene_arg = args.next().unwrap_or_else(|| "builtin:four-rooms".into());
-    let scene = match scene_arg.strip_prefix("builtin:") {
-        Some(name) => visgate_scenes::Builtin::from_name(name)
-            .ok_or("no such built-in scene")?
-            .scene()?,
-        None => Scene::load(
-            std::path::Path::new(&scene_arg),
-            &ImportOptions {
-                load_textures: true,
-            },
-        )?,
-    };
-    let level = match args.next() {
-        Some(p) if p != "-" => BakedLevel::read(std::path::Path::new(&p))?,
-        _ => {
-            let params = BakeParams {
-                resolution: Resolution::LongestAxisVoxels(128),
-                ..BakeParams::default()
-            };
-            bake(&scene, &params, &BakeOptions::default(), &|_| {})?.level
-        }
-    };
+    let (_, scene, level) = common::scene_and_level(&mut args)?;
     let size = args.next().unwrap_or_else(|| "1024x512".into());
     let (w, h) = size.split_once('x').ok_or("size WxH")?;
     let size = [w.parse()?, h.parse()?];

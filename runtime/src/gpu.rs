@@ -27,25 +27,34 @@ use crate::vpl::Vpl;
 mod clustered;
 pub use clustered::{ClusterFrame, GpuGeometryCluster, LightListStats, MAX_CLUSTERS, MAX_GATES};
 
-// WGSL has no includes: the grid and gate code is put in front of the shaders that use it.
+// WGSL has no includes: the VPL struct and the grid and gate code are put in front of the
+// shaders that use them.
 const GBUFFER_WGSL: &str = concat!(
     include_str!("shaders/grid.wgsl"),
     include_str!("shaders/gbuffer.wgsl")
 );
 const SHADOW_WGSL: &str = include_str!("shaders/shadow.wgsl");
 const SHADE_WGSL: &str = concat!(
+    include_str!("shaders/vpl.wgsl"),
     include_str!("shaders/grid.wgsl"),
     include_str!("shaders/gates.wgsl"),
     include_str!("shaders/shade.wgsl")
 );
 const CLUSTERS_WGSL: &str = concat!(
+    include_str!("shaders/vpl.wgsl"),
     include_str!("shaders/grid.wgsl"),
     include_str!("shaders/gates.wgsl"),
     include_str!("shaders/clusters.wgsl")
 );
 const VPL_SHADOW_WGSL: &str = include_str!("shaders/vpl_shadow.wgsl");
-const GATHER_BATCH_WGSL: &str = include_str!("shaders/gather_batch.wgsl");
-const RSM_VPLS_WGSL: &str = include_str!("shaders/rsm_vpls.wgsl");
+const GATHER_BATCH_WGSL: &str = concat!(
+    include_str!("shaders/vpl.wgsl"),
+    include_str!("shaders/gather_batch.wgsl")
+);
+const RSM_VPLS_WGSL: &str = concat!(
+    include_str!("shaders/vpl.wgsl"),
+    include_str!("shaders/rsm_vpls.wgsl")
+);
 
 /// The WGSL sources (with what is put in front of them), for validation without a GPU.
 pub const SHADERS: [(&str, &str); 7] = [

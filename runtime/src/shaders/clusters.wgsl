@@ -41,15 +41,6 @@ struct GeometryCluster {
     list: vec4<u32>,
 };
 
-struct Vpl {
-    position: vec3<f32>,
-    pad0: f32,
-    normal: vec3<f32>,
-    pad1: f32,
-    flux: vec3<f32>,
-    pad2: f32,
-};
-
 @group(0) @binding(0) var<uniform> frame: Frame;
 @group(0) @binding(1) var g_position: texture_2d<f32>;
 @group(0) @binding(2) var<storage, read_write> pixel_depth: array<f32>;

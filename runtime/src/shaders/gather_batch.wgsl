@@ -11,15 +11,6 @@ struct Batch {
     params: vec4<f32>,
 };
 
-struct Vpl {
-    position: vec3<f32>,
-    pad0: f32,
-    normal: vec3<f32>,
-    pad1: f32,
-    flux: vec3<f32>,
-    pad2: f32,
-};
-
 @group(0) @binding(0) var<uniform> batch: Batch;
 @group(0) @binding(1) var<storage, read> vpls: array<Vpl>;
 @group(0) @binding(2) var maps: texture_2d_array<f32>;

@@ -25,15 +25,6 @@ struct Light {
     layers: vec4<u32>,
 };
 
-struct Vpl {
-    position: vec3<f32>,
-    pad0: f32,
-    normal: vec3<f32>,
-    pad1: f32,
-    flux: vec3<f32>,
-    pad2: f32,
-};
-
 @group(0) @binding(0) var<uniform> globals: Globals;
 @group(0) @binding(1) var<storage, read> lights: array<Light>;
 @group(0) @binding(2) var<storage, read> vpls: array<Vpl>;
