@@ -539,6 +539,15 @@ fn gpu_gates_stay_stable_at_the_extremes() {
     ];
     let (_, rel) = gpu_vs_twin(&gpu, &ctx, &scene, &tracer, &gates, &on_gate, &view);
     assert!(rel < 0.05, "VPLs on a gate: {rel}");
+    // A gate of radius zero passes no light, as on the CPU.
+    let (scene0, level0) = baked(Builtin::FourRooms, 128);
+    let mut level0 = level0;
+    level0.topology.gates[0].radius_m = 0.0;
+    let gates0 = GateLevel::new(level0, &scene0).expect("level");
+    let mut gpu0 = GpuRenderer::new(&ctx, &scene0).expect("upload");
+    gpu0.set_level(&ctx, &gates0).expect("level");
+    let (_, rel) = gpu_vs_twin(&gpu0, &ctx, &scene0, &tracer, &gates0, &vpls, &view);
+    assert!(rel < 0.02, "gate of radius 0: {rel}");
     // A camera inside a wall: finite, and as the twin.
     let dir = (view.forward).normalize();
     let hit = tracer.trace(view.eye, dir).expect("a wall ahead");
