@@ -25,7 +25,10 @@ use crate::vpl::Vpl;
 
 #[path = "gpu_clustered.rs"]
 mod clustered;
+#[path = "gpu_vals.rs"]
+mod vals;
 pub use clustered::{ClusterFrame, GpuGeometryCluster, LightListStats, MAX_CLUSTERS, MAX_GATES};
+pub use vals::{ValFrame, centres_of};
 
 // WGSL has no includes: the VPL struct and the grid and gate code are put in front of the
 // shaders that use them.
@@ -46,6 +49,10 @@ const CLUSTERS_WGSL: &str = concat!(
     include_str!("shaders/gates.wgsl"),
     include_str!("shaders/clusters.wgsl")
 );
+const VALS_WGSL: &str = concat!(
+    include_str!("shaders/vpl.wgsl"),
+    include_str!("shaders/vals.wgsl")
+);
 const VPL_SHADOW_WGSL: &str = include_str!("shaders/vpl_shadow.wgsl");
 const GATHER_BATCH_WGSL: &str = concat!(
     include_str!("shaders/vpl.wgsl"),
@@ -57,7 +64,7 @@ const RSM_VPLS_WGSL: &str = concat!(
 );
 
 /// The WGSL sources (with what is put in front of them), for validation without a GPU.
-pub const SHADERS: [(&str, &str); 7] = [
+pub const SHADERS: [(&str, &str); 8] = [
     ("gbuffer.wgsl", GBUFFER_WGSL),
     ("shadow.wgsl", SHADOW_WGSL),
     ("shade.wgsl", SHADE_WGSL),
@@ -65,6 +72,7 @@ pub const SHADERS: [(&str, &str); 7] = [
     ("gather_batch.wgsl", GATHER_BATCH_WGSL),
     ("rsm_vpls.wgsl", RSM_VPLS_WGSL),
     ("clusters.wgsl", CLUSTERS_WGSL),
+    ("vals.wgsl", VALS_WGSL),
 ];
 
 /// One RSM sample for the VPL compute pass, shared with WGSL (`Sample` in rsm_vpls.wgsl).
@@ -749,6 +757,7 @@ pub struct GpuRenderer {
     /// Bound where a mode has no level or no light lists.
     no_level: wgpu::Buffer,
     cluster_pipelines: clustered::Pipelines,
+    val_pipelines: vals::Pipelines,
 }
 
 /// A level's gate tables on the GPU.
@@ -1010,6 +1019,7 @@ impl GpuRenderer {
             level: None,
             no_level: storage(d, "no level", &[]),
             cluster_pipelines: clustered::Pipelines::new(d, CLUSTERS_WGSL),
+            val_pipelines: vals::Pipelines::new(d, VALS_WGSL),
         })
     }
 

@@ -21,6 +21,7 @@ pub mod lights;
 pub mod metrics;
 pub mod reference;
 pub mod tracer;
+pub mod val;
 pub mod vpl;
 
 use std::path::Path;

@@ -179,8 +179,9 @@ fn gpu_structs_match_their_wgsl_layouts() {
     use std::mem::{offset_of, size_of};
     use visgate_runtime::gpu::{
         Batch, ClusterFrame, Globals, GpuGeometryCluster, GpuLight, GridUniform, RsmSample,
-        ShadowView, VplView,
+        ShadowView, ValFrame, VplView,
     };
+    use visgate_runtime::val::Val;
     use visgate_runtime::vpl::Vpl;
     let shade = SHADERS[2].1;
     let check = |src: &str, name: &str, size: usize, offsets: &[(&str, usize)]| {
@@ -333,6 +334,27 @@ fn gpu_structs_match_their_wgsl_layouts() {
         "Grid",
         size_of::<GridUniform>(),
         &[("origin", 0), ("dims", 16), ("params", 32)],
+    );
+    let vals = SHADERS[7].1;
+    check(
+        vals,
+        "Val",
+        size_of::<Val>(),
+        &[
+            ("position", offset_of!(Val, position)),
+            ("normal", offset_of!(Val, normal)),
+            ("flux", offset_of!(Val, flux)),
+            ("rect", offset_of!(Val, rect)),
+        ],
+    );
+    check(
+        vals,
+        "ValFrame",
+        size_of::<ValFrame>(),
+        &[
+            ("counts", offset_of!(ValFrame, counts)),
+            ("weights", offset_of!(ValFrame, weights)),
+        ],
     );
 }
 

@@ -1,0 +1,143 @@
+// Virtual area lights on the GPU (Dong et al. §5–6): k-means of the VPLs into M VALs by
+// d = w_x·Δx/D + w_α·Δα/π, restarted each frame from VAL k = VPL ⌊k·N/M⌋. vpl.wgsl comes
+// first; runtime::val is the CPU twin (same order of every sum, so the same VALs).
+//   init    centres from the restart VPLs
+//   assign  each VPL's nearest centre (ties to the lower index) → the mapping C
+//   update  each VAL's centre: mean position and normalised mean normal of its VPLs, summed
+//           in VPL order (an empty VAL keeps its centre)
+//   finish  each VAL's VPL count, flux and bounding rectangle in the plane normal to it
+
+const PI: f32 = 3.14159265358979;
+
+struct ValFrame {
+    // x VPLs N, y VALs M, z, w unused.
+    counts: vec4<u32>,
+    // x w_x, y w_α, z 1 / D (the VPLs' bounding-box diagonal), w unused.
+    weights: vec4<f32>,
+};
+
+struct Val {
+    // xyz centre, w VPL count.
+    position: vec4<f32>,
+    // xyz unit normal, w area (m²).
+    normal: vec4<f32>,
+    // rgb flux (W).
+    flux: vec4<f32>,
+    // s min, s max, t min, t max about the centre, in the frame of basis(normal).
+    rect: vec4<f32>,
+};
+
+@group(0) @binding(0) var<uniform> frame: ValFrame;
+@group(0) @binding(1) var<storage, read> vpls: array<Vpl>;
+// Per VAL: centre (xyz), normal (xyz) at 2k, 2k + 1.
+@group(0) @binding(2) var<storage, read_write> centres: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read_write> mapping: array<u32>;
+@group(0) @binding(4) var<storage, read_write> vals: array<Val>;
+
+@compute @workgroup_size(64)
+fn init(@builtin(global_invocation_id) id: vec3<u32>) {
+    let k = id.x;
+    let n = frame.counts.x;
+    let m = frame.counts.y;
+    if k >= m || n == 0u {
+        return;
+    }
+    // ⌊k·N/M⌋ without overflowing 32 bits.
+    let j = k * (n / m) + (k * (n % m)) / m;
+    centres[2u * k] = vec4<f32>(vpls[j].position, 0.0);
+    centres[2u * k + 1u] = vec4<f32>(vpls[j].normal, 0.0);
+}
+
+fn distance(v: Vpl, k: u32) -> f32 {
+    let dx = length(v.position - centres[2u * k].xyz) * frame.weights.z;
+    let da = acos(clamp(dot(v.normal, centres[2u * k + 1u].xyz), -1.0, 1.0)) / PI;
+    return frame.weights.x * dx + frame.weights.y * da;
+}
+
+@compute @workgroup_size(64)
+fn assign(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    if i >= frame.counts.x {
+        return;
+    }
+    let v = vpls[i];
+    var best = distance(v, 0u);
+    var at = 0u;
+    for (var k = 1u; k < frame.counts.y; k++) {
+        let d = distance(v, k);
+        if d < best {
+            best = d;
+            at = k;
+        }
+    }
+    mapping[i] = at;
+}
+
+@compute @workgroup_size(64)
+fn update(@builtin(global_invocation_id) id: vec3<u32>) {
+    let k = id.x;
+    if k >= frame.counts.y {
+        return;
+    }
+    var p = vec3<f32>(0.0);
+    var nrm = vec3<f32>(0.0);
+    var count = 0u;
+    for (var i = 0u; i < frame.counts.x; i++) {
+        if mapping[i] == k {
+            p += vpls[i].position;
+            nrm += vpls[i].normal;
+            count++;
+        }
+    }
+    if count > 0u {
+        centres[2u * k] = vec4<f32>(p / f32(count), 0.0);
+        let l = length(nrm);
+        if l > 0.0 {
+            centres[2u * k + 1u] = vec4<f32>(nrm / l, 0.0);
+        }
+    }
+}
+
+// The basis of runtime::vpl::basis (Duff et al. 2017).
+fn basis(n: vec3<f32>) -> mat2x3<f32> {
+    let s = select(-1.0, 1.0, n.z >= 0.0);
+    let a = -1.0 / (s + n.z);
+    let b = n.x * n.y * a;
+    return mat2x3<f32>(
+        vec3<f32>(1.0 + s * n.x * n.x * a, s * b, -s * n.x),
+        vec3<f32>(b, s + n.y * n.y * a, -n.y),
+    );
+}
+
+@compute @workgroup_size(64)
+fn finish(@builtin(global_invocation_id) id: vec3<u32>) {
+    let k = id.x;
+    if k >= frame.counts.y {
+        return;
+    }
+    let c = centres[2u * k].xyz;
+    let nrm = centres[2u * k + 1u].xyz;
+    let tb = basis(nrm);
+    var count = 0u;
+    var flux = vec3<f32>(0.0);
+    var rect = vec4<f32>(1e38, -1e38, 1e38, -1e38);
+    for (var i = 0u; i < frame.counts.x; i++) {
+        if mapping[i] == k {
+            let q = vpls[i].position - c;
+            let s = dot(q, tb[0]);
+            let t = dot(q, tb[1]);
+            rect = vec4<f32>(min(rect.x, s), max(rect.y, s), min(rect.z, t), max(rect.w, t));
+            flux += vpls[i].flux;
+            count++;
+        }
+    }
+    if count == 0u {
+        rect = vec4<f32>(0.0);
+    }
+    var v: Val;
+    v.position = vec4<f32>(c, f32(count));
+    v.normal = vec4<f32>(nrm, (rect.y - rect.x) * (rect.w - rect.z));
+    v.flux = vec4<f32>(flux, 0.0);
+    v.rect = rect;
+    vals[k] = v;
+}
