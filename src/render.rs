@@ -15,6 +15,7 @@ use visgate_runtime::hdr::{HdrImage, false_colour};
 use visgate_runtime::metrics::{errors, flip};
 use visgate_runtime::reference::{IndirectVisibility, ReferenceParams, render_with};
 use visgate_runtime::tracer::Tracer;
+use visgate_runtime::val::ValParams;
 use visgate_runtime::vpl::{GatherParams, PathParams, path_vpls};
 
 pub const RENDER_HELP: &str = "\
@@ -34,6 +35,10 @@ Modes:
                --cpu: the CPU twin, per point
   gates-per-pixel
                GPU: the same gate test, brute force (every pixel tests every VPL)
+  val-hard     GPU: the VPLs clustered into --vals virtual area lights (k-means by position
+               and normal, --val-iterations, restarted each frame); every VPL lights every
+               pixel through one hard paraboloid shadow map (--val-map-size) of its VAL (the
+               banding baseline of Dong et al.; no bake needed)
   direct-only  GPU: direct light alone
 With --cpu, none and direct-only run on the CPU twin (shadow rays for direct light), and
 per-vpl-shadow-maps is the reference (exact shadow rays).
@@ -73,6 +78,8 @@ pub enum Mode {
     Gates,
     /// The gate test brute force, every pixel against every VPL (GPU; needs --level).
     GatesPerPixel,
+    /// Every VPL through one hard shadow map of its virtual area light (GPU).
+    ValHard,
     /// Direct light only.
     DirectOnly,
 }
@@ -142,6 +149,15 @@ pub struct RenderArgs {
     /// more stops with the count it needs.
     #[arg(long, default_value_t = 1 << 23)]
     pub light_entries: u32,
+    /// Virtual area lights (--mode val-hard): the VPLs are clustered into this many.
+    #[arg(long, default_value_t = 30)]
+    pub vals: u32,
+    /// k-means iterations of the VAL clustering.
+    #[arg(long, default_value_t = 8)]
+    pub val_iterations: u32,
+    /// Paraboloid shadow map size per VAL, texels.
+    #[arg(long, default_value_t = 256)]
+    pub val_map_size: u32,
     /// Per-VPL paraboloid map size (GPU), texels.
     #[arg(long, default_value_t = 128)]
     pub vpl_map_size: u32,
@@ -195,6 +211,9 @@ pub fn run(args: RenderArgs) -> Result<()> {
     }
     if args.mode == Mode::GatesPerPixel && args.cpu {
         bail!("--mode gates-per-pixel runs on the GPU; the CPU twin is --mode gates --cpu");
+    }
+    if args.mode == Mode::ValHard && args.cpu {
+        bail!("--mode val-hard runs on the GPU; its reference is --mode reference");
     }
     let oversize_ok = args.gate_oversize > 0.0 && args.gate_oversize.is_finite();
     if !oversize_ok || !(1..=16).contains(&args.gate_hops) {
@@ -302,6 +321,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
                         Mode::PerVplShadowMaps => GpuMode::PerVplShadowMaps,
                         Mode::Gates => GpuMode::Gates,
                         Mode::GatesPerPixel => GpuMode::GatesPerPixel,
+                        Mode::ValHard => GpuMode::ValHard,
                         _ => GpuMode::DirectOnly,
                     },
                     clusters: ClusterParams {
@@ -309,6 +329,12 @@ pub fn run(args: RenderArgs) -> Result<()> {
                         depth_slices: args.depth_slices,
                     },
                     light_entries: args.light_entries,
+                    vals: ValParams {
+                        count: args.vals,
+                        iterations: args.val_iterations,
+                        ..ValParams::default()
+                    },
+                    val_map_size: args.val_map_size,
                     gates: GateParams {
                         oversize: args.gate_oversize,
                         max_hops: args.gate_hops,
@@ -428,6 +454,11 @@ fn print_passes(t: &PassTimes, mode: Mode) {
     if mode == Mode::PerVplShadowMaps {
         rows.push(("VPL paraboloid maps", t.vpl_maps, g.vpl_maps));
         rows.push(("VPL gather", t.vpl_gather, g.vpl_gather));
+    }
+    if mode == Mode::ValHard {
+        rows.push(("VAL clustering", t.val_clustering, g.val_clustering));
+        rows.push(("VAL paraboloid maps", t.vpl_maps, g.vpl_maps));
+        rows.push(("indirect lighting (all VPLs)", t.vpl_gather, g.vpl_gather));
     }
     println!("pass                               CPU wall (ms)   GPU (ms)");
     for (name, cpu, gpu) in rows {

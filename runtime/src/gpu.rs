@@ -28,7 +28,7 @@ mod clustered;
 #[path = "gpu_vals.rs"]
 mod vals;
 pub use clustered::{ClusterFrame, GpuGeometryCluster, LightListStats, MAX_CLUSTERS, MAX_GATES};
-pub use vals::{ValFrame, centres_of};
+pub use vals::{ValFrame, ValGather, ValMaps, centres_of};
 
 // WGSL has no includes: the VPL struct and the grid and gate code are put in front of the
 // shaders that use them.
@@ -51,11 +51,21 @@ const CLUSTERS_WGSL: &str = concat!(
 );
 const VALS_WGSL: &str = concat!(
     include_str!("shaders/vpl.wgsl"),
+    include_str!("shaders/val.wgsl"),
     include_str!("shaders/vals.wgsl")
 );
-const VPL_SHADOW_WGSL: &str = include_str!("shaders/vpl_shadow.wgsl");
+const VAL_GATHER_WGSL: &str = concat!(
+    include_str!("shaders/vpl.wgsl"),
+    include_str!("shaders/val.wgsl"),
+    include_str!("shaders/val_gather.wgsl")
+);
+const VPL_SHADOW_WGSL: &str = concat!(
+    include_str!("shaders/val.wgsl"),
+    include_str!("shaders/vpl_shadow.wgsl")
+);
 const GATHER_BATCH_WGSL: &str = concat!(
     include_str!("shaders/vpl.wgsl"),
+    include_str!("shaders/val.wgsl"),
     include_str!("shaders/gather_batch.wgsl")
 );
 const RSM_VPLS_WGSL: &str = concat!(
@@ -64,7 +74,7 @@ const RSM_VPLS_WGSL: &str = concat!(
 );
 
 /// The WGSL sources (with what is put in front of them), for validation without a GPU.
-pub const SHADERS: [(&str, &str); 8] = [
+pub const SHADERS: [(&str, &str); 9] = [
     ("gbuffer.wgsl", GBUFFER_WGSL),
     ("shadow.wgsl", SHADOW_WGSL),
     ("shade.wgsl", SHADE_WGSL),
@@ -73,6 +83,7 @@ pub const SHADERS: [(&str, &str); 8] = [
     ("rsm_vpls.wgsl", RSM_VPLS_WGSL),
     ("clusters.wgsl", CLUSTERS_WGSL),
     ("vals.wgsl", VALS_WGSL),
+    ("val_gather.wgsl", VAL_GATHER_WGSL),
 ];
 
 /// One RSM sample for the VPL compute pass, shared with WGSL (`Sample` in rsm_vpls.wgsl).
@@ -183,6 +194,10 @@ pub enum GpuMode {
     Gates,
     /// The same gate test, brute force: every fragment tests every VPL (for comparison).
     GatesPerPixel,
+    /// Every VPL lights every pixel with the visibility of its virtual area light: VPLs
+    /// clustered into VALs on the GPU, one hard paraboloid shadow map per VAL (the banding
+    /// baseline of Dong et al.).
+    ValHard,
 }
 
 /// Rendering parameters.
@@ -210,6 +225,10 @@ pub struct GpuParams {
     /// Capacity of the light-list pool of mode `Gates`, in (VPL, gates) entries of 8 bytes; a
     /// frame that needs more fails with the count it needs. [Limit: 1..=storage limit / 8]
     pub light_entries: u32,
+    /// Virtual area lights of mode `ValHard`.
+    pub vals: crate::val::ValParams,
+    /// Paraboloid map size per VAL. [Units: texels] [Limit: 16..=4096]
+    pub val_map_size: u32,
 }
 
 impl Default for GpuParams {
@@ -225,6 +244,8 @@ impl Default for GpuParams {
             gates: crate::gates::GateParams::default(),
             clusters: crate::clustered::ClusterParams::default(),
             light_entries: 1 << 23,
+            vals: crate::val::ValParams::default(),
+            val_map_size: 256,
         }
     }
 }
@@ -243,6 +264,8 @@ pub struct PassTimes {
     pub unique_clusters: f64,
     /// Mode gates: VPL clusters and the light lists.
     pub light_assignment: f64,
+    /// VAL modes: clustering the VPLs into VALs.
+    pub val_clustering: f64,
     /// Per-VPL paraboloid maps, all batches.
     pub vpl_maps: f64,
     /// Indirect gather with per-VPL maps, all batches.
@@ -272,6 +295,8 @@ pub struct GpuStageTimes {
     pub unique_clusters: f64,
     /// Light assignment (mode gates).
     pub light_assignment: f64,
+    /// VAL clustering (VAL modes).
+    pub val_clustering: f64,
 }
 
 /// Stages a [`Timer`] tells apart, in [`GpuStageTimes`] order.
@@ -284,6 +309,7 @@ enum Stage {
     VplGather,
     UniqueClusters,
     LightAssignment,
+    ValClustering,
 }
 
 /// Timestamp queries around stages: each span is the beginning of a stage's first pass and
@@ -381,7 +407,7 @@ impl Timer {
         ctx.wait();
         let ticks: Vec<u64> = bytemuck::cast_slice(&slice.get_mapped_range().ok()?).to_vec();
         read.unmap();
-        let mut t = [0f64; 7];
+        let mut t = [0f64; 8];
         for &(stage, b) in &self.spans {
             let (a, z) = (ticks[b as usize], ticks[b as usize + 1]);
             t[stage as usize] += z.saturating_sub(a) as f64 * period as f64 * 1e-9;
@@ -394,6 +420,7 @@ impl Timer {
             vpl_gather: t[4],
             unique_clusters: t[5],
             light_assignment: t[6],
+            val_clustering: t[7],
         })
     }
 }
@@ -599,6 +626,7 @@ fn distance_pass(
     bind_group: &wgpu::BindGroup,
     vertices: &wgpu::Buffer,
     count: u32,
+    instances: std::ops::Range<u32>,
     timestamps: Option<wgpu::RenderPassTimestampWrites>,
 ) {
     let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -632,7 +660,7 @@ fn distance_pass(
     pass.set_pipeline(pipeline);
     pass.set_bind_group(0, bind_group, &[]);
     pass.set_vertex_buffer(0, vertices.slice(..));
-    pass.draw(0..count, 0..1);
+    pass.draw(0..count, instances);
 }
 
 /// A fullscreen triangle into `target` (cleared to black) with `pipeline` and `bind_group`,
@@ -758,6 +786,8 @@ pub struct GpuRenderer {
     no_level: wgpu::Buffer,
     cluster_pipelines: clustered::Pipelines,
     val_pipelines: vals::Pipelines,
+    val_shadow: wgpu::RenderPipeline,
+    val_gather: wgpu::RenderPipeline,
 }
 
 /// A level's gate tables on the GPU.
@@ -975,7 +1005,41 @@ impl GpuRenderer {
             })],
             &[target(wgpu::TextureFormat::R32Float)],
             wgpu::PrimitiveState::default(),
-            depth,
+            depth.clone(),
+        );
+        let val_shadow = d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("val paraboloid maps"),
+            layout: None,
+            vertex: wgpu::VertexState {
+                module: &vs_mod,
+                entry_point: Some("vs_val"),
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: 12,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &pos12,
+                })],
+                compilation_options: Default::default(),
+            },
+            primitive: wgpu::PrimitiveState::default(),
+            depth_stencil: depth.clone(),
+            multisample: wgpu::MultisampleState::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &vs_mod,
+                entry_point: Some("fs"),
+                targets: &[target(wgpu::TextureFormat::R32Float)],
+                compilation_options: Default::default(),
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let vg_mod = module("val_gather.wgsl", VAL_GATHER_WGSL);
+        let val_gather = pipeline(
+            "val gather",
+            &vg_mod,
+            &[],
+            &[target(wgpu::TextureFormat::Rgba32Float)],
+            wgpu::PrimitiveState::default(),
+            None,
         );
         let gather_batch = pipeline(
             "gather batch",
@@ -1020,6 +1084,8 @@ impl GpuRenderer {
             no_level: storage(d, "no level", &[]),
             cluster_pipelines: clustered::Pipelines::new(d, CLUSTERS_WGSL),
             val_pipelines: vals::Pipelines::new(d, VALS_WGSL),
+            val_shadow,
+            val_gather,
         })
     }
 
@@ -1535,7 +1601,7 @@ impl GpuRenderer {
                 self.lights.len() as u32,
                 match params.mode {
                     GpuMode::None => 0,
-                    GpuMode::DirectOnly | GpuMode::PerVplShadowMaps => 1,
+                    GpuMode::DirectOnly | GpuMode::PerVplShadowMaps | GpuMode::ValHard => 1,
                     GpuMode::GatesPerPixel => 2,
                     GpuMode::Gates => 3,
                 },
@@ -1640,7 +1706,7 @@ impl GpuRenderer {
         } else {
             0
         };
-        let mut timer = Timer::new(ctx, 5 + 2 * batches);
+        let mut timer = Timer::new(ctx, 8 + 2 * batches);
         let layers = shadow_views.len().max(1) as u32;
         if layers > d.limits().max_texture_array_layers {
             return Err(RenderError::Param(format!(
@@ -1712,6 +1778,7 @@ impl GpuRenderer {
                 &bg,
                 &self.vertices,
                 self.vertex_count,
+                0..1,
                 timer.writes(span, i == 0, i == last),
             );
         }
@@ -1811,6 +1878,20 @@ impl GpuRenderer {
         // 3b. Per-VPL paraboloid maps and their gather, batch by batch, added onto the image.
         if params.mode == GpuMode::PerVplShadowMaps && !vpls.is_empty() {
             self.per_vpl_batches(
+                ctx,
+                params,
+                vpls,
+                &frame.vpls,
+                &views,
+                &out,
+                &mut times,
+                &mut timer,
+            )?;
+        }
+
+        // 3c. VAL modes: cluster, a map per VAL, the gather.
+        if params.mode == GpuMode::ValHard && !vpls.is_empty() {
+            self.val_frame(
                 ctx,
                 params,
                 vpls,
@@ -1950,6 +2031,7 @@ impl GpuRenderer {
                     &bg,
                     &self.vpl_vertices,
                     self.vpl_vertex_count,
+                    0..1,
                     timer.writes(span, k == 0, k + 1 == chunk.len()),
                 );
             }

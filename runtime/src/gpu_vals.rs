@@ -191,3 +191,201 @@ pub fn centres_of(c: &Clustering) -> Vec<(Vec3, Vec3)> {
         .map(|v| (v.centre(), v.unit_normal()))
         .collect()
 }
+
+/// Constants of the VAL maps' vertex stage, shared with WGSL (`ValMaps` in vpl_shadow.wgsl).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct ValMaps {
+    /// x far distance (m), y VAL centre offset along its normal (m).
+    pub params: [f32; 4],
+}
+
+/// Constants of the VAL gather, shared with WGSL (`ValGather` in val_gather.wgsl).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct ValGather {
+    /// x VPLs, y VALs, z map size (texels).
+    pub counts: [u32; 4],
+    /// x g_max (1/m²), y normal offset (texels), z bias (texels), w VAL centre offset (m).
+    pub params: [f32; 4],
+}
+
+impl GpuRenderer {
+    /// The VAL modes after the direct light: cluster `vpls` into VALs, render a paraboloid
+    /// distance map per VAL (one pass per layer: wgpu has no layered rendering without
+    /// multiview), then gather every VPL through its VAL's map, added onto `out`.
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn val_frame(
+        &self,
+        ctx: &GpuContext,
+        params: &super::GpuParams,
+        vpls: &[Vpl],
+        vpl_buf: &wgpu::Buffer,
+        gviews: &[wgpu::TextureView; 3],
+        out: &wgpu::Texture,
+        times: &mut super::PassTimes,
+        timer: &mut super::Timer,
+    ) -> Result<(), RenderError> {
+        use super::Stage;
+        use std::time::Instant;
+        let d = &ctx.device;
+        let (m, s) = (params.vals.count, params.val_map_size);
+        if !(16..=4096).contains(&s) || m > d.limits().max_texture_array_layers {
+            return Err(RenderError::Param(format!(
+                "VAL map size {s} must be 16..=4096 and VALs {m} at most the adapter's {} layers",
+                d.limits().max_texture_array_layers
+            )));
+        }
+        // The VAL's centre, a mean of VPLs, may sit on (or just inside) a surface: move it off
+        // by a hair, relative to the scene.
+        let offset = self.near_m;
+        // 1. Clustering.
+        let t0 = Instant::now();
+        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("val clustering"),
+        });
+        let span = timer.span(Stage::ValClustering);
+        let b = self.val_passes(
+            ctx,
+            &mut enc,
+            vpls,
+            vpl_buf,
+            &params.vals,
+            timer.compute_writes(span),
+        )?;
+        ctx.queue.submit([enc.finish()]);
+        ctx.wait();
+        times.val_clustering = t0.elapsed().as_secs_f64();
+
+        // 2. A paraboloid distance map per VAL.
+        let t0 = Instant::now();
+        let maps = super::texture(
+            d,
+            "val maps",
+            [s, s, m],
+            wgpu::TextureFormat::R32Float,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        );
+        let depth = super::texture(
+            d,
+            "val map depth",
+            [s, s, 1],
+            wgpu::TextureFormat::Depth32Float,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        );
+        let depth_view = depth.create_view(&Default::default());
+        let maps_uniform = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("val maps"),
+            contents: bytemuck::bytes_of(&ValMaps {
+                params: [self.far_m, offset, 0.0, 0.0],
+            }),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("val maps"),
+            layout: &self.val_shadow.get_bind_group_layout(0),
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: maps_uniform.as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: b.vals.as_entire_binding(),
+                },
+            ],
+        });
+        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("val maps"),
+        });
+        let span = timer.span(Stage::VplMaps);
+        for k in 0..m {
+            let layer = maps.create_view(&wgpu::TextureViewDescriptor {
+                label: Some("val map layer"),
+                dimension: Some(wgpu::TextureViewDimension::D2),
+                base_array_layer: k,
+                array_layer_count: Some(1),
+                ..Default::default()
+            });
+            super::distance_pass(
+                &mut enc,
+                "val map",
+                &layer,
+                &depth_view,
+                &self.val_shadow,
+                &bg,
+                &self.vpl_vertices,
+                self.vpl_vertex_count,
+                k..k + 1,
+                timer.writes(span, k == 0, k + 1 == m),
+            );
+        }
+        ctx.queue.submit([enc.finish()]);
+        ctx.wait();
+        times.vpl_maps = t0.elapsed().as_secs_f64();
+
+        // 3. The gather, read from `out` and written to a copy (ping-pong), copied back.
+        let t0 = Instant::now();
+        let other = super::texture(
+            d,
+            "hdr (ping-pong)",
+            [out.width(), out.height(), 1],
+            wgpu::TextureFormat::Rgba32Float,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        );
+        let uniform = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("val gather"),
+            contents: bytemuck::bytes_of(&ValGather {
+                counts: [vpls.len() as u32, m, s, 0],
+                params: [
+                    params.g_max,
+                    params.shadow_normal_offset,
+                    params.shadow_bias,
+                    offset,
+                ],
+            }),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let maps_view = maps.create_view(&wgpu::TextureViewDescriptor {
+            label: Some("val maps"),
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        let out_view = out.create_view(&Default::default());
+        let tex = wgpu::BindingResource::TextureView;
+        let entries = [
+            (0, uniform.as_entire_binding()),
+            (1, vpl_buf.as_entire_binding()),
+            (2, tex(&maps_view)),
+            (3, tex(&gviews[0])),
+            (4, tex(&gviews[1])),
+            (5, tex(&gviews[2])),
+            (6, tex(&out_view)),
+            (7, b.mapping.as_entire_binding()),
+            (8, b.vals.as_entire_binding()),
+        ]
+        .map(|(binding, resource)| wgpu::BindGroupEntry { binding, resource });
+        let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("val gather"),
+            layout: &self.val_gather.get_bind_group_layout(0),
+            entries: &entries,
+        });
+        let span = timer.span(Stage::VplGather);
+        super::fullscreen_pass(
+            ctx,
+            "val gather",
+            &other.create_view(&Default::default()),
+            &self.val_gather,
+            &bg,
+            timer.writes(span, true, true),
+        );
+        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("ping-pong copy"),
+        });
+        enc.copy_texture_to_texture(other.as_image_copy(), out.as_image_copy(), out.size());
+        ctx.queue.submit([enc.finish()]);
+        ctx.wait();
+        times.vpl_gather = t0.elapsed().as_secs_f64();
+        Ok(())
+    }
+}

@@ -179,7 +179,7 @@ fn gpu_structs_match_their_wgsl_layouts() {
     use std::mem::{offset_of, size_of};
     use visgate_runtime::gpu::{
         Batch, ClusterFrame, Globals, GpuGeometryCluster, GpuLight, GridUniform, RsmSample,
-        ShadowView, ValFrame, VplView,
+        ShadowView, ValFrame, ValGather, ValMaps, VplView,
     };
     use visgate_runtime::val::Val;
     use visgate_runtime::vpl::Vpl;
@@ -347,6 +347,29 @@ fn gpu_structs_match_their_wgsl_layouts() {
             ("rect", offset_of!(Val, rect)),
         ],
     );
+    check(
+        SHADERS[8].1,
+        "ValGather",
+        size_of::<ValGather>(),
+        &[
+            ("counts", offset_of!(ValGather, counts)),
+            ("params", offset_of!(ValGather, params)),
+        ],
+    );
+    check(
+        SHADERS[3].1,
+        "ValMaps",
+        size_of::<ValMaps>(),
+        &[("params", offset_of!(ValMaps, params))],
+    );
+    for src in [vals, SHADERS[3].1, SHADERS[8].1] {
+        check(
+            src,
+            "Val",
+            size_of::<Val>(),
+            &[("position", 0), ("normal", 16), ("flux", 32), ("rect", 48)],
+        );
+    }
     check(
         vals,
         "ValFrame",

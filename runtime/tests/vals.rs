@@ -210,3 +210,168 @@ fn a_static_light_gives_the_same_vals_every_frame_at_any_scale() {
         .count();
     assert!(same * 100 >= vpls.len() * 99, "{same} of {}", vpls.len());
 }
+
+mod common;
+
+/// GPU image of `scene` from `cam` with `vpls` in `mode`, 64×48.
+fn gpu_image(
+    ctx: &GpuContext,
+    scene: &visgate_formats::Scene,
+    cam: &visgate_formats::Camera,
+    vpls: &[Vpl],
+    mode: visgate_runtime::gpu::GpuMode,
+    vals: u32,
+) -> visgate_runtime::hdr::HdrImage {
+    use visgate_runtime::gpu::GpuParams;
+    let gpu = GpuRenderer::new(ctx, scene).expect("upload");
+    let view = visgate_runtime::camera::View::new(cam, [64, 48]).expect("view");
+    gpu.render(
+        ctx,
+        &view,
+        vpls,
+        &GpuParams {
+            mode,
+            vals: ValParams {
+                count: vals,
+                ..ValParams::default()
+            },
+            ..GpuParams::default()
+        },
+    )
+    .expect("render")
+    .0
+}
+
+#[test]
+fn val_hard_a_receiver_under_a_large_blocker_is_dark_and_one_in_the_open_lit() {
+    use visgate_runtime::gpu::GpuMode;
+    let ctx = context();
+    // A floor, a wide blocker 1 m above its middle strip, VPLs above the blocker facing down.
+    let blocker = [
+        Vec3::new(-1.5, 1.0, -5.0),
+        Vec3::new(1.5, 1.0, -5.0),
+        Vec3::new(1.5, 1.0, 5.0),
+        Vec3::new(-1.5, 1.0, 5.0),
+    ];
+    let scene = common::quads(&[common::floor(5.0), blocker], 0.5, vec![]);
+    let vpls: Vec<Vpl> = (0..256)
+        .map(|i| {
+            let p = Vec3::new(
+                -1.0 + (i % 8) as f32 * 2.0 / 7.0,
+                2.5,
+                -4.0 + (i / 8) as f32 * 8.0 / 31.0,
+            );
+            Vpl::new(p, Vec3::NEG_Y, Vec3::splat(0.05))
+        })
+        .collect();
+    let cam = visgate_formats::Camera {
+        name: "low".into(),
+        eye: Vec3::new(0.0, 0.5, -4.5),
+        target: Vec3::new(0.0, 0.0, 0.0),
+        up: Vec3::Y,
+        fov_x_rad: 70f32.to_radians(),
+    };
+    for m in [1, 4, 30] {
+        let img = gpu_image(&ctx, &scene, &cam, &vpls, GpuMode::ValHard, m);
+        let none = gpu_image(&ctx, &scene, &cam, &vpls, GpuMode::None, m);
+        // Floor pixels (found by ray casting) under the blocker's middle and in the open.
+        let view = visgate_runtime::camera::View::new(&cam, [64, 48]).expect("view");
+        let tracer = Tracer::new(&scene);
+        let (mut under, mut open, mut unshadowed) = (Vec::new(), Vec::new(), Vec::new());
+        let mut open_none = Vec::new();
+        for y in 0..48 {
+            for x in 0..64 {
+                let dir = view.ray_dir(glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+                let Some(hit) = tracer.trace(view.eye, dir) else {
+                    continue;
+                };
+                if hit.position.y.abs() > 1e-3 {
+                    continue;
+                }
+                if hit.position.x.abs() < 0.8 {
+                    under.push(img.at(x, y).x);
+                    unshadowed.push(none.at(x, y).x);
+                } else if hit.position.x.abs() > 3.0 {
+                    open.push(img.at(x, y).x);
+                    open_none.push(none.at(x, y).x);
+                }
+            }
+        }
+        let mean = |v: &[f32]| v.iter().sum::<f32>() / v.len().max(1) as f32;
+        assert!(
+            under.len() > 20 && open.len() > 20,
+            "{} / {} pixels",
+            under.len(),
+            open.len()
+        );
+        let (under, open, unshadowed) = (mean(&under), mean(&open), mean(&unshadowed));
+        eprintln!(
+            "M = {m}: under the blocker {under}, in the open {open}, unshadowed {unshadowed}"
+        );
+        // Every VPL sees the open floor over the blocker's edge: lit as without visibility.
+        let lit = mean(&open_none);
+        assert!(
+            open > 0.9 * lit && open > 0.0,
+            "the open floor is lit: {open} vs {lit}"
+        );
+        assert!(under < 0.02 * unshadowed, "under the blocker dark: {under}");
+    }
+}
+
+#[test]
+fn val_hard_is_closer_to_the_reference_than_no_visibility() {
+    use visgate_runtime::gpu::GpuMode;
+    use visgate_runtime::metrics::errors;
+    use visgate_runtime::reference::{ReferenceParams, render_reference};
+    let ctx = context();
+    for b in [Builtin::CornellBox, Builtin::FourRooms] {
+        let (scene, vpls) = vpls_of(b, 1024);
+        let cam = scene.cameras[0].clone();
+        let tracer = Tracer::new(&scene);
+        let view = visgate_runtime::camera::View::new(&cam, [64, 48]).expect("view");
+        let (reference, _) = render_reference(
+            &tracer,
+            &scene.lights,
+            &vpls,
+            &view,
+            &ReferenceParams {
+                samples_per_pixel: 1,
+                ..ReferenceParams::default()
+            },
+            &|_, _| {},
+        )
+        .expect("reference");
+        let none = errors(
+            &gpu_image(&ctx, &scene, &cam, &vpls, GpuMode::None, 30),
+            &reference,
+        )
+        .expect("size");
+        let vh = errors(
+            &gpu_image(&ctx, &scene, &cam, &vpls, GpuMode::ValHard, 30),
+            &reference,
+        )
+        .expect("size");
+        eprintln!(
+            "{}: MSE none {:.3e}, val-hard (30 VALs) {:.3e}; rel. MSE {:.3e} vs {:.3e}",
+            b.name(),
+            none.mse,
+            vh.mse,
+            none.rel_mse,
+            vh.rel_mse
+        );
+        // Relative MSE everywhere; MSE too in the Cornell box (in the four rooms' lit room
+        // the VALs' hard shadows cost about what leaking costs where it is brightest).
+        assert!(
+            vh.rel_mse < none.rel_mse,
+            "{}: {vh:?} vs {none:?}",
+            b.name()
+        );
+        if b == Builtin::CornellBox {
+            assert!(vh.mse < 0.6 * none.mse, "{vh:?} vs {none:?}");
+        }
+        assert!(
+            (vh.image_mean / vh.reference_mean - 1.0).abs() < 0.1,
+            "{vh:?}"
+        );
+    }
+}

@@ -25,17 +25,6 @@ fn vs(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
     return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
 }
 
-// The basis of shade_basis in Rust (Duff et al. 2017).
-fn basis(n: vec3<f32>) -> mat2x3<f32> {
-    let s = select(-1.0, 1.0, n.z >= 0.0);
-    let a = -1.0 / (s + n.z);
-    let b = n.x * n.y * a;
-    return mat2x3<f32>(
-        vec3<f32>(1.0 + s * n.x * n.x * a, s * b, -s * n.x),
-        vec3<f32>(b, s + n.y * n.y * a, -n.y),
-    );
-}
-
 fn visibility(layer: u32, v: Vpl, p: vec3<f32>, n: vec3<f32>) -> f32 {
     let size = f32(batch.range.z);
     let tb = basis(v.normal);
@@ -48,9 +37,7 @@ fn visibility(layer: u32, v: Vpl, p: vec3<f32>, n: vec3<f32>) -> f32 {
     if local.z <= 0.0 || d <= 0.0 {
         return 0.0;
     }
-    let dir = local / d;
-    let uv = dir.xy / (1.0 + dir.z);
-    let c = vec2<i32>(vec2<f32>(uv.x * 0.5 + 0.5, 0.5 - uv.y * 0.5) * size);
+    let c = paraboloid_texel(local, size);
     let ref_dist = d - texel * batch.params.z;
     var lit = 0.0;
     for (var dy = -1; dy <= 1; dy++) {

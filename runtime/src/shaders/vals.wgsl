@@ -1,6 +1,6 @@
 // Virtual area lights on the GPU (Dong et al. §5–6): k-means of the VPLs into M VALs by
-// d = w_x·Δx/D + w_α·Δα/π, restarted each frame from VAL k = VPL ⌊k·N/M⌋. vpl.wgsl comes
-// first; runtime::val is the CPU twin (same order of every sum, so the same VALs).
+// d = w_x·Δx/D + w_α·Δα/π, restarted each frame from VAL k = VPL ⌊k·N/M⌋. vpl.wgsl and
+// val.wgsl come first; runtime::val is the CPU twin (same order of every sum, so the same VALs).
 //   init    centres from the restart VPLs
 //   assign  each VPL's nearest centre (ties to the lower index) → the mapping C
 //   update  each VAL's centre: mean position and normalised mean normal of its VPLs, summed
@@ -14,17 +14,6 @@ struct ValFrame {
     counts: vec4<u32>,
     // x w_x, y w_α, z 1 / D (the VPLs' bounding-box diagonal), w unused.
     weights: vec4<f32>,
-};
-
-struct Val {
-    // xyz centre, w VPL count.
-    position: vec4<f32>,
-    // xyz unit normal, w area (m²).
-    normal: vec4<f32>,
-    // rgb flux (W).
-    flux: vec4<f32>,
-    // s min, s max, t min, t max about the centre, in the frame of basis(normal).
-    rect: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> frame: ValFrame;
@@ -96,17 +85,6 @@ fn update(@builtin(global_invocation_id) id: vec3<u32>) {
             centres[2u * k + 1u] = vec4<f32>(nrm / l, 0.0);
         }
     }
-}
-
-// The basis of runtime::vpl::basis (Duff et al. 2017).
-fn basis(n: vec3<f32>) -> mat2x3<f32> {
-    let s = select(-1.0, 1.0, n.z >= 0.0);
-    let a = -1.0 / (s + n.z);
-    let b = n.x * n.y * a;
-    return mat2x3<f32>(
-        vec3<f32>(1.0 + s * n.x * n.x * a, s * b, -s * n.x),
-        vec3<f32>(b, s + n.y * n.y * a, -n.y),
-    );
 }
 
 @compute @workgroup_size(64)

@@ -4,7 +4,7 @@
 // (t, b, n) maps to d.xy / (1 + d.z). The projection is not linear, so a long edge would be
 // bent wrongly: the renderer splits the scene's triangles until no edge is longer than a
 // fraction of the scene (see `gpu::VPL_SHADOW_MAX_EDGE`); vertices behind the VPL's plane go to
-// the map's rim, and fragments behind or in the plane are discarded.
+// the map's rim, and fragments behind or in the plane are discarded. val.wgsl comes first.
 
 struct VplView {
     // xyz position, w far distance (m).
@@ -21,23 +21,47 @@ struct VsOut {
     @location(0) local: vec3<f32>,
 };
 
-@vertex
-fn vs(@location(0) position: vec3<f32>) -> VsOut {
-    let v = position - vpl_view.position.xyz;
-    let local = vec3<f32>(dot(v, vpl_view.tangent.xyz), dot(v, vpl_view.bitangent.xyz), dot(v, vpl_view.normal.xyz));
+// The paraboloid projection of `local` (in the map's frame: t, b, n) with distances over
+// `far` in depth.
+fn project(local: vec3<f32>, far: f32) -> VsOut {
     let d = max(length(local), 1e-12);
     let dir = local / d;
     var o: VsOut;
-    // A vertex behind the VPL's plane would project far outside the map and drag its
+    // A vertex behind the map's plane would project far outside the map and drag its
     // triangle across it: put it on the rim instead (its fragments behind are discarded).
     var uv = dir.xy / max(1.0 + dir.z, 1e-4);
     if local.z < 0.0 {
         let r = length(local.xy);
         uv = select(vec2<f32>(1.0, 0.0), local.xy / r, r > 0.0);
     }
-    o.clip = vec4<f32>(uv, clamp(d / vpl_view.position.w, 0.0, 1.0), 1.0);
+    o.clip = vec4<f32>(uv, clamp(d / far, 0.0, 1.0), 1.0);
     o.local = local;
     return o;
+}
+
+@vertex
+fn vs(@location(0) position: vec3<f32>) -> VsOut {
+    let v = position - vpl_view.position.xyz;
+    let local = vec3<f32>(dot(v, vpl_view.tangent.xyz), dot(v, vpl_view.bitangent.xyz), dot(v, vpl_view.normal.xyz));
+    return project(local, vpl_view.position.w);
+}
+
+// A VAL's map (modes val-hard, val-cssm): the VAL of this instance, from the VALs the GPU
+// clustered, its centre moved off its surface by `val_maps.params.y`.
+struct ValMaps {
+    // x far distance (m), y centre offset along the normal (m).
+    params: vec4<f32>,
+};
+
+@group(0) @binding(1) var<uniform> val_maps: ValMaps;
+@group(0) @binding(2) var<storage, read> vals: array<Val>;
+
+@vertex
+fn vs_val(@location(0) position: vec3<f32>, @builtin(instance_index) k: u32) -> VsOut {
+    let n = vals[k].normal.xyz;
+    let tb = basis(n);
+    let v = position - (vals[k].position.xyz + n * val_maps.params.y);
+    return project(vec3<f32>(dot(v, tb[0]), dot(v, tb[1]), dot(v, n)), val_maps.params.x);
 }
 
 @fragment
