@@ -27,6 +27,8 @@ pub(super) struct Pipelines {
     assign: wgpu::ComputePipeline,
     update: wgpu::ComputePipeline,
     finish: wgpu::ComputePipeline,
+    offsets: wgpu::ComputePipeline,
+    scatter: wgpu::ComputePipeline,
 }
 
 impl Pipelines {
@@ -50,6 +52,8 @@ impl Pipelines {
             assign: pipe("assign"),
             update: pipe("update"),
             finish: pipe("finish"),
+            offsets: pipe("offsets"),
+            scatter: pipe("scatter"),
         }
     }
 }
@@ -58,6 +62,8 @@ impl Pipelines {
 pub(super) struct Buffers {
     pub vals: wgpu::Buffer,
     pub mapping: wgpu::Buffer,
+    /// M + 1 offsets, then the VPL indices sorted by VAL.
+    pub order: wgpu::Buffer,
 }
 
 impl GpuRenderer {
@@ -102,6 +108,7 @@ impl GpuRenderer {
         let centres = buf("val centres", m as u64 * 32);
         let mapping = buf("vpl → val", n as u64 * 4);
         let vals = buf("vals", m as u64 * std::mem::size_of::<Val>() as u64);
+        let order = buf("vpls by val", (m as u64 + 1 + n as u64) * 4);
         let p = &self.val_pipelines;
         let bind = |pipeline: &wgpu::ComputePipeline, with: &[(u32, &wgpu::Buffer)]| {
             let entries: Vec<wgpu::BindGroupEntry> = with
@@ -126,6 +133,8 @@ impl GpuRenderer {
             &p.finish,
             &[base[0], base[1], base[2], (3, &mapping), (4, &vals)],
         );
+        let offsets_bg = bind(&p.offsets, &[base[0], (4, &vals), (5, &order)]);
+        let scatter_bg = bind(&p.scatter, &[base[0], (3, &mapping), (5, &order)]);
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("val clustering"),
             timestamp_writes: timestamps,
@@ -149,9 +158,19 @@ impl GpuRenderer {
             pass.set_pipeline(&p.finish);
             pass.set_bind_group(0, &finish_bg, &[]);
             pass.dispatch_workgroups(gm, 1, 1);
+            pass.set_pipeline(&p.offsets);
+            pass.set_bind_group(0, &offsets_bg, &[]);
+            pass.dispatch_workgroups(1, 1, 1);
+            pass.set_pipeline(&p.scatter);
+            pass.set_bind_group(0, &scatter_bg, &[]);
+            pass.dispatch_workgroups(gm, 1, 1);
         }
         drop(pass);
-        Ok(Buffers { vals, mapping })
+        Ok(Buffers {
+            vals,
+            mapping,
+            order,
+        })
     }
 
     /// Clusters `vpls` into VALs on the GPU and reads them back (for tests and inspection).
@@ -361,7 +380,7 @@ impl GpuRenderer {
             (4, tex(&gviews[1])),
             (5, tex(&gviews[2])),
             (6, tex(&out_view)),
-            (7, b.mapping.as_entire_binding()),
+            (7, b.order.as_entire_binding()),
             (8, b.vals.as_entire_binding()),
         ]
         .map(|(binding, resource)| wgpu::BindGroupEntry { binding, resource });

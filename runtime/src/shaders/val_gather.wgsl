@@ -20,7 +20,8 @@ struct ValGather {
 @group(0) @binding(4) var g_normal: texture_2d<f32>;
 @group(0) @binding(5) var g_albedo: texture_2d<f32>;
 @group(0) @binding(6) var previous: texture_2d<f32>;
-@group(0) @binding(7) var<storage, read> mapping: array<u32>;
+// M + 1 offsets, then the VPL indices sorted by VAL (vals.wgsl's order).
+@group(0) @binding(7) var<storage, read> order: array<u32>;
 @group(0) @binding(8) var<storage, read> vals: array<Val>;
 
 @vertex
@@ -58,22 +59,36 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     let p = pos.xyz;
     let n = normalize(textureLoad(g_normal, px, 0).xyz);
     let albedo = textureLoad(g_albedo, px, 0).xyz;
+    // VAL by VAL: its visibility once, then its VPLs.
+    let m = gather.counts.y;
     var sum = vec3<f32>(0.0);
-    for (var i = 0u; i < gather.counts.x; i++) {
-        let v = vpls[i];
-        let d = v.position - p;
-        let d2 = dot(d, d);
-        if d2 <= 0.0 {
+    for (var k = 0u; k < m; k++) {
+        let first = order[k];
+        let last = order[k + 1u];
+        if first == last {
             continue;
         }
-        let w = d * inverseSqrt(d2);
-        let cos_x = dot(n, w);
-        let cos_v = -dot(v.normal, w);
-        if cos_x <= 0.0 || cos_v <= 0.0 {
+        let vis = val_visibility(k, p, n);
+        if vis <= 0.0 {
             continue;
         }
-        let vis = val_visibility(mapping[i], p, n);
-        sum += v.flux / PI * min(cos_x * cos_v / d2, gather.params.x) * vis;
+        var part = vec3<f32>(0.0);
+        for (var j = first; j < last; j++) {
+            let v = vpls[order[m + 1u + j]];
+            let d = v.position - p;
+            let d2 = dot(d, d);
+            if d2 <= 0.0 {
+                continue;
+            }
+            let w = d * inverseSqrt(d2);
+            let cos_x = dot(n, w);
+            let cos_v = -dot(v.normal, w);
+            if cos_x <= 0.0 || cos_v <= 0.0 {
+                continue;
+            }
+            part += v.flux / PI * min(cos_x * cos_v / d2, gather.params.x);
+        }
+        sum += part * vis;
     }
     return vec4<f32>(before.xyz + albedo / PI * sum, 1.0);
 }

@@ -119,3 +119,33 @@ fn finish(@builtin(global_invocation_id) id: vec3<u32>) {
     v.rect = rect;
     vals[k] = v;
 }
+
+// The VPLs sorted by VAL, for a gather that computes each VAL's visibility once per pixel:
+// M + 1 offsets, then the VPL indices, VAL by VAL, each VAL's in VPL order.
+@group(0) @binding(5) var<storage, read_write> order: array<u32>;
+
+@compute @workgroup_size(1)
+fn offsets() {
+    var run = 0u;
+    for (var k = 0u; k < frame.counts.y; k++) {
+        order[k] = run;
+        run += u32(vals[k].position.w);
+    }
+    order[frame.counts.y] = run;
+}
+
+@compute @workgroup_size(64)
+fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
+    let k = id.x;
+    let m = frame.counts.y;
+    if k >= m {
+        return;
+    }
+    var at = m + 1u + order[k];
+    for (var i = 0u; i < frame.counts.x; i++) {
+        if mapping[i] == k {
+            order[at] = i;
+            at++;
+        }
+    }
+}
