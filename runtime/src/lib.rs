@@ -14,6 +14,7 @@
 
 pub mod camera;
 pub mod clustered;
+pub mod cssm;
 pub mod gates;
 pub mod gpu;
 pub mod hdr;

@@ -375,3 +375,35 @@ fn val_hard_is_closer_to_the_reference_than_no_visibility() {
         );
     }
 }
+
+#[test]
+fn the_fourier_shadow_test_approaches_the_step_and_rings_within_its_bound() {
+    use visgate_runtime::cssm::{receiver_offset, reconstruct, ringing_bound};
+    let mut last = f32::INFINITY;
+    for terms in [1, 2, 4, 8, 16] {
+        let (mut err, mut lo, mut hi) = (0f32, f32::INFINITY, f32::NEG_INFINITY);
+        let n = 200;
+        for i in 0..=n {
+            for j in 0..=n {
+                let (d, z) = (i as f32 / n as f32, j as f32 / n as f32);
+                let f = reconstruct(d, z, terms);
+                lo = lo.min(f);
+                hi = hi.max(f);
+                let step = if z >= d { 1.0 } else { 0.0 };
+                err += (f - step).abs();
+            }
+        }
+        let err = err / ((n + 1) * (n + 1)) as f32;
+        eprintln!("K = {terms}: mean |error| {err:.4}, range [{lo:.4}, {hi:.4}]");
+        assert!(err < last, "K = {terms}: {err} not below {last}");
+        let b = ringing_bound(terms);
+        assert!(lo >= -b && hi <= 1.0 + b, "K = {terms}: [{lo}, {hi}]");
+        last = err;
+        // Past the receiver offset the step has risen: a surface is not its own blocker.
+        let off = receiver_offset(terms);
+        for i in 0..=20 {
+            let z = 0.2 + 0.6 * i as f32 / 20.0;
+            assert!(reconstruct(z - off, z, terms) > 0.9, "K = {terms} z = {z}");
+        }
+    }
+}
