@@ -39,6 +39,9 @@ Modes:
                and normal, --val-iterations, restarted each frame); every VPL lights every
                pixel through one hard paraboloid shadow map (--val-map-size) of its VAL (the
                banding baseline of Dong et al.; no bake needed)
+  val-cssm     GPU: as val-hard with convolution soft shadow maps per VAL (Dong et al.):
+               --cssm-terms Fourier terms of the depth, mip-mapped, filtered over the
+               penumbra each VAL's size and the average blocker depth give
   direct-only  GPU: direct light alone
 With --cpu, none and direct-only run on the CPU twin (shadow rays for direct light), and
 per-vpl-shadow-maps is the reference (exact shadow rays).
@@ -80,6 +83,8 @@ pub enum Mode {
     GatesPerPixel,
     /// Every VPL through one hard shadow map of its virtual area light (GPU).
     ValHard,
+    /// Every VPL through the convolution soft shadow map of its virtual area light (GPU).
+    ValCssm,
     /// Direct light only.
     DirectOnly,
 }
@@ -158,6 +163,9 @@ pub struct RenderArgs {
     /// Paraboloid shadow map size per VAL, texels.
     #[arg(long, default_value_t = 256)]
     pub val_map_size: u32,
+    /// Fourier terms of the convolution soft shadow maps (--mode val-cssm), 1..=16.
+    #[arg(long, default_value_t = 4)]
+    pub cssm_terms: u32,
     /// Per-VPL paraboloid map size (GPU), texels.
     #[arg(long, default_value_t = 128)]
     pub vpl_map_size: u32,
@@ -212,8 +220,8 @@ pub fn run(args: RenderArgs) -> Result<()> {
     if args.mode == Mode::GatesPerPixel && args.cpu {
         bail!("--mode gates-per-pixel runs on the GPU; the CPU twin is --mode gates --cpu");
     }
-    if args.mode == Mode::ValHard && args.cpu {
-        bail!("--mode val-hard runs on the GPU; its reference is --mode reference");
+    if matches!(args.mode, Mode::ValHard | Mode::ValCssm) && args.cpu {
+        bail!("the VAL modes run on the GPU; their reference is --mode reference");
     }
     let oversize_ok = args.gate_oversize > 0.0 && args.gate_oversize.is_finite();
     if !oversize_ok || !(1..=16).contains(&args.gate_hops) {
@@ -322,6 +330,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
                         Mode::Gates => GpuMode::Gates,
                         Mode::GatesPerPixel => GpuMode::GatesPerPixel,
                         Mode::ValHard => GpuMode::ValHard,
+                        Mode::ValCssm => GpuMode::ValCssm,
                         _ => GpuMode::DirectOnly,
                     },
                     clusters: ClusterParams {
@@ -335,6 +344,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
                         ..ValParams::default()
                     },
                     val_map_size: args.val_map_size,
+                    cssm_terms: args.cssm_terms,
                     gates: GateParams {
                         oversize: args.gate_oversize,
                         max_hops: args.gate_hops,
@@ -455,9 +465,12 @@ fn print_passes(t: &PassTimes, mode: Mode) {
         rows.push(("VPL paraboloid maps", t.vpl_maps, g.vpl_maps));
         rows.push(("VPL gather", t.vpl_gather, g.vpl_gather));
     }
-    if mode == Mode::ValHard {
+    if matches!(mode, Mode::ValHard | Mode::ValCssm) {
         rows.push(("VAL clustering", t.val_clustering, g.val_clustering));
         rows.push(("VAL paraboloid maps", t.vpl_maps, g.vpl_maps));
+        if mode == Mode::ValCssm {
+            rows.push(("CSSM basis + mips", t.cssm, g.cssm));
+        }
         rows.push(("indirect lighting (all VPLs)", t.vpl_gather, g.vpl_gather));
     }
     println!("pass                               CPU wall (ms)   GPU (ms)");

@@ -28,7 +28,7 @@ mod clustered;
 #[path = "gpu_vals.rs"]
 mod vals;
 pub use clustered::{ClusterFrame, GpuGeometryCluster, LightListStats, MAX_CLUSTERS, MAX_GATES};
-pub use vals::{ValFrame, ValGather, ValMaps, centres_of};
+pub use vals::{CssmFrame, ValFrame, ValGather, ValMaps, centres_of};
 
 // WGSL has no includes: the VPL struct and the grid and gate code are put in front of the
 // shaders that use them.
@@ -59,6 +59,7 @@ const VAL_GATHER_WGSL: &str = concat!(
     include_str!("shaders/val.wgsl"),
     include_str!("shaders/val_gather.wgsl")
 );
+const CSSM_WGSL: &str = include_str!("shaders/cssm.wgsl");
 const VPL_SHADOW_WGSL: &str = concat!(
     include_str!("shaders/val.wgsl"),
     include_str!("shaders/vpl_shadow.wgsl")
@@ -74,7 +75,7 @@ const RSM_VPLS_WGSL: &str = concat!(
 );
 
 /// The WGSL sources (with what is put in front of them), for validation without a GPU.
-pub const SHADERS: [(&str, &str); 9] = [
+pub const SHADERS: [(&str, &str); 10] = [
     ("gbuffer.wgsl", GBUFFER_WGSL),
     ("shadow.wgsl", SHADOW_WGSL),
     ("shade.wgsl", SHADE_WGSL),
@@ -84,6 +85,7 @@ pub const SHADERS: [(&str, &str); 9] = [
     ("clusters.wgsl", CLUSTERS_WGSL),
     ("vals.wgsl", VALS_WGSL),
     ("val_gather.wgsl", VAL_GATHER_WGSL),
+    ("cssm.wgsl", CSSM_WGSL),
 ];
 
 /// One RSM sample for the VPL compute pass, shared with WGSL (`Sample` in rsm_vpls.wgsl).
@@ -198,6 +200,9 @@ pub enum GpuMode {
     /// clustered into VALs on the GPU, one hard paraboloid shadow map per VAL (the banding
     /// baseline of Dong et al.).
     ValHard,
+    /// As `ValHard`, with convolution soft shadow maps per VAL (Dong et al.): the paper's
+    /// method.
+    ValCssm,
 }
 
 /// Rendering parameters.
@@ -229,6 +234,10 @@ pub struct GpuParams {
     pub vals: crate::val::ValParams,
     /// Paraboloid map size per VAL. [Units: texels] [Limit: 16..=4096]
     pub val_map_size: u32,
+    /// Fourier terms K of the CSSM (mode `ValCssm`). [Limit: 1..=16]
+    pub cssm_terms: u32,
+    /// Sharpening of the CSSM reconstruction ([`crate::cssm::visibility`]). [Limit: 1..=8]
+    pub cssm_sharpness: f32,
 }
 
 impl Default for GpuParams {
@@ -246,6 +255,8 @@ impl Default for GpuParams {
             light_entries: 1 << 23,
             vals: crate::val::ValParams::default(),
             val_map_size: 256,
+            cssm_terms: crate::cssm::DEFAULT_TERMS,
+            cssm_sharpness: crate::cssm::DEFAULT_SHARPNESS,
         }
     }
 }
@@ -266,6 +277,8 @@ pub struct PassTimes {
     pub light_assignment: f64,
     /// VAL modes: clustering the VPLs into VALs.
     pub val_clustering: f64,
+    /// Mode val-cssm: depth ranges, Fourier basis and mips.
+    pub cssm: f64,
     /// Per-VPL paraboloid maps, all batches.
     pub vpl_maps: f64,
     /// Indirect gather with per-VPL maps, all batches.
@@ -297,6 +310,8 @@ pub struct GpuStageTimes {
     pub light_assignment: f64,
     /// VAL clustering (VAL modes).
     pub val_clustering: f64,
+    /// CSSM basis and mips (mode val-cssm).
+    pub cssm: f64,
 }
 
 /// Stages a [`Timer`] tells apart, in [`GpuStageTimes`] order.
@@ -310,6 +325,7 @@ enum Stage {
     UniqueClusters,
     LightAssignment,
     ValClustering,
+    Cssm,
 }
 
 /// Timestamp queries around stages: each span is the beginning of a stage's first pass and
@@ -407,7 +423,7 @@ impl Timer {
         ctx.wait();
         let ticks: Vec<u64> = bytemuck::cast_slice(&slice.get_mapped_range().ok()?).to_vec();
         read.unmap();
-        let mut t = [0f64; 8];
+        let mut t = [0f64; 9];
         for &(stage, b) in &self.spans {
             let (a, z) = (ticks[b as usize], ticks[b as usize + 1]);
             t[stage as usize] += z.saturating_sub(a) as f64 * period as f64 * 1e-9;
@@ -421,6 +437,7 @@ impl Timer {
             unique_clusters: t[5],
             light_assignment: t[6],
             val_clustering: t[7],
+            cssm: t[8],
         })
     }
 }
@@ -787,7 +804,7 @@ pub struct GpuRenderer {
     cluster_pipelines: clustered::Pipelines,
     val_pipelines: vals::Pipelines,
     val_shadow: wgpu::RenderPipeline,
-    val_gather: wgpu::RenderPipeline,
+    cssm_pipelines: vals::CssmPipelines,
 }
 
 /// A level's gate tables on the GPU.
@@ -1032,15 +1049,6 @@ impl GpuRenderer {
             multiview_mask: None,
             cache: None,
         });
-        let vg_mod = module("val_gather.wgsl", VAL_GATHER_WGSL);
-        let val_gather = pipeline(
-            "val gather",
-            &vg_mod,
-            &[],
-            &[target(wgpu::TextureFormat::Rgba32Float)],
-            wgpu::PrimitiveState::default(),
-            None,
-        );
         let gather_batch = pipeline(
             "gather batch",
             &gb_mod,
@@ -1085,7 +1093,7 @@ impl GpuRenderer {
             cluster_pipelines: clustered::Pipelines::new(d, CLUSTERS_WGSL),
             val_pipelines: vals::Pipelines::new(d, VALS_WGSL),
             val_shadow,
-            val_gather,
+            cssm_pipelines: vals::CssmPipelines::new(d, CSSM_WGSL, VAL_GATHER_WGSL),
         })
     }
 
@@ -1601,7 +1609,10 @@ impl GpuRenderer {
                 self.lights.len() as u32,
                 match params.mode {
                     GpuMode::None => 0,
-                    GpuMode::DirectOnly | GpuMode::PerVplShadowMaps | GpuMode::ValHard => 1,
+                    GpuMode::DirectOnly
+                    | GpuMode::PerVplShadowMaps
+                    | GpuMode::ValHard
+                    | GpuMode::ValCssm => 1,
                     GpuMode::GatesPerPixel => 2,
                     GpuMode::Gates => 3,
                 },
@@ -1706,7 +1717,7 @@ impl GpuRenderer {
         } else {
             0
         };
-        let mut timer = Timer::new(ctx, 8 + 2 * batches);
+        let mut timer = Timer::new(ctx, 9 + 2 * batches);
         let layers = shadow_views.len().max(1) as u32;
         if layers > d.limits().max_texture_array_layers {
             return Err(RenderError::Param(format!(
@@ -1890,7 +1901,7 @@ impl GpuRenderer {
         }
 
         // 3c. VAL modes: cluster, a map per VAL, the gather.
-        if params.mode == GpuMode::ValHard && !vpls.is_empty() {
+        if matches!(params.mode, GpuMode::ValHard | GpuMode::ValCssm) && !vpls.is_empty() {
             self.val_frame(
                 ctx,
                 params,

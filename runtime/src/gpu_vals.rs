@@ -223,10 +223,88 @@ pub struct ValMaps {
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct ValGather {
-    /// x VPLs, y VALs, z map size (texels).
+    /// x VPLs, y VALs, z map size (texels), w Fourier terms K.
     pub counts: [u32; 4],
     /// x g_max (1/m²), y normal offset (texels), z bias (texels), w VAL centre offset (m).
     pub params: [f32; 4],
+    /// x receiver offset (normalised depth), y sharpening s.
+    pub cssm: [f32; 4],
+}
+
+/// Constants of the CSSM passes, shared with WGSL (`CssmFrame` in cssm.wgsl).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct CssmFrame {
+    /// x VALs, y terms K, z groups ⌈K/2⌉, w map size.
+    pub counts: [u32; 4],
+    /// x size of the mip level being written.
+    pub level: [u32; 4],
+}
+
+/// The CSSM pipelines and the two VAL gathers.
+pub(super) struct CssmPipelines {
+    ranges: wgpu::ComputePipeline,
+    basis: wgpu::ComputePipeline,
+    downsample: wgpu::ComputePipeline,
+    gather_hard: wgpu::RenderPipeline,
+    gather_cssm: wgpu::RenderPipeline,
+}
+
+impl CssmPipelines {
+    pub(super) fn new(d: &wgpu::Device, cssm: &str, gather: &str) -> CssmPipelines {
+        let module = |label: &str, src: &str| {
+            d.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some(label),
+                source: wgpu::ShaderSource::Wgsl(src.into()),
+            })
+        };
+        let cm = module("cssm.wgsl", cssm);
+        let gm = module("val_gather.wgsl", gather);
+        let compute = |entry: &str| {
+            d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: None,
+                module: &cm,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+        };
+        let fullscreen = |entry: &str| {
+            d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(entry),
+                layout: None,
+                vertex: wgpu::VertexState {
+                    module: &gm,
+                    entry_point: Some("vs"),
+                    buffers: &[],
+                    compilation_options: Default::default(),
+                },
+                primitive: wgpu::PrimitiveState::default(),
+                depth_stencil: None,
+                multisample: wgpu::MultisampleState::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &gm,
+                    entry_point: Some(entry),
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format: wgpu::TextureFormat::Rgba32Float,
+                        blend: None,
+                        write_mask: wgpu::ColorWrites::ALL,
+                    })],
+                    compilation_options: Default::default(),
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        CssmPipelines {
+            ranges: compute("ranges_of"),
+            basis: compute("basis"),
+            downsample: compute("downsample"),
+            gather_hard: fullscreen("fs_hard"),
+            gather_cssm: fullscreen("fs_cssm"),
+        }
+    }
 }
 
 impl GpuRenderer {
@@ -249,6 +327,12 @@ impl GpuRenderer {
         use std::time::Instant;
         let d = &ctx.device;
         let (m, s) = (params.vals.count, params.val_map_size);
+        let sharp = params.cssm_sharpness;
+        if !(1.0..=8.0).contains(&sharp) {
+            return Err(RenderError::Param(format!(
+                "CSSM sharpening {sharp} must be 1..=8"
+            )));
+        }
         if !(16..=4096).contains(&s) || m > d.limits().max_texture_array_layers {
             return Err(RenderError::Param(format!(
                 "VAL map size {s} must be 16..=4096 and VALs {m} at most the adapter's {} layers",
@@ -343,6 +427,18 @@ impl GpuRenderer {
         ctx.wait();
         times.vpl_maps = t0.elapsed().as_secs_f64();
 
+        // 2b. val-cssm: depth ranges, the Fourier basis and its mips.
+        let soft = params.mode == super::GpuMode::ValCssm;
+        let terms = params.cssm_terms;
+        let cssm = if soft {
+            let t0 = Instant::now();
+            let c = self.cssm_basis(ctx, &maps, m, s, terms, timer)?;
+            times.cssm = t0.elapsed().as_secs_f64();
+            Some(c)
+        } else {
+            None
+        };
+
         // 3. The gather, read from `out` and written to a copy (ping-pong), copied back.
         let t0 = Instant::now();
         let other = super::texture(
@@ -355,12 +451,18 @@ impl GpuRenderer {
         let uniform = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("val gather"),
             contents: bytemuck::bytes_of(&ValGather {
-                counts: [vpls.len() as u32, m, s, 0],
+                counts: [vpls.len() as u32, m, s, terms],
                 params: [
                     params.g_max,
                     params.shadow_normal_offset,
                     params.shadow_bias,
                     offset,
+                ],
+                cssm: [
+                    crate::cssm::receiver_offset(terms, params.cssm_sharpness),
+                    params.cssm_sharpness,
+                    0.0,
+                    0.0,
                 ],
             }),
             usage: wgpu::BufferUsages::UNIFORM,
@@ -372,21 +474,35 @@ impl GpuRenderer {
         });
         let out_view = out.create_view(&Default::default());
         let tex = wgpu::BindingResource::TextureView;
-        let entries = [
+        let mut entries: Vec<(u32, wgpu::BindingResource)> = vec![
             (0, uniform.as_entire_binding()),
             (1, vpl_buf.as_entire_binding()),
-            (2, tex(&maps_view)),
             (3, tex(&gviews[0])),
             (4, tex(&gviews[1])),
             (5, tex(&gviews[2])),
             (6, tex(&out_view)),
             (7, b.order.as_entire_binding()),
             (8, b.vals.as_entire_binding()),
-        ]
-        .map(|(binding, resource)| wgpu::BindGroupEntry { binding, resource });
+        ];
+        let pipeline = match &cssm {
+            Some(c) => {
+                entries.push((9, tex(&c.view)));
+                entries.push((10, wgpu::BindingResource::Sampler(&c.sampler)));
+                entries.push((11, c.ranges.as_entire_binding()));
+                &self.cssm_pipelines.gather_cssm
+            }
+            None => {
+                entries.push((2, tex(&maps_view)));
+                &self.cssm_pipelines.gather_hard
+            }
+        };
+        let entries: Vec<wgpu::BindGroupEntry> = entries
+            .into_iter()
+            .map(|(binding, resource)| wgpu::BindGroupEntry { binding, resource })
+            .collect();
         let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("val gather"),
-            layout: &self.val_gather.get_bind_group_layout(0),
+            layout: &pipeline.get_bind_group_layout(0),
             entries: &entries,
         });
         let span = timer.span(Stage::VplGather);
@@ -394,7 +510,7 @@ impl GpuRenderer {
             ctx,
             "val gather",
             &other.create_view(&Default::default()),
-            &self.val_gather,
+            pipeline,
             &bg,
             timer.writes(span, true, true),
         );
@@ -406,5 +522,174 @@ impl GpuRenderer {
         ctx.wait();
         times.vpl_gather = t0.elapsed().as_secs_f64();
         Ok(())
+    }
+}
+
+/// A VAL set's CSSM basis on the GPU.
+pub(super) struct CssmBasis {
+    /// All groups of all VALs, every mip level.
+    pub view: wgpu::TextureView,
+    /// Trilinear, clamped.
+    pub sampler: wgpu::Sampler,
+    /// Each VAL's depth range (m).
+    pub ranges: wgpu::Buffer,
+}
+
+impl GpuRenderer {
+    /// The CSSM basis of the VALs' distance `maps` (`m` layers of `size`²) with `terms` Fourier
+    /// terms: depth ranges, the basis images, their mips (one dispatch per level, every layer).
+    fn cssm_basis(
+        &self,
+        ctx: &GpuContext,
+        maps: &wgpu::Texture,
+        m: u32,
+        size: u32,
+        terms: u32,
+        timer: &mut super::Timer,
+    ) -> Result<CssmBasis, RenderError> {
+        let d = &ctx.device;
+        let groups = terms.div_ceil(2);
+        let layers = (2 * groups + 1) * m;
+        if !(1..=16).contains(&terms) || layers > d.limits().max_texture_array_layers {
+            return Err(RenderError::Param(format!(
+                "CSSM terms {terms} must be 1..=16, and its {layers} basis layers ({} per VAL) at \
+                 most the adapter's {}: use fewer terms or VALs",
+                2 * groups + 1,
+                d.limits().max_texture_array_layers
+            )));
+        }
+        let levels = size.ilog2() + 1;
+        let basis = d.create_texture(&wgpu::TextureDescriptor {
+            label: Some("cssm basis"),
+            size: wgpu::Extent3d {
+                width: size,
+                height: size,
+                depth_or_array_layers: layers,
+            },
+            mip_level_count: levels,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba16Float,
+            usage: wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let level_view = |l: u32| {
+            basis.create_view(&wgpu::TextureViewDescriptor {
+                label: Some("cssm level"),
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                base_mip_level: l,
+                mip_level_count: Some(1),
+                ..Default::default()
+            })
+        };
+        let ranges = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("val depth ranges"),
+            size: (m as u64 * 4).max(16),
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        let uniform = |level: u32| {
+            d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("cssm frame"),
+                contents: bytemuck::bytes_of(&CssmFrame {
+                    counts: [m, terms, groups, size],
+                    level: [level, 0, 0, 0],
+                }),
+                usage: wgpu::BufferUsages::UNIFORM,
+            })
+        };
+        let p = &self.cssm_pipelines;
+        let maps_view = maps.create_view(&wgpu::TextureViewDescriptor {
+            label: Some("val maps"),
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        let bind = |pipeline: &wgpu::ComputePipeline,
+                    entries: Vec<(u32, wgpu::BindingResource)>| {
+            let entries: Vec<wgpu::BindGroupEntry> = entries
+                .into_iter()
+                .map(|(binding, resource)| wgpu::BindGroupEntry { binding, resource })
+                .collect();
+            d.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("cssm"),
+                layout: &pipeline.get_bind_group_layout(0),
+                entries: &entries,
+            })
+        };
+        let tex = wgpu::BindingResource::TextureView;
+        let u0 = uniform(size);
+        let level0 = level_view(0);
+        let ranges_bg = bind(
+            &p.ranges,
+            vec![
+                (0, u0.as_entire_binding()),
+                (1, tex(&maps_view)),
+                (2, ranges.as_entire_binding()),
+            ],
+        );
+        let basis_bg = bind(
+            &p.basis,
+            vec![
+                (0, u0.as_entire_binding()),
+                (1, tex(&maps_view)),
+                (2, ranges.as_entire_binding()),
+                (3, tex(&level0)),
+            ],
+        );
+        let views: Vec<wgpu::TextureView> = (0..levels).map(level_view).collect();
+        let uniforms: Vec<wgpu::Buffer> =
+            (1..levels).map(|l| uniform((size >> l).max(1))).collect();
+        let down_bgs: Vec<wgpu::BindGroup> = (1..levels as usize)
+            .map(|l| {
+                bind(
+                    &p.downsample,
+                    vec![
+                        (0, uniforms[l - 1].as_entire_binding()),
+                        (3, tex(&views[l])),
+                        (4, tex(&views[l - 1])),
+                    ],
+                )
+            })
+            .collect();
+        let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("cssm"),
+        });
+        {
+            let span = timer.span(super::Stage::Cssm);
+            let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("cssm basis"),
+                timestamp_writes: timer.compute_writes(span),
+            });
+            pass.set_pipeline(&p.ranges);
+            pass.set_bind_group(0, &ranges_bg, &[]);
+            pass.dispatch_workgroups(m, 1, 1);
+            pass.set_pipeline(&p.basis);
+            pass.set_bind_group(0, &basis_bg, &[]);
+            pass.dispatch_workgroups(size.div_ceil(8), size.div_ceil(8), m);
+            pass.set_pipeline(&p.downsample);
+            for (l, bg) in (1..levels).zip(&down_bgs) {
+                let s = (size >> l).max(1);
+                pass.set_bind_group(0, bg, &[]);
+                pass.dispatch_workgroups(s.div_ceil(8), s.div_ceil(8), layers);
+            }
+        }
+        ctx.queue.submit([enc.finish()]);
+        ctx.wait();
+        let sampler = d.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("cssm basis"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            ..Default::default()
+        });
+        Ok(CssmBasis {
+            view: basis.create_view(&wgpu::TextureViewDescriptor {
+                label: Some("cssm basis"),
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                ..Default::default()
+            }),
+            sampler,
+            ranges,
+        })
     }
 }

@@ -178,8 +178,8 @@ fn wgsl_layout(src: &str, name: &str) -> (u32, Vec<(String, u32)>) {
 fn gpu_structs_match_their_wgsl_layouts() {
     use std::mem::{offset_of, size_of};
     use visgate_runtime::gpu::{
-        Batch, ClusterFrame, Globals, GpuGeometryCluster, GpuLight, GridUniform, RsmSample,
-        ShadowView, ValFrame, ValGather, ValMaps, VplView,
+        Batch, ClusterFrame, CssmFrame, Globals, GpuGeometryCluster, GpuLight, GridUniform,
+        RsmSample, ShadowView, ValFrame, ValGather, ValMaps, VplView,
     };
     use visgate_runtime::val::Val;
     use visgate_runtime::vpl::Vpl;
@@ -354,6 +354,16 @@ fn gpu_structs_match_their_wgsl_layouts() {
         &[
             ("counts", offset_of!(ValGather, counts)),
             ("params", offset_of!(ValGather, params)),
+            ("cssm", offset_of!(ValGather, cssm)),
+        ],
+    );
+    check(
+        SHADERS[9].1,
+        "CssmFrame",
+        size_of::<CssmFrame>(),
+        &[
+            ("counts", offset_of!(CssmFrame, counts)),
+            ("level", offset_of!(CssmFrame, level)),
         ],
     );
     check(

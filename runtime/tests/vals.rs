@@ -243,7 +243,7 @@ fn gpu_image(
 }
 
 #[test]
-fn val_hard_a_receiver_under_a_large_blocker_is_dark_and_one_in_the_open_lit() {
+fn vals_a_receiver_under_a_large_blocker_is_dark_and_one_in_the_open_lit() {
     use visgate_runtime::gpu::GpuMode;
     let ctx = context();
     // A floor, a wide blocker 1 m above its middle strip, VPLs above the blocker facing down.
@@ -271,8 +271,14 @@ fn val_hard_a_receiver_under_a_large_blocker_is_dark_and_one_in_the_open_lit() {
         up: Vec3::Y,
         fov_x_rad: 70f32.to_radians(),
     };
-    for m in [1, 4, 30] {
-        let img = gpu_image(&ctx, &scene, &cam, &vpls, GpuMode::ValHard, m);
+    for (mode, m) in [
+        (GpuMode::ValHard, 1),
+        (GpuMode::ValHard, 4),
+        (GpuMode::ValHard, 30),
+        (GpuMode::ValCssm, 30),
+        (GpuMode::ValCssm, 64),
+    ] {
+        let img = gpu_image(&ctx, &scene, &cam, &vpls, mode, m);
         let none = gpu_image(&ctx, &scene, &cam, &vpls, GpuMode::None, m);
         // Floor pixels (found by ray casting) under the blocker's middle and in the open.
         let view = visgate_runtime::camera::View::new(&cam, [64, 48]).expect("view");
@@ -306,20 +312,28 @@ fn val_hard_a_receiver_under_a_large_blocker_is_dark_and_one_in_the_open_lit() {
         );
         let (under, open, unshadowed) = (mean(&under), mean(&open), mean(&unshadowed));
         eprintln!(
-            "M = {m}: under the blocker {under}, in the open {open}, unshadowed {unshadowed}"
+            "{mode:?} M = {m}: under the blocker {under}, in the open {open}, unshadowed {unshadowed}"
         );
         // Every VPL sees the open floor over the blocker's edge: lit as without visibility.
+        // Hard maps get it exactly; soft ones blur over a penumbra the VAL's size sets.
         let lit = mean(&open_none);
+        let (lit_at_least, dark_below) = match mode {
+            GpuMode::ValHard => (0.9, 0.02),
+            _ => (0.75, 0.1),
+        };
         assert!(
-            open > 0.9 * lit && open > 0.0,
+            open > lit_at_least * lit && open > 0.0,
             "the open floor is lit: {open} vs {lit}"
         );
-        assert!(under < 0.02 * unshadowed, "under the blocker dark: {under}");
+        assert!(
+            under < dark_below * unshadowed,
+            "under the blocker dark: {under} vs {unshadowed}"
+        );
     }
 }
 
 #[test]
-fn val_hard_is_closer_to_the_reference_than_no_visibility() {
+fn vals_are_closer_to_the_reference_than_no_visibility() {
     use visgate_runtime::gpu::GpuMode;
     use visgate_runtime::metrics::errors;
     use visgate_runtime::reference::{ReferenceParams, render_reference};
@@ -346,39 +360,40 @@ fn val_hard_is_closer_to_the_reference_than_no_visibility() {
             &reference,
         )
         .expect("size");
-        let vh = errors(
-            &gpu_image(&ctx, &scene, &cam, &vpls, GpuMode::ValHard, 30),
-            &reference,
-        )
-        .expect("size");
-        eprintln!(
-            "{}: MSE none {:.3e}, val-hard (30 VALs) {:.3e}; rel. MSE {:.3e} vs {:.3e}",
-            b.name(),
-            none.mse,
-            vh.mse,
-            none.rel_mse,
-            vh.rel_mse
-        );
-        // Relative MSE everywhere; MSE too in the Cornell box (in the four rooms' lit room
-        // the VALs' hard shadows cost about what leaking costs where it is brightest).
-        assert!(
-            vh.rel_mse < none.rel_mse,
-            "{}: {vh:?} vs {none:?}",
-            b.name()
-        );
-        if b == Builtin::CornellBox {
-            assert!(vh.mse < 0.6 * none.mse, "{vh:?} vs {none:?}");
+        for mode in [GpuMode::ValHard, GpuMode::ValCssm] {
+            let vh =
+                errors(&gpu_image(&ctx, &scene, &cam, &vpls, mode, 30), &reference).expect("size");
+            eprintln!(
+                "{} {mode:?}: MSE none {:.3e}, 30 VALs {:.3e}; rel. MSE {:.3e} vs {:.3e}",
+                b.name(),
+                none.mse,
+                vh.mse,
+                none.rel_mse,
+                vh.rel_mse
+            );
+            // Relative MSE everywhere; MSE too in the Cornell box (in the four rooms' lit room
+            // the VALs' hard shadows cost about what leaking costs where it is brightest).
+            assert!(
+                vh.rel_mse < none.rel_mse,
+                "{}: {vh:?} vs {none:?}",
+                b.name()
+            );
+            if b == Builtin::CornellBox {
+                assert!(vh.mse < none.mse, "{vh:?} vs {none:?}");
+            }
+            assert!(
+                (vh.image_mean / vh.reference_mean - 1.0).abs() < 0.1,
+                "{vh:?}"
+            );
         }
-        assert!(
-            (vh.image_mean / vh.reference_mean - 1.0).abs() < 0.1,
-            "{vh:?}"
-        );
     }
 }
 
 #[test]
 fn the_fourier_shadow_test_approaches_the_step_and_rings_within_its_bound() {
-    use visgate_runtime::cssm::{receiver_offset, reconstruct, ringing_bound};
+    use visgate_runtime::cssm::{
+        DEFAULT_SHARPNESS, receiver_offset, reconstruct, ringing_bound, visibility,
+    };
     let mut last = f32::INFINITY;
     for terms in [1, 2, 4, 8, 16] {
         let (mut err, mut lo, mut hi) = (0f32, f32::INFINITY, f32::NEG_INFINITY);
@@ -399,11 +414,25 @@ fn the_fourier_shadow_test_approaches_the_step_and_rings_within_its_bound() {
         let b = ringing_bound(terms);
         assert!(lo >= -b && hi <= 1.0 + b, "K = {terms}: [{lo}, {hi}]");
         last = err;
-        // Past the receiver offset the step has risen: a surface is not its own blocker.
-        let off = receiver_offset(terms);
-        for i in 0..=20 {
-            let z = 0.2 + 0.6 * i as f32 / 20.0;
-            assert!(reconstruct(z - off, z, terms) > 0.9, "K = {terms} z = {z}");
+        // Sharpened and clamped, the test is the step but within the receiver offset of it:
+        // a surface is not its own blocker, and a blocker farther in front is whole.
+        let s = DEFAULT_SHARPNESS;
+        let off = receiver_offset(terms, s);
+        let mut worst = 0f32;
+        for i in 0..=n {
+            for j in 0..=n {
+                let (d, z) = (i as f32 / n as f32, j as f32 / n as f32);
+                if (z - d).abs() > off && (z - d).abs() < 1.0 - off && terms >= 4 {
+                    let step = if z >= d { 1.0 } else { 0.0 };
+                    worst = worst.max((visibility(d, z, terms, s) - step).abs());
+                }
+            }
+            let z = i as f32 / n as f32;
+            assert!(
+                visibility(z - off, z, terms, s) > 0.99,
+                "K = {terms} z = {z}"
+            );
         }
+        assert!(worst < 0.02, "K = {terms}: sharpened step off by {worst}");
     }
 }

@@ -1,16 +1,19 @@
 // Indirect light with the visibility of virtual area lights (Dong et al. §4): every VPL lights
 // every pixel, seen through the shadow map of its VAL C(i): L(x) = Σ_i L_i(x)·V_C(i)(x), added
-// to the image so far (`previous`, ping-pong). Mode val-hard tests one texel of the VAL's
-// paraboloid distance map (hard shadows: the banding baseline). A receiver in the negative
+// to the image so far (`previous`, ping-pong). Mode val-hard (fs_hard) tests one texel of the
+// VAL's paraboloid distance map (hard shadows: the banding baseline); val-cssm (fs_cssm)
+// filters its Fourier basis (convolution soft shadow maps). A receiver in the negative
 // half-space of a VAL is fully visible, as in the paper. vpl.wgsl and val.wgsl come first.
 
 const PI: f32 = 3.14159265358979;
 
 struct ValGather {
-    // x VPLs, y VALs, z map size (texels), w unused.
+    // x VPLs, y VALs, z map size (texels), w Fourier terms K (val-cssm).
     counts: vec4<u32>,
     // x g_max (1/m²), y normal offset (texels), z bias (texels), w VAL centre offset (m).
     params: vec4<f32>,
+    // x receiver offset (normalised depth, val-cssm), y sharpening s, z, w unused.
+    cssm: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> gather: ValGather;
@@ -48,47 +51,148 @@ fn val_visibility(k: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
     return select(0.0, 1.0, textureLoad(maps, t, i32(k), 0).x >= d - texel * gather.params.z);
 }
 
-@fragment
-fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
-    let px = vec2<i32>(frag.xy);
-    let before = textureLoad(previous, px, 0);
-    let pos = textureLoad(g_position, px, 0);
-    if pos.w == 0.0 {
-        return before;
-    }
-    let p = pos.xyz;
-    let n = normalize(textureLoad(g_normal, px, 0).xyz);
-    let albedo = textureLoad(g_albedo, px, 0).xyz;
-    // VAL by VAL: its visibility once, then its VPLs.
+// Light of VAL k's VPLs at p (normal n), without albedo / π and visibility.
+fn val_light(k: u32, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     let m = gather.counts.y;
-    var sum = vec3<f32>(0.0);
-    for (var k = 0u; k < m; k++) {
-        let first = order[k];
-        let last = order[k + 1u];
-        if first == last {
+    var part = vec3<f32>(0.0);
+    for (var j = order[k]; j < order[k + 1u]; j++) {
+        let v = vpls[order[m + 1u + j]];
+        let d = v.position - p;
+        let d2 = dot(d, d);
+        if d2 <= 0.0 {
             continue;
         }
-        let vis = val_visibility(k, p, n);
-        if vis <= 0.0 {
+        let w = d * inverseSqrt(d2);
+        let cos_x = dot(n, w);
+        let cos_v = -dot(v.normal, w);
+        if cos_x <= 0.0 || cos_v <= 0.0 {
             continue;
         }
-        var part = vec3<f32>(0.0);
-        for (var j = first; j < last; j++) {
-            let v = vpls[order[m + 1u + j]];
-            let d = v.position - p;
-            let d2 = dot(d, d);
-            if d2 <= 0.0 {
-                continue;
-            }
-            let w = d * inverseSqrt(d2);
-            let cos_x = dot(n, w);
-            let cos_v = -dot(v.normal, w);
-            if cos_x <= 0.0 || cos_v <= 0.0 {
-                continue;
-            }
-            part += v.flux / PI * min(cos_x * cos_v / d2, gather.params.x);
-        }
-        sum += part * vis;
+        part += v.flux / PI * min(cos_x * cos_v / d2, gather.params.x);
     }
-    return vec4<f32>(before.xyz + albedo / PI * sum, 1.0);
+    return part;
+}
+
+struct Surface {
+    p: vec3<f32>,
+    n: vec3<f32>,
+    albedo: vec3<f32>,
+    before: vec4<f32>,
+    found: bool,
+};
+
+fn surface(frag: vec4<f32>) -> Surface {
+    let px = vec2<i32>(frag.xy);
+    var s: Surface;
+    s.before = textureLoad(previous, px, 0);
+    let pos = textureLoad(g_position, px, 0);
+    s.found = pos.w != 0.0;
+    s.p = pos.xyz;
+    s.n = normalize(textureLoad(g_normal, px, 0).xyz);
+    s.albedo = textureLoad(g_albedo, px, 0).xyz;
+    return s;
+}
+
+// Mode val-hard. VAL by VAL: its visibility once, then its VPLs.
+@fragment
+fn fs_hard(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
+    let s = surface(frag);
+    if !s.found {
+        return s.before;
+    }
+    var sum = vec3<f32>(0.0);
+    for (var k = 0u; k < gather.counts.y; k++) {
+        if order[k] == order[k + 1u] {
+            continue;
+        }
+        let vis = val_visibility(k, s.p, s.n);
+        if vis > 0.0 {
+            sum += val_light(k, s.p, s.n) * vis;
+        }
+    }
+    return vec4<f32>(s.before.xyz + s.albedo / PI * sum, 1.0);
+}
+
+// ---- mode val-cssm: the VAL's visibility from its Fourier basis (cssm.wgsl) ----
+
+@group(0) @binding(9) var basis_tex: texture_2d_array<f32>;
+@group(0) @binding(10) var basis_sampler: sampler;
+@group(0) @binding(11) var<storage, read> ranges: array<f32>;
+
+// 2 Σ_k [cos(c_k d)·S_k − sin(c_k d)·C_k] / c_k over the basis groups from `base` (0: the
+// basis, G: the basis times z), filtered at `lod` around `uv`.
+fn series(base: u32, k: u32, uv: vec2<f32>, lod: f32, d: f32) -> f32 {
+    let m = gather.counts.y;
+    let terms = gather.counts.w;
+    var s = 0.0;
+    for (var g = 0u; 2u * g < terms; g++) {
+        let b = textureSampleLevel(basis_tex, basis_sampler, uv, i32((base + g) * m + k), lod);
+        let c1 = PI * f32(4u * g + 1u);
+        s += (cos(c1 * d) * b.x - sin(c1 * d) * b.y) / c1;
+        if 2u * g + 2u <= terms {
+            let c2 = PI * f32(4u * g + 3u);
+            s += (cos(c2 * d) * b.z - sin(c2 * d) * b.w) / c2;
+        }
+    }
+    return 2.0 * s;
+}
+
+// Soft visibility of p (normal n) from VAL k (Dong et al. §4.2): the average blocker depth
+// over the VAL's extent seen from p, the penumbra p·cos β = (d − z_avg)·Δ / z_avg, the kernel
+// α = atan(p·cos β / d) of size α/π in the map, the filtered Fourier shadow test there,
+// sharpened by s about ½ and clamped (runtime::cssm::visibility).
+fn cssm_visibility(k: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
+    let size = f32(gather.counts.z);
+    let val = vals[k];
+    let nv = val.normal.xyz;
+    let c = val.position.xyz + nv * gather.params.w;
+    let tb = basis(nv);
+    let texel = length(p - c) * 4.0 / size;
+    let q = p + n * texel * gather.params.y - c;
+    let local = vec3<f32>(dot(q, tb[0]), dot(q, tb[1]), dot(q, nv));
+    let dist = length(local);
+    if local.z <= 0.0 || dist <= 0.0 {
+        return 1.0;
+    }
+    let range = ranges[k];
+    let d = clamp(dist / range - gather.cssm.x, 0.0, 1.0);
+    let dir = local / dist;
+    let puv = dir.xy / (1.0 + dir.z);
+    let uv = vec2<f32>(puv.x * 0.5 + 0.5, 0.5 - puv.y * 0.5);
+    let groups = (gather.counts.w + 1u) / 2u;
+    // The sender's size Δ: the side of the square of its rectangle's area.
+    let sender = sqrt(max(val.normal.w, 0.0));
+    // Blocker search over the VAL's extent seen from p.
+    let search = atan(sender / dist) / PI;
+    let lod_s = log2(max(search * size, 1.0));
+    let blockers = 0.5 - series(0u, k, uv, lod_s, d);
+    if blockers <= 0.02 {
+        return 1.0;
+    }
+    let z_sum = 0.5 * textureSampleLevel(basis_tex, basis_sampler, uv, i32(2u * groups * gather.counts.y + k), lod_s).x
+        - series(groups, k, uv, lod_s, d);
+    let z_avg = clamp(z_sum / blockers, 1e-4, d) * range;
+    let penumbra = (dist - z_avg) * sender / z_avg;
+    let alpha = atan(penumbra / dist);
+    let lod = log2(max(alpha / PI * size, 1.0));
+    return clamp(0.5 + gather.cssm.y * series(0u, k, uv, lod, d), 0.0, 1.0);
+}
+
+@fragment
+fn fs_cssm(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
+    let s = surface(frag);
+    if !s.found {
+        return s.before;
+    }
+    var sum = vec3<f32>(0.0);
+    for (var k = 0u; k < gather.counts.y; k++) {
+        if order[k] == order[k + 1u] {
+            continue;
+        }
+        let vis = cssm_visibility(k, s.p, s.n);
+        if vis > 0.0 {
+            sum += val_light(k, s.p, s.n) * vis;
+        }
+    }
+    return vec4<f32>(s.before.xyz + s.albedo / PI * sum, 1.0);
 }
