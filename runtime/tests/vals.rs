@@ -436,3 +436,39 @@ fn the_fourier_shadow_test_approaches_the_step_and_rings_within_its_bound() {
         assert!(worst < 0.02, "K = {terms}: sharpened step off by {worst}");
     }
 }
+
+#[test]
+fn val_modes_render_0_vpls_m_above_n_one_val_and_coplanar_vpls_without_nan() {
+    use visgate_runtime::gpu::GpuMode;
+    let ctx = context();
+    let (scene, vpls) = vpls_of(Builtin::FourRooms, 256);
+    let cam = scene.cameras[0].clone();
+    let floor: Vec<Vpl> = (0..64)
+        .map(|i| {
+            Vpl::new(
+                Vec3::new(1.0 + (i % 8) as f32 * 0.3, 0.0, 1.0 + (i / 8) as f32 * 0.3),
+                Vec3::Y,
+                Vec3::splat(0.1),
+            )
+        })
+        .collect();
+    let direct = gpu_image(&ctx, &scene, &cam, &[], GpuMode::DirectOnly, 1);
+    for mode in [GpuMode::ValHard, GpuMode::ValCssm] {
+        // N = 0: direct light alone.
+        let img = gpu_image(&ctx, &scene, &cam, &[], mode, 30);
+        assert_eq!(img.pixels, direct.pixels, "{mode:?} without VPLs");
+        for (what, v, m) in [
+            ("M > N", &vpls[..5], 30),
+            ("M = 1", &vpls[..], 1),
+            ("one VPL per VAL", &vpls[..64], 64),
+            ("coplanar VPLs (zero-area VALs in one plane)", &floor[..], 4),
+        ] {
+            let img = gpu_image(&ctx, &scene, &cam, v, mode, m);
+            assert!(img.pixels.iter().all(|p| p.is_finite()), "{mode:?} {what}");
+            assert!(
+                img.mean().x >= direct.mean().x,
+                "{mode:?} {what}: light only adds"
+            );
+        }
+    }
+}
