@@ -166,6 +166,10 @@ pub struct RenderArgs {
     /// Fourier terms of the convolution soft shadow maps (--mode val-cssm), 1..=16.
     #[arg(long, default_value_t = 4)]
     pub cssm_terms: u32,
+    /// Normal offset of CSSM lookups, texels (slope-scaled up to 2×): larger avoids
+    /// self-shadowing under wide filter kernels, smaller keeps contact shadows.
+    #[arg(long, default_value_t = 3.0)]
+    pub cssm_normal_offset: f32,
     /// Per-VPL paraboloid map size (GPU), texels.
     #[arg(long, default_value_t = 128)]
     pub vpl_map_size: u32,
@@ -345,6 +349,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
                     },
                     val_map_size: args.val_map_size,
                     cssm_terms: args.cssm_terms,
+                    cssm_normal_offset: args.cssm_normal_offset,
                     gates: GateParams {
                         oversize: args.gate_oversize,
                         max_hops: args.gate_hops,

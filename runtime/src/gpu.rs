@@ -238,6 +238,9 @@ pub struct GpuParams {
     pub cssm_terms: u32,
     /// Sharpening of the CSSM reconstruction ([`crate::cssm::visibility`]). [Limit: 1..=8]
     pub cssm_sharpness: f32,
+    /// Normal offset of CSSM lookups (slope-scaled up to 2×): larger avoids self-shadowing
+    /// under wide kernels, smaller keeps contact shadows. [Units: texels] [Limit: 0..=64]
+    pub cssm_normal_offset: f32,
 }
 
 impl Default for GpuParams {
@@ -257,6 +260,7 @@ impl Default for GpuParams {
             val_map_size: 256,
             cssm_terms: crate::cssm::DEFAULT_TERMS,
             cssm_sharpness: crate::cssm::DEFAULT_SHARPNESS,
+            cssm_normal_offset: 3.0,
         }
     }
 }
@@ -805,6 +809,8 @@ pub struct GpuRenderer {
     val_pipelines: vals::Pipelines,
     val_shadow: wgpu::RenderPipeline,
     cssm_pipelines: vals::CssmPipelines,
+    /// Last frame's VAL centres (count, buffer), for a warm start.
+    val_centres: std::sync::Mutex<Option<(u32, wgpu::Buffer)>>,
 }
 
 /// A level's gate tables on the GPU.
@@ -1094,6 +1100,7 @@ impl GpuRenderer {
             val_pipelines: vals::Pipelines::new(d, VALS_WGSL),
             val_shadow,
             cssm_pipelines: vals::CssmPipelines::new(d, CSSM_WGSL, VAL_GATHER_WGSL),
+            val_centres: std::sync::Mutex::new(None),
         })
     }
 

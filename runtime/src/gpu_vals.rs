@@ -105,7 +105,17 @@ impl GpuRenderer {
                 mapped_at_creation: false,
             })
         };
-        let centres = buf("val centres", m as u64 * 32);
+        // Last frame's centres (warm start), or the restart from the VPLs.
+        let last = params
+            .warm_start
+            .then(|| self.val_centres.lock().ok()?.take())
+            .flatten()
+            .filter(|(count, _)| *count == m);
+        let restart = last.is_none();
+        let centres = match last {
+            Some((_, b)) => b,
+            None => buf("val centres", m as u64 * 32),
+        };
         let mapping = buf("vpl → val", n as u64 * 4);
         let vals = buf("vals", m as u64 * std::mem::size_of::<Val>() as u64);
         let order = buf("vpls by val", (m as u64 + 1 + n as u64) * 4);
@@ -141,9 +151,11 @@ impl GpuRenderer {
         });
         if n > 0 {
             let (gv, gm) = (n.div_ceil(64), m.div_ceil(64));
-            pass.set_pipeline(&p.init);
-            pass.set_bind_group(0, &init_bg, &[]);
-            pass.dispatch_workgroups(gm, 1, 1);
+            if restart {
+                pass.set_pipeline(&p.init);
+                pass.set_bind_group(0, &init_bg, &[]);
+                pass.dispatch_workgroups(gm, 1, 1);
+            }
             for _ in 0..params.iterations {
                 pass.set_pipeline(&p.assign);
                 pass.set_bind_group(0, &assign_bg, &[]);
@@ -166,6 +178,9 @@ impl GpuRenderer {
             pass.dispatch_workgroups(gm, 1, 1);
         }
         drop(pass);
+        if let Ok(mut keep) = self.val_centres.lock() {
+            *keep = Some((m, centres.clone()));
+        }
         Ok(Buffers {
             vals,
             mapping,
@@ -227,7 +242,7 @@ pub struct ValGather {
     pub counts: [u32; 4],
     /// x g_max (1/m²), y normal offset (texels), z bias (texels), w VAL centre offset (m).
     pub params: [f32; 4],
-    /// x receiver offset (normalised depth), y sharpening s.
+    /// x receiver offset (normalised depth), y sharpening s, z normal offset (texels).
     pub cssm: [f32; 4],
 }
 
@@ -328,9 +343,10 @@ impl GpuRenderer {
         let d = &ctx.device;
         let (m, s) = (params.vals.count, params.val_map_size);
         let sharp = params.cssm_sharpness;
-        if !(1.0..=8.0).contains(&sharp) {
+        let off = params.cssm_normal_offset;
+        if !(1.0..=8.0).contains(&sharp) || !(0.0..=64.0).contains(&off) {
             return Err(RenderError::Param(format!(
-                "CSSM sharpening {sharp} must be 1..=8"
+                "CSSM sharpening {sharp} must be 1..=8 and normal offset {off} 0..=64 texels"
             )));
         }
         if !(16..=4096).contains(&s) || m > d.limits().max_texture_array_layers {
@@ -461,7 +477,7 @@ impl GpuRenderer {
                 cssm: [
                     crate::cssm::receiver_offset(terms, params.cssm_sharpness),
                     params.cssm_sharpness,
-                    0.0,
+                    params.cssm_normal_offset,
                     0.0,
                 ],
             }),

@@ -32,6 +32,9 @@ pub struct ValParams {
     pub w_x: f32,
     /// Weight of the normal term. [Limit: ≥ 0]
     pub w_alpha: f32,
+    /// Start from last frame's centres instead of the restart (§5.2 rejects this: VALs get
+    /// lost as lights move; kept to measure it). On the GPU the renderer keeps the centres.
+    pub warm_start: bool,
 }
 
 impl Default for ValParams {
@@ -41,6 +44,7 @@ impl Default for ValParams {
             iterations: 8,
             w_x: 0.7,
             w_alpha: 0.3,
+            warm_start: false,
         }
     }
 }

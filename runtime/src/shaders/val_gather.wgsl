@@ -12,7 +12,8 @@ struct ValGather {
     counts: vec4<u32>,
     // x g_max (1/m²), y normal offset (texels), z bias (texels), w VAL centre offset (m).
     params: vec4<f32>,
-    // x receiver offset (normalised depth, val-cssm), y sharpening s, z, w unused.
+    // x receiver offset (normalised depth, val-cssm), y sharpening s, z normal offset
+    // (texels), w unused.
     cssm: vec4<f32>,
 };
 
@@ -148,7 +149,10 @@ fn cssm_visibility(k: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
     let c = val.position.xyz + nv * gather.params.w;
     let tb = basis(nv);
     let texel = length(p - c) * 4.0 / size;
-    let q = p + n * texel * gather.params.y - c;
+    // A filtered kernel spans depths of the receiver's own surface in front of it, the more
+    // the more grazing the VAL sees it: a normal offset of its own, slope-scaled up to 2×.
+    let grazing = clamp(1.0 / max(dot(n, normalize(c - p)), 1e-3), 1.0, 2.0);
+    let q = p + n * texel * gather.cssm.z * grazing - c;
     let local = vec3<f32>(dot(q, tb[0]), dot(q, tb[1]), dot(q, nv));
     let dist = length(local);
     if local.z <= 0.0 || dist <= 0.0 {
