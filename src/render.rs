@@ -170,6 +170,17 @@ pub struct RenderArgs {
     /// self-shadowing under wide filter kernels, smaller keeps contact shadows.
     #[arg(long, default_value_t = 3.0)]
     pub cssm_normal_offset: f32,
+    /// VAL modes: interleaved sampling in blocks of this side (each pixel lights itself with
+    /// one of side² VPL subsets, then a geometry-aware blur over the block); 1: every VPL
+    /// at every pixel.
+    #[arg(long, default_value_t = 8)]
+    pub interleave: u32,
+    /// Blur: leave out neighbours farther than this fraction of the scene's size.
+    #[arg(long, default_value_t = 0.1)]
+    pub blur_distance: f32,
+    /// Blur: leave out neighbours whose normals' cosine is below this.
+    #[arg(long, default_value_t = 0.8, allow_hyphen_values = true)]
+    pub blur_normal: f32,
     /// Per-VPL paraboloid map size (GPU), texels.
     #[arg(long, default_value_t = 128)]
     pub vpl_map_size: u32,
@@ -350,6 +361,9 @@ pub fn run(args: RenderArgs) -> Result<()> {
                     val_map_size: args.val_map_size,
                     cssm_terms: args.cssm_terms,
                     cssm_normal_offset: args.cssm_normal_offset,
+                    interleave: args.interleave,
+                    blur_distance: args.blur_distance,
+                    blur_normal: args.blur_normal,
                     gates: GateParams {
                         oversize: args.gate_oversize,
                         max_hops: args.gate_hops,
@@ -476,7 +490,8 @@ fn print_passes(t: &PassTimes, mode: Mode) {
         if mode == Mode::ValCssm {
             rows.push(("CSSM basis + mips", t.cssm, g.cssm));
         }
-        rows.push(("indirect lighting (all VPLs)", t.vpl_gather, g.vpl_gather));
+        rows.push(("indirect lighting", t.vpl_gather, g.vpl_gather));
+        rows.push(("blur + compose", t.blur, g.blur));
     }
     println!("pass                               CPU wall (ms)   GPU (ms)");
     for (name, cpu, gpu) in rows {

@@ -80,6 +80,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                         count: m,
                         ..ValParams::default()
                     },
+                    // Every VPL at every pixel: the error of the visibility alone.
+                    interleave: 1,
                     ..GpuParams::default()
                 },
             )?;

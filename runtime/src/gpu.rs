@@ -241,6 +241,16 @@ pub struct GpuParams {
     /// Normal offset of CSSM lookups (slope-scaled up to 2×): larger avoids self-shadowing
     /// under wide kernels, smaller keeps contact shadows. [Units: texels] [Limit: 0..=64]
     pub cssm_normal_offset: f32,
+    /// VAL modes: interleaved sampling in blocks of this side (a pixel lights itself with one
+    /// of side² VPL subsets; 1: every VPL at every pixel), then the geometry-aware blur over
+    /// the block. [Units: px] [Limit: 1..=16]
+    pub interleave: u32,
+    /// Blur: neighbours farther than this fraction of the scene's size are left out (Laine et
+    /// al.: 0.1). [Limit: ≥ 0]
+    pub blur_distance: f32,
+    /// Blur: neighbours whose normal's cosine to the pixel's is below this are left out (Laine
+    /// et al.: 0.8). [Limit: −1..=1]
+    pub blur_normal: f32,
 }
 
 impl Default for GpuParams {
@@ -261,6 +271,9 @@ impl Default for GpuParams {
             cssm_terms: crate::cssm::DEFAULT_TERMS,
             cssm_sharpness: crate::cssm::DEFAULT_SHARPNESS,
             cssm_normal_offset: 3.0,
+            interleave: 8,
+            blur_distance: 0.1,
+            blur_normal: 0.8,
         }
     }
 }
@@ -283,6 +296,8 @@ pub struct PassTimes {
     pub val_clustering: f64,
     /// Mode val-cssm: depth ranges, Fourier basis and mips.
     pub cssm: f64,
+    /// VAL modes: the geometry-aware blur and compose.
+    pub blur: f64,
     /// Per-VPL paraboloid maps, all batches.
     pub vpl_maps: f64,
     /// Indirect gather with per-VPL maps, all batches.
@@ -316,6 +331,8 @@ pub struct GpuStageTimes {
     pub val_clustering: f64,
     /// CSSM basis and mips (mode val-cssm).
     pub cssm: f64,
+    /// Blur and compose (VAL modes).
+    pub blur: f64,
 }
 
 /// Stages a [`Timer`] tells apart, in [`GpuStageTimes`] order.
@@ -330,6 +347,7 @@ enum Stage {
     LightAssignment,
     ValClustering,
     Cssm,
+    Blur,
 }
 
 /// Timestamp queries around stages: each span is the beginning of a stage's first pass and
@@ -427,7 +445,7 @@ impl Timer {
         ctx.wait();
         let ticks: Vec<u64> = bytemuck::cast_slice(&slice.get_mapped_range().ok()?).to_vec();
         read.unmap();
-        let mut t = [0f64; 9];
+        let mut t = [0f64; 10];
         for &(stage, b) in &self.spans {
             let (a, z) = (ticks[b as usize], ticks[b as usize + 1]);
             t[stage as usize] += z.saturating_sub(a) as f64 * period as f64 * 1e-9;
@@ -442,6 +460,7 @@ impl Timer {
             light_assignment: t[6],
             val_clustering: t[7],
             cssm: t[8],
+            blur: t[9],
         })
     }
 }
@@ -1724,7 +1743,7 @@ impl GpuRenderer {
         } else {
             0
         };
-        let mut timer = Timer::new(ctx, 9 + 2 * batches);
+        let mut timer = Timer::new(ctx, 10 + 2 * batches);
         let layers = shadow_views.len().max(1) as u32;
         if layers > d.limits().max_texture_array_layers {
             return Err(RenderError::Param(format!(

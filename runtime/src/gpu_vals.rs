@@ -15,7 +15,7 @@ use crate::vpl::Vpl;
 #[repr(C)]
 #[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
 pub struct ValFrame {
-    /// x VPLs, y VALs.
+    /// x VPLs, y VALs, z interleaving subsets B.
     pub counts: [u32; 4],
     /// x w_x, y w_α, z 1 / D.
     pub weights: [f32; 4],
@@ -27,6 +27,7 @@ pub(super) struct Pipelines {
     assign: wgpu::ComputePipeline,
     update: wgpu::ComputePipeline,
     finish: wgpu::ComputePipeline,
+    bucket_counts: wgpu::ComputePipeline,
     offsets: wgpu::ComputePipeline,
     scatter: wgpu::ComputePipeline,
 }
@@ -52,6 +53,7 @@ impl Pipelines {
             assign: pipe("assign"),
             update: pipe("update"),
             finish: pipe("finish"),
+            bucket_counts: pipe("bucket_counts"),
             offsets: pipe("offsets"),
             scatter: pipe("scatter"),
         }
@@ -62,13 +64,14 @@ impl Pipelines {
 pub(super) struct Buffers {
     pub vals: wgpu::Buffer,
     pub mapping: wgpu::Buffer,
-    /// M + 1 offsets, then the VPL indices sorted by VAL.
+    /// M·B + 1 offsets, then the VPL indices sorted by VAL and interleaving subset.
     pub order: wgpu::Buffer,
 }
 
 impl GpuRenderer {
     /// Clusters `vpls` (already in `vpl_buf`) into VALs on the GPU, recording into `enc`.
     /// The normalising length D comes from the VPLs on the CPU (they pass through it).
+    #[allow(clippy::too_many_arguments)]
     pub(super) fn val_passes(
         &self,
         ctx: &GpuContext,
@@ -76,11 +79,13 @@ impl GpuRenderer {
         vpls: &[Vpl],
         vpl_buf: &wgpu::Buffer,
         params: &ValParams,
+        subsets: u32,
         timestamps: Option<wgpu::ComputePassTimestampWrites>,
     ) -> Result<Buffers, RenderError> {
         params.check()?;
         let d = &ctx.device;
         let (n, m) = (vpls.len() as u32, params.count);
+        let subsets = subsets.max(1);
         let max = d.limits().max_compute_workgroups_per_dimension;
         if n.div_ceil(64) > max {
             return Err(RenderError::Param(format!(
@@ -88,7 +93,7 @@ impl GpuRenderer {
             )));
         }
         let frame = ValFrame {
-            counts: [n, m, 0, 0],
+            counts: [n, m, subsets, 0],
             weights: [params.w_x, params.w_alpha, 1.0 / scale_of(vpls), 0.0],
         };
         let frame_buf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -118,7 +123,8 @@ impl GpuRenderer {
         };
         let mapping = buf("vpl → val", n as u64 * 4);
         let vals = buf("vals", m as u64 * std::mem::size_of::<Val>() as u64);
-        let order = buf("vpls by val", (m as u64 + 1 + n as u64) * 4);
+        let buckets = m as u64 * subsets as u64;
+        let order = buf("vpls by val", (buckets + 1 + n as u64) * 4);
         let p = &self.val_pipelines;
         let bind = |pipeline: &wgpu::ComputePipeline, with: &[(u32, &wgpu::Buffer)]| {
             let entries: Vec<wgpu::BindGroupEntry> = with
@@ -143,7 +149,8 @@ impl GpuRenderer {
             &p.finish,
             &[base[0], base[1], base[2], (3, &mapping), (4, &vals)],
         );
-        let offsets_bg = bind(&p.offsets, &[base[0], (4, &vals), (5, &order)]);
+        let counts_bg = bind(&p.bucket_counts, &[base[0], (3, &mapping), (5, &order)]);
+        let offsets_bg = bind(&p.offsets, &[base[0], (5, &order)]);
         let scatter_bg = bind(&p.scatter, &[base[0], (3, &mapping), (5, &order)]);
         let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("val clustering"),
@@ -170,12 +177,16 @@ impl GpuRenderer {
             pass.set_pipeline(&p.finish);
             pass.set_bind_group(0, &finish_bg, &[]);
             pass.dispatch_workgroups(gm, 1, 1);
+            let gb = (buckets as u32).div_ceil(64);
+            pass.set_pipeline(&p.bucket_counts);
+            pass.set_bind_group(0, &counts_bg, &[]);
+            pass.dispatch_workgroups(gb, 1, 1);
             pass.set_pipeline(&p.offsets);
             pass.set_bind_group(0, &offsets_bg, &[]);
             pass.dispatch_workgroups(1, 1, 1);
             pass.set_pipeline(&p.scatter);
             pass.set_bind_group(0, &scatter_bg, &[]);
-            pass.dispatch_workgroups(gm, 1, 1);
+            pass.dispatch_workgroups(gb, 1, 1);
         }
         drop(pass);
         if let Ok(mut keep) = self.val_centres.lock() {
@@ -200,7 +211,7 @@ impl GpuRenderer {
         let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
             label: Some("vals"),
         });
-        let b = self.val_passes(ctx, &mut enc, vpls, &vpl_buf, params, None)?;
+        let b = self.val_passes(ctx, &mut enc, vpls, &vpl_buf, params, 1, None)?;
         ctx.queue.submit([enc.finish()]);
         let m = params.count as usize;
         let vals: Vec<Val> = if vpls.is_empty() {
@@ -244,6 +255,10 @@ pub struct ValGather {
     pub params: [f32; 4],
     /// x receiver offset (normalised depth), y sharpening s, z normal offset (texels).
     pub cssm: [f32; 4],
+    /// x interleaving block side b (1: none), y subsets b².
+    pub interleave: [u32; 4],
+    /// x blur distance threshold (m), y blur normal threshold (cosine).
+    pub blur: [f32; 4],
 }
 
 /// Constants of the CSSM passes, shared with WGSL (`CssmFrame` in cssm.wgsl).
@@ -263,6 +278,7 @@ pub(super) struct CssmPipelines {
     downsample: wgpu::ComputePipeline,
     gather_hard: wgpu::RenderPipeline,
     gather_cssm: wgpu::RenderPipeline,
+    compose: wgpu::RenderPipeline,
 }
 
 impl CssmPipelines {
@@ -318,6 +334,7 @@ impl CssmPipelines {
             downsample: compute("downsample"),
             gather_hard: fullscreen("fs_hard"),
             gather_cssm: fullscreen("fs_cssm"),
+            compose: fullscreen("fs_compose"),
         }
     }
 }
@@ -343,6 +360,15 @@ impl GpuRenderer {
         let d = &ctx.device;
         let (m, s) = (params.vals.count, params.val_map_size);
         let sharp = params.cssm_sharpness;
+        let (blur_d, blur_n) = (params.blur_distance, params.blur_normal);
+        let blur_ok = blur_d >= 0.0 && blur_d.is_finite() && (-1.0..=1.0).contains(&blur_n);
+        if !((1..=16).contains(&params.interleave) && blur_ok) {
+            return Err(RenderError::Param(format!(
+                "interleaving block {} must be 1..=16, blur distance {blur_d} ≥ 0 (fraction of \
+                 the scene) and blur normal threshold {blur_n} in -1..=1",
+                params.interleave
+            )));
+        }
         let off = params.cssm_normal_offset;
         if !(1.0..=8.0).contains(&sharp) || !(0.0..=64.0).contains(&off) {
             return Err(RenderError::Param(format!(
@@ -364,12 +390,14 @@ impl GpuRenderer {
             label: Some("val clustering"),
         });
         let span = timer.span(Stage::ValClustering);
+        let block = params.interleave;
         let b = self.val_passes(
             ctx,
             &mut enc,
             vpls,
             vpl_buf,
             &params.vals,
+            block * block,
             timer.compute_writes(span),
         )?;
         ctx.queue.submit([enc.finish()]);
@@ -455,15 +483,22 @@ impl GpuRenderer {
             None
         };
 
-        // 3. The gather, read from `out` and written to a copy (ping-pong), copied back.
+        // 3. The gather into an indirect target, then the compose (blur over the interleaving
+        // block, × albedo, onto `out` through a copy: ping-pong).
         let t0 = Instant::now();
-        let other = super::texture(
-            d,
-            "hdr (ping-pong)",
-            [out.width(), out.height(), 1],
-            wgpu::TextureFormat::Rgba32Float,
-            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-        );
+        let target = |label: &str| {
+            super::texture(
+                d,
+                label,
+                [out.width(), out.height(), 1],
+                wgpu::TextureFormat::Rgba32Float,
+                wgpu::TextureUsages::RENDER_ATTACHMENT
+                    | wgpu::TextureUsages::COPY_SRC
+                    | wgpu::TextureUsages::TEXTURE_BINDING,
+            )
+        };
+        let indirect = target("indirect irradiance");
+        let other = target("hdr (ping-pong)");
         let uniform = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("val gather"),
             contents: bytemuck::bytes_of(&ValGather {
@@ -480,6 +515,8 @@ impl GpuRenderer {
                     params.cssm_normal_offset,
                     0.0,
                 ],
+                interleave: [block, block * block, 0, 0],
+                blur: [blur_d * self.far_m / 4.0, blur_n, 0.0, 0.0],
             }),
             usage: wgpu::BufferUsages::UNIFORM,
         });
@@ -489,14 +526,24 @@ impl GpuRenderer {
             ..Default::default()
         });
         let out_view = out.create_view(&Default::default());
+        let indirect_view = indirect.create_view(&Default::default());
         let tex = wgpu::BindingResource::TextureView;
+        let bind = |pipeline: &wgpu::RenderPipeline, entries: Vec<(u32, wgpu::BindingResource)>| {
+            let entries: Vec<wgpu::BindGroupEntry> = entries
+                .into_iter()
+                .map(|(binding, resource)| wgpu::BindGroupEntry { binding, resource })
+                .collect();
+            d.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("val gather"),
+                layout: &pipeline.get_bind_group_layout(0),
+                entries: &entries,
+            })
+        };
         let mut entries: Vec<(u32, wgpu::BindingResource)> = vec![
             (0, uniform.as_entire_binding()),
             (1, vpl_buf.as_entire_binding()),
             (3, tex(&gviews[0])),
             (4, tex(&gviews[1])),
-            (5, tex(&gviews[2])),
-            (6, tex(&out_view)),
             (7, b.order.as_entire_binding()),
             (8, b.vals.as_entire_binding()),
         ];
@@ -512,21 +559,36 @@ impl GpuRenderer {
                 &self.cssm_pipelines.gather_hard
             }
         };
-        let entries: Vec<wgpu::BindGroupEntry> = entries
-            .into_iter()
-            .map(|(binding, resource)| wgpu::BindGroupEntry { binding, resource })
-            .collect();
-        let bg = d.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("val gather"),
-            layout: &pipeline.get_bind_group_layout(0),
-            entries: &entries,
-        });
+        let bg = bind(pipeline, entries);
         let span = timer.span(Stage::VplGather);
         super::fullscreen_pass(
             ctx,
             "val gather",
-            &other.create_view(&Default::default()),
+            &indirect_view,
             pipeline,
+            &bg,
+            timer.writes(span, true, true),
+        );
+        times.vpl_gather = t0.elapsed().as_secs_f64();
+        let t0 = Instant::now();
+        let compose = &self.cssm_pipelines.compose;
+        let bg = bind(
+            compose,
+            vec![
+                (0, uniform.as_entire_binding()),
+                (3, tex(&gviews[0])),
+                (4, tex(&gviews[1])),
+                (5, tex(&gviews[2])),
+                (6, tex(&out_view)),
+                (12, tex(&indirect_view)),
+            ],
+        );
+        let span = timer.span(Stage::Blur);
+        super::fullscreen_pass(
+            ctx,
+            "val compose",
+            &other.create_view(&Default::default()),
+            compose,
             &bg,
             timer.writes(span, true, true),
         );
@@ -536,7 +598,7 @@ impl GpuRenderer {
         enc.copy_texture_to_texture(other.as_image_copy(), out.as_image_copy(), out.size());
         ctx.queue.submit([enc.finish()]);
         ctx.wait();
-        times.vpl_gather = t0.elapsed().as_secs_f64();
+        times.blur = t0.elapsed().as_secs_f64();
         Ok(())
     }
 }

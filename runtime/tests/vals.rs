@@ -213,7 +213,7 @@ fn a_static_light_gives_the_same_vals_every_frame_at_any_scale() {
 
 mod common;
 
-/// GPU image of `scene` from `cam` with `vpls` in `mode`, 64×48.
+/// GPU image of `scene` from `cam` with `vpls` in `mode`, 64×48, every VPL at every pixel.
 fn gpu_image(
     ctx: &GpuContext,
     scene: &visgate_formats::Scene,
@@ -222,9 +222,24 @@ fn gpu_image(
     mode: visgate_runtime::gpu::GpuMode,
     vals: u32,
 ) -> visgate_runtime::hdr::HdrImage {
+    gpu_image_with(ctx, scene, cam, vpls, mode, vals, 1, [64, 48])
+}
+
+/// As [`gpu_image`] with interleaving blocks of side `interleave` at `size`.
+#[allow(clippy::too_many_arguments)]
+fn gpu_image_with(
+    ctx: &GpuContext,
+    scene: &visgate_formats::Scene,
+    cam: &visgate_formats::Camera,
+    vpls: &[Vpl],
+    mode: visgate_runtime::gpu::GpuMode,
+    vals: u32,
+    interleave: u32,
+    size: [u32; 2],
+) -> visgate_runtime::hdr::HdrImage {
     use visgate_runtime::gpu::GpuParams;
     let gpu = GpuRenderer::new(ctx, scene).expect("upload");
-    let view = visgate_runtime::camera::View::new(cam, [64, 48]).expect("view");
+    let view = visgate_runtime::camera::View::new(cam, size).expect("view");
     gpu.render(
         ctx,
         &view,
@@ -235,6 +250,7 @@ fn gpu_image(
                 count: vals,
                 ..ValParams::default()
             },
+            interleave,
             ..GpuParams::default()
         },
     )
@@ -470,5 +486,44 @@ fn val_modes_render_0_vpls_m_above_n_one_val_and_coplanar_vpls_without_nan() {
                 "{mode:?} {what}: light only adds"
             );
         }
+    }
+}
+
+#[test]
+fn interleaved_sampling_with_the_blur_stays_close_to_every_vpl_at_every_pixel() {
+    use visgate_runtime::gpu::GpuMode;
+    use visgate_runtime::metrics::errors;
+    let ctx = context();
+    let (scene, vpls) = vpls_of(Builtin::CornellBox, 1024);
+    let cam = scene.cameras[0].clone();
+    let full = gpu_image_with(
+        &ctx,
+        &scene,
+        &cam,
+        &vpls,
+        GpuMode::ValCssm,
+        30,
+        1,
+        [128, 128],
+    );
+    for block in [2, 4, 8] {
+        let img = gpu_image_with(
+            &ctx,
+            &scene,
+            &cam,
+            &vpls,
+            GpuMode::ValCssm,
+            30,
+            block,
+            [128, 128],
+        );
+        let e = errors(&img, &full).expect("size");
+        eprintln!("interleave {block}: {e:?}");
+        assert!(img.pixels.iter().all(|p| p.is_finite()));
+        assert!(e.rel_mse < 0.05, "block {block}: {e:?}");
+        assert!(
+            (e.image_mean / e.reference_mean - 1.0).abs() < 0.02,
+            "{e:?}"
+        );
     }
 }

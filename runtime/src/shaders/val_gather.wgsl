@@ -1,9 +1,12 @@
 // Indirect light with the visibility of virtual area lights (Dong et al. §4): every VPL lights
 // every pixel, seen through the shadow map of its VAL C(i): L(x) = Σ_i L_i(x)·V_C(i)(x), added
-// to the image so far (`previous`, ping-pong). Mode val-hard (fs_hard) tests one texel of the
-// VAL's paraboloid distance map (hard shadows: the banding baseline); val-cssm (fs_cssm)
-// filters its Fourier basis (convolution soft shadow maps). A receiver in the negative
-// half-space of a VAL is fully visible, as in the paper. vpl.wgsl and val.wgsl come first.
+// as irradiance into an indirect target, then composed onto the image so far (`previous`,
+// ping-pong). Mode val-hard (fs_hard) tests one texel of the VAL's paraboloid distance map
+// (hard shadows: the banding baseline); val-cssm (fs_cssm) filters its Fourier basis
+// (convolution soft shadow maps). A receiver in the negative half-space of a VAL is fully
+// visible, as in the paper. Interleaved sampling: a pixel of a b × b block lights itself with
+// one subset of the VPLs (i mod b² = its place in the block), and fs_compose blurs over the
+// block where the geometry agrees. vpl.wgsl and val.wgsl come first.
 
 const PI: f32 = 3.14159265358979;
 
@@ -15,6 +18,10 @@ struct ValGather {
     // x receiver offset (normalised depth, val-cssm), y sharpening s, z normal offset
     // (texels), w unused.
     cssm: vec4<f32>,
+    // x interleaving block side b (1: none), y subsets B = b², z, w unused.
+    interleave: vec4<u32>,
+    // x blur distance threshold (m), y normal threshold (cosine), z, w unused.
+    blur: vec4<f32>,
 };
 
 @group(0) @binding(0) var<uniform> gather: ValGather;
@@ -24,7 +31,7 @@ struct ValGather {
 @group(0) @binding(4) var g_normal: texture_2d<f32>;
 @group(0) @binding(5) var g_albedo: texture_2d<f32>;
 @group(0) @binding(6) var previous: texture_2d<f32>;
-// M + 1 offsets, then the VPL indices sorted by VAL (vals.wgsl's order).
+// M·B + 1 offsets, then the VPL indices sorted by VAL and subset (vals.wgsl's order).
 @group(0) @binding(7) var<storage, read> order: array<u32>;
 @group(0) @binding(8) var<storage, read> vals: array<Val>;
 
@@ -52,12 +59,14 @@ fn val_visibility(k: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
     return select(0.0, 1.0, textureLoad(maps, t, i32(k), 0).x >= d - texel * gather.params.z);
 }
 
-// Light of VAL k's VPLs at p (normal n), without albedo / π and visibility.
-fn val_light(k: u32, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
-    let m = gather.counts.y;
+// Light at p (normal n) of the VPLs of VAL k in interleaving subset j, without albedo / π
+// and visibility.
+fn val_light(k: u32, j: u32, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    let bucket = k * gather.interleave.y + j;
+    let first = gather.counts.y * gather.interleave.y + 1u;
     var part = vec3<f32>(0.0);
-    for (var j = order[k]; j < order[k + 1u]; j++) {
-        let v = vpls[order[m + 1u + j]];
+    for (var e = order[bucket]; e < order[bucket + 1u]; e++) {
+        let v = vpls[order[first + e]];
         let d = v.position - p;
         let d2 = dot(d, d);
         if d2 <= 0.0 {
@@ -77,41 +86,47 @@ fn val_light(k: u32, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
 struct Surface {
     p: vec3<f32>,
     n: vec3<f32>,
-    albedo: vec3<f32>,
-    before: vec4<f32>,
+    // This pixel's interleaving subset.
+    j: u32,
     found: bool,
 };
 
 fn surface(frag: vec4<f32>) -> Surface {
     let px = vec2<i32>(frag.xy);
     var s: Surface;
-    s.before = textureLoad(previous, px, 0);
     let pos = textureLoad(g_position, px, 0);
     s.found = pos.w != 0.0;
     s.p = pos.xyz;
     s.n = normalize(textureLoad(g_normal, px, 0).xyz);
-    s.albedo = textureLoad(g_albedo, px, 0).xyz;
+    let b = gather.interleave.x;
+    s.j = u32(px.x) % b + b * (u32(px.y) % b);
     return s;
 }
 
-// Mode val-hard. VAL by VAL: its visibility once, then its VPLs.
+fn bucket_empty(k: u32, j: u32) -> bool {
+    let bucket = k * gather.interleave.y + j;
+    return order[bucket] == order[bucket + 1u];
+}
+
+// Mode val-hard: the irradiance (× B, this pixel's subset standing for all) of the VPLs, VAL
+// by VAL: its visibility once, then its VPLs.
 @fragment
 fn fs_hard(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     let s = surface(frag);
     if !s.found {
-        return s.before;
+        return vec4<f32>(0.0);
     }
     var sum = vec3<f32>(0.0);
     for (var k = 0u; k < gather.counts.y; k++) {
-        if order[k] == order[k + 1u] {
+        if bucket_empty(k, s.j) {
             continue;
         }
         let vis = val_visibility(k, s.p, s.n);
         if vis > 0.0 {
-            sum += val_light(k, s.p, s.n) * vis;
+            sum += val_light(k, s.j, s.p, s.n) * vis;
         }
     }
-    return vec4<f32>(s.before.xyz + s.albedo / PI * sum, 1.0);
+    return vec4<f32>(sum * f32(gather.interleave.y), 1.0);
 }
 
 // ---- mode val-cssm: the VAL's visibility from its Fourier basis (cssm.wgsl) ----
@@ -186,17 +201,58 @@ fn cssm_visibility(k: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
 fn fs_cssm(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     let s = surface(frag);
     if !s.found {
-        return s.before;
+        return vec4<f32>(0.0);
     }
     var sum = vec3<f32>(0.0);
     for (var k = 0u; k < gather.counts.y; k++) {
-        if order[k] == order[k + 1u] {
+        if bucket_empty(k, s.j) {
             continue;
         }
         let vis = cssm_visibility(k, s.p, s.n);
         if vis > 0.0 {
-            sum += val_light(k, s.p, s.n) * vis;
+            sum += val_light(k, s.j, s.p, s.n) * vis;
         }
     }
-    return vec4<f32>(s.before.xyz + s.albedo / PI * sum, 1.0);
+    return vec4<f32>(sum * f32(gather.interleave.y), 1.0);
+}
+
+// ---- compose: the interleaved irradiance, blurred over the block where the geometry
+// agrees (Laine et al.: positions closer than a fraction of the scene, normals closer than a
+// cosine), times albedo / π, onto the direct light ----
+
+@group(0) @binding(12) var indirect: texture_2d<f32>;
+
+@fragment
+fn fs_compose(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
+    let px = vec2<i32>(frag.xy);
+    let before = textureLoad(previous, px, 0);
+    let pos = textureLoad(g_position, px, 0);
+    if pos.w == 0.0 {
+        return before;
+    }
+    let n = normalize(textureLoad(g_normal, px, 0).xyz);
+    let albedo = textureLoad(g_albedo, px, 0).xyz;
+    let b = i32(gather.interleave.x);
+    let size = vec2<i32>(textureDimensions(indirect));
+    var sum = vec3<f32>(0.0);
+    var weight = 0.0;
+    for (var dy = -b / 2; dy < b - b / 2; dy++) {
+        for (var dx = -b / 2; dx < b - b / 2; dx++) {
+            let q = px + vec2<i32>(dx, dy);
+            if any(q < vec2<i32>(0)) || any(q >= size) {
+                continue;
+            }
+            let qp = textureLoad(g_position, q, 0);
+            if qp.w == 0.0 {
+                continue;
+            }
+            let qn = normalize(textureLoad(g_normal, q, 0).xyz);
+            if length(qp.xyz - pos.xyz) > gather.blur.x || dot(qn, n) < gather.blur.y {
+                continue;
+            }
+            sum += textureLoad(indirect, q, 0).xyz;
+            weight += 1.0;
+        }
+    }
+    return vec4<f32>(before.xyz + albedo / PI * sum / max(weight, 1.0), 1.0);
 }

@@ -10,7 +10,7 @@
 const PI: f32 = 3.14159265358979;
 
 struct ValFrame {
-    // x VPLs N, y VALs M, z, w unused.
+    // x VPLs N, y VALs M, z interleaving subsets B (1: none), w unused.
     counts: vec4<u32>,
     // x w_x, y w_α, z 1 / D (the VPLs' bounding-box diagonal), w unused.
     weights: vec4<f32>,
@@ -120,29 +120,56 @@ fn finish(@builtin(global_invocation_id) id: vec3<u32>) {
     vals[k] = v;
 }
 
-// The VPLs sorted by VAL, for a gather that computes each VAL's visibility once per pixel:
-// M + 1 offsets, then the VPL indices, VAL by VAL, each VAL's in VPL order.
+// The VPLs sorted by VAL and, within a VAL, by interleaving subset j = i mod B (B = the
+// interleaving block's pixels, 1 without interleaving), each bucket in VPL order, for a gather
+// that computes each VAL's visibility once per pixel and lights a pixel with its subset:
+// M·B + 1 offsets (bucket k·B + j), then the VPL indices.
 @group(0) @binding(5) var<storage, read_write> order: array<u32>;
+
+fn buckets() -> u32 {
+    return frame.counts.y * frame.counts.z;
+}
+
+@compute @workgroup_size(64)
+fn bucket_counts(@builtin(global_invocation_id) id: vec3<u32>) {
+    let b = id.x;
+    if b >= buckets() {
+        return;
+    }
+    let k = b / frame.counts.z;
+    let j = b % frame.counts.z;
+    var c = 0u;
+    for (var i = j; i < frame.counts.x; i += frame.counts.z) {
+        if mapping[i] == k {
+            c++;
+        }
+    }
+    order[b] = c;
+}
 
 @compute @workgroup_size(1)
 fn offsets() {
     var run = 0u;
-    for (var k = 0u; k < frame.counts.y; k++) {
-        order[k] = run;
-        run += u32(vals[k].position.w);
+    let n = buckets();
+    for (var b = 0u; b < n; b++) {
+        let c = order[b];
+        order[b] = run;
+        run += c;
     }
-    order[frame.counts.y] = run;
+    order[n] = run;
 }
 
 @compute @workgroup_size(64)
 fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
-    let k = id.x;
-    let m = frame.counts.y;
-    if k >= m {
+    let b = id.x;
+    let n = buckets();
+    if b >= n {
         return;
     }
-    var at = m + 1u + order[k];
-    for (var i = 0u; i < frame.counts.x; i++) {
+    let k = b / frame.counts.z;
+    let j = b % frame.counts.z;
+    var at = n + 1u + order[b];
+    for (var i = j; i < frame.counts.x; i += frame.counts.z) {
         if mapping[i] == k {
             order[at] = i;
             at++;
