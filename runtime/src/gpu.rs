@@ -1123,6 +1123,11 @@ impl GpuRenderer {
         })
     }
 
+    /// Replaces the lights (they move freely: shadow maps and RSMs are made per frame).
+    pub fn set_lights(&mut self, lights: &[Light]) {
+        self.lights = lights.to_vec();
+    }
+
     /// The shadow layers' view-projections and the lights as the GPU sees them.
     fn light_views(&self) -> (Vec<GpuLight>, Vec<ShadowView>) {
         let mut lights = Vec::new();
