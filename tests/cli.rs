@@ -487,3 +487,64 @@ fn render_gates_uses_a_baked_level_and_refuses_a_missing_or_stale_one() {
     assert!(!o.status.success());
     assert!(stderr(&o).contains("re-bake"), "{}", stderr(&o));
 }
+
+#[test]
+fn render_val_modes_print_their_passes_and_refuse_bad_settings() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("v.exr");
+    let out = out.to_str().expect("utf-8");
+    let base = [
+        "render",
+        "builtin:cornell-box",
+        "--vpls",
+        "128",
+        "--size",
+        "32x24",
+        "--vals",
+        "8",
+        "--out",
+        out,
+    ];
+    for (mode, passes) in [
+        (
+            "val-cssm",
+            &[
+                "VAL clustering",
+                "VAL paraboloid maps",
+                "CSSM basis",
+                "blur + compose",
+            ][..],
+        ),
+        ("val-hard", &["VAL clustering", "indirect lighting"][..]),
+    ] {
+        let mut a = base.to_vec();
+        a.extend(["--mode", mode]);
+        let o = visgate(&a);
+        assert!(o.status.success(), "{mode}: {}", stderr(&o));
+        for p in passes {
+            assert!(stdout(&o).contains(p), "{mode} {p}: {}", stdout(&o));
+        }
+        for (flag, value, says) in [
+            ("--vals", "0", "VALs 0"),
+            ("--interleave", "0", "interleaving block 0"),
+            ("--cssm-terms", "0", "terms 0"),
+        ] {
+            if flag == "--cssm-terms" && mode == "val-hard" {
+                continue;
+            }
+            let mut bad = a.clone();
+            if let Some(i) = bad.iter().position(|x| *x == flag) {
+                bad[i + 1] = value;
+            } else {
+                bad.extend([flag, value]);
+            }
+            let o = visgate(&bad);
+            assert!(!o.status.success(), "{mode} {flag} {value}");
+            assert!(stderr(&o).contains(says), "{mode} {flag}: {}", stderr(&o));
+        }
+        let mut cpu = a.clone();
+        cpu.push("--cpu");
+        let o = visgate(&cpu);
+        assert!(stderr(&o).contains("--mode reference"), "{}", stderr(&o));
+    }
+}
