@@ -30,6 +30,17 @@
 //! cutoff_deg = 30             # half-angle where the light reaches 0
 //! beam_deg = 20               # half-angle of full intensity (<= cutoff); linear in angle between
 //!
+//! [[mesh]]                    # a dynamic mesh may move: keyframes (linear, held outside)
+//! path = "box.obj"
+//! static = false
+//! animate = [{ t = 0, translate = [1, 0, 1] }, { t = 4, translate = [3, 0, 1], rotate_deg = [0, 90, 0] }]
+//!
+//! [[light]]                   # a light may move too: keyframes, or an orbit about the up axis
+//! type = "point"
+//! position = [4, 2.5, 4]
+//! intensity = [8, 8, 8]
+//! orbit = { centre = [4, 2.5, 4], radius = 1.5, period_s = 8 }
+//!
 //! [[camera]]
 //! name = "main"
 //! eye = [0.5, 1.6, 0.5]
@@ -140,6 +151,57 @@ pub struct MeshDesc {
     /// Scale applied before rotation. [Limit: finite, non-zero]
     #[serde(default)]
     pub scale: Scale,
+    /// Keyframes of a dynamic mesh's translation and rotation (they replace `translate` and
+    /// `rotate_deg` at their times). [Limit: only with static = false]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub animate: Vec<MeshKey>,
+    /// A dynamic mesh's translation moves on a circle about the up axis.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub orbit: Option<Orbit>,
+}
+
+/// A keyframe of a dynamic mesh.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MeshKey {
+    /// Time. [Units: s] [Limit: finite, increasing along the keys]
+    pub t: f64,
+    /// Translation at this time, scene units.
+    #[serde(default)]
+    pub translate: [f64; 3],
+    /// Euler angles at this time, degrees, applied about X, then Y, then Z.
+    #[serde(default)]
+    pub rotate_deg: [f64; 3],
+}
+
+/// A keyframe of a light.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LightKey {
+    /// Time. [Units: s] [Limit: finite, increasing along the keys]
+    pub t: f64,
+    /// Position at this time, scene units.
+    pub position: [f64; 3],
+    /// A spot's target at this time (else its own `target`, or it keeps its direction).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub target: Option<[f64; 3]>,
+}
+
+/// Motion on a circle about the scene's up axis: at time t the point is
+/// `centre + radius·(cos φ, 0, sin φ)` (in the plane normal to the up axis), φ = 2π·t/period +
+/// phase.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Orbit {
+    /// Centre, scene units.
+    pub centre: [f64; 3],
+    /// Radius, scene units. [Limit: ≥ 0, finite]
+    pub radius: f64,
+    /// Time of one turn. [Units: s] [Limit: > 0, finite]
+    pub period_s: f64,
+    /// Angle at t = 0. [Units: degrees]
+    #[serde(default)]
+    pub phase_deg: f64,
 }
 
 /// Replaces a material's diffuse albedo (and drops its texture).
@@ -170,6 +232,12 @@ pub struct PointLightDesc {
     pub position: [f64; 3],
     /// Radiant intensity, W/sr per RGB channel. [Limit: >= 0, finite]
     pub intensity: [f32; 3],
+    /// Keyframes of its position.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub animate: Vec<LightKey>,
+    /// Its position moves on a circle.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub orbit: Option<Orbit>,
 }
 
 /// A spot light.
@@ -190,6 +258,12 @@ pub struct SpotLightDesc {
     pub cutoff_deg: f32,
     /// Half-angle of full intensity. [Limit: (0, cutoff_deg]] [Units: degrees]
     pub beam_deg: f32,
+    /// Keyframes of its position (and target).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub animate: Vec<LightKey>,
+    /// Its position moves on a circle (keeping its direction, or its target).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub orbit: Option<Orbit>,
 }
 
 /// A named look-at camera.
@@ -223,6 +297,8 @@ impl SceneDesc {
                 translate: [0.0; 3],
                 rotate_deg: [0.0; 3],
                 scale: Scale::Uniform(1.0),
+                animate: vec![],
+                orbit: None,
             }],
             materials: vec![],
             lights: vec![],
@@ -284,6 +360,24 @@ impl SceneDesc {
                     m.path.display()
                 )));
             }
+            let what = format!("mesh {} ({})", i + 1, m.path.display());
+            if (!m.animate.is_empty() || m.orbit.is_some()) && m.is_static {
+                return Err(bad(format!(
+                    "{what} moves (animate/orbit) but is static: set static = false (static \
+                     meshes are baked and must not move)"
+                )));
+            }
+            if !m.animate.is_empty() && m.orbit.is_some() {
+                return Err(bad(format!("{what}: give animate or orbit, not both")));
+            }
+            check_keys(
+                m.animate
+                    .iter()
+                    .map(|k| (k.t, finite3(&k.translate) && finite3(&k.rotate_deg))),
+                &what,
+            )
+            .map_err(bad)?;
+            check_orbit(m.orbit.as_ref(), &what).map_err(bad)?;
         }
         for o in &self.materials {
             if o.albedo.iter().any(|a| !(0.0..=1.0).contains(a)) {
@@ -302,6 +396,23 @@ impl SceneDesc {
             if !finite3(position) {
                 return Err(bad(format!("light {n}: position must be finite")));
             }
+            let (animate, orbit) = match l {
+                LightDesc::Point(p) => (&p.animate, &p.orbit),
+                LightDesc::Spot(s) => (&s.animate, &s.orbit),
+            };
+            let what = format!("light {n}");
+            if !animate.is_empty() && orbit.is_some() {
+                return Err(bad(format!("{what}: give animate or orbit, not both")));
+            }
+            check_keys(
+                animate.iter().map(|k| {
+                    let target_ok = k.target.is_none_or(|t| finite3(&t) && t != k.position);
+                    (k.t, finite3(&k.position) && target_ok)
+                }),
+                &what,
+            )
+            .map_err(bad)?;
+            check_orbit(orbit.as_ref(), &what).map_err(bad)?;
             if intensity.iter().any(|x| !(x.is_finite() && *x >= 0.0)) {
                 return Err(bad(format!(
                     "light {n}: intensity {intensity:?} W/sr must be finite and >= 0"
@@ -376,4 +487,44 @@ impl SceneDesc {
         }
         Ok(())
     }
+}
+
+/// Keys (time, values finite) must have finite, strictly increasing times and finite values.
+fn check_keys(keys: impl Iterator<Item = (f64, bool)>, what: &str) -> Result<(), String> {
+    let mut last = f64::NEG_INFINITY;
+    for (i, (t, finite)) in keys.enumerate() {
+        if !t.is_finite() || t <= last {
+            return Err(format!(
+                "{what}: key {} at t = {t} s: times must be finite and increase from key to key",
+                i + 1
+            ));
+        }
+        if !finite {
+            return Err(format!(
+                "{what}: key {} has a non-finite value (or a target on the position)",
+                i + 1
+            ));
+        }
+        last = t;
+    }
+    Ok(())
+}
+
+/// An orbit needs a finite centre, a finite radius ≥ 0 and a finite period > 0.
+fn check_orbit(orbit: Option<&Orbit>, what: &str) -> Result<(), String> {
+    let Some(o) = orbit else { return Ok(()) };
+    let ok = o.centre.iter().all(|x| x.is_finite())
+        && o.radius.is_finite()
+        && o.radius >= 0.0
+        && o.period_s.is_finite()
+        && o.period_s > 0.0
+        && o.phase_deg.is_finite();
+    if !ok {
+        return Err(format!(
+            "{what}: orbit needs a finite centre, radius >= 0, period_s > 0 and a finite phase \
+             (got radius {}, period_s {})",
+            o.radius, o.period_s
+        ));
+    }
+    Ok(())
 }

@@ -136,6 +136,142 @@ pub struct Scene {
     pub cameras: Vec<Camera>,
     /// What the import saw.
     pub report: ImportReport,
+    /// How its dynamic meshes and lights move ([`Scene::at`] poses it).
+    pub animation: Animation,
+}
+
+/// The motion of a scene's dynamic meshes and lights, in world space.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Animation {
+    /// Moving `[[mesh]]` entries.
+    pub meshes: Vec<MeshTrack>,
+    /// Moving lights.
+    pub lights: Vec<LightTrack>,
+}
+
+/// How one `[[mesh]]` entry moves: its world transform at time t against the one it was
+/// imported with.
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeshTrack {
+    /// The `[[mesh]]` entry (every [`Mesh`] with this `entry` moves).
+    pub entry: usize,
+    /// File space to world.
+    space: DMat4,
+    /// The entry's scale.
+    scale: DVec3,
+    /// Its rotation when not keyframed, degrees.
+    rotate_deg: DVec3,
+    /// World transform at rest (the imported geometry's).
+    rest: DMat4,
+    /// Keys (t, translation, rotation in degrees), file units.
+    keys: Vec<(f64, DVec3, DVec3)>,
+    /// Or a circle (file units).
+    orbit: Option<crate::desc::Orbit>,
+    /// The file's up axis (the orbit's axis).
+    up: UpAxis,
+}
+
+/// How one light moves.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LightTrack {
+    /// Index into [`Scene::lights`].
+    pub light: usize,
+    /// File space to world.
+    space: SceneSpace,
+    /// Keys (t, position, target), file units.
+    keys: Vec<(f64, DVec3, Option<DVec3>)>,
+    /// Or a circle (file units).
+    orbit: Option<crate::desc::Orbit>,
+    /// A spot's fixed target (file units): it re-aims as it moves.
+    target: Option<DVec3>,
+    /// The file's up axis.
+    up: UpAxis,
+}
+
+/// A point on an orbit at time t, file units.
+fn orbit_point(o: &crate::desc::Orbit, up: UpAxis, t: f64) -> DVec3 {
+    let phi = std::f64::consts::TAU * t / o.period_s + o.phase_deg.to_radians();
+    let (c, s) = (phi.cos() * o.radius, phi.sin() * o.radius);
+    DVec3::from(o.centre)
+        + match up {
+            UpAxis::Y => DVec3::new(c, 0.0, s),
+            UpAxis::Z => DVec3::new(c, s, 0.0),
+        }
+}
+
+/// Linear interpolation of keyed values at t, held before the first and after the last key.
+fn sample<T: Copy>(keys: &[(f64, T)], t: f64, lerp: impl Fn(T, T, f64) -> T) -> Option<T> {
+    let first = keys.first()?;
+    if t <= first.0 {
+        return Some(first.1);
+    }
+    for w in keys.windows(2) {
+        if t <= w[1].0 {
+            return Some(lerp(w[0].1, w[1].1, (t - w[0].0) / (w[1].0 - w[0].0)));
+        }
+    }
+    keys.last().map(|k| k.1)
+}
+
+impl MeshTrack {
+    /// World transform of the entry at time t.
+    pub fn world(&self, t: f64) -> DMat4 {
+        let (translate, rotate) = match &self.orbit {
+            Some(o) => (orbit_point(o, self.up, t), self.rotate_deg),
+            None => {
+                let keys: Vec<(f64, (DVec3, DVec3))> =
+                    self.keys.iter().map(|&(k, a, b)| (k, (a, b))).collect();
+                sample(&keys, t, |a, b, u| (a.0.lerp(b.0, u), a.1.lerp(b.1, u)))
+                    .unwrap_or((DVec3::ZERO, self.rotate_deg))
+            }
+        };
+        self.space * local_matrix(self.scale, rotate, translate)
+    }
+}
+
+impl LightTrack {
+    /// Position (world) and, for a spot, its axis (world) at time t.
+    pub fn pose(&self, t: f64) -> (Vec3, Option<Vec3>) {
+        let (pos, target) = match &self.orbit {
+            Some(o) => (orbit_point(o, self.up, t), self.target),
+            None => {
+                // A key without a target keeps the spot's own.
+                let keys: Vec<(f64, (DVec3, Option<DVec3>))> = self
+                    .keys
+                    .iter()
+                    .map(|&(k, p, q)| (k, (p, q.or(self.target))))
+                    .collect();
+                sample(&keys, t, |a, b, u| {
+                    let q = match (a.1, b.1) {
+                        (Some(x), Some(y)) => Some(x.lerp(y, u)),
+                        (x, y) => x.or(y),
+                    };
+                    (a.0.lerp(b.0, u), q)
+                })
+                .map(|(p, q)| (p, q.or(self.target)))
+                .unwrap_or((DVec3::ZERO, self.target))
+            }
+        };
+        let axis = target
+            .filter(|q| *q != pos)
+            .map(|q| self.space.direction(q - pos));
+        (self.space.point(pos.to_array()), axis)
+    }
+}
+
+/// A `[[mesh]]` entry's local transform: scale, then Euler rotation (X, then Y, then Z), then
+/// translation.
+fn local_matrix(scale: DVec3, rotate_deg: DVec3, translate: DVec3) -> DMat4 {
+    DMat4::from_scale_rotation_translation(
+        scale,
+        DQuat::from_euler(
+            EulerRot::ZYX,
+            rotate_deg.z.to_radians(),
+            rotate_deg.y.to_radians(),
+            rotate_deg.x.to_radians(),
+        ),
+        translate,
+    )
 }
 
 /// The kind of file a scene argument names.
@@ -223,19 +359,31 @@ impl Scene {
             lights: vec![],
             cameras: vec![],
             report: ImportReport::default(),
+            animation: Animation::default(),
         };
         for (entry, (mdesc, model)) in desc.meshes.iter().zip(models).enumerate() {
-            let local = DMat4::from_scale_rotation_translation(
+            let local = local_matrix(
                 DVec3::from(mdesc.scale.as_vec()),
-                DQuat::from_euler(
-                    EulerRot::ZYX,
-                    mdesc.rotate_deg[2].to_radians(),
-                    mdesc.rotate_deg[1].to_radians(),
-                    mdesc.rotate_deg[0].to_radians(),
-                ),
+                DVec3::from(mdesc.rotate_deg),
                 DVec3::from(mdesc.translate),
             );
             let m = to_world.matrix * local;
+            if !mdesc.animate.is_empty() || mdesc.orbit.is_some() {
+                scene.animation.meshes.push(MeshTrack {
+                    entry,
+                    space: to_world.matrix,
+                    scale: DVec3::from(mdesc.scale.as_vec()),
+                    rotate_deg: DVec3::from(mdesc.rotate_deg),
+                    rest: m,
+                    keys: mdesc
+                        .animate
+                        .iter()
+                        .map(|k| (k.t, DVec3::from(k.translate), DVec3::from(k.rotate_deg)))
+                        .collect(),
+                    orbit: mdesc.orbit.clone(),
+                    up: desc.up,
+                });
+            }
             let normal_m = m.inverse().transpose();
             let flip = m.determinant() < 0.0;
             let mat_base = scene.materials.len() as u32;
@@ -304,7 +452,24 @@ impl Scene {
                 });
             }
         }
-        for l in &desc.lights {
+        for (li, l) in desc.lights.iter().enumerate() {
+            let (animate, orbit, target) = match l {
+                LightDesc::Point(p) => (&p.animate, &p.orbit, None),
+                LightDesc::Spot(s) => (&s.animate, &s.orbit, s.target),
+            };
+            if !animate.is_empty() || orbit.is_some() {
+                scene.animation.lights.push(LightTrack {
+                    light: li,
+                    space: to_world,
+                    keys: animate
+                        .iter()
+                        .map(|k| (k.t, DVec3::from(k.position), k.target.map(DVec3::from)))
+                        .collect(),
+                    orbit: orbit.clone(),
+                    target: target.map(DVec3::from),
+                    up: desc.up,
+                });
+            }
             scene.lights.push(match l {
                 LightDesc::Point(p) => Light::Point {
                     position: to_world.point(p.position),
@@ -349,6 +514,50 @@ impl Scene {
             });
         }
         Ok(scene)
+    }
+
+    /// Whether anything moves.
+    pub fn is_animated(&self) -> bool {
+        !self.animation.meshes.is_empty() || !self.animation.lights.is_empty()
+    }
+
+    /// The scene at time `t` (seconds): dynamic meshes and lights where their keyframes or
+    /// orbits put them. Static meshes never move, so the static-geometry hash stays.
+    pub fn at(&self, t: f64) -> Scene {
+        let mut out = self.clone();
+        for track in &self.animation.meshes {
+            let delta = track.world(t) * track.rest.inverse();
+            let normal_m = delta.inverse().transpose();
+            for m in out.meshes.iter_mut().filter(|m| m.entry == track.entry) {
+                for p in &mut m.positions {
+                    *p = delta.transform_point3(p.as_dvec3()).as_vec3();
+                }
+                for n in &mut m.normals {
+                    *n = normal_m
+                        .transform_vector3(n.as_dvec3())
+                        .normalize_or_zero()
+                        .as_vec3();
+                }
+            }
+        }
+        for track in &self.animation.lights {
+            let (pos, axis) = track.pose(t);
+            match out.lights.get_mut(track.light) {
+                Some(Light::Point { position, .. }) => *position = pos,
+                Some(Light::Spot {
+                    position,
+                    direction,
+                    ..
+                }) => {
+                    *position = pos;
+                    if let Some(a) = axis {
+                        *direction = a;
+                    }
+                }
+                None => {}
+            }
+        }
+        out
     }
 
     /// Triangles of all meshes.
@@ -440,7 +649,7 @@ impl std::fmt::Display for GeometryHash {
 }
 
 /// The conversion from a scene file's space (its up axis and unit) to visgate's.
-#[derive(Debug, Clone, Copy)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SceneSpace {
     /// The affine map from file coordinates to metres, +Y up.
     pub matrix: DMat4,

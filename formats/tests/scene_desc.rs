@@ -282,3 +282,90 @@ fn a_scene_with_no_meshes_is_an_empty_scene_error() {
     let e = Scene::load(&path, &Default::default()).expect_err("empty");
     assert!(matches!(e, SceneError::Empty { .. }), "{e}");
 }
+
+#[test]
+fn dynamic_meshes_and_lights_follow_their_keys_and_orbits() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    write_obj(dir.path(), "t.obj", TRI_OBJ);
+    let toml = r#"
+[[mesh]]
+path = "t.obj"
+
+[[mesh]]
+path = "t.obj"
+static = false
+animate = [{ t = 1, translate = [0, 0, 0] }, { t = 3, translate = [4, 0, 0], rotate_deg = [0, 0, 90] }]
+
+[[light]]
+type = "point"
+position = [0, 2, 0]
+intensity = [1, 1, 1]
+orbit = { centre = [0, 2, 0], radius = 2, period_s = 4 }
+
+[[light]]
+type = "spot"
+position = [0, 3, 0]
+target = [0, 0, 0]
+intensity = [1, 1, 1]
+cutoff_deg = 30
+beam_deg = 20
+animate = [{ t = 0, position = [0, 3, 0] }, { t = 2, position = [2, 3, 0], target = [2, 0, 0] }]
+"#;
+    let path = dir.path().join("s.toml");
+    std::fs::write(&path, toml).expect("write");
+    let scene = Scene::load(&path, &Default::default()).expect("loads");
+    assert!(scene.is_animated());
+    let near = |a: glam::Vec3, b: glam::Vec3| (a - b).length() < 1e-5;
+    // Before the first key the mesh holds it; halfway it has moved 2 m and turned 45°.
+    let at0 = scene.at(0.0);
+    assert_eq!(at0.meshes[1].positions, scene.meshes[1].positions);
+    let at2 = scene.at(2.0);
+    let p = at2.meshes[1].positions[1]; // (1, 0, 0) at rest
+    let r = 45f32.to_radians();
+    assert!(near(p, glam::Vec3::new(2.0 + r.cos(), r.sin(), 0.0)), "{p}");
+    // After the last key it holds that: (1,0,0) turned 90° and moved 4 m.
+    assert!(near(
+        scene.at(9.0).meshes[1].positions[1],
+        glam::Vec3::new(4.0, 1.0, 0.0)
+    ));
+    // Static meshes never move, so the hash of the static geometry stays.
+    assert_eq!(at2.meshes[0].positions, scene.meshes[0].positions);
+    assert_eq!(at2.static_geometry_hash(), scene.static_geometry_hash());
+    // The orbit: a quarter period turns the light 90° about +Y.
+    let pos = |s: &Scene, i: usize| match s.lights[i] {
+        Light::Point { position, .. } | Light::Spot { position, .. } => position,
+    };
+    assert!(near(pos(&scene.at(0.0), 0), glam::Vec3::new(2.0, 2.0, 0.0)));
+    assert!(near(pos(&scene.at(1.0), 0), glam::Vec3::new(0.0, 2.0, 2.0)));
+    // The keyed spot moves and re-aims at its (interpolated) target.
+    let s1 = scene.at(1.0);
+    assert!(near(pos(&s1, 1), glam::Vec3::new(1.0, 3.0, 0.0)));
+    if let Light::Spot { direction, .. } = s1.lights[1] {
+        assert!(near(direction, glam::Vec3::NEG_Y), "{direction}");
+    }
+}
+
+#[test]
+fn bad_animations_are_errors_naming_what_to_fix() {
+    let base = "[[mesh]]\npath = \"m.obj\"\n";
+    let e = err(&format!(
+        "{base}animate = [{{ t = 0, translate = [1, 0, 0] }}]\n"
+    ));
+    assert!(e.contains("static = false"), "{e}");
+    let e = err(&format!(
+        "{base}static = false\nanimate = [{{ t = 1 }}, {{ t = 1 }}]\n"
+    ));
+    assert!(e.contains("increase"), "{e}");
+    let e = err(&format!(
+        "{base}static = false\norbit = {{ centre = [0, 0, 0], radius = 1, period_s = 0 }}\n"
+    ));
+    assert!(e.contains("period_s > 0"), "{e}");
+    let e = err(&format!(
+        "{base}static = false\norbit = {{ centre = [0, 0, 0], radius = 1, period_s = 2 }}\nanimate = [{{ t = 0 }}]\n"
+    ));
+    assert!(e.contains("not both"), "{e}");
+    let e = err(
+        "[[light]]\ntype = \"point\"\nposition = [0, 0, 0]\nintensity = [1, 1, 1]\nanimate = [{ t = 0, position = [0, 0, 0] }, { t = nan, position = [0, 0, 0] }]\n",
+    );
+    assert!(e.contains("key 2"), "{e}");
+}

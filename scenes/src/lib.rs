@@ -270,6 +270,8 @@ impl Builtin {
             LightDesc::Point(PointLightDesc {
                 position: p,
                 intensity: [i; 3],
+                animate: vec![],
+                orbit: None,
             })
         };
         let camera = |eye: [f64; 3], target: [f64; 3], fov: f32| CameraDesc {
@@ -317,6 +319,8 @@ impl Builtin {
                         intensity: [20.0, 18.0, 15.0],
                         cutoff_deg: 40.0,
                         beam_deg: 30.0,
+                        animate: vec![],
+                        orbit: None,
                     }),
                 ],
                 vec![camera([0.5, 1.6, 0.5], [4.1, 1.0, 2.0], 75.0)],
@@ -328,6 +332,8 @@ impl Builtin {
                 vec![LightDesc::Point(PointLightDesc {
                     position: [-0.005, 1.95, -0.03],
                     intensity: [3.04, 2.14, 0.71],
+                    animate: vec![],
+                    orbit: None,
                 })],
                 vec![camera([0.0, 1.0, 3.5], [0.0, 1.0, 0.0], 45.0)],
             ),
@@ -343,6 +349,8 @@ impl Builtin {
                 translate: [0.0; 3],
                 rotate_deg: [0.0; 3],
                 scale: Scale::Uniform(1.0),
+                animate: vec![],
+                orbit: None,
             }],
             materials: vec![],
             lights,

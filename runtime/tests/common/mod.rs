@@ -45,6 +45,7 @@ pub fn quads(quads: &[[Vec3; 4]], albedo: f32, lights: Vec<Light>) -> Scene {
         lights,
         cameras: Vec::new(),
         report: ImportReport::default(),
+        animation: Default::default(),
     }
 }
 
