@@ -51,6 +51,11 @@ VPLs come from light paths traced from the scene's lights on the CPU (--vpl-sour
 Halton points on the GPU (--vpl-source rsm: one bounce), deterministic for a --seed. Output: .exr is linear radiance (W/(m²·sr), for `visgate diff`),
 .png is sRGB at --exposure stops.
 
+Dynamic scenes: a scene file's dynamic meshes and lights may move (keyframes or orbits, see
+the README); --time poses the scene, --frames/--fps render a sequence. The VAL modes and the
+per-VPL maps follow every change without a bake; the gate modes keep the baked static topology
+(dynamic meshes are lit, and shadow direct light, but do not block indirect light there).
+
 Examples:
   visgate render builtin:cornell-box --mode reference --vpls 4096 --out cornell.exr
   visgate render builtin:four-rooms --mode none --size 320x240 --out none.png
@@ -187,6 +192,17 @@ pub struct RenderArgs {
     /// Per-VPL maps rendered and gathered per batch (bounds their memory).
     #[arg(long, default_value_t = 128)]
     pub vpl_batch: u32,
+    /// Time of the (first) frame, seconds: dynamic meshes and lights of the scene file are
+    /// posed there (their keyframes or orbits).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub time: f64,
+    /// Frames to render from --time on, --fps apart; with more than one, OUT gets a frame
+    /// number (shot.png → shot-0000.png, shot-0001.png, …).
+    #[arg(long, default_value_t = 1)]
+    pub frames: u32,
+    /// Frames per second of a sequence.
+    #[arg(long, default_value_t = 30.0)]
+    pub fps: f64,
     /// Rayon threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
@@ -216,6 +232,14 @@ pub fn run(args: RenderArgs) -> Result<()> {
         bail!(
             "--out {}: write .exr (linear radiance) or .png (sRGB)",
             args.out.display()
+        );
+    }
+    if args.frames == 0 || !(args.fps.is_finite() && args.fps > 0.0) || !args.time.is_finite() {
+        bail!(
+            "--frames {} must be >= 1, --fps {} > 0 and --time {} finite",
+            args.frames,
+            args.fps,
+            args.time
         );
     }
     if args.threads == Some(0) {
@@ -285,11 +309,8 @@ pub fn run(args: RenderArgs) -> Result<()> {
         );
     }
     let view = View::new(&camera, size)?;
+    let rest = &scene;
     pool.install(|| -> Result<()> {
-        let t = Instant::now();
-        let tracer = Tracer::new(&scene);
-        let bvh_s = t.elapsed().as_secs_f64();
-        let t = Instant::now();
         if args.vpl_source == VplSource::Rsm && args.bounces != 1 {
             bail!(
                 "--vpl-source rsm gives one bounce; use --vpl-source paths for --bounces {}",
@@ -297,170 +318,206 @@ pub fn run(args: RenderArgs) -> Result<()> {
             );
         }
         let on_gpu = args.mode != Mode::Reference && !args.cpu;
+        let t = Instant::now();
+        let first = rest.at(args.time);
         let gpu_ctx = if on_gpu || args.vpl_source == VplSource::Rsm {
             Some(GpuContext::new()?)
         } else {
             None
         };
         let mut gpu = match &gpu_ctx {
-            Some(ctx) => Some(GpuRenderer::new(ctx, &scene)?),
+            Some(ctx) => Some(GpuRenderer::new(ctx, &first)?),
             None => None,
         };
-        let vpls = match (args.mode, args.vpl_source, &gpu_ctx, &gpu) {
-            (Mode::DirectOnly, _, _, _) => Vec::new(),
-            (_, VplSource::Rsm, Some(ctx), Some(g)) => {
-                g.rsm_vpls(ctx, args.vpls, args.rsm_size, args.seed)?
-            }
-            _ => path_vpls(
-                &tracer,
-                &scene.lights,
-                &PathParams {
-                    paths: args.vpls,
-                    bounces: args.bounces,
-                    seed: args.seed,
-                },
-            )?,
-        };
-        let vpl_s = t.elapsed().as_secs_f64();
         let gate_level = match (&args.level, gated) {
             (Some(path), true) => {
                 let level = visgate_formats::BakedLevel::read(path)
                     .with_context(|| format!("cannot read the level {}", path.display()))?;
-                Some(GateLevel::new(level, &scene)?)
+                Some(GateLevel::new(level, &rest)?)
             }
             _ => None,
         };
-        if let (true, Some(ctx), Some(gpu)) = (on_gpu, &gpu_ctx, &mut gpu) {
-            if let Some(level) = &gate_level {
-                gpu.set_level(ctx, level)?;
+        if let (Some(ctx), Some(gpu), Some(level)) = (&gpu_ctx, &mut gpu, &gate_level) {
+            gpu.set_level(ctx, level)?;
+        }
+        let setup_s = t.elapsed().as_secs_f64();
+        for frame in 0..args.frames {
+            let time = args.time + frame as f64 / args.fps;
+            let scene = if frame == 0 { first.clone() } else { rest.at(time) };
+            let out = frame_path(&args.out, frame, args.frames);
+            if args.frames > 1 {
+                println!("frame {} of {} at t = {time:.3} s", frame + 1, args.frames);
             }
-            let (img, times) = gpu.render(
-                ctx,
-                &view,
-                &vpls,
-                &GpuParams {
-                    mode: match args.mode {
-                        Mode::None => GpuMode::None,
-                        Mode::PerVplShadowMaps => GpuMode::PerVplShadowMaps,
-                        Mode::Gates => GpuMode::Gates,
-                        Mode::GatesPerPixel => GpuMode::GatesPerPixel,
-                        Mode::ValHard => GpuMode::ValHard,
-                        Mode::ValCssm => GpuMode::ValCssm,
-                        _ => GpuMode::DirectOnly,
+            let t = Instant::now();
+            let tracer = Tracer::new(&scene);
+            let bvh_s = t.elapsed().as_secs_f64();
+            let t = Instant::now();
+            if let (Some(ctx), Some(g), true) = (&gpu_ctx, &mut gpu, frame > 0) {
+                g.set_scene(ctx, &scene);
+            }
+            let vpls = match (args.mode, args.vpl_source, &gpu_ctx, &gpu) {
+                (Mode::DirectOnly, _, _, _) => Vec::new(),
+                (_, VplSource::Rsm, Some(ctx), Some(g)) => {
+                    g.rsm_vpls(ctx, args.vpls, args.rsm_size, args.seed)?
+                }
+                _ => path_vpls(
+                    &tracer,
+                    &scene.lights,
+                    &PathParams {
+                        paths: args.vpls,
+                        bounces: args.bounces,
+                        seed: args.seed,
                     },
-                    clusters: ClusterParams {
-                        tile_px: args.tile_px,
-                        depth_slices: args.depth_slices,
+                )?,
+            };
+            let vpl_s = t.elapsed().as_secs_f64();
+            if let (true, Some(ctx), Some(gpu)) = (on_gpu, &gpu_ctx, &mut gpu) {
+                let (img, times) = gpu.render(
+                    ctx,
+                    &view,
+                    &vpls,
+                    &GpuParams {
+                        mode: match args.mode {
+                            Mode::None => GpuMode::None,
+                            Mode::PerVplShadowMaps => GpuMode::PerVplShadowMaps,
+                            Mode::Gates => GpuMode::Gates,
+                            Mode::GatesPerPixel => GpuMode::GatesPerPixel,
+                            Mode::ValHard => GpuMode::ValHard,
+                            Mode::ValCssm => GpuMode::ValCssm,
+                            _ => GpuMode::DirectOnly,
+                        },
+                        clusters: ClusterParams {
+                            tile_px: args.tile_px,
+                            depth_slices: args.depth_slices,
+                        },
+                        light_entries: args.light_entries,
+                        vals: ValParams {
+                            count: args.vals,
+                            iterations: args.val_iterations,
+                            ..ValParams::default()
+                        },
+                        val_map_size: args.val_map_size,
+                        cssm_terms: args.cssm_terms,
+                        cssm_normal_offset: args.cssm_normal_offset,
+                        interleave: args.interleave,
+                        blur_distance: args.blur_distance,
+                        blur_normal: args.blur_normal,
+                        gates: GateParams {
+                            oversize: args.gate_oversize,
+                            max_hops: args.gate_hops,
+                        },
+                        vpl_map_size: args.vpl_map_size,
+                        vpl_batch: args.vpl_batch,
+                        g_max: args.g_max,
+                        shadow_size: args.shadow_size,
+                        ..GpuParams::default()
                     },
-                    light_entries: args.light_entries,
-                    vals: ValParams {
-                        count: args.vals,
-                        iterations: args.val_iterations,
-                        ..ValParams::default()
-                    },
-                    val_map_size: args.val_map_size,
-                    cssm_terms: args.cssm_terms,
-                    cssm_normal_offset: args.cssm_normal_offset,
-                    interleave: args.interleave,
-                    blur_distance: args.blur_distance,
-                    blur_normal: args.blur_normal,
-                    gates: GateParams {
+                )?;
+                img.write(&out, args.exposure)?;
+                println!(
+                    "{} {:?} {}x{} on {} ({:?}): {} VPLs ({:?}, {} asked, {} bounce(s))",
+                    scene.name,
+                    args.mode,
+                    size[0],
+                    size[1],
+                    ctx.adapter_info.name,
+                    ctx.adapter_info.backend,
+                    vpls.len(),
+                    args.vpl_source,
+                    args.vpls,
+                    args.bounces
+                );
+                println!(
+                    "times: load {load_s:.3} s, adapter + upload + level {setup_s:.3} s, BVH {bvh_s:.3} s, \
+                     geometry + VPLs {vpl_s:.3} s"
+                );
+                print_passes(&times, args.mode);
+                let m = img.mean();
+                println!("mean radiance {:.5} {:.5} {:.5}", m.x, m.y, m.z);
+                println!("wrote {}", out.display());
+                continue;
+            }
+            let params = ReferenceParams {
+                samples_per_pixel: args.spp,
+                direct: true,
+                indirect: args.mode != Mode::DirectOnly,
+                indirect_visibility: matches!(args.mode, Mode::Reference | Mode::PerVplShadowMaps),
+                gather: GatherParams { g_max: args.g_max },
+            };
+            let bar = ProgressBar::new(size[1] as u64).with_style(
+                ProgressStyle::with_template("render {bar:40} {pos}/{len} rows {elapsed}<{eta}")
+                    .unwrap_or_else(|_| ProgressStyle::default_bar()),
+            );
+            let vis = match &gate_level {
+                Some(g) => IndirectVisibility::Gates(
+                    g,
+                    GateParams {
                         oversize: args.gate_oversize,
                         max_hops: args.gate_hops,
                     },
-                    vpl_map_size: args.vpl_map_size,
-                    vpl_batch: args.vpl_batch,
-                    g_max: args.g_max,
-                    shadow_size: args.shadow_size,
-                    ..GpuParams::default()
-                },
+                ),
+                None if params.indirect_visibility => IndirectVisibility::Exact,
+                None => IndirectVisibility::Unoccluded,
+            };
+            let (img, stats) = render_with(
+                &tracer,
+                &scene.lights,
+                &vpls,
+                &view,
+                &params,
+                vis,
+                &|done, _| bar.set_position(done as u64),
             )?;
-            img.write(&args.out, args.exposure)?;
+            bar.finish_and_clear();
+            img.write(&out, args.exposure)?;
             println!(
-                "{} {:?} {}x{} on {} ({:?}): {} VPLs ({:?}, {} asked, {} bounce(s))",
+                "{} {:?} {}x{} spp {}: {} triangles, {} VPLs ({:?}, {} asked, {} bounce(s))",
                 scene.name,
                 args.mode,
                 size[0],
                 size[1],
-                ctx.adapter_info.name,
-                ctx.adapter_info.backend,
+                args.spp,
+                tracer.triangle_count(),
                 vpls.len(),
                 args.vpl_source,
                 args.vpls,
                 args.bounces
             );
             println!(
-                "times: load {load_s:.3} s, BVH {bvh_s:.3} s, adapter + upload + VPLs {vpl_s:.3} s"
+                "times (CPU): load {load_s:.3} s, BVH {bvh_s:.3} s, VPLs {vpl_s:.3} s, render {:.3} s",
+                stats.seconds
             );
-            print_passes(&times, args.mode);
+            if stats.shadow_rays > 0 {
+                println!(
+                    "shadow rays {} ({:.2} M/s), camera rays {}",
+                    stats.shadow_rays,
+                    stats.shadow_rays as f64 / stats.seconds.max(1e-9) / 1e6,
+                    stats.camera_rays
+                );
+            }
             let m = img.mean();
             println!("mean radiance {:.5} {:.5} {:.5}", m.x, m.y, m.z);
-            println!("wrote {}", args.out.display());
-            return Ok(());
+            println!("wrote {}", out.display());
         }
-        let params = ReferenceParams {
-            samples_per_pixel: args.spp,
-            direct: true,
-            indirect: args.mode != Mode::DirectOnly,
-            indirect_visibility: matches!(args.mode, Mode::Reference | Mode::PerVplShadowMaps),
-            gather: GatherParams { g_max: args.g_max },
-        };
-        let bar = ProgressBar::new(size[1] as u64).with_style(
-            ProgressStyle::with_template("render {bar:40} {pos}/{len} rows {elapsed}<{eta}")
-                .unwrap_or_else(|_| ProgressStyle::default_bar()),
-        );
-        let vis = match &gate_level {
-            Some(g) => IndirectVisibility::Gates(
-                g,
-                GateParams {
-                    oversize: args.gate_oversize,
-                    max_hops: args.gate_hops,
-                },
-            ),
-            None if params.indirect_visibility => IndirectVisibility::Exact,
-            None => IndirectVisibility::Unoccluded,
-        };
-        let (img, stats) = render_with(
-            &tracer,
-            &scene.lights,
-            &vpls,
-            &view,
-            &params,
-            vis,
-            &|done, _| bar.set_position(done as u64),
-        )?;
-        bar.finish_and_clear();
-        img.write(&args.out, args.exposure)?;
-        println!(
-            "{} {:?} {}x{} spp {}: {} triangles, {} VPLs ({:?}, {} asked, {} bounce(s))",
-            scene.name,
-            args.mode,
-            size[0],
-            size[1],
-            args.spp,
-            tracer.triangle_count(),
-            vpls.len(),
-            args.vpl_source,
-            args.vpls,
-            args.bounces
-        );
-        println!(
-            "times (CPU): load {load_s:.3} s, BVH {bvh_s:.3} s, VPLs {vpl_s:.3} s, render {:.3} s",
-            stats.seconds
-        );
-        if stats.shadow_rays > 0 {
-            println!(
-                "shadow rays {} ({:.2} M/s), camera rays {}",
-                stats.shadow_rays,
-                stats.shadow_rays as f64 / stats.seconds.max(1e-9) / 1e6,
-                stats.camera_rays
-            );
-        }
-        let m = img.mean();
-        println!("mean radiance {:.5} {:.5} {:.5}", m.x, m.y, m.z);
-        println!("wrote {}", args.out.display());
         Ok(())
     })
+}
+
+/// The output of frame `frame` of `frames`: OUT itself for one frame, else OUT's stem with a
+/// four-digit frame number (`shot.png` → `shot-0000.png`, `shot-0001.png`, …).
+fn frame_path(out: &std::path::Path, frame: u32, frames: u32) -> PathBuf {
+    if frames <= 1 {
+        return out.to_path_buf();
+    }
+    let stem = out
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let ext = out
+        .extension()
+        .map(|e| e.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    out.with_file_name(format!("{stem}-{frame:04}.{ext}"))
 }
 
 /// Prints the passes that ran (named as the paper's Table I in mode gates), each with its CPU

@@ -548,3 +548,90 @@ fn render_val_modes_print_their_passes_and_refuse_bad_settings() {
         assert!(stderr(&o).contains("--mode reference"), "{}", stderr(&o));
     }
 }
+
+#[test]
+fn render_frames_of_a_dynamic_scene_pose_meshes_and_lights() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let p = |n: &str| dir.path().join(n);
+    // A floor and a small box that slides across it, lit by a light on an orbit.
+    std::fs::write(
+        p("floor.obj"),
+        "v -3 0 -3\nv 3 0 -3\nv 3 0 3\nv -3 0 3\nf 1 4 3 2\n",
+    )
+    .expect("write");
+    std::fs::write(
+        p("box.obj"),
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n\
+         f 1 2 3 4\nf 5 8 7 6\nf 1 5 6 2\nf 2 6 7 3\nf 3 7 8 4\nf 4 8 5 1\n",
+    )
+    .expect("write");
+    std::fs::write(
+        p("scene.toml"),
+        r#"
+[[mesh]]
+path = "floor.obj"
+
+[[mesh]]
+path = "box.obj"
+static = false
+animate = [{ t = 0, translate = [-2, 0, -0.5] }, { t = 2, translate = [1, 0, -0.5] }]
+
+[[light]]
+type = "point"
+position = [0, 3, 0]
+intensity = [10, 10, 10]
+orbit = { centre = [0, 3, 0], radius = 1, period_s = 4 }
+
+[[camera]]
+name = "main"
+eye = [0, 4, 6]
+target = [0, 0, 0]
+fov_deg = 60
+"#,
+    )
+    .expect("write");
+    let scene = p("scene.toml");
+    let out = p("shot.png");
+    for mode in ["val-hard", "none", "reference"] {
+        let o = visgate(&[
+            "render",
+            scene.to_str().expect("utf-8"),
+            "--mode",
+            mode,
+            "--frames",
+            "3",
+            "--fps",
+            "1",
+            "--size",
+            "32x24",
+            "--spp",
+            "1",
+            "--vpls",
+            "64",
+            "--out",
+            out.to_str().expect("utf-8"),
+        ]);
+        assert!(o.status.success(), "{mode}: {}", stderr(&o));
+        assert!(
+            stdout(&o).contains("frame 3 of 3 at t = 2.000 s"),
+            "{}",
+            stdout(&o)
+        );
+        let frames: Vec<Vec<u8>> = (0..3)
+            .map(|f| std::fs::read(p(&format!("shot-{f:04}.png"))).expect("frame written"))
+            .collect();
+        assert!(
+            frames[0] != frames[1] && frames[1] != frames[2],
+            "{mode}: frames differ"
+        );
+    }
+    let o = visgate(&[
+        "render",
+        scene.to_str().expect("utf-8"),
+        "--frames",
+        "0",
+        "--out",
+        "x.png",
+    ]);
+    assert!(stderr(&o).contains("--frames 0"), "{}", stderr(&o));
+}

@@ -867,11 +867,19 @@ const VERTEX_FLOATS: usize = 12;
 /// Textures are resized (nearest) to one layer size, at most this. [Units: texels]
 pub const MAX_TEXTURE_SIZE: u32 = 1024;
 
-impl GpuRenderer {
-    /// Uploads every mesh of `scene` (albedo per vertex from its material, textures as layers
-    /// of one sRGB array, resized to the largest texture's size up to [`MAX_TEXTURE_SIZE`]) and
-    /// builds the pipelines.
-    pub fn new(ctx: &GpuContext, scene: &Scene) -> Result<GpuRenderer, RenderError> {
+/// A scene's triangles on the GPU: for the G-buffer and shadow maps (position, normal,
+/// albedo, texture coordinates), and subdivided for paraboloid maps.
+struct Geometry {
+    vertices: wgpu::Buffer,
+    vertex_count: u32,
+    vpl_vertices: wgpu::Buffer,
+    vpl_vertex_count: u32,
+    /// The scene's diagonal. [Units: m]
+    size: f32,
+}
+
+impl Geometry {
+    fn upload(d: &wgpu::Device, scene: &Scene) -> Geometry {
         let mut data: Vec<f32> = Vec::new();
         for m in &scene.meshes {
             for (t, idx) in m.triangles.iter().enumerate() {
@@ -900,7 +908,7 @@ impl GpuRenderer {
             }
         }
         let vertex_count = (data.len() / VERTEX_FLOATS) as u32;
-        let diag = scene
+        let size = scene
             .bounds()
             .map(|(lo, hi)| (hi - lo).length())
             .unwrap_or(1.0)
@@ -911,7 +919,7 @@ impl GpuRenderer {
                 [0, VERTEX_FLOATS, 2 * VERTEX_FLOATS].map(|o| Vec3::new(c[o], c[o + 1], c[o + 2]))
             })
             .collect();
-        let mut vpl_data: Vec<f32> = subdivide(&tris, diag * VPL_SHADOW_MAX_EDGE)
+        let mut vpl_data: Vec<f32> = subdivide(&tris, size * VPL_SHADOW_MAX_EDGE)
             .iter()
             .flat_map(|t| t.iter().flat_map(|p| p.to_array()))
             .collect();
@@ -922,17 +930,36 @@ impl GpuRenderer {
         if data.is_empty() {
             data.resize(VERTEX_FLOATS, 0.0);
         }
+        let buffer = |label: &str, v: &[f32]| {
+            d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some(label),
+                contents: bytemuck::cast_slice(v),
+                usage: wgpu::BufferUsages::VERTEX,
+            })
+        };
+        Geometry {
+            vertices: buffer("scene vertices", &data),
+            vertex_count,
+            vpl_vertices: buffer("vpl map vertices (subdivided)", &vpl_data),
+            vpl_vertex_count,
+            size,
+        }
+    }
+}
+
+impl GpuRenderer {
+    /// Uploads every mesh of `scene` (albedo per vertex from its material, textures as layers
+    /// of one sRGB array, resized to the largest texture's size up to [`MAX_TEXTURE_SIZE`]) and
+    /// builds the pipelines.
+    pub fn new(ctx: &GpuContext, scene: &Scene) -> Result<GpuRenderer, RenderError> {
+        let Geometry {
+            vertices,
+            vertex_count,
+            vpl_vertices,
+            vpl_vertex_count,
+            size,
+        } = Geometry::upload(&ctx.device, scene);
         let d = &ctx.device;
-        let vertices = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("scene vertices"),
-            contents: bytemuck::cast_slice(&data),
-            usage: wgpu::BufferUsages::VERTEX,
-        });
-        let size = scene
-            .bounds()
-            .map(|(lo, hi)| (hi - lo).length())
-            .unwrap_or(1.0)
-            .max(1e-6);
         let module = |label: &str, src: &str| {
             d.create_shader_module(wgpu::ShaderModuleDescriptor {
                 label: Some(label),
@@ -1092,11 +1119,6 @@ impl GpuRenderer {
             compilation_options: Default::default(),
             cache: None,
         });
-        let vpl_vertices = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("vpl map vertices (subdivided)"),
-            contents: bytemuck::cast_slice(&vpl_data),
-            usage: wgpu::BufferUsages::VERTEX,
-        });
         Ok(GpuRenderer {
             vertices,
             vertex_count,
@@ -1121,6 +1143,18 @@ impl GpuRenderer {
             cssm_pipelines: vals::CssmPipelines::new(d, CSSM_WGSL, VAL_GATHER_WGSL),
             val_centres: std::sync::Mutex::new(None),
         })
+    }
+
+    /// Replaces the geometry and the lights with those of `scene` posed at another time (the
+    /// same meshes and materials; dynamic meshes moved, see `Scene::at`). Pipelines, textures
+    /// and the level stay.
+    pub fn set_scene(&mut self, ctx: &GpuContext, scene: &Scene) {
+        let g = Geometry::upload(&ctx.device, scene);
+        self.vertices = g.vertices;
+        self.vertex_count = g.vertex_count;
+        self.vpl_vertices = g.vpl_vertices;
+        self.vpl_vertex_count = g.vpl_vertex_count;
+        self.lights = scene.lights.clone();
     }
 
     /// Replaces the lights (they move freely: shadow maps and RSMs are made per frame).

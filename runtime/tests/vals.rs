@@ -527,3 +527,56 @@ fn interleaved_sampling_with_the_blur_stays_close_to_every_vpl_at_every_pixel() 
         );
     }
 }
+
+#[test]
+fn set_scene_moves_geometry_and_lights_as_a_fresh_upload_does() {
+    use visgate_runtime::gpu::{GpuMode, GpuParams};
+    let ctx = context();
+    let blocker = |x: f32| {
+        [
+            Vec3::new(x - 1.0, 1.0, -1.0),
+            Vec3::new(x + 1.0, 1.0, -1.0),
+            Vec3::new(x + 1.0, 1.0, 1.0),
+            Vec3::new(x - 1.0, 1.0, 1.0),
+        ]
+    };
+    let light = |x: f32| visgate_formats::Light::Point {
+        position: Vec3::new(x, 3.0, 0.0),
+        intensity: Vec3::splat(5.0),
+    };
+    let a = common::quads(&[common::floor(5.0), blocker(-2.0)], 0.5, vec![light(-1.0)]);
+    let b = common::quads(&[common::floor(5.0), blocker(2.0)], 0.5, vec![light(1.0)]);
+    let cam = visgate_formats::Camera {
+        name: "above".into(),
+        eye: Vec3::new(0.0, 6.0, 6.0),
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        fov_x_rad: 60f32.to_radians(),
+    };
+    let view = visgate_runtime::camera::View::new(&cam, [48, 36]).expect("view");
+    let tracer = Tracer::new(&b);
+    let vpls = path_vpls(
+        &tracer,
+        &b.lights,
+        &PathParams {
+            paths: 256,
+            bounces: 1,
+            seed: 1,
+        },
+    )
+    .expect("vpls");
+    for mode in [GpuMode::None, GpuMode::ValCssm, GpuMode::PerVplShadowMaps] {
+        let params = GpuParams {
+            mode,
+            ..GpuParams::default()
+        };
+        let fresh = GpuRenderer::new(&ctx, &b).expect("upload b");
+        let (want, _) = fresh.render(&ctx, &view, &vpls, &params).expect("fresh");
+        let mut moved = GpuRenderer::new(&ctx, &a).expect("upload a");
+        let (before, _) = moved.render(&ctx, &view, &vpls, &params).expect("a");
+        moved.set_scene(&ctx, &b);
+        let (got, _) = moved.render(&ctx, &view, &vpls, &params).expect("moved");
+        assert_ne!(before.pixels, want.pixels, "{mode:?}: the scenes differ");
+        assert_eq!(got.pixels, want.pixels, "{mode:?}");
+    }
+}
