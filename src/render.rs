@@ -333,7 +333,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
             (Some(path), true) => {
                 let level = visgate_formats::BakedLevel::read(path)
                     .with_context(|| format!("cannot read the level {}", path.display()))?;
-                Some(GateLevel::new(level, &rest)?)
+                Some(GateLevel::new(level, rest)?)
             }
             _ => None,
         };
