@@ -517,6 +517,12 @@ fn render_val_modes_print_their_passes_and_refuse_bad_settings() {
         ),
         ("val-hard", &["VAL clustering", "indirect lighting"][..]),
     ] {
+        // Both VPL sources feed the VAL modes.
+        let mut rsm = base.to_vec();
+        rsm.extend(["--mode", mode, "--vpl-source", "rsm"]);
+        let o = visgate(&rsm);
+        assert!(o.status.success(), "{mode} rsm: {}", stderr(&o));
+        assert!(stdout(&o).contains("Rsm"), "{}", stdout(&o));
         let mut a = base.to_vec();
         a.extend(["--mode", mode]);
         let o = visgate(&a);

@@ -355,6 +355,8 @@ fn gpu_structs_match_their_wgsl_layouts() {
             ("counts", offset_of!(ValGather, counts)),
             ("params", offset_of!(ValGather, params)),
             ("cssm", offset_of!(ValGather, cssm)),
+            ("interleave", offset_of!(ValGather, interleave)),
+            ("blur", offset_of!(ValGather, blur)),
         ],
     );
     check(
