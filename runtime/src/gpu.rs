@@ -529,6 +529,47 @@ impl GpuContext {
     }
 }
 
+/// The compute pipelines of `source`'s entry points `entries`, in order (auto layouts).
+fn compute_pipelines<const N: usize>(
+    d: &wgpu::Device,
+    label: &str,
+    source: &str,
+    entries: [&str; N],
+) -> [wgpu::ComputePipeline; N] {
+    let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(label),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    entries.map(|entry| {
+        d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(entry),
+            layout: None,
+            module: &module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            cache: None,
+        })
+    })
+}
+
+/// A bind group for `layout` from (binding, resource) pairs.
+fn bind_group(
+    d: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    label: &str,
+    resources: Vec<(u32, wgpu::BindingResource)>,
+) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry> = resources
+        .into_iter()
+        .map(|(binding, resource)| wgpu::BindGroupEntry { binding, resource })
+        .collect();
+    d.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &entries,
+    })
+}
+
 /// A storage buffer holding `bytes` (64 zero bytes when empty: bindings cannot be empty).
 fn storage(d: &wgpu::Device, label: &str, bytes: &[u8]) -> wgpu::Buffer {
     let mut v = bytes.to_vec();

@@ -73,27 +73,33 @@ pub(super) struct Pipelines {
 
 impl Pipelines {
     pub(super) fn new(d: &wgpu::Device, source: &str) -> Pipelines {
-        let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("clusters.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(source.into()),
-        });
-        let pipe = |entry: &str| {
-            d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: None,
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
+        let [
+            depths,
+            tile_count,
+            scan_tiles,
+            tile_clusters,
+            vpl_clusters,
+            assign,
+        ] = super::compute_pipelines(
+            d,
+            "clusters.wgsl",
+            source,
+            [
+                "depths",
+                "tile_count",
+                "scan_tiles",
+                "tile_clusters",
+                "vpl_clusters",
+                "assign",
+            ],
+        );
         Pipelines {
-            depths: pipe("depths"),
-            tile_count: pipe("tile_count"),
-            scan_tiles: pipe("scan_tiles"),
-            tile_clusters: pipe("tile_clusters"),
-            vpl_clusters: pipe("vpl_clusters"),
-            assign: pipe("assign"),
+            depths,
+            tile_count,
+            scan_tiles,
+            tile_clusters,
+            vpl_clusters,
+            assign,
         }
     }
 }
@@ -114,15 +120,7 @@ fn bind_group(
     pipeline: &wgpu::ComputePipeline,
     resources: Vec<(u32, wgpu::BindingResource)>,
 ) -> wgpu::BindGroup {
-    let entries: Vec<wgpu::BindGroupEntry> = resources
-        .into_iter()
-        .map(|(binding, resource)| wgpu::BindGroupEntry { binding, resource })
-        .collect();
-    d.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("clusters"),
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &entries,
-    })
+    super::bind_group(d, &pipeline.get_bind_group_layout(0), "clusters", resources)
 }
 
 impl GpuRenderer {

@@ -34,28 +34,36 @@ pub(super) struct Pipelines {
 
 impl Pipelines {
     pub(super) fn new(d: &wgpu::Device, source: &str) -> Pipelines {
-        let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("vals.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(source.into()),
-        });
-        let pipe = |entry: &str| {
-            d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: None,
-                module: &module,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
+        let [
+            init,
+            assign,
+            update,
+            finish,
+            bucket_counts,
+            offsets,
+            scatter,
+        ] = super::compute_pipelines(
+            d,
+            "vals.wgsl",
+            source,
+            [
+                "init",
+                "assign",
+                "update",
+                "finish",
+                "bucket_counts",
+                "offsets",
+                "scatter",
+            ],
+        );
         Pipelines {
-            init: pipe("init"),
-            assign: pipe("assign"),
-            update: pipe("update"),
-            finish: pipe("finish"),
-            bucket_counts: pipe("bucket_counts"),
-            offsets: pipe("offsets"),
-            scatter: pipe("scatter"),
+            init,
+            assign,
+            update,
+            finish,
+            bucket_counts,
+            offsets,
+            scatter,
         }
     }
 }
@@ -127,18 +135,11 @@ impl GpuRenderer {
         let order = buf("vpls by val", (buckets + 1 + n as u64) * 4);
         let p = &self.val_pipelines;
         let bind = |pipeline: &wgpu::ComputePipeline, with: &[(u32, &wgpu::Buffer)]| {
-            let entries: Vec<wgpu::BindGroupEntry> = with
+            let resources = with
                 .iter()
-                .map(|&(binding, b)| wgpu::BindGroupEntry {
-                    binding,
-                    resource: b.as_entire_binding(),
-                })
+                .map(|&(binding, b)| (binding, b.as_entire_binding()))
                 .collect();
-            d.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("vals"),
-                layout: &pipeline.get_bind_group_layout(0),
-                entries: &entries,
-            })
+            super::bind_group(d, &pipeline.get_bind_group_layout(0), "vals", resources)
         };
         let base = [(0, &frame_buf), (1, vpl_buf), (2, &centres)];
         let init_bg = bind(&p.init, &base);
@@ -289,18 +290,9 @@ impl CssmPipelines {
                 source: wgpu::ShaderSource::Wgsl(src.into()),
             })
         };
-        let cm = module("cssm.wgsl", cssm);
         let gm = module("val_gather.wgsl", gather);
-        let compute = |entry: &str| {
-            d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry),
-                layout: None,
-                module: &cm,
-                entry_point: Some(entry),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-        };
+        let [ranges, basis, downsample] =
+            super::compute_pipelines(d, "cssm.wgsl", cssm, ["ranges_of", "basis", "downsample"]);
         let fullscreen = |entry: &str| {
             d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(entry),
@@ -329,9 +321,9 @@ impl CssmPipelines {
             })
         };
         CssmPipelines {
-            ranges: compute("ranges_of"),
-            basis: compute("basis"),
-            downsample: compute("downsample"),
+            ranges,
+            basis,
+            downsample,
             gather_hard: fullscreen("fs_hard"),
             gather_cssm: fullscreen("fs_cssm"),
             compose: fullscreen("fs_compose"),
@@ -529,15 +521,7 @@ impl GpuRenderer {
         let indirect_view = indirect.create_view(&Default::default());
         let tex = wgpu::BindingResource::TextureView;
         let bind = |pipeline: &wgpu::RenderPipeline, entries: Vec<(u32, wgpu::BindingResource)>| {
-            let entries: Vec<wgpu::BindGroupEntry> = entries
-                .into_iter()
-                .map(|(binding, resource)| wgpu::BindGroupEntry { binding, resource })
-                .collect();
-            d.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("val gather"),
-                layout: &pipeline.get_bind_group_layout(0),
-                entries: &entries,
-            })
+            super::bind_group(d, &pipeline.get_bind_group_layout(0), "val gather", entries)
         };
         let mut entries: Vec<(u32, wgpu::BindingResource)> = vec![
             (0, uniform.as_entire_binding()),
@@ -684,15 +668,7 @@ impl GpuRenderer {
         });
         let bind = |pipeline: &wgpu::ComputePipeline,
                     entries: Vec<(u32, wgpu::BindingResource)>| {
-            let entries: Vec<wgpu::BindGroupEntry> = entries
-                .into_iter()
-                .map(|(binding, resource)| wgpu::BindGroupEntry { binding, resource })
-                .collect();
-            d.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("cssm"),
-                layout: &pipeline.get_bind_group_layout(0),
-                entries: &entries,
-            })
+            super::bind_group(d, &pipeline.get_bind_group_layout(0), "cssm", entries)
         };
         let tex = wgpu::BindingResource::TextureView;
         let u0 = uniform(size);
