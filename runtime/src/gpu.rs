@@ -1187,8 +1187,8 @@ impl GpuRenderer {
     }
 
     /// Replaces the geometry and the lights with those of `scene` posed at another time (the
-    /// same meshes and materials; dynamic meshes moved, see `Scene::at`). Pipelines, textures
-    /// and the level stay.
+    /// same meshes and materials; dynamic meshes moved, see `Scene::at`). Pipelines, textures,
+    /// the level and the near/far planes (from the first scene's size) stay.
     pub fn set_scene(&mut self, ctx: &GpuContext, scene: &Scene) {
         let g = Geometry::upload(&ctx.device, scene);
         self.vertices = g.vertices;
