@@ -90,6 +90,7 @@ fn main() -> ExitCode {
         .with_writer(std::io::stderr)
         .with_target(false)
         .init();
+    quiet_on_closed_stdout();
     let cli = Cli::parse();
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
@@ -158,4 +159,22 @@ pub fn load_scene(arg: &str, options: &ImportOptions) -> Result<Scene> {
         );
     }
     Ok(Scene::load(path, options)?)
+}
+
+/// `visgate … | head` closes stdout early; Rust's print then panics. Exit quietly instead, as
+/// command-line tools do when their reader goes away (status 141 = 128 + SIGPIPE).
+fn quiet_on_closed_stdout() {
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let msg = info
+            .payload()
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| info.payload().downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        if msg.contains("failed printing to stdout") {
+            std::process::exit(141);
+        }
+        default(info)
+    }));
 }

@@ -641,3 +641,27 @@ fov_deg = 60
     ]);
     assert!(stderr(&o).contains("--frames 0"), "{}", stderr(&o));
 }
+
+#[test]
+fn a_reader_that_goes_away_ends_visgate_quietly() {
+    use std::io::Read;
+    use std::process::{Command, Stdio};
+    let mut child = Command::new(env!("CARGO_BIN_EXE_visgate"))
+        .args(["scenes"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("spawn");
+    // Close the pipe before visgate writes: its prints fail.
+    drop(child.stdout.take());
+    let status = child.wait().expect("wait");
+    let mut err = String::new();
+    child
+        .stderr
+        .take()
+        .expect("stderr")
+        .read_to_string(&mut err)
+        .expect("read");
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(status.code() == Some(141) || status.success(), "{status:?}");
+}
