@@ -234,13 +234,14 @@ pub fn run(args: RenderArgs) -> Result<()> {
             args.out.display()
         );
     }
-    if args.frames == 0 || !(args.fps.is_finite() && args.fps > 0.0) || !args.time.is_finite() {
-        bail!(
-            "--frames {} must be >= 1, --fps {} > 0 and --time {} finite",
-            args.frames,
-            args.fps,
-            args.time
-        );
+    if args.frames == 0 {
+        bail!("--frames 0: render at least 1 frame");
+    }
+    if !(args.fps.is_finite() && args.fps > 0.0) {
+        bail!("--fps {}: give a number of frames per second > 0", args.fps);
+    }
+    if !args.time.is_finite() {
+        bail!("--time {}: give a finite time in seconds", args.time);
     }
     if args.threads == Some(0) {
         bail!("--threads 0: give at least 1 thread, or leave it out to use all cores");

@@ -353,12 +353,16 @@ impl GpuRenderer {
         let (m, s) = (params.vals.count, params.val_map_size);
         let sharp = params.cssm_sharpness;
         let (blur_d, blur_n) = (params.blur_distance, params.blur_normal);
-        let blur_ok = blur_d >= 0.0 && blur_d.is_finite() && (-1.0..=1.0).contains(&blur_n);
-        if !((1..=16).contains(&params.interleave) && blur_ok) {
+        if !(1..=16).contains(&params.interleave) {
             return Err(RenderError::Param(format!(
-                "interleaving block {} must be 1..=16, blur distance {blur_d} ≥ 0 (fraction of \
-                 the scene) and blur normal threshold {blur_n} in -1..=1",
+                "interleaving block {} must be 1..=16 pixels (1: every VPL at every pixel)",
                 params.interleave
+            )));
+        }
+        if !(blur_d >= 0.0 && blur_d.is_finite() && (-1.0..=1.0).contains(&blur_n)) {
+            return Err(RenderError::Param(format!(
+                "blur distance {blur_d} must be >= 0 (a fraction of the scene's size) and blur \
+                 normal threshold {blur_n} a cosine in -1..=1"
             )));
         }
         let off = params.cssm_normal_offset;
@@ -367,10 +371,15 @@ impl GpuRenderer {
                 "CSSM sharpening {sharp} must be 1..=8 and normal offset {off} 0..=64 texels"
             )));
         }
-        if !(16..=4096).contains(&s) || m > d.limits().max_texture_array_layers {
+        if !(16..=4096).contains(&s) {
             return Err(RenderError::Param(format!(
-                "VAL map size {s} must be 16..=4096 and VALs {m} at most the adapter's {} layers",
-                d.limits().max_texture_array_layers
+                "VAL map size {s} must be 16..=4096 texels"
+            )));
+        }
+        let layers = d.limits().max_texture_array_layers;
+        if m > layers {
+            return Err(RenderError::Param(format!(
+                "{m} VALs need {m} map layers, more than the adapter's {layers}: use fewer VALs"
             )));
         }
         // The VAL's centre, a mean of VPLs, may sit on (or just inside) a surface: move it off
