@@ -7,9 +7,12 @@
 //! point along its normal and compare with a bias, both in texels of the layer at that
 //! distance, and filter 3 × 3 (PCF).
 //!
-//! Modes: `none` (every VPL lights every pixel), `per-vpl-shadow-maps` (a paraboloid distance
-//! map per VPL, rendered and gathered in batches of `vpl_batch` so memory stays bounded) and
-//! `direct-only`. GPU RSM VPLs and timestamp queries come next.
+//! Modes ([`GpuMode`]): `None` (every VPL lights every pixel), `PerVplShadowMaps` (a paraboloid
+//! distance map per VPL, rendered and gathered in batches of `vpl_batch` so memory stays
+//! bounded), `Gates` (clustered shading through a baked level's gates, `gpu_clustered.rs`),
+//! `GatesPerPixel` (the same test brute force), `ValHard` / `ValCssm` (virtual area lights with
+//! hard or convolution soft shadow maps, `gpu_vals.rs`) and `DirectOnly`. VPLs from reflective
+//! shadow maps ([`GpuRenderer::rsm_vpls`]); GPU time per stage from timestamp queries.
 
 use std::time::Instant;
 

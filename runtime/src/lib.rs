@@ -10,7 +10,10 @@
 //!
 //! What stands so far: the CPU side — [`tracer`] (BVH ray casting), [`camera`], [`lights`]
 //! (radiometry and direct light), [`vpl`] (the VPL struct, light-path VPLs, the gather term),
-//! [`reference`] (the exact-visibility renderer), [`hdr`] (EXR/PNG) and [`metrics`].
+//! [`reference`] (the exact-visibility renderer), [`hdr`] (EXR/PNG), [`metrics`], the CPU twins
+//! [`gates`] and [`clustered`] (gate visibility and clustered light lists), [`val`] (VAL
+//! clustering) and [`cssm`] (the Fourier shadow test) — and the GPU renderer [`gpu`] with every
+//! mode. The viewer comes later.
 
 pub mod camera;
 pub mod clustered;
