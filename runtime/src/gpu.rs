@@ -33,8 +33,8 @@ mod vals;
 pub use clustered::{ClusterFrame, GpuGeometryCluster, LightListStats, MAX_CLUSTERS, MAX_GATES};
 pub use vals::{CssmFrame, ValFrame, ValGather, ValMaps, centres_of};
 
-// WGSL has no includes: the VPL struct and the grid and gate code are put in front of the
-// shaders that use them.
+// WGSL has no includes: the VPL struct and gather term, the fullscreen triangle, and the grid
+// and gate code are put in front of the shaders that use them.
 const GBUFFER_WGSL: &str = concat!(
     include_str!("shaders/grid.wgsl"),
     include_str!("shaders/gbuffer.wgsl")
@@ -44,6 +44,7 @@ const SHADE_WGSL: &str = concat!(
     include_str!("shaders/vpl.wgsl"),
     include_str!("shaders/grid.wgsl"),
     include_str!("shaders/gates.wgsl"),
+    include_str!("shaders/fullscreen.wgsl"),
     include_str!("shaders/shade.wgsl")
 );
 const CLUSTERS_WGSL: &str = concat!(
@@ -60,6 +61,7 @@ const VALS_WGSL: &str = concat!(
 const VAL_GATHER_WGSL: &str = concat!(
     include_str!("shaders/vpl.wgsl"),
     include_str!("shaders/val.wgsl"),
+    include_str!("shaders/fullscreen.wgsl"),
     include_str!("shaders/val_gather.wgsl")
 );
 const CSSM_WGSL: &str = include_str!("shaders/cssm.wgsl");
@@ -70,6 +72,7 @@ const VPL_SHADOW_WGSL: &str = concat!(
 const GATHER_BATCH_WGSL: &str = concat!(
     include_str!("shaders/vpl.wgsl"),
     include_str!("shaders/val.wgsl"),
+    include_str!("shaders/fullscreen.wgsl"),
     include_str!("shaders/gather_batch.wgsl")
 );
 const RSM_VPLS_WGSL: &str = concat!(

@@ -1,8 +1,6 @@
 // Indirect light of one batch of VPLs with their paraboloid shadow maps (mode
 // per-vpl-shadow-maps), added to the image so far (`previous`, ping-pong: 32-bit float targets
-// are not blendable everywhere). Same gather term as shade.wgsl.
-
-const PI: f32 = 3.14159265358979;
+// are not blendable everywhere). The gather term is vpl.wgsl's vpl_light.
 
 struct Batch {
     // x first VPL, y count, z map size (texels), w unused.
@@ -18,12 +16,6 @@ struct Batch {
 @group(0) @binding(4) var g_normal: texture_2d<f32>;
 @group(0) @binding(5) var g_albedo: texture_2d<f32>;
 @group(0) @binding(6) var previous: texture_2d<f32>;
-
-@vertex
-fn vs(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
-    let uv = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
-    return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
-}
 
 fn visibility(layer: u32, v: Vpl, p: vec3<f32>, n: vec3<f32>) -> f32 {
     let size = f32(batch.range.z);
@@ -63,19 +55,10 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     var radiance = vec3<f32>(0.0);
     for (var k = 0u; k < batch.range.y; k++) {
         let v = vpls[batch.range.x + k];
-        let d = v.position - p;
-        let d2 = dot(d, d);
-        if d2 <= 0.0 {
-            continue;
+        let l = vpl_light(v, p, n, batch.params.x);
+        if any(l > vec3<f32>(0.0)) {
+            radiance += albedo / PI * l * visibility(k, v, p, n);
         }
-        let w = d * inverseSqrt(d2);
-        let cos_x = dot(n, w);
-        let cos_v = -dot(v.normal, w);
-        if cos_x <= 0.0 || cos_v <= 0.0 {
-            continue;
-        }
-        let g = min(cos_x * cos_v / d2, batch.params.x);
-        radiance += albedo / PI * v.flux / PI * g * visibility(k, v, p, n);
     }
     return vec4<f32>(before.xyz + radiance, 1.0);
 }

@@ -5,8 +5,6 @@
 // Radiometry as the CPU reference: L = ρ/π · I · falloff · cos θ / d² for lights, and
 // ρ/π · Φ/π · min(cos θ_v cos θ_x / d², g_max) for VPLs.
 
-const PI: f32 = 3.14159265358979;
-
 struct Globals {
     view_proj: mat4x4<f32>,
     eye: vec4<f32>,
@@ -77,12 +75,6 @@ fn through_gates(a: vec3<f32>, ca: u32, b: vec3<f32>, cb: u32) -> bool {
         }
     }
     return false;
-}
-
-@vertex
-fn vs(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
-    let uv = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
-    return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
 }
 
 fn spot_falloff(angle: f32, beam: f32, cutoff: f32) -> f32 {
@@ -197,7 +189,7 @@ fn clustered_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
             continue;
         }
         let v = vpls[entry.x];
-        let l = vpl_light(v, p, n);
+        let l = vpl_light(v, p, n, globals.params.x);
         if all(l == vec3<f32>(0.0)) {
             continue;
         }
@@ -215,28 +207,11 @@ fn clustered_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     return sum;
 }
 
-// The light of VPL v at p (normal n) without albedo / π: Φ/π · min(cos θ_v cos θ_x / d², g_max);
-// zero behind either.
-fn vpl_light(v: Vpl, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
-    let d = v.position - p;
-    let d2 = dot(d, d);
-    if d2 <= 0.0 {
-        return vec3<f32>(0.0);
-    }
-    let w = d * inverseSqrt(d2);
-    let cos_x = dot(n, w);
-    let cos_v = -dot(v.normal, w);
-    if cos_x <= 0.0 || cos_v <= 0.0 {
-        return vec3<f32>(0.0);
-    }
-    return v.flux / PI * min(cos_x * cos_v / d2, globals.params.x);
-}
-
 // Mode 0: every VPL, no visibility.
 fn gather_all(p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
     for (var j = 0u; j < globals.counts.x; j++) {
-        sum += vpl_light(vpls[j], p, n);
+        sum += vpl_light(vpls[j], p, n, globals.params.x);
     }
     return sum;
 }
@@ -246,7 +221,7 @@ fn gather_per_pixel(p: vec3<f32>, n: vec3<f32>, here: u32) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
     for (var j = 0u; j < globals.counts.x; j++) {
         let v = vpls[j];
-        let l = vpl_light(v, p, n);
+        let l = vpl_light(v, p, n, globals.params.x);
         if any(l > vec3<f32>(0.0)) && through_gates(v.position, cluster_at(v.position, v.normal), p, here) {
             sum += l;
         }

@@ -8,8 +8,6 @@
 // one subset of the VPLs (i mod b² = its place in the block), and fs_compose blurs over the
 // block where the geometry agrees. vpl.wgsl and val.wgsl come first.
 
-const PI: f32 = 3.14159265358979;
-
 struct ValGather {
     // x VPLs, y VALs, z map size (texels), w Fourier terms K (val-cssm).
     counts: vec4<u32>,
@@ -34,12 +32,6 @@ struct ValGather {
 // M·B + 1 offsets, then the VPL indices sorted by VAL and subset (vals.wgsl's order).
 @group(0) @binding(7) var<storage, read> order: array<u32>;
 @group(0) @binding(8) var<storage, read> vals: array<Val>;
-
-@vertex
-fn vs(@builtin(vertex_index) i: u32) -> @builtin(position) vec4<f32> {
-    let uv = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
-    return vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
-}
 
 // Hard visibility of p (normal n) from VAL k.
 fn val_visibility(k: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
@@ -66,19 +58,7 @@ fn val_light(k: u32, j: u32, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     let first = gather.counts.y * gather.interleave.y + 1u;
     var part = vec3<f32>(0.0);
     for (var e = order[bucket]; e < order[bucket + 1u]; e++) {
-        let v = vpls[order[first + e]];
-        let d = v.position - p;
-        let d2 = dot(d, d);
-        if d2 <= 0.0 {
-            continue;
-        }
-        let w = d * inverseSqrt(d2);
-        let cos_x = dot(n, w);
-        let cos_v = -dot(v.normal, w);
-        if cos_x <= 0.0 || cos_v <= 0.0 {
-            continue;
-        }
-        part += v.flux / PI * min(cos_x * cos_v / d2, gather.params.x);
+        part += vpl_light(vpls[order[first + e]], p, n, gather.params.x);
     }
     return part;
 }

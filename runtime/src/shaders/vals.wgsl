@@ -7,8 +7,6 @@
 //           in VPL order (an empty VAL keeps its centre)
 //   finish  each VAL's VPL count, flux and bounding rectangle in the plane normal to it
 
-const PI: f32 = 3.14159265358979;
-
 struct ValFrame {
     // x VPLs N, y VALs M, z interleaving subsets B (1: none), w unused.
     counts: vec4<u32>,
