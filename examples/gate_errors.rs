@@ -13,10 +13,10 @@
 use glam::Vec3;
 use visgate_formats::Camera;
 use visgate_runtime::camera::View;
-use visgate_runtime::gates::{GateLevel, GateParams};
+use visgate_runtime::cpu::gates::{GateLevel, GateParams};
+use visgate_runtime::cpu::reference::{IndirectVisibility, ReferenceParams, render_with};
+use visgate_runtime::cpu::tracer::Tracer;
 use visgate_runtime::metrics::{errors, flip};
-use visgate_runtime::reference::{IndirectVisibility, ReferenceParams, render_with};
-use visgate_runtime::tracer::Tracer;
 use visgate_runtime::vpl::{PathParams, path_vpls};
 
 mod common;

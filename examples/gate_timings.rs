@@ -8,9 +8,11 @@
 //! per-VPL shadow maps' total over gates' total at the same VPLs, measured in one run.
 
 use visgate_runtime::camera::View;
-use visgate_runtime::gates::GateLevel;
-use visgate_runtime::gpu::{GpuContext, GpuMode, GpuParams, GpuRenderer, GpuStageTimes};
-use visgate_runtime::tracer::Tracer;
+use visgate_runtime::cpu::gates::GateLevel;
+use visgate_runtime::cpu::tracer::Tracer;
+use visgate_runtime::gpu::{
+    GpuContext, GpuMode, GpuParams, GpuRenderer, MethodSettings, PassTimes,
+};
 use visgate_runtime::vpl::{PathParams, path_vpls};
 
 mod common;
@@ -39,10 +41,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let ctx = GpuContext::new()?;
         let mut gpu = GpuRenderer::new(&ctx, &scene)?;
         gpu.set_level(&ctx, &gates)?;
-        let params = GpuParams {
-            mode,
-            ..GpuParams::default()
-        };
+        let params = GpuParams::with_mode(mode);
         gpu.render(&ctx, &view, &vpls[..vpls.len().min(16)], &params)?;
         gpu.render(&ctx, &view, vpls, &params)
             .map(|(_, t)| (t, ctx.adapter_info.name.clone()))
@@ -67,12 +66,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 seed: 1,
             },
         )?;
-        let mut rows: Vec<(&str, GpuStageTimes, Option<u64>)> = Vec::new();
+        let mut rows: Vec<(&str, Stages, Option<u64>)> = Vec::new();
+        let s = MethodSettings::default();
         let modes = [
             ("none", GpuMode::None),
-            ("gates", GpuMode::Gates),
-            ("gates per pixel", GpuMode::GatesPerPixel),
-            ("per-VPL shadow maps", GpuMode::PerVplShadowMaps),
+            ("gates", GpuMode::Gates(s.gates)),
+            ("gates per pixel", GpuMode::GatesPerPixel(s.gates.gates)),
+            ("per-VPL shadow maps", GpuMode::PerVplShadowMaps(s.per_vpl)),
         ];
         let order: Vec<(&str, GpuMode)> = match &only {
             Some(list) => list
@@ -83,10 +83,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         };
         for (name, mode) in order {
             let (t, _) = render(mode, &vpls)?;
-            let g = t.gpu.ok_or("the adapter has no timestamp queries")?;
+            let g = Stages::of(&t).ok_or("the adapter has no timestamp queries")?;
             rows.push((name, g, t.lists.map(|l| l.entries)));
         }
-        let total = |g: &GpuStageTimes| {
+        let total = |g: &Stages| {
             g.gbuffer + g.unique_clusters + g.light_assignment + g.shade + g.vpl_maps + g.vpl_gather
         };
         let base = rows
@@ -112,4 +112,29 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     }
     Ok(())
+}
+
+/// GPU seconds of the passes this table shows.
+struct Stages {
+    gbuffer: f64,
+    unique_clusters: f64,
+    light_assignment: f64,
+    shade: f64,
+    vpl_maps: f64,
+    vpl_gather: f64,
+}
+
+impl Stages {
+    fn of(t: &PassTimes) -> Option<Stages> {
+        t.gpu_total()?;
+        let g = |name: &str| t.gpu(name).unwrap_or(0.0);
+        Some(Stages {
+            gbuffer: g("geometry pass (G-buffer)"),
+            unique_clusters: g("unique clusters"),
+            light_assignment: g("light assignment"),
+            shade: g("shading: direct + indirect lighting") + g("shading: direct lighting"),
+            vpl_maps: g("VPL paraboloid maps"),
+            vpl_gather: g("VPL gather"),
+        })
+    }
 }

@@ -5,10 +5,10 @@ mod bake;
 mod inspect;
 mod render;
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use visgate_formats::{ImportOptions, Scene};
 use visgate_scenes::Builtin;
@@ -132,33 +132,32 @@ fn run(cli: Cli) -> Result<()> {
 }
 
 fn builtin_or_err(name: &str) -> Result<Builtin> {
-    match Builtin::from_name(name) {
-        Some(b) => Ok(b),
-        None => {
-            let names: Vec<&str> = Builtin::ALL.iter().map(|b| b.name()).collect();
-            bail!(
-                "there is no built-in scene '{name}'; the built-in scenes are: {}",
-                names.join(", ")
-            )
-        }
-    }
+    Ok(visgate_scenes::builtin(name)?)
 }
 
 /// Loads a SCENE argument: `builtin:NAME`, a scene TOML, or a bare OBJ/glTF/GLB file.
 pub fn load_scene(arg: &str, options: &ImportOptions) -> Result<Scene> {
-    if let Some(name) = arg.strip_prefix("builtin:") {
-        let start = std::time::Instant::now();
-        let mut scene = builtin_or_err(name)?.scene()?;
-        scene.report.load_seconds = start.elapsed().as_secs_f64();
-        return Ok(scene);
+    Ok(visgate_scenes::load(arg, options)?)
+}
+
+/// The camera named `name` of `scene` (loaded from `arg`), or its first.
+pub fn camera_of(scene: &Scene, arg: &str, name: Option<&str>) -> Result<visgate_formats::Camera> {
+    match name {
+        Some(name) => scene.camera(name).cloned().with_context(|| {
+            let names: Vec<&str> = scene.cameras.iter().map(|c| c.name.as_str()).collect();
+            format!(
+                "{arg}: no camera '{name}'; its cameras are: {}",
+                if names.is_empty() {
+                    "none".to_string()
+                } else {
+                    names.join(", ")
+                }
+            )
+        }),
+        None => scene.cameras.first().cloned().with_context(|| {
+            format!("{arg}: the scene has no camera; add a [[camera]] to its TOML (see README)")
+        }),
     }
-    let path = Path::new(arg);
-    if !path.exists() {
-        bail!(
-            "{arg}: no such file (a scene is a .toml, .obj, .gltf or .glb file, or builtin:NAME)"
-        );
-    }
-    Ok(Scene::load(path, options)?)
 }
 
 /// `visgate … | head` closes stdout early; Rust's print then panics. Exit quietly instead, as

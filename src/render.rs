@@ -7,16 +7,18 @@ use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 use visgate_formats::ImportOptions;
-use visgate_runtime::camera::View;
-use visgate_runtime::clustered::ClusterParams;
-use visgate_runtime::gates::{GateLevel, GateParams};
-use visgate_runtime::gpu::{GpuContext, GpuMode, GpuParams, GpuRenderer, PassTimes};
+use visgate_runtime::cpu::clustered::ClusterParams;
+use visgate_runtime::cpu::gates::{GateLevel, GateParams};
+use visgate_runtime::cpu::val::ValParams;
+use visgate_runtime::gpu::{
+    CssmParams, GatesParams, GpuMode, GpuParams, InterleaveParams, METHODS, MethodSettings,
+    PerVplParams, ShadowParams, ValModeParams, method,
+};
 use visgate_runtime::hdr::{HdrImage, false_colour};
+use visgate_runtime::job::{
+    FrameStats, JobFrame, RenderJob, Renderer, VplSource as JobVpls, pass_table,
+};
 use visgate_runtime::metrics::{errors, flip};
-use visgate_runtime::reference::{IndirectVisibility, ReferenceParams, render_with};
-use visgate_runtime::tracer::Tracer;
-use visgate_runtime::val::ValParams;
-use visgate_runtime::vpl::{GatherParams, PathParams, path_vpls};
 
 pub const RENDER_HELP: &str = "\
 Modes:
@@ -73,25 +75,11 @@ pub enum VplSource {
     Rsm,
 }
 
-/// Indirect-light visibility.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum Mode {
-    /// Exact: a shadow ray per VPL and sample.
-    Reference,
-    /// No visibility on indirect light.
-    None,
-    /// One paraboloid shadow map per VPL (GPU, in batches).
-    PerVplShadowMaps,
-    /// Visibility through the gates of a baked level by clustered shading (needs --level).
-    Gates,
-    /// The gate test brute force, every pixel against every VPL (GPU; needs --level).
-    GatesPerPixel,
-    /// Every VPL through one hard shadow map of its virtual area light (GPU).
-    ValHard,
-    /// Every VPL through the convolution soft shadow map of its virtual area light (GPU).
-    ValCssm,
-    /// Direct light only.
-    DirectOnly,
+/// `--mode`'s values: `reference` and every GPU method of the runtime's registry.
+fn mode_names() -> Vec<&'static str> {
+    std::iter::once("reference")
+        .chain(METHODS.iter().map(|m| m.name))
+        .collect()
 }
 
 #[derive(Debug, Args)]
@@ -101,9 +89,9 @@ pub struct RenderArgs {
     /// Camera by name (default: the scene's first camera).
     #[arg(long)]
     pub camera: Option<String>,
-    /// Visibility of indirect light.
-    #[arg(long, value_enum, default_value_t = Mode::Reference)]
-    pub mode: Mode,
+    /// Visibility of indirect light (see the list below).
+    #[arg(long, default_value = "reference", value_parser = clap::builder::PossibleValuesParser::new(mode_names()))]
+    pub mode: String,
     /// Light paths traced from the lights (VPLs: one per path and bounce that hits).
     #[arg(long, default_value_t = 1024)]
     pub vpls: u32,
@@ -223,8 +211,82 @@ fn parse_size(s: &str) -> Result<[u32; 2]> {
     Ok([w, h])
 }
 
+impl RenderArgs {
+    /// Every method's settings from the flags.
+    fn settings(&self) -> MethodSettings {
+        MethodSettings {
+            per_vpl: PerVplParams {
+                map_size: self.vpl_map_size,
+                batch: self.vpl_batch,
+            },
+            gates: GatesParams {
+                gates: GateParams {
+                    oversize: self.gate_oversize,
+                    max_hops: self.gate_hops,
+                },
+                clusters: ClusterParams {
+                    tile_px: self.tile_px,
+                    depth_slices: self.depth_slices,
+                },
+                light_entries: self.light_entries,
+            },
+            vals: ValModeParams {
+                vals: ValParams {
+                    count: self.vals,
+                    iterations: self.val_iterations,
+                    ..ValParams::default()
+                },
+                map_size: self.val_map_size,
+                interleave: InterleaveParams {
+                    block: self.interleave,
+                    blur_distance: self.blur_distance,
+                    blur_normal: self.blur_normal,
+                },
+            },
+            cssm: CssmParams {
+                terms: self.cssm_terms,
+                normal_offset: self.cssm_normal_offset,
+                ..CssmParams::default()
+            },
+        }
+    }
+
+    /// The job the flags describe.
+    fn job(&self) -> Result<RenderJob> {
+        let renderer = match method(&self.mode) {
+            None => Renderer::Reference,
+            Some(m) if self.cpu => Renderer::CpuTwin((m.make)(&self.settings())),
+            Some(m) => Renderer::Gpu((m.make)(&self.settings())),
+        };
+        Ok(RenderJob {
+            renderer,
+            params: GpuParams {
+                mode: GpuMode::None,
+                g_max: self.g_max,
+                shadows: ShadowParams {
+                    size: self.shadow_size,
+                    ..ShadowParams::default()
+                },
+            },
+            vpls: self.vpls,
+            vpl_source: match self.vpl_source {
+                VplSource::Paths => JobVpls::Paths,
+                VplSource::Rsm => JobVpls::Rsm,
+            },
+            rsm_size: self.rsm_size,
+            bounces: self.bounces,
+            seed: self.seed,
+            size: parse_size(&self.size)?,
+            spp: self.spp,
+            time: self.time,
+            frames: self.frames,
+            fps: self.fps,
+        })
+    }
+}
+
 pub fn run(args: RenderArgs) -> Result<()> {
-    let size = parse_size(&args.size)?;
+    let job = args.job()?;
     if !matches!(
         args.out.extension().and_then(|e| e.to_str()),
         Some("exr" | "png")
@@ -234,43 +296,10 @@ pub fn run(args: RenderArgs) -> Result<()> {
             args.out.display()
         );
     }
-    if args.frames == 0 {
-        bail!("--frames 0: render at least 1 frame");
-    }
-    if !(args.fps.is_finite() && args.fps > 0.0) {
-        bail!("--fps {}: give a number of frames per second > 0", args.fps);
-    }
-    if !args.time.is_finite() {
-        bail!("--time {}: give a finite time in seconds", args.time);
-    }
     if args.threads == Some(0) {
         bail!("--threads 0: give at least 1 thread, or leave it out to use all cores");
     }
-    let gated = matches!(args.mode, Mode::Gates | Mode::GatesPerPixel);
-    if gated && args.level.is_none() {
-        bail!(
-            "--mode {} needs --level LEVEL.vgate (bake one with `visgate bake SCENE -o LEVEL.vgate`)",
-            if args.mode == Mode::Gates {
-                "gates"
-            } else {
-                "gates-per-pixel"
-            }
-        );
-    }
-    if args.mode == Mode::GatesPerPixel && args.cpu {
-        bail!("--mode gates-per-pixel runs on the GPU; the CPU twin is --mode gates --cpu");
-    }
-    if matches!(args.mode, Mode::ValHard | Mode::ValCssm) && args.cpu {
-        bail!("the VAL modes run on the GPU; their reference is --mode reference");
-    }
-    let oversize_ok = args.gate_oversize > 0.0 && args.gate_oversize.is_finite();
-    if !oversize_ok || !(1..=16).contains(&args.gate_hops) {
-        bail!(
-            "--gate-oversize {} must be > 0 and --gate-hops {} 1..=16",
-            args.gate_oversize,
-            args.gate_hops
-        );
-    }
+    job.check(args.level.is_some())?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads.unwrap_or(0))
         .build()
@@ -283,211 +312,79 @@ pub fn run(args: RenderArgs) -> Result<()> {
         },
     )?;
     let load_s = t.elapsed().as_secs_f64();
-    let camera = match &args.camera {
-        Some(name) => scene.camera(name).cloned().with_context(|| {
-            let names: Vec<&str> = scene.cameras.iter().map(|c| c.name.as_str()).collect();
-            format!(
-                "{}: no camera '{name}'; its cameras are: {}",
-                args.scene,
-                if names.is_empty() {
-                    "none".to_string()
-                } else {
-                    names.join(", ")
-                }
-            )
-        })?,
-        None => scene.cameras.first().cloned().with_context(|| {
-            format!(
-                "{}: the scene has no camera; add a [[camera]] to its TOML (see README)",
-                args.scene
-            )
-        })?,
-    };
+    let camera = crate::camera_of(&scene, &args.scene, args.camera.as_deref())?;
     if scene.lights.is_empty() {
         tracing::warn!(
             "{}: the scene has no lights; the image is black",
             args.scene
         );
     }
-    let view = View::new(&camera, size)?;
-    let rest = &scene;
-    pool.install(|| -> Result<()> {
-        if args.vpl_source == VplSource::Rsm && args.bounces != 1 {
-            bail!(
-                "--vpl-source rsm gives one bounce; use --vpl-source paths for --bounces {}",
-                args.bounces
-            );
+    let level = match (&args.level, job.mode().and_then(|m| m.gates())) {
+        (Some(path), Some(_)) => {
+            let level = visgate_formats::BakedLevel::read(path)
+                .with_context(|| format!("cannot read the level {}", path.display()))?;
+            Some(GateLevel::new(level, &scene)?)
         }
-        let on_gpu = args.mode != Mode::Reference && !args.cpu;
-        let t = Instant::now();
-        let first = rest.at(args.time);
-        let gpu_ctx = if on_gpu || args.vpl_source == VplSource::Rsm {
-            Some(GpuContext::new()?)
-        } else {
-            None
-        };
-        let mut gpu = match &gpu_ctx {
-            Some(ctx) => Some(GpuRenderer::new(ctx, &first)?),
-            None => None,
-        };
-        let gate_level = match (&args.level, gated) {
-            (Some(path), true) => {
-                let level = visgate_formats::BakedLevel::read(path)
-                    .with_context(|| format!("cannot read the level {}", path.display()))?;
-                Some(GateLevel::new(level, rest)?)
-            }
-            _ => None,
-        };
-        if let (Some(ctx), Some(gpu), Some(level)) = (&gpu_ctx, &mut gpu, &gate_level) {
-            gpu.set_level(ctx, level)?;
-        }
-        let setup_s = t.elapsed().as_secs_f64();
-        for frame in 0..args.frames {
-            let time = args.time + frame as f64 / args.fps;
-            let scene = if frame == 0 { first.clone() } else { rest.at(time) };
-            let out = frame_path(&args.out, frame, args.frames);
-            if args.frames > 1 {
-                println!("frame {} of {} at t = {time:.3} s", frame + 1, args.frames);
-            }
-            let t = Instant::now();
-            let tracer = Tracer::new(&scene);
-            let bvh_s = t.elapsed().as_secs_f64();
-            let t = Instant::now();
-            if let (Some(ctx), Some(g), true) = (&gpu_ctx, &mut gpu, frame > 0) {
-                g.set_scene(ctx, &scene);
-            }
-            let vpls = match (args.mode, args.vpl_source, &gpu_ctx, &gpu) {
-                (Mode::DirectOnly, _, _, _) => Vec::new(),
-                (_, VplSource::Rsm, Some(ctx), Some(g)) => {
-                    g.rsm_vpls(ctx, args.vpls, args.rsm_size, args.seed)?
+        _ => None,
+    };
+    let bar = ProgressBar::new(job.size[1] as u64).with_style(
+        ProgressStyle::with_template("render {bar:40} {pos}/{len} rows {elapsed}<{eta}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let setup = std::sync::Mutex::new(String::new());
+    pool.install(|| {
+        job.run(
+            &scene,
+            &camera,
+            level.as_ref(),
+            &mut |s| {
+                *setup.lock().unwrap_or_else(|e| e.into_inner()) = match &s.adapter {
+                    Some(a) => format!("on {a}, adapter + upload + level {:.3} s", s.seconds),
+                    None => String::new(),
+                };
+            },
+            &|done, _| bar.set_position(done as u64),
+            &mut |f| {
+                bar.finish_and_clear();
+                let out = frame_path(&args.out, f.index, job.frames);
+                if job.frames > 1 {
+                    println!(
+                        "frame {} of {} at t = {:.3} s",
+                        f.index + 1,
+                        job.frames,
+                        f.time
+                    );
                 }
-                _ => path_vpls(
-                    &tracer,
-                    &scene.lights,
-                    &PathParams {
-                        paths: args.vpls,
-                        bounces: args.bounces,
-                        seed: args.seed,
-                    },
-                )?,
-            };
-            let vpl_s = t.elapsed().as_secs_f64();
-            if let (true, Some(ctx), Some(gpu)) = (on_gpu, &gpu_ctx, &mut gpu) {
-                let (img, times) = gpu.render(
-                    ctx,
-                    &view,
-                    &vpls,
-                    &GpuParams {
-                        mode: match args.mode {
-                            Mode::None => GpuMode::None,
-                            Mode::PerVplShadowMaps => GpuMode::PerVplShadowMaps,
-                            Mode::Gates => GpuMode::Gates,
-                            Mode::GatesPerPixel => GpuMode::GatesPerPixel,
-                            Mode::ValHard => GpuMode::ValHard,
-                            Mode::ValCssm => GpuMode::ValCssm,
-                            _ => GpuMode::DirectOnly,
-                        },
-                        clusters: ClusterParams {
-                            tile_px: args.tile_px,
-                            depth_slices: args.depth_slices,
-                        },
-                        light_entries: args.light_entries,
-                        vals: ValParams {
-                            count: args.vals,
-                            iterations: args.val_iterations,
-                            ..ValParams::default()
-                        },
-                        val_map_size: args.val_map_size,
-                        cssm_terms: args.cssm_terms,
-                        cssm_normal_offset: args.cssm_normal_offset,
-                        interleave: args.interleave,
-                        blur_distance: args.blur_distance,
-                        blur_normal: args.blur_normal,
-                        gates: GateParams {
-                            oversize: args.gate_oversize,
-                            max_hops: args.gate_hops,
-                        },
-                        vpl_map_size: args.vpl_map_size,
-                        vpl_batch: args.vpl_batch,
-                        g_max: args.g_max,
-                        shadow_size: args.shadow_size,
-                        ..GpuParams::default()
-                    },
-                )?;
-                img.write(&out, args.exposure)?;
-                println!(
-                    "{} {:?} {}x{} on {} ({:?}): {} VPLs ({:?}, {} asked, {} bounce(s))",
-                    scene.name,
-                    args.mode,
-                    size[0],
-                    size[1],
-                    ctx.adapter_info.name,
-                    ctx.adapter_info.backend,
-                    vpls.len(),
-                    args.vpl_source,
-                    args.vpls,
-                    args.bounces
-                );
-                println!(
-                    "times: load {load_s:.3} s, adapter + upload + level {setup_s:.3} s, BVH {bvh_s:.3} s, \
-                     geometry + VPLs {vpl_s:.3} s"
-                );
-                print_passes(&times, args.mode);
-                let m = img.mean();
-                println!("mean radiance {:.5} {:.5} {:.5}", m.x, m.y, m.z);
+                f.image.write(&out, args.exposure)?;
+                let setup = setup.lock().unwrap_or_else(|e| e.into_inner()).clone();
+                print_frame(&args, &scene.name, &f, load_s, &setup);
                 println!("wrote {}", out.display());
-                continue;
-            }
-            let params = ReferenceParams {
-                samples_per_pixel: args.spp,
-                direct: true,
-                indirect: args.mode != Mode::DirectOnly,
-                indirect_visibility: matches!(args.mode, Mode::Reference | Mode::PerVplShadowMaps),
-                gather: GatherParams { g_max: args.g_max },
-            };
-            let bar = ProgressBar::new(size[1] as u64).with_style(
-                ProgressStyle::with_template("render {bar:40} {pos}/{len} rows {elapsed}<{eta}")
-                    .unwrap_or_else(|_| ProgressStyle::default_bar()),
-            );
-            let vis = match &gate_level {
-                Some(g) => IndirectVisibility::Gates(
-                    g,
-                    GateParams {
-                        oversize: args.gate_oversize,
-                        max_hops: args.gate_hops,
-                    },
-                ),
-                None if params.indirect_visibility => IndirectVisibility::Exact,
-                None => IndirectVisibility::Unoccluded,
-            };
-            let (img, stats) = render_with(
-                &tracer,
-                &scene.lights,
-                &vpls,
-                &view,
-                &params,
-                vis,
-                &|done, _| bar.set_position(done as u64),
-            )?;
-            bar.finish_and_clear();
-            img.write(&out, args.exposure)?;
-            println!(
-                "{} {:?} {}x{} spp {}: {} triangles, {} VPLs ({:?}, {} asked, {} bounce(s))",
-                scene.name,
-                args.mode,
-                size[0],
-                size[1],
-                args.spp,
-                tracer.triangle_count(),
-                vpls.len(),
-                args.vpl_source,
-                args.vpls,
-                args.bounces
-            );
-            println!(
-                "times (CPU): load {load_s:.3} s, BVH {bvh_s:.3} s, VPLs {vpl_s:.3} s, render {:.3} s",
-                stats.seconds
-            );
+                Ok(())
+            },
+        )
+    })?;
+    Ok(())
+}
+
+/// Prints what a frame was and took.
+fn print_frame(args: &RenderArgs, scene: &str, f: &JobFrame, load_s: f64, setup: &str) {
+    let [bvh_s, vpl_s] = f.prep_s;
+    println!(
+        "{scene} {} {} spp {}{}: {} VPLs ({:?}, {} asked, {} bounce(s))",
+        args.mode,
+        args.size,
+        args.spp,
+        if args.cpu { " (CPU twin)" } else { "" },
+        f.vpl_count,
+        args.vpl_source,
+        args.vpls,
+        args.bounces
+    );
+    println!("times: load {load_s:.3} s, BVH {bvh_s:.3} s, VPLs {vpl_s:.3} s {setup}");
+    match &f.stats {
+        FrameStats::Gpu(t) => print!("{}", pass_table(t)),
+        FrameStats::Cpu(stats) => {
+            println!("render (CPU) {:.3} s", stats.seconds);
             if stats.shadow_rays > 0 {
                 println!(
                     "shadow rays {} ({:.2} M/s), camera rays {}",
@@ -496,12 +393,10 @@ pub fn run(args: RenderArgs) -> Result<()> {
                     stats.camera_rays
                 );
             }
-            let m = img.mean();
-            println!("mean radiance {:.5} {:.5} {:.5}", m.x, m.y, m.z);
-            println!("wrote {}", out.display());
         }
-        Ok(())
-    })
+    }
+    let m = f.image.mean();
+    println!("mean radiance {:.5} {:.5} {:.5}", m.x, m.y, m.z);
 }
 
 /// The output of frame `frame` of `frames`: OUT itself for one frame, else OUT's stem with a
@@ -519,60 +414,6 @@ fn frame_path(out: &std::path::Path, frame: u32, frames: u32) -> PathBuf {
         .map(|e| e.to_string_lossy().into_owned())
         .unwrap_or_default();
     out.with_file_name(format!("{stem}-{frame:04}.{ext}"))
-}
-
-/// Prints the passes that ran (named as the paper's Table I in mode gates), each with its CPU
-/// wall time and, where the adapter has timestamp queries, its GPU time.
-fn print_passes(t: &PassTimes, mode: Mode) {
-    let g = t.gpu.unwrap_or_default();
-    let shading = match mode {
-        Mode::Gates | Mode::GatesPerPixel | Mode::None => "shading: direct + indirect lighting",
-        _ => "shading: direct lighting",
-    };
-    let mut rows = vec![
-        ("shadow maps", t.shadows, g.shadows),
-        ("geometry pass (G-buffer)", t.gbuffer, g.gbuffer),
-    ];
-    if mode == Mode::Gates {
-        rows.push(("unique clusters", t.unique_clusters, g.unique_clusters));
-        rows.push(("light assignment", t.light_assignment, g.light_assignment));
-    }
-    rows.push((shading, t.shade, g.shade));
-    if mode == Mode::PerVplShadowMaps {
-        rows.push(("VPL paraboloid maps", t.vpl_maps, g.vpl_maps));
-        rows.push(("VPL gather", t.vpl_gather, g.vpl_gather));
-    }
-    if matches!(mode, Mode::ValHard | Mode::ValCssm) {
-        rows.push(("VAL clustering", t.val_clustering, g.val_clustering));
-        rows.push(("VAL paraboloid maps", t.vpl_maps, g.vpl_maps));
-        if mode == Mode::ValCssm {
-            rows.push(("CSSM basis + mips", t.cssm, g.cssm));
-        }
-        rows.push(("indirect lighting", t.vpl_gather, g.vpl_gather));
-        rows.push(("blur + compose", t.blur, g.blur));
-    }
-    println!("pass                               CPU wall (ms)   GPU (ms)");
-    for (name, cpu, gpu) in rows {
-        match t.gpu {
-            Some(_) => println!("  {name:<33}{:>12.2}{:>11.2}", cpu * 1e3, gpu * 1e3),
-            None => println!("  {name:<33}{:>12.2}          -", cpu * 1e3),
-        }
-    }
-    println!("  {:<33}{:>12.2}", "readback", t.readback * 1e3);
-    if t.gpu.is_none() {
-        println!("(the adapter has no timestamp queries: no GPU times)");
-    }
-    if let Some(l) = t.lists {
-        println!(
-            "light lists: {} geometry clusters, {} entries ({:.1} per cluster), pool {} \
-             entries ({:.1} % used)",
-            l.geometry_clusters,
-            l.entries,
-            l.entries as f64 / l.geometry_clusters.max(1) as f64,
-            l.capacity,
-            l.entries as f64 / l.capacity.max(1) as f64 * 100.0
-        );
-    }
 }
 
 #[derive(Debug, Args)]

@@ -5,8 +5,8 @@ use glam::Vec3;
 use visgate_formats::vgate::BakeParams;
 use visgate_formats::vgate::Resolution;
 use visgate_preprocess::bake::{BakeOptions, bake};
-use visgate_runtime::gates::{GateLevel, GateParams};
-use visgate_runtime::tracer::Tracer;
+use visgate_runtime::cpu::gates::{GateLevel, GateParams};
+use visgate_runtime::cpu::tracer::Tracer;
 use visgate_scenes::Builtin;
 
 fn baked(b: Builtin, res: u32) -> (visgate_formats::Scene, visgate_formats::BakedLevel) {
@@ -120,7 +120,7 @@ fn a_level_baked_from_other_geometry_is_refused_with_a_re_bake_message() {
 
 #[test]
 fn gate_tests_are_stable_at_the_extremes() {
-    use visgate_runtime::gates::segment_crosses_disk;
+    use visgate_runtime::cpu::gates::segment_crosses_disk;
     let (c, n) = (Vec3::ZERO, Vec3::X);
     // A VPL in the plane of a gate: the segment never crosses the plane.
     assert!(!segment_crosses_disk(
@@ -154,9 +154,9 @@ fn gate_tests_are_stable_at_the_extremes() {
 
 #[test]
 fn gpu_gates_agree_with_the_cpu_twin() {
-    use visgate_runtime::gpu::{GpuContext, GpuMode, GpuParams, GpuRenderer};
+    use visgate_runtime::cpu::reference::{IndirectVisibility, ReferenceParams, render_with};
+    use visgate_runtime::gpu::{GatesParams, GpuContext, GpuMode, GpuParams, GpuRenderer};
     use visgate_runtime::metrics::errors;
-    use visgate_runtime::reference::{IndirectVisibility, ReferenceParams, render_with};
     let ctx = GpuContext::new().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"));
     for (b, res) in [(Builtin::FourRooms, 128), (Builtin::TwoRooms, 96)] {
         let (scene, gates, tracer, vpls, view) = fixture(b, res);
@@ -166,36 +166,27 @@ fn gpu_gates_agree_with_the_cpu_twin() {
                 &ctx,
                 &view,
                 &vpls,
-                &GpuParams {
-                    mode: GpuMode::Gates,
-                    ..GpuParams::default()
-                }
+                &GpuParams::with_mode(GpuMode::Gates(GatesParams::default()))
             )
             .is_err(),
             "gates without a level must be refused"
         );
         gpu.set_level(&ctx, &gates).expect("level upload");
-        for (mode, hops) in [
-            (GpuMode::Gates, 1),
-            (GpuMode::Gates, 2),
-            (GpuMode::GatesPerPixel, 1),
-            (GpuMode::GatesPerPixel, 2),
-        ] {
+        for (clustered, hops) in [(true, 1), (true, 2), (false, 1), (false, 2)] {
             let gp = GateParams {
                 oversize: 1.5,
                 max_hops: hops,
             };
+            let mode = if clustered {
+                GpuMode::Gates(GatesParams {
+                    gates: gp,
+                    ..GatesParams::default()
+                })
+            } else {
+                GpuMode::GatesPerPixel(gp)
+            };
             let (img, _) = gpu
-                .render(
-                    &ctx,
-                    &view,
-                    &vpls,
-                    &GpuParams {
-                        mode,
-                        gates: gp,
-                        ..GpuParams::default()
-                    },
-                )
+                .render(&ctx, &view, &vpls, &GpuParams::with_mode(mode))
                 .expect("render");
             let (cpu, _) = render_with(
                 &tracer,
@@ -211,8 +202,13 @@ fn gpu_gates_agree_with_the_cpu_twin() {
             )
             .expect("cpu");
             let e = errors(&img, &cpu).expect("same size");
-            eprintln!("{} {mode:?} {hops} hop(s): {e:?}", b.name());
-            assert!(e.rel_mse < 0.02, "{} {mode:?} {hops}: {e:?}", b.name());
+            eprintln!("{} {} {hops} hop(s): {e:?}", b.name(), mode.name());
+            assert!(
+                e.rel_mse < 0.02,
+                "{} {} {hops}: {e:?}",
+                b.name(),
+                mode.name()
+            );
             assert!(
                 (e.image_mean / e.reference_mean - 1.0).abs() < 0.01,
                 "{e:?}"
@@ -224,7 +220,7 @@ fn gpu_gates_agree_with_the_cpu_twin() {
 #[test]
 fn clustered_light_lists_give_exactly_the_per_point_gate_test() {
     use glam::Vec2;
-    use visgate_runtime::clustered::{ClusterParams, PixelSurface, assign, entry_reaches};
+    use visgate_runtime::cpu::clustered::{ClusterParams, PixelSurface, assign, entry_reaches};
     for (b, res) in [(Builtin::FourRooms, 128), (Builtin::TwoRooms, 96)] {
         let (_scene, gates, tracer, vpls, view) = fixture(b, res);
         let pixels: Vec<Option<PixelSurface>> = (0..48u32)
@@ -296,8 +292,8 @@ fn clustered_light_lists_give_exactly_the_per_point_gate_test() {
 
 #[test]
 fn gpu_light_lists_equal_the_cpu_twin() {
-    use visgate_runtime::clustered::{CONE_SLACK, ClusterParams, assign, cone_margin};
-    use visgate_runtime::gpu::{GpuContext, GpuParams, GpuRenderer};
+    use visgate_runtime::cpu::clustered::{CONE_SLACK, ClusterParams, assign, cone_margin};
+    use visgate_runtime::gpu::{GatesParams, GpuContext, GpuRenderer};
     let ctx = GpuContext::new().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"));
     for (b, res) in [(Builtin::FourRooms, 128), (Builtin::TwoRooms, 96)] {
         let (scene, gates, _tracer, vpls, view) = fixture(b, res);
@@ -322,10 +318,10 @@ fn gpu_light_lists_equal_the_cpu_twin() {
                 },
             ),
         ] {
-            let params = GpuParams {
+            let params = GatesParams {
                 gates: gp,
                 clusters: cp,
-                ..GpuParams::default()
+                ..GatesParams::default()
             };
             let (pixels, got) = gpu.light_lists(&ctx, &view, &vpls, &params).expect("lists");
             // The G-buffer's visibility cluster follows the CPU rule (through the normal side;
@@ -405,7 +401,7 @@ mod common;
 
 /// GPU gates (clustered) and the CPU twin on `vpls`, relative MSE of the GPU image.
 fn gpu_vs_twin(
-    gpu: &visgate_runtime::gpu::GpuRenderer,
+    gpu: &mut visgate_runtime::gpu::GpuRenderer,
     ctx: &visgate_runtime::gpu::GpuContext,
     scene: &visgate_formats::Scene,
     tracer: &Tracer,
@@ -413,18 +409,15 @@ fn gpu_vs_twin(
     vpls: &[visgate_runtime::vpl::Vpl],
     view: &visgate_runtime::camera::View,
 ) -> (visgate_runtime::hdr::HdrImage, f64) {
-    use visgate_runtime::gpu::{GpuMode, GpuParams};
+    use visgate_runtime::cpu::reference::{IndirectVisibility, ReferenceParams, render_with};
+    use visgate_runtime::gpu::{GatesParams, GpuMode, GpuParams};
     use visgate_runtime::metrics::errors;
-    use visgate_runtime::reference::{IndirectVisibility, ReferenceParams, render_with};
     let (img, _) = gpu
         .render(
             ctx,
             view,
             vpls,
-            &GpuParams {
-                mode: GpuMode::Gates,
-                ..GpuParams::default()
-            },
+            &GpuParams::with_mode(GpuMode::Gates(GatesParams::default())),
         )
         .expect("gpu");
     assert!(img.pixels.iter().all(|p| p.is_finite()), "finite");
@@ -447,19 +440,17 @@ fn gpu_vs_twin(
 
 #[test]
 fn gpu_gates_stay_stable_at_the_extremes() {
-    use visgate_runtime::gpu::{GpuContext, GpuMode, GpuParams, GpuRenderer};
+    use visgate_runtime::gpu::{GatesParams, GpuContext, GpuMode, GpuParams, GpuRenderer};
     use visgate_runtime::vpl::{PathParams, Vpl, path_vpls};
     let ctx = GpuContext::new().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"));
     let (scene, gates, tracer, vpls, view) = fixture(Builtin::FourRooms, 128);
     let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
     gpu.set_level(&ctx, &gates).expect("level");
-    let params = |mode| GpuParams {
-        mode,
-        ..GpuParams::default()
-    };
+    let params = GpuParams::with_mode;
+    let gates_mode = || GpuMode::Gates(GatesParams::default());
     // No VPLs: direct light alone, empty lists.
     let (none, t) = gpu
-        .render(&ctx, &view, &[], &params(GpuMode::Gates))
+        .render(&ctx, &view, &[], &params(gates_mode()))
         .expect("0 VPLs");
     let (direct, _) = gpu
         .render(&ctx, &view, &[], &params(GpuMode::DirectOnly))
@@ -481,7 +472,7 @@ fn gpu_gates_stay_stable_at_the_extremes() {
         visgate_runtime::camera::View::new(scene.cameras.first().expect("camera"), [16, 12])
             .expect("view");
     let (img, t) = gpu
-        .render(&ctx, &small, &many, &params(GpuMode::Gates))
+        .render(&ctx, &small, &many, &params(gates_mode()))
         .expect("65536 VPLs");
     assert!(img.pixels.iter().all(|p| p.is_finite()));
     let (d, _) = gpu
@@ -500,10 +491,10 @@ fn gpu_gates_stay_stable_at_the_extremes() {
             &ctx,
             &view,
             &vpls,
-            &GpuParams {
+            &params(GpuMode::Gates(GatesParams {
                 light_entries: 1000,
-                ..params(GpuMode::Gates)
-            },
+                ..GatesParams::default()
+            })),
         )
         .expect_err("overflow");
     assert!(e.to_string().contains("--light-entries"), "{e}");
@@ -517,10 +508,10 @@ fn gpu_gates_stay_stable_at_the_extremes() {
         .copied()
         .collect();
     assert!(one.len() > 20, "{} VPLs in the camera's cluster", one.len());
-    let (_, rel) = gpu_vs_twin(&gpu, &ctx, &scene, &tracer, &gates, &one, &view);
+    let (_, rel) = gpu_vs_twin(&mut gpu, &ctx, &scene, &tracer, &gates, &one, &view);
     assert!(rel < 0.02, "one cluster: {rel}");
     let (_, lists) = gpu
-        .light_lists(&ctx, &view, &one, &params(GpuMode::Gates))
+        .light_lists(&ctx, &view, &one, &GatesParams::default())
         .expect("lists");
     for (c, l) in lists.clusters.iter().zip(&lists.lists) {
         if c.cluster == Some(home) {
@@ -537,7 +528,7 @@ fn gpu_gates_stay_stable_at_the_extremes() {
         Vpl::new(c, -n, flux),
         Vpl::new(c + t * (0.5 * r), n.cross(t), flux),
     ];
-    let (_, rel) = gpu_vs_twin(&gpu, &ctx, &scene, &tracer, &gates, &on_gate, &view);
+    let (_, rel) = gpu_vs_twin(&mut gpu, &ctx, &scene, &tracer, &gates, &on_gate, &view);
     assert!(rel < 0.05, "VPLs on a gate: {rel}");
     // A gate of radius zero passes no light, as on the CPU.
     let (scene0, level0) = baked(Builtin::FourRooms, 128);
@@ -546,7 +537,7 @@ fn gpu_gates_stay_stable_at_the_extremes() {
     let gates0 = GateLevel::new(level0, &scene0).expect("level");
     let mut gpu0 = GpuRenderer::new(&ctx, &scene0).expect("upload");
     gpu0.set_level(&ctx, &gates0).expect("level");
-    let (_, rel) = gpu_vs_twin(&gpu0, &ctx, &scene0, &tracer, &gates0, &vpls, &view);
+    let (_, rel) = gpu_vs_twin(&mut gpu0, &ctx, &scene0, &tracer, &gates0, &vpls, &view);
     assert!(rel < 0.02, "gate of radius 0: {rel}");
     // A camera inside a wall: finite, and as the twin.
     let dir = (view.forward).normalize();
@@ -555,14 +546,14 @@ fn gpu_gates_stay_stable_at_the_extremes() {
     cam.eye = hit.position + dir * 0.02;
     cam.target = cam.eye + dir;
     let inside = visgate_runtime::camera::View::new(&cam, [64, 48]).expect("view");
-    let (img, rel) = gpu_vs_twin(&gpu, &ctx, &scene, &tracer, &gates, &vpls, &inside);
+    let (img, rel) = gpu_vs_twin(&mut gpu, &ctx, &scene, &tracer, &gates, &vpls, &inside);
     eprintln!("camera in a wall: mean {}, rel. MSE {rel}", img.mean());
     assert!(rel < 0.05, "camera in a wall: {rel}");
 }
 
 #[test]
 fn gpu_gates_give_the_same_image_at_scales_1e_3_to_1e4() {
-    use visgate_runtime::gpu::{GpuContext, GpuMode, GpuParams, GpuRenderer};
+    use visgate_runtime::gpu::{GatesParams, GpuContext, GpuMode, GpuParams, GpuRenderer};
     use visgate_runtime::metrics::errors;
     use visgate_runtime::vpl::{PathParams, path_vpls};
     let ctx = GpuContext::new().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"));
@@ -597,9 +588,8 @@ fn gpu_gates_give_the_same_image_at_scales_1e_3_to_1e4() {
                 &view,
                 &vpls,
                 &GpuParams {
-                    mode: GpuMode::Gates,
                     g_max: 10.0 / (s * s),
-                    ..GpuParams::default()
+                    ..GpuParams::with_mode(GpuMode::Gates(GatesParams::default()))
                 },
             )
             .expect("render");

@@ -10,17 +10,12 @@ pub fn scene_and_level(
     args: &mut impl Iterator<Item = String>,
 ) -> Result<(String, Scene, BakedLevel), Box<dyn std::error::Error>> {
     let scene_arg = args.next().unwrap_or_else(|| "builtin:four-rooms".into());
-    let scene = match scene_arg.strip_prefix("builtin:") {
-        Some(name) => visgate_scenes::Builtin::from_name(name)
-            .ok_or("no such built-in scene")?
-            .scene()?,
-        None => Scene::load(
-            std::path::Path::new(&scene_arg),
-            &ImportOptions {
-                load_textures: true,
-            },
-        )?,
-    };
+    let scene = visgate_scenes::load(
+        &scene_arg,
+        &ImportOptions {
+            load_textures: true,
+        },
+    )?;
     let level = match args.next() {
         Some(p) if p != "-" => BakedLevel::read(std::path::Path::new(&p))?,
         _ => {

@@ -17,6 +17,7 @@ pub mod desc;
 pub mod error;
 pub mod export;
 pub mod import;
+pub mod load;
 pub mod scene;
 pub mod vgate;
 

@@ -2,14 +2,11 @@
 //! once to visgate's space (right-handed, +Y up, metres).
 
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 use glam::{DMat4, DQuat, DVec3, EulerRot, Vec2, Vec3};
 use serde::Serialize;
 
-use crate::desc::{LightDesc, SceneDesc, UpAxis};
-use crate::error::SceneError;
-use crate::import::{self, ImportOptions, ImportedModel};
+use crate::desc::UpAxis;
 
 /// A diffuse material. The effective albedo at a point is `albedo × texture(uv)` (the
 /// texture decoded from sRGB to linear), as in both MTL (`Kd` × `map_Kd`) and glTF
@@ -156,19 +153,19 @@ pub struct MeshTrack {
     /// The `[[mesh]]` entry (every [`Mesh`] with this `entry` moves).
     pub entry: usize,
     /// File space to world.
-    space: DMat4,
+    pub(crate) space: DMat4,
     /// The entry's scale.
-    scale: DVec3,
+    pub(crate) scale: DVec3,
     /// Its rotation when not keyframed, degrees.
-    rotate_deg: DVec3,
+    pub(crate) rotate_deg: DVec3,
     /// World transform at rest (the imported geometry's).
-    rest: DMat4,
+    pub(crate) rest: DMat4,
     /// Keys (t, translation, rotation in degrees), file units.
-    keys: Vec<(f64, DVec3, DVec3)>,
+    pub(crate) keys: Vec<(f64, DVec3, DVec3)>,
     /// Or a circle (file units).
-    orbit: Option<crate::desc::Orbit>,
+    pub(crate) orbit: Option<crate::desc::Orbit>,
     /// The file's up axis (the orbit's axis).
-    up: UpAxis,
+    pub(crate) up: UpAxis,
 }
 
 /// How one light moves.
@@ -177,15 +174,15 @@ pub struct LightTrack {
     /// Index into [`Scene::lights`].
     pub light: usize,
     /// File space to world.
-    space: SceneSpace,
+    pub(crate) space: SceneSpace,
     /// Keys (t, position, target), file units.
-    keys: Vec<(f64, DVec3, Option<DVec3>)>,
+    pub(crate) keys: Vec<(f64, DVec3, Option<DVec3>)>,
     /// Or a circle (file units).
-    orbit: Option<crate::desc::Orbit>,
+    pub(crate) orbit: Option<crate::desc::Orbit>,
     /// A spot's fixed target (file units): it re-aims as it moves.
-    target: Option<DVec3>,
+    pub(crate) target: Option<DVec3>,
     /// The file's up axis.
-    up: UpAxis,
+    pub(crate) up: UpAxis,
 }
 
 /// A point on an orbit at time t, file units.
@@ -261,7 +258,7 @@ impl LightTrack {
 
 /// A `[[mesh]]` entry's local transform: scale, then Euler rotation (X, then Y, then Z), then
 /// translation.
-fn local_matrix(scale: DVec3, rotate_deg: DVec3, translate: DVec3) -> DMat4 {
+pub(crate) fn local_matrix(scale: DVec3, rotate_deg: DVec3, translate: DVec3) -> DMat4 {
     DMat4::from_scale_rotation_translation(
         scale,
         DQuat::from_euler(
@@ -302,220 +299,6 @@ impl FileKind {
 }
 
 impl Scene {
-    /// Loads a scene TOML, or a bare OBJ/glTF/GLB file as one static mesh with no lights.
-    pub fn load(path: &Path, options: &ImportOptions) -> Result<Scene, SceneError> {
-        let start = Instant::now();
-        let (desc, base) = match FileKind::of(path) {
-            Some(FileKind::SceneToml) => (SceneDesc::read(path)?, parent_dir(path)),
-            Some(FileKind::Obj | FileKind::Gltf) => {
-                (SceneDesc::for_mesh_file(path), parent_dir(path))
-            }
-            _ => {
-                return Err(SceneError::UnknownFileType {
-                    file: path.to_path_buf(),
-                });
-            }
-        };
-        let models = desc
-            .meshes
-            .iter()
-            .map(|m| import::import_file(&base.join(&m.path), options))
-            .collect::<Result<Vec<_>, _>>()?;
-        let mut scene = Scene::assemble(&desc, models, path)?;
-        scene.report.load_seconds = start.elapsed().as_secs_f64();
-        Ok(scene)
-    }
-
-    /// Builds a scene from a description and its already imported models (one per
-    /// `[[mesh]]`, in order); `file` names the scene in errors. Applies the mesh transforms,
-    /// the scene's up axis and units, and the material overrides.
-    pub fn assemble(
-        desc: &SceneDesc,
-        models: Vec<ImportedModel>,
-        file: &Path,
-    ) -> Result<Scene, SceneError> {
-        if models.len() != desc.meshes.len() {
-            return Err(SceneError::Invalid {
-                file: file.to_path_buf(),
-                what: format!(
-                    "{} meshes described but {} imported",
-                    desc.meshes.len(),
-                    models.len()
-                ),
-            });
-        }
-        let to_world = SceneSpace::new(desc.up, desc.metres_per_unit);
-        let mut scene = Scene {
-            name: desc.name.clone().unwrap_or_else(|| {
-                file.file_stem()
-                    .map(|s| s.to_string_lossy().into_owned())
-                    .unwrap_or_else(|| "scene".into())
-            }),
-            source: Some(file.to_path_buf()),
-            closed: desc.closed,
-            meshes: vec![],
-            materials: vec![],
-            textures: vec![],
-            lights: vec![],
-            cameras: vec![],
-            report: ImportReport::default(),
-            animation: Animation::default(),
-        };
-        for (entry, (mdesc, model)) in desc.meshes.iter().zip(models).enumerate() {
-            let local = local_matrix(
-                DVec3::from(mdesc.scale.as_vec()),
-                DVec3::from(mdesc.rotate_deg),
-                DVec3::from(mdesc.translate),
-            );
-            let m = to_world.matrix * local;
-            if !mdesc.animate.is_empty() || mdesc.orbit.is_some() {
-                scene.animation.meshes.push(MeshTrack {
-                    entry,
-                    space: to_world.matrix,
-                    scale: DVec3::from(mdesc.scale.as_vec()),
-                    rotate_deg: DVec3::from(mdesc.rotate_deg),
-                    rest: m,
-                    keys: mdesc
-                        .animate
-                        .iter()
-                        .map(|k| (k.t, DVec3::from(k.translate), DVec3::from(k.rotate_deg)))
-                        .collect(),
-                    orbit: mdesc.orbit.clone(),
-                    up: desc.up,
-                });
-            }
-            let normal_m = m.inverse().transpose();
-            let flip = m.determinant() < 0.0;
-            let mat_base = scene.materials.len() as u32;
-            let tex_base = scene.textures.len() as u32;
-            scene.report.triangles_read += model.triangles_read;
-            scene.report.degenerate_dropped += model.degenerate_dropped;
-            scene.report.textures_failed += model.textures_failed;
-            scene.report.warnings.extend(model.warnings);
-            scene.textures.extend(model.textures);
-            scene
-                .materials
-                .extend(model.materials.into_iter().map(|mut mat| {
-                    mat.texture = mat.texture.map(|t| t + tex_base);
-                    mat
-                }));
-            for raw in model.meshes {
-                let positions = raw
-                    .positions
-                    .iter()
-                    .map(|p| m.transform_point3(p.as_dvec3()).as_vec3())
-                    .collect();
-                let normals = raw
-                    .normals
-                    .iter()
-                    .map(|n| {
-                        normal_m
-                            .transform_vector3(n.as_dvec3())
-                            .normalize_or_zero()
-                            .as_vec3()
-                    })
-                    .collect();
-                let triangles = raw
-                    .triangles
-                    .iter()
-                    .map(|&[a, b, c]| if flip { [a, c, b] } else { [a, b, c] })
-                    .collect::<Vec<_>>();
-                let material = vec![raw.material + mat_base; triangles.len()];
-                scene.meshes.push(Mesh {
-                    name: raw.name,
-                    entry,
-                    is_static: mdesc.is_static,
-                    positions,
-                    normals,
-                    uvs: raw.uvs,
-                    triangles,
-                    material,
-                });
-            }
-        }
-        for o in &desc.materials {
-            let mut found = false;
-            for mat in scene.materials.iter_mut().filter(|m| m.name == o.name) {
-                mat.albedo = Vec3::from(o.albedo);
-                mat.texture = None;
-                found = true;
-            }
-            if !found {
-                let mut known: Vec<&str> =
-                    scene.materials.iter().map(|m| m.name.as_str()).collect();
-                known.sort_unstable();
-                known.dedup();
-                return Err(SceneError::UnknownMaterial {
-                    file: file.to_path_buf(),
-                    name: o.name.clone(),
-                    known: known.join(", "),
-                });
-            }
-        }
-        for (li, l) in desc.lights.iter().enumerate() {
-            let (animate, orbit, target) = match l {
-                LightDesc::Point(p) => (&p.animate, &p.orbit, None),
-                LightDesc::Spot(s) => (&s.animate, &s.orbit, s.target),
-            };
-            if !animate.is_empty() || orbit.is_some() {
-                scene.animation.lights.push(LightTrack {
-                    light: li,
-                    space: to_world,
-                    keys: animate
-                        .iter()
-                        .map(|k| (k.t, DVec3::from(k.position), k.target.map(DVec3::from)))
-                        .collect(),
-                    orbit: orbit.clone(),
-                    target: target.map(DVec3::from),
-                    up: desc.up,
-                });
-            }
-            scene.lights.push(match l {
-                LightDesc::Point(p) => Light::Point {
-                    position: to_world.point(p.position),
-                    intensity: Vec3::from(p.intensity),
-                },
-                LightDesc::Spot(s) => {
-                    let pos = DVec3::from(s.position);
-                    let dir = match (s.target, s.direction) {
-                        (Some(t), _) => DVec3::from(t) - pos,
-                        (None, Some(d)) => DVec3::from(d),
-                        (None, None) => DVec3::NEG_Y,
-                    };
-                    Light::Spot {
-                        position: to_world.point(s.position),
-                        direction: to_world.direction(dir),
-                        intensity: Vec3::from(s.intensity),
-                        cutoff_rad: s.cutoff_deg.to_radians(),
-                        beam_rad: s.beam_deg.to_radians(),
-                    }
-                }
-            });
-        }
-        for c in &desc.cameras {
-            let up = match c.up {
-                Some(u) => DVec3::from(u),
-                None => match desc.up {
-                    UpAxis::Y => DVec3::Y,
-                    UpAxis::Z => DVec3::Z,
-                },
-            };
-            scene.cameras.push(Camera {
-                name: c.name.clone(),
-                eye: to_world.point(c.eye),
-                target: to_world.point(c.target),
-                up: to_world.direction(up),
-                fov_x_rad: c.fov_deg.to_radians(),
-            });
-        }
-        if scene.triangle_count() == 0 {
-            return Err(SceneError::Empty {
-                file: file.to_path_buf(),
-            });
-        }
-        Ok(scene)
-    }
-
     /// Whether anything moves.
     pub fn is_animated(&self) -> bool {
         !self.animation.meshes.is_empty() || !self.animation.lights.is_empty()
@@ -629,7 +412,7 @@ fn bounds_of<'a>(meshes: impl Iterator<Item = &'a Mesh>) -> Option<(Vec3, Vec3)>
     Some(it.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p))))
 }
 
-fn parent_dir(path: &Path) -> PathBuf {
+pub(crate) fn parent_dir(path: &Path) -> PathBuf {
     path.parent()
         .map(Path::to_path_buf)
         .unwrap_or_else(|| PathBuf::from("."))

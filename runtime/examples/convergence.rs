@@ -8,9 +8,9 @@
 //! N_REF the reference's paths (65536). Prints a Markdown table for N = 256 … 16384.
 
 use visgate_runtime::camera::View;
+use visgate_runtime::cpu::reference::{ReferenceParams, render_reference};
+use visgate_runtime::cpu::tracer::Tracer;
 use visgate_runtime::metrics::{errors, flip};
-use visgate_runtime::reference::{ReferenceParams, render_reference};
-use visgate_runtime::tracer::Tracer;
 use visgate_runtime::vpl::{PathParams, path_vpls};
 use visgate_scenes::Builtin;
 

@@ -15,10 +15,13 @@ mod plot;
 use glam::Vec3;
 use visgate_formats::Light;
 use visgate_runtime::camera::View;
-use visgate_runtime::gpu::{GpuContext, GpuMode, GpuParams, GpuRenderer, centres_of};
+use visgate_runtime::cpu::tracer::Tracer;
+use visgate_runtime::cpu::val::centres_of;
+use visgate_runtime::cpu::val::{ValParams, cluster};
+use visgate_runtime::gpu::{
+    CssmParams, GpuContext, GpuMode, GpuParams, GpuRenderer, InterleaveParams, ValModeParams,
+};
 use visgate_runtime::hdr::HdrImage;
-use visgate_runtime::tracer::Tracer;
-use visgate_runtime::val::{ValParams, cluster};
 use visgate_runtime::vpl::{PathParams, path_vpls};
 use visgate_scenes::Builtin;
 
@@ -40,11 +43,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         warm_start,
         ..ValParams::default()
     };
-    let params = |mode, warm_start| GpuParams {
-        mode,
-        vals: vals(warm_start),
-        interleave: 1,
-        ..GpuParams::default()
+    let params = |warm_start| {
+        GpuParams::with_mode(GpuMode::ValCssm(
+            ValModeParams {
+                vals: vals(warm_start),
+                interleave: InterleaveParams {
+                    block: 1,
+                    ..InterleaveParams::default()
+                },
+                ..ValModeParams::new()
+            },
+            CssmParams::default(),
+        ))
     };
     let indirect = |img: &HdrImage, direct: &HdrImage| -> Vec<Vec3> {
         img.pixels
@@ -87,9 +97,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         )?;
         restart.set_lights(&scene.lights);
         warm.set_lights(&scene.lights);
-        let (direct, _) = restart.render(&ctx, &view, &[], &params(GpuMode::DirectOnly, false))?;
-        let (img_r, _) = restart.render(&ctx, &view, &vpls, &params(GpuMode::ValCssm, false))?;
-        let (img_w, _) = warm.render(&ctx, &view, &vpls, &params(GpuMode::ValCssm, true))?;
+        let (direct, _) =
+            restart.render(&ctx, &view, &[], &GpuParams::with_mode(GpuMode::DirectOnly))?;
+        let (img_r, _) = restart.render(&ctx, &view, &vpls, &params(false))?;
+        let (img_w, _) = warm.render(&ctx, &view, &vpls, &params(true))?;
         // The same clusterings on the CPU twin (equal to the GPU's) for the live counts.
         let cr = cluster(&vpls, &vals(false), None)?;
         let cw = cluster(&vpls, &vals(true), warm_centres.as_deref())?;

@@ -12,11 +12,14 @@
 mod plot;
 
 use visgate_runtime::camera::View;
-use visgate_runtime::gpu::{GpuContext, GpuMode, GpuParams, GpuRenderer};
+use visgate_runtime::cpu::reference::{ReferenceParams, render_reference};
+use visgate_runtime::cpu::tracer::Tracer;
+use visgate_runtime::cpu::val::ValParams;
+use visgate_runtime::gpu::{
+    CssmParams, GpuContext, GpuMode, GpuParams, GpuRenderer, InterleaveParams, MethodSettings,
+    ValModeParams,
+};
 use visgate_runtime::metrics::errors;
-use visgate_runtime::reference::{ReferenceParams, render_reference};
-use visgate_runtime::tracer::Tracer;
-use visgate_runtime::val::ValParams;
 use visgate_runtime::vpl::{PathParams, path_vpls};
 use visgate_scenes::Builtin;
 
@@ -68,27 +71,34 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             },
             &|_, _| {},
         )?;
-        let gpu = GpuRenderer::new(&ctx, &scene)?;
-        let mse = |mode: GpuMode, m: u32| -> Result<f64, Box<dyn std::error::Error>> {
+        let mut gpu = GpuRenderer::new(&ctx, &scene)?;
+        let mut mse = |mode: fn(ValModeParams) -> GpuMode,
+                       m: u32|
+         -> Result<f64, Box<dyn std::error::Error>> {
             let (img, _) = gpu.render(
                 &ctx,
                 &view,
                 &vpls,
-                &GpuParams {
-                    mode,
+                &GpuParams::with_mode(mode(ValModeParams {
                     vals: ValParams {
                         count: m,
                         ..ValParams::default()
                     },
                     // Every VPL at every pixel: the error of the visibility alone.
-                    interleave: 1,
-                    ..GpuParams::default()
-                },
+                    interleave: InterleaveParams {
+                        block: 1,
+                        ..InterleaveParams::default()
+                    },
+                    ..ValModeParams::new()
+                })),
             )?;
             Ok(errors(&img, &reference)?.mse)
         };
-        let none = mse(GpuMode::None, 1)?;
-        let per_vpl = mse(GpuMode::PerVplShadowMaps, 1)?;
+        let none = mse(|_| GpuMode::None, 1)?;
+        let per_vpl = mse(
+            |_| GpuMode::PerVplShadowMaps(MethodSettings::default().per_vpl),
+            1,
+        )?;
         for (x, c) in [(none, [150, 150, 150]), (per_vpl, [0, 0, 0])] {
             series.push(plot::Series {
                 colour: c,
@@ -99,7 +109,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         lo = lo.min(none).min(per_vpl);
         hi = hi.max(none).max(per_vpl);
         for (name, mode, dashed) in [
-            ("val-cssm", GpuMode::ValCssm, false),
+            (
+                "val-cssm",
+                (|v| GpuMode::ValCssm(v, CssmParams::default())) as fn(ValModeParams) -> GpuMode,
+                false,
+            ),
             ("val-hard", GpuMode::ValHard, true),
         ] {
             let e: Vec<f64> = COUNTS

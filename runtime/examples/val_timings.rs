@@ -8,11 +8,10 @@
 //!
 //! Defaults: cornell-box, 800 (square), N = 1024 RSM VPLs, M = 30.
 
-use std::time::Instant;
-
 use visgate_runtime::camera::View;
-use visgate_runtime::gpu::{GpuContext, GpuMode, GpuParams, GpuRenderer, PassTimes};
-use visgate_runtime::val::ValParams;
+use visgate_runtime::gpu::{
+    GpuContext, GpuMode, GpuParams, GpuRenderer, MethodSettings, PassTimes, RsmParams, VplInput,
+};
 use visgate_scenes::Builtin;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -24,42 +23,40 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let b = Builtin::from_name(&name).ok_or(format!("no built-in scene '{name}'"))?;
     let scene = b.scene()?;
     let view = View::new(scene.cameras.first().ok_or("no camera")?, [size, size])?;
-    let run = |mode: GpuMode| -> Result<(f64, PassTimes, String), Box<dyn std::error::Error>> {
+    let run = |mode: GpuMode| -> Result<(PassTimes, String), Box<dyn std::error::Error>> {
         let ctx = GpuContext::new()?;
-        let gpu = GpuRenderer::new(&ctx, &scene)?;
-        let params = GpuParams {
-            mode,
-            vals: ValParams {
-                count: m,
-                ..ValParams::default()
-            },
-            ..GpuParams::default()
+        let mut gpu = GpuRenderer::new(&ctx, &scene)?;
+        let params = GpuParams::with_mode(mode);
+        let rsm = |count| {
+            VplInput::Rsm(RsmParams {
+                count,
+                rsm_size: 256,
+                seed: 1,
+            })
         };
-        let warm = gpu.rsm_vpls(&ctx, 64, 256, 1)?;
-        gpu.render(&ctx, &view, &warm, &params)?;
-        let t0 = Instant::now();
-        let vpls = gpu.rsm_vpls(&ctx, n, 256, 1)?;
-        let gen_s = t0.elapsed().as_secs_f64();
-        let (_, t) = gpu.render(&ctx, &view, &vpls, &params)?;
-        Ok((gen_s, t, ctx.adapter_info.name.clone()))
+        gpu.render_frame(&ctx, &view, rsm(64), &params)?;
+        let (_, t) = gpu.render_frame(&ctx, &view, rsm(n), &params)?;
+        Ok((t, ctx.adapter_info.name.clone()))
     };
-    let (gen_c, c, adapter) = run(GpuMode::ValCssm)?;
-    let (gen_h, hd, _) = run(GpuMode::ValHard)?;
-    let (gen_p, p, _) = run(GpuMode::PerVplShadowMaps)?;
+    let mut s = MethodSettings::default();
+    s.vals.vals.count = m;
+    let (c, adapter) = run(GpuMode::ValCssm(s.vals, s.cssm))?;
+    let (hd, _) = run(GpuMode::ValHard(s.vals))?;
+    let (p, _) = run(GpuMode::PerVplShadowMaps(s.per_vpl))?;
     let ms = |x: f64| format!("{:.1}", x * 1e3);
-    let g = |t: &PassTimes| t.gpu.unwrap_or_default();
+    let g = |t: &PassTimes| Stages::of(t);
     println!(
         "{name}, {size}×{size}, N = {n} RSM VPLs, M = {m}, on {adapter}: GPU ms per stage \
-         (VPL generation: CPU wall time of the RSM pass and read-back)"
+         (VPL generation: the RSM pass, the VPLs staying on the GPU)"
     );
     println!(
         "| mode | VPL generation | G-buffer + direct | clustering | shadow maps (per VAL / per VPL) | \
          CSSM basis + mips | indirect lighting | blur | total | speedup |"
     );
     println!("|---|---|---|---|---|---|---|---|---|---|");
-    let total = |vpl_s: f64, t: &PassTimes| {
+    let total = |t: &PassTimes| {
         let s = g(t);
-        vpl_s
+        s.rsm
             + s.shadows
             + s.gbuffer
             + s.shade
@@ -69,25 +66,55 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             + s.vpl_gather
             + s.blur
     };
-    let base = total(gen_p, &p);
-    for (label, vpl_s, t) in [
-        ("val-cssm", gen_c, &c),
-        ("val-hard", gen_h, &hd),
-        ("per-vpl-shadow-maps", gen_p, &p),
+    let base = total(&p);
+    for (label, t) in [
+        ("val-cssm", &c),
+        ("val-hard", &hd),
+        ("per-vpl-shadow-maps", &p),
     ] {
         let s = g(t);
         println!(
             "| {label} | {} | {} | {} | {} | {} | {} | {} | {} | {:.2}× |",
-            ms(vpl_s),
+            ms(s.rsm),
             ms(s.shadows + s.gbuffer + s.shade),
             ms(s.val_clustering),
             ms(s.vpl_maps),
             ms(s.cssm),
             ms(s.vpl_gather),
             ms(s.blur),
-            ms(total(vpl_s, t)),
-            base / total(vpl_s, t)
+            ms(total(t)),
+            base / total(t)
         );
     }
     Ok(())
+}
+
+/// GPU seconds of the stages this table shows.
+struct Stages {
+    rsm: f64,
+    shadows: f64,
+    gbuffer: f64,
+    shade: f64,
+    val_clustering: f64,
+    vpl_maps: f64,
+    cssm: f64,
+    vpl_gather: f64,
+    blur: f64,
+}
+
+impl Stages {
+    fn of(t: &PassTimes) -> Stages {
+        let g = |name: &str| t.gpu(name).unwrap_or(0.0);
+        Stages {
+            rsm: g("RSM VPLs"),
+            shadows: g("shadow maps"),
+            gbuffer: g("geometry pass (G-buffer)"),
+            shade: g("shading: direct lighting"),
+            val_clustering: g("VAL clustering"),
+            vpl_maps: g("VAL paraboloid maps") + g("VPL paraboloid maps"),
+            cssm: g("CSSM basis + mips"),
+            vpl_gather: g("indirect lighting") + g("VPL gather"),
+            blur: g("blur + compose"),
+        }
+    }
 }

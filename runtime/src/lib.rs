@@ -4,28 +4,35 @@
 //! VPL generation from reflective shadow maps or traced light paths, the visibility modes for
 //! indirect light — none, per-VPL shadow maps, visibility gates with clustered shading, virtual
 //! area lights with convolution soft shadow maps — the indirect gather and tone mapping), the
-//! CPU reference renderer with exact visibility, image metrics, and the egui viewer.
+//! CPU reference renderer with exact visibility, and image metrics.
 //!
 //! It reads baked levels through `visgate-formats` and never imports `visgate-preprocess`.
 //!
-//! What stands so far: the CPU side — [`tracer`] (BVH ray casting), [`camera`], [`lights`]
-//! (radiometry and direct light), [`vpl`] (the VPL struct, light-path VPLs, the gather term),
-//! [`reference`] (the exact-visibility renderer), [`hdr`] (EXR/PNG), [`metrics`], the CPU twins
-//! [`gates`] and [`clustered`] (gate visibility and clustered light lists), [`val`] (VAL
-//! clustering) and [`cssm`] (the Fourier shadow test) — and the GPU renderer [`gpu`] with every
-//! mode. The viewer comes later.
+//! Where things live:
+//!
+//! - [`gpu`]: the renderer ([`gpu::GpuRenderer`], made once per scene, keeping its resources),
+//!   its passes (`gpu/passes/`, each beside its WGSL), the methods and their typed parameters
+//!   with the registry the CLI, viewer and `compare` read ([`gpu::methods`]), every struct
+//!   shared with WGSL ([`gpu::layout`]), the WGSL include step ([`gpu::shaders`]), timing.
+//! - [`cpu`]: the tracer, the exact reference, and the CPU twin of each method.
+//! - [`job`]: what `visgate render` does — CPU or GPU, VPLs, animation frames — as one library
+//!   call the CLI, the viewer and `compare` share.
+//! - [`vpl`] (VPLs, light paths, the gather term), [`lights`], [`camera`], [`hdr`],
+//!   [`metrics`].
+//!
+//! A frame: VPLs (uploaded, or made from the lights' RSMs on the GPU) → shadow maps → G-buffer
+//! → the method's passes → shading → readback, one command encoder and (with timestamp
+//! queries) one submission; see [`gpu`]. To add a method: a pass module beside its WGSL, a
+//! [`gpu::GpuMode`] variant with its params, its line in [`gpu::METHODS`], its branch in the
+//! frame.
 
 pub mod camera;
-pub mod clustered;
-pub mod cssm;
-pub mod gates;
+pub mod cpu;
 pub mod gpu;
 pub mod hdr;
+pub mod job;
 pub mod lights;
 pub mod metrics;
-pub mod reference;
-pub mod tracer;
-pub mod val;
 pub mod vpl;
 
 use std::path::Path;

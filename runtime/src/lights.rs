@@ -7,7 +7,7 @@ use std::f32::consts::PI;
 use glam::Vec3;
 use visgate_formats::Light;
 
-use crate::tracer::{Surface, Tracer};
+use crate::cpu::tracer::{Surface, Tracer};
 
 /// Falloff of a spot light at angle `angle_rad` from its axis.
 pub fn spot_falloff(angle_rad: f32, beam_rad: f32, cutoff_rad: f32) -> f32 {

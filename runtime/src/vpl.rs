@@ -21,8 +21,8 @@ use glam::{Vec2, Vec3};
 use visgate_formats::Light;
 
 use crate::RenderError;
+use crate::cpu::tracer::Tracer;
 use crate::lights::{intensity_towards, light_position, light_power};
-use crate::tracer::Tracer;
 
 /// One virtual point light, laid out for the GPU (48 bytes, 16-byte aligned fields).
 #[repr(C)]

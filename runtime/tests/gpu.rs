@@ -5,34 +5,26 @@ use std::f32::consts::PI;
 
 use glam::Vec3;
 use visgate_runtime::camera::View;
-use visgate_runtime::gpu::{GpuContext, GpuMode, GpuParams, GpuRenderer, SHADERS};
+use visgate_runtime::cpu::reference::{ReferenceParams, render_reference};
+use visgate_runtime::cpu::tracer::Tracer;
+use visgate_runtime::gpu::{
+    GpuContext, GpuMode, GpuParams, GpuRenderer, PerVplParams, ShadowParams,
+};
 use visgate_runtime::metrics::{errors, flip};
-use visgate_runtime::reference::{ReferenceParams, render_reference};
-use visgate_runtime::tracer::Tracer;
 use visgate_runtime::vpl::{GatherParams, PathParams, path_vpls};
 use visgate_scenes::Builtin;
 
 mod common;
 use common::{closed_box, floor, quads, scaled_four_rooms};
 
+fn per_vpl() -> GpuMode {
+    GpuMode::PerVplShadowMaps(PerVplParams::default())
+}
+
 fn context() -> GpuContext {
     match GpuContext::new() {
         Ok(c) => c,
         Err(e) => panic!("GPU tests need an adapter (CI installs lavapipe): {e}"),
-    }
-}
-
-#[test]
-fn every_shader_parses_and_validates_without_a_gpu() {
-    for (name, src) in SHADERS {
-        let module = naga::front::wgsl::parse_str(src)
-            .unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(src)));
-        naga::valid::Validator::new(
-            naga::valid::ValidationFlags::all(),
-            naga::valid::Capabilities::all(),
-        )
-        .validate(&module)
-        .unwrap_or_else(|e| panic!("{name}: {e:?}"));
     }
 }
 
@@ -60,7 +52,7 @@ fn both(
     )
     .expect("vpls");
     let view = View::new(scene.cameras.first().expect("camera"), size).expect("view");
-    let gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
     let (img, _) = gpu
         .render(
             &ctx,
@@ -80,7 +72,7 @@ fn both(
         &ReferenceParams {
             samples_per_pixel: 1,
             indirect: mode != GpuMode::DirectOnly,
-            indirect_visibility: mode == GpuMode::PerVplShadowMaps,
+            indirect_visibility: matches!(mode, GpuMode::PerVplShadowMaps(_)),
             gather: GatherParams::default(),
             ..ReferenceParams::default()
         },
@@ -96,8 +88,8 @@ fn gpu_modes_agree_with_the_cpu_reference_with_the_same_vpls_and_visibility() {
         (Builtin::FourRooms, GpuMode::None),
         (Builtin::FourRooms, GpuMode::DirectOnly),
         (Builtin::CornellBox, GpuMode::None),
-        (Builtin::FourRooms, GpuMode::PerVplShadowMaps),
-        (Builtin::CornellBox, GpuMode::PerVplShadowMaps),
+        (Builtin::FourRooms, per_vpl()),
+        (Builtin::CornellBox, per_vpl()),
     ] {
         let (gpu, cpu) = both(b, [64, 48], 256, mode);
         let e = errors(&gpu, &cpu).expect("same size");
@@ -126,7 +118,7 @@ fn gpu_white_plane_under_a_point_light_has_the_closed_form_radiance() {
         }],
     );
     let ctx = context();
-    let gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
     // Looking straight down from beside the light at the point under it.
     let cam = Camera {
         name: "down".into(),
@@ -152,247 +144,6 @@ fn gpu_white_plane_under_a_point_light_has_the_closed_form_radiance() {
     assert!((got - want).abs() / want < 1e-3, "{got} vs {want}");
 }
 
-/// Size and member offsets of struct `name` in `src`, as naga lays it out.
-fn wgsl_layout(src: &str, name: &str) -> (u32, Vec<(String, u32)>) {
-    let module = naga::front::wgsl::parse_str(src).expect("parses");
-    let mut layouter = naga::proc::Layouter::default();
-    layouter.update(module.to_ctx()).expect("layout");
-    let (h, ty) = module
-        .types
-        .iter()
-        .find(|(_, t)| t.name.as_deref() == Some(name))
-        .unwrap_or_else(|| panic!("no struct {name}"));
-    let naga::TypeInner::Struct { members, .. } = &ty.inner else {
-        panic!("{name} is not a struct");
-    };
-    (
-        layouter[h].size,
-        members
-            .iter()
-            .map(|m| (m.name.clone().unwrap_or_default(), m.offset))
-            .collect(),
-    )
-}
-
-#[test]
-fn gpu_structs_match_their_wgsl_layouts() {
-    use std::mem::{offset_of, size_of};
-    use visgate_runtime::gpu::{
-        Batch, ClusterFrame, CssmFrame, Globals, GpuGeometryCluster, GpuLight, GridUniform,
-        RsmSample, ShadowView, ValFrame, ValGather, ValMaps, VplView,
-    };
-    use visgate_runtime::val::Val;
-    use visgate_runtime::vpl::Vpl;
-    let shade = SHADERS[2].1;
-    let check = |src: &str, name: &str, size: usize, offsets: &[(&str, usize)]| {
-        let (s, members) = wgsl_layout(src, name);
-        assert_eq!(s as usize, size, "{name} size");
-        assert_eq!(members.len(), offsets.len(), "{name} members {members:?}");
-        for ((m, o), (want_name, want)) in members.iter().zip(offsets) {
-            assert_eq!((m.as_str(), *o as usize), (*want_name, *want), "{name}");
-        }
-    };
-    check(
-        shade,
-        "Globals",
-        size_of::<Globals>(),
-        &[
-            ("view_proj", offset_of!(Globals, view_proj)),
-            ("eye", offset_of!(Globals, eye)),
-            ("params", offset_of!(Globals, params)),
-            ("counts", offset_of!(Globals, counts)),
-        ],
-    );
-    check(
-        SHADERS[0].1,
-        "Globals",
-        size_of::<Globals>(),
-        &[
-            ("view_proj", 0),
-            ("eye", 64),
-            ("params", 80),
-            ("counts", 96),
-        ],
-    );
-    check(
-        shade,
-        "Light",
-        size_of::<GpuLight>(),
-        &[
-            ("position", offset_of!(GpuLight, position)),
-            ("intensity", offset_of!(GpuLight, intensity)),
-            ("direction", offset_of!(GpuLight, direction)),
-            ("layers", offset_of!(GpuLight, layers)),
-        ],
-    );
-    for src in [shade, SHADERS[4].1] {
-        check(
-            src,
-            "Vpl",
-            size_of::<Vpl>(),
-            &[
-                ("position", offset_of!(Vpl, position)),
-                ("pad0", offset_of!(Vpl, _pad0)),
-                ("normal", offset_of!(Vpl, normal)),
-                ("pad1", offset_of!(Vpl, _pad1)),
-                ("flux", offset_of!(Vpl, flux)),
-                ("pad2", offset_of!(Vpl, _pad2)),
-            ],
-        );
-    }
-    check(
-        SHADERS[1].1,
-        "ShadowView",
-        size_of::<ShadowView>(),
-        &[
-            ("view_proj", offset_of!(ShadowView, view_proj)),
-            ("light", offset_of!(ShadowView, light)),
-        ],
-    );
-    check(
-        SHADERS[3].1,
-        "VplView",
-        size_of::<VplView>(),
-        &[
-            ("position", offset_of!(VplView, position)),
-            ("tangent", offset_of!(VplView, tangent)),
-            ("bitangent", offset_of!(VplView, bitangent)),
-            ("normal", offset_of!(VplView, normal)),
-        ],
-    );
-    check(
-        shade,
-        "Grid",
-        size_of::<GridUniform>(),
-        &[
-            ("origin", offset_of!(GridUniform, origin)),
-            ("dims", offset_of!(GridUniform, dims)),
-            ("params", offset_of!(GridUniform, params)),
-        ],
-    );
-    // Gates go up as 12 words each (GateLevel::tables): centre + radius, normal, clusters.
-    check(
-        shade,
-        "Gate",
-        48,
-        &[("centre", 0), ("normal", 16), ("clusters", 32)],
-    );
-    check(
-        SHADERS[5].1,
-        "Sample",
-        size_of::<RsmSample>(),
-        &[
-            ("texel", offset_of!(RsmSample, texel)),
-            ("power", offset_of!(RsmSample, power)),
-        ],
-    );
-    check(
-        SHADERS[5].1,
-        "Vpl",
-        size_of::<Vpl>(),
-        &[
-            ("position", 0),
-            ("pad0", 12),
-            ("normal", 16),
-            ("pad1", 28),
-            ("flux", 32),
-            ("pad2", 44),
-        ],
-    );
-    check(
-        SHADERS[4].1,
-        "Batch",
-        size_of::<Batch>(),
-        &[
-            ("range", offset_of!(Batch, range)),
-            ("params", offset_of!(Batch, params)),
-        ],
-    );
-    let clusters = SHADERS[6].1;
-    check(
-        clusters,
-        "Frame",
-        size_of::<ClusterFrame>(),
-        &[
-            ("eye", offset_of!(ClusterFrame, eye)),
-            ("forward", offset_of!(ClusterFrame, forward)),
-            ("size", offset_of!(ClusterFrame, size)),
-            ("counts", offset_of!(ClusterFrame, counts)),
-        ],
-    );
-    let cluster_members = [
-        ("key", offset_of!(GpuGeometryCluster, key)),
-        ("lo", offset_of!(GpuGeometryCluster, lo)),
-        ("hi", offset_of!(GpuGeometryCluster, hi)),
-        ("list", offset_of!(GpuGeometryCluster, list)),
-    ];
-    let size = size_of::<GpuGeometryCluster>();
-    check(clusters, "GeometryCluster", size, &cluster_members);
-    check(shade, "ClusterLists", size, &cluster_members);
-    check(
-        clusters,
-        "Grid",
-        size_of::<GridUniform>(),
-        &[("origin", 0), ("dims", 16), ("params", 32)],
-    );
-    let vals = SHADERS[7].1;
-    check(
-        vals,
-        "Val",
-        size_of::<Val>(),
-        &[
-            ("position", offset_of!(Val, position)),
-            ("normal", offset_of!(Val, normal)),
-            ("flux", offset_of!(Val, flux)),
-            ("rect", offset_of!(Val, rect)),
-        ],
-    );
-    check(
-        SHADERS[8].1,
-        "ValGather",
-        size_of::<ValGather>(),
-        &[
-            ("counts", offset_of!(ValGather, counts)),
-            ("params", offset_of!(ValGather, params)),
-            ("cssm", offset_of!(ValGather, cssm)),
-            ("interleave", offset_of!(ValGather, interleave)),
-            ("blur", offset_of!(ValGather, blur)),
-        ],
-    );
-    check(
-        SHADERS[9].1,
-        "CssmFrame",
-        size_of::<CssmFrame>(),
-        &[
-            ("counts", offset_of!(CssmFrame, counts)),
-            ("level", offset_of!(CssmFrame, level)),
-        ],
-    );
-    check(
-        SHADERS[3].1,
-        "ValMaps",
-        size_of::<ValMaps>(),
-        &[("params", offset_of!(ValMaps, params))],
-    );
-    for src in [vals, SHADERS[3].1, SHADERS[8].1] {
-        check(
-            src,
-            "Val",
-            size_of::<Val>(),
-            &[("position", 0), ("normal", 16), ("flux", 32), ("rect", 48)],
-        );
-    }
-    check(
-        vals,
-        "ValFrame",
-        size_of::<ValFrame>(),
-        &[
-            ("counts", offset_of!(ValFrame, counts)),
-            ("weights", offset_of!(ValFrame, weights)),
-        ],
-    );
-}
-
 #[test]
 fn gpu_renders_0_1_and_65536_vpls_and_a_vpl_on_the_receiver_without_nan() {
     let ctx = context();
@@ -409,7 +160,7 @@ fn gpu_renders_0_1_and_65536_vpls_and_a_vpl_on_the_receiver_without_nan() {
     )
     .expect("vpls");
     let view = View::new(scene.cameras.first().expect("camera"), [16, 12]).expect("view");
-    let gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
     let mut means = Vec::new();
     for v in [&vpls[..0], &vpls[..1], &vpls[..]] {
         let (img, _) = gpu
@@ -430,27 +181,43 @@ fn gpu_renders_0_1_and_65536_vpls_and_a_vpl_on_the_receiver_without_nan() {
             &ctx,
             &view,
             &vpls[..64],
-            &GpuParams {
-                mode: GpuMode::PerVplShadowMaps,
-                vpl_batch: 16,
-                ..GpuParams::default()
-            },
+            &GpuParams::with_mode(GpuMode::PerVplShadowMaps(PerVplParams {
+                batch: 16,
+                ..PerVplParams::default()
+            })),
         )
         .expect("render");
-    match (ctx.timestamp_period, times.gpu) {
-        (Some(_), Some(g)) => {
-            assert!(g.shadows > 0.0 && g.gbuffer > 0.0 && g.shade > 0.0, "{g:?}");
-            assert!(g.vpl_maps > 0.0 && g.vpl_gather > 0.0, "{g:?}");
-        }
-        (None, None) => eprintln!("adapter without timestamp queries: CPU times only"),
-        other => panic!("timestamp support and times disagree: {other:?}"),
+    let names: Vec<&str> = times.passes.iter().map(|p| p.name).collect();
+    // 64 VPLs in batches of 16: 4 × (maps, gather), after the shadow maps, G-buffer, shading.
+    assert_eq!(
+        names
+            .iter()
+            .filter(|n| **n == "VPL paraboloid maps")
+            .count(),
+        4
+    );
+    assert_eq!(names.iter().filter(|n| **n == "VPL gather").count(), 4);
+    assert_eq!(
+        names[..3],
+        [
+            "shadow maps",
+            "geometry pass (G-buffer)",
+            "shading: direct lighting"
+        ]
+    );
+    let spans_timed = times
+        .passes
+        .iter()
+        .all(|p| p.gpu_s.is_some_and(|s| s > 0.0));
+    let spans_waited = times.passes.iter().all(|p| p.cpu_s.is_some());
+    match ctx.timestamp_period {
+        Some(_) => assert!(spans_timed, "{times:?}"),
+        None => assert!(spans_waited, "{times:?}"),
     }
     let (_, times) = gpu
         .render(&ctx, &view, &vpls[..64], &GpuParams::default())
         .expect("render");
-    if let Some(g) = times.gpu {
-        assert_eq!((g.vpl_maps, g.vpl_gather), (0.0, 0.0));
-    }
+    assert!(times.gpu("VPL paraboloid maps").is_none() && times.gpu("VPL gather").is_none());
     // VPLs lying on the surfaces the camera sees (every light-path VPL does): the clamp holds.
     let (img, _) = gpu
         .render(
@@ -471,13 +238,16 @@ fn gpu_renders_0_1_and_65536_vpls_and_a_vpl_on_the_receiver_without_nan() {
             ..GpuParams::default()
         },
         GpuParams {
-            shadow_size: 1,
+            shadows: ShadowParams {
+                size: 1,
+                ..ShadowParams::default()
+            },
             ..GpuParams::default()
         },
-        GpuParams {
-            vpl_batch: 0,
-            ..GpuParams::default()
-        },
+        GpuParams::with_mode(GpuMode::PerVplShadowMaps(PerVplParams {
+            batch: 0,
+            ..PerVplParams::default()
+        })),
     ] {
         assert!(gpu.render(&ctx, &view, &[], &bad).is_err(), "{bad:?}");
     }
@@ -489,7 +259,7 @@ fn rsm_vpls_carry_the_reflected_power_and_do_not_flicker() {
     // hold ρ × the light's power, as the light paths do.
     let ctx = context();
     let scene = Builtin::EmptyBox.scene().expect("scene");
-    let gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
     let tracer = Tracer::new(&scene);
     let n = 4096;
     let rsm = gpu.rsm_vpls(&ctx, n, 256, 1).expect("rsm vpls");
@@ -555,7 +325,7 @@ fn gpu_scene_scales_from_1e_minus_3_to_1e4_give_the_same_image_after_scaling_the
             },
         )
         .expect("vpls");
-        let gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+        let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
         let view = View::new(&cam, [32, 24]).expect("view");
         let params = GpuParams {
             g_max: 10.0 / (scale * scale),
@@ -589,7 +359,7 @@ fn gpu_a_light_inside_geometry_lights_nothing_outside_it() {
         }],
     );
     let ctx = context();
-    let gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
     let cam = Camera {
         name: "floor".into(),
         eye: Vec3::new(3.0, 2.0, 0.0),
@@ -660,7 +430,7 @@ fn gpu_samples_albedo_textures_as_the_reference_does() {
     };
     let view = View::new(&cam, [40, 40]).expect("view");
     let ctx = context();
-    let gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
     let (img, _) = gpu
         .render(
             &ctx,
@@ -720,7 +490,7 @@ fn gpu_spot_falloff_matches_the_conventions_at_beam_mid_ramp_and_cutoff() {
         }],
     );
     let ctx = context();
-    let gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
     for angle in [0.0f32, beam * 0.95, 0.5 * (beam + cutoff), cutoff * 1.1] {
         let x = h * angle.tan();
         // A narrow camera straight above the point at `angle` from the spot's axis.
@@ -758,13 +528,9 @@ fn gpu_a_closed_box_with_no_light_is_black() {
     let ctx = context();
     let mut scene = Builtin::EmptyBox.scene().expect("scene");
     scene.lights.clear();
-    let gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
     let view = View::new(scene.cameras.first().expect("camera"), [16, 12]).expect("view");
-    for mode in [
-        GpuMode::None,
-        GpuMode::PerVplShadowMaps,
-        GpuMode::DirectOnly,
-    ] {
+    for mode in [GpuMode::None, per_vpl(), GpuMode::DirectOnly] {
         let (img, _) = gpu
             .render(
                 &ctx,

@@ -8,9 +8,9 @@ use std::f32::consts::PI;
 use glam::{Vec2, Vec3};
 use visgate_formats::{Camera, Light, Scene};
 use visgate_runtime::camera::View;
+use visgate_runtime::cpu::reference::{ReferenceParams, render_reference, shade_point};
+use visgate_runtime::cpu::tracer::Tracer;
 use visgate_runtime::lights::{light_power, spot_falloff};
-use visgate_runtime::reference::{ReferenceParams, render_reference, shade_point};
-use visgate_runtime::tracer::Tracer;
 use visgate_runtime::vpl::{GatherParams, PathParams, Vpl, clamp_loss, gather_one, path_vpls};
 
 use common::{closed_box, floor, quads, scaled_four_rooms};

@@ -1,11 +1,20 @@
 //! Virtual area lights: the GPU k-means against its CPU twin, and the edge cases.
 
 use glam::Vec3;
-use visgate_runtime::gpu::{GpuContext, GpuRenderer, centres_of};
-use visgate_runtime::tracer::Tracer;
-use visgate_runtime::val::{Clustering, ValParams, cluster};
+use visgate_runtime::cpu::tracer::Tracer;
+use visgate_runtime::cpu::val::centres_of;
+use visgate_runtime::cpu::val::{Clustering, ValParams, cluster};
+use visgate_runtime::gpu::{CssmParams, GpuContext, GpuMode, GpuRenderer, ValModeParams};
 use visgate_runtime::vpl::{PathParams, Vpl, path_vpls};
 use visgate_scenes::Builtin;
+
+fn hard() -> GpuMode {
+    GpuMode::ValHard(ValModeParams::new())
+}
+
+fn cssm() -> GpuMode {
+    GpuMode::ValCssm(ValModeParams::new(), CssmParams::default())
+}
 
 fn context() -> GpuContext {
     GpuContext::new()
@@ -51,7 +60,7 @@ fn gpu_k_means_equals_the_cpu_twin() {
     let ctx = context();
     for b in [Builtin::CornellBox, Builtin::FourRooms] {
         let (scene, vpls) = vpls_of(b, 1024);
-        let gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+        let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
         for m in [1, 4, 30, 64] {
             let params = ValParams {
                 count: m,
@@ -101,7 +110,7 @@ fn gpu_k_means_equals_the_cpu_twin() {
 fn vals_stay_sane_at_the_extremes() {
     let ctx = context();
     let (scene, vpls) = vpls_of(Builtin::FourRooms, 256);
-    let gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
     let p = |count| ValParams {
         count,
         ..ValParams::default()
@@ -175,7 +184,7 @@ fn vals_stay_sane_at_the_extremes() {
 fn a_static_light_gives_the_same_vals_every_frame_at_any_scale() {
     let ctx = context();
     let (scene, vpls) = vpls_of(Builtin::FourRooms, 1024);
-    let gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
     let params = ValParams::default();
     let a = gpu.cluster_vals(&ctx, &vpls, &params).expect("frame 1");
     let b = gpu.cluster_vals(&ctx, &vpls, &params).expect("frame 2");
@@ -237,30 +246,32 @@ fn gpu_image_with(
     interleave: u32,
     size: [u32; 2],
 ) -> visgate_runtime::hdr::HdrImage {
-    use visgate_runtime::gpu::GpuParams;
-    let gpu = GpuRenderer::new(ctx, scene).expect("upload");
-    let view = visgate_runtime::camera::View::new(cam, size).expect("view");
-    gpu.render(
-        ctx,
-        &view,
-        vpls,
-        &GpuParams {
-            mode,
-            vals: ValParams {
-                count: vals,
-                ..ValParams::default()
-            },
-            interleave,
-            ..GpuParams::default()
+    use visgate_runtime::gpu::{GpuParams, InterleaveParams};
+    let mut gpu = GpuRenderer::new(ctx, scene).expect("upload");
+    let v = ValModeParams {
+        vals: ValParams {
+            count: vals,
+            ..ValParams::default()
         },
-    )
-    .expect("render")
-    .0
+        interleave: InterleaveParams {
+            block: interleave,
+            ..InterleaveParams::default()
+        },
+        ..ValModeParams::new()
+    };
+    let mode = match mode {
+        GpuMode::ValHard(_) => GpuMode::ValHard(v),
+        GpuMode::ValCssm(_, c) => GpuMode::ValCssm(v, c),
+        other => other,
+    };
+    let view = visgate_runtime::camera::View::new(cam, size).expect("view");
+    gpu.render(ctx, &view, vpls, &GpuParams::with_mode(mode))
+        .expect("render")
+        .0
 }
 
 #[test]
 fn vals_a_receiver_under_a_large_blocker_is_dark_and_one_in_the_open_lit() {
-    use visgate_runtime::gpu::GpuMode;
     let ctx = context();
     // A floor, a wide blocker 1 m above its middle strip, VPLs above the blocker facing down.
     let blocker = [
@@ -288,11 +299,11 @@ fn vals_a_receiver_under_a_large_blocker_is_dark_and_one_in_the_open_lit() {
         fov_x_rad: 70f32.to_radians(),
     };
     for (mode, m) in [
-        (GpuMode::ValHard, 1),
-        (GpuMode::ValHard, 4),
-        (GpuMode::ValHard, 30),
-        (GpuMode::ValCssm, 30),
-        (GpuMode::ValCssm, 64),
+        (hard(), 1),
+        (hard(), 4),
+        (hard(), 30),
+        (cssm(), 30),
+        (cssm(), 64),
     ] {
         let img = gpu_image(&ctx, &scene, &cam, &vpls, mode, m);
         let none = gpu_image(&ctx, &scene, &cam, &vpls, GpuMode::None, m);
@@ -334,7 +345,7 @@ fn vals_a_receiver_under_a_large_blocker_is_dark_and_one_in_the_open_lit() {
         // Hard maps get it exactly; soft ones blur over a penumbra the VAL's size sets.
         let lit = mean(&open_none);
         let (lit_at_least, dark_below) = match mode {
-            GpuMode::ValHard => (0.9, 0.02),
+            GpuMode::ValHard(_) => (0.9, 0.02),
             _ => (0.75, 0.1),
         };
         assert!(
@@ -350,9 +361,8 @@ fn vals_a_receiver_under_a_large_blocker_is_dark_and_one_in_the_open_lit() {
 
 #[test]
 fn vals_are_closer_to_the_reference_than_no_visibility() {
-    use visgate_runtime::gpu::GpuMode;
+    use visgate_runtime::cpu::reference::{ReferenceParams, render_reference};
     use visgate_runtime::metrics::errors;
-    use visgate_runtime::reference::{ReferenceParams, render_reference};
     let ctx = context();
     for b in [Builtin::CornellBox, Builtin::FourRooms] {
         let (scene, vpls) = vpls_of(b, 1024);
@@ -376,7 +386,7 @@ fn vals_are_closer_to_the_reference_than_no_visibility() {
             &reference,
         )
         .expect("size");
-        for mode in [GpuMode::ValHard, GpuMode::ValCssm] {
+        for mode in [hard(), cssm()] {
             let vh =
                 errors(&gpu_image(&ctx, &scene, &cam, &vpls, mode, 30), &reference).expect("size");
             eprintln!(
@@ -407,7 +417,7 @@ fn vals_are_closer_to_the_reference_than_no_visibility() {
 
 #[test]
 fn the_fourier_shadow_test_approaches_the_step_and_rings_within_its_bound() {
-    use visgate_runtime::cssm::{
+    use visgate_runtime::cpu::cssm::{
         DEFAULT_SHARPNESS, receiver_offset, reconstruct, ringing_bound, visibility,
     };
     let mut last = f32::INFINITY;
@@ -455,7 +465,6 @@ fn the_fourier_shadow_test_approaches_the_step_and_rings_within_its_bound() {
 
 #[test]
 fn val_modes_render_0_vpls_m_above_n_one_val_and_coplanar_vpls_without_nan() {
-    use visgate_runtime::gpu::GpuMode;
     let ctx = context();
     let (scene, vpls) = vpls_of(Builtin::FourRooms, 256);
     let cam = scene.cameras[0].clone();
@@ -469,7 +478,7 @@ fn val_modes_render_0_vpls_m_above_n_one_val_and_coplanar_vpls_without_nan() {
         })
         .collect();
     let direct = gpu_image(&ctx, &scene, &cam, &[], GpuMode::DirectOnly, 1);
-    for mode in [GpuMode::ValHard, GpuMode::ValCssm] {
+    for mode in [hard(), cssm()] {
         // N = 0: direct light alone.
         let img = gpu_image(&ctx, &scene, &cam, &[], mode, 30);
         assert_eq!(img.pixels, direct.pixels, "{mode:?} without VPLs");
@@ -491,32 +500,13 @@ fn val_modes_render_0_vpls_m_above_n_one_val_and_coplanar_vpls_without_nan() {
 
 #[test]
 fn interleaved_sampling_with_the_blur_stays_close_to_every_vpl_at_every_pixel() {
-    use visgate_runtime::gpu::GpuMode;
     use visgate_runtime::metrics::errors;
     let ctx = context();
     let (scene, vpls) = vpls_of(Builtin::CornellBox, 1024);
     let cam = scene.cameras[0].clone();
-    let full = gpu_image_with(
-        &ctx,
-        &scene,
-        &cam,
-        &vpls,
-        GpuMode::ValCssm,
-        30,
-        1,
-        [128, 128],
-    );
+    let full = gpu_image_with(&ctx, &scene, &cam, &vpls, cssm(), 30, 1, [128, 128]);
     for block in [2, 4, 8] {
-        let img = gpu_image_with(
-            &ctx,
-            &scene,
-            &cam,
-            &vpls,
-            GpuMode::ValCssm,
-            30,
-            block,
-            [128, 128],
-        );
+        let img = gpu_image_with(&ctx, &scene, &cam, &vpls, cssm(), 30, block, [128, 128]);
         let e = errors(&img, &full).expect("size");
         eprintln!("interleave {block}: {e:?}");
         assert!(img.pixels.iter().all(|p| p.is_finite()));
@@ -530,7 +520,7 @@ fn interleaved_sampling_with_the_blur_stays_close_to_every_vpl_at_every_pixel() 
 
 #[test]
 fn set_scene_moves_geometry_and_lights_as_a_fresh_upload_does() {
-    use visgate_runtime::gpu::{GpuMode, GpuParams};
+    use visgate_runtime::gpu::GpuParams;
     let ctx = context();
     let blocker = |x: f32| {
         [
@@ -565,12 +555,10 @@ fn set_scene_moves_geometry_and_lights_as_a_fresh_upload_does() {
         },
     )
     .expect("vpls");
-    for mode in [GpuMode::None, GpuMode::ValCssm, GpuMode::PerVplShadowMaps] {
-        let params = GpuParams {
-            mode,
-            ..GpuParams::default()
-        };
-        let fresh = GpuRenderer::new(&ctx, &b).expect("upload b");
+    let per_vpl = GpuMode::PerVplShadowMaps(Default::default());
+    for mode in [GpuMode::None, cssm(), per_vpl] {
+        let params = GpuParams::with_mode(mode);
+        let mut fresh = GpuRenderer::new(&ctx, &b).expect("upload b");
         let (want, _) = fresh.render(&ctx, &view, &vpls, &params).expect("fresh");
         let mut moved = GpuRenderer::new(&ctx, &a).expect("upload a");
         let (before, _) = moved.render(&ctx, &view, &vpls, &params).expect("a");

@@ -436,3 +436,39 @@ impl Builtin {
         Ok(scene_path)
     }
 }
+
+/// The built-in scene `name`, or an error that lists them.
+pub fn builtin(name: &str) -> Result<Builtin, SceneError> {
+    Builtin::from_name(name).ok_or_else(|| {
+        let names: Vec<&str> = Builtin::ALL.iter().map(|b| b.name()).collect();
+        SceneError::Invalid {
+            file: PathBuf::from(format!("builtin:{name}")),
+            what: format!(
+                "there is no built-in scene '{name}'; the built-in scenes are: {}",
+                names.join(", ")
+            ),
+        }
+    })
+}
+
+/// Loads a SCENE argument as every command and example takes it: `builtin:NAME`, a scene TOML,
+/// or a bare OBJ/glTF/GLB file (one static mesh, no lights).
+pub fn load(arg: &str, options: &visgate_formats::ImportOptions) -> Result<Scene, SceneError> {
+    if let Some(name) = arg.strip_prefix("builtin:") {
+        let start = std::time::Instant::now();
+        let mut scene = builtin(name)?.scene()?;
+        scene.report.load_seconds = start.elapsed().as_secs_f64();
+        return Ok(scene);
+    }
+    let path = Path::new(arg);
+    if !path.exists() {
+        return Err(SceneError::Io {
+            file: path.to_path_buf(),
+            source: std::io::Error::new(
+                std::io::ErrorKind::NotFound,
+                "no such file (a scene is a .toml, .obj, .gltf or .glb file, or builtin:NAME)",
+            ),
+        });
+    }
+    Scene::load(path, options)
+}

@@ -1,0 +1,279 @@
+//! Gate visibility (section V of the visibility-gates paper), the CPU side: a baked level's
+//! voxel→cluster grid and gates, the visibility cluster of a surface point (the cluster of the
+//! empty space it faces), and the gate test — a VPL lights a point of another cluster only if
+//! the segment between them passes through the disk of a gate between the two clusters (the
+//! point lies in the cone from the VPL through the disk).
+//!
+//! Beyond the paper, each a parameter: disks oversized by a factor (the paper's suggested fix
+//! for darkening), and light through a chain of up to K gates (the paper stops at neighbouring
+//! clusters, K = 1).
+
+use glam::Vec3;
+use visgate_formats::vgate::GridMeta;
+use visgate_formats::{BakedLevel, Scene};
+
+use crate::RenderError;
+
+/// How light passes gates.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GateParams {
+    /// Gate disks are this many times their baked radius. [Limit: > 0] [Units: ratio]
+    pub oversize: f32,
+    /// Gates a VPL's light may pass on its way, in a chain through intermediate clusters.
+    /// [Limit: 1..=16]
+    pub max_hops: u32,
+}
+
+impl Default for GateParams {
+    fn default() -> Self {
+        GateParams {
+            oversize: 1.0,
+            max_hops: 2,
+        }
+    }
+}
+
+/// A baked level checked against its scene, ready for gate tests.
+pub struct GateLevel {
+    grid: GridMeta,
+    level: BakedLevel,
+    /// Gates of each cluster, as indices into the level's gates.
+    cluster_gates: Vec<Vec<usize>>,
+}
+
+impl GateLevel {
+    /// Takes `level` for `scene`; refuses a level baked from other static geometry.
+    pub fn new(level: BakedLevel, scene: &Scene) -> Result<GateLevel, RenderError> {
+        if level.info.geometry_hash != scene.static_geometry_hash() {
+            return Err(RenderError::Param(format!(
+                "the level was baked from other static geometry than scene '{}' (hash {} vs \
+                 {}): re-bake it with `visgate bake`",
+                scene.name,
+                level.info.geometry_hash,
+                scene.static_geometry_hash()
+            )));
+        }
+        let clusters = level.topology.clusters.len();
+        let mut cluster_gates = vec![Vec::new(); clusters];
+        for (i, g) in level.topology.gates.iter().enumerate() {
+            for c in g.clusters {
+                if let Some(list) = cluster_gates.get_mut(c as usize) {
+                    list.push(i);
+                }
+            }
+        }
+        Ok(GateLevel {
+            grid: level.info.grid,
+            level,
+            cluster_gates,
+        })
+    }
+
+    /// Number of visibility clusters.
+    pub fn cluster_count(&self) -> usize {
+        self.cluster_gates.len()
+    }
+
+    /// Number of gates.
+    pub fn gate_count(&self) -> usize {
+        self.level.topology.gates.len()
+    }
+
+    fn cluster_of_voxel(&self, p: Vec3) -> Option<u32> {
+        let v = self.grid.world_to_voxel(p.to_array())?;
+        self.level
+            .voxel_cluster
+            .get(self.grid.index(v))
+            .filter(|&c| c != u32::MAX)
+    }
+
+    /// The visibility cluster of a surface point: that of the empty space it faces, looked up
+    /// half a voxel and then 1.5 voxels along its normal, then at the point itself (the bake's
+    /// grid reaches two voxels into the solid).
+    pub fn cluster_at(&self, p: Vec3, n: Vec3) -> Option<u32> {
+        let vs = self.grid.voxel_size_m;
+        [0.5, 1.5, 0.0]
+            .iter()
+            .find_map(|&k| self.cluster_of_voxel(p + n * (k * vs)))
+    }
+
+    /// Gate `i`: centre, unit normal, radius (m).
+    pub fn gate(&self, i: u32) -> (Vec3, Vec3, f32) {
+        let g = &self.level.topology.gates[i as usize];
+        (Vec3::from(g.centre_m), Vec3::from(g.normal), g.radius_m)
+    }
+
+    /// Every chain of at most `max_hops` gates leading from cluster `ca` to `cb` through
+    /// distinct clusters, in a deterministic order.
+    pub fn chains(&self, ca: u32, cb: u32, max_hops: u32) -> Vec<Vec<u32>> {
+        let gates = &self.level.topology.gates;
+        let mut out = Vec::new();
+        let mut stack: Vec<(u32, Vec<u32>, Vec<u32>)> = vec![(ca, Vec::new(), vec![ca])];
+        while let Some((c, chain, visited)) = stack.pop() {
+            if chain.len() as u32 >= max_hops {
+                continue;
+            }
+            for &gi in self
+                .cluster_gates
+                .get(c as usize)
+                .into_iter()
+                .flatten()
+                .rev()
+            {
+                let g = &gates[gi];
+                let other = if g.clusters[0] == c {
+                    g.clusters[1]
+                } else {
+                    g.clusters[0]
+                };
+                if visited.contains(&other) {
+                    continue;
+                }
+                let mut next = chain.clone();
+                next.push(gi as u32);
+                if other == cb {
+                    out.push(next);
+                } else {
+                    let mut v = visited.clone();
+                    v.push(other);
+                    stack.push((other, next, v));
+                }
+            }
+        }
+        out.sort();
+        out
+    }
+
+    /// Whether light from `a` (cluster `ca`) reaches `b` (cluster `cb`) through the gates: same
+    /// cluster, or the segment passes through a chain of at most `max_hops` gate disks that
+    /// leads from `ca` to `cb`.
+    pub fn visible(&self, a: Vec3, ca: u32, b: Vec3, cb: u32, params: &GateParams) -> bool {
+        if ca == cb {
+            return true;
+        }
+        let gates = &self.level.topology.gates;
+        let mut frontier = vec![ca];
+        let mut seen = vec![ca];
+        for _ in 0..params.max_hops {
+            let mut next = Vec::new();
+            for &c in &frontier {
+                for &gi in self.cluster_gates.get(c as usize).into_iter().flatten() {
+                    let g = &gates[gi];
+                    let other = if g.clusters[0] == c {
+                        g.clusters[1]
+                    } else {
+                        g.clusters[0]
+                    };
+                    if seen.contains(&other)
+                        || !segment_crosses_disk(
+                            a,
+                            b,
+                            Vec3::from(g.centre_m),
+                            Vec3::from(g.normal),
+                            g.radius_m * params.oversize,
+                        )
+                    {
+                        continue;
+                    }
+                    if other == cb {
+                        return true;
+                    }
+                    seen.push(other);
+                    next.push(other);
+                }
+            }
+            if next.is_empty() {
+                break;
+            }
+            frontier = next;
+        }
+        false
+    }
+}
+
+/// Whether segment `a`–`b` crosses the disk of `centre`, unit `normal` and `radius`.
+pub fn segment_crosses_disk(a: Vec3, b: Vec3, centre: Vec3, normal: Vec3, radius: f32) -> bool {
+    let d = b - a;
+    let den = d.dot(normal);
+    if den.abs() <= f32::EPSILON * d.length() || radius.is_nan() || radius < 0.0 {
+        return false;
+    }
+    let t = (centre - a).dot(normal) / den;
+    if !(0.0..=1.0).contains(&t) {
+        return false;
+    }
+    (a + d * t - centre).length_squared() <= radius * radius
+}
+
+/// The GPU's copy of a level's gate data: the voxel→cluster grid as little-endian words of its
+/// stored element size (u8, u16 or u32: only what the scene's cluster count needs), the gates,
+/// and each cluster's gates as offsets + indices.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GateTables {
+    /// Grid origin (xyz, m) and voxel size (w, m).
+    pub origin: [f32; 4],
+    /// Grid dims (xyz) and bytes per value (w: 1, 2 or 4).
+    pub dims: [u32; 4],
+    /// The grid's values packed into u32 words, little-endian.
+    pub voxel_words: Vec<u32>,
+    /// The gate disks.
+    pub gates: Vec<crate::gpu::layout::Gate>,
+    /// `clusters + 1` offsets into the list that follows them, then the gate indices.
+    pub cluster_gates: Vec<u32>,
+}
+
+impl GateLevel {
+    /// The tables the GPU's gate test reads.
+    pub fn tables(&self) -> GateTables {
+        use visgate_formats::vgate::VoxelValues;
+        let (bytes, words): (u32, Vec<u32>) = match &self.level.voxel_cluster {
+            VoxelValues::U8(v) => (
+                1,
+                v.chunks(4)
+                    .map(|c| {
+                        let mut b = [u8::MAX; 4];
+                        b[..c.len()].copy_from_slice(c);
+                        u32::from_le_bytes(b)
+                    })
+                    .collect(),
+            ),
+            VoxelValues::U16(v) => (
+                2,
+                v.chunks(2)
+                    .map(|c| u32::from(c[0]) | (u32::from(*c.get(1).unwrap_or(&u16::MAX)) << 16))
+                    .collect(),
+            ),
+            VoxelValues::U32(v) => (4, v.clone()),
+        };
+        let gates = self
+            .level
+            .topology
+            .gates
+            .iter()
+            .map(|g| crate::gpu::layout::Gate {
+                centre: g.centre_m,
+                radius: g.radius_m,
+                normal: g.normal,
+                clusters: g.clusters,
+                ..bytemuck::Zeroable::zeroed()
+            })
+            .collect();
+        let mut starts = Vec::with_capacity(self.cluster_gates.len() + 1);
+        let mut list = Vec::new();
+        let base = self.cluster_gates.len() as u32 + 1;
+        for l in &self.cluster_gates {
+            starts.push(base + list.len() as u32);
+            list.extend(l.iter().map(|&g| g as u32));
+        }
+        starts.push(base + list.len() as u32);
+        starts.extend(list);
+        let g = &self.grid;
+        GateTables {
+            origin: [g.origin_m[0], g.origin_m[1], g.origin_m[2], g.voxel_size_m],
+            dims: [g.dims[0], g.dims[1], g.dims[2], bytes],
+            voxel_words: words,
+            gates,
+            cluster_gates: starts,
+        }
+    }
+}

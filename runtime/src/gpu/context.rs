@@ -1,0 +1,433 @@
+//! The device, small wgpu helpers, and the [`Pool`] that keeps a renderer's resources across
+//! frames.
+
+use std::collections::HashMap;
+
+use wgpu::util::DeviceExt;
+
+use crate::RenderError;
+
+/// A device and queue (both are handles: cloning shares them).
+#[derive(Clone)]
+pub struct GpuContext {
+    /// The device.
+    pub device: wgpu::Device,
+    /// Its queue.
+    pub queue: wgpu::Queue,
+    /// What the adapter says it is.
+    pub adapter_info: wgpu::AdapterInfo,
+    /// Nanoseconds per timestamp tick, where the adapter has timestamp queries.
+    pub timestamp_period: Option<f32>,
+}
+
+impl GpuContext {
+    /// Opens the first adapter wgpu finds (backends from `WGPU_BACKEND`, else all that are
+    /// built in); an error that says what to install when there is none.
+    pub fn new() -> Result<GpuContext, RenderError> {
+        let instance =
+            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            force_fallback_adapter: false,
+            compatible_surface: None,
+            apply_limit_buckets: false,
+        }))
+        .map_err(|e| {
+            RenderError::NoAdapter(format!(
+                "{e}. Install a Vulkan driver (on Debian/Ubuntu without a GPU: apt-get install \
+                 mesa-vulkan-drivers for the software driver, lavapipe), or Metal/DX12 on macOS/Windows"
+            ))
+        })?;
+        let adapter_info = adapter.get_info();
+        let limits = wgpu::Limits {
+            max_texture_array_layers: adapter.limits().max_texture_array_layers,
+            max_storage_buffer_binding_size: adapter.limits().max_storage_buffer_binding_size,
+            max_storage_buffers_per_shader_stage: adapter
+                .limits()
+                .max_storage_buffers_per_shader_stage
+                .min(16),
+            ..wgpu::Limits::downlevel_defaults()
+        };
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("visgate device"),
+            required_features: adapter.features() & wgpu::Features::TIMESTAMP_QUERY,
+            required_limits: limits,
+            ..Default::default()
+        }))
+        .map_err(|e| RenderError::NoAdapter(format!("cannot open {}: {e}", adapter_info.name)))?;
+        let timestamp_period = device
+            .features()
+            .contains(wgpu::Features::TIMESTAMP_QUERY)
+            .then(|| queue.get_timestamp_period());
+        Ok(GpuContext {
+            device,
+            queue,
+            adapter_info,
+            timestamp_period,
+        })
+    }
+
+    /// Waits until the GPU is idle.
+    pub fn wait(&self) {
+        let _ = self.device.poll(wgpu::PollType::wait_indefinitely());
+    }
+}
+
+/// The compute pipelines of shader module `module`'s entry points `entries`, in order (auto
+/// layouts).
+pub fn compute_pipelines<const N: usize>(
+    d: &wgpu::Device,
+    module: &wgpu::ShaderModule,
+    entries: [&str; N],
+) -> [wgpu::ComputePipeline; N] {
+    entries.map(|entry| {
+        d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(entry),
+            layout: None,
+            module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            cache: None,
+        })
+    })
+}
+
+/// A render pipeline (auto layout) of `module`'s `vertex` and `fragment` entries with one
+/// colour target per format, optional depth (Depth32Float, less) and vertex buffers.
+pub fn render_pipeline(
+    d: &wgpu::Device,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    (vertex, fragment): (&str, &str),
+    buffers: &[Option<wgpu::VertexBufferLayout>],
+    targets: &[wgpu::TextureFormat],
+    depth: bool,
+) -> wgpu::RenderPipeline {
+    let targets: Vec<Option<wgpu::ColorTargetState>> = targets
+        .iter()
+        .map(|&format| {
+            Some(wgpu::ColorTargetState {
+                format,
+                blend: None,
+                write_mask: wgpu::ColorWrites::ALL,
+            })
+        })
+        .collect();
+    d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: None,
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some(vertex),
+            buffers,
+            compilation_options: Default::default(),
+        },
+        primitive: wgpu::PrimitiveState::default(),
+        depth_stencil: depth.then(|| wgpu::DepthStencilState {
+            format: wgpu::TextureFormat::Depth32Float,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Less),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: wgpu::MultisampleState::default(),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some(fragment),
+            targets: &targets,
+            compilation_options: Default::default(),
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+/// A bind group for group 0 of a pipeline's layout from (binding, resource) pairs.
+pub fn bind_group(
+    d: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    label: &str,
+    resources: Vec<(u32, wgpu::BindingResource)>,
+) -> wgpu::BindGroup {
+    let entries: Vec<wgpu::BindGroupEntry> = resources
+        .into_iter()
+        .map(|(binding, resource)| wgpu::BindGroupEntry { binding, resource })
+        .collect();
+    d.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some(label),
+        layout,
+        entries: &entries,
+    })
+}
+
+/// The binding of `size` bytes of `buffer` from `offset` (a strided uniform's element).
+pub fn slice(buffer: &wgpu::Buffer, offset: u64, size: u64) -> wgpu::BindingResource<'_> {
+    wgpu::BindingResource::Buffer(wgpu::BufferBinding {
+        buffer,
+        offset,
+        size: std::num::NonZeroU64::new(size),
+    })
+}
+
+/// A view of one layer of a 2D array texture.
+pub fn layer_view(t: &wgpu::Texture, layer: u32) -> wgpu::TextureView {
+    t.create_view(&wgpu::TextureViewDescriptor {
+        label: Some("layer"),
+        dimension: Some(wgpu::TextureViewDimension::D2),
+        base_array_layer: layer,
+        array_layer_count: Some(1),
+        ..Default::default()
+    })
+}
+
+/// A view of a whole 2D array texture.
+pub fn array_view(t: &wgpu::Texture) -> wgpu::TextureView {
+    t.create_view(&wgpu::TextureViewDescriptor {
+        label: Some("array"),
+        dimension: Some(wgpu::TextureViewDimension::D2Array),
+        ..Default::default()
+    })
+}
+
+/// A buffer holding `bytes` now (for data that lives as long as the scene).
+pub fn init_buffer(
+    d: &wgpu::Device,
+    label: &str,
+    bytes: &[u8],
+    usage: wgpu::BufferUsages,
+) -> wgpu::Buffer {
+    let mut v = bytes.to_vec();
+    if v.len() < 64 {
+        v.resize(64, 0);
+    }
+    d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents: &v,
+        usage,
+    })
+}
+
+/// What a kept texture was made with; another request under the same label with another key
+/// replaces it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct TextureKey {
+    size: [u32; 3],
+    mips: u32,
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+}
+
+/// A renderer's frame resources, kept by label across frames: a request for a label with the
+/// same size, format and usage returns the texture or buffer made before; a request with
+/// another size replaces it. [`Pool::created`] counts what was ever made, so a test can check
+/// that a frame with the same settings makes nothing.
+#[derive(Default)]
+pub struct Pool {
+    textures: HashMap<&'static str, (TextureKey, wgpu::Texture)>,
+    buffers: HashMap<&'static str, wgpu::Buffer>,
+    /// The frame's timestamp queries ([`Pool::query_set`]).
+    pub(super) queries: Option<wgpu::QuerySet>,
+    created: u64,
+}
+
+impl Pool {
+    /// Textures, buffers and query sets made so far.
+    pub fn created(&self) -> u64 {
+        self.created
+    }
+
+    /// Counts a resource made outside the pool's own methods.
+    pub(super) fn note_created(&mut self) {
+        self.created += 1;
+    }
+
+    /// The 2D (array) texture `label` of `size` = [width, height, layers] and `mips` levels.
+    pub fn texture(
+        &mut self,
+        d: &wgpu::Device,
+        label: &'static str,
+        size: [u32; 3],
+        mips: u32,
+        format: wgpu::TextureFormat,
+        usage: wgpu::TextureUsages,
+    ) -> wgpu::Texture {
+        let key = TextureKey {
+            size,
+            mips,
+            format,
+            usage,
+        };
+        if let Some((k, t)) = self.textures.get(label)
+            && *k == key
+        {
+            return t.clone();
+        }
+        self.created += 1;
+        let t = d.create_texture(&wgpu::TextureDescriptor {
+            label: Some(label),
+            size: wgpu::Extent3d {
+                width: size[0],
+                height: size[1],
+                depth_or_array_layers: size[2],
+            },
+            mip_level_count: mips,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage,
+            view_formats: &[],
+        });
+        self.textures.insert(label, (key, t.clone()));
+        t
+    }
+
+    /// The buffer `label` of `bytes` (at least 64) with `usage`.
+    pub fn buffer(
+        &mut self,
+        d: &wgpu::Device,
+        label: &'static str,
+        bytes: u64,
+        usage: wgpu::BufferUsages,
+    ) -> wgpu::Buffer {
+        let size = bytes.max(64).next_multiple_of(4);
+        if let Some(b) = self.buffers.get(label)
+            && b.size() == size
+            && b.usage() == usage
+        {
+            return b.clone();
+        }
+        self.created += 1;
+        let b = d.create_buffer(&wgpu::BufferDescriptor {
+            label: Some(label),
+            size,
+            usage,
+            mapped_at_creation: false,
+        });
+        self.buffers.insert(label, b.clone());
+        b
+    }
+
+    /// The buffer `label` holding `bytes`, written through the queue (it is in place before
+    /// the next submission).
+    pub fn upload(
+        &mut self,
+        ctx: &super::GpuContext,
+        label: &'static str,
+        bytes: &[u8],
+        usage: wgpu::BufferUsages,
+    ) -> wgpu::Buffer {
+        let b = self.buffer(
+            &ctx.device,
+            label,
+            bytes.len() as u64,
+            usage | wgpu::BufferUsages::COPY_DST,
+        );
+        if !bytes.is_empty() {
+            ctx.queue.write_buffer(&b, 0, bytes);
+        }
+        b
+    }
+}
+
+/// Copies `buf` (made with COPY_SRC) back to the CPU, waiting for the GPU (tests and
+/// inspection; a frame reads back through its recorder instead).
+pub fn read_buffer(ctx: &GpuContext, buf: &wgpu::Buffer) -> Result<Vec<u8>, RenderError> {
+    let d = &ctx.device;
+    let read = d.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size: buf.size(),
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut enc = d.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+        label: Some("readback"),
+    });
+    enc.copy_buffer_to_buffer(buf, 0, &read, 0, buf.size());
+    ctx.queue.submit([enc.finish()]);
+    map_read(ctx, &read)
+}
+
+/// Maps `read` (MAP_READ, its copies submitted), waits, and returns its bytes.
+pub fn map_read(ctx: &GpuContext, read: &wgpu::Buffer) -> Result<Vec<u8>, RenderError> {
+    let slice = read.slice(..);
+    slice.map_async(wgpu::MapMode::Read, |_| {});
+    ctx.wait();
+    let bytes = slice
+        .get_mapped_range()
+        .map_err(|e| RenderError::Gpu(format!("cannot read a buffer back: {e}")))?
+        .to_vec();
+    read.unmap();
+    Ok(bytes)
+}
+
+/// Bytes per row of a texture copy of `width` texels of `texel` bytes (256-aligned).
+pub fn row_bytes(width: u32, texel: u64) -> u64 {
+    (width as u64 * texel).div_ceil(256) * 256
+}
+
+/// Records a copy of 2D texture `tex` into `read` (rows of [`row_bytes`]).
+pub fn copy_texture(enc: &mut wgpu::CommandEncoder, tex: &wgpu::Texture, read: &wgpu::Buffer) {
+    let texel = if tex.format() == wgpu::TextureFormat::Rgba16Float {
+        8
+    } else {
+        16
+    };
+    enc.copy_texture_to_buffer(
+        tex.as_image_copy(),
+        wgpu::TexelCopyBufferInfo {
+            buffer: read,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(row_bytes(tex.width(), texel) as u32),
+                rows_per_image: Some(tex.height()),
+            },
+        },
+        wgpu::Extent3d {
+            width: tex.width(),
+            height: tex.height(),
+            depth_or_array_layers: 1,
+        },
+    );
+}
+
+/// The texels of a 4-channel image (Rgba32Float, or Rgba16Float widened) of `w` × `h` from the
+/// bytes of [`copy_texture`].
+pub fn texels(bytes: &[u8], w: u32, h: u32, half: bool) -> Vec<[f32; 4]> {
+    let texel = if half { 8u64 } else { 16 };
+    let row = row_bytes(w, texel);
+    let mut out = Vec::with_capacity((w * h) as usize);
+    for y in 0..h as u64 {
+        let r = &bytes[(y * row) as usize..][..(w as u64 * texel) as usize];
+        if half {
+            let v: &[u16] = bytemuck::cast_slice(r);
+            out.extend(
+                v.chunks_exact(4)
+                    .map(|c| [0, 1, 2, 3].map(|k| half::f16::from_bits(c[k]).to_f32())),
+            );
+        } else {
+            let v: &[f32] = bytemuck::cast_slice(r);
+            out.extend(v.chunks_exact(4).map(|c| [c[0], c[1], c[2], c[3]]));
+        }
+    }
+    out
+}
+
+/// Copies a 2D texture of 4 channels back to the CPU, waiting (tests and inspection).
+pub fn read_texture(ctx: &GpuContext, tex: &wgpu::Texture) -> Result<Vec<[f32; 4]>, RenderError> {
+    let half = tex.format() == wgpu::TextureFormat::Rgba16Float;
+    let (w, h) = (tex.width(), tex.height());
+    let read = ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("texture readback"),
+        size: row_bytes(w, if half { 8 } else { 16 }) * h as u64,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut enc = ctx
+        .device
+        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
+            label: Some("texture readback"),
+        });
+    copy_texture(&mut enc, tex, &read);
+    ctx.queue.submit([enc.finish()]);
+    Ok(texels(&map_read(ctx, &read)?, w, h, half))
+}

@@ -1,0 +1,253 @@
+//! The visibility methods for indirect light: [`GpuMode`] carries each method's own typed
+//! parameters (as Bevy's `ClusterConfig` variants do), and [`METHODS`] is the registry that the
+//! CLI's `--mode` values, the viewer's mode list and `compare --modes all` are read from.
+//!
+//! Adding a method: a pass module in `passes/` beside its WGSL, a variant here with its params,
+//! its line in [`METHODS`], and its branch in [`super::GpuRenderer`]'s frame.
+
+use crate::RenderError;
+use crate::cpu::gates::GateParams;
+
+pub use super::passes::clustered_gates::GatesParams;
+pub use super::passes::cssm::CssmParams;
+pub use super::passes::interleave_blur::InterleaveParams;
+pub use super::passes::per_vpl_maps::PerVplParams;
+pub use super::passes::val_gather::ValModeParams;
+
+/// Indirect-light visibility on the GPU, with the method's parameters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum GpuMode {
+    /// Every VPL lights every pixel (no indirect shadows: the baseline).
+    None,
+    /// Direct light only.
+    DirectOnly,
+    /// One paraboloid shadow map per VPL, rendered in batches (the brute-force baseline).
+    PerVplShadowMaps(PerVplParams),
+    /// VPL light through the gates of the level set with
+    /// [`super::GpuRenderer::set_level`], the paper's clustered shading: geometry clusters
+    /// (tiles × depth slices × visibility cluster), light lists of (VPL, gate chain) assigned
+    /// by cones through the gates, the gather over each pixel's list with the chain tested per
+    /// fragment. At most 2 hops.
+    Gates(GatesParams),
+    /// The same gate test, brute force: every fragment tests every VPL (for comparison).
+    GatesPerPixel(GateParams),
+    /// Every VPL lights every pixel with the visibility of its virtual area light: VPLs
+    /// clustered into VALs on the GPU, one hard paraboloid shadow map per VAL (the banding
+    /// baseline of Dong et al.).
+    ValHard(ValModeParams),
+    /// As `ValHard`, with convolution soft shadow maps per VAL (Dong et al.): the paper's
+    /// method.
+    ValCssm(ValModeParams, CssmParams),
+}
+
+/// Every method's settings at once — what a command line or a viewer panel holds; each method
+/// takes its own part ([`MethodInfo::make`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MethodSettings {
+    /// Per-VPL maps.
+    pub per_vpl: PerVplParams,
+    /// Clustered gates (`gates.gates` also serves `gates-per-pixel`).
+    pub gates: GatesParams,
+    /// The VAL modes.
+    pub vals: ValModeParams,
+    /// The CSSM of `val-cssm`.
+    pub cssm: CssmParams,
+}
+
+impl Default for MethodSettings {
+    fn default() -> Self {
+        MethodSettings {
+            per_vpl: PerVplParams::default(),
+            gates: GatesParams::default(),
+            vals: ValModeParams::new(),
+            cssm: CssmParams::default(),
+        }
+    }
+}
+
+/// A registry entry.
+#[derive(Debug, Clone, Copy)]
+pub struct MethodInfo {
+    /// The name on the command line and in reports (`--mode NAME`).
+    pub name: &'static str,
+    /// One line for `--help` and the viewer.
+    pub summary: &'static str,
+    /// Whether it needs a baked level.
+    pub needs_level: bool,
+    /// The mode with its part of `settings`.
+    pub make: fn(&MethodSettings) -> GpuMode,
+}
+
+/// Every GPU method, in the order lists show them.
+pub const METHODS: [MethodInfo; 7] = [
+    MethodInfo {
+        name: "none",
+        summary: "every VPL lights every point (no indirect shadows)",
+        needs_level: false,
+        make: |_| GpuMode::None,
+    },
+    MethodInfo {
+        name: "per-vpl-shadow-maps",
+        summary: "a paraboloid shadow map per VPL, in batches (brute force)",
+        needs_level: false,
+        make: |s| GpuMode::PerVplShadowMaps(s.per_vpl),
+    },
+    MethodInfo {
+        name: "gates",
+        summary: "visibility through the baked level's gates, by clustered shading",
+        needs_level: true,
+        make: |s| GpuMode::Gates(s.gates),
+    },
+    MethodInfo {
+        name: "gates-per-pixel",
+        summary: "the gate test brute force, every pixel against every VPL",
+        needs_level: true,
+        make: |s| GpuMode::GatesPerPixel(s.gates.gates),
+    },
+    MethodInfo {
+        name: "val-hard",
+        summary: "VPLs clustered into virtual area lights, one hard shadow map each",
+        needs_level: false,
+        make: |s| GpuMode::ValHard(s.vals),
+    },
+    MethodInfo {
+        name: "val-cssm",
+        summary: "virtual area lights with convolution soft shadow maps (Dong et al.)",
+        needs_level: false,
+        make: |s| GpuMode::ValCssm(s.vals, s.cssm),
+    },
+    MethodInfo {
+        name: "direct-only",
+        summary: "direct light alone",
+        needs_level: false,
+        make: |_| GpuMode::DirectOnly,
+    },
+];
+
+/// The registry entry named `name`.
+pub fn method(name: &str) -> Option<&'static MethodInfo> {
+    METHODS.iter().find(|m| m.name == name)
+}
+
+impl GpuMode {
+    /// The method's registry name.
+    pub fn name(&self) -> &'static str {
+        match self {
+            GpuMode::None => "none",
+            GpuMode::DirectOnly => "direct-only",
+            GpuMode::PerVplShadowMaps(_) => "per-vpl-shadow-maps",
+            GpuMode::Gates(_) => "gates",
+            GpuMode::GatesPerPixel(_) => "gates-per-pixel",
+            GpuMode::ValHard(_) => "val-hard",
+            GpuMode::ValCssm(..) => "val-cssm",
+        }
+    }
+
+    /// Checks the method's parameters against their limits (the adapter's limits are checked
+    /// when a frame is rendered).
+    pub fn check(&self) -> Result<(), RenderError> {
+        match self {
+            GpuMode::None | GpuMode::DirectOnly => Ok(()),
+            GpuMode::PerVplShadowMaps(p) => p.check(),
+            GpuMode::Gates(p) => p.check(),
+            GpuMode::GatesPerPixel(g) => super::passes::clustered_gates::check_gates(g),
+            GpuMode::ValHard(v) => v.check(),
+            GpuMode::ValCssm(v, c) => v.check().and(c.check()),
+        }
+    }
+
+    /// The gate parameters of the gate modes.
+    pub fn gates(&self) -> Option<GateParams> {
+        match self {
+            GpuMode::Gates(p) => Some(p.gates),
+            GpuMode::GatesPerPixel(g) => Some(*g),
+            _ => None,
+        }
+    }
+}
+
+/// The lights' shadow maps.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ShadowParams {
+    /// Layer side. [Units: texels] [Limit: 16..=4096]
+    pub size: u32,
+    /// Normal offset of lookups. [Units: texels]
+    pub normal_offset: f32,
+    /// Depth bias of lookups. [Units: texels]
+    pub bias: f32,
+}
+
+impl Default for ShadowParams {
+    fn default() -> Self {
+        ShadowParams {
+            size: 1024,
+            normal_offset: 1.5,
+            bias: 1.0,
+        }
+    }
+}
+
+/// What a frame is rendered with.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GpuParams {
+    /// The visibility method and its parameters.
+    pub mode: GpuMode,
+    /// Geometry-term clamp of every VPL gather. [Units: 1/m²] [Limit: > 0]
+    pub g_max: f32,
+    /// The lights' shadow maps (their normal offset and bias also serve the per-VPL and VAL
+    /// maps' hard lookups).
+    pub shadows: ShadowParams,
+}
+
+impl Default for GpuParams {
+    fn default() -> Self {
+        GpuParams {
+            mode: GpuMode::None,
+            g_max: 10.0,
+            shadows: ShadowParams::default(),
+        }
+    }
+}
+
+impl GpuParams {
+    /// Default parameters with `mode`.
+    pub fn with_mode(mode: GpuMode) -> GpuParams {
+        GpuParams {
+            mode,
+            ..GpuParams::default()
+        }
+    }
+
+    /// Checks every parameter's limits.
+    pub fn check(&self) -> Result<(), RenderError> {
+        if self.g_max.is_nan() || self.g_max <= 0.0 {
+            return Err(RenderError::Param(format!(
+                "geometry-term clamp {} must be > 0",
+                self.g_max
+            )));
+        }
+        if !(16..=4096).contains(&self.shadows.size) {
+            return Err(RenderError::Param(format!(
+                "shadow map size {} must be 16..=4096",
+                self.shadows.size
+            )));
+        }
+        self.mode.check()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_registered_method_makes_its_own_mode() {
+        let s = MethodSettings::default();
+        for m in METHODS {
+            let mode = (m.make)(&s);
+            assert_eq!(mode.name(), m.name);
+            assert_eq!(mode.gates().is_some(), m.needs_level, "{}", m.name);
+            assert!(mode.check().is_ok(), "{}", m.name);
+        }
+    }
+}

@@ -1,0 +1,615 @@
+//! The wgpu renderer. A [`GpuRenderer`] is made once for a scene (and a baked level), keeps its
+//! pipelines and — in a [`context::Pool`] — every texture and buffer a frame needs, and renders
+//! frames: per-frame inputs (view, VPLs or their RSM source, [`GpuParams`]) go in, an HDR image
+//! and the [`PassTimes`] come out. A second frame with the same sizes and settings makes no GPU
+//! resource; a frame is recorded into one command encoder and, where the adapter has timestamp
+//! queries, submitted once and waited for once, at its readback.
+//!
+//! A frame, as [`record_passes`] lists it:
+//!
+//! 1. VPLs: uploaded, or made from the lights' RSMs on the GPU ([`passes::rsm_vpls`]), where
+//!    they stay;
+//! 2. the lights' shadow maps ([`passes::shadow_maps`]);
+//! 3. the G-buffer ([`passes::gbuffer`]);
+//! 4. mode `gates`: unique clusters and light assignment ([`passes::clustered_gates`]);
+//! 5. shading: direct light, and the indirect light of modes `none` and the gate modes
+//!    ([`passes::shade`]);
+//! 6. mode `per-vpl-shadow-maps`: maps and gather per batch ([`passes::per_vpl_maps`]); the VAL
+//!    modes: clustering, maps, CSSM basis, gather, blur ([`passes::vals`], [`passes::cssm`],
+//!    [`passes::val_gather`], [`passes::interleave_blur`]);
+//! 7. readback.
+//!
+//! The methods and their parameters are in [`methods`] (the registry [`METHODS`]); every
+//! struct shared with WGSL in [`layout`]; the WGSL include step and injected constants in
+//! [`shaders`].
+
+pub mod context;
+pub mod geometry;
+pub mod layout;
+pub mod methods;
+pub mod passes;
+pub mod shaders;
+pub mod timing;
+
+use std::time::Instant;
+
+use glam::Vec3;
+use visgate_formats::{Light as SceneLight, Scene};
+
+use crate::RenderError;
+use crate::camera::View;
+use crate::cpu::clustered::PixelSurface;
+use crate::cpu::clustered::{Clustered, GeometryCluster as CpuGeometryCluster, LightEntry};
+use crate::cpu::gates::GateLevel;
+use crate::cpu::val::{Clustering, ValParams, scale_of};
+use crate::hdr::HdrImage;
+use crate::vpl::Vpl;
+use context::{Pool, init_buffer, map_read, read_buffer, read_texture, row_bytes, texels};
+use geometry::{Geometry, albedo_array};
+use layout::{GeometryCluster, Globals, Grid};
+use passes::clustered_gates::{ClusteredGates, LevelBuffers, ListBuffers};
+use passes::cssm::Cssm;
+use passes::gbuffer::{GBuffer, GBufferOutput};
+use passes::interleave_blur::InterleaveBlur;
+use passes::per_vpl_maps::ParaboloidMaps;
+use passes::rsm_vpls::RsmVpls;
+use passes::shade::Shade;
+use passes::shadow_maps::ShadowMaps;
+use passes::val_gather::{ValGathers, ValPasses};
+use passes::vals::{ValClustering, ValInput};
+use shaders::ShadeIndirect;
+use timing::Recorder;
+
+pub use context::GpuContext;
+pub use geometry::{MAX_TEXTURE_SIZE, VPL_SHADOW_MAX_EDGE};
+pub use methods::{
+    CssmParams, GatesParams, GpuMode, GpuParams, InterleaveParams, METHODS, MethodInfo,
+    MethodSettings, PerVplParams, ShadowParams, ValModeParams, method,
+};
+pub use passes::clustered_gates::{MAX_CLUSTERS, MAX_GATES};
+pub use passes::rsm_vpls::RsmParams;
+pub use timing::{LightListStats, PassTime, PassTimes};
+
+/// Where a frame's VPLs come from.
+#[derive(Debug, Clone, Copy)]
+pub enum VplInput<'a> {
+    /// These, uploaded.
+    Given(&'a [Vpl]),
+    /// The lights' RSMs, on the GPU (they stay there).
+    Rsm(RsmParams),
+}
+
+/// The scene as the GPU holds it.
+pub struct SceneGpu {
+    /// Triangles.
+    pub geometry: Geometry,
+    /// The lights (they move freely: shadow maps and RSMs are made per frame).
+    pub lights: Vec<SceneLight>,
+    /// Near plane (1e-4 of the first scene's diagonal). [Units: m]
+    pub near_m: f32,
+    /// Far plane (4 diagonals). [Units: m]
+    pub far_m: f32,
+    /// Albedo textures as one array.
+    pub albedo_maps: wgpu::TextureView,
+    /// Nearest, repeating.
+    pub albedo_sampler: wgpu::Sampler,
+    /// The baked level's gate tables.
+    pub level: Option<LevelBuffers>,
+    /// Bound where a mode has no level or no light lists.
+    pub no_level: wgpu::Buffer,
+    /// A grid of no voxels (the lights' views need no clusters).
+    pub no_grid: wgpu::Buffer,
+}
+
+impl SceneGpu {
+    /// The level's voxel words, or a placeholder.
+    pub fn voxel_words(&self) -> &wgpu::Buffer {
+        self.level
+            .as_ref()
+            .map_or(&self.no_level, |l| &l.voxel_words)
+    }
+}
+
+/// What every pass of a frame reads.
+pub struct Frame<'a> {
+    /// The device.
+    pub ctx: &'a GpuContext,
+    /// The scene.
+    pub scene: &'a SceneGpu,
+    /// The camera.
+    pub view: &'a View,
+    /// The settings.
+    pub params: &'a GpuParams,
+    /// [`Globals`].
+    pub globals: wgpu::Buffer,
+    /// [`Grid`].
+    pub grid: wgpu::Buffer,
+    /// The VPLs.
+    pub vpls: wgpu::Buffer,
+    /// How many.
+    pub vpl_count: u32,
+    /// The same VPLs on the CPU, where the caller gave them.
+    pub vpls_cpu: Option<&'a [Vpl]>,
+}
+
+/// Every pass's pipelines.
+pub struct Pipelines {
+    shadow_maps: ShadowMaps,
+    gbuffer: GBuffer,
+    shade: Shade,
+    rsm: RsmVpls,
+    maps: ParaboloidMaps,
+    clustered: ClusteredGates,
+    vals: ValClustering,
+    cssm: Cssm,
+    val_gather: ValGathers,
+    blur: InterleaveBlur,
+}
+
+impl Pipelines {
+    fn new(d: &wgpu::Device) -> Result<Pipelines, RenderError> {
+        Ok(Pipelines {
+            shadow_maps: ShadowMaps::new(d)?,
+            gbuffer: GBuffer::new(d)?,
+            shade: Shade::new(d)?,
+            rsm: RsmVpls::new(d)?,
+            maps: ParaboloidMaps::new(d)?,
+            clustered: ClusteredGates::new(d)?,
+            vals: ValClustering::new(d)?,
+            cssm: Cssm::new(d)?,
+            val_gather: ValGathers::new(d)?,
+            blur: InterleaveBlur::new(d)?,
+        })
+    }
+}
+
+/// The scene on the GPU, the pipelines, and the resources kept across frames.
+pub struct GpuRenderer {
+    scene: SceneGpu,
+    pipelines: Pipelines,
+    pool: Pool,
+    /// VALs clustered last frame (their centres are in the pool): a warm start's condition.
+    val_warm: Option<u32>,
+}
+
+/// What [`record_passes`] leaves: the image, and the light lists of mode gates.
+struct Recorded {
+    hdr: wgpu::Texture,
+    lists: Option<ListBuffers>,
+}
+
+/// The frame as its passes (after the VPLs): shadow maps, G-buffer, the mode's passes,
+/// shading. `warm`: the VAL clustering may start from last frame's centres.
+fn record_passes(
+    p: &Pipelines,
+    f: &Frame,
+    pool: &mut Pool,
+    rec: &mut Recorder,
+    warm: bool,
+) -> Result<Recorded, RenderError> {
+    let shadows = p.shadow_maps.record(f, pool, rec)?;
+    let g = p.gbuffer.record(f, pool, rec);
+    let lists = match &f.params.mode {
+        GpuMode::Gates(gp) => Some(p.clustered.record(f, gp, pool, rec, &g.views[0])?),
+        _ => None,
+    };
+    let shading = match f.params.mode {
+        GpuMode::None | GpuMode::Gates(_) | GpuMode::GatesPerPixel(_) => {
+            "shading: direct + indirect lighting"
+        }
+        _ => "shading: direct lighting",
+    };
+    let hdr = p
+        .shade
+        .record(f, pool, rec, (&shadows, &g, lists.as_ref()), shading);
+    match &f.params.mode {
+        GpuMode::PerVplShadowMaps(pv) => p.maps.record(f, pv, pool, rec, (&g, &hdr)),
+        GpuMode::ValHard(v) | GpuMode::ValCssm(v, _) => {
+            let cssm = match &f.params.mode {
+                GpuMode::ValCssm(_, c) => Some(c),
+                _ => None,
+            };
+            let passes = ValPasses {
+                clustering: &p.vals,
+                maps: &p.maps,
+                cssm: &p.cssm,
+                blur: &p.blur,
+            };
+            p.val_gather
+                .record(f, v, cssm, warm, &passes, pool, rec, (&g, &hdr))?;
+        }
+        _ => {}
+    }
+    Ok(Recorded { hdr, lists })
+}
+
+impl GpuRenderer {
+    /// Uploads every mesh of `scene` (albedo per vertex from its material, textures as layers
+    /// of one sRGB array, resized to the largest texture's size up to [`MAX_TEXTURE_SIZE`]) and
+    /// builds the pipelines.
+    pub fn new(ctx: &GpuContext, scene: &Scene) -> Result<GpuRenderer, RenderError> {
+        let d = &ctx.device;
+        let geometry = Geometry::upload(d, scene);
+        let size = geometry.size;
+        let (albedo_maps, albedo_sampler) = albedo_array(ctx, scene);
+        let no_grid = Grid {
+            voxel_size: 1.0,
+            value_bytes: 4,
+            oversize: 1.0,
+            max_hops: 1,
+            ..bytemuck::Zeroable::zeroed()
+        };
+        Ok(GpuRenderer {
+            scene: SceneGpu {
+                geometry,
+                lights: scene.lights.clone(),
+                near_m: size * 1e-4,
+                far_m: size * 4.0,
+                albedo_maps,
+                albedo_sampler,
+                level: None,
+                no_level: init_buffer(d, "no level", &[], wgpu::BufferUsages::STORAGE),
+                no_grid: init_buffer(
+                    d,
+                    "no grid",
+                    bytemuck::bytes_of(&no_grid),
+                    wgpu::BufferUsages::UNIFORM,
+                ),
+            },
+            pipelines: Pipelines::new(d)?,
+            pool: Pool::default(),
+            val_warm: None,
+        })
+    }
+
+    /// Replaces the geometry and the lights with those of `scene` posed at another time (the
+    /// same meshes and materials; dynamic meshes moved, see `Scene::at`). Pipelines, textures,
+    /// the level, the kept frame resources and the near/far planes (from the first scene's
+    /// size) stay.
+    pub fn set_scene(&mut self, ctx: &GpuContext, scene: &Scene) {
+        self.scene.geometry = Geometry::upload(&ctx.device, scene);
+        self.scene.lights = scene.lights.clone();
+    }
+
+    /// Replaces the lights (they move freely: shadow maps and RSMs are made per frame).
+    pub fn set_lights(&mut self, lights: &[SceneLight]) {
+        self.scene.lights = lights.to_vec();
+    }
+
+    /// Uploads a baked level's gate tables for the gate modes; the voxel→cluster grid keeps
+    /// the smallest integer type that holds the level's clusters.
+    pub fn set_level(&mut self, ctx: &GpuContext, level: &GateLevel) -> Result<(), RenderError> {
+        self.scene.level = Some(LevelBuffers::upload(ctx, level)?);
+        Ok(())
+    }
+
+    /// GPU textures, buffers and query sets the renderer's frames have made so far (a frame
+    /// with the same sizes and settings as the last makes none).
+    pub fn resources_created(&self) -> u64 {
+        self.pool.created()
+    }
+
+    /// Renders `view` with `vpls` and returns the linear HDR image and the pass times.
+    pub fn render(
+        &mut self,
+        ctx: &GpuContext,
+        view: &View,
+        vpls: &[Vpl],
+        params: &GpuParams,
+    ) -> Result<(HdrImage, PassTimes), RenderError> {
+        self.render_frame(ctx, view, VplInput::Given(vpls), params)
+    }
+
+    /// The frame's VPL buffer and count.
+    fn frame_vpls(
+        &mut self,
+        ctx: &GpuContext,
+        vpls: &VplInput,
+        rec: &mut Recorder,
+    ) -> Result<(wgpu::Buffer, u32), RenderError> {
+        match vpls {
+            VplInput::Given(v) => {
+                let bytes = std::mem::size_of_val(*v) as u64;
+                let limit = ctx.device.limits().max_storage_buffer_binding_size;
+                if bytes > limit {
+                    return Err(RenderError::Param(format!(
+                        "{} VPLs need {bytes} bytes, more than the adapter's storage binding \
+                         limit {limit}",
+                        v.len()
+                    )));
+                }
+                let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
+                let buf = self
+                    .pool
+                    .upload(ctx, "vpls", bytemuck::cast_slice(v), usage);
+                Ok((buf, v.len() as u32))
+            }
+            VplInput::Rsm(p) => self.pipelines.rsm.record(
+                ctx,
+                &self.pipelines.gbuffer,
+                &self.scene,
+                p,
+                &mut self.pool,
+                rec,
+            ),
+        }
+    }
+
+    /// The frame's constants, uploaded.
+    fn frame<'a>(
+        &'a mut self,
+        ctx: &'a GpuContext,
+        view: &'a View,
+        params: &'a GpuParams,
+        (vpls, vpl_count, vpls_cpu): (wgpu::Buffer, u32, Option<&'a [Vpl]>),
+    ) -> (Frame<'a>, &'a Pipelines, &'a mut Pool) {
+        let scene = &self.scene;
+        let shade_mode = match params.mode {
+            GpuMode::None => ShadeIndirect::All,
+            GpuMode::GatesPerPixel(_) => ShadeIndirect::GatesPerPixel,
+            GpuMode::Gates(_) => ShadeIndirect::GatesClustered,
+            _ => ShadeIndirect::DirectOnly,
+        };
+        let globals = Globals {
+            view_proj: view.view_proj(scene.near_m, scene.far_m).to_cols_array_2d(),
+            eye: view.eye.extend(1.0).to_array(),
+            g_max: params.g_max,
+            shadow_normal_offset: params.shadows.normal_offset,
+            shadow_bias: params.shadows.bias,
+            vpl_count,
+            light_count: scene.lights.len() as u32,
+            shade_mode: shade_mode as u32,
+            shadow_size: params.shadows.size,
+            ..bytemuck::Zeroable::zeroed()
+        };
+        let level = scene.level.as_ref();
+        let gates = params.mode.gates().unwrap_or_default();
+        let grid = Grid {
+            origin: level.map_or([0.0; 3], |l| [l.origin[0], l.origin[1], l.origin[2]]),
+            voxel_size: level.map_or(1.0, |l| l.origin[3]),
+            dims: level.map_or([0; 3], |l| [l.dims[0], l.dims[1], l.dims[2]]),
+            value_bytes: level.map_or(4, |l| l.dims[3]),
+            oversize: gates.oversize,
+            max_hops: gates.max_hops,
+            ..bytemuck::Zeroable::zeroed()
+        };
+        let uniform = wgpu::BufferUsages::UNIFORM;
+        let pool = &mut self.pool;
+        let frame = Frame {
+            ctx,
+            scene,
+            view,
+            params,
+            globals: pool.upload(ctx, "globals", bytemuck::bytes_of(&globals), uniform),
+            grid: pool.upload(ctx, "grid", bytemuck::bytes_of(&grid), uniform),
+            vpls,
+            vpl_count,
+            vpls_cpu,
+        };
+        (frame, &self.pipelines, pool)
+    }
+
+    /// Renders `view` with VPLs from `vpls` and returns the linear HDR image and the pass
+    /// times. The same call serves tests, the CLI and the viewer.
+    pub fn render_frame(
+        &mut self,
+        ctx: &GpuContext,
+        view: &View,
+        vpls: VplInput,
+        params: &GpuParams,
+    ) -> Result<(HdrImage, PassTimes), RenderError> {
+        let t0 = Instant::now();
+        params.check()?;
+        if params.mode.gates().is_some() && self.scene.level.is_none() {
+            return Err(RenderError::Param(format!(
+                "mode {} needs a baked level (GpuRenderer::set_level, --level)",
+                params.mode.name()
+            )));
+        }
+        let val_count = match params.mode {
+            GpuMode::ValHard(v) | GpuMode::ValCssm(v, _) => Some(v.vals.count),
+            _ => None,
+        };
+        let warm = val_count.is_some_and(|m| {
+            let p = match params.mode {
+                GpuMode::ValHard(v) | GpuMode::ValCssm(v, _) => v.vals,
+                _ => ValParams::default(),
+            };
+            p.warm_start && self.val_warm == Some(m)
+        });
+        let mut rec = Recorder::new(ctx, &mut self.pool);
+        let (vpl_buf, count) = self.frame_vpls(ctx, &vpls, &mut rec)?;
+        let cpu = match vpls {
+            VplInput::Given(v) => Some(v),
+            VplInput::Rsm(_) => None,
+        };
+        let [w, h] = view.size;
+        let (frame, pipelines, pool) = self.frame(ctx, view, params, (vpl_buf, count, cpu));
+        let out = record_passes(pipelines, &frame, pool, &mut rec, warm)?;
+        let read = pool.buffer(
+            &ctx.device,
+            "hdr readback",
+            row_bytes(w, 16) * h as u64,
+            wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        );
+        context::copy_texture(&mut rec.enc, &out.hdr, &read);
+        let counter_read = out.lists.as_ref().map(|l| {
+            let r = pool.buffer(
+                &ctx.device,
+                "light list counter readback",
+                16,
+                wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            );
+            rec.enc.copy_buffer_to_buffer(&l.counter, 0, &r, 0, 16);
+            r
+        });
+        let mut times = rec.finish(pool)?;
+        let t1 = Instant::now();
+        if let (Some(l), Some(r)) = (&out.lists, &counter_read) {
+            let c: Vec<u32> = bytemuck::cast_slice(&map_read(ctx, r)?).to_vec();
+            times.lists = Some(l.stats(&c)?);
+        }
+        let px = texels(&map_read(ctx, &read)?, w, h, false);
+        let mut img = HdrImage::new(w, h);
+        for (o, p) in img.pixels.iter_mut().zip(&px) {
+            *o = Vec3::new(p[0], p[1], p[2]);
+        }
+        if val_count.is_some() && count > 0 {
+            self.val_warm = val_count;
+        }
+        times.readback_s += t1.elapsed().as_secs_f64();
+        times.frame_s = t0.elapsed().as_secs_f64();
+        Ok((img, times))
+    }
+
+    /// VPLs from the lights' reflective shadow maps ([`RsmParams`]), read back to the CPU (so
+    /// that the reference can use the very same). A frame with [`VplInput::Rsm`] makes the
+    /// same VPLs and keeps them on the GPU.
+    pub fn rsm_vpls(
+        &mut self,
+        ctx: &GpuContext,
+        n: u32,
+        rsm_size: u32,
+        seed: u64,
+    ) -> Result<Vec<Vpl>, RenderError> {
+        let p = RsmParams {
+            count: n,
+            rsm_size,
+            seed,
+        };
+        let mut rec = Recorder::new(ctx, &mut self.pool);
+        let (buf, count) = self.frame_vpls(ctx, &VplInput::Rsm(p), &mut rec)?;
+        rec.finish(&mut self.pool)?;
+        if count == 0 {
+            return Ok(Vec::new());
+        }
+        let bytes = read_buffer(ctx, &buf)?;
+        Ok(bytemuck::cast_slice::<u8, Vpl>(&bytes)[..count as usize].to_vec())
+    }
+
+    /// Clusters `vpls` into VALs on the GPU and reads them back (for tests and inspection).
+    pub fn cluster_vals(
+        &mut self,
+        ctx: &GpuContext,
+        vpls: &[Vpl],
+        params: &ValParams,
+    ) -> Result<Clustering, RenderError> {
+        let mut rec = Recorder::new(ctx, &mut self.pool);
+        let (buf, count) = self.frame_vpls(ctx, &VplInput::Given(vpls), &mut rec)?;
+        let input = ValInput {
+            buffer: &buf,
+            count,
+            cpu: Some(vpls),
+        };
+        let b =
+            self.pipelines
+                .vals
+                .record(ctx, &input, params, 1, false, &mut self.pool, &mut rec)?;
+        rec.finish(&mut self.pool)?;
+        let m = params.count as usize;
+        let vals = if vpls.is_empty() {
+            vec![bytemuck::Zeroable::zeroed(); m]
+        } else {
+            bytemuck::cast_slice(&read_buffer(ctx, &b.vals)?)[..m].to_vec()
+        };
+        let mapping: Vec<u32> =
+            bytemuck::cast_slice(&read_buffer(ctx, &b.mapping)?)[..vpls.len()].to_vec();
+        Ok(Clustering {
+            vals,
+            mapping,
+            scale_m: scale_of(vpls),
+        })
+    }
+
+    /// Runs the G-buffer, unique-clusters and light-assignment passes of mode gates for `view`
+    /// and reads back what they built, as the CPU twin [`crate::cpu::clustered::assign`] gives
+    /// it: each pixel's surface (the G-buffer's position, normal, visibility cluster, and the
+    /// GPU's view depth), the geometry clusters with their boxes, and each cluster's light
+    /// list. For tests and inspection; slow (reads all back).
+    pub fn light_lists(
+        &mut self,
+        ctx: &GpuContext,
+        view: &View,
+        vpls: &[Vpl],
+        gates: &GatesParams,
+    ) -> Result<(Vec<Option<PixelSurface>>, Clustered), RenderError> {
+        let params = GpuParams::with_mode(GpuMode::Gates(*gates));
+        params.check()?;
+        let mut rec = Recorder::new(ctx, &mut self.pool);
+        let v = self.frame_vpls(ctx, &VplInput::Given(vpls), &mut rec)?;
+        let n = v.1;
+        let (frame, p, pool) = self.frame(ctx, view, &params, (v.0, n, Some(vpls)));
+        let g = p.gbuffer.record(&frame, pool, &mut rec);
+        let b = p
+            .clustered
+            .record(&frame, gates, pool, &mut rec, &g.views[0])?;
+        rec.finish(pool)?;
+        read_lists(ctx, &g, &b)
+    }
+}
+
+/// Reads back a frame's G-buffer surfaces and light lists (for [`GpuRenderer::light_lists`]).
+fn read_lists(
+    ctx: &GpuContext,
+    g: &GBufferOutput,
+    b: &ListBuffers,
+) -> Result<(Vec<Option<PixelSurface>>, Clustered), RenderError> {
+    let c: Vec<u32> = bytemuck::cast_slice(&read_buffer(ctx, &b.counter)?).to_vec();
+    let stats = b.stats(&c)?;
+    let pos = read_texture(ctx, &g.textures[0])?;
+    let nrm = read_texture(ctx, &g.textures[1])?;
+    let depth: Vec<f32> =
+        bytemuck::cast_slice(&read_buffer(ctx, &b.pixel_depth)?)[..pos.len()].to_vec();
+    let pixels = pos
+        .iter()
+        .zip(&nrm)
+        .zip(&depth)
+        .map(|((p, n), &d)| {
+            (p[3] != 0.0).then(|| PixelSurface {
+                position: Vec3::new(p[0], p[1], p[2]),
+                normal: Vec3::new(n[0], n[1], n[2]),
+                depth: d,
+                cluster: ((p[3] - 1.0) as u32).checked_sub(1),
+            })
+        })
+        .collect();
+    let pixel_cluster: Vec<u32> =
+        bytemuck::cast_slice(&read_buffer(ctx, &b.pixel_cluster)?)[..pos.len()].to_vec();
+    let n = stats.geometry_clusters as usize;
+    let records: Vec<GeometryCluster> =
+        bytemuck::cast_slice(&read_buffer(ctx, &b.clusters)?)[..n].to_vec();
+    let pool: Vec<[u32; 2]> =
+        bytemuck::cast_slice(&read_buffer(ctx, &b.entries)?)[..stats.entries as usize].to_vec();
+    let clusters = records
+        .iter()
+        .map(|r| CpuGeometryCluster {
+            tile: [r.key[0], r.key[1], r.key[2]],
+            cluster: (r.key[3] != u32::MAX).then_some(r.key[3]),
+            bounds: [Vec3::from_slice(&r.lo[..3]), Vec3::from_slice(&r.hi[..3])],
+        })
+        .collect();
+    let lists = records
+        .iter()
+        .map(|r| {
+            pool[r.list[0] as usize..(r.list[0] + r.list[1]) as usize]
+                .iter()
+                .map(|&[vpl, g]| LightEntry {
+                    vpl,
+                    gates: [g & 0xffff, g >> 16]
+                        .into_iter()
+                        .filter(|&x| x != 0)
+                        .map(|x| x - 1)
+                        .collect(),
+                })
+                .collect()
+        })
+        .collect();
+    Ok((
+        pixels,
+        Clustered {
+            pixel_cluster,
+            clusters,
+            lists,
+        },
+    ))
+}

@@ -1,0 +1,424 @@
+//! Clustered shading with gates (clusters.wgsl; section V of the visibility-gates paper): between
+//! the G-buffer (which holds each pixel's visibility cluster) and the shading pass, the *unique
+//! clusters* pass finds the geometry clusters in view (screen tiles × exponential depth slices ×
+//! visibility cluster) with their boxes, and the *light assignment* pass gives each one its
+//! list of (VPL, gate chain) entries in one pool. [`crate::cpu::clustered`] is the CPU twin;
+//! the tests hold the two equal ([`crate::gpu::GpuRenderer::light_lists`]).
+
+use crate::RenderError;
+use crate::cpu::clustered::ClusterParams;
+use crate::cpu::gates::{GateLevel, GateParams};
+use crate::gpu::context::{Pool, bind_group, compute_pipelines, init_buffer};
+use crate::gpu::layout::ClusterFrame;
+use crate::gpu::shaders::{self, CLUSTER_BITS, WG_LINEAR, WG_TILE};
+use crate::gpu::timing::{LightListStats, Recorder};
+use crate::gpu::{Frame, GpuContext};
+
+/// Entry encoding: the chain's gates as (g0 + 1) | (g1 + 1) << 16, so at most this many gates.
+pub const MAX_GATES: usize = 0xfffe;
+/// Keys hold a visibility cluster in [`CLUSTER_BITS`] bits, the all-ones value meaning "none".
+pub const MAX_CLUSTERS: usize = (1 << CLUSTER_BITS) - 2;
+
+/// Parameters of mode `gates` (clustered shading).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GatesParams {
+    /// How light passes gates (`max_hops` 1 or 2 on the GPU).
+    pub gates: GateParams,
+    /// Geometry clusters (`tile_px` 1..=16 on the GPU).
+    pub clusters: ClusterParams,
+    /// Capacity of the light-list pool, in (VPL, gates) entries of 8 bytes; a frame that needs
+    /// more fails with the count it needs. [Limit: 1..=storage limit / 8]
+    pub light_entries: u32,
+}
+
+impl Default for GatesParams {
+    fn default() -> Self {
+        GatesParams {
+            gates: GateParams::default(),
+            clusters: ClusterParams::default(),
+            light_entries: 1 << 23,
+        }
+    }
+}
+
+/// Checks gate parameters against what the GPU's test does (≤ 2 hops).
+pub fn check_gates(g: &GateParams) -> Result<(), RenderError> {
+    let o = g.oversize;
+    if !(o > 0.0 && o.is_finite() && (1..=2).contains(&g.max_hops)) {
+        return Err(RenderError::Param(format!(
+            "gate oversize {o} must be > 0 and hops {} 1 or 2 on the GPU (the CPU twin, --cpu, \
+             takes more)",
+            g.max_hops
+        )));
+    }
+    Ok(())
+}
+
+impl GatesParams {
+    /// Checks the limits (the pool's size against the adapter's at render time).
+    pub fn check(&self) -> Result<(), RenderError> {
+        check_gates(&self.gates)?;
+        let cp = self.clusters;
+        if !(1..=WG_TILE).contains(&cp.tile_px) || !(1..=256).contains(&cp.depth_slices) {
+            return Err(RenderError::Param(format!(
+                "tile side {} px must be 1..={WG_TILE} on the GPU (one workgroup per tile) and \
+                 depth slices {} 1..=256",
+                cp.tile_px, cp.depth_slices
+            )));
+        }
+        if self.light_entries == 0 {
+            return Err(RenderError::Param(
+                "the light-entry pool (--light-entries) must hold at least 1 entry".into(),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// A level's gate tables on the GPU.
+pub struct LevelBuffers {
+    /// Grid origin (xyz, m) and voxel size (w, m).
+    pub origin: [f32; 4],
+    /// Grid dims (xyz) and bytes per value (w).
+    pub dims: [u32; 4],
+    /// The voxel→cluster grid in words.
+    pub voxel_words: wgpu::Buffer,
+    /// The gate disks.
+    pub gates: wgpu::Buffer,
+    /// Each cluster's gates: offsets, then indices.
+    pub cluster_gates: wgpu::Buffer,
+}
+
+impl LevelBuffers {
+    /// Uploads `level`'s tables; the voxel grid keeps the smallest integer type that holds the
+    /// level's clusters.
+    pub fn upload(ctx: &GpuContext, level: &GateLevel) -> Result<LevelBuffers, RenderError> {
+        let t = level.tables();
+        let d = &ctx.device;
+        if t.gates.len() > MAX_GATES || level.cluster_count() > MAX_CLUSTERS {
+            return Err(RenderError::Param(format!(
+                "the level has {} gates and {} clusters; the GPU's light lists hold at most {} \
+                 gates and {} clusters: bake at a lower resolution",
+                t.gates.len(),
+                level.cluster_count(),
+                MAX_GATES,
+                MAX_CLUSTERS
+            )));
+        }
+        let bytes = (t.voxel_words.len() * 4) as u64;
+        if bytes > d.limits().max_storage_buffer_binding_size {
+            return Err(RenderError::Param(format!(
+                "the voxel→cluster grid needs {bytes} bytes, more than the adapter's storage \
+                 binding limit {}: bake at a lower resolution",
+                d.limits().max_storage_buffer_binding_size
+            )));
+        }
+        let storage = wgpu::BufferUsages::STORAGE;
+        Ok(LevelBuffers {
+            origin: t.origin,
+            dims: t.dims,
+            voxel_words: init_buffer(
+                d,
+                "voxel clusters",
+                bytemuck::cast_slice(&t.voxel_words),
+                storage,
+            ),
+            gates: init_buffer(d, "gates", bytemuck::cast_slice(&t.gates), storage),
+            cluster_gates: init_buffer(
+                d,
+                "cluster gates",
+                bytemuck::cast_slice(&t.cluster_gates),
+                storage,
+            ),
+        })
+    }
+}
+
+/// The compute pipelines of clusters.wgsl.
+pub struct ClusteredGates {
+    depths: wgpu::ComputePipeline,
+    tile_count: wgpu::ComputePipeline,
+    scan_tiles: wgpu::ComputePipeline,
+    tile_clusters: wgpu::ComputePipeline,
+    vpl_clusters: wgpu::ComputePipeline,
+    assign: wgpu::ComputePipeline,
+}
+
+/// The buffers the clustered passes fill; the shading pass reads `pixel_cluster`, `clusters`
+/// and `entries`.
+pub struct ListBuffers {
+    /// View depth per pixel.
+    pub pixel_depth: wgpu::Buffer,
+    /// Geometry cluster per pixel.
+    pub pixel_cluster: wgpu::Buffer,
+    /// The geometry clusters and their lists.
+    pub clusters: wgpu::Buffer,
+    /// Entries used (or needed), lists that did not fit, geometry clusters.
+    pub counter: wgpu::Buffer,
+    /// The pool of entries.
+    pub entries: wgpu::Buffer,
+    /// The pool's capacity.
+    pub capacity: u32,
+}
+
+impl ListBuffers {
+    /// How full the lists came out from the counter's words; an error naming the setting to
+    /// raise when some did not fit (their light is never cut silently).
+    pub fn stats(&self, c: &[u32]) -> Result<LightListStats, RenderError> {
+        let stats = LightListStats {
+            geometry_clusters: c[2],
+            entries: c[0] as u64,
+            capacity: self.capacity,
+        };
+        if c[1] > 0 {
+            return Err(RenderError::Param(format!(
+                "the light lists of {} geometry clusters need {} entries, more than the pool's {} \
+                 ({} lists did not fit): raise --light-entries (GatesParams::light_entries) to at \
+                 least {}, or use fewer VPLs",
+                stats.geometry_clusters, stats.entries, self.capacity, c[1], stats.entries
+            )));
+        }
+        Ok(stats)
+    }
+}
+
+impl ClusteredGates {
+    /// Builds the pipelines.
+    pub fn new(d: &wgpu::Device) -> Result<ClusteredGates, RenderError> {
+        let module = shaders::module(d, "clusters.wgsl")?;
+        let [
+            depths,
+            tile_count,
+            scan_tiles,
+            tile_clusters,
+            vpl_clusters,
+            assign,
+        ] = compute_pipelines(
+            d,
+            &module,
+            [
+                "depths",
+                "tile_count",
+                "scan_tiles",
+                "tile_clusters",
+                "vpl_clusters",
+                "assign",
+            ],
+        );
+        Ok(ClusteredGates {
+            depths,
+            tile_count,
+            scan_tiles,
+            tile_clusters,
+            vpl_clusters,
+            assign,
+        })
+    }
+
+    /// The frame's list buffers (kept in `pool`), after checking their sizes.
+    fn buffers(f: &Frame, p: &GatesParams, pool: &mut Pool) -> Result<ListBuffers, RenderError> {
+        let d = &f.ctx.device;
+        let [w, h] = f.view.size;
+        let pixels = w as u64 * h as u64;
+        let limits = d.limits();
+        let max_binding = limits
+            .max_storage_buffer_binding_size
+            .min(limits.max_buffer_size);
+        let capacity = p.light_entries;
+        let sizes = [
+            ("geometry clusters", pixels * 64, "a smaller image"),
+            (
+                "light entries",
+                capacity as u64 * 8,
+                "a smaller --light-entries (GatesParams::light_entries)",
+            ),
+        ];
+        for (what, bytes, fix) in sizes {
+            if bytes > max_binding {
+                return Err(RenderError::Param(format!(
+                    "the {what} need {bytes} bytes, more than the adapter's storage binding limit \
+                     {max_binding}: use {fix}"
+                )));
+            }
+        }
+        let rw = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
+        Ok(ListBuffers {
+            pixel_depth: pool.buffer(d, "pixel depth", pixels * 4, rw),
+            pixel_cluster: pool.buffer(d, "pixel cluster", pixels * 4, rw),
+            clusters: pool.buffer(d, "geometry clusters", pixels * 64, rw),
+            counter: pool.buffer(
+                d,
+                "light list counter",
+                16,
+                rw | wgpu::BufferUsages::COPY_DST,
+            ),
+            entries: pool.buffer(d, "light entries", capacity as u64 * 8, rw),
+            capacity,
+        })
+    }
+
+    /// Records the unique-clusters and light-assignment passes over the G-buffer positions
+    /// `g_position` (w = visibility cluster).
+    pub fn record(
+        &self,
+        f: &Frame,
+        p: &GatesParams,
+        pool: &mut Pool,
+        rec: &mut Recorder,
+        g_position: &wgpu::TextureView,
+    ) -> Result<ListBuffers, RenderError> {
+        let d = &f.ctx.device;
+        let level = f.scene.level.as_ref().ok_or_else(|| {
+            RenderError::Param("mode gates needs a baked level (GpuRenderer::set_level)".into())
+        })?;
+        let cp = p.clusters;
+        let [w, h] = f.view.size;
+        let tiles = [w.div_ceil(cp.tile_px), h.div_ceil(cp.tile_px)];
+        let vpl_groups = f.vpl_count.div_ceil(WG_LINEAR);
+        let max = d.limits().max_compute_workgroups_per_dimension;
+        if vpl_groups > max {
+            return Err(RenderError::Param(format!(
+                "{} VPLs need {vpl_groups} workgroups, more than the adapter's {max}",
+                f.vpl_count
+            )));
+        }
+        let b = Self::buffers(f, p, pool)?;
+        let frame = ClusterFrame {
+            eye: f.view.eye.to_array(),
+            forward: f.view.forward.to_array(),
+            width: w,
+            height: h,
+            tile_px: cp.tile_px,
+            depth_slices: cp.depth_slices,
+            tiles_x: tiles[0],
+            tiles_y: tiles[1],
+            vpl_count: f.vpl_count,
+            capacity: b.capacity,
+            ..bytemuck::Zeroable::zeroed()
+        };
+        let uniform = wgpu::BufferUsages::UNIFORM;
+        let frame_buf = pool.upload(f.ctx, "cluster frame", bytemuck::bytes_of(&frame), uniform);
+        let rw = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
+        let range: [u32; 2] = [u32::MAX, 0];
+        let depth_range = pool.upload(f.ctx, "depth range", bytemuck::cast_slice(&range), rw);
+        let n_tiles = tiles[0] as u64 * tiles[1] as u64;
+        let tile_buf = pool.buffer(d, "tile clusters", (n_tiles + 1) * 4, rw);
+        let vpl_cluster = pool.buffer(d, "vpl cluster", f.vpl_count as u64 * 4, rw);
+        let dispatch = pool.buffer(
+            d,
+            "assignment dispatch",
+            12,
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT,
+        );
+        rec.enc.clear_buffer(&b.counter, 0, None);
+        fn res(b: &wgpu::Buffer) -> wgpu::BindingResource<'_> {
+            b.as_entire_binding()
+        }
+        let tex = || wgpu::BindingResource::TextureView(g_position);
+        let bind = |pl: &wgpu::ComputePipeline, r: Vec<(u32, wgpu::BindingResource)>| {
+            bind_group(d, &pl.get_bind_group_layout(0), "clusters", r)
+        };
+        let frame0 = || (0, res(&frame_buf));
+        let depths_bg = bind(
+            &self.depths,
+            vec![
+                frame0(),
+                (1, tex()),
+                (2, res(&b.pixel_depth)),
+                (3, res(&depth_range)),
+            ],
+        );
+        let count_bg = bind(
+            &self.tile_count,
+            vec![
+                frame0(),
+                (1, tex()),
+                (2, res(&b.pixel_depth)),
+                (3, res(&depth_range)),
+                (4, res(&tile_buf)),
+            ],
+        );
+        let scan_bg = bind(
+            &self.scan_tiles,
+            vec![
+                frame0(),
+                (4, res(&tile_buf)),
+                (7, res(&b.counter)),
+                (15, res(&dispatch)),
+            ],
+        );
+        let clusters_bg = bind(
+            &self.tile_clusters,
+            vec![
+                frame0(),
+                (1, tex()),
+                (2, res(&b.pixel_depth)),
+                (3, res(&depth_range)),
+                (4, res(&tile_buf)),
+                (5, res(&b.pixel_cluster)),
+                (6, res(&b.clusters)),
+            ],
+        );
+        let vpl_bg = bind(
+            &self.vpl_clusters,
+            vec![
+                frame0(),
+                (8, res(&f.grid)),
+                (9, res(&level.voxel_words)),
+                (12, res(&f.vpls)),
+                (13, res(&vpl_cluster)),
+            ],
+        );
+        let assign_bg = bind(
+            &self.assign,
+            vec![
+                frame0(),
+                (6, res(&b.clusters)),
+                (7, res(&b.counter)),
+                (8, res(&f.grid)),
+                (10, res(&level.gates)),
+                (11, res(&level.cluster_gates)),
+                (12, res(&f.vpls)),
+                (13, res(&vpl_cluster)),
+                (14, res(&b.entries)),
+            ],
+        );
+        let span = rec.begin("unique clusters");
+        {
+            let mut pass = rec.enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("unique clusters"),
+                timestamp_writes: span.compute(),
+            });
+            pass.set_pipeline(&self.depths);
+            pass.set_bind_group(0, &depths_bg, &[]);
+            pass.dispatch_workgroups(w.div_ceil(WG_TILE), h.div_ceil(WG_TILE), 1);
+            pass.set_pipeline(&self.tile_count);
+            pass.set_bind_group(0, &count_bg, &[]);
+            pass.dispatch_workgroups(tiles[0], tiles[1], 1);
+            pass.set_pipeline(&self.scan_tiles);
+            pass.set_bind_group(0, &scan_bg, &[]);
+            pass.dispatch_workgroups(1, 1, 1);
+            pass.set_pipeline(&self.tile_clusters);
+            pass.set_bind_group(0, &clusters_bg, &[]);
+            pass.dispatch_workgroups(tiles[0], tiles[1], 1);
+        }
+        rec.end();
+        let span = rec.begin("light assignment");
+        {
+            let mut pass = rec.enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("light assignment"),
+                timestamp_writes: span.compute(),
+            });
+            if vpl_groups > 0 {
+                pass.set_pipeline(&self.vpl_clusters);
+                pass.set_bind_group(0, &vpl_bg, &[]);
+                pass.dispatch_workgroups(vpl_groups, 1, 1);
+            }
+            pass.set_pipeline(&self.assign);
+            pass.set_bind_group(0, &assign_bg, &[]);
+            pass.dispatch_workgroups_indirect(&dispatch, 0);
+        }
+        rec.end();
+        Ok(b)
+    }
+}

@@ -1,0 +1,63 @@
+//! include: globals.wgsl grid.wgsl
+// G-buffer pass: world position (w: the visibility cluster it faces, 0 where
+// no surface is, see encode_cluster), shading normal turned towards the camera (surfaces are
+// two-sided), linear albedo (material × texture, the texture an sRGB layer
+// of one array, sampled nearest with repeat as the CPU reference does). Depth test less.
+
+@group(0) @binding(0) var<uniform> globals: Globals;
+@group(0) @binding(1) var albedo_maps: texture_2d_array<f32>;
+@group(0) @binding(2) var albedo_sampler: sampler;
+@group(0) @binding(8) var<uniform> grid: Grid;
+@group(0) @binding(9) var<storage, read> voxel_words: array<u32>;
+
+struct VsIn {
+    @location(0) position: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) albedo: vec3<f32>,
+    // xy texture coordinates, z texture layer (< 0: none).
+    @location(3) uv_layer: vec3<f32>,
+};
+
+struct VsOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) albedo: vec3<f32>,
+    @location(3) uv_layer: vec3<f32>,
+};
+
+@vertex
+fn vs(v: VsIn) -> VsOut {
+    var o: VsOut;
+    o.clip = globals.view_proj * vec4<f32>(v.position, 1.0);
+    o.world = v.position;
+    o.normal = v.normal;
+    o.albedo = v.albedo;
+    o.uv_layer = v.uv_layer;
+    return o;
+}
+
+struct GOut {
+    @location(0) position: vec4<f32>,
+    @location(1) normal: vec4<f32>,
+    @location(2) albedo: vec4<f32>,
+};
+
+@fragment
+fn fs(i: VsOut) -> GOut {
+    var n = normalize(i.normal);
+    // Two-sided: face the camera.
+    if dot(n, globals.eye.xyz - i.world) < 0.0 {
+        n = -n;
+    }
+    var o: GOut;
+    o.position = vec4<f32>(i.world, encode_cluster(cluster_at(i.world, n)));
+    o.normal = vec4<f32>(n, 0.0);
+    var albedo = i.albedo;
+    if i.uv_layer.z >= 0.0 {
+        let layer = i32(i.uv_layer.z + 0.5);
+        albedo *= textureSampleLevel(albedo_maps, albedo_sampler, i.uv_layer.xy, layer, 0.0).xyz;
+    }
+    o.albedo = vec4<f32>(albedo, 1.0);
+    return o;
+}

@@ -1,0 +1,118 @@
+//! Interleaved sampling's other half (blur.wgsl): the indirect irradiance that the gather wrote
+//! with each pixel lit by one of b² VPL subsets, blurred over the b × b block where the
+//! geometry agrees (Laine et al.'s thresholds), times albedo / π, added onto the image (through
+//! a ping-pong target and a copy).
+
+use super::gbuffer::GBufferOutput;
+use super::shade::{HDR, frame_target, fullscreen};
+use crate::RenderError;
+use crate::gpu::context::{Pool, bind_group, render_pipeline};
+use crate::gpu::timing::Recorder;
+use crate::gpu::{Frame, shaders};
+
+/// Interleaved sampling and the geometry-aware blur.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct InterleaveParams {
+    /// Block side b: a pixel lights itself with one of b² VPL subsets (1: every VPL at every
+    /// pixel), then the blur over the block. [Units: px] [Limit: 1..=16]
+    pub block: u32,
+    /// Blur: neighbours farther than this fraction of the scene's size are left out (Laine et
+    /// al.: 0.1). [Limit: ≥ 0]
+    pub blur_distance: f32,
+    /// Blur: neighbours whose normal's cosine to the pixel's is below this are left out (Laine
+    /// et al.: 0.8). [Limit: −1..=1]
+    pub blur_normal: f32,
+}
+
+impl Default for InterleaveParams {
+    fn default() -> Self {
+        InterleaveParams {
+            block: 8,
+            blur_distance: 0.1,
+            blur_normal: 0.8,
+        }
+    }
+}
+
+impl InterleaveParams {
+    /// Checks the limits.
+    pub fn check(&self) -> Result<(), RenderError> {
+        if !(1..=16).contains(&self.block) {
+            return Err(RenderError::Param(format!(
+                "interleaving block {} must be 1..=16 pixels (1: every VPL at every pixel)",
+                self.block
+            )));
+        }
+        let (d, n) = (self.blur_distance, self.blur_normal);
+        if !(d >= 0.0 && d.is_finite() && (-1.0..=1.0).contains(&n)) {
+            return Err(RenderError::Param(format!(
+                "blur distance {d} must be >= 0 (a fraction of the scene's size) and blur \
+                 normal threshold {n} a cosine in -1..=1"
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// The blur-and-compose pipeline.
+pub struct InterleaveBlur {
+    pipeline: wgpu::RenderPipeline,
+}
+
+impl InterleaveBlur {
+    /// Builds the pipeline.
+    pub fn new(d: &wgpu::Device) -> Result<InterleaveBlur, RenderError> {
+        let module = shaders::module(d, "blur.wgsl")?;
+        let pipeline =
+            render_pipeline(d, "blur", &module, ("vs", "fs_compose"), &[], &[HDR], false);
+        Ok(InterleaveBlur { pipeline })
+    }
+
+    /// Records the blur of `indirect` composed onto `out`, with the gather's constants
+    /// `uniform` (a `ValGather`).
+    pub fn record(
+        &self,
+        f: &Frame,
+        pool: &mut Pool,
+        rec: &mut Recorder,
+        (g, uniform, indirect, out): (
+            &GBufferOutput,
+            &wgpu::Buffer,
+            &wgpu::Texture,
+            &wgpu::Texture,
+        ),
+    ) {
+        let d = &f.ctx.device;
+        let other = frame_target(f, pool, "hdr (ping-pong)");
+        let tex = wgpu::BindingResource::TextureView;
+        let (out_view, indirect_view) = (
+            out.create_view(&Default::default()),
+            indirect.create_view(&Default::default()),
+        );
+        let bg = bind_group(
+            d,
+            &self.pipeline.get_bind_group_layout(0),
+            "blur",
+            vec![
+                (0, uniform.as_entire_binding()),
+                (3, tex(&g.views[0])),
+                (4, tex(&g.views[1])),
+                (5, tex(&g.views[2])),
+                (6, tex(&out_view)),
+                (12, tex(&indirect_view)),
+            ],
+        );
+        let span = rec.begin("blur + compose");
+        fullscreen(
+            &mut rec.enc,
+            "blur + compose",
+            &other.create_view(&Default::default()),
+            &self.pipeline,
+            &bg,
+            span.render(true, true),
+        );
+        rec.enc
+            .copy_texture_to_texture(other.as_image_copy(), out.as_image_copy(), out.size());
+        rec.end();
+    }
+}

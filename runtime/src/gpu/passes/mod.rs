@@ -1,0 +1,13 @@
+//! One module per pass, each beside its WGSL (`NAME.wgsl` in this folder): what it owns (its
+//! pipelines, its parameters' checks) and how it records into a frame.
+
+pub mod clustered_gates;
+pub mod cssm;
+pub mod gbuffer;
+pub mod interleave_blur;
+pub mod per_vpl_maps;
+pub mod rsm_vpls;
+pub mod shade;
+pub mod shadow_maps;
+pub mod val_gather;
+pub mod vals;

@@ -1,0 +1,214 @@
+//! Per-VPL paraboloid shadow maps, the brute-force baseline (vpl_shadow.wgsl, gather_batch.wgsl):
+//! the VPLs in batches of `batch`; per batch a paraboloid distance map per VPL (one render pass
+//! per layer, the VPL read from the VPL buffer by instance) and a gather of the batch's light
+//! through them, added onto the image (ping-pong: 32-bit float targets are not blendable
+//! everywhere). Memory stays bounded by the batch.
+
+use super::gbuffer::GBufferOutput;
+use super::shade::{HDR, frame_target, fullscreen};
+use super::shadow_maps::DistancePass;
+use crate::RenderError;
+use crate::gpu::context::{Pool, array_view, bind_group, layer_view, render_pipeline, slice};
+use crate::gpu::layout::{Batch, MapParams, UNIFORM_STRIDE, strided};
+use crate::gpu::timing::Recorder;
+use crate::gpu::{Frame, shaders};
+
+/// Parameters of mode `per-vpl-shadow-maps`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PerVplParams {
+    /// Paraboloid map side per VPL. [Units: texels] [Limit: 16..=2048]
+    pub map_size: u32,
+    /// VPL maps rendered and gathered per batch (bounds their memory). [Limit: 1..=2048]
+    pub batch: u32,
+}
+
+impl Default for PerVplParams {
+    fn default() -> Self {
+        PerVplParams {
+            map_size: 128,
+            batch: 128,
+        }
+    }
+}
+
+impl PerVplParams {
+    /// Checks the limits.
+    pub fn check(&self) -> Result<(), RenderError> {
+        if !(16..=2048).contains(&self.map_size) || !(1..=2048).contains(&self.batch) {
+            return Err(RenderError::Param(format!(
+                "VPL map size {} must be 16..=2048 and VPL batch {} 1..=2048",
+                self.map_size, self.batch
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// The paraboloid map pipelines (per VPL, per VAL) and the batch gather.
+pub struct ParaboloidMaps {
+    /// A VPL's map: vertex entry `vs`.
+    pub vpl: wgpu::RenderPipeline,
+    /// A VAL's map: vertex entry `vs_val`.
+    pub val: wgpu::RenderPipeline,
+    gather: wgpu::RenderPipeline,
+}
+
+impl ParaboloidMaps {
+    /// Builds the pipelines.
+    pub fn new(d: &wgpu::Device) -> Result<ParaboloidMaps, RenderError> {
+        let maps = shaders::module(d, "vpl_shadow.wgsl")?;
+        let attrs = [wgpu::VertexAttribute {
+            format: wgpu::VertexFormat::Float32x3,
+            offset: 0,
+            shader_location: 0,
+        }];
+        let layout = || wgpu::VertexBufferLayout {
+            array_stride: 12,
+            step_mode: wgpu::VertexStepMode::Vertex,
+            attributes: &attrs,
+        };
+        let r32 = [wgpu::TextureFormat::R32Float];
+        let gather = shaders::module(d, "gather_batch.wgsl")?;
+        Ok(ParaboloidMaps {
+            vpl: render_pipeline(
+                d,
+                "vpl maps",
+                &maps,
+                ("vs", "fs"),
+                &[Some(layout())],
+                &r32,
+                true,
+            ),
+            val: render_pipeline(
+                d,
+                "val maps",
+                &maps,
+                ("vs_val", "fs"),
+                &[Some(layout())],
+                &r32,
+                true,
+            ),
+            gather: render_pipeline(d, "gather batch", &gather, ("vs", "fs"), &[], &[HDR], false),
+        })
+    }
+
+    /// Records every batch's maps and gather onto `out`.
+    pub fn record(
+        &self,
+        f: &Frame,
+        p: &PerVplParams,
+        pool: &mut Pool,
+        rec: &mut Recorder,
+        (g, out): (&GBufferOutput, &wgpu::Texture),
+    ) {
+        let d = &f.ctx.device;
+        let n = f.vpl_count as usize;
+        if n == 0 {
+            return;
+        }
+        let batch = p.batch.min(d.limits().max_texture_array_layers).max(1) as usize;
+        let m = p.map_size;
+        let maps = pool.texture(
+            d,
+            "vpl paraboloid maps",
+            [m, m, batch as u32],
+            1,
+            wgpu::TextureFormat::R32Float,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        );
+        let depth = pool.texture(
+            d,
+            "vpl map depth",
+            [m, m, 1],
+            1,
+            wgpu::TextureFormat::Depth32Float,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        );
+        let other = frame_target(f, pool, "hdr (ping-pong)");
+        let uniform = wgpu::BufferUsages::UNIFORM;
+        let map_params = MapParams {
+            far: f.scene.far_m,
+            ..bytemuck::Zeroable::zeroed()
+        };
+        let params_buf = pool.upload(
+            f.ctx,
+            "map params",
+            bytemuck::bytes_of(&map_params),
+            uniform,
+        );
+        let batches: Vec<Batch> = (0..n.div_ceil(batch))
+            .map(|b| Batch {
+                first: (b * batch) as u32,
+                count: batch.min(n - b * batch) as u32,
+                map_size: m,
+                g_max: f.params.g_max,
+                normal_offset: f.params.shadows.normal_offset,
+                bias: f.params.shadows.bias,
+                ..bytemuck::Zeroable::zeroed()
+            })
+            .collect();
+        let batch_buf = pool.upload(f.ctx, "batches", &strided(&batches), uniform);
+        let pair = [out, &other].map(|t| t.create_view(&Default::default()));
+        let layers: Vec<wgpu::TextureView> =
+            (0..batch as u32).map(|l| layer_view(&maps, l)).collect();
+        let maps_view = array_view(&maps);
+        let depth_view = depth.create_view(&Default::default());
+        let map_bg = bind_group(
+            d,
+            &self.vpl.get_bind_group_layout(0),
+            "vpl maps",
+            vec![
+                (0, params_buf.as_entire_binding()),
+                (1, f.vpls.as_entire_binding()),
+            ],
+        );
+        let mut current = 0;
+        for (bi, b) in batches.iter().enumerate() {
+            let span = rec.begin("VPL paraboloid maps");
+            for k in 0..b.count {
+                DistancePass {
+                    color: &layers[k as usize],
+                    depth: &depth_view,
+                    pipeline: &self.vpl,
+                    bind_group: &map_bg,
+                    vertices: &f.scene.geometry.vpl_vertices,
+                    count: f.scene.geometry.vpl_vertex_count,
+                    instances: b.first + k..b.first + k + 1,
+                }
+                .record(&mut rec.enc, span.render(k == 0, k + 1 == b.count));
+            }
+            rec.end();
+            let tex = wgpu::BindingResource::TextureView;
+            let size = size_of::<Batch>() as u64;
+            let bg = bind_group(
+                d,
+                &self.gather.get_bind_group_layout(0),
+                "gather batch",
+                vec![
+                    (0, slice(&batch_buf, (bi * UNIFORM_STRIDE) as u64, size)),
+                    (1, f.vpls.as_entire_binding()),
+                    (2, tex(&maps_view)),
+                    (3, tex(&g.views[0])),
+                    (4, tex(&g.views[1])),
+                    (5, tex(&g.views[2])),
+                    (6, tex(&pair[current])),
+                ],
+            );
+            let span = rec.begin("VPL gather");
+            fullscreen(
+                &mut rec.enc,
+                "gather batch",
+                &pair[1 - current],
+                &self.gather,
+                &bg,
+                span.render(true, true),
+            );
+            rec.end();
+            current = 1 - current;
+        }
+        if current == 1 {
+            rec.enc
+                .copy_texture_to_texture(other.as_image_copy(), out.as_image_copy(), out.size());
+        }
+    }
+}

@@ -1,0 +1,135 @@
+//! Deferred shading (shade.wgsl): direct light from every light with its shadow maps (PCF), plus
+//! what the mode's [`ShadeIndirect`] says of the VPLs (all of them unoccluded, through the
+//! gates per pixel or by the clustered light lists, or none), into the frame's HDR target.
+
+use super::clustered_gates::ListBuffers;
+use super::gbuffer::GBufferOutput;
+use super::shadow_maps::ShadowOutput;
+use crate::RenderError;
+use crate::gpu::context::{Pool, array_view, bind_group, render_pipeline};
+use crate::gpu::timing::Recorder;
+use crate::gpu::{Frame, shaders};
+
+/// The HDR target's format.
+pub const HDR: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+
+/// The shading pipeline.
+pub struct Shade {
+    pipeline: wgpu::RenderPipeline,
+}
+
+/// A fullscreen triangle into `target` (cleared to black) with `pipeline` and `bind_group`.
+pub fn fullscreen(
+    enc: &mut wgpu::CommandEncoder,
+    label: &str,
+    target: &wgpu::TextureView,
+    pipeline: &wgpu::RenderPipeline,
+    bind_group: &wgpu::BindGroup,
+    timestamps: Option<wgpu::RenderPassTimestampWrites>,
+) {
+    let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: target,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        depth_stencil_attachment: None,
+        timestamp_writes: timestamps,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    pass.set_pipeline(pipeline);
+    pass.set_bind_group(0, bind_group, &[]);
+    pass.draw(0..3, 0..1);
+}
+
+/// A full-frame RGBA32F target `label` of the frame's size (kept in `pool`).
+pub fn frame_target(f: &Frame, pool: &mut Pool, label: &'static str) -> wgpu::Texture {
+    let [w, h] = f.view.size;
+    pool.texture(
+        &f.ctx.device,
+        label,
+        [w, h, 1],
+        1,
+        HDR,
+        wgpu::TextureUsages::RENDER_ATTACHMENT
+            | wgpu::TextureUsages::COPY_SRC
+            | wgpu::TextureUsages::COPY_DST
+            | wgpu::TextureUsages::TEXTURE_BINDING,
+    )
+}
+
+impl Shade {
+    /// Builds the pipeline.
+    pub fn new(d: &wgpu::Device) -> Result<Shade, RenderError> {
+        let module = shaders::module(d, "shade.wgsl")?;
+        let pipeline = render_pipeline(d, "shade", &module, ("vs", "fs"), &[], &[HDR], false);
+        Ok(Shade { pipeline })
+    }
+
+    /// Records the shading pass; returns the frame's HDR image so far.
+    pub fn record(
+        &self,
+        f: &Frame,
+        pool: &mut Pool,
+        rec: &mut Recorder,
+        (shadows, g, lists): (&ShadowOutput, &GBufferOutput, Option<&ListBuffers>),
+        name: &'static str,
+    ) -> wgpu::Texture {
+        let d = &f.ctx.device;
+        let out = frame_target(f, pool, "hdr");
+        let level = f.scene.level.as_ref();
+        let none = &f.scene.no_level;
+        let maps = array_view(&shadows.maps);
+        let buffers: [(u32, &wgpu::Buffer); 11] = [
+            (0, &f.globals),
+            (1, &shadows.lights),
+            (2, &f.vpls),
+            (3, &shadows.matrices),
+            (8, &f.grid),
+            (9, level.map_or(none, |l| &l.voxel_words)),
+            (10, level.map_or(none, |l| &l.gates)),
+            (11, level.map_or(none, |l| &l.cluster_gates)),
+            (12, lists.map_or(none, |b| &b.pixel_cluster)),
+            (13, lists.map_or(none, |b| &b.clusters)),
+            (14, lists.map_or(none, |b| &b.entries)),
+        ];
+        let textures = [
+            (4, &maps),
+            (5, &g.views[0]),
+            (6, &g.views[1]),
+            (7, &g.views[2]),
+        ];
+        let resources = buffers
+            .iter()
+            .map(|&(k, b)| (k, b.as_entire_binding()))
+            .chain(
+                textures
+                    .iter()
+                    .map(|&(k, v)| (k, wgpu::BindingResource::TextureView(v))),
+            )
+            .collect();
+        let bg = bind_group(
+            d,
+            &self.pipeline.get_bind_group_layout(0),
+            "shade",
+            resources,
+        );
+        let span = rec.begin(name);
+        fullscreen(
+            &mut rec.enc,
+            "shade",
+            &out.create_view(&Default::default()),
+            &self.pipeline,
+            &bg,
+            span.render(true, true),
+        );
+        rec.end();
+        out
+    }
+}

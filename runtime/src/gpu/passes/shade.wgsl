@@ -1,0 +1,232 @@
+//! include: globals.wgsl vpl.wgsl gates.wgsl fullscreen.wgsl
+// Deferred shading: direct light from point and spot lights with shadow-map PCF (3 × 3), and
+// the indirect sum over VPLs without visibility (SHADE_ALL), through the gates of a baked
+// level per pixel (SHADE_GATES_PER_PIXEL) or by clustered light lists (SHADE_GATES_CLUSTERED),
+// or none (SHADE_DIRECT: direct light only), into a linear HDR target.
+//
+// Radiometry as the CPU reference: L = ρ/π · I · falloff · cos θ / d² for lights, and
+// ρ/π · Φ/π · min(cos θ_v cos θ_x / d², g_max) for VPLs.
+
+// As runtime::gpu::layout::Light.
+struct Light {
+    // xyz position (m), w kind (LIGHT_POINT or LIGHT_SPOT).
+    position: vec4<f32>,
+    // rgb intensity (W/sr), w beam half-angle (rad).
+    intensity: vec4<f32>,
+    // xyz unit axis, w cutoff half-angle (rad).
+    direction: vec4<f32>,
+    // x first shadow layer, y layers, z, w unused.
+    layers: vec4<u32>,
+};
+
+@group(0) @binding(0) var<uniform> globals: Globals;
+@group(0) @binding(1) var<storage, read> lights: array<Light>;
+@group(0) @binding(2) var<storage, read> vpls: array<Vpl>;
+@group(0) @binding(3) var<storage, read> shadow_mats: array<mat4x4<f32>>;
+@group(0) @binding(4) var shadow_maps: texture_2d_array<f32>;
+@group(0) @binding(5) var g_position: texture_2d<f32>;
+@group(0) @binding(6) var g_normal: texture_2d<f32>;
+@group(0) @binding(7) var g_albedo: texture_2d<f32>;
+
+// Gate visibility: a pixel's cluster is in the G-buffer (position.w). SHADE_GATES_PER_PIXEL
+// tests every VPL with a chain of at most 2 gate disks; SHADE_GATES_CLUSTERED walks the light
+// list of the pixel's geometry cluster that the clusters.wgsl passes built.
+
+@group(0) @binding(8) var<uniform> grid: Grid;
+@group(0) @binding(9) var<storage, read> voxel_words: array<u32>;
+@group(0) @binding(10) var<storage, read> gates: array<Gate>;
+// Offsets (clusters + 1) into this same array, then the gate indices.
+@group(0) @binding(11) var<storage, read> cluster_gates: array<u32>;
+
+// As runtime::gpu::layout::GeometryCluster (clusters.wgsl writes them).
+struct GeometryCluster {
+    // x tile x, y tile y, z depth slice, w visibility cluster.
+    key: vec4<u32>,
+    lo: vec4<f32>,
+    hi: vec4<f32>,
+    // x first entry, y entries, z entries needed, w unused.
+    list: vec4<u32>,
+};
+
+@group(0) @binding(12) var<storage, read> pixel_cluster: array<u32>;
+@group(0) @binding(13) var<storage, read> geometry_clusters: array<GeometryCluster>;
+// (VPL, gates): gates (g0 + 1) | (g1 + 1) << 16, 0 for none.
+@group(0) @binding(14) var<storage, read> light_entries: array<vec2<u32>>;
+
+fn through_gates(a: vec3<f32>, ca: u32, b: vec3<f32>, cb: u32) -> bool {
+    if ca == cb || ca == NONE || cb == NONE {
+        return true;
+    }
+    for (var i = cluster_gates[ca]; i < cluster_gates[ca + 1u]; i++) {
+        let g = gates[cluster_gates[i]];
+        if !crosses(a, b, g) {
+            continue;
+        }
+        let c = other_side(g, ca);
+        if c == cb {
+            return true;
+        }
+        if grid.max_hops < 2u {
+            continue;
+        }
+        for (var j = cluster_gates[c]; j < cluster_gates[c + 1u]; j++) {
+            let h = gates[cluster_gates[j]];
+            if other_side(h, c) == cb && crosses(a, b, h) {
+                return true;
+            }
+        }
+    }
+    return false;
+}
+
+fn spot_falloff(angle: f32, beam: f32, cutoff: f32) -> f32 {
+    if angle <= beam {
+        return 1.0;
+    }
+    if angle >= cutoff || cutoff <= beam {
+        return 0.0;
+    }
+    return (cutoff - angle) / (cutoff - beam);
+}
+
+// Visibility of `p` (normal `n`) from light `l`: 3 × 3 PCF of distance comparisons.
+fn shadow(l: Light, p: vec3<f32>, n: vec3<f32>) -> f32 {
+    let size = f32(globals.shadow_size);
+    let d = p - l.position.xyz;
+    let dist = length(d);
+    var layer = l.layers.x;
+    // Texel footprint at this distance: 90° faces span 2·dist, spots 2·dist·tan(cutoff).
+    var span = 2.0 * dist;
+    if l.position.w == LIGHT_POINT {
+        let a = abs(d);
+        if a.x >= a.y && a.x >= a.z {
+            layer += select(1u, 0u, d.x > 0.0);
+        } else if a.y >= a.z {
+            layer += select(3u, 2u, d.y > 0.0);
+        } else {
+            layer += select(5u, 4u, d.z > 0.0);
+        }
+    } else {
+        span = 2.0 * dist * tan(min(l.direction.w, 1.5));
+    }
+    let texel = span / size;
+    let q = p + n * texel * globals.shadow_normal_offset;
+    let clip = shadow_mats[layer] * vec4<f32>(q, 1.0);
+    let ndc = clip.xyz / clip.w;
+    let uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
+    let c = vec2<i32>(uv * size);
+    let ref_dist = length(q - l.position.xyz) - texel * globals.shadow_bias;
+    var lit = 0.0;
+    for (var dy = -1; dy <= 1; dy++) {
+        for (var dx = -1; dx <= 1; dx++) {
+            let t = clamp(c + vec2<i32>(dx, dy), vec2<i32>(0), vec2<i32>(i32(size) - 1));
+            let stored = textureLoad(shadow_maps, t, i32(layer), 0).x;
+            lit += select(0.0, 1.0, stored >= ref_dist);
+        }
+    }
+    return lit / 9.0;
+}
+
+@fragment
+fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
+    let px = vec2<i32>(frag.xy);
+    let pos = textureLoad(g_position, px, 0);
+    if pos.w == 0.0 {
+        return vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    }
+    let p = pos.xyz;
+    let n = normalize(textureLoad(g_normal, px, 0).xyz);
+    let albedo = textureLoad(g_albedo, px, 0).xyz;
+    var radiance = vec3<f32>(0.0);
+    for (var i = 0u; i < globals.light_count; i++) {
+        let l = lights[i];
+        let to_light = l.position.xyz - p;
+        let d2 = dot(to_light, to_light);
+        if d2 <= 0.0 {
+            continue;
+        }
+        let w = to_light * inverseSqrt(d2);
+        let cos_x = dot(n, w);
+        if cos_x <= 0.0 {
+            continue;
+        }
+        var intensity = l.intensity.xyz;
+        if l.position.w == LIGHT_SPOT {
+            let angle = acos(clamp(dot(l.direction.xyz, -w), -1.0, 1.0));
+            intensity *= spot_falloff(angle, l.intensity.w, l.direction.w);
+        }
+        if all(intensity == vec3<f32>(0.0)) {
+            continue;
+        }
+        radiance += albedo / PI * intensity * cos_x / d2 * shadow(l, p, n);
+    }
+    // One loop per mode: a software rasterizer (lavapipe) runs a loop that carries another
+    // mode's branch several times slower.
+    let mode = globals.shade_mode;
+    if mode == SHADE_ALL {
+        radiance += albedo / PI * gather_all(p, n);
+    } else if mode == SHADE_GATES_PER_PIXEL {
+        radiance += albedo / PI * gather_per_pixel(p, n, decode_cluster(pos.w));
+    } else if mode == SHADE_GATES_CLUSTERED {
+        radiance += albedo / PI * clustered_gather(px, p, n);
+    }
+    return vec4<f32>(radiance, 1.0);
+}
+
+// SHADE_GATES_CLUSTERED: the VPL light at p through its geometry cluster's list (without albedo / π). An
+// entry with gates is tested here, per fragment; a VPL whose light passes by several chains
+// counts once (a list is sorted by VPL).
+fn clustered_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    let width = textureDimensions(g_position).x;
+    let gc = pixel_cluster[u32(px.x) + u32(px.y) * width];
+    if gc == NONE {
+        return vec3<f32>(0.0);
+    }
+    let list = geometry_clusters[gc].list;
+    var sum = vec3<f32>(0.0);
+    var last = NONE;
+    for (var e = list.x; e < list.x + list.y; e++) {
+        let entry = light_entries[e];
+        if entry.x == last {
+            continue;
+        }
+        let v = vpls[entry.x];
+        let l = vpl_light(v, p, n, globals.g_max);
+        if all(l == vec3<f32>(0.0)) {
+            continue;
+        }
+        let g0 = entry.y & 0xffffu;
+        if g0 != 0u && !crosses(v.position, p, gates[g0 - 1u]) {
+            continue;
+        }
+        let g1 = entry.y >> 16u;
+        if g1 != 0u && !crosses(v.position, p, gates[g1 - 1u]) {
+            continue;
+        }
+        last = entry.x;
+        sum += l;
+    }
+    return sum;
+}
+
+// SHADE_ALL: every VPL, no visibility.
+fn gather_all(p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    var sum = vec3<f32>(0.0);
+    for (var j = 0u; j < globals.vpl_count; j++) {
+        sum += vpl_light(vpls[j], p, n, globals.g_max);
+    }
+    return sum;
+}
+
+// SHADE_GATES_PER_PIXEL: every VPL through the gates, brute force.
+fn gather_per_pixel(p: vec3<f32>, n: vec3<f32>, here: u32) -> vec3<f32> {
+    var sum = vec3<f32>(0.0);
+    for (var j = 0u; j < globals.vpl_count; j++) {
+        let v = vpls[j];
+        let l = vpl_light(v, p, n, globals.g_max);
+        if any(l > vec3<f32>(0.0)) && through_gates(v.position, cluster_at(v.position, v.normal), p, here) {
+            sum += l;
+        }
+    }
+    return sum;
+}

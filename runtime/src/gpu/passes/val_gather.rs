@@ -1,0 +1,256 @@
+//! The VAL modes after the direct light (val_gather.wgsl; Dong et al. §4): a paraboloid distance
+//! map per VAL (one render pass per layer: wgpu has no layered rendering without multiview),
+//! for `val-cssm` its convolution basis ([`super::cssm`]), then every VPL gathered through its
+//! VAL's visibility — hard (`fs_hard`) or soft (`fs_cssm`) — into an indirect target, each pixel
+//! with its interleaving subset, and the blur composing it ([`super::interleave_blur`]).
+
+use super::cssm::{Cssm, CssmParams};
+use super::gbuffer::GBufferOutput;
+use super::interleave_blur::{InterleaveBlur, InterleaveParams};
+use super::per_vpl_maps::ParaboloidMaps;
+use super::shade::{HDR, frame_target, fullscreen};
+use super::shadow_maps::DistancePass;
+use super::vals::{ValClustering, ValInput};
+use crate::RenderError;
+use crate::cpu::val::ValParams;
+use crate::gpu::context::{Pool, array_view, bind_group, layer_view, render_pipeline};
+use crate::gpu::layout::{MapParams, ValGather};
+use crate::gpu::timing::Recorder;
+use crate::gpu::{Frame, shaders};
+
+/// Parameters of modes `val-hard` and `val-cssm`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ValModeParams {
+    /// The clustering of VPLs into VALs.
+    pub vals: ValParams,
+    /// Paraboloid map side per VAL. [Units: texels] [Limit: 16..=4096]
+    pub map_size: u32,
+    /// Interleaved sampling and the blur.
+    pub interleave: InterleaveParams,
+}
+
+impl ValModeParams {
+    /// The defaults: 30 VALs, 256² maps, 8 × 8 interleaving.
+    pub fn new() -> ValModeParams {
+        ValModeParams {
+            vals: ValParams::default(),
+            map_size: 256,
+            interleave: InterleaveParams::default(),
+        }
+    }
+
+    /// Checks the limits (the VAL count against the adapter's layers at render time).
+    pub fn check(&self) -> Result<(), RenderError> {
+        self.vals.check()?;
+        self.interleave.check()?;
+        if !(16..=4096).contains(&self.map_size) {
+            return Err(RenderError::Param(format!(
+                "VAL map size {} must be 16..=4096 texels",
+                self.map_size
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// The VAL gathers (hard and CSSM).
+pub struct ValGathers {
+    hard: wgpu::RenderPipeline,
+    cssm: wgpu::RenderPipeline,
+    sampler: wgpu::Sampler,
+}
+
+/// The pipelines a VAL frame uses besides the gathers.
+pub struct ValPasses<'a> {
+    /// The clustering.
+    pub clustering: &'a ValClustering,
+    /// The VAL maps.
+    pub maps: &'a ParaboloidMaps,
+    /// The CSSM basis.
+    pub cssm: &'a Cssm,
+    /// The blur.
+    pub blur: &'a InterleaveBlur,
+}
+
+impl ValGathers {
+    /// Builds the pipelines.
+    pub fn new(d: &wgpu::Device) -> Result<ValGathers, RenderError> {
+        let m = shaders::module(d, "val_gather.wgsl")?;
+        Ok(ValGathers {
+            hard: render_pipeline(
+                d,
+                "val gather (hard)",
+                &m,
+                ("vs", "fs_hard"),
+                &[],
+                &[HDR],
+                false,
+            ),
+            cssm: render_pipeline(
+                d,
+                "val gather (cssm)",
+                &m,
+                ("vs", "fs_cssm"),
+                &[],
+                &[HDR],
+                false,
+            ),
+            sampler: super::cssm::sampler(d),
+        })
+    }
+
+    /// Records a VAL frame onto `out`: with `cssm` the soft mode. `warm`: start the
+    /// clustering from last frame's centres.
+    #[allow(clippy::too_many_arguments)]
+    pub fn record(
+        &self,
+        f: &Frame,
+        p: &ValModeParams,
+        cssm: Option<&CssmParams>,
+        warm: bool,
+        passes: &ValPasses,
+        pool: &mut Pool,
+        rec: &mut Recorder,
+        (g, out): (&GBufferOutput, &wgpu::Texture),
+    ) -> Result<(), RenderError> {
+        p.check()?;
+        let d = &f.ctx.device;
+        let (m, s) = (p.vals.count, p.map_size);
+        let layers = d.limits().max_texture_array_layers;
+        if m > layers {
+            return Err(RenderError::Param(format!(
+                "{m} VALs need {m} map layers, more than the adapter's {layers}: use fewer VALs"
+            )));
+        }
+        if f.vpl_count == 0 {
+            return Ok(());
+        }
+        let block = p.interleave.block;
+        let input = ValInput {
+            buffer: &f.vpls,
+            count: f.vpl_count,
+            cpu: f.vpls_cpu,
+        };
+        let b = passes
+            .clustering
+            .record(f.ctx, &input, &p.vals, block * block, warm, pool, rec)?;
+        // The VAL's centre, a mean of VPLs, may sit on (or just inside) a surface: move it off
+        // by a hair, relative to the scene.
+        let offset = f.scene.near_m;
+        let maps = pool.texture(
+            d,
+            "val maps",
+            [s, s, m],
+            1,
+            wgpu::TextureFormat::R32Float,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        );
+        let depth = pool.texture(
+            d,
+            "val map depth",
+            [s, s, 1],
+            1,
+            wgpu::TextureFormat::Depth32Float,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        );
+        let map_params = MapParams {
+            far: f.scene.far_m,
+            centre_offset: offset,
+            ..bytemuck::Zeroable::zeroed()
+        };
+        let uniform = wgpu::BufferUsages::UNIFORM;
+        let params_buf = pool.upload(
+            f.ctx,
+            "val map params",
+            bytemuck::bytes_of(&map_params),
+            uniform,
+        );
+        let map_bg = bind_group(
+            d,
+            &passes.maps.val.get_bind_group_layout(0),
+            "val maps",
+            vec![
+                (0, params_buf.as_entire_binding()),
+                (2, b.vals.as_entire_binding()),
+            ],
+        );
+        let depth_view = depth.create_view(&Default::default());
+        let span = rec.begin("VAL paraboloid maps");
+        for k in 0..m {
+            DistancePass {
+                color: &layer_view(&maps, k),
+                depth: &depth_view,
+                pipeline: &passes.maps.val,
+                bind_group: &map_bg,
+                vertices: &f.scene.geometry.vpl_vertices,
+                count: f.scene.geometry.vpl_vertex_count,
+                instances: k..k + 1,
+            }
+            .record(&mut rec.enc, span.render(k == 0, k + 1 == m));
+        }
+        rec.end();
+        let basis = match cssm {
+            Some(c) => Some(passes.cssm.record(f.ctx, c, (&maps, m, s), pool, rec)?),
+            None => None,
+        };
+        let c = cssm.copied().unwrap_or_default();
+        let il = &p.interleave;
+        let constants = ValGather {
+            vpl_count: f.vpl_count,
+            val_count: m,
+            map_size: s,
+            terms: c.terms,
+            g_max: f.params.g_max,
+            normal_offset: f.params.shadows.normal_offset,
+            bias: f.params.shadows.bias,
+            centre_offset: offset,
+            receiver_offset: crate::cpu::cssm::receiver_offset(c.terms, c.sharpness),
+            sharpness: c.sharpness,
+            cssm_normal_offset: c.normal_offset,
+            block,
+            subsets: block * block,
+            blur_distance: il.blur_distance * f.scene.far_m / 4.0,
+            blur_normal: il.blur_normal,
+            ..bytemuck::Zeroable::zeroed()
+        };
+        let uniform_buf = pool.upload(f.ctx, "val gather", bytemuck::bytes_of(&constants), uniform);
+        let indirect = frame_target(f, pool, "indirect irradiance");
+        let maps_view = array_view(&maps);
+        let tex = wgpu::BindingResource::TextureView;
+        let mut entries: Vec<(u32, wgpu::BindingResource)> = vec![
+            (0, uniform_buf.as_entire_binding()),
+            (1, f.vpls.as_entire_binding()),
+            (3, tex(&g.views[0])),
+            (4, tex(&g.views[1])),
+            (7, b.order.as_entire_binding()),
+            (8, b.vals.as_entire_binding()),
+        ];
+        let pipeline = match &basis {
+            Some(basis) => {
+                entries.push((9, tex(&basis.view)));
+                entries.push((10, wgpu::BindingResource::Sampler(&self.sampler)));
+                entries.push((11, basis.ranges.as_entire_binding()));
+                &self.cssm
+            }
+            None => {
+                entries.push((2, tex(&maps_view)));
+                &self.hard
+            }
+        };
+        let bg = bind_group(d, &pipeline.get_bind_group_layout(0), "val gather", entries);
+        let span = rec.begin("indirect lighting");
+        fullscreen(
+            &mut rec.enc,
+            "val gather",
+            &indirect.create_view(&Default::default()),
+            pipeline,
+            &bg,
+            span.render(true, true),
+        );
+        rec.end();
+        passes
+            .blur
+            .record(f, pool, rec, (g, &uniform_buf, &indirect, out));
+        Ok(())
+    }
+}

@@ -1,0 +1,216 @@
+//! include: vpl.wgsl val.wgsl
+// Virtual area lights on the GPU (Dong et al. §5–6): k-means of the VPLs into M VALs by
+// d = w_x·Δx/D + w_α·Δα/π, restarted each frame from VAL k = VPL ⌊k·N/M⌋.
+// runtime::cpu::val is the CPU twin (same order of every sum, so the same VALs).
+//   init    centres from the restart VPLs
+//   assign  each VPL's nearest centre (ties to the lower index) → the mapping C
+//   update  each VAL's centre: mean position and normalised mean normal of its VPLs, summed
+//           in VPL order (an empty VAL keeps its centre)
+//   finish  each VAL's VPL count, flux and bounding rectangle in the plane normal to it
+
+// As runtime::gpu::layout::ValFrame.
+struct ValFrame {
+    vpl_count: u32,
+    val_count: u32,
+    // Interleaving subsets B (1: none).
+    subsets: u32,
+    pad0: u32,
+    w_x: f32,
+    w_alpha: f32,
+    pad1: vec2<f32>,
+};
+
+@group(0) @binding(0) var<uniform> frame: ValFrame;
+@group(0) @binding(1) var<storage, read> vpls: array<Vpl>;
+// Per VAL: centre (xyz), normal (xyz) at 2k, 2k + 1.
+@group(0) @binding(2) var<storage, read_write> centres: array<vec4<f32>>;
+@group(0) @binding(3) var<storage, read_write> mapping: array<u32>;
+@group(0) @binding(4) var<storage, read_write> vals: array<Val>;
+// 1 / D, D the VPLs' bounding-box diagonal: uploaded when the CPU has the VPLs, else computed
+// by `scale` (RSM VPLs stay on the GPU).
+@group(0) @binding(6) var<storage, read_write> inv_scale: array<f32, 1>;
+
+var<workgroup> wg_lo: array<vec3<f32>, WG_LINEAR>;
+var<workgroup> wg_hi: array<vec3<f32>, WG_LINEAR>;
+
+// One workgroup: 1 / D as runtime::cpu::val::scale_of gives it (1 for no VPLs).
+@compute @workgroup_size(WG_LINEAR)
+fn scale(@builtin(local_invocation_index) li: u32) {
+    var lo = vec3<f32>(3.4e38);
+    var hi = vec3<f32>(-3.4e38);
+    for (var i = li; i < frame.vpl_count; i += WG_LINEAR) {
+        lo = min(lo, vpls[i].position);
+        hi = max(hi, vpls[i].position);
+    }
+    wg_lo[li] = lo;
+    wg_hi[li] = hi;
+    workgroupBarrier();
+    for (var o = WG_LINEAR / 2u; o > 0u; o >>= 1u) {
+        if li < o {
+            wg_lo[li] = min(wg_lo[li], wg_lo[li + o]);
+            wg_hi[li] = max(wg_hi[li], wg_hi[li + o]);
+        }
+        workgroupBarrier();
+    }
+    if li == 0u {
+        var d = 1.0;
+        if frame.vpl_count > 0u {
+            d = max(length(wg_hi[0] - wg_lo[0]), 1e-30);
+        }
+        inv_scale[0] = 1.0 / d;
+    }
+}
+
+@compute @workgroup_size(WG_LINEAR)
+fn init(@builtin(global_invocation_id) id: vec3<u32>) {
+    let k = id.x;
+    let n = frame.vpl_count;
+    let m = frame.val_count;
+    if k >= m || n == 0u {
+        return;
+    }
+    // ⌊k·N/M⌋ without overflowing 32 bits.
+    let j = k * (n / m) + (k * (n % m)) / m;
+    centres[2u * k] = vec4<f32>(vpls[j].position, 0.0);
+    centres[2u * k + 1u] = vec4<f32>(vpls[j].normal, 0.0);
+}
+
+fn distance(v: Vpl, k: u32) -> f32 {
+    let dx = length(v.position - centres[2u * k].xyz) * inv_scale[0];
+    let da = acos(clamp(dot(v.normal, centres[2u * k + 1u].xyz), -1.0, 1.0)) / PI;
+    return frame.w_x * dx + frame.w_alpha * da;
+}
+
+@compute @workgroup_size(WG_LINEAR)
+fn assign(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    if i >= frame.vpl_count {
+        return;
+    }
+    let v = vpls[i];
+    var best = distance(v, 0u);
+    var at = 0u;
+    for (var k = 1u; k < frame.val_count; k++) {
+        let d = distance(v, k);
+        if d < best {
+            best = d;
+            at = k;
+        }
+    }
+    mapping[i] = at;
+}
+
+@compute @workgroup_size(WG_LINEAR)
+fn update(@builtin(global_invocation_id) id: vec3<u32>) {
+    let k = id.x;
+    if k >= frame.val_count {
+        return;
+    }
+    var p = vec3<f32>(0.0);
+    var nrm = vec3<f32>(0.0);
+    var count = 0u;
+    for (var i = 0u; i < frame.vpl_count; i++) {
+        if mapping[i] == k {
+            p += vpls[i].position;
+            nrm += vpls[i].normal;
+            count++;
+        }
+    }
+    if count > 0u {
+        centres[2u * k] = vec4<f32>(p / f32(count), 0.0);
+        let l = length(nrm);
+        if l > 0.0 {
+            centres[2u * k + 1u] = vec4<f32>(nrm / l, 0.0);
+        }
+    }
+}
+
+@compute @workgroup_size(WG_LINEAR)
+fn finish(@builtin(global_invocation_id) id: vec3<u32>) {
+    let k = id.x;
+    if k >= frame.val_count {
+        return;
+    }
+    let c = centres[2u * k].xyz;
+    let nrm = centres[2u * k + 1u].xyz;
+    let tb = basis(nrm);
+    var count = 0u;
+    var flux = vec3<f32>(0.0);
+    var rect = vec4<f32>(1e38, -1e38, 1e38, -1e38);
+    for (var i = 0u; i < frame.vpl_count; i++) {
+        if mapping[i] == k {
+            let q = vpls[i].position - c;
+            let s = dot(q, tb[0]);
+            let t = dot(q, tb[1]);
+            rect = vec4<f32>(min(rect.x, s), max(rect.y, s), min(rect.z, t), max(rect.w, t));
+            flux += vpls[i].flux;
+            count++;
+        }
+    }
+    if count == 0u {
+        rect = vec4<f32>(0.0);
+    }
+    var v: Val;
+    v.position = vec4<f32>(c, f32(count));
+    v.normal = vec4<f32>(nrm, (rect.y - rect.x) * (rect.w - rect.z));
+    v.flux = vec4<f32>(flux, 0.0);
+    v.rect = rect;
+    vals[k] = v;
+}
+
+// The VPLs sorted by VAL and, within a VAL, by interleaving subset j = i mod B (B = the
+// interleaving block's pixels, 1 without interleaving), each bucket in VPL order, for a gather
+// that computes each VAL's visibility once per pixel and lights a pixel with its subset:
+// M·B + 1 offsets (bucket k·B + j), then the VPL indices.
+@group(0) @binding(5) var<storage, read_write> order: array<u32>;
+
+fn buckets() -> u32 {
+    return frame.val_count * frame.subsets;
+}
+
+@compute @workgroup_size(WG_LINEAR)
+fn bucket_counts(@builtin(global_invocation_id) id: vec3<u32>) {
+    let b = id.x;
+    if b >= buckets() {
+        return;
+    }
+    let k = b / frame.subsets;
+    let j = b % frame.subsets;
+    var c = 0u;
+    for (var i = j; i < frame.vpl_count; i += frame.subsets) {
+        if mapping[i] == k {
+            c++;
+        }
+    }
+    order[b] = c;
+}
+
+@compute @workgroup_size(1)
+fn offsets() {
+    var run = 0u;
+    let n = buckets();
+    for (var b = 0u; b < n; b++) {
+        let c = order[b];
+        order[b] = run;
+        run += c;
+    }
+    order[n] = run;
+}
+
+@compute @workgroup_size(WG_LINEAR)
+fn scatter(@builtin(global_invocation_id) id: vec3<u32>) {
+    let b = id.x;
+    let n = buckets();
+    if b >= n {
+        return;
+    }
+    let k = b / frame.subsets;
+    let j = b % frame.subsets;
+    var at = n + 1u + order[b];
+    for (var i = j; i < frame.vpl_count; i += frame.subsets) {
+        if mapping[i] == k {
+            order[at] = i;
+            at++;
+        }
+    }
+}

@@ -1,0 +1,210 @@
+//! WGSL composition: a small include step and constants injected from Rust.
+//!
+//! WGSL has no includes. A pass's shader names what it needs on its first line,
+//!
+//! ```wgsl
+//! //! include: vpl.wgsl grid.wgsl
+//! ```
+//!
+//! and [`compose`] puts in front of it: first the constants of [`constants`] (generated from
+//! the Rust definitions below, so a workgroup size, a mode id or a bit count has one home),
+//! then each include once, after its own includes, in the order named. Include files live in
+//! `gpu/shaders/`; they declare structs, constants and functions, **never bindings**: a
+//! function that reads a binding (grid.wgsl's `cluster_of` reads `grid` and `voxel_words`)
+//! says so in its header, and each pass declares that binding at the number it chooses. Pass
+//! shaders live beside their pass in `gpu/passes/`.
+
+use crate::RenderError;
+
+/// The include files (`gpu/shaders/`).
+const INCLUDES: [(&str, &str); 6] = [
+    ("globals.wgsl", include_str!("shaders/globals.wgsl")),
+    ("vpl.wgsl", include_str!("shaders/vpl.wgsl")),
+    ("grid.wgsl", include_str!("shaders/grid.wgsl")),
+    ("gates.wgsl", include_str!("shaders/gates.wgsl")),
+    ("val.wgsl", include_str!("shaders/val.wgsl")),
+    ("fullscreen.wgsl", include_str!("shaders/fullscreen.wgsl")),
+];
+
+/// The pass shaders (`gpu/passes/`), before composition.
+pub const SOURCES: [(&str, &str); 11] = [
+    ("gbuffer.wgsl", include_str!("passes/gbuffer.wgsl")),
+    ("shadow.wgsl", include_str!("passes/shadow.wgsl")),
+    ("shade.wgsl", include_str!("passes/shade.wgsl")),
+    ("rsm_vpls.wgsl", include_str!("passes/rsm_vpls.wgsl")),
+    ("vpl_shadow.wgsl", include_str!("passes/vpl_shadow.wgsl")),
+    (
+        "gather_batch.wgsl",
+        include_str!("passes/gather_batch.wgsl"),
+    ),
+    ("clusters.wgsl", include_str!("passes/clusters.wgsl")),
+    ("vals.wgsl", include_str!("passes/vals.wgsl")),
+    ("val_gather.wgsl", include_str!("passes/val_gather.wgsl")),
+    ("blur.wgsl", include_str!("passes/blur.wgsl")),
+    ("cssm.wgsl", include_str!("passes/cssm.wgsl")),
+];
+
+/// What the shading pass adds to the direct light (`Globals::shade_mode`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[repr(u32)]
+pub enum ShadeIndirect {
+    /// Every VPL at every pixel, no visibility (`SHADE_ALL`).
+    All = 0,
+    /// Nothing: direct light only; another pass may add indirect light (`SHADE_DIRECT`).
+    DirectOnly = 1,
+    /// Every VPL through the gates, per pixel (`SHADE_GATES_PER_PIXEL`).
+    GatesPerPixel = 2,
+    /// The clustered light lists (`SHADE_GATES_CLUSTERED`).
+    GatesClustered = 3,
+}
+
+/// Workgroup size of the 1D compute passes (VPLs, VALs, RSM samples).
+pub const WG_LINEAR: u32 = 64;
+/// Side of the clustered passes' square workgroups; also the largest tile side. [Units: px]
+pub const WG_TILE: u32 = 16;
+/// Workgroup size of the tile scan and of the CSSM depth-range reduction.
+pub const WG_WIDE: u32 = 256;
+/// Side of the CSSM basis and mip passes' square workgroups. [Units: texels]
+pub const WG_CSSM: u32 = 8;
+/// Bits of a visibility cluster in a geometry-cluster key (depth slice above them).
+pub const CLUSTER_BITS: u32 = 23;
+/// The "no cluster" value of every cluster field.
+pub const NONE: u32 = u32::MAX;
+
+/// The constants every composed shader starts with, generated from the Rust definitions.
+pub fn constants() -> String {
+    let u = |name: &str, v: u32| format!("const {name}: u32 = {v}u;\n");
+    let mut s =
+        String::from("// Injected from runtime::gpu::shaders (one Rust definition each).\n");
+    s += &format!("const PI: f32 = {:?};\n", std::f32::consts::PI);
+    s += &u("NONE", NONE);
+    s += &u("CLUSTER_BITS", CLUSTER_BITS);
+    s += &u("CLUSTER_MASK", (1 << CLUSTER_BITS) - 1);
+    s += &u("WG_LINEAR", WG_LINEAR);
+    s += &u("WG_TILE", WG_TILE);
+    s += &u("WG_WIDE", WG_WIDE);
+    s += &u("WG_CSSM", WG_CSSM);
+    s += &u("SHADE_ALL", ShadeIndirect::All as u32);
+    s += &u("SHADE_DIRECT", ShadeIndirect::DirectOnly as u32);
+    s += &u("SHADE_GATES_PER_PIXEL", ShadeIndirect::GatesPerPixel as u32);
+    s += &u(
+        "SHADE_GATES_CLUSTERED",
+        ShadeIndirect::GatesClustered as u32,
+    );
+    s += "const LIGHT_POINT: f32 = 0.0;\nconst LIGHT_SPOT: f32 = 1.0;\n";
+    s
+}
+
+/// The includes a source names on its first line (`//! include: a.wgsl b.wgsl`).
+fn includes_of(source: &str) -> Vec<&str> {
+    source
+        .lines()
+        .next()
+        .and_then(|l| l.trim().strip_prefix("//! include:"))
+        .map(|l| l.split_whitespace().collect())
+        .unwrap_or_default()
+}
+
+/// `source` with the constants and its includes in front, reading includes through `lookup`.
+pub fn compose_with(
+    name: &str,
+    source: &str,
+    lookup: &dyn Fn(&str) -> Option<String>,
+) -> Result<String, RenderError> {
+    fn visit(
+        name: &str,
+        source: &str,
+        lookup: &dyn Fn(&str) -> Option<String>,
+        done: &mut Vec<String>,
+        out: &mut String,
+        depth: usize,
+    ) -> Result<(), RenderError> {
+        if depth > 8 {
+            return Err(RenderError::Param(format!(
+                "{name}: includes nest deeper than 8 (a cycle?)"
+            )));
+        }
+        for inc in includes_of(source) {
+            if done.iter().any(|d| d == inc) {
+                continue;
+            }
+            let text = lookup(inc).ok_or_else(|| {
+                RenderError::Param(format!("{name}: includes {inc}, which does not exist"))
+            })?;
+            visit(inc, &text, lookup, done, out, depth + 1)?;
+            done.push(inc.to_string());
+            *out += &format!("// ---- {inc}\n{text}\n");
+        }
+        Ok(())
+    }
+    let mut out = constants();
+    let mut done = Vec::new();
+    visit(name, source, lookup, &mut done, &mut out, 0)?;
+    out += &format!("// ---- {name}\n{source}");
+    Ok(out)
+}
+
+/// A built-in include's text.
+pub fn include(name: &str) -> Option<String> {
+    INCLUDES
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, s)| s.to_string())
+}
+
+/// The built-in pass shader `name`, composed.
+pub fn compose(name: &str) -> Result<String, RenderError> {
+    let (_, source) = SOURCES
+        .iter()
+        .find(|(n, _)| *n == name)
+        .ok_or_else(|| RenderError::Param(format!("no shader {name}")))?;
+    compose_with(name, source, &include)
+}
+
+/// Every pass shader, composed (for validation without a GPU).
+pub fn all() -> Vec<(&'static str, String)> {
+    SOURCES
+        .iter()
+        .map(|(n, _)| (*n, compose(n).unwrap_or_else(|e| format!("// {e}"))))
+        .collect()
+}
+
+/// A shader module of the built-in pass shader `name`.
+pub fn module(d: &wgpu::Device, name: &str) -> Result<wgpu::ShaderModule, RenderError> {
+    let source = compose(name)?;
+    Ok(d.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(name),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn includes_come_once_after_their_own_includes() {
+        let lookup = |n: &str| match n {
+            "a.wgsl" => Some("//! include: b.wgsl\nfn a() {}".to_string()),
+            "b.wgsl" => Some("fn b() {}".to_string()),
+            _ => None,
+        };
+        let s = compose_with("m.wgsl", "//! include: a.wgsl b.wgsl\nfn m() {}", &lookup)
+            .expect("composes");
+        let (a, b, m) = (
+            s.find("fn a()").expect("a"),
+            s.find("fn b()").expect("b"),
+            s.find("fn m()").expect("m"),
+        );
+        assert!(b < a && a < m, "{s}");
+        assert_eq!(s.matches("fn b()").count(), 1);
+        assert!(compose_with("m.wgsl", "//! include: nope.wgsl\n", &lookup).is_err());
+    }
+
+    #[test]
+    fn include_files_declare_no_bindings() {
+        for (name, text) in INCLUDES {
+            assert!(!text.contains("@binding"), "{name} declares a binding");
+        }
+    }
+}

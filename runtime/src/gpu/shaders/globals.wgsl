@@ -1,0 +1,17 @@
+// Per-frame constants of the G-buffer and shading passes, as runtime::gpu::layout::Globals.
+struct Globals {
+    view_proj: mat4x4<f32>,
+    eye: vec4<f32>,
+    // Geometry-term clamp g_max (1/m²).
+    g_max: f32,
+    // Shadow lookups: normal offset and bias, in texels.
+    shadow_normal_offset: f32,
+    shadow_bias: f32,
+    pad0: f32,
+    vpl_count: u32,
+    light_count: u32,
+    // SHADE_ALL, SHADE_DIRECT, SHADE_GATES_PER_PIXEL or SHADE_GATES_CLUSTERED.
+    shade_mode: u32,
+    // Shadow map layer side (texels).
+    shadow_size: u32,
+};
