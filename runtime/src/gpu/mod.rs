@@ -38,18 +38,18 @@ use visgate_formats::{Light as SceneLight, Scene};
 
 use crate::RenderError;
 use crate::camera::View;
+use crate::cpu::clustered::Clustered;
 use crate::cpu::clustered::PixelSurface;
-use crate::cpu::clustered::{Clustered, GeometryCluster as CpuGeometryCluster, LightEntry};
 use crate::cpu::gates::GateLevel;
 use crate::cpu::val::{Clustering, ValParams, scale_of};
 use crate::hdr::HdrImage;
 use crate::vpl::Vpl;
-use context::{Pool, init_buffer, map_read, read_buffer, read_texture, row_bytes, texels};
+use context::{Pool, init_buffer, map_read, read_buffer, row_bytes, texels};
 use geometry::{Geometry, albedo_array};
-use layout::{GeometryCluster, Globals, Grid};
+use layout::{Globals, Grid};
 use passes::clustered_gates::{ClusteredGates, LevelBuffers, ListBuffers};
 use passes::cssm::Cssm;
-use passes::gbuffer::{GBuffer, GBufferOutput};
+use passes::gbuffer::GBuffer;
 use passes::interleave_blur::InterleaveBlur;
 use passes::per_vpl_maps::ParaboloidMaps;
 use passes::rsm_vpls::RsmVpls;
@@ -544,72 +544,6 @@ impl GpuRenderer {
             .clustered
             .record(&frame, gates, pool, &mut rec, &g.views[0])?;
         rec.finish(pool)?;
-        read_lists(ctx, &g, &b)
+        b.read_back(ctx, &g)
     }
-}
-
-/// Reads back a frame's G-buffer surfaces and light lists (for [`GpuRenderer::light_lists`]).
-fn read_lists(
-    ctx: &GpuContext,
-    g: &GBufferOutput,
-    b: &ListBuffers,
-) -> Result<(Vec<Option<PixelSurface>>, Clustered), RenderError> {
-    let c: Vec<u32> = bytemuck::cast_slice(&read_buffer(ctx, &b.counter)?).to_vec();
-    let stats = b.stats(&c)?;
-    let pos = read_texture(ctx, &g.textures[0])?;
-    let nrm = read_texture(ctx, &g.textures[1])?;
-    let depth: Vec<f32> =
-        bytemuck::cast_slice(&read_buffer(ctx, &b.pixel_depth)?)[..pos.len()].to_vec();
-    let pixels = pos
-        .iter()
-        .zip(&nrm)
-        .zip(&depth)
-        .map(|((p, n), &d)| {
-            (p[3] != 0.0).then(|| PixelSurface {
-                position: Vec3::new(p[0], p[1], p[2]),
-                normal: Vec3::new(n[0], n[1], n[2]),
-                depth: d,
-                cluster: ((p[3] - 1.0) as u32).checked_sub(1),
-            })
-        })
-        .collect();
-    let pixel_cluster: Vec<u32> =
-        bytemuck::cast_slice(&read_buffer(ctx, &b.pixel_cluster)?)[..pos.len()].to_vec();
-    let n = stats.geometry_clusters as usize;
-    let records: Vec<GeometryCluster> =
-        bytemuck::cast_slice(&read_buffer(ctx, &b.clusters)?)[..n].to_vec();
-    let pool: Vec<[u32; 2]> =
-        bytemuck::cast_slice(&read_buffer(ctx, &b.entries)?)[..stats.entries as usize].to_vec();
-    let clusters = records
-        .iter()
-        .map(|r| CpuGeometryCluster {
-            tile: [r.key[0], r.key[1], r.key[2]],
-            cluster: (r.key[3] != u32::MAX).then_some(r.key[3]),
-            bounds: [Vec3::from_slice(&r.lo[..3]), Vec3::from_slice(&r.hi[..3])],
-        })
-        .collect();
-    let lists = records
-        .iter()
-        .map(|r| {
-            pool[r.list[0] as usize..(r.list[0] + r.list[1]) as usize]
-                .iter()
-                .map(|&[vpl, g]| LightEntry {
-                    vpl,
-                    gates: [g & 0xffff, g >> 16]
-                        .into_iter()
-                        .filter(|&x| x != 0)
-                        .map(|x| x - 1)
-                        .collect(),
-                })
-                .collect()
-        })
-        .collect();
-    Ok((
-        pixels,
-        Clustered {
-            pixel_cluster,
-            clusters,
-            lists,
-        },
-    ))
 }

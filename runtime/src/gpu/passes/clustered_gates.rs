@@ -6,10 +6,17 @@
 //! the tests hold the two equal ([`crate::gpu::GpuRenderer::light_lists`]).
 
 use crate::RenderError;
-use crate::cpu::clustered::ClusterParams;
+use glam::Vec3;
+
+use super::gbuffer::GBufferOutput;
+use crate::cpu::clustered::{
+    ClusterParams, Clustered, GeometryCluster as CpuGeometryCluster, LightEntry, PixelSurface,
+};
 use crate::cpu::gates::{GateLevel, GateParams};
-use crate::gpu::context::{Pool, bind_group, compute_pipelines, init_buffer};
-use crate::gpu::layout::ClusterFrame;
+use crate::gpu::context::{
+    Pool, bind_group, compute_pipelines, init_buffer, read_buffer, read_texture,
+};
+use crate::gpu::layout::{ClusterFrame, GeometryCluster};
 use crate::gpu::shaders::{self, CLUSTER_BITS, WG_LINEAR, WG_TILE};
 use crate::gpu::timing::{LightListStats, Recorder};
 use crate::gpu::{Frame, GpuContext};
@@ -283,106 +290,10 @@ impl ClusteredGates {
             )));
         }
         let b = Self::buffers(f, p, pool)?;
-        let frame = ClusterFrame {
-            eye: f.view.eye.to_array(),
-            forward: f.view.forward.to_array(),
-            width: w,
-            height: h,
-            tile_px: cp.tile_px,
-            depth_slices: cp.depth_slices,
-            tiles_x: tiles[0],
-            tiles_y: tiles[1],
-            vpl_count: f.vpl_count,
-            capacity: b.capacity,
-            ..bytemuck::Zeroable::zeroed()
-        };
-        let uniform = wgpu::BufferUsages::UNIFORM;
-        let frame_buf = pool.upload(f.ctx, "cluster frame", bytemuck::bytes_of(&frame), uniform);
-        let rw = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
-        let range: [u32; 2] = [u32::MAX, 0];
-        let depth_range = pool.upload(f.ctx, "depth range", bytemuck::cast_slice(&range), rw);
-        let n_tiles = tiles[0] as u64 * tiles[1] as u64;
-        let tile_buf = pool.buffer(d, "tile clusters", (n_tiles + 1) * 4, rw);
-        let vpl_cluster = pool.buffer(d, "vpl cluster", f.vpl_count as u64 * 4, rw);
-        let dispatch = pool.buffer(
-            d,
-            "assignment dispatch",
-            12,
-            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT,
-        );
+        let s = Scratch::new(f, p, &b, tiles, pool);
         rec.enc.clear_buffer(&b.counter, 0, None);
-        fn res(b: &wgpu::Buffer) -> wgpu::BindingResource<'_> {
-            b.as_entire_binding()
-        }
-        let tex = || wgpu::BindingResource::TextureView(g_position);
-        let bind = |pl: &wgpu::ComputePipeline, r: Vec<(u32, wgpu::BindingResource)>| {
-            bind_group(d, &pl.get_bind_group_layout(0), "clusters", r)
-        };
-        let frame0 = || (0, res(&frame_buf));
-        let depths_bg = bind(
-            &self.depths,
-            vec![
-                frame0(),
-                (1, tex()),
-                (2, res(&b.pixel_depth)),
-                (3, res(&depth_range)),
-            ],
-        );
-        let count_bg = bind(
-            &self.tile_count,
-            vec![
-                frame0(),
-                (1, tex()),
-                (2, res(&b.pixel_depth)),
-                (3, res(&depth_range)),
-                (4, res(&tile_buf)),
-            ],
-        );
-        let scan_bg = bind(
-            &self.scan_tiles,
-            vec![
-                frame0(),
-                (4, res(&tile_buf)),
-                (7, res(&b.counter)),
-                (15, res(&dispatch)),
-            ],
-        );
-        let clusters_bg = bind(
-            &self.tile_clusters,
-            vec![
-                frame0(),
-                (1, tex()),
-                (2, res(&b.pixel_depth)),
-                (3, res(&depth_range)),
-                (4, res(&tile_buf)),
-                (5, res(&b.pixel_cluster)),
-                (6, res(&b.clusters)),
-            ],
-        );
-        let vpl_bg = bind(
-            &self.vpl_clusters,
-            vec![
-                frame0(),
-                (8, res(&f.grid)),
-                (9, res(&level.voxel_words)),
-                (12, res(&f.vpls)),
-                (13, res(&vpl_cluster)),
-            ],
-        );
-        let assign_bg = bind(
-            &self.assign,
-            vec![
-                frame0(),
-                (6, res(&b.clusters)),
-                (7, res(&b.counter)),
-                (8, res(&f.grid)),
-                (10, res(&level.gates)),
-                (11, res(&level.cluster_gates)),
-                (12, res(&f.vpls)),
-                (13, res(&vpl_cluster)),
-                (14, res(&b.entries)),
-            ],
-        );
+        let [depths_bg, count_bg, scan_bg, clusters_bg, vpl_bg, assign_bg] =
+            self.bind_groups(f, level, &b, &s, g_position);
         let span = rec.begin("unique clusters");
         {
             let mut pass = rec.enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -416,9 +327,223 @@ impl ClusteredGates {
             }
             pass.set_pipeline(&self.assign);
             pass.set_bind_group(0, &assign_bg, &[]);
-            pass.dispatch_workgroups_indirect(&dispatch, 0);
+            pass.dispatch_workgroups_indirect(&s.dispatch, 0);
         }
         rec.end();
         Ok(b)
+    }
+}
+
+/// The clustered passes' own buffers of a frame.
+struct Scratch {
+    frame: wgpu::Buffer,
+    depth_range: wgpu::Buffer,
+    tile_buf: wgpu::Buffer,
+    vpl_cluster: wgpu::Buffer,
+    dispatch: wgpu::Buffer,
+}
+
+impl Scratch {
+    fn new(
+        f: &Frame,
+        p: &GatesParams,
+        b: &ListBuffers,
+        tiles: [u32; 2],
+        pool: &mut Pool,
+    ) -> Scratch {
+        let d = &f.ctx.device;
+        let cp = p.clusters;
+        let [w, h] = f.view.size;
+        let frame = ClusterFrame {
+            eye: f.view.eye.to_array(),
+            forward: f.view.forward.to_array(),
+            width: w,
+            height: h,
+            tile_px: cp.tile_px,
+            depth_slices: cp.depth_slices,
+            tiles_x: tiles[0],
+            tiles_y: tiles[1],
+            vpl_count: f.vpl_count,
+            capacity: b.capacity,
+            ..bytemuck::Zeroable::zeroed()
+        };
+        let uniform = wgpu::BufferUsages::UNIFORM;
+        let frame_buf = pool.upload(f.ctx, "cluster frame", bytemuck::bytes_of(&frame), uniform);
+        let rw = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
+        let range: [u32; 2] = [u32::MAX, 0];
+        let depth_range = pool.upload(f.ctx, "depth range", bytemuck::cast_slice(&range), rw);
+        let n_tiles = tiles[0] as u64 * tiles[1] as u64;
+        let tile_buf = pool.buffer(d, "tile clusters", (n_tiles + 1) * 4, rw);
+        let vpl_cluster = pool.buffer(d, "vpl cluster", f.vpl_count as u64 * 4, rw);
+        let dispatch = pool.buffer(
+            d,
+            "assignment dispatch",
+            12,
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT,
+        );
+        Scratch {
+            frame: frame_buf,
+            depth_range,
+            tile_buf,
+            vpl_cluster,
+            dispatch,
+        }
+    }
+}
+
+impl ClusteredGates {
+    /// The bind groups of depths, tile_count, scan_tiles, tile_clusters, vpl_clusters, assign.
+    fn bind_groups(
+        &self,
+        f: &Frame,
+        level: &LevelBuffers,
+        b: &ListBuffers,
+        s: &Scratch,
+        g_position: &wgpu::TextureView,
+    ) -> [wgpu::BindGroup; 6] {
+        let d = &f.ctx.device;
+        fn res(b: &wgpu::Buffer) -> wgpu::BindingResource<'_> {
+            b.as_entire_binding()
+        }
+        let tex = || wgpu::BindingResource::TextureView(g_position);
+        let bind = |pl: &wgpu::ComputePipeline, r: Vec<(u32, wgpu::BindingResource)>| {
+            bind_group(d, &pl.get_bind_group_layout(0), "clusters", r)
+        };
+        let frame0 = || (0, res(&s.frame));
+        let depths_bg = bind(
+            &self.depths,
+            vec![
+                frame0(),
+                (1, tex()),
+                (2, res(&b.pixel_depth)),
+                (3, res(&s.depth_range)),
+            ],
+        );
+        let count_bg = bind(
+            &self.tile_count,
+            vec![
+                frame0(),
+                (1, tex()),
+                (2, res(&b.pixel_depth)),
+                (3, res(&s.depth_range)),
+                (4, res(&s.tile_buf)),
+            ],
+        );
+        let scan_bg = bind(
+            &self.scan_tiles,
+            vec![
+                frame0(),
+                (4, res(&s.tile_buf)),
+                (7, res(&b.counter)),
+                (15, res(&s.dispatch)),
+            ],
+        );
+        let clusters_bg = bind(
+            &self.tile_clusters,
+            vec![
+                frame0(),
+                (1, tex()),
+                (2, res(&b.pixel_depth)),
+                (3, res(&s.depth_range)),
+                (4, res(&s.tile_buf)),
+                (5, res(&b.pixel_cluster)),
+                (6, res(&b.clusters)),
+            ],
+        );
+        let vpl_bg = bind(
+            &self.vpl_clusters,
+            vec![
+                frame0(),
+                (8, res(&f.grid)),
+                (9, res(&level.voxel_words)),
+                (12, res(&f.vpls)),
+                (13, res(&s.vpl_cluster)),
+            ],
+        );
+        let assign_bg = bind(
+            &self.assign,
+            vec![
+                frame0(),
+                (6, res(&b.clusters)),
+                (7, res(&b.counter)),
+                (8, res(&f.grid)),
+                (10, res(&level.gates)),
+                (11, res(&level.cluster_gates)),
+                (12, res(&f.vpls)),
+                (13, res(&s.vpl_cluster)),
+                (14, res(&b.entries)),
+            ],
+        );
+        [depths_bg, count_bg, scan_bg, clusters_bg, vpl_bg, assign_bg]
+    }
+}
+
+impl ListBuffers {
+    /// Reads back a frame's G-buffer surfaces and these lists, as the CPU twin gives them (for
+    /// [`crate::gpu::GpuRenderer::light_lists`]; waits for the GPU).
+    pub fn read_back(
+        &self,
+        ctx: &GpuContext,
+        g: &GBufferOutput,
+    ) -> Result<(Vec<Option<PixelSurface>>, Clustered), RenderError> {
+        let b = self;
+        let c: Vec<u32> = bytemuck::cast_slice(&read_buffer(ctx, &b.counter)?).to_vec();
+        let stats = b.stats(&c)?;
+        let pos = read_texture(ctx, &g.textures[0])?;
+        let nrm = read_texture(ctx, &g.textures[1])?;
+        let depth: Vec<f32> =
+            bytemuck::cast_slice(&read_buffer(ctx, &b.pixel_depth)?)[..pos.len()].to_vec();
+        let pixels = pos
+            .iter()
+            .zip(&nrm)
+            .zip(&depth)
+            .map(|((p, n), &d)| {
+                (p[3] != 0.0).then(|| PixelSurface {
+                    position: Vec3::new(p[0], p[1], p[2]),
+                    normal: Vec3::new(n[0], n[1], n[2]),
+                    depth: d,
+                    cluster: ((p[3] - 1.0) as u32).checked_sub(1),
+                })
+            })
+            .collect();
+        let pixel_cluster: Vec<u32> =
+            bytemuck::cast_slice(&read_buffer(ctx, &b.pixel_cluster)?)[..pos.len()].to_vec();
+        let n = stats.geometry_clusters as usize;
+        let records: Vec<GeometryCluster> =
+            bytemuck::cast_slice(&read_buffer(ctx, &b.clusters)?)[..n].to_vec();
+        let pool: Vec<[u32; 2]> =
+            bytemuck::cast_slice(&read_buffer(ctx, &b.entries)?)[..stats.entries as usize].to_vec();
+        let clusters = records
+            .iter()
+            .map(|r| CpuGeometryCluster {
+                tile: [r.key[0], r.key[1], r.key[2]],
+                cluster: (r.key[3] != u32::MAX).then_some(r.key[3]),
+                bounds: [Vec3::from_slice(&r.lo[..3]), Vec3::from_slice(&r.hi[..3])],
+            })
+            .collect();
+        let lists = records
+            .iter()
+            .map(|r| {
+                pool[r.list[0] as usize..(r.list[0] + r.list[1]) as usize]
+                    .iter()
+                    .map(|&[vpl, g]| LightEntry {
+                        vpl,
+                        gates: [g & 0xffff, g >> 16]
+                            .into_iter()
+                            .filter(|&x| x != 0)
+                            .map(|x| x - 1)
+                            .collect(),
+                    })
+                    .collect()
+            })
+            .collect();
+        Ok((
+            pixels,
+            Clustered {
+                pixel_cluster,
+                clusters,
+                lists,
+            },
+        ))
     }
 }

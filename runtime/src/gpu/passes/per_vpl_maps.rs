@@ -211,4 +211,71 @@ impl ParaboloidMaps {
                 .copy_texture_to_texture(other.as_image_copy(), out.as_image_copy(), out.size());
         }
     }
+
+    /// Records a paraboloid distance map per VAL of `vals` (`m` of them, `s`² each; one render
+    /// pass per layer: wgpu has no layered rendering without multiview), each VAL's centre
+    /// moved off its surface by the near plane's hair; returns the maps.
+    pub fn record_vals(
+        &self,
+        f: &Frame,
+        vals: &wgpu::Buffer,
+        (m, s): (u32, u32),
+        pool: &mut Pool,
+        rec: &mut Recorder,
+    ) -> wgpu::Texture {
+        let d = &f.ctx.device;
+        let maps = pool.texture(
+            d,
+            "val maps",
+            [s, s, m],
+            1,
+            wgpu::TextureFormat::R32Float,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        );
+        let depth = pool.texture(
+            d,
+            "val map depth",
+            [s, s, 1],
+            1,
+            wgpu::TextureFormat::Depth32Float,
+            wgpu::TextureUsages::RENDER_ATTACHMENT,
+        );
+        let map_params = MapParams {
+            far: f.scene.far_m,
+            centre_offset: f.scene.near_m,
+            ..bytemuck::Zeroable::zeroed()
+        };
+        let uniform = wgpu::BufferUsages::UNIFORM;
+        let params_buf = pool.upload(
+            f.ctx,
+            "val map params",
+            bytemuck::bytes_of(&map_params),
+            uniform,
+        );
+        let map_bg = bind_group(
+            d,
+            &self.val.get_bind_group_layout(0),
+            "val maps",
+            vec![
+                (0, params_buf.as_entire_binding()),
+                (2, vals.as_entire_binding()),
+            ],
+        );
+        let depth_view = depth.create_view(&Default::default());
+        let span = rec.begin("VAL paraboloid maps");
+        for k in 0..m {
+            DistancePass {
+                color: &layer_view(&maps, k),
+                depth: &depth_view,
+                pipeline: &self.val,
+                bind_group: &map_bg,
+                vertices: &f.scene.geometry.vpl_vertices,
+                count: f.scene.geometry.vpl_vertex_count,
+                instances: k..k + 1,
+            }
+            .record(&mut rec.enc, span.render(k == 0, k + 1 == m));
+        }
+        rec.end();
+        maps
+    }
 }

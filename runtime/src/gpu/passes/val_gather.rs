@@ -9,12 +9,11 @@ use super::gbuffer::GBufferOutput;
 use super::interleave_blur::{InterleaveBlur, InterleaveParams};
 use super::per_vpl_maps::ParaboloidMaps;
 use super::shade::{HDR, frame_target, fullscreen};
-use super::shadow_maps::DistancePass;
 use super::vals::{ValClustering, ValInput};
 use crate::RenderError;
 use crate::cpu::val::ValParams;
-use crate::gpu::context::{Pool, array_view, bind_group, layer_view, render_pipeline};
-use crate::gpu::layout::{MapParams, ValGather};
+use crate::gpu::context::{Pool, array_view, bind_group, render_pipeline};
+use crate::gpu::layout::ValGather;
 use crate::gpu::timing::Recorder;
 use crate::gpu::{Frame, shaders};
 
@@ -137,58 +136,7 @@ impl ValGathers {
         // The VAL's centre, a mean of VPLs, may sit on (or just inside) a surface: move it off
         // by a hair, relative to the scene.
         let offset = f.scene.near_m;
-        let maps = pool.texture(
-            d,
-            "val maps",
-            [s, s, m],
-            1,
-            wgpu::TextureFormat::R32Float,
-            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-        );
-        let depth = pool.texture(
-            d,
-            "val map depth",
-            [s, s, 1],
-            1,
-            wgpu::TextureFormat::Depth32Float,
-            wgpu::TextureUsages::RENDER_ATTACHMENT,
-        );
-        let map_params = MapParams {
-            far: f.scene.far_m,
-            centre_offset: offset,
-            ..bytemuck::Zeroable::zeroed()
-        };
-        let uniform = wgpu::BufferUsages::UNIFORM;
-        let params_buf = pool.upload(
-            f.ctx,
-            "val map params",
-            bytemuck::bytes_of(&map_params),
-            uniform,
-        );
-        let map_bg = bind_group(
-            d,
-            &passes.maps.val.get_bind_group_layout(0),
-            "val maps",
-            vec![
-                (0, params_buf.as_entire_binding()),
-                (2, b.vals.as_entire_binding()),
-            ],
-        );
-        let depth_view = depth.create_view(&Default::default());
-        let span = rec.begin("VAL paraboloid maps");
-        for k in 0..m {
-            DistancePass {
-                color: &layer_view(&maps, k),
-                depth: &depth_view,
-                pipeline: &passes.maps.val,
-                bind_group: &map_bg,
-                vertices: &f.scene.geometry.vpl_vertices,
-                count: f.scene.geometry.vpl_vertex_count,
-                instances: k..k + 1,
-            }
-            .record(&mut rec.enc, span.render(k == 0, k + 1 == m));
-        }
-        rec.end();
+        let maps = passes.maps.record_vals(f, &b.vals, (m, s), pool, rec);
         let basis = match cssm {
             Some(c) => Some(passes.cssm.record(f.ctx, c, (&maps, m, s), pool, rec)?),
             None => None,
@@ -213,7 +161,12 @@ impl ValGathers {
             blur_normal: il.blur_normal,
             ..bytemuck::Zeroable::zeroed()
         };
-        let uniform_buf = pool.upload(f.ctx, "val gather", bytemuck::bytes_of(&constants), uniform);
+        let uniform_buf = pool.upload(
+            f.ctx,
+            "val gather",
+            bytemuck::bytes_of(&constants),
+            wgpu::BufferUsages::UNIFORM,
+        );
         let indirect = frame_target(f, pool, "indirect irradiance");
         let maps_view = array_view(&maps);
         let tex = wgpu::BindingResource::TextureView;
