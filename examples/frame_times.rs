@@ -43,8 +43,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         vpls.len(),
         ctx.adapter_info.name
     );
-    println!("| mode | first frame | second frame | resources made (first / second) |");
-    println!("|---|---|---|---|");
+    println!(
+        "| mode | first frame | second frame | its GPU time | its recording | resources made \
+         (first / second) |"
+    );
+    println!("|---|---|---|---|---|---|");
     let settings = MethodSettings::default();
     for m in METHODS {
         let mut gpu = GpuRenderer::new(&ctx, &scene)?;
@@ -55,13 +58,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let first = t0.elapsed().as_secs_f64();
         let made = gpu.resources_created();
         let t0 = Instant::now();
-        let (img, _) = gpu.render(&ctx, &view, &vpls, &params)?;
+        let (img, t) = gpu.render(&ctx, &view, &vpls, &params)?;
         let second = t0.elapsed().as_secs_f64();
+        let ms = |x: Option<f64>| x.map_or("–".into(), |v| format!("{:.1}", v * 1e3));
         println!(
-            "| {} | {:.1} | {:.1} | {} / {} |",
+            "| {} | {:.1} | {:.1} | {} | {:.1} | {} / {} |",
             m.name,
             first * 1e3,
             second * 1e3,
+            ms(t.gpu_total()),
+            (t.frame_s - t.readback_s) * 1e3,
             made,
             gpu.resources_created() - made
         );

@@ -93,6 +93,23 @@ fn subdivide(tris: &[[Vec3; 3]], max_edge: f32) -> Vec<[Vec3; 3]> {
     out
 }
 
+/// The first vertex attribute, a position (f32 × 3 at location 0).
+pub const POSITION: [wgpu::VertexAttribute; 1] = [wgpu::VertexAttribute {
+    format: wgpu::VertexFormat::Float32x3,
+    offset: 0,
+    shader_location: 0,
+}];
+
+/// A vertex buffer of `stride`-byte vertices read for their [`POSITION`] alone (shadow and
+/// paraboloid maps).
+pub fn positions(stride: u64) -> wgpu::VertexBufferLayout<'static> {
+    wgpu::VertexBufferLayout {
+        array_stride: stride,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes: &POSITION,
+    }
+}
+
 /// Vertex layout: position, normal, albedo, (u, v, texture layer or −1) — f32 × 3 each.
 pub const VERTEX_STRIDE: u64 = 48;
 /// Floats per vertex.

@@ -9,7 +9,7 @@ use visgate_formats::Light as SceneLight;
 use crate::RenderError;
 use crate::camera::{look_to, perspective};
 use crate::gpu::context::{Pool, bind_group, layer_view, render_pipeline, slice};
-use crate::gpu::geometry::VERTEX_STRIDE;
+use crate::gpu::geometry::{VERTEX_STRIDE, positions};
 use crate::gpu::layout::{Light, ShadowView, UNIFORM_STRIDE, strided};
 use crate::gpu::timing::Recorder;
 use crate::gpu::{Frame, shaders};
@@ -160,22 +160,12 @@ impl ShadowMaps {
     /// Builds the pipeline.
     pub fn new(d: &wgpu::Device) -> Result<ShadowMaps, RenderError> {
         let module = shaders::module(d, "shadow.wgsl")?;
-        let attrs = [wgpu::VertexAttribute {
-            format: wgpu::VertexFormat::Float32x3,
-            offset: 0,
-            shader_location: 0,
-        }];
-        let layout = wgpu::VertexBufferLayout {
-            array_stride: VERTEX_STRIDE,
-            step_mode: wgpu::VertexStepMode::Vertex,
-            attributes: &attrs,
-        };
         let pipeline = render_pipeline(
             d,
             "shadow",
             &module,
             ("vs", "fs"),
-            &[Some(layout)],
+            &[Some(positions(VERTEX_STRIDE))],
             &[wgpu::TextureFormat::R32Float],
             true,
         );
