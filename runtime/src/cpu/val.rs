@@ -1,6 +1,6 @@
 //! Virtual area lights (Dong et al., "Interactive global illumination using clustered
 //! visibility", §5): k-means of the N VPLs into M clusters (VALs) by position and normal. This
-//! is the CPU twin of the GPU clustering (`shaders/vals.wgsl`); the tests hold the two equal.
+//! is the CPU twin of the GPU clustering (`gpu/passes/vals.wgsl`); the tests hold the two equal.
 //!
 //! - **Distance** `d = w_x·Δx/D + w_α·Δα/π`: Δx the distance between a VPL and a VAL centre,
 //!   D the diagonal of the VPLs' bounding box (so that the weights mean the same in a 1 m room

@@ -110,7 +110,7 @@ fn depths(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocatio
     }
 }
 
-// The exponential depth slice of view depth d, as runtime::clustered::assign.
+// The exponential depth slice of view depth d, as runtime::cpu::clustered::assign.
 fn slice_of(d: f32) -> u32 {
     let near = bitcast<f32>(atomicLoad(&depth_range[0]));
     let far = bitcast<f32>(atomicLoad(&depth_range[1]));
@@ -318,7 +318,7 @@ fn vpl_clusters(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 
 // Whether the cone from `apex` through the sphere (dc, dr) — which holds the cone through the
-// disk — meets the sphere (c, r), within the slack, as runtime::clustered::cone_meets_sphere.
+// disk — meets the sphere (c, r), within the slack, as runtime::cpu::clustered::cone_meets_sphere.
 const CONE_SLACK: f32 = 1e-4;
 
 fn cone_meets_sphere(apex: vec3<f32>, dc: vec3<f32>, dr: f32, c: vec3<f32>, r: f32) -> bool {

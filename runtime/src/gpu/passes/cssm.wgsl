@@ -2,7 +2,7 @@
 // distance maps: per VAL the farthest surface its map sees (its depth range), then the
 // Fourier basis images of the normalised depth z — sin(c_k z), cos(c_k z) for k = 1..K, the
 // same times z, and z — in one mip-mapped RGBA16F array (layer g·M + k for group g of VAL k),
-// mip-mapped by 2 × 2 averages. runtime::cssm holds the expansion's CPU side.
+// mip-mapped by 2 × 2 averages. runtime::cpu::cssm holds the expansion's CPU side.
 //   ranges     per VAL: the largest finite distance in its map
 //   basis      level 0 of every group
 //   downsample level l from level l − 1, every layer at once

@@ -120,7 +120,7 @@ fn series(base: u32, k: u32, uv: vec2<f32>, lod: f32, d: f32) -> f32 {
 // Soft visibility of p (normal n) from VAL k (Dong et al. §4.2): the average blocker depth
 // over the VAL's extent seen from p, the penumbra p·cos β = (d − z_avg)·Δ / z_avg, the kernel
 // α = atan(p·cos β / d) of size α/π in the map, the filtered Fourier shadow test there,
-// sharpened by s about ½ and clamped (runtime::cssm::visibility).
+// sharpened by s about ½ and clamped (runtime::cpu::cssm::visibility).
 fn cssm_visibility(k: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
     let size = f32(gather.map_size);
     let val = vals[k];

@@ -1,4 +1,4 @@
-// A virtual area light, as runtime::val::Val (64 bytes), and the tangent frame of a normal, as
+// A virtual area light, as runtime::cpu::val::Val (64 bytes), and the tangent frame of a normal, as
 // runtime::vpl::basis (Duff et al. 2017), the texel of a paraboloid map, and the constants of
 // the VAL gather and its blur.
 struct Val {
