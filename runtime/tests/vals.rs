@@ -568,3 +568,61 @@ fn set_scene_moves_geometry_and_lights_as_a_fresh_upload_does() {
         assert_eq!(got.pixels, want.pixels, "{mode:?}");
     }
 }
+
+/// A horizontal square of half-side `r` at height `y`.
+fn square(r: f32, y: f32) -> [Vec3; 4] {
+    [
+        Vec3::new(-r, y, -r),
+        Vec3::new(r, y, -r),
+        Vec3::new(r, y, r),
+        Vec3::new(-r, y, r),
+    ]
+}
+
+#[test]
+fn cssm_receivers_at_a_val_of_no_area_stay_finite_and_the_open_stays_lit() {
+    // Every VPL at one point on the floor (a VAL of no area), a small blocker 5 cm above it and
+    // receivers 10 cm above it: within range/32 of the VAL, where its normalised depth is 0
+    // (the receiver offset), and one receiver at the VAL's centre itself.
+    let ctx = context();
+    let scene = common::quads(
+        &[
+            square(3.0, 0.0),
+            square(3.0, 3.0),
+            square(0.02, 0.05),
+            square(0.3, 0.1),
+        ],
+        0.5,
+        vec![],
+    );
+    let mut vpls: Vec<Vpl> = (0..16)
+        .map(|_| Vpl::new(Vec3::new(0.0, 1e-3, 0.0), Vec3::Y, Vec3::splat(0.05)))
+        .collect();
+    // A VPL exactly on the blocker's underside's centre line: p = c for a receiver there.
+    vpls.push(Vpl::new(
+        Vec3::new(0.0, 0.05, 0.0),
+        Vec3::NEG_Y,
+        Vec3::splat(0.05),
+    ));
+    let cam = visgate_formats::Camera {
+        name: "under".into(),
+        eye: Vec3::new(0.6, 0.02, 0.6),
+        target: Vec3::new(0.0, 0.1, 0.0),
+        up: Vec3::Y,
+        fov_x_rad: 90f32.to_radians(),
+    };
+    for m in [1, 2] {
+        let img = gpu_image_with(&ctx, &scene, &cam, &vpls, cssm(), m, 1, [48, 36]);
+        let bad = img.pixels.iter().filter(|p| !p.is_finite()).count();
+        assert_eq!(bad, 0, "M = {m}: {bad} pixels not finite");
+        let none = gpu_image_with(&ctx, &scene, &cam, &vpls, GpuMode::None, m, 1, [48, 36]);
+        // Light only darkens under visibility, and the receivers away from the blocker are lit.
+        assert!(
+            img.mean().x > 0.2 * none.mean().x,
+            "{} vs {}",
+            img.mean(),
+            none.mean()
+        );
+        assert!(img.mean().x <= none.mean().x * 1.0001);
+    }
+}

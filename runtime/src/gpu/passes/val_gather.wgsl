@@ -130,7 +130,11 @@ fn cssm_visibility(k: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
     let texel = length(p - c) * 4.0 / size;
     // A filtered kernel spans depths of the receiver's own surface in front of it, the more
     // the more grazing the VAL sees it: a normal offset of its own, slope-scaled up to 2×.
-    let grazing = clamp(1.0 / max(dot(n, normalize(c - p)), 1e-3), 1.0, 2.0);
+    // (A receiver at the VAL's centre has no direction to it: no grazing, not a NaN.)
+    let to_c = c - p;
+    let len_c = length(to_c);
+    let cos_c = select(1.0, dot(n, to_c) / len_c, len_c > 0.0);
+    let grazing = clamp(1.0 / max(cos_c, 1e-3), 1.0, 2.0);
     let q = p + n * texel * gather.cssm_normal_offset * grazing - c;
     let local = vec3<f32>(dot(q, tb[0]), dot(q, tb[1]), dot(q, nv));
     let dist = length(local);
@@ -154,8 +158,10 @@ fn cssm_visibility(k: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
     }
     let z_sum = 0.5 * textureSampleLevel(basis_tex, basis_sampler, uv, i32(2u * groups * gather.val_count + k), lod_s).x
         - series(groups, k, uv, lod_s, d);
-    let z_avg = clamp(z_sum / blockers, 1e-4, d) * range;
-    let penumbra = (dist - z_avg) * sender / z_avg;
+    // A receiver within 1e-4 of the range from the VAL (d < 1e-4) keeps z_avg at 1e-4 of the
+    // range, not at d = 0 (an infinite penumbra, or 0/0 for a VAL of no area).
+    let z_avg = clamp(z_sum / blockers, 1e-4, max(d, 1e-4)) * range;
+    let penumbra = max(dist - z_avg, 0.0) * sender / z_avg;
     let alpha = atan(penumbra / dist);
     let lod = log2(max(alpha / PI * size, 1.0));
     return clamp(0.5 + gather.sharpness * series(0u, k, uv, lod, d), 0.0, 1.0);
