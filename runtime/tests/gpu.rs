@@ -254,6 +254,41 @@ fn gpu_renders_0_1_and_65536_vpls_and_a_vpl_on_the_receiver_without_nan() {
 }
 
 #[test]
+fn rsm_vpls_of_a_spot_wider_than_one_frustum_carry_its_power() {
+    // An 89° spot in a closed box: its RSM is a cube of six layers (no clamped frustum), and
+    // the VPLs hold what light paths from the same spot hold.
+    let ctx = context();
+    let mut scene = Builtin::EmptyBox.scene().expect("scene");
+    let p = visgate_runtime::lights::light_position(&scene.lights[0]);
+    scene.lights = vec![visgate_formats::Light::Spot {
+        position: p,
+        direction: Vec3::new(0.3, -1.0, 0.2).normalize(),
+        intensity: Vec3::splat(4.0),
+        cutoff_rad: 89f32.to_radians(),
+        beam_rad: 70f32.to_radians(),
+    }];
+    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    let tracer = Tracer::new(&scene);
+    let n = 4096;
+    let rsm = gpu.rsm_vpls(&ctx, n, 256, 1).expect("rsm vpls");
+    let paths = path_vpls(
+        &tracer,
+        &scene.lights,
+        &PathParams {
+            paths: n,
+            bounces: 1,
+            seed: 1,
+        },
+    )
+    .expect("paths");
+    let sum =
+        |v: &[visgate_runtime::vpl::Vpl]| -> Vec3 { v.iter().map(|v| Vec3::from(v.flux)).sum() };
+    let (a, b) = (sum(&rsm), sum(&paths));
+    eprintln!("89° spot: RSM flux {a}, path flux {b}");
+    assert!(((a - b) / b).abs().max_element() < 0.02, "{a} vs {b}");
+}
+
+#[test]
 fn rsm_vpls_carry_the_reflected_power_and_do_not_flicker() {
     // A point light inside a closed box: the RSM sees walls in every direction, so the VPLs
     // hold ρ × the light's power, as the light paths do.
@@ -478,48 +513,48 @@ fn floor_scene(rho: f32, lights: Vec<visgate_formats::Light>) -> visgate_formats
 fn gpu_spot_falloff_matches_the_conventions_at_beam_mid_ramp_and_cutoff() {
     use visgate_formats::{Camera, Light};
     use visgate_runtime::lights::spot_falloff;
-    let (beam, cutoff, h, i) = (20f32.to_radians(), 40f32.to_radians(), 2.0f32, 5.0f32);
-    let scene = floor_scene(
-        1.0,
-        vec![Light::Spot {
-            position: Vec3::new(0.0, h, 0.0),
-            direction: -Vec3::Y,
-            intensity: Vec3::splat(i),
-            cutoff_rad: cutoff,
-            beam_rad: beam,
-        }],
-    );
-    let ctx = context();
-    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
-    for angle in [0.0f32, beam * 0.95, 0.5 * (beam + cutoff), cutoff * 1.1] {
-        let x = h * angle.tan();
-        // A narrow camera straight above the point at `angle` from the spot's axis.
-        let cam = Camera {
-            name: "probe".into(),
-            eye: Vec3::new(x, 0.5, 0.0),
-            target: Vec3::new(x, 0.0, 0.0),
-            up: Vec3::Z,
-            fov_x_rad: 0.01,
-        };
-        let view = View::new(&cam, [3, 3]).expect("view");
-        let (img, _) = gpu
-            .render(
-                &ctx,
-                &view,
-                &[],
-                &GpuParams {
-                    mode: GpuMode::DirectOnly,
-                    ..GpuParams::default()
-                },
-            )
-            .expect("render");
-        let d2 = x * x + h * h;
-        let want = 1.0 / PI * i * spot_falloff(angle, beam, cutoff) * angle.cos() / d2;
-        let got = img.at(1, 1).x;
-        assert!(
-            (got - want).abs() <= 2e-3 * (1.0 + want),
-            "angle {angle}: {got} vs {want}"
+    // A 40° spot (one shadow layer), and an 89° one (wider than one frustum spans: a cube of
+    // six layers, probed past 86°, where a clamped frustum would leave the floor dark).
+    for (beam_deg, cutoff_deg, probes_deg) in [
+        (20f32, 40f32, vec![0.0f32, 19.0, 30.0, 44.0]),
+        (80.0, 89.0, vec![0.0, 60.0, 87.0, 89.5]),
+    ] {
+        let (beam, cutoff, h, i) = (beam_deg.to_radians(), cutoff_deg.to_radians(), 2.0f32, 5.0);
+        let scene = floor_scene(
+            1.0,
+            vec![Light::Spot {
+                position: Vec3::new(0.0, h, 0.0),
+                direction: -Vec3::Y,
+                intensity: Vec3::splat(i),
+                cutoff_rad: cutoff,
+                beam_rad: beam,
+            }],
         );
+        let ctx = context();
+        let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+        for angle in probes_deg.iter().map(|a| a.to_radians()) {
+            let x = h * angle.tan();
+            // A narrow camera straight above the point at `angle` from the spot's axis.
+            let cam = Camera {
+                name: "probe".into(),
+                eye: Vec3::new(x, 0.5, 0.0),
+                target: Vec3::new(x, 0.0, 0.0),
+                up: Vec3::Z,
+                fov_x_rad: 0.01,
+            };
+            let view = View::new(&cam, [3, 3]).expect("view");
+            let (img, _) = gpu
+                .render(&ctx, &view, &[], &GpuParams::with_mode(GpuMode::DirectOnly))
+                .expect("render");
+            let d2 = x * x + h * h;
+            let want = 1.0 / PI * i * spot_falloff(angle, beam, cutoff) * angle.cos() / d2;
+            let got = img.at(1, 1).x;
+            assert!(
+                // Relative: past 86° the light is 1e-5 of the axis's.
+                (got - want).abs() <= 5e-3 * want + 1e-8,
+                "cutoff {cutoff_deg}°, angle {angle}: {got} vs {want}"
+            );
+        }
     }
 }
 

@@ -9,7 +9,7 @@ use glam::{Mat4, Vec3};
 use visgate_formats::Light as SceneLight;
 
 use super::gbuffer::{FORMATS, GBuffer};
-use super::shadow_maps::{MAX_SPOT_FRUSTUM_RAD, light_views};
+use super::shadow_maps::light_views;
 use crate::RenderError;
 use crate::gpu::context::{Pool, array_view, bind_group, compute_pipelines, layer_view, slice};
 use crate::gpu::layout::{Globals, RsmSample, ShadowView, UNIFORM_STRIDE, Vpl, strided};
@@ -63,11 +63,16 @@ fn samples(lights: &[SceneLight], views: &[ShadowView], p: &RsmParams) -> Vec<Rs
         let m = share[li];
         let first = gpu_lights[li].layers[0];
         let shift = crate::vpl::seed_shift(p.seed ^ li as u64, 0);
-        let point = matches!(l, SceneLight::Point { .. });
+        // Point lights and wide spots: six cube faces; other spots: their one frustum.
+        let cube = gpu_lights[li].layers[1] == 6;
         for k in 0..m as u64 {
             let u = crate::vpl::halton2(k, 2, 3, shift);
             let (layer, x, y, half) = match *l {
-                SceneLight::Point { .. } => {
+                SceneLight::Spot { cutoff_rad, .. } if !cube => {
+                    let t = cutoff_rad.tan();
+                    (first, (u.x * 2.0 - 1.0) * t, (u.y * 2.0 - 1.0) * t, t)
+                }
+                _ => {
                     let f = ((u.x * 6.0) as u32).min(5);
                     (
                         first + f,
@@ -76,12 +81,8 @@ fn samples(lights: &[SceneLight], views: &[ShadowView], p: &RsmParams) -> Vec<Rs
                         1.0,
                     )
                 }
-                SceneLight::Spot { cutoff_rad, .. } => {
-                    let t = cutoff_rad.min(MAX_SPOT_FRUSTUM_RAD).tan();
-                    (first, (u.x * 2.0 - 1.0) * t, (u.y * 2.0 - 1.0) * t, t)
-                }
             };
-            let faces = if point { 6.0 } else { 1.0 };
+            let faces = if cube { 6.0 } else { 1.0 };
             // Direction through (x, y) on the layer's image plane at distance 1.
             let view = &views[layer as usize];
             let inv = Mat4::from_cols_array_2d(&view.view_proj).inverse();

@@ -95,9 +95,10 @@ fn shadow(l: Light, p: vec3<f32>, n: vec3<f32>) -> f32 {
     let d = p - l.position.xyz;
     let dist = length(d);
     var layer = l.layers.x;
-    // Texel footprint at this distance: 90° faces span 2·dist, spots 2·dist·tan(cutoff).
+    // Texel footprint at this distance: 90° faces span 2·dist, a spot's layer 2·dist·tan(cutoff).
     var span = 2.0 * dist;
-    if l.position.w == LIGHT_POINT {
+    // Six layers: the cube faces of a point light or of a spot too wide for one frustum.
+    if l.layers.y == 6u {
         let a = abs(d);
         if a.x >= a.y && a.x >= a.z {
             layer += select(1u, 0u, d.x > 0.0);
@@ -107,7 +108,7 @@ fn shadow(l: Light, p: vec3<f32>, n: vec3<f32>) -> f32 {
             layer += select(5u, 4u, d.z > 0.0);
         }
     } else {
-        span = 2.0 * dist * tan(min(l.direction.w, 1.5));
+        span = 2.0 * dist * tan(l.direction.w);
     }
     let texel = span / size;
     let q = p + n * texel * globals.shadow_normal_offset;

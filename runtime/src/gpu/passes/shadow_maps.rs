@@ -14,7 +14,8 @@ use crate::gpu::layout::{Light, ShadowView, UNIFORM_STRIDE, strided};
 use crate::gpu::timing::Recorder;
 use crate::gpu::{Frame, shaders};
 
-/// The spot cutoff a shadow layer's frustum can span (tan of it). [Units: rad]
+/// The widest spot cutoff one shadow layer's frustum spans; wider spots get a cube of six.
+/// [Units: rad]
 pub const MAX_SPOT_FRUSTUM_RAD: f32 = 1.5;
 
 /// The shadow-map pipeline.
@@ -22,10 +23,31 @@ pub struct ShadowMaps {
     pipeline: wgpu::RenderPipeline,
 }
 
-/// The lights as the GPU sees them and each shadow layer's view.
+/// The six 90° cube faces (axis, up) of a point light's (or a wide spot's) shadow layers.
+const CUBE_FACES: [(Vec3, Vec3); 6] = [
+    (Vec3::X, Vec3::NEG_Y),
+    (Vec3::NEG_X, Vec3::NEG_Y),
+    (Vec3::Y, Vec3::Z),
+    (Vec3::NEG_Y, Vec3::NEG_Z),
+    (Vec3::Z, Vec3::NEG_Y),
+    (Vec3::NEG_Z, Vec3::NEG_Y),
+];
+
+/// The lights as the GPU sees them and each shadow layer's view. A spot whose cutoff is wider
+/// than one frustum can span ([`MAX_SPOT_FRUSTUM_RAD`]) gets the six cube faces of a point
+/// light (its falloff still applies), so no cutoff a scene file accepts is clamped.
 pub fn light_views(lights: &[SceneLight], near: f32, far: f32) -> (Vec<Light>, Vec<ShadowView>) {
     let mut gpu = Vec::new();
     let mut views = Vec::new();
+    let cube = |position: Vec3, views: &mut Vec<ShadowView>| {
+        for (f, up) in CUBE_FACES {
+            let vp = perspective(1.0, 1.0, near, far) * look_to(position, f, up);
+            views.push(ShadowView {
+                view_proj: vp.to_cols_array_2d(),
+                light: position.extend(1.0).to_array(),
+            });
+        }
+    };
     for l in lights {
         let first = views.len() as u32;
         match *l {
@@ -33,21 +55,7 @@ pub fn light_views(lights: &[SceneLight], near: f32, far: f32) -> (Vec<Light>, V
                 position,
                 intensity,
             } => {
-                let faces = [
-                    (Vec3::X, Vec3::NEG_Y),
-                    (Vec3::NEG_X, Vec3::NEG_Y),
-                    (Vec3::Y, Vec3::Z),
-                    (Vec3::NEG_Y, Vec3::NEG_Z),
-                    (Vec3::Z, Vec3::NEG_Y),
-                    (Vec3::NEG_Z, Vec3::NEG_Y),
-                ];
-                for (f, up) in faces {
-                    let vp = perspective(1.0, 1.0, near, far) * look_to(position, f, up);
-                    views.push(ShadowView {
-                        view_proj: vp.to_cols_array_2d(),
-                        light: position.extend(1.0).to_array(),
-                    });
-                }
+                cube(position, &mut views);
                 gpu.push(Light {
                     position: position.extend(0.0).to_array(),
                     intensity: intensity.extend(0.0).to_array(),
@@ -62,22 +70,26 @@ pub fn light_views(lights: &[SceneLight], near: f32, far: f32) -> (Vec<Light>, V
                 cutoff_rad,
                 beam_rad,
             } => {
-                let up = if direction.y.abs() > 0.9 {
-                    Vec3::Z
+                if cutoff_rad > MAX_SPOT_FRUSTUM_RAD {
+                    cube(position, &mut views);
                 } else {
-                    Vec3::Y
-                };
-                let t = cutoff_rad.min(MAX_SPOT_FRUSTUM_RAD).tan();
-                let vp = perspective(t, t, near, far) * look_to(position, direction, up);
-                views.push(ShadowView {
-                    view_proj: vp.to_cols_array_2d(),
-                    light: position.extend(1.0).to_array(),
-                });
+                    let up = if direction.y.abs() > 0.9 {
+                        Vec3::Z
+                    } else {
+                        Vec3::Y
+                    };
+                    let t = cutoff_rad.tan();
+                    let vp = perspective(t, t, near, far) * look_to(position, direction, up);
+                    views.push(ShadowView {
+                        view_proj: vp.to_cols_array_2d(),
+                        light: position.extend(1.0).to_array(),
+                    });
+                }
                 gpu.push(Light {
                     position: position.extend(1.0).to_array(),
                     intensity: intensity.extend(beam_rad).to_array(),
                     direction: direction.extend(cutoff_rad).to_array(),
-                    layers: [first, 1, 0, 0],
+                    layers: [first, views.len() as u32 - first, 0, 0],
                 });
             }
         }
