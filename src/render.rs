@@ -34,7 +34,8 @@ Modes:
                clustered shading (the paper's Table I passes: geometry pass, unique clusters
                of --tile-px tiles × --depth-slices slices × visibility cluster, light
                assignment into a pool of --light-entries, indirect lighting); GPU: ≤ 2 hops;
-               --cpu: the CPU twin, per point
+               --cpu: the CPU twin, per point. Pixels and VPLs outside every visibility
+               cluster are not occluded (the pass report counts them)
   gates-per-pixel
                GPU: the same gate test, brute force (every pixel tests every VPL)
   val-hard     GPU: the VPLs clustered into --vals virtual area lights (k-means by position

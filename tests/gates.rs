@@ -607,3 +607,49 @@ fn gpu_gates_give_the_same_image_at_scales_1e_3_to_1e4() {
         assert!(e.rel_mse < 1e-3, "{e:?}");
     }
 }
+
+#[test]
+fn the_pass_report_counts_pixels_and_vpls_outside_every_cluster() {
+    use visgate_runtime::gpu::{GatesParams, GpuContext, GpuMode, GpuParams, GpuRenderer};
+    use visgate_runtime::vpl::Vpl;
+    let ctx = GpuContext::new().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"));
+    let (scene, gates, _tracer, mut vpls, inside) = fixture(Builtin::FourRooms, 128);
+    // A camera outside the building sees its outer walls, which face no cluster's space.
+    let (lo, hi) = scene.bounds().expect("bounds");
+    let outside_cam = visgate_formats::Camera {
+        name: "outside".into(),
+        eye: lo - (hi - lo) * 0.5 + Vec3::Y * (hi - lo).y,
+        target: (lo + hi) * 0.5,
+        up: Vec3::Y,
+        fov_x_rad: 60f32.to_radians(),
+    };
+    let view = visgate_runtime::camera::View::new(&outside_cam, inside.size).expect("view");
+    // Five VPLs far outside the baked grid: no cluster, their light unoccluded.
+    vpls.extend((0..5).map(|k| Vpl::new(Vec3::new(1e3 + k as f32, 1e3, 0.0), Vec3::Y, Vec3::ONE)));
+    let want_vpls = vpls
+        .iter()
+        .filter(|v| {
+            gates
+                .cluster_at(Vec3::from(v.position), Vec3::from(v.normal))
+                .is_none()
+        })
+        .count();
+    assert!(want_vpls >= 5);
+    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    gpu.set_level(&ctx, &gates).expect("level");
+    let params = GpuParams::with_mode(GpuMode::Gates(GatesParams::default()));
+    let (_, t) = gpu.render(&ctx, &view, &vpls, &params).expect("render");
+    let lists = t.lists.expect("lists");
+    assert_eq!(lists.vpls_outside as usize, want_vpls);
+    let (pixels, _) = gpu
+        .light_lists(&ctx, &view, &vpls, &GatesParams::default())
+        .expect("lists");
+    let outside = pixels
+        .iter()
+        .flatten()
+        .filter(|p| p.cluster.is_none())
+        .count();
+    assert_eq!(lists.pixels_outside as usize, outside);
+    assert!(outside > 100, "{outside} pixels outside every cluster");
+    eprintln!("outside: {outside} pixels, {want_vpls} VPLs");
+}

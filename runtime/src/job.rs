@@ -427,6 +427,10 @@ pub fn pass_table(t: &PassTimes) -> String {
             l.capacity,
             l.entries as f64 / l.capacity.max(1) as f64 * 100.0
         );
+        s += &format!(
+            "outside every visibility cluster (light unoccluded there): {} pixels, {} VPLs\n",
+            l.pixels_outside, l.vpls_outside
+        );
     }
     s
 }

@@ -437,10 +437,10 @@ impl GpuRenderer {
             let r = pool.buffer(
                 &ctx.device,
                 "light list counter readback",
-                16,
+                32,
                 wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
             );
-            rec.enc.copy_buffer_to_buffer(&l.counter, 0, &r, 0, 16);
+            rec.enc.copy_buffer_to_buffer(&l.counter, 0, &r, 0, 32);
             r
         });
         let mut times = rec.finish(pool)?;

@@ -36,6 +36,11 @@ pub struct LightListStats {
     pub entries: u64,
     /// The pool's capacity.
     pub capacity: u32,
+    /// Pixels with a surface outside every visibility cluster (inside geometry, or outside the
+    /// baked grid): every VPL lights them unoccluded.
+    pub pixels_outside: u32,
+    /// VPLs outside every visibility cluster: they light every pixel unoccluded.
+    pub vpls_outside: u32,
 }
 
 /// What a frame took.

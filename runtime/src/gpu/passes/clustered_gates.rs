@@ -176,6 +176,8 @@ impl ListBuffers {
             geometry_clusters: c[2],
             entries: c[0] as u64,
             capacity: self.capacity,
+            pixels_outside: c[3],
+            vpls_outside: c[4],
         };
         if c[1] > 0 {
             return Err(RenderError::Param(format!(
@@ -417,6 +419,7 @@ impl ClusteredGates {
                 (1, tex()),
                 (2, res(&b.pixel_depth)),
                 (3, res(&s.depth_range)),
+                (7, res(&b.counter)),
             ],
         );
         let count_bg = bind(
@@ -454,6 +457,7 @@ impl ClusteredGates {
             &self.vpl_clusters,
             vec![
                 frame0(),
+                (7, res(&b.counter)),
                 (8, res(&f.grid)),
                 (9, res(&level.voxel_words)),
                 (12, res(&f.vpls)),

@@ -61,8 +61,9 @@ struct GeometryCluster {
 @group(0) @binding(4) var<storage, read_write> tile_clusters_of: array<u32>;
 @group(0) @binding(5) var<storage, read_write> pixel_cluster: array<u32>;
 @group(0) @binding(6) var<storage, read_write> clusters: array<GeometryCluster>;
-// x entries used (or needed), y lists that did not fit, z geometry clusters.
-@group(0) @binding(7) var<storage, read_write> counter: array<atomic<u32>, 4>;
+// 0 entries used (or needed), 1 lists that did not fit, 2 geometry clusters, 3 pixels and 4 VPLs
+// outside every visibility cluster (their light is not occluded), 5–7 unused.
+@group(0) @binding(7) var<storage, read_write> counter: array<atomic<u32>, 8>;
 @group(0) @binding(8) var<uniform> grid: Grid;
 @group(0) @binding(9) var<storage, read> voxel_words: array<u32>;
 @group(0) @binding(10) var<storage, read> gates: array<Gate>;
@@ -94,6 +95,9 @@ fn depths(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocatio
         let pos = textureLoad(g_position, vec2<i32>(id.xy), 0);
         var d = -1.0;
         if pos.w != 0.0 {
+            if decode_cluster(pos.w) == NONE {
+                atomicAdd(&counter[3], 1u);
+            }
             d = max(dot(pos.xyz - frame.eye, frame.forward), 1e-6);
             atomicMin(&wg_near, bitcast<u32>(d));
             atomicMax(&wg_far, bitcast<u32>(d));
@@ -313,7 +317,11 @@ fn tile_clusters(
 fn vpl_clusters(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x < frame.vpl_count {
         let v = vpls[id.x];
-        vpl_cluster[id.x] = cluster_at(v.position, v.normal);
+        let c = cluster_at(v.position, v.normal);
+        vpl_cluster[id.x] = c;
+        if c == NONE {
+            atomicAdd(&counter[4], 1u);
+        }
     }
 }
 
