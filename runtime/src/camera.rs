@@ -98,10 +98,23 @@ pub fn perspective(tan_x: f32, tan_y: f32, near: f32, far: f32) -> glam::Mat4 {
     )
 }
 
+/// Perspective to wgpu clip space with reversed depth and no far plane: depth `near / d` at
+/// view distance `d` (1 at `near`, → 0 far away), for a depth test "greater" cleared to 0.
+/// Float depth is densest near 0, so precision follows distance; nothing is clipped far away.
+pub fn perspective_reversed_infinite(tan_x: f32, tan_y: f32, near: f32) -> glam::Mat4 {
+    glam::Mat4::from_cols(
+        glam::Vec4::new(1.0 / tan_x, 0.0, 0.0, 0.0),
+        glam::Vec4::new(0.0, 1.0 / tan_y, 0.0, 0.0),
+        glam::Vec4::new(0.0, 0.0, 0.0, -1.0),
+        glam::Vec4::new(0.0, 0.0, near, 0.0),
+    )
+}
+
 impl View {
-    /// View-projection to wgpu clip space matching [`View::ray_dir`] at pixel centres.
-    pub fn view_proj(&self, near: f32, far: f32) -> glam::Mat4 {
+    /// View-projection to wgpu clip space matching [`View::ray_dir`] at pixel centres, with
+    /// reversed depth and no far plane ([`perspective_reversed_infinite`]).
+    pub fn view_proj(&self, near: f32) -> glam::Mat4 {
         let t = self.tan_half();
-        perspective(t.x, t.y, near, far) * look_to(self.eye, self.forward, self.up)
+        perspective_reversed_infinite(t.x, t.y, near) * look_to(self.eye, self.forward, self.up)
     }
 }

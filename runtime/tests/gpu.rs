@@ -559,6 +559,52 @@ fn gpu_spot_falloff_matches_the_conventions_at_beam_mid_ramp_and_cutoff() {
 }
 
 #[test]
+fn gpu_a_camera_ten_diagonals_away_sees_the_level_as_the_cpu_does() {
+    // The camera's depth is reversed with no far plane: nothing is clipped however far the
+    // camera stands (with a far plane at 4 diagonals this image was black).
+    use visgate_formats::Camera;
+    let ctx = context();
+    let scene = Builtin::CornellBox.scene().expect("scene");
+    let (lo, hi) = scene.bounds().expect("bounds");
+    let (centre, diagonal) = ((lo + hi) * 0.5, (hi - lo).length());
+    let cam = Camera {
+        name: "far".into(),
+        eye: centre + Vec3::new(0.2, 0.1, 1.0).normalize() * 10.0 * diagonal,
+        target: centre,
+        up: Vec3::Y,
+        fov_x_rad: 0.12,
+    };
+    let view = View::new(&cam, [48, 48]).expect("view");
+    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    let (img, _) = gpu
+        .render(&ctx, &view, &[], &GpuParams::with_mode(GpuMode::DirectOnly))
+        .expect("render");
+    let tracer = Tracer::new(&scene);
+    let (cpu, _) = render_reference(
+        &tracer,
+        &scene.lights,
+        &[],
+        &view,
+        &ReferenceParams {
+            samples_per_pixel: 1,
+            indirect: false,
+            ..ReferenceParams::default()
+        },
+        &|_, _| {},
+    )
+    .expect("reference");
+    let e = errors(&img, &cpu).expect("same size");
+    eprintln!("10 diagonals away: {e:?}");
+    assert!(
+        img.mean().x > 0.5 * cpu.mean().x,
+        "{} vs {}",
+        img.mean(),
+        cpu.mean()
+    );
+    assert!(e.rel_mse < 0.05, "{e:?}");
+}
+
+#[test]
 fn gpu_a_closed_box_with_no_light_is_black() {
     let ctx = context();
     let mut scene = Builtin::EmptyBox.scene().expect("scene");
@@ -580,4 +626,27 @@ fn gpu_a_closed_box_with_no_light_is_black() {
         assert!(img.pixels.iter().all(|p| *p == Vec3::ZERO), "{mode:?}");
     }
     assert!(gpu.rsm_vpls(&ctx, 64, 64, 1).expect("rsm").is_empty());
+}
+
+#[test]
+fn a_gpu_validation_error_comes_back_as_an_error_not_a_panic() {
+    let ctx = context();
+    let e = visgate_runtime::gpu::context::scoped(&ctx, || {
+        // MAP_READ with STORAGE is invalid without a feature adapters rarely have.
+        ctx.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("invalid on purpose"),
+            size: 64,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        Ok(())
+    })
+    .expect_err("a validation error");
+    assert!(e.to_string().contains("refused"), "{e}");
+    // And the device goes on working.
+    let scene = Builtin::CornellBox.scene().expect("scene");
+    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    let view = View::new(scene.cameras.first().expect("camera"), [8, 8]).expect("view");
+    gpu.render(&ctx, &view, &[], &GpuParams::default())
+        .expect("render after an error");
 }

@@ -73,6 +73,27 @@ impl GpuContext {
     }
 }
 
+/// Runs `f` with the device's validation and out-of-memory errors captured: a GPU error comes
+/// back as a [`RenderError::Gpu`] naming it, never as a panic (wgpu's default for errors no
+/// scope catches).
+pub fn scoped<T>(
+    ctx: &GpuContext,
+    f: impl FnOnce() -> Result<T, RenderError>,
+) -> Result<T, RenderError> {
+    let oom = ctx.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+    let validation = ctx.device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let result = f();
+    let invalid = pollster::block_on(validation.pop());
+    let out_of_memory = pollster::block_on(oom.pop());
+    match (invalid, out_of_memory) {
+        (Some(e), _) => Err(RenderError::Gpu(format!("the GPU refused the frame: {e}"))),
+        (None, Some(e)) => Err(RenderError::Gpu(format!(
+            "out of GPU memory ({e}): use a smaller image, fewer VPLs or smaller maps"
+        ))),
+        (None, None) => result,
+    }
+}
+
 /// The compute pipelines of shader module `module`'s entry points `entries`, in order (auto
 /// layouts).
 pub fn compute_pipelines<const N: usize>(
@@ -93,7 +114,8 @@ pub fn compute_pipelines<const N: usize>(
 }
 
 /// A render pipeline (auto layout) of `module`'s `vertex` and `fragment` entries with one
-/// colour target per format, optional depth (Depth32Float, less) and vertex buffers.
+/// colour target per format, a Depth32Float test with `depth` where given (`Less` for standard
+/// depth, `Greater` for the camera's reversed depth), and vertex buffers.
 pub fn render_pipeline(
     d: &wgpu::Device,
     label: &str,
@@ -101,7 +123,7 @@ pub fn render_pipeline(
     (vertex, fragment): (&str, &str),
     buffers: &[Option<wgpu::VertexBufferLayout>],
     targets: &[wgpu::TextureFormat],
-    depth: bool,
+    depth: Option<wgpu::CompareFunction>,
 ) -> wgpu::RenderPipeline {
     let targets: Vec<Option<wgpu::ColorTargetState>> = targets
         .iter()
@@ -123,10 +145,10 @@ pub fn render_pipeline(
             compilation_options: Default::default(),
         },
         primitive: wgpu::PrimitiveState::default(),
-        depth_stencil: depth.then(|| wgpu::DepthStencilState {
+        depth_stencil: depth.map(|compare| wgpu::DepthStencilState {
             format: wgpu::TextureFormat::Depth32Float,
             depth_write_enabled: Some(true),
-            depth_compare: Some(wgpu::CompareFunction::Less),
+            depth_compare: Some(compare),
             stencil: Default::default(),
             bias: Default::default(),
         }),

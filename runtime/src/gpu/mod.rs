@@ -87,7 +87,8 @@ pub struct SceneGpu {
     pub lights: Vec<SceneLight>,
     /// Near plane (1e-4 of the first scene's diagonal). [Units: m]
     pub near_m: f32,
-    /// Far plane (4 diagonals). [Units: m]
+    /// Far distance of the lights' shadow and paraboloid maps (4 diagonals; the camera has no
+    /// far plane). [Units: m]
     pub far_m: f32,
     /// Albedo textures as one array.
     pub albedo_maps: wgpu::TextureView,
@@ -351,7 +352,7 @@ impl GpuRenderer {
             _ => ShadeIndirect::DirectOnly,
         };
         let globals = Globals {
-            view_proj: view.view_proj(scene.near_m, scene.far_m).to_cols_array_2d(),
+            view_proj: view.view_proj(scene.near_m).to_cols_array_2d(),
             eye: view.eye.extend(1.0).to_array(),
             g_max: params.g_max,
             shadow_normal_offset: params.shadows.normal_offset,
@@ -390,8 +391,20 @@ impl GpuRenderer {
     }
 
     /// Renders `view` with VPLs from `vpls` and returns the linear HDR image and the pass
-    /// times. The same call serves tests, the CLI and the viewer.
+    /// times. The same call serves tests, the CLI and the viewer. A GPU error (validation,
+    /// out of memory) is returned, not raised.
     pub fn render_frame(
+        &mut self,
+        ctx: &GpuContext,
+        view: &View,
+        vpls: VplInput,
+        params: &GpuParams,
+    ) -> Result<(HdrImage, PassTimes), RenderError> {
+        context::scoped(ctx, || self.frame_unscoped(ctx, view, vpls, params))
+    }
+
+    /// [`GpuRenderer::render_frame`] without the error scope.
+    fn frame_unscoped(
         &mut self,
         ctx: &GpuContext,
         view: &View,

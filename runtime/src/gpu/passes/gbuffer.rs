@@ -15,9 +15,21 @@ pub const FORMATS: [wgpu::TextureFormat; 3] = [
     wgpu::TextureFormat::Rgba16Float,
 ];
 
-/// The G-buffer pipeline.
+/// The G-buffer pipelines: the camera's with reversed depth (an infinite far plane, depth
+/// `near / distance`, compare greater, cleared to 0: no far clipping, precision where it is
+/// needed), the lights' RSM views with their standard depth.
 pub struct GBuffer {
     pipeline: wgpu::RenderPipeline,
+    light: wgpu::RenderPipeline,
+}
+
+/// Which depth convention a G-buffer pass uses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Depth {
+    /// The camera's: reversed, infinite far plane.
+    Reversed,
+    /// A light's view: 0 at near, 1 at far.
+    Standard,
 }
 
 /// A frame's G-buffer.
@@ -40,30 +52,40 @@ impl GBuffer {
             step_mode: wgpu::VertexStepMode::Vertex,
             attributes: &attrs,
         };
-        let pipeline = render_pipeline(
-            d,
-            "gbuffer",
-            &module,
-            ("vs", "fs"),
-            &[Some(layout)],
-            &FORMATS,
-            true,
-        );
-        Ok(GBuffer { pipeline })
+        let make = |label, compare| {
+            render_pipeline(
+                d,
+                label,
+                &module,
+                ("vs", "fs"),
+                &[Some(layout.clone())],
+                &FORMATS,
+                Some(compare),
+            )
+        };
+        Ok(GBuffer {
+            pipeline: make("gbuffer", wgpu::CompareFunction::Greater),
+            light: make("rsm gbuffer", wgpu::CompareFunction::Less),
+        })
     }
 
     /// A bind group of the G-buffer's inputs: `globals` (whole, or a 112-byte element at
     /// `offset`), the albedo array and sampler, the level's `grid` and voxel words.
     pub fn bind_group(
         &self,
+        convention: Depth,
         d: &wgpu::Device,
         scene: &SceneGpu,
         globals: wgpu::BindingResource,
         grid: &wgpu::Buffer,
     ) -> wgpu::BindGroup {
+        let pipeline = match convention {
+            Depth::Reversed => &self.pipeline,
+            Depth::Standard => &self.light,
+        };
         bind_group(
             d,
-            &self.pipeline.get_bind_group_layout(0),
+            &pipeline.get_bind_group_layout(0),
             "gbuffer",
             vec![
                 (0, globals),
@@ -75,9 +97,11 @@ impl GBuffer {
         )
     }
 
-    /// Records one G-buffer pass into `targets` and `depth`.
+    /// Records one G-buffer pass into `targets` and `depth` with the `convention`'s pipeline.
+    #[allow(clippy::too_many_arguments)]
     pub fn draw(
         &self,
+        convention: Depth,
         enc: &mut wgpu::CommandEncoder,
         scene: &SceneGpu,
         targets: &[wgpu::TextureView; 3],
@@ -102,7 +126,10 @@ impl GBuffer {
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: depth,
                 depth_ops: Some(wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(1.0),
+                    load: wgpu::LoadOp::Clear(match convention {
+                        Depth::Reversed => 0.0,
+                        Depth::Standard => 1.0,
+                    }),
                     store: wgpu::StoreOp::Discard,
                 }),
                 stencil_ops: None,
@@ -111,7 +138,10 @@ impl GBuffer {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(&self.pipeline);
+        pass.set_pipeline(match convention {
+            Depth::Reversed => &self.pipeline,
+            Depth::Standard => &self.light,
+        });
         pass.set_bind_group(0, bind_group, &[]);
         pass.set_vertex_buffer(0, scene.geometry.vertices.slice(..));
         pass.draw(0..scene.geometry.vertex_count, 0..1);
@@ -137,9 +167,16 @@ impl GBuffer {
         let views = textures
             .each_ref()
             .map(|t| t.create_view(&Default::default()));
-        let bg = self.bind_group(d, f.scene, f.globals.as_entire_binding(), &f.grid);
+        let bg = self.bind_group(
+            Depth::Reversed,
+            d,
+            f.scene,
+            f.globals.as_entire_binding(),
+            &f.grid,
+        );
         let span = rec.begin("geometry pass (G-buffer)");
         self.draw(
+            Depth::Reversed,
             &mut rec.enc,
             f.scene,
             &views,

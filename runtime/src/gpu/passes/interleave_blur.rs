@@ -63,8 +63,7 @@ impl InterleaveBlur {
     /// Builds the pipeline.
     pub fn new(d: &wgpu::Device) -> Result<InterleaveBlur, RenderError> {
         let module = shaders::module(d, "blur.wgsl")?;
-        let pipeline =
-            render_pipeline(d, "blur", &module, ("vs", "fs_compose"), &[], &[HDR], false);
+        let pipeline = render_pipeline(d, "blur", &module, ("vs", "fs_compose"), &[], &[HDR], None);
         Ok(InterleaveBlur { pipeline })
     }
 

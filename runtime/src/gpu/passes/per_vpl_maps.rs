@@ -68,7 +68,7 @@ impl ParaboloidMaps {
                 ("vs", "fs"),
                 &[Some(positions(12))],
                 &r32,
-                true,
+                Some(wgpu::CompareFunction::Less),
             ),
             val: render_pipeline(
                 d,
@@ -77,9 +77,9 @@ impl ParaboloidMaps {
                 ("vs_val", "fs"),
                 &[Some(positions(12))],
                 &r32,
-                true,
+                Some(wgpu::CompareFunction::Less),
             ),
-            gather: render_pipeline(d, "gather batch", &gather, ("vs", "fs"), &[], &[HDR], false),
+            gather: render_pipeline(d, "gather batch", &gather, ("vs", "fs"), &[], &[HDR], None),
         })
     }
 

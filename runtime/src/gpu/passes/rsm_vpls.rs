@@ -8,7 +8,7 @@
 use glam::{Mat4, Vec3};
 use visgate_formats::Light as SceneLight;
 
-use super::gbuffer::{FORMATS, GBuffer};
+use super::gbuffer::{Depth, FORMATS, GBuffer};
 use super::shadow_maps::light_views;
 use crate::RenderError;
 use crate::gpu::context::{Pool, array_view, bind_group, compute_pipelines, layer_view, slice};
@@ -184,9 +184,10 @@ impl RsmVpls {
                 (i * UNIFORM_STRIDE) as u64,
                 size_of::<Globals>() as u64,
             );
-            let bg = gbuffer.bind_group(d, scene, g, &scene.no_grid);
+            let bg = gbuffer.bind_group(Depth::Standard, d, scene, g, &scene.no_grid);
             let targets = maps.each_ref().map(|t| layer_view(t, i as u32));
             gbuffer.draw(
+                Depth::Standard,
                 &mut rec.enc,
                 scene,
                 &targets,

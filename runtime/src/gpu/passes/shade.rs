@@ -68,7 +68,7 @@ impl Shade {
     /// Builds the pipeline.
     pub fn new(d: &wgpu::Device) -> Result<Shade, RenderError> {
         let module = shaders::module(d, "shade.wgsl")?;
-        let pipeline = render_pipeline(d, "shade", &module, ("vs", "fs"), &[], &[HDR], false);
+        let pipeline = render_pipeline(d, "shade", &module, ("vs", "fs"), &[], &[HDR], None);
         Ok(Shade { pipeline })
     }
 

@@ -179,7 +179,7 @@ impl ShadowMaps {
             ("vs", "fs"),
             &[Some(positions(VERTEX_STRIDE))],
             &[wgpu::TextureFormat::R32Float],
-            true,
+            Some(wgpu::CompareFunction::Less),
         );
         Ok(ShadowMaps { pipeline })
     }

@@ -83,7 +83,7 @@ impl ValGathers {
                 ("vs", "fs_hard"),
                 &[],
                 &[HDR],
-                false,
+                None,
             ),
             cssm: render_pipeline(
                 d,
@@ -92,7 +92,7 @@ impl ValGathers {
                 ("vs", "fs_cssm"),
                 &[],
                 &[HDR],
-                false,
+                None,
             ),
             sampler: super::cssm::sampler(d),
         })
