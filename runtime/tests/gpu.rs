@@ -633,7 +633,7 @@ fn a_gpu_validation_error_comes_back_as_an_error_not_a_panic() {
     let ctx = context();
     let e = visgate_runtime::gpu::context::scoped(&ctx, || {
         // MAP_READ with STORAGE is invalid without a feature adapters rarely have.
-        ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        let _invalid = ctx.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("invalid on purpose"),
             size: 64,
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::STORAGE,
