@@ -151,9 +151,16 @@ pub struct RenderArgs {
     /// Virtual area lights (--mode val-hard): the VPLs are clustered into this many.
     #[arg(long, default_value_t = 30)]
     pub vals: u32,
-    /// k-means iterations of the VAL clustering.
+    /// Most k-means iterations of the VAL clustering (it stops earlier where the assignment
+    /// repeats itself; the pass report says whether it converged).
     #[arg(long, default_value_t = 8)]
     pub val_iterations: u32,
+    /// Weight of the position term of the VAL clustering distance (the paper: 0.7).
+    #[arg(long, default_value_t = 0.7, allow_hyphen_values = true)]
+    pub val_w_x: f32,
+    /// Weight of the normal-angle term of the VAL clustering distance (the paper: 0.3).
+    #[arg(long, default_value_t = 0.3, allow_hyphen_values = true)]
+    pub val_w_alpha: f32,
     /// Paraboloid shadow map size per VAL, texels.
     #[arg(long, default_value_t = 256)]
     pub val_map_size: u32,
@@ -235,6 +242,8 @@ impl RenderArgs {
                 vals: ValParams {
                     count: self.vals,
                     iterations: self.val_iterations,
+                    w_x: self.val_w_x,
+                    w_alpha: self.val_w_alpha,
                     ..ValParams::default()
                 },
                 map_size: self.val_map_size,

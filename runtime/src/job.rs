@@ -413,6 +413,18 @@ pub fn pass_table(t: &PassTimes) -> String {
         ms(t.gpu_total()),
         t.frame_s * 1e3
     );
+    if let Some(v) = t.vals {
+        s += &match v.converged {
+            true => format!(
+                "VAL clustering: converged after {} of at most {} iterations\n",
+                v.iterations, v.max
+            ),
+            false => format!(
+                "VAL clustering: not converged in {} iterations (raise --val-iterations)\n",
+                v.max
+            ),
+        };
+    }
     if t.passes.iter().all(|p| p.gpu_s.is_none()) {
         s += "(the adapter has no timestamp queries: each pass was submitted and waited for \
               alone, for its CPU wall time)\n";

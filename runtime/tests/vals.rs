@@ -61,13 +61,21 @@ fn gpu_k_means_equals_the_cpu_twin() {
     for b in [Builtin::CornellBox, Builtin::FourRooms] {
         let (scene, vpls) = vpls_of(b, 1024);
         let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
-        for m in [1, 4, 30, 64] {
+        for (m, iterations) in [(1, 8), (4, 8), (30, 8), (64, 8), (30, 64), (4, 2)] {
             let params = ValParams {
                 count: m,
+                iterations,
                 ..ValParams::default()
             };
             let cpu = cluster(&vpls, &params, None).expect("cpu");
             let got = gpu.cluster_vals(&ctx, &vpls, &params).expect("gpu");
+            // Both stop where the assignment repeats itself, after the same updates.
+            assert_eq!(
+                (cpu.iterations, cpu.converged),
+                (got.iterations, got.converged),
+                "{} M = {m}, at most {iterations}",
+                b.name()
+            );
             assert_sane(&cpu, vpls.len(), m);
             assert_sane(&got, vpls.len(), m);
             let differ = cpu
@@ -77,10 +85,13 @@ fn gpu_k_means_equals_the_cpu_twin() {
                 .filter(|(a, b)| a != b)
                 .count();
             eprintln!(
-                "{} M = {m}: {} live VALs, {differ} of {} VPLs mapped differently",
+                "{} M = {m}: {} live VALs, {differ} of {} VPLs mapped differently, {} \
+                 iterations (at most {iterations}), converged {}",
                 b.name(),
                 cpu.live(),
-                vpls.len()
+                vpls.len(),
+                cpu.iterations,
+                cpu.converged
             );
             assert_eq!(differ, 0, "{} M = {m}", b.name());
             for (a, g) in cpu.vals.iter().zip(&got.vals) {
@@ -625,4 +636,39 @@ fn cssm_receivers_at_a_val_of_no_area_stay_finite_and_the_open_stays_lit() {
         );
         assert!(img.mean().x <= none.mean().x * 1.0001);
     }
+}
+
+#[test]
+fn k_means_stops_where_the_assignment_repeats_and_more_iterations_change_nothing() {
+    let (_, vpls) = vpls_of(Builtin::CornellBox, 1024);
+    let at = |iterations| {
+        cluster(
+            &vpls,
+            &ValParams {
+                count: 30,
+                iterations,
+                ..ValParams::default()
+            },
+            None,
+        )
+        .expect("cluster")
+    };
+    let long = at(256);
+    assert!(long.converged, "30 VALs of the Cornell box converge");
+    assert!(long.iterations < 256);
+    // Allowing exactly the updates it needed, or any more, gives the same clustering.
+    for more in [long.iterations + 1, long.iterations + 20] {
+        let c = at(more);
+        assert!(c.converged);
+        assert_eq!(c.mapping, long.mapping);
+        assert_eq!(c.vals, long.vals);
+    }
+    // One update fewer than needed has not converged.
+    if long.iterations > 0 {
+        assert!(!at(long.iterations - 1).converged || long.iterations == 1);
+    }
+    eprintln!(
+        "Cornell box, 30 VALs: converged after {} updates",
+        long.iterations
+    );
 }

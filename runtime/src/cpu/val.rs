@@ -12,7 +12,8 @@
 //!   alternative the paper rejects, kept to measure it).
 //! - **Iterations**: assign each VPL to the nearest centre (ties to the lower index), then
 //!   move each non-empty centre to its VPLs' mean position and (normalised) mean normal; an
-//!   empty VAL keeps its centre. A fixed number of iterations, then the final mapping C.
+//!   empty VAL keeps its centre; until the assignment repeats itself (convergence, as the
+//!   paper iterates), at most `iterations` times; then the final mapping C.
 //! - **Area**: the 2D bounding rectangle of the VAL's VPLs projected on the plane normal to
 //!   its normal (the frame of [`crate::vpl::basis`]).
 
@@ -110,6 +111,10 @@ pub struct Clustering {
     pub mapping: Vec<u32>,
     /// The normalising length D of the position term. [Units: m]
     pub scale_m: f32,
+    /// Centre updates run (at most `ValParams::iterations`).
+    pub iterations: u32,
+    /// Whether the assignment stopped changing within them (the paper's convergence).
+    pub converged: bool,
 }
 
 impl Clustering {
@@ -179,6 +184,8 @@ pub fn cluster(
             vals: vec![bytemuck::Zeroable::zeroed(); m],
             mapping: Vec::new(),
             scale_m,
+            iterations: 0,
+            converged: true,
         });
     }
     let inv_d = 1.0 / scale_m;
@@ -192,11 +199,20 @@ pub fn cluster(
         }
         None => initial_centres(vpls, params.count),
     };
+    // Iterate until the assignment repeats itself (then every later iteration would repeat
+    // the last: the GPU stops there too), at most `params.iterations` updates.
+    let (mut iterations, mut converged) = (0, false);
+    let mut last: Option<Vec<u32>> = None;
     for _ in 0..params.iterations {
         let mapping: Vec<u32> = vpls
             .iter()
             .map(|v| nearest(v, &centres, inv_d, params))
             .collect();
+        if last.as_ref() == Some(&mapping) {
+            converged = true;
+            break;
+        }
+        iterations += 1;
         let mut sums = vec![(Vec3::ZERO, Vec3::ZERO, 0u32); m];
         for (v, &k) in vpls.iter().zip(&mapping) {
             let s = &mut sums[k as usize];
@@ -211,6 +227,7 @@ pub fn cluster(
                 *c = (s.0 / s.2 as f32, if l > 0.0 { s.1 / l } else { c.1 });
             }
         }
+        last = Some(mapping);
     }
     let mapping: Vec<u32> = vpls
         .iter()
@@ -220,6 +237,8 @@ pub fn cluster(
         vals: vals_of(vpls, &mapping, &centres),
         mapping,
         scale_m,
+        iterations,
+        converged,
     })
 }
 

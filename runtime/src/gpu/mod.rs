@@ -68,7 +68,7 @@ pub use methods::{
 };
 pub use passes::clustered_gates::{MAX_CLUSTERS, MAX_GATES};
 pub use passes::rsm_vpls::RsmParams;
-pub use timing::{LightListStats, PassTime, PassTimes};
+pub use timing::{LightListStats, PassTime, PassTimes, ValIterations};
 
 /// Where a frame's VPLs come from.
 #[derive(Debug, Clone, Copy)]
@@ -177,6 +177,8 @@ pub struct GpuRenderer {
 struct Recorded {
     hdr: wgpu::Texture,
     lists: Option<ListBuffers>,
+    /// The VAL clustering's convergence words, in the VAL modes.
+    val_state: Option<wgpu::Buffer>,
 }
 
 /// The frame as its passes (after the VPLs): shadow maps, G-buffer, the mode's passes,
@@ -203,6 +205,7 @@ fn record_passes(
     let hdr = p
         .shade
         .record(f, pool, rec, (&shadows, &g, lists.as_ref()), shading);
+    let mut val_state = None;
     match &f.params.mode {
         GpuMode::PerVplShadowMaps(pv) => p.maps.record(f, pv, pool, rec, (&g, &hdr)),
         GpuMode::ValHard(v) | GpuMode::ValCssm(v, _) => {
@@ -216,12 +219,17 @@ fn record_passes(
                 cssm: &p.cssm,
                 blur: &p.blur,
             };
-            p.val_gather
+            val_state = p
+                .val_gather
                 .record(f, v, cssm, warm, &passes, pool, rec, (&g, &hdr))?;
         }
         _ => {}
     }
-    Ok(Recorded { hdr, lists })
+    Ok(Recorded {
+        hdr,
+        lists,
+        val_state,
+    })
 }
 
 impl GpuRenderer {
@@ -456,11 +464,30 @@ impl GpuRenderer {
             rec.enc.copy_buffer_to_buffer(&l.counter, 0, &r, 0, 32);
             r
         });
+        let state_read = out.val_state.as_ref().map(|s| {
+            let r = pool.buffer(
+                &ctx.device,
+                "val convergence readback",
+                16,
+                wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            );
+            rec.enc.copy_buffer_to_buffer(s, 0, &r, 0, 16);
+            r
+        });
         let mut times = rec.finish(pool)?;
         let t1 = Instant::now();
         if let (Some(l), Some(r)) = (&out.lists, &counter_read) {
             let c: Vec<u32> = bytemuck::cast_slice(&map_read(ctx, r)?).to_vec();
             times.lists = Some(l.stats(&c)?);
+        }
+        if let (Some(r), GpuMode::ValHard(v) | GpuMode::ValCssm(v, _)) = (&state_read, params.mode)
+        {
+            let c: Vec<u32> = bytemuck::cast_slice(&map_read(ctx, r)?).to_vec();
+            times.vals = Some(ValIterations {
+                iterations: c[2],
+                max: v.vals.iterations,
+                converged: c[1] != 0,
+            });
         }
         let px = texels(&map_read(ctx, &read)?, w, h, false);
         let mut img = HdrImage::new(w, h);
@@ -527,10 +554,13 @@ impl GpuRenderer {
         };
         let mapping: Vec<u32> =
             bytemuck::cast_slice(&read_buffer(ctx, &b.mapping)?)[..vpls.len()].to_vec();
+        let state: Vec<u32> = bytemuck::cast_slice(&read_buffer(ctx, &b.state)?).to_vec();
         Ok(Clustering {
             vals,
             mapping,
             scale_m: scale_of(vpls),
+            iterations: state[2],
+            converged: vpls.is_empty() || state[1] != 0,
         })
     }
 

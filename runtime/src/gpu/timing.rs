@@ -54,6 +54,19 @@ pub struct PassTimes {
     pub readback_s: f64,
     /// Mode gates: how full the light lists came out.
     pub lists: Option<LightListStats>,
+    /// The VAL modes: how the clustering converged.
+    pub vals: Option<ValIterations>,
+}
+
+/// How the VAL clustering's iterations went.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct ValIterations {
+    /// Centre updates run.
+    pub iterations: u32,
+    /// The most allowed (`ValParams::iterations`).
+    pub max: u32,
+    /// Whether the assignment stopped changing within them.
+    pub converged: bool,
 }
 
 impl PassTimes {
@@ -226,6 +239,7 @@ impl<'c> Recorder<'c> {
             frame_s: 0.0,
             readback_s: t0.elapsed().as_secs_f64(),
             lists: None,
+            vals: None,
         })
     }
 }

@@ -99,7 +99,8 @@ impl ValGathers {
     }
 
     /// Records a VAL frame onto `out`: with `cssm` the soft mode. `warm`: start the
-    /// clustering from last frame's centres.
+    /// clustering from last frame's centres. Returns the clustering's convergence words (none
+    /// without VPLs).
     #[allow(clippy::too_many_arguments)]
     pub fn record(
         &self,
@@ -111,7 +112,7 @@ impl ValGathers {
         pool: &mut Pool,
         rec: &mut Recorder,
         (g, out): (&GBufferOutput, &wgpu::Texture),
-    ) -> Result<(), RenderError> {
+    ) -> Result<Option<wgpu::Buffer>, RenderError> {
         p.check()?;
         let d = &f.ctx.device;
         let (m, s) = (p.vals.count, p.map_size);
@@ -122,7 +123,7 @@ impl ValGathers {
             )));
         }
         if f.vpl_count == 0 {
-            return Ok(());
+            return Ok(None);
         }
         let block = p.interleave.block;
         let input = ValInput {
@@ -204,6 +205,6 @@ impl ValGathers {
         passes
             .blur
             .record(f, pool, rec, (g, &uniform_buf, &indirect, out));
-        Ok(())
+        Ok(Some(b.state))
     }
 }

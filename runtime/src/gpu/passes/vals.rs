@@ -16,6 +16,7 @@ pub struct ValClustering {
     scale: wgpu::ComputePipeline,
     init: wgpu::ComputePipeline,
     assign: wgpu::ComputePipeline,
+    converge: wgpu::ComputePipeline,
     update: wgpu::ComputePipeline,
     finish: wgpu::ComputePipeline,
     bucket_counts: wgpu::ComputePipeline,
@@ -31,6 +32,8 @@ pub struct ValBuffers {
     pub mapping: wgpu::Buffer,
     /// M·B + 1 offsets, then the VPL indices sorted by VAL and interleaving subset.
     pub order: wgpu::Buffer,
+    /// Convergence: changes in the last assignment, done, updates run (u32 each).
+    pub state: wgpu::Buffer,
 }
 
 /// The VPLs to cluster: on the GPU (`buffer`, `count`), and on the CPU where the caller has
@@ -52,6 +55,7 @@ impl ValClustering {
             scale,
             init,
             assign,
+            converge,
             update,
             finish,
             bucket_counts,
@@ -64,6 +68,7 @@ impl ValClustering {
                 "scale",
                 "init",
                 "assign",
+                "converge",
                 "update",
                 "finish",
                 "bucket_counts",
@@ -75,6 +80,7 @@ impl ValClustering {
             scale,
             init,
             assign,
+            converge,
             update,
             finish,
             bucket_counts,
@@ -129,7 +135,9 @@ impl ValClustering {
             (buckets + 1 + n as u64) * 4,
             rw | wgpu::BufferUsages::COPY_DST,
         );
+        let state = pool.buffer(d, "val convergence", 16, rw | wgpu::BufferUsages::COPY_DST);
         rec.enc.clear_buffer(&order, 0, None);
+        rec.enc.clear_buffer(&state, 0, None);
         let bind = |pipeline: &wgpu::ComputePipeline, with: &[(u32, &wgpu::Buffer)]| {
             let resources = with
                 .iter()
@@ -142,9 +150,20 @@ impl ValClustering {
         let init_bg = bind(&self.init, &base);
         let assign_bg = bind(
             &self.assign,
-            &[base[0], base[1], base[2], (3, &mapping), (6, &inv_scale)],
+            &[
+                base[0],
+                base[1],
+                base[2],
+                (3, &mapping),
+                (6, &inv_scale),
+                (7, &state),
+            ],
         );
-        let update_bg = bind(&self.update, &[base[0], base[1], base[2], (3, &mapping)]);
+        let converge_bg = bind(&self.converge, &[(7, &state)]);
+        let update_bg = bind(
+            &self.update,
+            &[base[0], base[1], base[2], (3, &mapping), (7, &state)],
+        );
         let finish_bg = bind(
             &self.finish,
             &[base[0], base[1], base[2], (3, &mapping), (4, &vals)],
@@ -171,8 +190,11 @@ impl ValClustering {
                 if !warm {
                     run(&self.init, &init_bg, gm);
                 }
+                // The iterations stop on the GPU once the assignment repeats itself (the
+                // later dispatches return at once): no read-back, no wait.
                 for _ in 0..params.iterations {
                     run(&self.assign, &assign_bg, gv);
+                    run(&self.converge, &converge_bg, 1);
                     run(&self.update, &update_bg, gm);
                 }
                 run(&self.assign, &assign_bg, gv);
@@ -188,6 +210,7 @@ impl ValClustering {
             vals,
             mapping,
             order,
+            state,
         })
     }
 }

@@ -4,6 +4,8 @@
 // runtime::cpu::val is the CPU twin (same order of every sum, so the same VALs).
 //   init    centres from the restart VPLs
 //   assign  each VPL's nearest centre (ties to the lower index) → the mapping C
+//   converge stops the iterations once the assignment repeats itself (the paper iterates to
+//           convergence; the iteration count is a maximum)
 //   update  each VAL's centre: mean position and normalised mean normal of its VPLs, summed
 //           in VPL order (an empty VAL keeps its centre)
 //   finish  each VAL's VPL count, flux and bounding rectangle in the plane normal to it
@@ -29,6 +31,9 @@ struct ValFrame {
 // 1 / D, D the VPLs' bounding-box diagonal: uploaded when the CPU has the VPLs, else computed
 // by `scale` (RSM VPLs stay on the GPU).
 @group(0) @binding(6) var<storage, read_write> inv_scale: array<f32, 1>;
+// Convergence: 0 VPLs whose VAL changed in this iteration's assignment, 1 done (the mapping
+// stopped changing: every later iteration would repeat the last), 2 updates run.
+@group(0) @binding(7) var<storage, read_write> state: array<atomic<u32>, 4>;
 
 var<workgroup> wg_lo: array<vec3<f32>, WG_LINEAR>;
 var<workgroup> wg_hi: array<vec3<f32>, WG_LINEAR>;
@@ -84,7 +89,7 @@ fn distance(v: Vpl, k: u32) -> f32 {
 @compute @workgroup_size(WG_LINEAR)
 fn assign(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = id.x;
-    if i >= frame.vpl_count {
+    if i >= frame.vpl_count || atomicLoad(&state[1]) != 0u {
         return;
     }
     let v = vpls[i];
@@ -97,13 +102,31 @@ fn assign(@builtin(global_invocation_id) id: vec3<u32>) {
             at = k;
         }
     }
+    if mapping[i] != at {
+        atomicAdd(&state[0], 1u);
+    }
     mapping[i] = at;
+}
+
+// After each iteration's assignment: done when it changed nothing (the first always counts as
+// a change: the mapping held last frame's), else one more update runs.
+@compute @workgroup_size(1)
+fn converge() {
+    if atomicLoad(&state[1]) != 0u {
+        return;
+    }
+    if atomicLoad(&state[2]) > 0u && atomicLoad(&state[0]) == 0u {
+        atomicStore(&state[1], 1u);
+    } else {
+        atomicAdd(&state[2], 1u);
+    }
+    atomicStore(&state[0], 0u);
 }
 
 @compute @workgroup_size(WG_LINEAR)
 fn update(@builtin(global_invocation_id) id: vec3<u32>) {
     let k = id.x;
-    if k >= frame.val_count {
+    if k >= frame.val_count || atomicLoad(&state[1]) != 0u {
         return;
     }
     var p = vec3<f32>(0.0);
