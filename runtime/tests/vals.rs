@@ -3,7 +3,7 @@
 use glam::Vec3;
 use visgate_runtime::cpu::tracer::Tracer;
 use visgate_runtime::cpu::val::centres_of;
-use visgate_runtime::cpu::val::{Clustering, ValParams, cluster};
+use visgate_runtime::cpu::val::{Clustering, NO_VAL, ValParams, cluster};
 use visgate_runtime::gpu::{CssmParams, GpuContext, GpuMode, GpuRenderer, ValModeParams};
 use visgate_runtime::vpl::{PathParams, Vpl, path_vpls};
 use visgate_scenes::Builtin;
@@ -40,9 +40,10 @@ fn vpls_of(b: Builtin, paths: u32) -> (visgate_formats::Scene, Vec<Vpl>) {
 fn assert_sane(c: &Clustering, n: usize, m: u32) {
     assert_eq!(c.vals.len(), m as usize);
     assert_eq!(c.mapping.len(), n);
-    assert!(c.mapping.iter().all(|&k| k < m));
+    assert!(c.mapping.iter().all(|&k| k < m || k == NO_VAL));
     let counted: u32 = c.vals.iter().map(|v| v.vpl_count()).sum();
-    assert_eq!(counted as usize, n);
+    let live = c.mapping.iter().filter(|&&k| k != NO_VAL).count();
+    assert_eq!(counted as usize, live);
     for v in &c.vals {
         let all = v
             .position
@@ -671,4 +672,41 @@ fn k_means_stops_where_the_assignment_repeats_and_more_iterations_change_nothing
         "Cornell box, 30 VALs: converged after {} updates",
         long.iterations
     );
+}
+
+#[test]
+fn rsm_samples_that_find_nothing_join_no_val_on_the_gpu_as_on_the_cpu() {
+    // The Cornell box is open at the front: a share of its light's RSM sees nothing and gives
+    // VPLs of zero flux at the origin. They join no VAL and leave D alone.
+    let ctx = context();
+    let scene = Builtin::CornellBox.scene().expect("scene");
+    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    let vpls = gpu.rsm_vpls(&ctx, 2048, 128, 1).expect("rsm");
+    let dead = vpls.iter().filter(|v| v.flux == [0.0; 3]).count();
+    assert!(
+        dead > 20,
+        "{dead} of {} RSM samples find nothing",
+        vpls.len()
+    );
+    let live: Vec<Vpl> = vpls
+        .iter()
+        .filter(|v| v.flux != [0.0; 3])
+        .copied()
+        .collect();
+    let params = ValParams {
+        count: 30,
+        ..ValParams::default()
+    };
+    let cpu = cluster(&vpls, &params, None).expect("cpu");
+    let got = gpu.cluster_vals(&ctx, &vpls, &params).expect("gpu");
+    assert_sane(&cpu, vpls.len(), 30);
+    assert_sane(&got, vpls.len(), 30);
+    assert_eq!(cpu.mapping, got.mapping);
+    for (v, k) in vpls.iter().zip(&got.mapping) {
+        assert_eq!(v.flux == [0.0; 3], *k == NO_VAL, "{v:?} → {k}");
+    }
+    // D is the live VPLs' diagonal, as if the dead ones were not there.
+    let alone = cluster(&live, &params, None).expect("live alone");
+    assert_eq!(cpu.scale_m, alone.scale_m);
+    eprintln!("{dead} dead of {}; D {} m", vpls.len(), cpu.scale_m);
 }

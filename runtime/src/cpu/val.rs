@@ -124,14 +124,25 @@ impl Clustering {
     }
 }
 
-/// The normalising length D: the diagonal of the VPLs' bounding box (1e-30 m at least).
+/// Whether a VPL carries light. An RSM sample that found no surface gives a VPL of zero flux
+/// (at the origin): it takes no part in the clustering — not in D, not a restart centre, in no
+/// VAL (its mapping is [`NO_VAL`]) — so open scenes' VALs are not pulled towards the origin.
+pub fn is_live(v: &Vpl) -> bool {
+    v.flux != [0.0; 3]
+}
+
+/// The mapping of a VPL of zero flux: no VAL.
+pub const NO_VAL: u32 = u32::MAX;
+
+/// The normalising length D: the diagonal of the live VPLs' bounding box (1e-30 m at least; 1
+/// when none is live).
 pub fn scale_of(vpls: &[Vpl]) -> f32 {
     let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-    for v in vpls {
+    for v in vpls.iter().filter(|v| is_live(v)) {
         lo = lo.min(Vec3::from(v.position));
         hi = hi.max(Vec3::from(v.position));
     }
-    if vpls.is_empty() {
+    if lo.x > hi.x {
         return 1.0;
     }
     (hi - lo).length().max(1e-30)
@@ -145,19 +156,26 @@ pub fn distance(p: Vec3, n: Vec3, c: Vec3, m: Vec3, inv_d: f32, params: &ValPara
     params.w_x * dx + params.w_alpha * da
 }
 
-/// The initial centres: VAL k starts at VPL ⌊k·N/M⌋ (§5.2).
+/// The initial centres: VAL k starts at VPL ⌊k·N/M⌋ (§5.2), or the next live VPL after it.
 pub fn initial_centres(vpls: &[Vpl], count: u32) -> Vec<(Vec3, Vec3)> {
-    let n = vpls.len() as u64;
+    let n = vpls.len();
     (0..count as u64)
         .map(|k| {
-            let v = &vpls[(k * n / count as u64) as usize];
+            let j = (k * n as u64 / count as u64) as usize;
+            let v = (0..n)
+                .map(|s| &vpls[(j + s) % n])
+                .find(|v| is_live(v))
+                .unwrap_or(&vpls[j]);
             (Vec3::from(v.position), Vec3::from(v.normal))
         })
         .collect()
 }
 
-/// Index of the nearest centre (the lower index on ties).
+/// Index of the nearest centre (the lower index on ties); [`NO_VAL`] for a VPL of zero flux.
 pub fn nearest(v: &Vpl, centres: &[(Vec3, Vec3)], inv_d: f32, params: &ValParams) -> u32 {
+    if !is_live(v) {
+        return NO_VAL;
+    }
     let (p, n) = (Vec3::from(v.position), Vec3::from(v.normal));
     let mut best = (f32::INFINITY, 0u32);
     for (k, &(c, m)) in centres.iter().enumerate() {
@@ -214,7 +232,7 @@ pub fn cluster(
         }
         iterations += 1;
         let mut sums = vec![(Vec3::ZERO, Vec3::ZERO, 0u32); m];
-        for (v, &k) in vpls.iter().zip(&mapping) {
+        for (v, &k) in vpls.iter().zip(&mapping).filter(|(_, k)| **k != NO_VAL) {
             let s = &mut sums[k as usize];
             s.0 += Vec3::from(v.position);
             s.1 += Vec3::from(v.normal);
@@ -259,7 +277,7 @@ fn vals_of(vpls: &[Vpl], mapping: &[u32], centres: &[(Vec3, Vec3)]) -> Vec<Val> 
             ],
         })
         .collect();
-    for (v, &k) in vpls.iter().zip(mapping) {
+    for (v, &k) in vpls.iter().zip(mapping).filter(|(_, k)| **k != NO_VAL) {
         let val = &mut vals[k as usize];
         let (t, b) = basis(val.unit_normal());
         let q = Vec3::from(v.position) - val.centre();

@@ -3,7 +3,8 @@
 // d = w_x·Δx/D + w_α·Δα/π, restarted each frame from VAL k = VPL ⌊k·N/M⌋.
 // runtime::cpu::val is the CPU twin (same order of every sum, so the same VALs).
 //   init    centres from the restart VPLs
-//   assign  each VPL's nearest centre (ties to the lower index) → the mapping C
+//   assign  each live VPL's nearest centre (ties to the lower index) → the mapping C; a VPL of
+//           zero flux (an RSM sample that found nothing) maps to NONE and joins no VAL
 //   converge stops the iterations once the assignment repeats itself (the paper iterates to
 //           convergence; the iteration count is a maximum)
 //   update  each VAL's centre: mean position and normalised mean normal of its VPLs, summed
@@ -38,14 +39,22 @@ struct ValFrame {
 var<workgroup> wg_lo: array<vec3<f32>, WG_LINEAR>;
 var<workgroup> wg_hi: array<vec3<f32>, WG_LINEAR>;
 
-// One workgroup: 1 / D as runtime::cpu::val::scale_of gives it (1 for no VPLs).
+// A VPL that carries light: an RSM sample that found no surface gives one of zero flux, which
+// takes no part in the clustering (runtime::cpu::val::is_live).
+fn live(v: Vpl) -> bool {
+    return any(v.flux != vec3<f32>(0.0));
+}
+
+// One workgroup: 1 / D over the live VPLs, as runtime::cpu::val::scale_of gives it (1 for none).
 @compute @workgroup_size(WG_LINEAR)
 fn scale(@builtin(local_invocation_index) li: u32) {
     var lo = vec3<f32>(3.4e38);
     var hi = vec3<f32>(-3.4e38);
     for (var i = li; i < frame.vpl_count; i += WG_LINEAR) {
-        lo = min(lo, vpls[i].position);
-        hi = max(hi, vpls[i].position);
+        if live(vpls[i]) {
+            lo = min(lo, vpls[i].position);
+            hi = max(hi, vpls[i].position);
+        }
     }
     wg_lo[li] = lo;
     wg_hi[li] = hi;
@@ -59,7 +68,7 @@ fn scale(@builtin(local_invocation_index) li: u32) {
     }
     if li == 0u {
         var d = 1.0;
-        if frame.vpl_count > 0u {
+        if wg_lo[0].x <= wg_hi[0].x {
             d = max(length(wg_hi[0] - wg_lo[0]), 1e-30);
         }
         inv_scale[0] = 1.0 / d;
@@ -74,8 +83,15 @@ fn init(@builtin(global_invocation_id) id: vec3<u32>) {
     if k >= m || n == 0u {
         return;
     }
-    // ⌊k·N/M⌋ without overflowing 32 bits.
-    let j = k * (n / m) + (k * (n % m)) / m;
+    // ⌊k·N/M⌋ without overflowing 32 bits; a dead VPL there gives way to the next live one.
+    var j = k * (n / m) + (k * (n % m)) / m;
+    for (var s = 0u; s < n; s++) {
+        let i = (j + s) % n;
+        if live(vpls[i]) {
+            j = i;
+            break;
+        }
+    }
     centres[2u * k] = vec4<f32>(vpls[j].position, 0.0);
     centres[2u * k + 1u] = vec4<f32>(vpls[j].normal, 0.0);
 }
@@ -93,6 +109,10 @@ fn assign(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let v = vpls[i];
+    if !live(v) {
+        mapping[i] = NONE;
+        return;
+    }
     var best = distance(v, 0u);
     var at = 0u;
     for (var k = 1u; k < frame.val_count; k++) {
