@@ -253,6 +253,30 @@ fn gpu_renders_0_1_and_65536_vpls_and_a_vpl_on_the_receiver_without_nan() {
     }
 }
 
+/// `n` RSM VPLs of `scene`'s lights and their summed flux beside that of `n` light paths'.
+fn rsm_and_path_flux(
+    ctx: &GpuContext,
+    gpu: &mut GpuRenderer,
+    scene: &visgate_formats::Scene,
+    n: u32,
+) -> (Vec<visgate_runtime::vpl::Vpl>, Vec3, Vec3) {
+    let rsm = gpu.rsm_vpls(ctx, n, 256, 1).expect("rsm vpls");
+    let paths = path_vpls(
+        &Tracer::new(scene),
+        &scene.lights,
+        &PathParams {
+            paths: n,
+            bounces: 1,
+            seed: 1,
+        },
+    )
+    .expect("paths");
+    let sum =
+        |v: &[visgate_runtime::vpl::Vpl]| -> Vec3 { v.iter().map(|v| Vec3::from(v.flux)).sum() };
+    let (a, b) = (sum(&rsm), sum(&paths));
+    (rsm, a, b)
+}
+
 #[test]
 fn rsm_vpls_of_a_spot_wider_than_one_frustum_carry_its_power() {
     // An 89° spot in a closed box: its RSM is a cube of six layers (no clamped frustum), and
@@ -268,22 +292,7 @@ fn rsm_vpls_of_a_spot_wider_than_one_frustum_carry_its_power() {
         beam_rad: 70f32.to_radians(),
     }];
     let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
-    let tracer = Tracer::new(&scene);
-    let n = 4096;
-    let rsm = gpu.rsm_vpls(&ctx, n, 256, 1).expect("rsm vpls");
-    let paths = path_vpls(
-        &tracer,
-        &scene.lights,
-        &PathParams {
-            paths: n,
-            bounces: 1,
-            seed: 1,
-        },
-    )
-    .expect("paths");
-    let sum =
-        |v: &[visgate_runtime::vpl::Vpl]| -> Vec3 { v.iter().map(|v| Vec3::from(v.flux)).sum() };
-    let (a, b) = (sum(&rsm), sum(&paths));
+    let (_, a, b) = rsm_and_path_flux(&ctx, &mut gpu, &scene, 4096);
     eprintln!("89° spot: RSM flux {a}, path flux {b}");
     assert!(((a - b) / b).abs().max_element() < 0.02, "{a} vs {b}");
 }
@@ -297,21 +306,8 @@ fn rsm_vpls_carry_the_reflected_power_and_do_not_flicker() {
     let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
     let tracer = Tracer::new(&scene);
     let n = 4096;
-    let rsm = gpu.rsm_vpls(&ctx, n, 256, 1).expect("rsm vpls");
+    let (rsm, a, b) = rsm_and_path_flux(&ctx, &mut gpu, &scene, n);
     assert_eq!(rsm.len(), n as usize);
-    let paths = path_vpls(
-        &tracer,
-        &scene.lights,
-        &PathParams {
-            paths: n,
-            bounces: 1,
-            seed: 1,
-        },
-    )
-    .expect("paths");
-    let sum =
-        |v: &[visgate_runtime::vpl::Vpl]| -> Vec3 { v.iter().map(|v| Vec3::from(v.flux)).sum() };
-    let (a, b) = (sum(&rsm), sum(&paths));
     eprintln!("RSM flux {a}, path flux {b}");
     assert!(((a - b) / b).abs().max_element() < 0.02, "{a} vs {b}");
     // The same light gives the same VPLs.

@@ -454,26 +454,20 @@ impl GpuRenderer {
             wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
         );
         context::copy_texture(&mut rec.enc, &out.hdr, &read);
-        let counter_read = out.lists.as_ref().map(|l| {
+        let mut read_back = |label, src: &wgpu::Buffer, bytes| {
             let r = pool.buffer(
                 &ctx.device,
-                "light list counter readback",
-                32,
+                label,
+                bytes,
                 wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
             );
-            rec.enc.copy_buffer_to_buffer(&l.counter, 0, &r, 0, 32);
+            rec.enc.copy_buffer_to_buffer(src, 0, &r, 0, bytes);
             r
-        });
-        let state_read = out.val_state.as_ref().map(|s| {
-            let r = pool.buffer(
-                &ctx.device,
-                "val convergence readback",
-                16,
-                wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            );
-            rec.enc.copy_buffer_to_buffer(s, 0, &r, 0, 16);
-            r
-        });
+        };
+        let counter_read =
+            (out.lists.as_ref()).map(|l| read_back("light list counter readback", &l.counter, 32));
+        let state_read =
+            (out.val_state.as_ref()).map(|s| read_back("val convergence readback", s, 16));
         let mut times = rec.finish(pool)?;
         let t1 = Instant::now();
         if let (Some(l), Some(r)) = (&out.lists, &counter_read) {
