@@ -231,13 +231,14 @@ pub fn cluster(
             break;
         }
         iterations += 1;
-        let mut sums = vec![(Vec3::ZERO, Vec3::ZERO, 0u32); m];
-        for (v, &k) in vpls.iter().zip(&mapping).filter(|(_, k)| **k != NO_VAL) {
-            let s = &mut sums[k as usize];
-            s.0 += Vec3::from(v.position);
-            s.1 += Vec3::from(v.normal);
-            s.2 += 1;
-        }
+        let sums: Vec<(Vec3, Vec3, u32)> = (0..m as u32)
+            .map(|k| {
+                let of =
+                    |f: fn(&Vpl) -> [f32; 3]| lane_sums(vpls, &mapping, k, |v| Vec3::from(f(v)));
+                let count = mapping.iter().filter(|&&x| x == k).count() as u32;
+                (of(|v| v.position), of(|v| v.normal), count)
+            })
+            .collect();
         for (c, s) in centres.iter_mut().zip(&sums) {
             if s.2 > 0 {
                 // As the GPU divides (not normalize's reciprocal), for the same bits.
@@ -258,6 +259,32 @@ pub fn cluster(
         iterations,
         converged,
     })
+}
+
+/// Lanes of the GPU's workgroup per VAL: VPL i is summed in lane i mod this.
+pub const LANES: usize = 64;
+
+/// The sum of `f` over the VPLs mapped to `k`, in the GPU's order: lane t sums VPLs
+/// i ≡ t (mod [`LANES`]) in increasing i, then the lanes fold as a tree (t += t + o for
+/// o = 32, 16, …, 1) — so that the CPU twin gives the GPU's bits.
+pub fn lane_sums(vpls: &[Vpl], mapping: &[u32], k: u32, f: impl Fn(&Vpl) -> Vec3) -> Vec3 {
+    let mut lanes = [Vec3::ZERO; LANES];
+    for (i, (v, _)) in vpls
+        .iter()
+        .zip(mapping)
+        .enumerate()
+        .filter(|(_, (_, x))| **x == k)
+    {
+        lanes[i % LANES] += f(v);
+    }
+    let mut o = LANES / 2;
+    while o > 0 {
+        for t in 0..o {
+            lanes[t] += lanes[t + o];
+        }
+        o /= 2;
+    }
+    lanes[0]
 }
 
 /// The VALs of a mapping: centre and normal from `centres`, count, flux and bounding rectangle
@@ -283,9 +310,6 @@ fn vals_of(vpls: &[Vpl], mapping: &[u32], centres: &[(Vec3, Vec3)]) -> Vec<Val> 
         let q = Vec3::from(v.position) - val.centre();
         let (s, u) = (q.dot(t), q.dot(b));
         val.position[3] += 1.0;
-        for (f, x) in val.flux.iter_mut().zip(v.flux) {
-            *f += x;
-        }
         val.rect = [
             val.rect[0].min(s),
             val.rect[1].max(s),
@@ -293,7 +317,9 @@ fn vals_of(vpls: &[Vpl], mapping: &[u32], centres: &[(Vec3, Vec3)]) -> Vec<Val> 
             val.rect[3].max(u),
         ];
     }
-    for val in &mut vals {
+    for (k, val) in vals.iter_mut().enumerate() {
+        let flux = lane_sums(vpls, mapping, k as u32, |v| Vec3::from(v.flux));
+        val.flux = flux.extend(0.0).to_array();
         if val.position[3] == 0.0 {
             val.rect = [0.0; 4];
         }

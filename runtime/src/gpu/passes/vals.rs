@@ -195,10 +195,10 @@ impl ValClustering {
                 for _ in 0..params.iterations {
                     run(&self.assign, &assign_bg, gv);
                     run(&self.converge, &converge_bg, 1);
-                    run(&self.update, &update_bg, gm);
+                    run(&self.update, &update_bg, m);
                 }
                 run(&self.assign, &assign_bg, gv);
-                run(&self.finish, &finish_bg, gm);
+                run(&self.finish, &finish_bg, m);
                 let gb = (buckets as u32).div_ceil(WG_LINEAR);
                 run(&self.bucket_counts, &counts_bg, gb);
                 run(&self.offsets, &offsets_bg, 1);

@@ -143,34 +143,69 @@ fn converge() {
     atomicStore(&state[0], 0u);
 }
 
+// One workgroup per VAL: lane t sums the VPLs i ≡ t (mod WG_LINEAR) in increasing i, then the
+// lanes fold in a fixed tree (t += t + o for o = WG_LINEAR/2 … 1), the order the CPU twin
+// (runtime::cpu::val::lane_sums) follows: the same bits, N / WG_LINEAR steps per lane instead
+// of N per VAL.
+var<workgroup> wg_done: u32;
+var<workgroup> wg_a: array<vec3<f32>, WG_LINEAR>;
+var<workgroup> wg_b: array<vec3<f32>, WG_LINEAR>;
+var<workgroup> wg_count: array<u32, WG_LINEAR>;
+var<workgroup> wg_rect: array<vec4<f32>, WG_LINEAR>;
+
+// Folds the lanes of wg_a, wg_b, wg_count (and wg_rect by min/max) into lane 0.
+fn fold(li: u32) {
+    workgroupBarrier();
+    for (var o = WG_LINEAR / 2u; o > 0u; o >>= 1u) {
+        if li < o {
+            wg_a[li] += wg_a[li + o];
+            wg_b[li] += wg_b[li + o];
+            wg_count[li] += wg_count[li + o];
+            let r = wg_rect[li];
+            let q = wg_rect[li + o];
+            wg_rect[li] = vec4<f32>(min(r.x, q.x), max(r.y, q.y), min(r.z, q.z), max(r.w, q.w));
+        }
+        workgroupBarrier();
+    }
+}
+
 @compute @workgroup_size(WG_LINEAR)
-fn update(@builtin(global_invocation_id) id: vec3<u32>) {
-    let k = id.x;
-    if k >= frame.val_count || atomicLoad(&state[1]) != 0u {
+fn update(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    let k = wg.x;
+    if li == 0u {
+        wg_done = atomicLoad(&state[1]);
+    }
+    let done = workgroupUniformLoad(&wg_done);
+    if k >= frame.val_count || done != 0u {
         return;
     }
     var p = vec3<f32>(0.0);
     var nrm = vec3<f32>(0.0);
     var count = 0u;
-    for (var i = 0u; i < frame.vpl_count; i++) {
+    for (var i = li; i < frame.vpl_count; i += WG_LINEAR) {
         if mapping[i] == k {
             p += vpls[i].position;
             nrm += vpls[i].normal;
             count++;
         }
     }
-    if count > 0u {
-        centres[2u * k] = vec4<f32>(p / f32(count), 0.0);
-        let l = length(nrm);
+    wg_a[li] = p;
+    wg_b[li] = nrm;
+    wg_count[li] = count;
+    wg_rect[li] = vec4<f32>(0.0);
+    fold(li);
+    if li == 0u && wg_count[0] > 0u {
+        centres[2u * k] = vec4<f32>(wg_a[0] / f32(wg_count[0]), 0.0);
+        let l = length(wg_b[0]);
         if l > 0.0 {
-            centres[2u * k + 1u] = vec4<f32>(nrm / l, 0.0);
+            centres[2u * k + 1u] = vec4<f32>(wg_b[0] / l, 0.0);
         }
     }
 }
 
 @compute @workgroup_size(WG_LINEAR)
-fn finish(@builtin(global_invocation_id) id: vec3<u32>) {
-    let k = id.x;
+fn finish(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index) li: u32) {
+    let k = wg.x;
     if k >= frame.val_count {
         return;
     }
@@ -180,7 +215,7 @@ fn finish(@builtin(global_invocation_id) id: vec3<u32>) {
     var count = 0u;
     var flux = vec3<f32>(0.0);
     var rect = vec4<f32>(1e38, -1e38, 1e38, -1e38);
-    for (var i = 0u; i < frame.vpl_count; i++) {
+    for (var i = li; i < frame.vpl_count; i += WG_LINEAR) {
         if mapping[i] == k {
             let q = vpls[i].position - c;
             let s = dot(q, tb[0]);
@@ -190,13 +225,23 @@ fn finish(@builtin(global_invocation_id) id: vec3<u32>) {
             count++;
         }
     }
+    wg_a[li] = flux;
+    wg_b[li] = vec3<f32>(0.0);
+    wg_count[li] = count;
+    wg_rect[li] = rect;
+    fold(li);
+    if li != 0u {
+        return;
+    }
+    count = wg_count[0];
+    rect = wg_rect[0];
     if count == 0u {
         rect = vec4<f32>(0.0);
     }
     var v: Val;
     v.position = vec4<f32>(c, f32(count));
     v.normal = vec4<f32>(nrm, (rect.y - rect.x) * (rect.w - rect.z));
-    v.flux = vec4<f32>(flux, 0.0);
+    v.flux = vec4<f32>(wg_a[0], 0.0);
     v.rect = rect;
     vals[k] = v;
 }
