@@ -380,11 +380,14 @@ pub fn run(args: RenderArgs) -> Result<()> {
 fn print_frame(args: &RenderArgs, scene: &str, f: &JobFrame, load_s: f64, setup: &str) {
     let [bvh_s, vpl_s] = f.prep_s;
     println!(
-        "{scene} {} {} spp {}{}: {} VPLs ({:?}, {} asked, {} bounce(s))",
+        "{scene} {} {}{}: {} VPLs ({:?}, {} asked, {} bounce(s))",
         args.mode,
         args.size,
-        args.spp,
-        if args.cpu { " (CPU twin)" } else { "" },
+        match f.stats {
+            FrameStats::Gpu(_) => " (GPU)".to_string(),
+            FrameStats::Cpu(_) if args.cpu => format!(" spp {} (CPU twin)", args.spp),
+            FrameStats::Cpu(_) => format!(" spp {} (CPU)", args.spp),
+        },
         f.vpl_count,
         args.vpl_source,
         args.vpls,
