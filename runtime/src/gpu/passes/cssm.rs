@@ -125,20 +125,10 @@ impl Cssm {
             m as u64 * 4,
             wgpu::BufferUsages::STORAGE,
         );
-        let frames: Vec<CssmFrame> = (0..levels)
-            .map(|l| CssmFrame {
-                val_count: m,
-                terms,
-                groups,
-                map_size: size,
-                level_size: (size >> l).max(1),
-                ..bytemuck::Zeroable::zeroed()
-            })
-            .collect();
         let uniforms = pool.upload(
             ctx,
             "cssm frames",
-            &strided(&frames),
+            &strided(&frames(m, terms, size)),
             wgpu::BufferUsages::UNIFORM,
         );
         let frame = |l: u32| {
@@ -209,6 +199,20 @@ impl Cssm {
             ranges,
         })
     }
+}
+
+/// The constants of each mip level's pass, level 0 first.
+fn frames(m: u32, terms: u32, size: u32) -> Vec<CssmFrame> {
+    (0..size.ilog2() + 1)
+        .map(|l| CssmFrame {
+            val_count: m,
+            terms,
+            groups: terms.div_ceil(2),
+            map_size: size,
+            level_size: (size >> l).max(1),
+            ..bytemuck::Zeroable::zeroed()
+        })
+        .collect()
 }
 
 /// The CSSM basis sampler (trilinear, clamped), kept with the scene.
