@@ -710,3 +710,48 @@ fn rsm_samples_that_find_nothing_join_no_val_on_the_gpu_as_on_the_cpu() {
     assert_eq!(cpu.scale_m, alone.scale_m);
     eprintln!("{dead} dead of {}; D {} m", vpls.len(), cpu.scale_m);
 }
+
+#[test]
+fn cssm_receivers_near_a_val_under_an_open_sky_are_lit() {
+    // VPLs on a floor facing up, nothing above but a small receiver panel 20 cm up (facing
+    // down) and a far wall that sets the VAL's depth range: nothing blocks the panel. Its
+    // filter kernel reaches the map's empty texels (the open sky), whose depth must read as
+    // "no blocker", not as a half-shadowing wrap-around of the Fourier step.
+    let ctx = context();
+    let wall = [
+        Vec3::new(-20.0, 0.0, -20.0),
+        Vec3::new(20.0, 0.0, -20.0),
+        Vec3::new(20.0, 20.0, -20.0),
+        Vec3::new(-20.0, 20.0, -20.0),
+    ];
+    let scene = common::quads(&[square(1.0, 0.0), square(0.3, 0.2), wall], 0.5, vec![]);
+    let vpls: Vec<Vpl> = (0..64)
+        .map(|i| {
+            let p = Vec3::new(
+                -0.2 + (i % 8) as f32 * 0.05,
+                1e-3,
+                -0.2 + (i / 8) as f32 * 0.05,
+            );
+            Vpl::new(p, Vec3::Y, Vec3::splat(0.02))
+        })
+        .collect();
+    let cam = visgate_formats::Camera {
+        name: "under the panel".into(),
+        eye: Vec3::new(0.0, 0.05, 0.6),
+        target: Vec3::new(0.0, 0.2, 0.0),
+        up: Vec3::Y,
+        fov_x_rad: 60f32.to_radians(),
+    };
+    let soft = gpu_image_with(&ctx, &scene, &cam, &vpls, cssm(), 1, 1, [32, 24]);
+    let open = gpu_image_with(&ctx, &scene, &cam, &vpls, GpuMode::None, 1, 1, [32, 24]);
+    let ratio = soft.mean().x / open.mean().x;
+    eprintln!(
+        "open sky: CSSM {} vs unoccluded {} ({ratio})",
+        soft.mean().x,
+        open.mean().x
+    );
+    assert!(
+        ratio > 0.9,
+        "the unblocked panel is darkened to {ratio} of its light"
+    );
+}

@@ -70,6 +70,12 @@ pub const WG_CSSM: u32 = 8;
 pub const CLUSTER_BITS: u32 = 23;
 /// The "no cluster" value of every cluster field.
 pub const NONE: u32 = u32::MAX;
+/// CSSM depths are normalised into [0, this] of the period-2 Fourier step, so that a
+/// receiver–blocker difference never reaches ±1, where the step reads ½ (a guard band).
+pub const CSSM_DEPTH_SCALE: f32 = 0.9;
+/// The normalised depth of a CSSM texel that sees no surface: beyond every receiver, and less
+/// than 1 from each (no wrap-around).
+pub const CSSM_EMPTY_DEPTH: f32 = 0.95;
 
 /// The constants every composed shader starts with, generated from the Rust definitions.
 pub fn constants() -> String {
@@ -92,6 +98,8 @@ pub fn constants() -> String {
         ShadeIndirect::GatesClustered as u32,
     );
     s += "const LIGHT_POINT: f32 = 0.0;\nconst LIGHT_SPOT: f32 = 1.0;\n";
+    s += &format!("const CSSM_DEPTH_SCALE: f32 = {CSSM_DEPTH_SCALE:?};\n");
+    s += &format!("const CSSM_EMPTY_DEPTH: f32 = {CSSM_EMPTY_DEPTH:?};\n");
     s
 }
 

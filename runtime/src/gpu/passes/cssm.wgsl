@@ -65,7 +65,8 @@ fn basis(@builtin(global_invocation_id) id: vec3<u32>) {
     let m = cssm.val_count;
     let k = id.z;
     let d = textureLoad(maps, id.xy, k, 0).x;
-    let z = select(1.0, clamp(d / ranges[k], 0.0, 1.0), d < NO_SURFACE);
+    // Depth in [0, CSSM_DEPTH_SCALE], empty texels at CSSM_EMPTY_DEPTH: a guard band.
+    let z = select(CSSM_EMPTY_DEPTH, clamp(d / ranges[k], 0.0, 1.0) * CSSM_DEPTH_SCALE, d < NO_SURFACE);
     let groups = cssm.groups;
     for (var g = 0u; g < groups; g++) {
         let c1 = PI * f32(4u * g + 1u);

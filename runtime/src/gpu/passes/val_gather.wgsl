@@ -142,7 +142,7 @@ fn cssm_visibility(k: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
         return 1.0;
     }
     let range = ranges[k];
-    let d = clamp(dist / range - gather.receiver_offset, 0.0, 1.0);
+    let d = clamp(dist / range - gather.receiver_offset, 0.0, 1.0) * CSSM_DEPTH_SCALE;
     let dir = local / dist;
     let puv = dir.xy / (1.0 + dir.z);
     let uv = vec2<f32>(puv.x * 0.5 + 0.5, 0.5 - puv.y * 0.5);
@@ -160,11 +160,12 @@ fn cssm_visibility(k: u32, p: vec3<f32>, n: vec3<f32>) -> f32 {
         - series(groups, k, uv, lod_s, d);
     // A receiver within 1e-4 of the range from the VAL (d < 1e-4) keeps z_avg at 1e-4 of the
     // range, not at d = 0 (an infinite penumbra, or 0/0 for a VAL of no area).
-    let z_avg = clamp(z_sum / blockers, 1e-4, max(d, 1e-4)) * range;
+    let z_avg = clamp(z_sum / blockers, 1e-4, max(d, 1e-4)) * range / CSSM_DEPTH_SCALE;
     let penumbra = max(dist - z_avg, 0.0) * sender / z_avg;
     let alpha = atan(penumbra / dist);
     let lod = log2(max(alpha / PI * size, 1.0));
-    return clamp(0.5 + gather.sharpness * series(0u, k, uv, lod, d), 0.0, 1.0);
+    // The sharpening divided by the guard band's scale keeps the step's slope per metre.
+    return clamp(0.5 + gather.sharpness / CSSM_DEPTH_SCALE * series(0u, k, uv, lod, d), 0.0, 1.0);
 }
 
 @fragment
