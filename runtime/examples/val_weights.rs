@@ -1,0 +1,90 @@
+//! The effect of the VAL clustering's weights, like Fig. 6 of Dong et al. (which shows the
+//! clusterings): MSE against the exact CPU reference with the same VPLs for w_x = 1 − w_α from
+//! 0 (normals only) to 1 (positions only), M = 30 VALs, val-cssm and val-hard, every VPL at
+//! every pixel, on the Cornell box and the four rooms; and each clustering's mean VAL area.
+//!
+//! `cargo run --release -p visgate-runtime --example val_weights -- [WxH] [VPL paths]`
+
+use visgate_runtime::camera::View;
+use visgate_runtime::cpu::reference::{ReferenceParams, render_reference};
+use visgate_runtime::cpu::tracer::Tracer;
+use visgate_runtime::cpu::val::{ValParams, cluster};
+use visgate_runtime::gpu::{
+    CssmParams, GpuContext, GpuMode, GpuParams, GpuRenderer, InterleaveParams, ValModeParams,
+};
+use visgate_runtime::metrics::errors;
+use visgate_runtime::vpl::{PathParams, path_vpls};
+use visgate_scenes::Builtin;
+
+const W_X: [f32; 5] = [0.0, 0.3, 0.5, 0.7, 1.0];
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let mut args = std::env::args().skip(1);
+    let size = args.next().unwrap_or_else(|| "128x96".into());
+    let (w, h) = size.split_once('x').ok_or("size WxH")?;
+    let size = [w.parse()?, h.parse()?];
+    let paths: u32 = args.next().map(|a| a.parse()).transpose()?.unwrap_or(1024);
+    let ctx = GpuContext::new()?;
+    println!(
+        "M = 30, {paths} light paths, {}×{}; MSE (mean VAL area, m²)",
+        size[0], size[1]
+    );
+    println!("| scene | mode | w_x = 0 | 0.3 | 0.5 | 0.7 (paper) | 1 |");
+    println!("|---|---|---|---|---|---|---|");
+    for b in [Builtin::CornellBox, Builtin::FourRooms] {
+        let scene = b.scene()?;
+        let view = View::new(scene.cameras.first().ok_or("no camera")?, size)?;
+        let tracer = Tracer::new(&scene);
+        let vpls = path_vpls(
+            &tracer,
+            &scene.lights,
+            &PathParams {
+                paths,
+                bounces: 1,
+                seed: 1,
+            },
+        )?;
+        let params = ReferenceParams {
+            samples_per_pixel: 1,
+            ..ReferenceParams::default()
+        };
+        let (reference, _) =
+            render_reference(&tracer, &scene.lights, &vpls, &view, &params, &|_, _| {})?;
+        let mut gpu = GpuRenderer::new(&ctx, &scene)?;
+        for soft in [true, false] {
+            let mut row = format!(
+                "| {} | {} |",
+                b.name(),
+                if soft { "val-cssm" } else { "val-hard" }
+            );
+            for w_x in W_X {
+                let vals = ValParams {
+                    count: 30,
+                    w_x,
+                    w_alpha: 1.0 - w_x,
+                    ..ValParams::default()
+                };
+                let v = ValModeParams {
+                    vals,
+                    interleave: InterleaveParams {
+                        block: 1,
+                        ..InterleaveParams::default()
+                    },
+                    ..ValModeParams::new()
+                };
+                let mode = match soft {
+                    true => GpuMode::ValCssm(v, CssmParams::default()),
+                    false => GpuMode::ValHard(v),
+                };
+                let (img, _) = gpu.render(&ctx, &view, &vpls, &GpuParams::with_mode(mode))?;
+                let c = cluster(&vpls, &vals, None)?;
+                let live = c.vals.iter().filter(|v| v.vpl_count() > 0);
+                let area: f32 =
+                    live.clone().map(|v| v.normal[3]).sum::<f32>() / live.count().max(1) as f32;
+                row += &format!(" {:.3e} ({area:.2}) |", errors(&img, &reference)?.mse);
+            }
+            println!("{row}");
+        }
+    }
+    Ok(())
+}
