@@ -3,7 +3,8 @@
 //! frames: per-frame inputs (view, VPLs or their RSM source, [`GpuParams`]) go in, an HDR image
 //! and the [`PassTimes`] come out. A second frame with the same sizes and settings makes no GPU
 //! resource; a frame is recorded into one command encoder and, where the adapter has timestamp
-//! queries, submitted once and waited for once, at its readback.
+//! queries, submitted once (per-VPL maps: once per batch, as recorded) and waited for once, at
+//! its readback. GPU errors of a frame come back as [`RenderError`], not as panics.
 //!
 //! A frame, as [`record_passes`] lists it:
 //!
