@@ -66,6 +66,9 @@ pub fn clusters(
     order.sort_by(|&a, &b| rad(b).total_cmp(&rad(a)).then(a.cmp(&b)));
     let mut cluster = vec![u32::MAX; n];
     let mut seeds = Vec::new();
+    // Membership of the current max-ball walk: `in_ball[x] == m` while walking node m's ball
+    // (each node is walked once), so the test is O(1) instead of a scan of the walk.
+    let mut in_ball = vec![u32::MAX; n];
     for &start in &order {
         if cluster[start as usize] != u32::MAX {
             continue;
@@ -91,10 +94,12 @@ pub fn clusters(
             // Nodes inside m's max ball, reachable through nodes inside it.
             let (pm, rm) = (pos(m), rad(m));
             let mut inside = vec![m];
+            in_ball[m as usize] = m;
             let mut k = 0;
             while k < inside.len() {
                 for &nb in &adj[inside[k] as usize] {
-                    if !inside.contains(&nb) && (pos(nb) - pm).length() <= rm {
+                    if in_ball[nb as usize] != m && (pos(nb) - pm).length() <= rm {
+                        in_ball[nb as usize] = m;
                         inside.push(nb);
                         if cluster[nb as usize] == u32::MAX {
                             stack.push(nb);
