@@ -231,19 +231,17 @@ pub fn cluster(
             break;
         }
         iterations += 1;
-        let sums: Vec<(Vec3, Vec3, u32)> = (0..m as u32)
-            .map(|k| {
-                let of =
-                    |f: fn(&Vpl) -> [f32; 3]| lane_sums(vpls, &mapping, k, |v| Vec3::from(f(v)));
-                let count = mapping.iter().filter(|&&x| x == k).count() as u32;
-                (of(|v| v.position), of(|v| v.normal), count)
-            })
-            .collect();
-        for (c, s) in centres.iter_mut().zip(&sums) {
-            if s.2 > 0 {
+        let positions = lane_sums(vpls, &mapping, m, |v| v.position);
+        let normals = lane_sums(vpls, &mapping, m, |v| v.normal);
+        let counts = counts_of(&mapping, m);
+        for (k, c) in centres.iter_mut().enumerate() {
+            if counts[k] > 0 {
                 // As the GPU divides (not normalize's reciprocal), for the same bits.
-                let l = s.1.length();
-                *c = (s.0 / s.2 as f32, if l > 0.0 { s.1 / l } else { c.1 });
+                let l = normals[k].length();
+                *c = (
+                    positions[k] / counts[k] as f32,
+                    if l > 0.0 { normals[k] / l } else { c.1 },
+                );
             }
         }
         last = Some(mapping);
@@ -264,27 +262,38 @@ pub fn cluster(
 /// Lanes of the GPU's workgroup per VAL: VPL i is summed in lane i mod this.
 pub const LANES: usize = 64;
 
-/// The sum of `f` over the VPLs mapped to `k`, in the GPU's order: lane t sums VPLs
-/// i ≡ t (mod [`LANES`]) in increasing i, then the lanes fold as a tree (t += t + o for
-/// o = 32, 16, …, 1) — so that the CPU twin gives the GPU's bits.
-pub fn lane_sums(vpls: &[Vpl], mapping: &[u32], k: u32, f: impl Fn(&Vpl) -> Vec3) -> Vec3 {
-    let mut lanes = [Vec3::ZERO; LANES];
-    for (i, (v, _)) in vpls
-        .iter()
-        .zip(mapping)
-        .enumerate()
-        .filter(|(_, (_, x))| **x == k)
-    {
-        lanes[i % LANES] += f(v);
-    }
-    let mut o = LANES / 2;
-    while o > 0 {
-        for t in 0..o {
-            lanes[t] += lanes[t + o];
+/// Each VAL's sum of `f` over its VPLs (`m` VALs, one pass over the VPLs), in the GPU's
+/// order: lane t of VAL k sums its VPLs i ≡ t (mod [`LANES`]) in increasing i, then the lanes
+/// fold as a tree (t += t + o for o = 32, 16, …, 1) — so that the CPU twin gives the GPU's bits.
+pub fn lane_sums(vpls: &[Vpl], mapping: &[u32], m: usize, f: fn(&Vpl) -> [f32; 3]) -> Vec<Vec3> {
+    let mut lanes = vec![[Vec3::ZERO; LANES]; m];
+    for (i, (v, &k)) in vpls.iter().zip(mapping).enumerate() {
+        if k != NO_VAL {
+            lanes[k as usize][i % LANES] += Vec3::from(f(v));
         }
-        o /= 2;
     }
-    lanes[0]
+    lanes
+        .iter_mut()
+        .map(|l| {
+            let mut o = LANES / 2;
+            while o > 0 {
+                for t in 0..o {
+                    l[t] += l[t + o];
+                }
+                o /= 2;
+            }
+            l[0]
+        })
+        .collect()
+}
+
+/// VPLs per VAL (`m` VALs; [`NO_VAL`] counts nowhere).
+fn counts_of(mapping: &[u32], m: usize) -> Vec<u32> {
+    let mut counts = vec![0u32; m];
+    for &k in mapping.iter().filter(|&&k| k != NO_VAL) {
+        counts[k as usize] += 1;
+    }
+    counts
 }
 
 /// The VALs of a mapping: centre and normal from `centres`, count, flux and bounding rectangle
@@ -317,8 +326,8 @@ fn vals_of(vpls: &[Vpl], mapping: &[u32], centres: &[(Vec3, Vec3)]) -> Vec<Val> 
             val.rect[3].max(u),
         ];
     }
-    for (k, val) in vals.iter_mut().enumerate() {
-        let flux = lane_sums(vpls, mapping, k as u32, |v| Vec3::from(v.flux));
+    let fluxes = lane_sums(vpls, mapping, vals.len(), |v| v.flux);
+    for (val, flux) in vals.iter_mut().zip(fluxes) {
         val.flux = flux.extend(0.0).to_array();
         if val.position[3] == 0.0 {
             val.rect = [0.0; 4];
