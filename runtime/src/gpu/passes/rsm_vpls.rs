@@ -12,7 +12,7 @@ use super::gbuffer::{Depth, FORMATS, GBuffer};
 use super::shadow_maps::light_views;
 use crate::RenderError;
 use crate::gpu::context::{Pool, array_view, bind_group, compute_pipelines, layer_view, slice};
-use crate::gpu::layout::{Globals, RsmSample, ShadowView, UNIFORM_STRIDE, Vpl, strided};
+use crate::gpu::layout::{Globals, Light, RsmSample, ShadowView, UNIFORM_STRIDE, Vpl, strided};
 use crate::gpu::shaders::{self, WG_LINEAR};
 use crate::gpu::timing::Recorder;
 use crate::gpu::{GpuContext, SceneGpu};
@@ -54,8 +54,11 @@ pub struct RsmVpls {
 }
 
 /// The Halton samples of the lights' RSM layers: (layer, texel) and power of each.
-fn samples(lights: &[SceneLight], views: &[ShadowView], p: &RsmParams) -> Vec<RsmSample> {
-    let (gpu_lights, _) = light_views(lights, 1.0, 2.0);
+fn samples(
+    lights: &[SceneLight],
+    (gpu_lights, views): (&[Light], &[ShadowView]),
+    p: &RsmParams,
+) -> Vec<RsmSample> {
     let share = crate::vpl::share_by_power(lights, p.count);
     let s = p.rsm_size;
     let mut out = Vec::with_capacity(p.count as usize);
@@ -122,11 +125,11 @@ impl RsmVpls {
     ) -> Result<(wgpu::Buffer, u32), RenderError> {
         p.check()?;
         let d = &ctx.device;
-        let (_, views) = light_views(&scene.lights, scene.near_m, scene.far_m);
+        let (gpu_lights, views) = light_views(&scene.lights, scene.near_m, scene.far_m);
         let samples = if views.is_empty() {
             Vec::new()
         } else {
-            samples(&scene.lights, &views, p)
+            samples(&scene.lights, (&gpu_lights, &views), p)
         };
         let n = samples.len() as u32;
         let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
