@@ -9,18 +9,15 @@
 //! no visibility grey and per-VPL shadow maps black as flat lines, solid for the Cornell box,
 //! dashed for the four rooms).
 
+mod fixture;
 mod plot;
 
-use visgate_runtime::camera::View;
-use visgate_runtime::cpu::reference::{ReferenceParams, render_reference};
-use visgate_runtime::cpu::tracer::Tracer;
 use visgate_runtime::cpu::val::ValParams;
 use visgate_runtime::gpu::{
     CssmParams, GpuContext, GpuMode, GpuParams, GpuRenderer, InterleaveParams, MethodSettings,
     ValModeParams,
 };
 use visgate_runtime::metrics::errors;
-use visgate_runtime::vpl::{PathParams, path_vpls};
 use visgate_scenes::Builtin;
 
 const COUNTS: [u32; 6] = [2, 4, 8, 16, 30, 64];
@@ -48,29 +45,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         (Builtin::CornellBox, [200, 30, 30]),
         (Builtin::FourRooms, [30, 60, 200]),
     ] {
-        let scene = b.scene()?;
-        let view = View::new(scene.cameras.first().ok_or("no camera")?, size)?;
-        let tracer = Tracer::new(&scene);
-        let vpls = path_vpls(
-            &tracer,
-            &scene.lights,
-            &PathParams {
-                paths,
-                bounces: 1,
-                seed: 1,
-            },
-        )?;
-        let (reference, _) = render_reference(
-            &tracer,
-            &scene.lights,
-            &vpls,
-            &view,
-            &ReferenceParams {
-                samples_per_pixel: 1,
-                ..ReferenceParams::default()
-            },
-            &|_, _| {},
-        )?;
+        let fixture::Fixture {
+            scene,
+            view,
+            vpls,
+            reference,
+        } = fixture::fixture(b, size, paths)?;
         let mut gpu = GpuRenderer::new(&ctx, &scene)?;
         let mut mse = |mode: fn(ValModeParams) -> GpuMode,
                        m: u32|

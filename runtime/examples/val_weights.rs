@@ -5,15 +5,13 @@
 //!
 //! `cargo run --release -p visgate-runtime --example val_weights -- [WxH] [VPL paths]`
 
-use visgate_runtime::camera::View;
-use visgate_runtime::cpu::reference::{ReferenceParams, render_reference};
-use visgate_runtime::cpu::tracer::Tracer;
+mod fixture;
+
 use visgate_runtime::cpu::val::{ValParams, cluster};
 use visgate_runtime::gpu::{
     CssmParams, GpuContext, GpuMode, GpuParams, GpuRenderer, InterleaveParams, ValModeParams,
 };
 use visgate_runtime::metrics::errors;
-use visgate_runtime::vpl::{PathParams, path_vpls};
 use visgate_scenes::Builtin;
 
 const W_X: [f32; 5] = [0.0, 0.3, 0.5, 0.7, 1.0];
@@ -32,24 +30,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     println!("| scene | mode | w_x = 0 | 0.3 | 0.5 | 0.7 (paper) | 1 |");
     println!("|---|---|---|---|---|---|---|");
     for b in [Builtin::CornellBox, Builtin::FourRooms] {
-        let scene = b.scene()?;
-        let view = View::new(scene.cameras.first().ok_or("no camera")?, size)?;
-        let tracer = Tracer::new(&scene);
-        let vpls = path_vpls(
-            &tracer,
-            &scene.lights,
-            &PathParams {
-                paths,
-                bounces: 1,
-                seed: 1,
-            },
-        )?;
-        let params = ReferenceParams {
-            samples_per_pixel: 1,
-            ..ReferenceParams::default()
-        };
-        let (reference, _) =
-            render_reference(&tracer, &scene.lights, &vpls, &view, &params, &|_, _| {})?;
+        let fixture::Fixture {
+            scene,
+            view,
+            vpls,
+            reference,
+        } = fixture::fixture(b, size, paths)?;
         let mut gpu = GpuRenderer::new(&ctx, &scene)?;
         for soft in [true, false] {
             let mut row = format!(
