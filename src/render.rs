@@ -19,6 +19,7 @@ use visgate_runtime::job::{
     FrameStats, JobFrame, RenderJob, Renderer, VplSource as JobVpls, pass_table,
 };
 use visgate_runtime::metrics::{errors, flip};
+use visgate_runtime::vpl::GeometryClamp;
 
 pub const RENDER_HELP: &str = "\
 Modes:
@@ -114,9 +115,14 @@ pub struct RenderArgs {
     /// Pixel samples (jittered).
     #[arg(long, default_value_t = 4)]
     pub spp: u32,
-    /// Upper bound of the VPL geometry term cos·cos/d², 1/m² (against spikes near VPLs).
-    #[arg(long, default_value_t = 10.0)]
-    pub g_max: f32,
+    /// Upper bound of the VPL geometry term cos·cos/d², 1/m² (against spikes near VPLs);
+    /// absolute, so the image changes with the scene's scale. Default: from --clamp-distance.
+    #[arg(long, conflicts_with = "clamp_distance")]
+    pub g_max: Option<f32>,
+    /// The geometry-term clamp starts at this fraction of the scene's bounding diagonal
+    /// (g_max = 1 / (F·diagonal)²): the same image, up to scale, at any scale of the level.
+    #[arg(long, default_value_t = 0.025)]
+    pub clamp_distance: f32,
     /// Exposure of the PNG, in stops.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub exposure: f32,
@@ -272,11 +278,15 @@ impl RenderArgs {
             renderer,
             params: GpuParams {
                 mode: GpuMode::None,
-                g_max: self.g_max,
+                g_max: GpuParams::default().g_max,
                 shadows: ShadowParams {
                     size: self.shadow_size,
                     ..ShadowParams::default()
                 },
+            },
+            clamp: match self.g_max {
+                Some(g) => GeometryClamp::PerSquareMetre(g),
+                None => GeometryClamp::DiagonalFraction(self.clamp_distance),
             },
             vpls: self.vpls,
             vpl_source: match self.vpl_source {
@@ -337,6 +347,15 @@ pub fn run(args: RenderArgs) -> Result<()> {
         }
         _ => None,
     };
+    let g_max = job.for_scene(&scene)?.params.g_max;
+    match job.clamp {
+        GeometryClamp::PerSquareMetre(_) => println!("geometry-term clamp g_max {g_max:.4} 1/m²"),
+        GeometryClamp::DiagonalFraction(f) => println!(
+            "geometry-term clamp g_max {g_max:.4} 1/m² (from {f} of the scene's diagonal: it acts \
+             within {:.4} m of a VPL)",
+            g_max.powf(-0.5)
+        ),
+    }
     let bar = ProgressBar::new(job.size[1] as u64).with_style(
         ProgressStyle::with_template("render {bar:40} {pos}/{len} rows {elapsed}<{eta}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),

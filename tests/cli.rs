@@ -392,6 +392,8 @@ fn render_and_diff_refuse_bad_arguments_clearly() {
         (vec!["--bounces", "0"], "bounces"),
         (vec!["--spp", "0"], "samples per pixel"),
         (vec!["--g-max", "0"], "clamp"),
+        (vec!["--clamp-distance", "0"], "fraction of the diagonal"),
+        (vec!["--clamp-distance", "0.1", "--g-max", "3"], "cannot be used with"),
     ] {
         let mut a = vec!["render", "builtin:cornell-box", "--out", out];
         if !args.contains(&"--size") {

@@ -172,9 +172,15 @@ fn a_render_job_gives_the_image_of_a_direct_renderer_call() {
     .expect("vpls");
     let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
     let view = View::new(&cam, [24, 24]).expect("view");
-    let (img, _) = gpu
-        .render(&ctx, &view, &vpls, &GpuParams::default())
-        .expect("render");
+    // The job's clamp follows the scene's size: 1 / (0.025 · diagonal)².
+    let (lo, hi) = scene.bounds().expect("bounds");
+    let g_max = (0.025 * (hi - lo).length()).powi(-2);
+    assert_eq!(job.for_scene(&scene).expect("job").params.g_max, g_max);
+    let params = GpuParams {
+        g_max,
+        ..GpuParams::default()
+    };
+    let (img, _) = gpu.render(&ctx, &view, &vpls, &params).expect("render");
     assert_eq!(frames[0].image.pixels, img.pixels);
     // The limits are the library's: a gate mode without a level, RSM with 2 bounces.
     let gates = RenderJob {

@@ -14,7 +14,7 @@ use crate::cpu::reference::{IndirectVisibility, ReferenceParams, ReferenceStats,
 use crate::cpu::tracer::Tracer;
 use crate::gpu::{GpuContext, GpuMode, GpuParams, GpuRenderer, PassTimes, RsmParams, VplInput};
 use crate::hdr::HdrImage;
-use crate::vpl::{GatherParams, PathParams, Vpl, path_vpls};
+use crate::vpl::{GatherParams, GeometryClamp, PathParams, Vpl, path_vpls};
 
 /// Where the VPLs come from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -42,8 +42,11 @@ pub enum Renderer {
 pub struct RenderJob {
     /// The renderer and method.
     pub renderer: Renderer,
-    /// GPU settings (the method inside is `renderer`'s; g_max and shadows serve every renderer).
+    /// GPU settings: the method inside is `renderer`'s, and `g_max` is replaced by `clamp`'s
+    /// value for the scene; the shadows serve every renderer.
     pub params: GpuParams,
+    /// The geometry-term clamp of every renderer (by default relative to the scene's size).
+    pub clamp: GeometryClamp,
     /// Light paths (VPL source paths) or VPLs (RSM). [Limit: ≤ 2^24]
     pub vpls: u32,
     /// Where the VPLs come from.
@@ -71,6 +74,7 @@ impl Default for RenderJob {
         RenderJob {
             renderer: Renderer::Reference,
             params: GpuParams::default(),
+            clamp: GeometryClamp::default(),
             vpls: 1024,
             vpl_source: VplSource::Paths,
             rsm_size: 256,
@@ -179,6 +183,7 @@ impl RenderJob {
                 m.name()
             )));
         }
+        self.clamp.g_max(1.0)?;
         match self.renderer {
             Renderer::Gpu(_) => self.params.check(),
             Renderer::Reference => Ok(()),
@@ -209,11 +214,12 @@ impl RenderJob {
         on_frame: &mut dyn FnMut(JobFrame) -> Result<(), RenderError>,
     ) -> Result<(), RenderError> {
         self.check(level.is_some())?;
-        let view = View::new(camera, self.size)?;
-        let on_gpu = matches!(self.renderer, Renderer::Gpu(_));
+        let job = self.for_scene(scene)?;
+        let view = View::new(camera, job.size)?;
+        let on_gpu = matches!(job.renderer, Renderer::Gpu(_));
         let t = Instant::now();
-        let first = scene.at(self.time);
-        let ctx = if on_gpu || self.vpl_source == VplSource::Rsm {
+        let first = scene.at(job.time);
+        let ctx = if on_gpu || job.vpl_source == VplSource::Rsm {
             Some(GpuContext::new()?)
         } else {
             None
@@ -233,8 +239,8 @@ impl RenderJob {
                 .map(|c| format!("{} ({:?})", c.adapter_info.name, c.adapter_info.backend)),
             seconds: t.elapsed().as_secs_f64(),
         });
-        for index in 0..self.frames {
-            let time = self.time + index as f64 / self.fps;
+        for index in 0..job.frames {
+            let time = job.time + index as f64 / job.fps;
             let posed = if index == 0 {
                 first.clone()
             } else {
@@ -244,8 +250,8 @@ impl RenderJob {
                 g.set_scene(ctx, &posed);
             }
             let frame = match (&ctx, &mut gpu) {
-                (Some(ctx), Some(g)) => self.frame_gpu(ctx, g, &posed, &view, level)?,
-                _ => self.frame_cpu(&posed, &view, level, &[], progress)?,
+                (Some(ctx), Some(g)) => job.frame_gpu(ctx, g, &posed, &view, level)?,
+                _ => job.frame_cpu(&posed, &view, level, &[], progress)?,
             };
             on_frame(JobFrame {
                 index,
@@ -254,6 +260,14 @@ impl RenderJob {
             })?;
         }
         Ok(())
+    }
+
+    /// The job with `params.g_max` resolved from `clamp` for `scene` (its bounding diagonal).
+    pub fn for_scene(&self, scene: &Scene) -> Result<RenderJob, RenderError> {
+        let diagonal = scene.bounds().map_or(0.0, |(lo, hi)| (hi - lo).length());
+        let mut job = self.clone();
+        job.params.g_max = self.clamp.g_max(diagonal)?;
+        Ok(job)
     }
 
     /// Light-path VPLs of `scene` (none for direct light only).

@@ -1,0 +1,95 @@
+//! One command at any scale: the built-in four rooms at 1e-3 … 1e4 metres per unit (every
+//! length × s, the lights' intensities × s² so that the radiance is the same), baked and
+//! rendered by every method of the registry and the CPU reference with default settings, gives
+//! the same image (relative MSE < 1e-3), with no NaN.
+
+#[path = "../runtime/tests/common/mod.rs"]
+mod common;
+
+use visgate_formats::vgate::BakeParams;
+use visgate_preprocess::bake::{BakeOptions, bake};
+use visgate_runtime::cpu::gates::GateLevel;
+use visgate_runtime::gpu::{METHODS, MethodSettings};
+use visgate_runtime::hdr::HdrImage;
+use visgate_runtime::job::{RenderJob, Renderer, VplSource};
+use visgate_runtime::metrics::errors;
+
+/// Every method's image of the four rooms scaled by `s`, the reference's last.
+fn images_at(s: f32, source: VplSource) -> Vec<(String, HdrImage)> {
+    let (scene, cam) = common::scaled_four_rooms(s);
+    let level = bake(
+        &scene,
+        &BakeParams::default(),
+        &BakeOptions::default(),
+        &|_| {},
+    )
+    .expect("bake")
+    .level;
+    let gates = GateLevel::new(level, &scene).expect("level");
+    let mut renderers: Vec<(String, Renderer)> = METHODS
+        .iter()
+        .map(|m| {
+            let mode = (m.make)(&MethodSettings::default());
+            (m.name.to_string(), Renderer::Gpu(mode))
+        })
+        .collect();
+    renderers.push(("reference".into(), Renderer::Reference));
+    renderers
+        .into_iter()
+        .map(|(name, renderer)| {
+            let job = RenderJob {
+                renderer,
+                vpls: 128,
+                vpl_source: source,
+                size: [48, 32],
+                spp: 1,
+                ..RenderJob::default()
+            };
+            let mut image = None;
+            job.run(
+                &scene,
+                &cam,
+                Some(&gates),
+                &mut |_| {},
+                &|_, _| {},
+                &mut |f| {
+                    image = Some(f.image);
+                    Ok(())
+                },
+            )
+            .unwrap_or_else(|e| panic!("{name} at scale {s}: {e}"));
+            let image = image.expect("a frame");
+            assert!(
+                image.pixels.iter().all(|p| p.is_finite()),
+                "{name} at scale {s}: not finite"
+            );
+            (name, image)
+        })
+        .collect()
+}
+
+fn assert_same_at_every_scale(source: VplSource, scales: &[f32]) {
+    let one = images_at(1.0, source);
+    for &s in scales {
+        for ((name, img), (_, want)) in images_at(s, source).iter().zip(&one) {
+            let e = errors(img, want).expect("same size");
+            eprintln!(
+                "{source:?} {name} at scale {s}: rel. MSE {:.3e}, mean {}",
+                e.rel_mse,
+                img.mean()
+            );
+            assert!(want.mean().x > 0.0, "{name}: a black image proves nothing");
+            assert!(e.rel_mse < 1e-3, "{source:?} {name} at scale {s}: {e:?}");
+        }
+    }
+}
+
+#[test]
+fn every_method_gives_the_same_image_at_scales_1e_3_to_1e4_with_light_paths() {
+    assert_same_at_every_scale(VplSource::Paths, &[1e-3, 1e-2, 0.1, 10.0, 100.0, 1e3, 1e4]);
+}
+
+#[test]
+fn every_method_gives_the_same_image_at_scales_1e_3_to_1e4_with_rsm_vpls() {
+    assert_same_at_every_scale(VplSource::Rsm, &[1e-3, 1e4]);
+}
