@@ -1,5 +1,6 @@
 //! An error table like Table II of the visibility-gates paper, from the CPU renderers: MSE
-//! (and relative MSE, FLIP) against the exact reference with the same VPLs, for direct light
+//! (and relative MSE, FLIP, the indirect energy ratio and the share of pixels black where the
+//! reference's indirect light is) against the exact reference with the same VPLs, for direct light
 //! only, no visibility on indirect light, and gate visibility (the paper's 1 hop, 2 hops,
 //! oversized disks). The CPU twin of the gates mode gives the same image as the GPU's
 //! clustered gates (the tests hold them equal).
@@ -16,7 +17,7 @@ use visgate_runtime::camera::View;
 use visgate_runtime::cpu::gates::{GateLevel, GateParams};
 use visgate_runtime::cpu::reference::{IndirectVisibility, ReferenceParams, render_with};
 use visgate_runtime::cpu::tracer::Tracer;
-use visgate_runtime::metrics::{errors, flip};
+use visgate_runtime::metrics::{errors, flip, indirect_errors};
 use visgate_runtime::vpl::{PathParams, path_vpls};
 
 mod common;
@@ -85,6 +86,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             render_with(&tracer, lights, &vpls, &view, &params, vis, &|_, _| {}).map(|r| r.0)
         };
         let reference = run(IndirectVisibility::Exact, true)?;
+        let direct = run(IndirectVisibility::Unoccluded, false)?;
         let light = match &lights[..] {
             [visgate_formats::Light::Point { position, .. }] => {
                 format!("point light at {position}")
@@ -93,8 +95,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             _ => format!("{} lights", lights.len()),
         };
         println!("\n{light} ({} VPLs), camera {}", vpls.len(), cam.name);
-        println!("| method | MSE | rel. MSE | FLIP |");
-        println!("|---|---|---|---|");
+        println!("| method | MSE | rel. MSE | FLIP | indirect energy | black where lit |");
+        println!("|---|---|---|---|---|---|");
         let gp = |oversize: f32, max_hops: u32| {
             IndirectVisibility::Gates(&gates, GateParams { oversize, max_hops })
         };
@@ -109,7 +111,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let img = run(vis, indirect)?;
             let e = errors(&img, &reference)?;
             let (f, _) = flip(&img, &reference, 0.0)?;
-            println!("| {name} | {:.3e} | {:.3e} | {f:.4} |", e.mse, e.rel_mse);
+            let i = indirect_errors(&img, &reference, &direct)?;
+            println!(
+                "| {name} | {:.3e} | {:.3e} | {f:.4} | {:.3} | {:.1} % |",
+                e.mse,
+                e.rel_mse,
+                i.energy_ratio,
+                i.black_where_lit * 100.0
+            );
         }
     }
     Ok(())

@@ -8,7 +8,9 @@ use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 use visgate_formats::ImportOptions;
-use visgate_formats::vgate::{BakeParams, GatePlacement, Resolution};
+use visgate_formats::vgate::{
+    AlphaRule, BakeParams, CurvatureTo, GatePlacement, MaxBall, Resolution,
+};
 use visgate_preprocess::bake::{BakeOptions, Progress, bake};
 
 /// Options of `visgate bake`.
@@ -34,6 +36,16 @@ pub struct BakeArgs {
     /// Where gates sit on a segmented edge that joins two clusters.
     #[arg(long, value_enum, default_value_t = Gates::Narrowest)]
     pub gates: Gates,
+    /// What a skeleton node's max-ball radius measures (default: solid-centre; see README).
+    #[arg(long, value_enum)]
+    pub max_ball: Option<MaxBallArg>,
+    /// What the cluster growth's α compares a neighbour's radius with (default: popped-node;
+    /// see README).
+    #[arg(long, value_enum)]
+    pub alpha_rule: Option<AlphaRuleArg>,
+    /// What a skeleton line node's curvature measures the distance to (default: line, the paper's).
+    #[arg(long, value_enum)]
+    pub curvature_to: Option<CurvatureArg>,
     /// Empty components with no camera or light and fewer voxels than this are dropped.
     #[arg(long, default_value_t = 64)]
     pub min_component_voxels: u64,
@@ -66,6 +78,33 @@ pub enum Gates {
     Midpoint,
 }
 
+/// `--max-ball`.
+#[derive(Clone, Copy, ValueEnum)]
+pub enum MaxBallArg {
+    /// The ball contained in the empty space: to the nearest solid voxel's surface (the paper's).
+    Contained,
+    /// To the nearest solid voxel's centre: up to half a voxel larger.
+    SolidCentre,
+}
+
+/// `--alpha-rule`.
+#[derive(Clone, Copy, ValueEnum)]
+pub enum AlphaRuleArg {
+    /// |r(neighbour) − r(popped node)| ≤ α · the cluster's largest radius.
+    PoppedNode,
+    /// |r(neighbour) − the cluster's largest radius| ≤ α · that radius.
+    ClusterMax,
+}
+
+/// `--curvature-to`.
+#[derive(Clone, Copy, ValueEnum)]
+pub enum CurvatureArg {
+    /// The straight line through the line's ends (the paper's).
+    Line,
+    /// The segment between the line's ends.
+    Segment,
+}
+
 pub const AFTER_HELP: &str = "\
 Stages: load static meshes → voxelize → empty space → distance → thin → skeleton graph →
 segment → clusters → gates → flatten. A timing tree and a summary are printed at the end.
@@ -90,6 +129,7 @@ pub fn run(args: BakeArgs) -> Result<()> {
     if args.threads == Some(0) {
         bail!("--threads 0: give at least 1 thread, or leave it out to use all cores");
     }
+    let defaults = BakeParams::default();
     let params = BakeParams {
         resolution,
         alpha: args.alpha,
@@ -99,6 +139,20 @@ pub fn run(args: BakeArgs) -> Result<()> {
             Gates::Narrowest => GatePlacement::Narrowest,
             Gates::Midpoint => GatePlacement::Midpoint,
         },
+        max_ball: args.max_ball.map_or(defaults.max_ball, |m| match m {
+            MaxBallArg::Contained => MaxBall::Contained,
+            MaxBallArg::SolidCentre => MaxBall::SolidCentre,
+        }),
+        alpha_rule: args.alpha_rule.map_or(defaults.alpha_rule, |r| match r {
+            AlphaRuleArg::PoppedNode => AlphaRule::PoppedNode,
+            AlphaRuleArg::ClusterMax => AlphaRule::ClusterMax,
+        }),
+        curvature_to: args
+            .curvature_to
+            .map_or(defaults.curvature_to, |c| match c {
+                CurvatureArg::Line => CurvatureTo::Line,
+                CurvatureArg::Segment => CurvatureTo::Segment,
+            }),
         allow_leaks: args.allow_leaks,
     };
     let options = BakeOptions {

@@ -267,6 +267,60 @@ fn bake_writes_the_level_report_and_debug_exports() {
 }
 
 #[test]
+fn bake_takes_the_papers_readings_and_records_them_in_the_file() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("ring.vgate");
+    let out = out.to_str().expect("utf-8");
+    let bake = |extra: &[&str]| {
+        let mut a = vec![
+            "bake",
+            "builtin:ring-corridor",
+            "-o",
+            out,
+            "--resolution",
+            "64",
+            "-q",
+        ];
+        a.extend(extra);
+        let o = visgate(&a);
+        assert!(o.status.success(), "{}", stderr(&o));
+        stdout(&o)
+    };
+    let text = bake(&[]);
+    assert!(
+        text.contains("max ball SolidCentre, curvature to Line") && text.contains("PoppedNode"),
+        "{text}"
+    );
+    let text = bake(&[
+        "--max-ball",
+        "contained",
+        "--alpha-rule",
+        "cluster-max",
+        "--curvature-to",
+        "segment",
+    ]);
+    assert!(text.contains("against ClusterMax"), "{text}");
+    let o = visgate(&["inspect", out]);
+    let info = stdout(&o);
+    for want in [
+        "max_ball: Contained",
+        "alpha_rule: ClusterMax",
+        "curvature_to: Segment",
+    ] {
+        assert!(info.contains(want), "missing '{want}' in {info}");
+    }
+    let o = visgate(&[
+        "bake",
+        "builtin:two-rooms",
+        "-o",
+        out,
+        "--max-ball",
+        "centre",
+    ]);
+    assert!(stderr(&o).contains("solid-centre"), "{}", stderr(&o));
+}
+
+#[test]
 fn bake_refuses_bad_arguments_clearly() {
     let dir = tempfile::tempdir().expect("tempdir");
     let out = dir.path().join("x.vgate");
@@ -393,7 +447,10 @@ fn render_and_diff_refuse_bad_arguments_clearly() {
         (vec!["--spp", "0"], "samples per pixel"),
         (vec!["--g-max", "0"], "clamp"),
         (vec!["--clamp-distance", "0"], "fraction of the diagonal"),
-        (vec!["--clamp-distance", "0.1", "--g-max", "3"], "cannot be used with"),
+        (
+            vec!["--clamp-distance", "0.1", "--g-max", "3"],
+            "cannot be used with",
+        ),
     ] {
         let mut a = vec!["render", "builtin:cornell-box", "--out", out];
         if !args.contains(&"--size") {

@@ -30,7 +30,7 @@ use crate::scene::GeometryHash;
 /// The first eight bytes of every `.vgate` file.
 pub const MAGIC: [u8; 8] = *b"VGATE\r\n\x1a";
 /// The format version this build writes and reads.
-pub const FORMAT_VERSION: u32 = 1;
+pub const FORMAT_VERSION: u32 = 2;
 /// "No node / no cluster" in a grid decoded to u32.
 pub const NONE: u32 = u32::MAX;
 
@@ -98,6 +98,37 @@ pub enum GatePlacement {
     Midpoint,
 }
 
+/// What the max-ball radius of an empty voxel measures.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum MaxBall {
+    /// The ball contained in the empty space (the paper's, IV.B): the distance from the voxel's
+    /// centre to the nearest solid voxel's surface.
+    Contained,
+    /// The distance to the nearest solid voxel's centre: up to half a voxel larger.
+    SolidCentre,
+}
+
+/// What α compares in the cluster growth of IV.B.2 ("radius of maximal balls does not differ
+/// more than α % of the maximal radius contained in the cluster").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum AlphaRule {
+    /// A neighbour joins when `|r(neighbour) − r(popped node)| ≤ α · r_max(cluster)`: a slowly
+    /// narrowing corridor can grow one cluster without end.
+    PoppedNode,
+    /// A neighbour joins when `r_max(cluster) − r(neighbour) ≤ α · r_max(cluster)` (and a wider
+    /// neighbour by no more than α · r_max): every node within α of the cluster's widest.
+    ClusterMax,
+}
+
+/// What a line node's curvature measures its distance to (IV.B.1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum CurvatureTo {
+    /// The infinite straight line through the line's extrema (the paper's).
+    Line,
+    /// The segment between the extrema: larger where a line bends back past its ends.
+    Segment,
+}
+
 /// The bake parameters a file was made with.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BakeParams {
@@ -113,6 +144,12 @@ pub struct BakeParams {
     pub min_component_voxels: u64,
     /// Gate placement rule.
     pub gate_placement: GatePlacement,
+    /// What the max-ball radius measures.
+    pub max_ball: MaxBall,
+    /// What the cluster growth's α compares.
+    pub alpha_rule: AlphaRule,
+    /// What curvature measures the distance to.
+    pub curvature_to: CurvatureTo,
     /// Whether a leaking closed scene was baked anyway.
     pub allow_leaks: bool,
 }
@@ -125,6 +162,9 @@ impl Default for BakeParams {
             persistence: None,
             min_component_voxels: 64,
             gate_placement: GatePlacement::Narrowest,
+            max_ball: MaxBall::SolidCentre,
+            alpha_rule: AlphaRule::PoppedNode,
+            curvature_to: CurvatureTo::Line,
             allow_leaks: false,
         }
     }

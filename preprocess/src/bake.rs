@@ -286,7 +286,7 @@ pub fn bake(
     // 4. Distance.
     clock.start("distance", 0);
     let not_empty: Vec<bool> = es.empty.iter().map(|&e| !e).collect();
-    let dist2 = distance::squared_distance(meta.dims, &not_empty);
+    let dist2 = distance::transform(meta.dims, &not_empty, params.max_ball);
     drop(not_empty);
     let max_r = es
         .empty
@@ -296,7 +296,7 @@ pub fn bake(
         .map(|(_, d)| *d)
         .max()
         .unwrap_or(0);
-    clock.end(json!({ "largest_radius_vx": (max_r as f64).sqrt() }));
+    clock.end(json!({ "largest_radius_vx": distance::radius_vx(max_r, params.max_ball) }));
 
     // 5. Thin.
     clock.start("thin", es.empty_voxels);
@@ -333,7 +333,7 @@ pub fn bake(
     let radius: Vec<f32> = sg
         .voxels
         .iter()
-        .map(|&v| (dist2[v as usize] as f64).sqrt() as f32 * vs)
+        .map(|&v| distance::radius_vx(dist2[v as usize], params.max_ball) as f32 * vs)
         .collect();
     let cycles = sg.cycles();
     let components = petgraph::algo::connected_components(&sg.graph) as u64;
@@ -349,7 +349,11 @@ pub fn bake(
     // 7. Segment.
     clock.start("segment", 0);
     let adjacency = sg.adjacency();
-    let seg: Segmented = segment(&adjacency, &position, &radius, &SegmentParams::default());
+    let seg_params = SegmentParams {
+        curvature_to: params.curvature_to,
+        ..SegmentParams::default()
+    };
+    let seg: Segmented = segment(&adjacency, &position, &radius, &seg_params);
     let count_kind =
         |k: SegNodeKind| seg.skeleton.nodes.iter().filter(|n| n.kind == k).count() as u64;
     let seg_counts = [
@@ -372,6 +376,7 @@ pub fn bake(
         &radius,
         &ClusterParams {
             alpha: params.alpha,
+            rule: params.alpha_rule,
         },
     );
     let greedy_clusters = seeds_of.len();
@@ -790,14 +795,18 @@ impl BakeReport {
             m.segmented_nodes[4]
         );
         s += &format!(
-            "clusters {}  gates {}  cycles {}  components {}  (alpha {}, persistence {}, gates at {:?})\n",
+            "clusters {}  gates {}  cycles {}  components {}  (alpha {} against {:?}, \
+             persistence {}, gates at {:?}, max ball {:?}, curvature to {:?})\n",
             m.clusters,
             m.gates,
             m.cycles,
             m.components,
             self.params.alpha,
+            self.params.alpha_rule,
             self.params.persistence.unwrap_or(0),
-            self.params.gate_placement
+            self.params.gate_placement,
+            self.params.max_ball,
+            self.params.curvature_to
         );
         let (e, k) = (&self.empty_topology, &self.skeleton_topology);
         s += &format!(

@@ -3,8 +3,10 @@
 //!
 //! **Clusters.** The segmented nodes are taken by decreasing max-ball radius. An unclustered
 //! node starts a cluster and goes on a stack. A node popped from the stack joins the cluster;
-//! its segmented neighbours that are not curvature nodes and whose radius differs from its own
-//! by at most `α` times the largest radius in the cluster go on the stack, and so do the nodes
+//! its segmented neighbours that are not curvature nodes and whose radius differs by at most `α`
+//! times the largest radius in the cluster — from the popped node's ([`AlphaRule::PoppedNode`])
+//! or from that largest radius ([`AlphaRule::ClusterMax`]; the paper leaves it open) — go on
+//! the stack, and so do the nodes
 //! inside its max ball reachable from it through nodes inside that ball. Each cluster is a
 //! connected part of the segmented skeleton.
 //!
@@ -29,7 +31,7 @@
 //! (see `bake`'s flatten stage).
 
 use glam::Vec3;
-use visgate_formats::vgate::{GatePlacement, SegNodeKind, SegmentedSkeleton};
+use visgate_formats::vgate::{AlphaRule, GatePlacement, SegNodeKind, SegmentedSkeleton};
 
 /// Parameters of [`clusters`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -37,6 +39,8 @@ pub struct ClusterParams {
     /// Growth tolerance α: a neighbour joins when its radius differs by at most α × the
     /// cluster's largest radius. [Limit: 0..=1] [Units: ratio]
     pub alpha: f32,
+    /// What α compares.
+    pub rule: AlphaRule,
 }
 
 /// Cluster of every segmented node, and each cluster's seed (a segmented node), in creation
@@ -62,6 +66,11 @@ pub fn clusters(
         l.sort_unstable();
         l.dedup();
     });
+    // The radius a neighbour's is compared with.
+    let to = |m: u32, max_r: f32| match params.rule {
+        AlphaRule::PoppedNode => rad(m),
+        AlphaRule::ClusterMax => max_r,
+    };
     let mut order: Vec<u32> = (0..n as u32).collect();
     order.sort_by(|&a, &b| rad(b).total_cmp(&rad(a)).then(a.cmp(&b)));
     let mut cluster = vec![u32::MAX; n];
@@ -86,7 +95,7 @@ pub fn clusters(
             for &nb in &adj[m as usize] {
                 if cluster[nb as usize] == u32::MAX
                     && seg.nodes[nb as usize].kind != SegNodeKind::Curvature
-                    && (rad(nb) - rad(m)).abs() <= params.alpha * max_r
+                    && (rad(nb) - to(m, max_r)).abs() <= params.alpha * max_r
                 {
                     stack.push(nb);
                 }
@@ -453,6 +462,38 @@ mod tests {
             gate([6.0, 1.0, 2.0], [1.0, 0.0, 0.0], 0.5, [1, 2]),
         ];
         assert_eq!(find_sliver(&far, &[1.4, 0.5, 1.5], 0.2), None);
+    }
+
+    #[test]
+    fn a_slowly_narrowing_corridor_is_one_cluster_against_the_popped_node_and_not_against_the_max()
+    {
+        // 15 segmented nodes in a row, 2 m apart (no ball holds a neighbour), radii 1.0 … 0.3.
+        let n = 15u32;
+        let seg = SegmentedSkeleton {
+            nodes: (0..n)
+                .map(|i| visgate_formats::vgate::SegNode {
+                    skeleton_node: i,
+                    kind: SegNodeKind::Coverage,
+                })
+                .collect(),
+            edges: (0..n - 1)
+                .map(|i| visgate_formats::vgate::SegEdge {
+                    nodes: [i, i + 1],
+                    path: vec![i, i + 1],
+                })
+                .collect(),
+        };
+        let position: Vec<Vec3> = (0..n)
+            .map(|i| Vec3::new(2.0 * i as f32, 0.0, 0.0))
+            .collect();
+        let radius: Vec<f32> = (0..n).map(|i| 1.0 - 0.05 * i as f32).collect();
+        let count = |rule| {
+            let params = ClusterParams { alpha: 0.2, rule };
+            clusters(&seg, &position, &radius, &params).1.len()
+        };
+        assert_eq!(count(AlphaRule::PoppedNode), 1);
+        // Within 20 % of each cluster's widest: 1.0–0.8, 0.75–0.6, 0.55–0.45, 0.4–0.35, 0.3.
+        assert_eq!(count(AlphaRule::ClusterMax), 5);
     }
 
     #[test]

@@ -1,18 +1,43 @@
 //! Stage 4, distance: the exact Euclidean distance transform of the empty space.
 //!
-//! Convention: for every empty voxel, `dist2_vx` is the squared distance, in voxel units, from
-//! its centre to the centre of the nearest solid voxel (0 for solid voxels). The maximal ball
-//! centred on an empty voxel has radius `sqrt(dist2_vx) · voxel_size_m`: it reaches the
-//! nearest solid voxel's centre. Computed exactly by three separable passes of the
-//! lower-envelope algorithm of Felzenszwalb & Huttenlocher (2012), each parallel over lines.
+//! Two conventions ([`MaxBall`]), each exact, by three separable passes of the lower-envelope
+//! algorithm of Felzenszwalb & Huttenlocher (2012), each parallel over lines:
+//!
+//! - `SolidCentre`: the squared distance, in voxels, from a voxel's centre to the centre of
+//!   the nearest solid voxel (0 for solid voxels); radius `sqrt(d) · voxel_size`.
+//! - `Contained` (the paper's maximal ball contained in the empty space): four times the
+//!   squared distance from the centre to the nearest solid voxel's *cube*; radius
+//!   `sqrt(d) / 2 · voxel_size`. Per axis the cube is `max(|k| − ½, 0)` away, and
+//!   `(2|k| − 1)²` is the parabola `(2q ∓ 1 − 2p)²` on the side of `p` it lies: the envelope
+//!   of parabolas centred at `2p`, read at `2q − 1` and `2q + 1`, and the line's own value at
+//!   `q`, give the exact minimum.
 
 use rayon::prelude::*;
+use visgate_formats::vgate::MaxBall;
 
 /// "Infinitely far": larger than any squared distance in a grid of up to 2^20 voxels a side.
 const INF: i64 = 1 << 42;
 
-/// Squared Euclidean distance (voxel units) to the nearest solid voxel, per voxel.
+/// Squared Euclidean distance (voxel units) to the nearest solid voxel's centre, per voxel.
 pub fn squared_distance(dims: [u32; 3], solid: &[bool]) -> Vec<u64> {
+    transform(dims, solid, MaxBall::SolidCentre)
+}
+
+/// The max-ball radius, in voxels, of a value of [`transform`] with `rule`.
+pub fn radius_vx(d: u64, rule: MaxBall) -> f64 {
+    match rule {
+        MaxBall::SolidCentre => (d as f64).sqrt(),
+        MaxBall::Contained => (d as f64).sqrt() * 0.5,
+    }
+}
+
+/// Per voxel, the squared distance to the nearest solid voxel under `rule` (see the module
+/// notes for the units); 0 for solid voxels, ordered as the radii.
+pub fn transform(dims: [u32; 3], solid: &[bool], rule: MaxBall) -> Vec<u64> {
+    let envelope = |f: &[i64]| match rule {
+        MaxBall::SolidCentre => envelope(f),
+        MaxBall::Contained => envelope_to_cubes(f),
+    };
     let [nx, ny, nz] = dims.map(|d| d as usize);
     let mut d: Vec<i64> = solid.iter().map(|&s| if s { 0 } else { INF }).collect();
     // Along x: contiguous rows.
@@ -49,6 +74,25 @@ pub fn squared_distance(dims: [u32; 3], solid: &[bool]) -> Vec<u64> {
 
 /// 1D squared distance transform of sampled function `f` (lower envelope of parabolas).
 fn envelope(f: &[i64]) -> Vec<i64> {
+    lower_envelope(f, 1, &|q, eval| eval(q as i64))
+}
+
+/// 1D transform to the nearest cube, ×4: `min_p f[p] + g(q − p)` with `g(0) = 0` and
+/// `g(k) = (2|k| − 1)²`.
+fn envelope_to_cubes(f: &[i64]) -> Vec<i64> {
+    lower_envelope(f, 2, &|q, eval| {
+        let q2 = 2 * q as i64;
+        f[q].min(eval(q2 - 1)).min(eval(q2 + 1))
+    })
+}
+
+/// How [`lower_envelope`] reads line position `q` from the envelope's value at any `x`.
+type Read<'a> = dyn Fn(usize, &mut dyn FnMut(i64) -> i64) -> i64 + 'a;
+
+/// The lower envelope of the parabolas `f[p] + (x − c·p)²` (`f[p] ≥ INF`: none), and for each
+/// `q`, `read(q, eval)` with `eval(x)` its value at `x`. The `x` read must not decrease with
+/// `q`.
+fn lower_envelope(f: &[i64], c: i64, read: &Read<'_>) -> Vec<i64> {
     let n = f.len();
     let mut out = vec![INF; n];
     let mut v = vec![0usize; n];
@@ -69,8 +113,9 @@ fn envelope(f: &[i64]) -> Vec<i64> {
             }
             Some(_) => loop {
                 let p = v[k];
-                let s = ((f[q] + (q * q) as i64) - (f[p] + (p * p) as i64)) as f64
-                    / (2.0 * (q as f64 - p as f64));
+                let (cq, cp) = (c * q as i64, c * p as i64);
+                let s =
+                    ((f[q] + cq * cq) - (f[p] + cp * cp)) as f64 / (2.0 * (cq as f64 - cp as f64));
                 // z[0] = −∞, so k never goes below 0.
                 if s <= z[k] {
                     k -= 1;
@@ -89,12 +134,81 @@ fn envelope(f: &[i64]) -> Vec<i64> {
     }
     let mut k = 0;
     for (q, o) in out.iter_mut().enumerate() {
-        while z[k + 1] < q as f64 {
-            k += 1;
-        }
-        let p = v[k];
-        let dq = q as i64 - p as i64;
-        *o = dq * dq + f[p];
+        let mut eval = |x: i64| {
+            while z[k + 1] < x as f64 {
+                k += 1;
+            }
+            let d = x - c * v[k] as i64;
+            d * d + f[v[k]]
+        };
+        *o = read(q, &mut eval).min(INF);
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Brute force: the minimum over solid voxels of the per-axis distances under `rule`.
+    fn brute(dims: [u32; 3], solid: &[bool], rule: MaxBall) -> Vec<u64> {
+        let [nx, ny, nz] = dims.map(|d| d as i64);
+        let idx = |x: i64, y: i64, z: i64| (x + nx * (y + ny * z)) as usize;
+        let axis = |k: i64| -> u64 {
+            match (rule, k) {
+                (MaxBall::SolidCentre, _) => (k * k) as u64,
+                (MaxBall::Contained, 0) => 0,
+                (MaxBall::Contained, _) => ((2 * k.abs() - 1) * (2 * k.abs() - 1)) as u64,
+            }
+        };
+        let mut out = vec![INF as u64; solid.len()];
+        for (z, y, x) in
+            (0..nz).flat_map(|z| (0..ny).flat_map(move |y| (0..nx).map(move |x| (z, y, x))))
+        {
+            for (c, d, e) in
+                (0..nz).flat_map(|c| (0..ny).flat_map(move |d| (0..nx).map(move |e| (c, d, e))))
+            {
+                if solid[idx(e, d, c)] {
+                    let v = axis(x - e) + axis(y - d) + axis(z - c);
+                    out[idx(x, y, z)] = out[idx(x, y, z)].min(v);
+                }
+            }
+        }
+        out
+    }
+
+    #[test]
+    fn both_transforms_equal_brute_force_and_the_contained_ball_is_the_smaller() {
+        let dims = [9, 7, 6];
+        let n = 9 * 7 * 6;
+        // A pseudo-random sprinkle of solid voxels (about one in eight).
+        let solid: Vec<bool> = (0..n as u64)
+            .map(|i| (i.wrapping_mul(2_654_435_761) >> 7) % 8 == 0)
+            .collect();
+        assert!(solid.iter().any(|&s| s) && !solid.iter().all(|&s| s));
+        for rule in [MaxBall::SolidCentre, MaxBall::Contained] {
+            assert_eq!(
+                transform(dims, &solid, rule),
+                brute(dims, &solid, rule),
+                "{rule:?}"
+            );
+        }
+        let centre = transform(dims, &solid, MaxBall::SolidCentre);
+        let cube = transform(dims, &solid, MaxBall::Contained);
+        for (&a, &b) in centre.iter().zip(&cube) {
+            let (ra, rb) = (
+                radius_vx(a, MaxBall::SolidCentre),
+                radius_vx(b, MaxBall::Contained),
+            );
+            // Half a voxel smaller along an axis, at most √3/2 smaller along a diagonal.
+            assert!(rb <= ra - 0.5 + 1e-9 || a == 0, "{ra} {rb}");
+            assert!(rb >= ra - 3f64.sqrt() / 2.0 - 1e-9, "{ra} {rb}");
+        }
+        // One voxel from a wall: the ball reaches the wall's face, half a voxel away.
+        let mut wall = vec![false; n];
+        (0..9 * 7).for_each(|i| wall[i] = true);
+        let d = transform(dims, &wall, MaxBall::Contained);
+        assert_eq!(radius_vx(d[9 * 7], MaxBall::Contained), 0.5);
+        assert_eq!(radius_vx(d[3 * 9 * 7 + 4], MaxBall::Contained), 2.5);
+    }
 }

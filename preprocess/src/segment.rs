@@ -5,7 +5,9 @@
 //!    one so the loop has an extremity.
 //! 2. **Lines**: the chains of degree-2 nodes between two topology nodes `L1 … Lk`.
 //! 3. **Curvature nodes**: on a line, `curv(n) = dist(n, L1Lk) / maxball(n)`, the distance from
-//!    `n` to the straight segment between the extrema over its max-ball radius. If the largest
+//!    `n` to the straight line through the extrema (the paper's; or, with
+//!    [`CurvatureTo::Segment`], to the segment between them, which also keeps a node where the
+//!    line bends back past an end) over its max-ball radius. If the largest
 //!    curvature exceeds 1, that node becomes a curvature node and both halves are processed
 //!    again, recursively.
 //! 4. **Coverage nodes**: on the lines left, every node must lie in the max ball of one of the
@@ -21,7 +23,7 @@
 //! its line, by length along the line.
 
 use glam::Vec3;
-use visgate_formats::vgate::{SegEdge, SegNode, SegNodeKind, SegmentedSkeleton};
+use visgate_formats::vgate::{CurvatureTo, SegEdge, SegNode, SegNodeKind, SegmentedSkeleton};
 
 /// Parameters of [`segment`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -31,6 +33,8 @@ pub struct SegmentParams {
     /// A line node whose max ball is smaller than this fraction of both end balls is kept as
     /// a narrowing node (0 turns the rule off). [Limit: 0..1] [Units: ratio]
     pub narrowing_ratio: f32,
+    /// What the curvature measures the distance to.
+    pub curvature_to: CurvatureTo,
 }
 
 impl Default for SegmentParams {
@@ -38,6 +42,7 @@ impl Default for SegmentParams {
         SegmentParams {
             curvature_limit: 1.0,
             narrowing_ratio: 0.6,
+            curvature_to: CurvatureTo::Line,
         }
     }
 }
@@ -141,7 +146,12 @@ pub fn segment(
         let mut best: Option<(f32, usize)> = None;
         for (k, &m) in line.iter().enumerate().take(line.len() - 1).skip(1) {
             let r = radius[m as usize].max(f32::MIN_POSITIVE);
-            let c = segment_distance(position[m as usize], a, b) / r;
+            let p = position[m as usize];
+            let d = match params.curvature_to {
+                CurvatureTo::Segment => segment_distance(p, a, b),
+                CurvatureTo::Line => line_distance(p, a, b),
+            };
+            let c = d / r;
             if c > params.curvature_limit && best.is_none_or(|(bc, _)| c > bc) {
                 best = Some((c, k));
             }
@@ -247,6 +257,14 @@ pub fn segment_distance(p: Vec3, a: Vec3, b: Vec3) -> f32 {
     (p - (a + ab * t)).length()
 }
 
+/// Distance from `p` to the straight line through `a` and `b` (to `a` if they coincide).
+pub fn line_distance(p: Vec3, a: Vec3, b: Vec3) -> f32 {
+    let ab = b - a;
+    let l2 = ab.length_squared();
+    let t = if l2 > 0.0 { (p - a).dot(ab) / l2 } else { 0.0 };
+    (p - (a + ab * t)).length()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -276,6 +294,31 @@ mod tests {
         assert_eq!(s.skeleton.edges[0].path.len(), 10);
         assert_eq!(s.node_segment[3], 0);
         assert_eq!(s.node_segment[6], 1);
+    }
+
+    #[test]
+    fn a_line_that_bends_back_past_its_end_is_curved_to_the_segment_and_not_to_the_line() {
+        // A hook: 0..=10 along x, then back along z = 1 to x = 3; radii 4 (no coverage node).
+        let mut pos: Vec<Vec3> = (0..=10).map(|i| Vec3::new(i as f32, 0.0, 0.0)).collect();
+        pos.extend((3..=10).rev().map(|i| Vec3::new(i as f32, 0.0, 1.0)));
+        let adj = chain(pos.len());
+        let radius = vec![4.0; pos.len()];
+        let kinds = |curvature_to| {
+            let p = SegmentParams {
+                curvature_to,
+                ..SegmentParams::default()
+            };
+            let s = segment(&adj, &pos, &radius, &p);
+            s.skeleton
+                .nodes
+                .iter()
+                .filter(|n| n.kind == SegNodeKind::Curvature)
+                .count()
+        };
+        // To the line through (0,0,0) and (3,0,1), no node is farther than 2.2: curvature ≤ 0.55.
+        assert_eq!(kinds(CurvatureTo::Line), 0);
+        // To the segment, (10,0,0) is 7.07 away from its end: curvature 1.77.
+        assert!(kinds(CurvatureTo::Segment) >= 1);
     }
 
     #[test]

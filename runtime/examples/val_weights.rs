@@ -2,12 +2,15 @@
 //! clusterings): MSE against the exact CPU reference with the same VPLs for w_x = 1 − w_α from
 //! 0 (normals only) to 1 (positions only), M = 30 VALs, val-cssm and val-hard, every VPL at
 //! every pixel, on the Cornell box and the four rooms; and each clustering's mean VAL area.
+//! The last column is the paper's own metric, `0.7·Δx + 0.3·Δα` in metres and radians: the
+//! normalised one with `w_x = 0.7·D / (0.7·D + 0.3·π)` (D the VPLs' diagonal), so it changes
+//! with the scene's scale.
 //!
 //! `cargo run --release -p visgate-runtime --example val_weights -- [WxH] [VPL paths]`
 
 mod fixture;
 
-use visgate_runtime::cpu::val::{ValParams, cluster};
+use visgate_runtime::cpu::val::{ValParams, cluster, scale_of};
 use visgate_runtime::gpu::{
     CssmParams, GpuContext, GpuMode, GpuParams, GpuRenderer, InterleaveParams, ValModeParams,
 };
@@ -27,8 +30,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         "M = 30, {paths} light paths, {}×{}; MSE (mean VAL area, m²)",
         size[0], size[1]
     );
-    println!("| scene | mode | w_x = 0 | 0.3 | 0.5 | 0.7 (paper) | 1 |");
-    println!("|---|---|---|---|---|---|---|");
+    println!("| scene | mode | w_x = 0 | 0.3 | 0.5 | 0.7 (paper) | 1 | paper, unnormalised |");
+    println!("|---|---|---|---|---|---|---|---|");
     for b in [Builtin::CornellBox, Builtin::FourRooms] {
         let fixture::Fixture {
             scene,
@@ -43,7 +46,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 b.name(),
                 if soft { "val-cssm" } else { "val-hard" }
             );
-            for w_x in W_X {
+            // The paper's unnormalised 0.7 / 0.3 as normalised weights (scaled to sum 1).
+            let d = scale_of(&vpls);
+            let unnormalised = 0.7 * d / (0.7 * d + 0.3 * std::f32::consts::PI);
+            for w_x in W_X.into_iter().chain([unnormalised]) {
                 let vals = ValParams {
                     count: 30,
                     w_x,
@@ -67,7 +73,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 let live = c.vals.iter().filter(|v| v.vpl_count() > 0);
                 let area: f32 =
                     live.clone().map(|v| v.normal[3]).sum::<f32>() / live.count().max(1) as f32;
-                row += &format!(" {:.3e} ({area:.2}) |", errors(&img, &reference)?.mse);
+                let mse = errors(&img, &reference)?.mse;
+                row += &match w_x == unnormalised {
+                    true => format!(" {mse:.3e} ({area:.2}; w_x {w_x:.3}, D {d:.2} m) |"),
+                    false => format!(" {mse:.3e} ({area:.2}) |"),
+                };
             }
             println!("{row}");
         }

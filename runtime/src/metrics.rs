@@ -59,6 +59,49 @@ pub fn errors(a: &HdrImage, r: &HdrImage) -> Result<ImageErrors, RenderError> {
     })
 }
 
+/// How an image's indirect light (the image less the direct light) compares with the
+/// reference's: the failures a mean error hides.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct IndirectErrors {
+    /// Mean indirect radiance over the reference's (1: no energy lost or gained).
+    pub energy_ratio: f64,
+    /// Of the pixels whose reference indirect light is at least a tenth of its mean, the share
+    /// where the image's is under a tenth of the reference's there: black where it is lit.
+    pub black_where_lit: f64,
+}
+
+/// [`IndirectErrors`] of `a` against reference `r`, both less the direct light `direct`.
+pub fn indirect_errors(
+    a: &HdrImage,
+    r: &HdrImage,
+    direct: &HdrImage,
+) -> Result<IndirectErrors, RenderError> {
+    same_size(a, r)?;
+    same_size(direct, r)?;
+    let sum = |p: Vec3| (p.x + p.y + p.z) as f64;
+    let ind = |img: &HdrImage| -> Vec<f64> {
+        img.pixels
+            .iter()
+            .zip(&direct.pixels)
+            .map(|(p, d)| sum(*p - *d).max(0.0))
+            .collect()
+    };
+    let (ia, ir) = (ind(a), ind(r));
+    let n = ir.len().max(1) as f64;
+    let (mean_a, mean_r) = (ia.iter().sum::<f64>() / n, ir.iter().sum::<f64>() / n);
+    let lit: Vec<(f64, f64)> = ia
+        .iter()
+        .zip(&ir)
+        .filter(|(_, r)| **r > 0.0 && **r >= 0.1 * mean_r)
+        .map(|(a, r)| (*a, *r))
+        .collect();
+    let black = lit.iter().filter(|(a, r)| *a < 0.1 * r).count();
+    Ok(IndirectErrors {
+        energy_ratio: if mean_r > 0.0 { mean_a / mean_r } else { 1.0 },
+        black_where_lit: black as f64 / lit.len().max(1) as f64,
+    })
+}
+
 /// Per-pixel absolute error, averaged over channels.
 pub fn abs_error_map(a: &HdrImage, r: &HdrImage) -> Result<Vec<f32>, RenderError> {
     same_size(a, r)?;
@@ -84,4 +127,28 @@ pub fn flip(
     let map = nv_flip::flip(to_flip(r), to_flip(a), nv_flip::DEFAULT_PIXELS_PER_DEGREE);
     let pool = nv_flip::FlipPool::from_image(&map);
     Ok((pool.mean(), map.to_vec()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn image(px: &[f32]) -> HdrImage {
+        let mut img = HdrImage::new(px.len() as u32, 1);
+        img.pixels = px.iter().map(|&v| Vec3::splat(v)).collect();
+        img
+    }
+
+    #[test]
+    fn indirect_errors_count_energy_and_black_pixels_above_the_direct_light() {
+        let direct = image(&[1.0, 1.0, 0.0, 0.0]);
+        let reference = image(&[2.0, 1.5, 1.0, 0.5]); // indirect 1, 0.5, 1, 0.5
+        let method = image(&[2.0, 1.02, 0.0, 0.5]); // indirect 1, 0.02, 0, 0.5
+        let e = indirect_errors(&method, &reference, &direct).expect("same size");
+        assert!((e.energy_ratio - 1.52 / 3.0).abs() < 1e-6, "{e:?}");
+        // Two of the four lit pixels are under a tenth of the reference's indirect light.
+        assert!((e.black_where_lit - 0.5).abs() < 1e-12, "{e:?}");
+        let same = indirect_errors(&reference, &reference, &direct).expect("same size");
+        assert_eq!((same.energy_ratio, same.black_where_lit), (1.0, 0.0));
+    }
 }
