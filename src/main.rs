@@ -4,6 +4,7 @@
 mod bake;
 mod inspect;
 mod render;
+mod view;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -22,6 +23,7 @@ A SCENE argument is any of:
 Examples:
   visgate bake builtin:two-rooms -o two-rooms.vgate
   visgate render builtin:cornell-box --out cornell.png
+  visgate view builtin:two-rooms --level two-rooms.vgate
   visgate inspect builtin:four-rooms
   visgate inspect --json ../shared/scenes/crytek_sponza/sponza.glb
   visgate scenes export two-rooms out/two-rooms
@@ -48,6 +50,9 @@ enum Command {
     /// Render an image of a scene (CPU: exact reference, no indirect visibility, or direct only).
     #[command(after_help = render::RENDER_HELP)]
     Render(render::RenderArgs),
+    /// Walk through a scene in a window, switching the visibility method live.
+    #[command(after_help = view::VIEW_HELP)]
+    View(view::ViewArgs),
     /// Compare an image with a reference: MSE, relative MSE, FLIP, and an error map.
     Diff(render::DiffArgs),
     /// Print a summary of a scene, a mesh file or a baked .vgate level.
@@ -105,6 +110,7 @@ fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Bake(args) => bake::run(args),
         Command::Render(args) => render::run(args),
+        Command::View(args) => view::run(args),
         Command::Diff(args) => render::diff(args),
         Command::Inspect {
             file,

@@ -1,0 +1,202 @@
+//! `visgate view`: walk through a level in a window (eframe, wgpu renderer only) and switch the
+//! visibility method live. The frame is `GpuRenderer::render_frame`, the call `visgate render`
+//! makes, with the same VPLs and clamp, so both give the same image of the same view.
+
+mod app;
+mod camera;
+mod panel;
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result, bail};
+use clap::{Args, Parser};
+use visgate_formats::ImportOptions;
+use visgate_runtime::cpu::gates::GateLevel;
+use visgate_runtime::gpu::method;
+use visgate_runtime::job::RenderJob;
+
+/// Options of `visgate view`.
+#[derive(Args)]
+pub struct ViewArgs {
+    /// The scene: a .toml description, a bare .obj/.gltf/.glb, or builtin:NAME.
+    pub scene: String,
+    /// A baked level of the scene (`visgate bake`), for the gate methods.
+    #[arg(long)]
+    pub level: Option<PathBuf>,
+    /// The method to start with (any of `visgate render --mode`, but `reference`); default
+    /// `gates` with a level, else `none`.
+    #[arg(long)]
+    pub mode: Option<String>,
+    /// Light paths (VPLs), changeable in the window (default: 1024 on a GPU, 64 on a software
+    /// adapter, where 1024 take seconds a frame).
+    #[arg(long)]
+    pub vpls: Option<u32>,
+    /// Take the VPLs from the lights' reflective shadow maps on the GPU.
+    #[arg(long)]
+    pub rsm: bool,
+    /// The scene camera to start from (default: the first; `--camera level` frames the level).
+    #[arg(long)]
+    pub camera: Option<String>,
+    /// Render at this size, WIDTHxHEIGHT, shown fitted into the window (default: the window's).
+    #[arg(long)]
+    pub render_size: Option<String>,
+    /// Write the last frame (.png sRGB, .exr linear) after --frames frames, then close.
+    #[arg(long)]
+    pub screenshot: Option<PathBuf>,
+    /// Frames to render before --screenshot is written.
+    #[arg(long, default_value_t = 3)]
+    pub frames: u32,
+    /// With no display, render this image headless instead (`visgate render` with the same
+    /// scene, level, method and VPLs) rather than fail.
+    #[arg(long)]
+    pub or_render: Option<PathBuf>,
+}
+
+pub const VIEW_HELP: &str = "\
+In the window: WASD + QE fly (metres per second, scroll to change), right drag looks around,
+F frames the whole level; the scene's cameras are buttons; the method and its settings apply on
+the next frame; a setting the GPU refuses shows its error and keeps the last frame.
+
+Without a display (no DISPLAY or WAYLAND_DISPLAY), use `visgate render`, run under Xvfb
+(`Xvfb :99 & DISPLAY=:99 visgate view …`), or give --or-render OUT.png.
+
+Examples:
+  visgate bake builtin:four-rooms -o four-rooms.vgate
+  visgate view builtin:four-rooms --level four-rooms.vgate
+  visgate view builtin:cornell-box --mode val-cssm --rsm --vpls 4096
+  visgate view builtin:cornell-box --render-size 320x240 --screenshot shot.png --frames 3";
+
+/// `--render-size` or `--size` as `[w, h]`.
+fn parse_size(s: &str) -> Result<[u32; 2]> {
+    let (w, h) = s
+        .split_once('x')
+        .with_context(|| format!("size '{s}': give WIDTHxHEIGHT, e.g. 640x360"))?;
+    let (w, h): (u32, u32) = (w.trim().parse()?, h.trim().parse()?);
+    if !(8..=16384).contains(&w) || !(8..=16384).contains(&h) {
+        bail!("size {w}x{h}: each side must be 8..=16384 pixels");
+    }
+    Ok([w, h])
+}
+
+/// Whether a window can open here.
+fn has_display() -> bool {
+    if cfg!(any(target_os = "windows", target_os = "macos")) {
+        return true;
+    }
+    ["DISPLAY", "WAYLAND_DISPLAY"]
+        .iter()
+        .any(|v| std::env::var_os(v).is_some_and(|s| !s.is_empty()))
+}
+
+/// `visgate render` with the viewer's scene, level, method and VPLs, headless.
+fn render_instead(args: &ViewArgs, mode: &str, out: &std::path::Path) -> Result<()> {
+    #[derive(Parser)]
+    struct Render {
+        #[command(flatten)]
+        args: crate::render::RenderArgs,
+    }
+    let mut argv: Vec<String> = ["render", &args.scene, "--mode", mode, "--vpls"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    argv.push(args.vpls.unwrap_or(1024).to_string());
+    argv.extend(["--out".into(), out.display().to_string()]);
+    if let Some(l) = &args.level {
+        argv.extend(["--level".into(), l.display().to_string()]);
+    }
+    if args.rsm {
+        argv.extend(["--vpl-source".into(), "rsm".into()]);
+    }
+    if let Some(s) = &args.render_size {
+        argv.extend(["--size".into(), s.clone()]);
+    }
+    if let Some(c) = &args.camera {
+        argv.extend(["--camera".into(), c.clone()]);
+    }
+    crate::render::run(Render::try_parse_from(argv)?.args)
+}
+
+pub fn run(args: ViewArgs) -> Result<()> {
+    let mode = match (&args.mode, &args.level) {
+        (Some(m), _) => m.clone(),
+        (None, Some(_)) => "gates".into(),
+        (None, None) => "none".into(),
+    };
+    let Some(info) = method(&mode) else {
+        bail!(
+            "--mode {mode}: give one of {}",
+            visgate_runtime::gpu::METHODS.map(|m| m.name).join(", ")
+        );
+    };
+    if info.needs_level && args.level.is_none() {
+        bail!("--mode {mode} needs --level LEVEL.vgate (bake one with `visgate bake`)");
+    }
+    let size = args.render_size.as_deref().map(parse_size).transpose()?;
+    if args.frames == 0 {
+        bail!("--frames 0: render at least 1 frame before the screenshot");
+    }
+    if !has_display() {
+        if let Some(out) = &args.or_render {
+            println!("no display: rendering {} headless instead", out.display());
+            return render_instead(&args, &mode, out);
+        }
+        bail!(
+            "no display to open a window on (DISPLAY and WAYLAND_DISPLAY are unset): use \
+             `visgate render {} --out image.png`, run the viewer under Xvfb (`Xvfb :99 & \
+             DISPLAY=:99 visgate view …`), or give --or-render image.png",
+            args.scene
+        );
+    }
+    let scene = crate::load_scene(
+        &args.scene,
+        &ImportOptions {
+            load_textures: true,
+        },
+    )?
+    .at(0.0);
+    let level = match &args.level {
+        Some(path) => {
+            let l = visgate_formats::BakedLevel::read(path)
+                .with_context(|| format!("cannot read the level {}", path.display()))?;
+            Some(GateLevel::new(l, &scene)?)
+        }
+        None => None,
+    };
+    let camera = match args.camera.as_deref() {
+        Some("level") => None,
+        Some(name) => Some(
+            scene
+                .cameras
+                .iter()
+                .position(|c| c.name == name)
+                .with_context(|| format!("--camera {name}: the scene has no such camera"))?,
+        ),
+        None => (!scene.cameras.is_empty()).then_some(0),
+    };
+    let g_max = RenderJob::default().for_scene(&scene)?.params.g_max;
+    let start = app::Start {
+        level,
+        mode: info.name,
+        vpls: args.vpls,
+        rsm: args.rsm,
+        size,
+        g_max,
+        camera,
+        screenshot: args.screenshot.clone().map(|p| (p, args.frames)),
+        scene,
+    };
+    let viewer = app::ViewerApp::new(start)?;
+    let options = eframe::NativeOptions {
+        viewport: eframe::egui::ViewportBuilder::default()
+            .with_inner_size([1280.0, 760.0])
+            .with_title("visgate"),
+        renderer: eframe::Renderer::Wgpu,
+        ..Default::default()
+    };
+    eframe::run_native(
+        "visgate",
+        options,
+        Box::new(move |_cc| Ok(Box::new(viewer))),
+    )
+    .map_err(|e| anyhow::anyhow!("the window failed: {e}"))
+}

@@ -1,0 +1,137 @@
+//! The viewer's side-panel sections: each method's settings, the camera, the frame's passes.
+
+use std::collections::VecDeque;
+
+use eframe::egui;
+use visgate_formats::Scene;
+use visgate_runtime::gpu::{MethodSettings, PassTimes};
+use visgate_runtime::hdr::HdrImage;
+
+use super::camera::FlyCamera;
+
+/// The settings of method `mode` (by its registry name).
+pub fn method_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
+    match mode {
+        "gates" | "gates-per-pixel" => {
+            ui.add(egui::Slider::new(&mut s.gates.gates.max_hops, 1..=2).text("gate hops"));
+            ui.add(egui::Slider::new(&mut s.gates.gates.oversize, 0.5..=3.0).text("gate oversize"));
+        }
+        "val-hard" | "val-cssm" => {
+            let v = &mut s.vals;
+            ui.add(egui::Slider::new(&mut v.vals.count, 1..=256).text("VALs"));
+            ui.add(egui::Slider::new(&mut v.vals.iterations, 0..=64).text("k-means iterations"));
+            ui.add(egui::Slider::new(&mut v.interleave.block, 1..=8).text("interleave block"));
+            ui.add(egui::Slider::new(&mut v.map_size, 32..=512).text("VAL map size"));
+        }
+        "per-vpl-shadow-maps" => {
+            ui.add(egui::Slider::new(&mut s.per_vpl.map_size, 16..=512).text("map size"));
+            ui.add(egui::Slider::new(&mut s.per_vpl.batch, 1..=256).text("VPLs per batch"));
+        }
+        _ => {}
+    }
+}
+
+/// The camera: speed, field of view, the scene's cameras as bookmarks, framing the level.
+pub fn camera_controls(ui: &mut egui::Ui, camera: &mut FlyCamera, scene: &Scene) {
+    ui.label("WASD + QE fly, right drag looks, scroll sets the speed, F frames the level");
+    ui.add(
+        egui::Slider::new(&mut camera.speed, 1e-3..=1e4)
+            .logarithmic(true)
+            .text("speed (m/s)"),
+    );
+    let mut fov = camera.fov_x.to_degrees();
+    if ui
+        .add(egui::Slider::new(&mut fov, 10.0..=150.0).text("field of view (°)"))
+        .changed()
+    {
+        camera.fov_x = fov.to_radians();
+    }
+    ui.horizontal_wrapped(|ui| {
+        for c in &scene.cameras {
+            if ui.button(&c.name).clicked() {
+                *camera = FlyCamera::from_camera(c, camera.speed);
+            }
+        }
+    });
+    let e = camera.eye;
+    ui.label(format!("eye ({:.2}, {:.2}, {:.2}) m", e.x, e.y, e.z));
+}
+
+/// The frame's passes as a stacked bar and a table, and the frame times of the last frames.
+pub fn pass_times(ui: &mut egui::Ui, img: &HdrImage, t: &PassTimes, history: &VecDeque<f32>) {
+    ui.label(format!("{} × {}", img.width, img.height));
+    let passes = t.by_name();
+    let total: f64 = passes
+        .iter()
+        .map(|(_, g, c)| g.or(*c).unwrap_or(0.0))
+        .sum::<f64>()
+        .max(1e-9);
+    let (rect, _) =
+        ui.allocate_exact_size(egui::vec2(ui.available_width(), 14.0), egui::Sense::hover());
+    let mut x = rect.left();
+    for (k, (_, g, c)) in passes.iter().enumerate() {
+        let w = (g.or(*c).unwrap_or(0.0) / total) as f32 * rect.width();
+        let colour = egui::ecolor::Hsva::new(k as f32 * 0.13 % 1.0, 0.6, 0.8, 1.0);
+        let r = egui::Rect::from_min_size(egui::pos2(x, rect.top()), egui::vec2(w, 14.0));
+        ui.painter().rect_filled(r, 0.0, colour);
+        x += w;
+    }
+    let source = if t.gpu_total().is_some() {
+        "GPU"
+    } else {
+        "CPU wall"
+    };
+    egui::Grid::new("passes").striped(true).show(ui, |ui| {
+        for (name, g, c) in &passes {
+            ui.label(*name);
+            ui.label(format!("{:.2} ms", g.or(*c).unwrap_or(0.0) * 1e3));
+            ui.end_row();
+        }
+        ui.label(format!("frame ({source})"));
+        ui.label(format!(
+            "{:.2} ms",
+            t.gpu_total().unwrap_or(t.frame_s) * 1e3
+        ));
+        ui.end_row();
+    });
+    if let Some(l) = &t.lists {
+        ui.label(format!("light lists: {l:?}"));
+    }
+    if let Some(v) = &t.vals {
+        ui.label(format!(
+            "VAL clustering: {} of at most {} iterations{}",
+            v.iterations,
+            v.max,
+            if v.converged { ", converged" } else { "" }
+        ));
+    }
+    // Frame times, newest right, scaled to the slowest.
+    let (rect, _) =
+        ui.allocate_exact_size(egui::vec2(ui.available_width(), 48.0), egui::Sense::hover());
+    let max = history.iter().copied().fold(1e-3f32, f32::max);
+    let n = history.len().max(2) - 1;
+    let points: Vec<egui::Pos2> = history
+        .iter()
+        .enumerate()
+        .map(|(i, ms)| {
+            egui::pos2(
+                rect.left() + rect.width() * i as f32 / n as f32,
+                rect.bottom() - rect.height() * ms / max,
+            )
+        })
+        .collect();
+    ui.painter().rect_stroke(
+        rect,
+        0.0,
+        egui::Stroke::new(1.0, egui::Color32::GRAY),
+        egui::StrokeKind::Inside,
+    );
+    ui.painter().add(egui::Shape::line(
+        points,
+        egui::Stroke::new(1.5, egui::Color32::LIGHT_GREEN),
+    ));
+    ui.label(format!(
+        "frame time, last {} frames (max {max:.1} ms)",
+        history.len()
+    ));
+}

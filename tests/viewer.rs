@@ -1,0 +1,146 @@
+//! `visgate view` as a person runs it: in a window on a virtual X display (Xvfb, which CI
+//! installs; a machine without it fails here rather than skipping), its screenshot equals
+//! `visgate render`'s image of the same view; without a display it says what to do instead.
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+use visgate_runtime::hdr::HdrImage;
+use visgate_runtime::metrics::errors;
+
+fn visgate(args: &[&str], display: Option<&str>) -> Output {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_visgate"));
+    c.args(args).env("RUST_LOG", "error");
+    match display {
+        Some(d) => c.env("DISPLAY", d),
+        None => c.env_remove("DISPLAY"),
+    };
+    c.env_remove("WAYLAND_DISPLAY")
+        .output()
+        .expect("runs visgate")
+}
+
+fn text(o: &Output) -> String {
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    )
+}
+
+/// An Xvfb server on a free display, stopped when dropped.
+struct Xvfb(Child, String);
+
+impl Xvfb {
+    fn start() -> Xvfb {
+        let n = 40 + std::process::id() % 400;
+        let display = format!(":{n}");
+        let child = Command::new("Xvfb")
+            .args([&display, "-screen", "0", "1280x800x24", "-nolisten", "tcp"])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .spawn()
+            .unwrap_or_else(|e| panic!("the viewer test needs Xvfb (apt-get install xvfb): {e}"));
+        let socket = PathBuf::from(format!("/tmp/.X11-unix/X{n}"));
+        let t = Instant::now();
+        while !socket.exists() {
+            assert!(
+                t.elapsed() < Duration::from_secs(20),
+                "Xvfb did not start on {display}"
+            );
+            std::thread::sleep(Duration::from_millis(50));
+        }
+        Xvfb(child, display)
+    }
+}
+
+impl Drop for Xvfb {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+fn read(p: &Path) -> HdrImage {
+    HdrImage::read(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+}
+
+#[test]
+fn the_viewers_screenshot_is_visgate_renders_image_of_the_same_view() {
+    let x = Xvfb::start();
+    let dir = tempfile::tempdir().expect("tempdir");
+    let shot = dir.path().join("shot.exr");
+    let want = dir.path().join("render.exr");
+    let (shot_s, want_s) = (shot.to_str().expect("utf-8"), want.to_str().expect("utf-8"));
+    let o = visgate(
+        &[
+            "view",
+            "builtin:cornell-box",
+            "--render-size",
+            "64x48",
+            "--vpls",
+            "64",
+            "--screenshot",
+            shot_s,
+            "--frames",
+            "3",
+        ],
+        Some(&x.1),
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(text(&o).contains("after 3 frames"), "{}", text(&o));
+    let o = visgate(
+        &[
+            "render",
+            "builtin:cornell-box",
+            "--mode",
+            "none",
+            "--size",
+            "64x48",
+            "--vpls",
+            "64",
+            "--out",
+            want_s,
+        ],
+        None,
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    let (img, reference) = (read(&shot), read(&want));
+    assert!(img.mean().x > 0.01, "a blank screenshot: {}", img.mean());
+    let e = errors(&img, &reference).expect("same size");
+    // The same call with the same VPLs, clamp and shadow maps: equal to float rounding.
+    assert!(e.rel_mse < 1e-9, "{e:?}");
+}
+
+#[test]
+fn without_a_display_the_viewer_says_what_to_do_or_renders_headless() {
+    let o = visgate(&["view", "builtin:cornell-box"], None);
+    assert!(!o.status.success());
+    for want in ["no display", "visgate render", "Xvfb", "--or-render"] {
+        assert!(text(&o).contains(want), "missing '{want}': {}", text(&o));
+    }
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("headless.png");
+    let o = visgate(
+        &[
+            "view",
+            "builtin:cornell-box",
+            "--render-size",
+            "32x24",
+            "--vpls",
+            "16",
+            "--or-render",
+            out.to_str().expect("utf-8"),
+        ],
+        None,
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(text(&o).contains("headless"), "{}", text(&o));
+    assert!(std::fs::metadata(&out).expect("written").len() > 100);
+    // Bad arguments are refused before any window.
+    let o = visgate(&["view", "builtin:cornell-box", "--mode", "gates"], None);
+    assert!(text(&o).contains("--level"), "{}", text(&o));
+    let o = visgate(&["view", "builtin:cornell-box", "--mode", "nope"], None);
+    assert!(text(&o).contains("give one of"), "{}", text(&o));
+}
