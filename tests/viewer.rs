@@ -34,7 +34,15 @@ struct Xvfb(Child, String);
 
 impl Xvfb {
     fn start() -> Xvfb {
-        let n = 40 + std::process::id() % 400;
+        // A display number no other server (or test of this run) holds.
+        static NEXT: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
+        let n = (0..)
+            .map(|_| {
+                let k = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                40 + (std::process::id() * 7 + k) % 900
+            })
+            .find(|n| !Path::new(&format!("/tmp/.X{n}-lock")).exists())
+            .expect("a free display");
         let display = format!(":{n}");
         let child = Command::new("Xvfb")
             .args([&display, "-screen", "0", "1280x800x24", "-nolisten", "tcp"])
@@ -143,4 +151,58 @@ fn without_a_display_the_viewer_says_what_to_do_or_renders_headless() {
     assert!(text(&o).contains("--level"), "{}", text(&o));
     let o = visgate(&["view", "builtin:cornell-box", "--mode", "nope"], None);
     assert!(text(&o).contains("give one of"), "{}", text(&o));
+}
+
+#[test]
+fn the_viewer_draws_its_layers_and_the_reference_beside_the_method() {
+    let x = Xvfb::start();
+    let dir = tempfile::tempdir().expect("tempdir");
+    let p = |n: &str| dir.path().join(n).to_str().expect("utf-8").to_string();
+    let o = visgate(
+        &[
+            "bake",
+            "builtin:four-rooms",
+            "-o",
+            &p("rooms.vgate"),
+            "--resolution",
+            "64",
+            "-q",
+        ],
+        None,
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    let o = visgate(
+        &[
+            "view",
+            "builtin:four-rooms",
+            "--level",
+            &p("rooms.vgate"),
+            "--render-size",
+            "48x32",
+            "--vpls",
+            "16",
+            "--layers",
+            "clusters,gates,skeleton,vpls",
+            "--compare",
+            "--screenshot",
+            &p("frame.png"),
+            "--window-shot",
+            &p("window.png"),
+            "--frames",
+            "2",
+        ],
+        Some(&x.1),
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(text(&o).contains("the window"), "{}", text(&o));
+    // The window holds the panel, the frame and its layers: many distinct colours.
+    let window = image::open(p("window.png")).expect("window shot").to_rgb8();
+    assert_eq!(window.dimensions(), (1280, 760));
+    let seen: std::collections::BTreeSet<[u8; 3]> = window.pixels().map(|px| px.0).collect();
+    assert!(seen.len() > 50, "{} colours: a blank window?", seen.len());
+    let o = visgate(
+        &["view", "builtin:four-rooms", "--layers", "gates"],
+        Some(&x.1),
+    );
+    assert!(text(&o).contains("--level"), "{}", text(&o));
 }

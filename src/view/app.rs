@@ -19,6 +19,8 @@ use visgate_runtime::hdr::HdrImage;
 use visgate_runtime::vpl::{PathParams, Vpl, path_vpls};
 
 use super::camera::FlyCamera;
+use super::compare::Compare;
+use super::layers::{self, Layers};
 
 /// What the viewer starts with.
 pub struct Start {
@@ -40,6 +42,12 @@ pub struct Start {
     pub camera: Option<usize>,
     /// Write the last frame here after `frames` frames, then close.
     pub screenshot: Option<(PathBuf, u32)>,
+    /// Write the whole window (panels and layers) here as PNG with the screenshot.
+    pub window_shot: Option<PathBuf>,
+    /// The debug layers on at the start.
+    pub layers: Layers,
+    /// Render the reference of the first view (and wait for it before the screenshot).
+    pub compare: bool,
 }
 
 /// The viewer's state.
@@ -63,6 +71,15 @@ pub struct ViewerApp {
     /// Recent frame times. [Units: ms]
     history: VecDeque<f32>,
     frames: u32,
+    /// The view of the last frame (the layers are drawn with it).
+    last_view: Option<View>,
+    layers: Layers,
+    /// The cluster layer and the view it was made for.
+    cluster_tex: Option<(View, egui::TextureHandle)>,
+    compare: Compare,
+    compare_started: bool,
+    /// What the last frame was rendered with: a frame with nothing changed is not rendered again.
+    last_key: String,
 }
 
 impl ViewerApp {
@@ -103,6 +120,12 @@ impl ViewerApp {
             error: None,
             history: VecDeque::new(),
             frames: 0,
+            last_view: None,
+            layers: start.layers,
+            cluster_tex: None,
+            compare: Compare::new(),
+            compare_started: false,
+            last_key: String::new(),
             start,
         })
     }
@@ -146,10 +169,26 @@ impl ViewerApp {
             (false, false, Some((_, v))) => VplInput::Given(v),
             (false, false, None) => VplInput::Given(&[]),
         };
-        let result = View::new(&self.camera.camera(), size)
-            .and_then(|view| self.gpu.render_frame(&self.ctx, &view, input, &params));
-        match result {
+        let key = format!(
+            "{params:?} {:?} {size:?} {} {}",
+            self.camera.camera(),
+            self.vpl_count,
+            self.start.rsm
+        );
+        if key == self.last_key && self.start.screenshot.is_none() && self.error.is_none() {
+            return;
+        }
+        self.last_key = key;
+        let view = match View::new(&self.camera.camera(), size) {
+            Ok(v) => v,
+            Err(e) => {
+                self.error = Some(e.to_string());
+                return;
+            }
+        };
+        match self.gpu.render_frame(&self.ctx, &view, input, &params) {
             Ok((img, times)) => {
+                self.last_view = Some(view);
                 self.history.push_back((times.frame_s * 1e3) as f32);
                 if self.history.len() > 120 {
                     self.history.pop_front();
@@ -226,6 +265,25 @@ impl ViewerApp {
         ui.add(egui::Slider::new(&mut self.exposure, -8.0..=8.0).text("exposure (stops)"));
         ui.add(egui::Slider::new(&mut self.moving_scale, 0.125..=1.0).text("resolution moving"));
         ui.separator();
+        let has_level = self.start.level.is_some();
+        ui.add_enabled_ui(has_level, |ui| {
+            ui.checkbox(
+                &mut self.layers.clusters,
+                "visibility cluster of each pixel",
+            );
+            ui.checkbox(&mut self.layers.gates, "gates");
+            ui.checkbox(
+                &mut self.layers.skeleton,
+                "skeleton (blue narrow, red wide)",
+            );
+        });
+        ui.checkbox(&mut self.layers.vpls, "VPLs (colour: flux)");
+        ui.separator();
+        let image = self.last.as_ref().map(|(img, _)| img);
+        if self.compare.panel(ui, image) {
+            self.start_reference();
+        }
+        ui.separator();
         super::panel::camera_controls(ui, &mut self.camera, &self.start.scene);
         ui.separator();
         if let Some(e) = &self.error {
@@ -269,8 +327,86 @@ impl ViewerApp {
             let fitted = egui::Rect::from_center_size(rect.center(), size);
             let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
             ui.painter().image(t.id(), fitted, uv, egui::Color32::WHITE);
+            if let Some((img, _)) = &self.last {
+                self.compare.draw(ui, fitted, img, self.exposure, &response);
+            }
+            self.draw_layers(ui, fitted, &response);
         }
         response
+    }
+
+    /// The debug layers over the frame at `rect`, and what lies under the pointer.
+    fn draw_layers(&mut self, ui: &egui::Ui, rect: egui::Rect, response: &egui::Response) {
+        let Some(view) = self.last_view else {
+            return;
+        };
+        let level = self.start.level.as_ref();
+        if let (true, Some(l)) = (self.layers.clusters, level) {
+            // At most 320 pixels wide: a CPU ray per pixel.
+            let k = (view.size[0] as f32 / 320.0).max(1.0);
+            let small = [
+                ((view.size[0] as f32 / k) as u32).max(1),
+                ((view.size[1] as f32 / k) as u32).max(1),
+            ];
+            let fresh = self.cluster_tex.as_ref().is_some_and(|(v, _)| {
+                v.eye == view.eye && v.forward == view.forward && v.size == small
+            });
+            let cam = visgate_formats::Camera {
+                name: "frame".into(),
+                eye: view.eye,
+                target: view.eye + view.forward,
+                up: view.up,
+                fov_x_rad: view.fov_x_rad,
+            };
+            if !fresh && let Ok(sv) = View::new(&cam, small) {
+                let ids = layers::pixel_clusters(&sv, &self.tracer, l);
+                let img = layers::cluster_image(&sv, &ids);
+                let tex = ui
+                    .ctx()
+                    .load_texture("clusters", img, egui::TextureOptions::NEAREST);
+                self.cluster_tex = Some((sv, tex));
+            }
+            if let Some((_, t)) = &self.cluster_tex {
+                let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
+                let tint = egui::Color32::from_white_alpha(150);
+                ui.painter().image(t.id(), rect, uv, tint);
+            }
+        }
+        let vpls = self.vpls.as_ref().map_or(&[][..], |v| &v.1[..]);
+        let painter = ui.painter().with_clip_rect(rect);
+        layers::draw_lines(&painter, rect, &view, self.layers, level, vpls);
+        if let Some(pos) = response.hover_pos().filter(|p| rect.contains(*p)) {
+            let p = glam::Vec2::new(
+                (pos.x - rect.left()) / rect.width() * view.size[0] as f32,
+                (pos.y - rect.top()) / rect.height() * view.size[1] as f32,
+            );
+            let gates = self.settings.gates.gates;
+            let text = layers::probe(&view, p, &self.tracer, level, vpls, &gates);
+            ui.painter().text(
+                rect.left_bottom() + egui::vec2(4.0, -4.0),
+                egui::Align2::LEFT_BOTTOM,
+                text,
+                egui::FontId::monospace(12.0),
+                egui::Color32::WHITE,
+            );
+        }
+    }
+
+    /// Starts the reference of the last frame's view, with its VPLs.
+    fn start_reference(&mut self) {
+        let Some(view) = &self.last_view else {
+            return;
+        };
+        let vpls = match (self.start.rsm, &self.vpls) {
+            (true, _) => self
+                .gpu
+                .rsm_vpls(&self.ctx, self.vpl_count, 256, 1)
+                .unwrap_or_default(),
+            (false, Some((_, v))) => v.clone(),
+            (false, None) => Vec::new(),
+        };
+        self.compare
+            .start(&self.start.scene, view, &vpls, self.start.g_max);
     }
 
     /// Writes the screenshot and closes the window once its frames are rendered.
@@ -278,7 +414,7 @@ impl ViewerApp {
         let Some((path, frames)) = &self.start.screenshot else {
             return;
         };
-        if self.frames < *frames {
+        if self.frames < *frames || (self.start.compare && !self.compare.is_done()) {
             return;
         }
         let outcome = match &self.last {
@@ -299,7 +435,27 @@ impl ViewerApp {
             Err(e) => eprintln!("error: screenshot {}: {e}", path.display()),
         }
         self.start.screenshot = None;
-        ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+        let Some(path) = self.start.window_shot.take() else {
+            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+            return;
+        };
+        // The window as drawn, then close.
+        let c = ctx.clone();
+        ctx.request_screenshot(move |img| {
+            let rgba: Vec<u8> = img
+                .pixels
+                .iter()
+                .flat_map(|p| p.to_srgba_unmultiplied())
+                .collect();
+            let [w, h] = img.size;
+            match image::save_buffer(&path, &rgba, w as u32, h as u32, image::ColorType::Rgba8) {
+                Ok(()) => println!("wrote {} ({w} x {h}, the window)", path.display()),
+                Err(e) => eprintln!("error: window shot {}: {e}", path.display()),
+            }
+            c.send_viewport_cmd(egui::ViewportCommand::Close);
+            c.request_repaint();
+        });
+        ctx.request_repaint();
     }
 }
 
@@ -323,6 +479,11 @@ impl eframe::App for ViewerApp {
                 ]
             });
             self.render(size);
+            self.compare.poll(self.last_view.as_ref());
+            if self.start.compare && !self.compare_started && self.last_view.is_some() {
+                self.compare_started = true;
+                self.start_reference();
+            }
             if moved {
                 ui.ctx().request_repaint();
             }

@@ -4,6 +4,8 @@
 
 mod app;
 mod camera;
+mod compare;
+mod layers;
 mod panel;
 
 use std::path::PathBuf;
@@ -46,6 +48,16 @@ pub struct ViewArgs {
     /// Frames to render before --screenshot is written.
     #[arg(long, default_value_t = 3)]
     pub frames: u32,
+    /// Also write the whole window (panels and debug layers) as PNG with --screenshot.
+    #[arg(long, requires = "screenshot")]
+    pub window_shot: Option<PathBuf>,
+    /// Debug layers on at the start, comma separated: clusters, gates, skeleton, vpls.
+    #[arg(long, value_delimiter = ',')]
+    pub layers: Vec<String>,
+    /// Render the exact CPU reference of the first view and show it beside the method (the
+    /// screenshot waits for it).
+    #[arg(long)]
+    pub compare: bool,
     /// With no display, render this image headless instead (`visgate render` with the same
     /// scene, level, method and VPLs) rather than fail.
     #[arg(long)]
@@ -173,6 +185,19 @@ pub fn run(args: ViewArgs) -> Result<()> {
         ),
         None => (!scene.cameras.is_empty()).then_some(0),
     };
+    let mut layers = layers::Layers::default();
+    for l in &args.layers {
+        match l.as_str() {
+            "clusters" => layers.clusters = true,
+            "gates" => layers.gates = true,
+            "skeleton" => layers.skeleton = true,
+            "vpls" => layers.vpls = true,
+            _ => bail!("--layers {l}: give clusters, gates, skeleton or vpls"),
+        }
+    }
+    if (layers.clusters || layers.gates || layers.skeleton) && args.level.is_none() {
+        bail!("--layers clusters, gates and skeleton draw a baked level: give --level");
+    }
     let g_max = RenderJob::default().for_scene(&scene)?.params.g_max;
     let start = app::Start {
         level,
@@ -183,6 +208,9 @@ pub fn run(args: ViewArgs) -> Result<()> {
         g_max,
         camera,
         screenshot: args.screenshot.clone().map(|p| (p, args.frames)),
+        window_shot: args.window_shot.clone(),
+        layers,
+        compare: args.compare,
         scene,
     };
     let viewer = app::ViewerApp::new(start)?;

@@ -95,7 +95,15 @@ pub fn pass_times(ui: &mut egui::Ui, img: &HdrImage, t: &PassTimes, history: &Ve
         ui.end_row();
     });
     if let Some(l) = &t.lists {
-        ui.label(format!("light lists: {l:?}"));
+        ui.label(format!(
+            "light lists: {} geometry clusters, {} entries ({:.1} % of the pool); outside every \
+             visibility cluster: {} pixels, {} VPLs",
+            l.geometry_clusters,
+            l.entries,
+            100.0 * l.entries as f64 / l.capacity.max(1) as f64,
+            l.pixels_outside,
+            l.vpls_outside
+        ));
     }
     if let Some(v) = &t.vals {
         ui.label(format!(

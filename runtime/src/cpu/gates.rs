@@ -69,6 +69,11 @@ impl GateLevel {
         })
     }
 
+    /// The baked level (skeleton, clusters, gates), for drawing.
+    pub fn baked(&self) -> &BakedLevel {
+        &self.level
+    }
+
     /// Number of visibility clusters.
     pub fn cluster_count(&self) -> usize {
         self.cluster_gates.len()

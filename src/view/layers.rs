@@ -1,0 +1,188 @@
+//! The viewer's debug layers, drawn over the image: the visibility cluster of every pixel
+//! (found by a CPU ray per pixel and the level's voxel→cluster grid, as the renderer finds
+//! it), the gates as disks, the skeleton coloured by max-ball radius, the VPLs coloured by
+//! flux; and what lies under the pointer (cluster, position, normal, VPLs that reach it).
+
+use eframe::egui;
+use glam::Vec3;
+use rayon::prelude::*;
+use visgate_runtime::camera::View;
+use visgate_runtime::cpu::gates::{GateLevel, GateParams};
+use visgate_runtime::cpu::tracer::Tracer;
+use visgate_runtime::vpl::Vpl;
+
+/// Which layers are on.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Layers {
+    /// Each pixel's visibility cluster, in distinct colours (grey: none).
+    pub clusters: bool,
+    /// The gates as disks.
+    pub gates: bool,
+    /// The skeleton, blue narrow to red wide.
+    pub skeleton: bool,
+    /// The VPLs as points.
+    pub vpls: bool,
+}
+
+/// A distinct colour for id `k`.
+pub fn id_colour(k: u32) -> egui::Color32 {
+    let h = (k as f32 * 0.618_034) % 1.0;
+    egui::Color32::from(egui::ecolor::Hsva::new(h, 0.75, 0.95, 1.0))
+}
+
+/// Where world point `p` falls in `rect`, showing `view`; `None` behind the camera.
+pub fn project(view: &View, rect: egui::Rect, p: Vec3) -> Option<egui::Pos2> {
+    let d = p - view.eye;
+    let z = d.dot(view.forward);
+    if z <= 1e-6 * d.length().max(1e-30) {
+        return None;
+    }
+    let tx = (0.5 * view.fov_x_rad).tan();
+    let ty = tx * view.size[1] as f32 / view.size[0] as f32;
+    let x = d.dot(view.right) / (z * tx);
+    let y = d.dot(view.up) / (z * ty);
+    Some(egui::pos2(
+        rect.left() + (x + 1.0) * 0.5 * rect.width(),
+        rect.top() + (1.0 - y) * 0.5 * rect.height(),
+    ))
+}
+
+/// The cluster of every pixel of `view` (row-major; `None`: no surface or no cluster).
+pub fn pixel_clusters(view: &View, tracer: &Tracer, level: &GateLevel) -> Vec<Option<u32>> {
+    let [w, h] = view.size;
+    (0..w * h)
+        .into_par_iter()
+        .map(|i| {
+            let p = glam::Vec2::new((i % w) as f32 + 0.5, (i / w) as f32 + 0.5);
+            let dir = view.ray_dir(p);
+            let s = tracer.trace(view.eye, dir)?;
+            level.cluster_at(s.position, s.normal)
+        })
+        .collect()
+}
+
+/// The cluster image as an egui image.
+pub fn cluster_image(view: &View, clusters: &[Option<u32>]) -> egui::ColorImage {
+    let px: Vec<egui::Color32> = clusters
+        .iter()
+        .map(|c| match c {
+            Some(k) => id_colour(*k),
+            None => egui::Color32::from_gray(40),
+        })
+        .collect();
+    egui::ColorImage::new([view.size[0] as usize, view.size[1] as usize], px)
+}
+
+/// Draws the line layers (gates, skeleton, VPLs) over `rect`.
+pub fn draw_lines(
+    painter: &egui::Painter,
+    rect: egui::Rect,
+    view: &View,
+    on: Layers,
+    level: Option<&GateLevel>,
+    vpls: &[Vpl],
+) {
+    let seg = |a: Vec3, b: Vec3, colour: egui::Color32, width: f32| {
+        if let (Some(p), Some(q)) = (project(view, rect, a), project(view, rect, b)) {
+            painter.line_segment([p, q], egui::Stroke::new(width, colour));
+        }
+    };
+    if let (true, Some(l)) = (on.skeleton, level) {
+        let sk = &l.baked().topology.skeleton;
+        let r_max = sk.nodes.iter().map(|n| n.radius_m).fold(1e-30, f32::max);
+        for [a, b] in &sk.edges {
+            let (na, nb) = (&sk.nodes[*a as usize], &sk.nodes[*b as usize]);
+            let t = 0.5 * (na.radius_m + nb.radius_m) / r_max;
+            let colour = egui::Color32::from_rgb((255.0 * t) as u8, 60, (255.0 * (1.0 - t)) as u8);
+            seg(na.position_m.into(), nb.position_m.into(), colour, 2.0);
+        }
+    }
+    if let (true, Some(l)) = (on.gates, level) {
+        for i in 0..l.gate_count() as u32 {
+            let (c, n, r) = l.gate(i);
+            let u = n.any_orthonormal_vector();
+            let v = n.cross(u);
+            let colour = id_colour(i);
+            let ring = |k: u32| {
+                let a = k as f32 / 32.0 * std::f32::consts::TAU;
+                c + (u * a.cos() + v * a.sin()) * r
+            };
+            for k in 0..32 {
+                seg(ring(k), ring(k + 1), colour, 2.0);
+            }
+            seg(c, c + n * r * 0.3, colour, 1.0);
+        }
+    }
+    if on.vpls {
+        let max = vpls
+            .iter()
+            .map(|v| Vec3::from(v.flux).max_element())
+            .fold(1e-30, f32::max);
+        for v in vpls {
+            if let Some(p) = project(view, rect, v.position.into()) {
+                let f = Vec3::from(v.flux) / max;
+                let colour = egui::Color32::from_rgb(
+                    (255.0 * f.x.sqrt()) as u8,
+                    (255.0 * f.y.sqrt()) as u8,
+                    (255.0 * f.z.sqrt()) as u8,
+                );
+                painter.circle_filled(p, 2.0, colour);
+            }
+        }
+    }
+}
+
+/// What lies under image point `p` (pixels of `view`): a line of text.
+pub fn probe(
+    view: &View,
+    p: glam::Vec2,
+    tracer: &Tracer,
+    level: Option<&GateLevel>,
+    vpls: &[Vpl],
+    gates: &GateParams,
+) -> String {
+    let Some(s) = tracer.trace(view.eye, view.ray_dir(p)) else {
+        return "no surface".into();
+    };
+    let (x, n) = (s.position, s.normal);
+    let facing: Vec<&Vpl> = vpls
+        .iter()
+        .filter(|v| {
+            let d = Vec3::from(v.position) - x;
+            d.dot(n) > 0.0 && d.dot(Vec3::from(v.normal)) < 0.0
+        })
+        .collect();
+    let exact = facing
+        .iter()
+        .filter(|v| !tracer.occluded(x + n * 1e-4 * (1.0 + x.length()), v.position.into()))
+        .count();
+    let mut out = format!(
+        "({:.2}, {:.2}, {:.2}) m, normal ({:.2}, {:.2}, {:.2}); VPLs facing {}, unoccluded {}",
+        x.x,
+        x.y,
+        x.z,
+        n.x,
+        n.y,
+        n.z,
+        facing.len(),
+        exact
+    );
+    if let Some(l) = level {
+        let c = l.cluster_at(x, n);
+        let through = facing
+            .iter()
+            .filter(|v| {
+                let (vp, vn) = (Vec3::from(v.position), Vec3::from(v.normal));
+                match (c, l.cluster_at(vp, vn)) {
+                    (Some(a), Some(b)) => l.visible(x, a, vp, b, gates),
+                    _ => true,
+                }
+            })
+            .count();
+        out += &match c {
+            Some(k) => format!("; cluster {k}, through the gates {through}"),
+            None => format!("; no cluster (unoccluded), through the gates {through}"),
+        };
+    }
+    out
+}
