@@ -206,3 +206,35 @@ fn the_viewer_draws_its_layers_and_the_reference_beside_the_method() {
     );
     assert!(text(&o).contains("--level"), "{}", text(&o));
 }
+
+#[test]
+fn a_benchmark_walks_its_path_and_writes_every_frames_passes() {
+    let x = Xvfb::start();
+    let dir = tempfile::tempdir().expect("tempdir");
+    let csv = dir.path().join("times.csv");
+    let o = visgate(
+        &[
+            "view",
+            "builtin:cornell-box",
+            "--mode",
+            "val-cssm",
+            "--render-size",
+            "40x30",
+            "--vpls",
+            "32",
+            "--benchmark",
+            "4",
+            "--benchmark-out",
+            csv.to_str().expect("utf-8"),
+        ],
+        Some(&x.1),
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(text(&o).contains("benchmark: 4 frames"), "{}", text(&o));
+    let rows = std::fs::read_to_string(&csv).expect("csv");
+    assert!(rows.starts_with("frame,pass,gpu_ms,cpu_wall_ms\n"), "{rows}");
+    let frames: Vec<&str> = rows.lines().filter(|l| l.contains(",frame,")).collect();
+    assert_eq!(frames.len(), 4, "{rows}");
+    assert!(rows.contains("3,frame,"), "{rows}");
+    assert!(rows.lines().any(|l| l.contains("VAL")), "{rows}");
+}

@@ -18,6 +18,7 @@ use visgate_runtime::gpu::{
 use visgate_runtime::hdr::HdrImage;
 use visgate_runtime::vpl::{PathParams, Vpl, path_vpls};
 
+use super::bench::Bench;
 use super::camera::FlyCamera;
 use super::compare::Compare;
 use super::layers::{self, Layers};
@@ -48,6 +49,8 @@ pub struct Start {
     pub layers: Layers,
     /// Render the reference of the first view (and wait for it before the screenshot).
     pub compare: bool,
+    /// Play a benchmark path of this many frames, write its CSV here, then close.
+    pub benchmark: Option<(u32, PathBuf)>,
 }
 
 /// The viewer's state.
@@ -80,6 +83,7 @@ pub struct ViewerApp {
     compare_started: bool,
     /// What the last frame was rendered with: a frame with nothing changed is not rendered again.
     last_key: String,
+    bench: Option<Bench>,
 }
 
 impl ViewerApp {
@@ -126,6 +130,10 @@ impl ViewerApp {
             compare: Compare::new(),
             compare_started: false,
             last_key: String::new(),
+            bench: start
+                .benchmark
+                .clone()
+                .map(|(n, out)| Bench::new(&start.scene, n, out)),
             start,
         })
     }
@@ -175,7 +183,9 @@ impl ViewerApp {
             self.vpl_count,
             self.start.rsm
         );
-        if key == self.last_key && self.start.screenshot.is_none() && self.error.is_none() {
+        let forced =
+            self.start.screenshot.is_some() || self.bench.is_some() || self.error.is_some();
+        if key == self.last_key && !forced {
             return;
         }
         self.last_key = key;
@@ -392,6 +402,32 @@ impl ViewerApp {
         }
     }
 
+    /// Records a benchmark frame (if one was rendered since `before`); writes the CSV and
+    /// closes after the last.
+    fn bench_step(&mut self, ctx: &egui::Context, before: u32) {
+        let Some(b) = &mut self.bench else {
+            return;
+        };
+        if self.frames > before
+            && let Some((_, t)) = &self.last
+        {
+            b.record(t);
+        }
+        if b.done >= b.frames {
+            match b.finish() {
+                Ok(s) => println!("{s}"),
+                Err(e) => eprintln!("error: benchmark: {e}"),
+            }
+            self.bench = None;
+            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+        } else if let Some(e) = &self.error {
+            eprintln!("error: benchmark frame {}: {e}", b.done);
+            self.bench = None;
+            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+        }
+        ctx.request_repaint();
+    }
+
     /// Starts the reference of the last frame's view, with its VPLs.
     fn start_reference(&mut self) {
         let Some(view) = &self.last_view else {
@@ -478,7 +514,12 @@ impl eframe::App for ViewerApp {
                     ((full.y * ppp * s) as u32).max(8),
                 ]
             });
+            if let Some(b) = &self.bench {
+                self.camera = FlyCamera::from_camera(&b.camera(b.done), self.camera.speed);
+            }
+            let before = self.frames;
             self.render(size);
+            self.bench_step(ui.ctx(), before);
             self.compare.poll(self.last_view.as_ref());
             if self.start.compare && !self.compare_started && self.last_view.is_some() {
                 self.compare_started = true;

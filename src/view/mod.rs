@@ -3,6 +3,7 @@
 //! makes, with the same VPLs and clamp, so both give the same image of the same view.
 
 mod app;
+mod bench;
 mod camera;
 mod compare;
 mod layers;
@@ -58,6 +59,13 @@ pub struct ViewArgs {
     /// screenshot waits for it).
     #[arg(long)]
     pub compare: bool,
+    /// Play a camera path of this many frames through the scene's cameras (or a turn about
+    /// the level), write every frame's pass times to --benchmark-out, then close.
+    #[arg(long, requires = "benchmark_out")]
+    pub benchmark: Option<u32>,
+    /// The benchmark's CSV: frame,pass,gpu_ms,cpu_wall_ms.
+    #[arg(long)]
+    pub benchmark_out: Option<PathBuf>,
     /// With no display, render this image headless instead (`visgate render` with the same
     /// scene, level, method and VPLs) rather than fail.
     #[arg(long)]
@@ -144,6 +152,9 @@ pub fn run(args: ViewArgs) -> Result<()> {
         bail!("--mode {mode} needs --level LEVEL.vgate (bake one with `visgate bake`)");
     }
     let size = args.render_size.as_deref().map(parse_size).transpose()?;
+    if args.benchmark == Some(0) {
+        bail!("--benchmark 0: give the number of frames of the path");
+    }
     if args.frames == 0 {
         bail!("--frames 0: render at least 1 frame before the screenshot");
     }
@@ -211,6 +222,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
         window_shot: args.window_shot.clone(),
         layers,
         compare: args.compare,
+        benchmark: args.benchmark.zip(args.benchmark_out.clone()),
         scene,
     };
     let viewer = app::ViewerApp::new(start)?;
