@@ -74,51 +74,104 @@ fn read(p: &Path) -> HdrImage {
     HdrImage::read(p).unwrap_or_else(|e| panic!("{}: {e}", p.display()))
 }
 
+/// A floor and a box sliding across it, lit by a light on an orbit: a dynamic scene.
+fn dynamic_scene(dir: &Path) -> PathBuf {
+    let w = |n: &str, t: &str| std::fs::write(dir.join(n), t).expect("write");
+    w(
+        "floor.obj",
+        "v -3 0 -3\nv 3 0 -3\nv 3 0 3\nv -3 0 3\nf 1 4 3 2\n",
+    );
+    w(
+        "box.obj",
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n\
+         f 1 2 3 4\nf 5 8 7 6\nf 1 5 6 2\nf 2 6 7 3\nf 3 7 8 4\nf 4 8 5 1\n",
+    );
+    w(
+        "scene.toml",
+        r#"
+[[mesh]]
+path = "floor.obj"
+
+[[mesh]]
+path = "box.obj"
+static = false
+animate = [{ t = 0, translate = [-2, 0, -0.5] }, { t = 2, translate = [1, 0, -0.5] }]
+
+[[light]]
+type = "point"
+position = [0, 3, 0]
+intensity = [10, 10, 10]
+orbit = { centre = [0, 3, 0], radius = 1, period_s = 4 }
+
+[[camera]]
+name = "main"
+eye = [0, 4, 6]
+target = [0, 0, 0]
+fov_deg = 60
+"#,
+    );
+    dir.join("scene.toml")
+}
+
 #[test]
 fn the_viewers_screenshot_is_visgate_renders_image_of_the_same_view() {
     let x = Xvfb::start();
     let dir = tempfile::tempdir().expect("tempdir");
-    let shot = dir.path().join("shot.exr");
-    let want = dir.path().join("render.exr");
-    let (shot_s, want_s) = (shot.to_str().expect("utf-8"), want.to_str().expect("utf-8"));
+    let dynamic = dynamic_scene(dir.path());
+    let dynamic = dynamic.to_str().expect("utf-8");
+    for (scene, time) in [("builtin:cornell-box", "0"), (dynamic, "1.5")] {
+        let shot = dir.path().join("shot.exr");
+        let want = dir.path().join("render.exr");
+        let (shot_s, want_s) = (shot.to_str().expect("utf-8"), want.to_str().expect("utf-8"));
+        let common = ["--vpls", "64", "--time", time];
+        let mut view = vec![
+            "view",
+            scene,
+            "--render-size",
+            "64x48",
+            "--screenshot",
+            shot_s,
+        ];
+        view.extend(common);
+        let o = visgate(&view, Some(&x.1));
+        assert!(o.status.success(), "{}", text(&o));
+        assert!(text(&o).contains("after 3 frames"), "{}", text(&o));
+        let mut render = vec![
+            "render", scene, "--mode", "none", "--size", "64x48", "--out", want_s,
+        ];
+        render.extend(common);
+        let o = visgate(&render, None);
+        assert!(o.status.success(), "{}", text(&o));
+        let (img, reference) = (read(&shot), read(&want));
+        assert!(
+            img.mean().x > 1e-4,
+            "{scene}: a blank screenshot: {}",
+            img.mean()
+        );
+        let e = errors(&img, &reference).expect("same size");
+        // The same call with the same VPLs, clamp, shadow maps and pose: equal to rounding.
+        assert!(e.rel_mse < 1e-9, "{scene} at {time} s: {e:?}");
+    }
+    // Another time poses the box and the light elsewhere: another image.
+    let other = dir.path().join("other.exr");
     let o = visgate(
         &[
             "view",
-            "builtin:cornell-box",
+            dynamic,
             "--render-size",
             "64x48",
             "--vpls",
             "64",
+            "--time",
+            "0.2",
             "--screenshot",
-            shot_s,
-            "--frames",
-            "3",
+            other.to_str().expect("utf-8"),
         ],
         Some(&x.1),
     );
     assert!(o.status.success(), "{}", text(&o));
-    assert!(text(&o).contains("after 3 frames"), "{}", text(&o));
-    let o = visgate(
-        &[
-            "render",
-            "builtin:cornell-box",
-            "--mode",
-            "none",
-            "--size",
-            "64x48",
-            "--vpls",
-            "64",
-            "--out",
-            want_s,
-        ],
-        None,
-    );
-    assert!(o.status.success(), "{}", text(&o));
-    let (img, reference) = (read(&shot), read(&want));
-    assert!(img.mean().x > 0.01, "a blank screenshot: {}", img.mean());
-    let e = errors(&img, &reference).expect("same size");
-    // The same call with the same VPLs, clamp and shadow maps: equal to float rounding.
-    assert!(e.rel_mse < 1e-9, "{e:?}");
+    let e = errors(&read(&other), &read(&dir.path().join("shot.exr"))).expect("same size");
+    assert!(e.rel_mse > 1e-4, "the pose did not change the image: {e:?}");
 }
 
 #[test]
@@ -232,7 +285,10 @@ fn a_benchmark_walks_its_path_and_writes_every_frames_passes() {
     assert!(o.status.success(), "{}", text(&o));
     assert!(text(&o).contains("benchmark: 4 frames"), "{}", text(&o));
     let rows = std::fs::read_to_string(&csv).expect("csv");
-    assert!(rows.starts_with("frame,pass,gpu_ms,cpu_wall_ms\n"), "{rows}");
+    assert!(
+        rows.starts_with("frame,pass,gpu_ms,cpu_wall_ms\n"),
+        "{rows}"
+    );
     let frames: Vec<&str> = rows.lines().filter(|l| l.contains(",frame,")).collect();
     assert_eq!(frames.len(), 4, "{rows}");
     assert!(rows.contains("3,frame,"), "{rows}");

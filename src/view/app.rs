@@ -25,8 +25,10 @@ use super::layers::{self, Layers};
 
 /// What the viewer starts with.
 pub struct Start {
-    /// The scene, posed at time 0.
+    /// The scene (its animation included; the viewer poses it).
     pub scene: Scene,
+    /// The time to pose it at first. [Units: s]
+    pub time: f64,
     /// Its baked level, if given.
     pub level: Option<GateLevel>,
     /// The first method's name.
@@ -84,6 +86,12 @@ pub struct ViewerApp {
     /// What the last frame was rendered with: a frame with nothing changed is not rendered again.
     last_key: String,
     bench: Option<Bench>,
+    /// The scene at `time`.
+    posed: Scene,
+    /// The scene's time. [Units: s]
+    time: f64,
+    /// Whether time runs.
+    playing: bool,
 }
 
 impl ViewerApp {
@@ -99,7 +107,8 @@ impl ViewerApp {
                 ctx.adapter_info.name
             );
         }
-        let mut gpu = GpuRenderer::new(&ctx, &start.scene)?;
+        let posed = start.scene.at(start.time);
+        let mut gpu = GpuRenderer::new(&ctx, &posed)?;
         if let Some(l) = &start.level {
             gpu.set_level(&ctx, l)?;
         }
@@ -110,7 +119,10 @@ impl ViewerApp {
             None => FlyCamera::framing(lo, hi),
         };
         Ok(ViewerApp {
-            tracer: Tracer::new(&start.scene),
+            tracer: Tracer::new(&posed),
+            posed,
+            time: start.time,
+            playing: false,
             ctx,
             gpu,
             vpls: None,
@@ -159,7 +171,7 @@ impl ViewerApp {
                 bounces: 1,
                 seed: 1,
             };
-            match path_vpls(&self.tracer, &self.start.scene.lights, &paths) {
+            match path_vpls(&self.tracer, &self.posed.lights, &paths) {
                 Ok(v) => self.vpls = Some((self.vpl_count, v)),
                 Err(e) => {
                     self.error = Some(e.to_string());
@@ -178,8 +190,9 @@ impl ViewerApp {
             (false, false, None) => VplInput::Given(&[]),
         };
         let key = format!(
-            "{params:?} {:?} {size:?} {} {}",
+            "{params:?} {:?} {size:?} {} {} {}",
             self.camera.camera(),
+            self.time,
             self.vpl_count,
             self.start.rsm
         );
@@ -295,6 +308,19 @@ impl ViewerApp {
         }
         ui.separator();
         super::panel::camera_controls(ui, &mut self.camera, &self.start.scene);
+        if self.start.scene.is_animated() {
+            ui.separator();
+            ui.horizontal(|ui| {
+                ui.checkbox(&mut self.playing, "play");
+                let mut t = self.time;
+                if ui
+                    .add(egui::Slider::new(&mut t, 0.0..=30.0).text("time (s)"))
+                    .changed()
+                {
+                    self.set_time(t);
+                }
+            });
+        }
         ui.separator();
         if let Some(e) = &self.error {
             ui.colored_label(
@@ -402,6 +428,16 @@ impl ViewerApp {
         }
     }
 
+    /// Poses the scene at `t` seconds: geometry and lights on the GPU, the CPU tracer, and
+    /// the light paths (made again on the next frame).
+    fn set_time(&mut self, t: f64) {
+        self.time = t;
+        self.posed = self.start.scene.at(t);
+        self.gpu.set_scene(&self.ctx, &self.posed);
+        self.tracer = Tracer::new(&self.posed);
+        self.vpls = None;
+    }
+
     /// Records a benchmark frame (if one was rendered since `before`); writes the CSV and
     /// closes after the last.
     fn bench_step(&mut self, ctx: &egui::Context, before: u32) {
@@ -442,7 +478,7 @@ impl ViewerApp {
             (false, None) => Vec::new(),
         };
         self.compare
-            .start(&self.start.scene, view, &vpls, self.start.g_max);
+            .start(&self.posed, view, &vpls, self.start.g_max);
     }
 
     /// Writes the screenshot and closes the window once its frames are rendered.
@@ -514,6 +550,11 @@ impl eframe::App for ViewerApp {
                     ((full.y * ppp * s) as u32).max(8),
                 ]
             });
+            if self.playing {
+                let dt = ui.input(|i| i.stable_dt.min(0.1)) as f64;
+                self.set_time(self.time + dt);
+                ui.ctx().request_repaint();
+            }
             if let Some(b) = &self.bench {
                 self.camera = FlyCamera::from_camera(&b.camera(b.done), self.camera.speed);
             }

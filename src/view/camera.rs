@@ -5,7 +5,7 @@ use glam::Vec3;
 use visgate_formats::Camera;
 
 /// A fly camera: looks along `forward()` from `eye`, +Y up.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct FlyCamera {
     /// Position. [Units: m]
     pub eye: Vec3,
@@ -17,6 +17,9 @@ pub struct FlyCamera {
     pub fov_x: f32,
     /// Flying speed. [Units: m/s]
     pub speed: f32,
+    /// The scene camera it was made from, returned as is until it moves or turns (so that a
+    /// scene camera renders exactly as `visgate render` renders it).
+    origin: Option<Camera>,
 }
 
 /// Pitch stays short of straight up or down, where yaw loses its meaning.
@@ -32,6 +35,7 @@ impl FlyCamera {
             pitch: d.y.clamp(-1.0, 1.0).asin().clamp(-MAX_PITCH, MAX_PITCH),
             fov_x: c.fov_x_rad,
             speed,
+            origin: Some(c.clone()),
         }
     }
 
@@ -70,16 +74,24 @@ impl FlyCamera {
         let right = f.cross(Vec3::Y).normalize_or(Vec3::X);
         let step = right * local.x + Vec3::Y * local.y + f * local.z;
         self.eye += step * self.speed * dt;
+        self.origin = None;
     }
 
     /// Turns it by a mouse drag of `dx`, `dy` pixels (`rad_per_px` each).
     pub fn look(&mut self, dx: f32, dy: f32, rad_per_px: f32) {
         self.yaw -= dx * rad_per_px;
         self.pitch = (self.pitch - dy * rad_per_px).clamp(-MAX_PITCH, MAX_PITCH);
+        self.origin = None;
     }
 
     /// The scene camera it is (what the renderer takes).
     pub fn camera(&self) -> Camera {
+        if let Some(c) = &self.origin
+            && c.fov_x_rad == self.fov_x
+            && c.eye == self.eye
+        {
+            return c.clone();
+        }
         Camera {
             name: "viewer".into(),
             eye: self.eye,
@@ -103,7 +115,11 @@ mod tests {
             up: Vec3::Y,
             fov_x_rad: 1.2,
         };
-        let f = FlyCamera::from_camera(&c, 2.0);
+        let mut f = FlyCamera::from_camera(&c, 2.0);
+        // Untouched, it is the scene camera itself (renders as `visgate render` does).
+        assert_eq!(f.camera(), c);
+        // Turned by nothing, it is the same direction from its yaw and pitch.
+        f.look(0.0, 0.0, 0.01);
         let back = f.camera();
         let want = (c.target - c.eye).normalize();
         assert!((back.target - back.eye).distance(want) < 1e-5, "{back:?}");

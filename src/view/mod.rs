@@ -43,6 +43,9 @@ pub struct ViewArgs {
     /// Render at this size, WIDTHxHEIGHT, shown fitted into the window (default: the window's).
     #[arg(long)]
     pub render_size: Option<String>,
+    /// The scene's time to start at, seconds (animated meshes and lights; play in the window).
+    #[arg(long, default_value_t = 0.0)]
+    pub time: f64,
     /// Write the last frame (.png sRGB, .exr linear) after --frames frames, then close.
     #[arg(long)]
     pub screenshot: Option<PathBuf>,
@@ -133,6 +136,7 @@ fn render_instead(args: &ViewArgs, mode: &str, out: &std::path::Path) -> Result<
     if let Some(c) = &args.camera {
         argv.extend(["--camera".into(), c.clone()]);
     }
+    argv.extend(["--time".into(), args.time.to_string()]);
     crate::render::run(Render::try_parse_from(argv)?.args)
 }
 
@@ -175,8 +179,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
         &ImportOptions {
             load_textures: true,
         },
-    )?
-    .at(0.0);
+    )?;
     let level = match &args.level {
         Some(path) => {
             let l = visgate_formats::BakedLevel::read(path)
@@ -222,9 +225,13 @@ pub fn run(args: ViewArgs) -> Result<()> {
         window_shot: args.window_shot.clone(),
         layers,
         compare: args.compare,
+        time: args.time,
         benchmark: args.benchmark.zip(args.benchmark_out.clone()),
         scene,
     };
+    if !args.time.is_finite() {
+        bail!("--time {}: give a finite time in seconds", args.time);
+    }
     let viewer = app::ViewerApp::new(start)?;
     let options = eframe::NativeOptions {
         viewport: eframe::egui::ViewportBuilder::default()
