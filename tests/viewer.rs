@@ -199,7 +199,7 @@ fn the_viewer_draws_its_layers_and_the_reference_beside_the_method() {
             "--vpls",
             "16",
             "--layers",
-            "clusters,gates,skeleton,vpls",
+            "clusters,gates,skeleton,vpls,indirect",
             "--compare",
             "--screenshot",
             &p("frame.png"),

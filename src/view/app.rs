@@ -92,6 +92,12 @@ pub struct ViewerApp {
     time: f64,
     /// Whether time runs.
     playing: bool,
+    /// Where the frame was drawn last.
+    image_rect: Option<egui::Rect>,
+    /// The point a middle drag orbits about.
+    pivot: Option<Vec3>,
+    /// The last frame's indirect light alone, when that layer is on.
+    indirect: Option<HdrImage>,
 }
 
 impl ViewerApp {
@@ -123,6 +129,9 @@ impl ViewerApp {
             posed,
             time: start.time,
             playing: false,
+            image_rect: None,
+            pivot: None,
+            indirect: None,
             ctx,
             gpu,
             vpls: None,
@@ -190,8 +199,9 @@ impl ViewerApp {
             (false, false, None) => VplInput::Given(&[]),
         };
         let key = format!(
-            "{params:?} {:?} {size:?} {} {} {}",
+            "{params:?} {:?} {size:?} {} {} {} {}",
             self.camera.camera(),
+            self.layers.indirect,
             self.time,
             self.vpl_count,
             self.start.rsm
@@ -216,12 +226,30 @@ impl ViewerApp {
                 if self.history.len() > 120 {
                     self.history.pop_front();
                 }
+                self.indirect = match self.layers.indirect && !direct_only {
+                    true => self.indirect_of(&view, &img),
+                    false => None,
+                };
                 self.last = Some((img, times));
                 self.error = None;
                 self.frames += 1;
             }
             Err(e) => self.error = Some(e.to_string()),
         }
+    }
+
+    /// The surface point under the pointer (else the level's centre).
+    fn pick(&self, image: &egui::Response) -> Option<Vec3> {
+        let view = self.last_view?;
+        let rect = self.image_rect?;
+        let pos = image.interact_pointer_pos()?;
+        let p = glam::Vec2::new(
+            (pos.x - rect.left()) / rect.width() * view.size[0] as f32,
+            (pos.y - rect.top()) / rect.height() * view.size[1] as f32,
+        );
+        let hit = self.tracer.trace(view.eye, view.ray_dir(p));
+        let (lo, hi) = self.posed.bounds().unwrap_or((Vec3::ZERO, Vec3::ONE));
+        Some(hit.map_or((lo + hi) * 0.5, |s| s.position))
     }
 
     /// Moves the camera from the keyboard and the mouse; true if it moved.
@@ -248,6 +276,17 @@ impl ViewerApp {
                 self.camera = FlyCamera::framing(lo, hi);
                 moved = true;
             }
+        }
+        // Middle drag orbits about the surface under the pointer where the drag began.
+        if image.drag_started_by(egui::PointerButton::Middle) {
+            self.pivot = self.pick(image);
+        }
+        if image.dragged_by(egui::PointerButton::Middle)
+            && let Some(p) = self.pivot
+        {
+            let d = image.drag_delta();
+            self.camera.orbit(p, d.x, d.y, 0.006);
+            moved = true;
         }
         if image.dragged_by(egui::PointerButton::Secondary) {
             let d = image.drag_delta();
@@ -301,6 +340,7 @@ impl ViewerApp {
             );
         });
         ui.checkbox(&mut self.layers.vpls, "VPLs (colour: flux)");
+        ui.checkbox(&mut self.layers.indirect, "indirect light alone");
         ui.separator();
         let image = self.last.as_ref().map(|(img, _)| img);
         if self.compare.panel(ui, image) {
@@ -336,7 +376,8 @@ impl ViewerApp {
     /// Shows the last frame, fitted into the panel.
     fn show_image(&mut self, ui: &mut egui::Ui) -> egui::Response {
         let avail = ui.available_size();
-        if let Some((img, _)) = &self.last {
+        let shown = self.indirect.as_ref().or(self.last.as_ref().map(|l| &l.0));
+        if let Some(img) = shown {
             let rgb = img.to_srgb8(self.exposure);
             let colour =
                 egui::ColorImage::from_rgb([img.width as usize, img.height as usize], rgb.as_raw());
@@ -361,6 +402,7 @@ impl ViewerApp {
                 size.y = size.x / aspect;
             }
             let fitted = egui::Rect::from_center_size(rect.center(), size);
+            self.image_rect = Some(fitted);
             let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
             ui.painter().image(t.id(), fitted, uv, egui::Color32::WHITE);
             if let Some((img, _)) = &self.last {
@@ -436,6 +478,25 @@ impl ViewerApp {
         self.gpu.set_scene(&self.ctx, &self.posed);
         self.tracer = Tracer::new(&self.posed);
         self.vpls = None;
+    }
+
+    /// The indirect light alone: `img` less a direct-only frame of `view`.
+    fn indirect_of(&mut self, view: &View, img: &HdrImage) -> Option<HdrImage> {
+        let params = GpuParams {
+            mode: GpuMode::DirectOnly,
+            g_max: self.start.g_max,
+            ..GpuParams::default()
+        };
+        let (direct, _) = self
+            .gpu
+            .render_frame(&self.ctx, view, VplInput::Given(&[]), &params)
+            .map_err(|e| self.error = Some(e.to_string()))
+            .ok()?;
+        let mut out = img.clone();
+        for (o, d) in out.pixels.iter_mut().zip(&direct.pixels) {
+            *o = (*o - *d).max(Vec3::ZERO);
+        }
+        Some(out)
     }
 
     /// Records a benchmark frame (if one was rendered since `before`); writes the CSV and

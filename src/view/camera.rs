@@ -84,6 +84,17 @@ impl FlyCamera {
         self.origin = None;
     }
 
+    /// Turns it about `pivot` by a drag of `dx`, `dy` pixels, keeping its distance and
+    /// looking at the pivot.
+    pub fn orbit(&mut self, pivot: Vec3, dx: f32, dy: f32, rad_per_px: f32) {
+        let dist = self.eye.distance(pivot);
+        let d = (pivot - self.eye).normalize_or(self.forward());
+        self.yaw = (-d.x).atan2(-d.z);
+        self.pitch = d.y.clamp(-1.0, 1.0).asin().clamp(-MAX_PITCH, MAX_PITCH);
+        self.look(dx, dy, rad_per_px);
+        self.eye = pivot - self.forward() * dist;
+    }
+
     /// The scene camera it is (what the renderer takes).
     pub fn camera(&self) -> Camera {
         if let Some(c) = &self.origin
@@ -153,6 +164,12 @@ mod tests {
         );
         f.look(0.0, -1e6, 0.01);
         assert!(f.pitch <= MAX_PITCH && f.forward().is_finite());
+        // Orbiting keeps the distance to the pivot and looks at it.
+        let pivot = Vec3::new(1.0, 0.5, 2.0);
+        let d0 = f.eye.distance(pivot);
+        f.orbit(pivot, 40.0, 10.0, 0.01);
+        assert!((f.eye.distance(pivot) - d0).abs() < 1e-4);
+        assert!(f.forward().dot((pivot - f.eye).normalize()) > 0.9999);
         let framing = FlyCamera::framing(Vec3::ZERO, Vec3::new(10.0, 3.0, 10.0));
         assert!((framing.speed - Vec3::new(10.0, 3.0, 10.0).length() / 10.0).abs() < 1e-5);
         // It looks at the box's centre.

@@ -22,6 +22,8 @@ pub struct Layers {
     pub skeleton: bool,
     /// The VPLs as points.
     pub vpls: bool,
+    /// The frame less its direct light.
+    pub indirect: bool,
 }
 
 /// A distinct colour for id `k`.

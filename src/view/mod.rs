@@ -55,7 +55,8 @@ pub struct ViewArgs {
     /// Also write the whole window (panels and debug layers) as PNG with --screenshot.
     #[arg(long, requires = "screenshot")]
     pub window_shot: Option<PathBuf>,
-    /// Debug layers on at the start, comma separated: clusters, gates, skeleton, vpls.
+    /// Debug layers on at the start, comma separated: clusters, gates, skeleton, vpls,
+    /// indirect (the frame less its direct light).
     #[arg(long, value_delimiter = ',')]
     pub layers: Vec<String>,
     /// Render the exact CPU reference of the first view and show it beside the method (the
@@ -77,7 +78,7 @@ pub struct ViewArgs {
 
 pub const VIEW_HELP: &str = "\
 In the window: WASD + QE fly (metres per second, scroll to change), right drag looks around,
-F frames the whole level; the scene's cameras are buttons; the method and its settings apply on
+middle drag orbits about the surface under the pointer, F frames the whole level; the scene's cameras are buttons; the method and its settings apply on
 the next frame; a setting the GPU refuses shows its error and keeps the last frame.
 
 Without a display (no DISPLAY or WAYLAND_DISPLAY), use `visgate render`, run under Xvfb
@@ -206,7 +207,8 @@ pub fn run(args: ViewArgs) -> Result<()> {
             "gates" => layers.gates = true,
             "skeleton" => layers.skeleton = true,
             "vpls" => layers.vpls = true,
-            _ => bail!("--layers {l}: give clusters, gates, skeleton or vpls"),
+            "indirect" => layers.indirect = true,
+            _ => bail!("--layers {l}: give clusters, gates, skeleton, vpls or indirect"),
         }
     }
     if (layers.clusters || layers.gates || layers.skeleton) && args.level.is_none() {

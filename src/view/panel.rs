@@ -33,7 +33,10 @@ pub fn method_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
 
 /// The camera: speed, field of view, the scene's cameras as bookmarks, framing the level.
 pub fn camera_controls(ui: &mut egui::Ui, camera: &mut FlyCamera, scene: &Scene) {
-    ui.label("WASD + QE fly, right drag looks, scroll sets the speed, F frames the level");
+    ui.label(
+        "WASD + QE fly, right drag looks, middle drag orbits about the surface under the \
+         pointer, scroll sets the speed, F frames the level",
+    );
     ui.add(
         egui::Slider::new(&mut camera.speed, 1e-3..=1e4)
             .logarithmic(true)
