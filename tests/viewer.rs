@@ -258,3 +258,43 @@ fn a_benchmark_walks_its_path_and_writes_every_frames_passes() {
     assert!(rows.contains("3,frame,"), "{rows}");
     assert!(rows.lines().any(|l| l.contains("VAL")), "{rows}");
 }
+
+#[test]
+fn the_method_and_the_view_come_back_in_the_next_run_but_not_in_scripted_ones() {
+    let x = Xvfb::start();
+    let config = tempfile::tempdir().expect("tempdir");
+    // An interactive run (no --screenshot) stopped from outside after a few seconds.
+    let run = |extra: &[&str]| {
+        let mut c = Command::new("timeout");
+        c.args([
+            "6",
+            env!("CARGO_BIN_EXE_visgate"),
+            "view",
+            "builtin:cornell-box",
+        ])
+        .args(["--render-size", "32x24", "--vpls", "8"])
+        .args(extra)
+        .env("DISPLAY", &x.1)
+        .env("XDG_CONFIG_HOME", config.path())
+        .env("RUST_LOG", "error");
+        c.output().expect("runs")
+    };
+    let state = config.path().join("visgate").join("viewer.json");
+    let o = run(&["--mode", "val-hard"]);
+    let saved = std::fs::read_to_string(&state).unwrap_or_else(|e| panic!("{e}: {}", text(&o)));
+    assert!(saved.contains("\"val-hard\""), "{saved}");
+    let o = run(&[]);
+    assert!(
+        text(&o).contains("restored the last run's view of cornell-box (val-hard)"),
+        "{}",
+        text(&o)
+    );
+    // --fresh neither reads nor writes it.
+    let o = run(&["--fresh", "--mode", "none"]);
+    assert!(!text(&o).contains("restored"), "{}", text(&o));
+    assert!(
+        std::fs::read_to_string(&state)
+            .expect("state")
+            .contains("\"val-hard\"")
+    );
+}

@@ -22,6 +22,7 @@ use super::bench::Bench;
 use super::camera::FlyCamera;
 use super::compare::Compare;
 use super::layers::{self, Layers};
+use super::state::{self, SavedView};
 
 /// What the viewer starts with.
 pub struct Start {
@@ -53,6 +54,10 @@ pub struct Start {
     pub compare: bool,
     /// Play a benchmark path of this many frames, write its CSV here, then close.
     pub benchmark: Option<(u32, PathBuf)>,
+    /// The state of the last run to take the camera, exposure and settings from.
+    pub restore: Option<SavedView>,
+    /// Save the state when the window closes.
+    pub persist: bool,
 }
 
 /// The viewer's state.
@@ -98,6 +103,8 @@ pub struct ViewerApp {
     pivot: Option<Vec3>,
     /// The last frame's indirect light alone, when that layer is on.
     indirect: Option<HdrImage>,
+    /// The state last saved, and when.
+    last_saved: Option<(SavedView, std::time::Instant)>,
 }
 
 impl ViewerApp {
@@ -124,7 +131,7 @@ impl ViewerApp {
             Some(c) => FlyCamera::from_camera(c, speed),
             None => FlyCamera::framing(lo, hi),
         };
-        Ok(ViewerApp {
+        let mut app = ViewerApp {
             tracer: Tracer::new(&posed),
             posed,
             time: start.time,
@@ -132,6 +139,7 @@ impl ViewerApp {
             image_rect: None,
             pivot: None,
             indirect: None,
+            last_saved: None,
             ctx,
             gpu,
             vpls: None,
@@ -156,7 +164,15 @@ impl ViewerApp {
                 .clone()
                 .map(|(n, out)| Bench::new(&start.scene, n, out)),
             start,
-        })
+        };
+        if let Some(saved) = app.start.restore.take() {
+            println!(
+                "restored the last run's view of {} ({})",
+                app.start.scene.name, saved.mode
+            );
+            app.restore(&saved);
+        }
+        Ok(app)
     }
 
     /// Renders one frame at `size`; an error keeps the last good frame.
@@ -470,6 +486,58 @@ impl ViewerApp {
         }
     }
 
+    /// What the next run takes back.
+    fn saved(&self) -> SavedView {
+        let (c, g, v, p) = (
+            &self.camera,
+            &self.settings.gates.gates,
+            &self.settings.vals,
+            &self.settings.per_vpl,
+        );
+        let l = &self.layers;
+        SavedView {
+            mode: self.start.mode.to_string(),
+            vpls: self.vpl_count,
+            rsm: self.start.rsm,
+            exposure: self.exposure,
+            moving_scale: self.moving_scale,
+            camera: [c.eye.x, c.eye.y, c.eye.z, c.yaw, c.pitch, c.fov_x, c.speed],
+            layers: [l.clusters, l.gates, l.skeleton, l.vpls, l.indirect],
+            settings: [
+                g.max_hops as f32,
+                g.oversize,
+                v.vals.count as f32,
+                v.vals.iterations as f32,
+                v.interleave.block as f32,
+                v.map_size as f32,
+                p.map_size as f32,
+                p.batch as f32,
+            ],
+        }
+    }
+
+    /// Takes back the camera, exposure and settings of a saved state.
+    fn restore(&mut self, s: &SavedView) {
+        let c = s.camera;
+        self.camera = FlyCamera::from_parts(Vec3::new(c[0], c[1], c[2]), c[3], c[4], c[5], c[6]);
+        self.exposure = s.exposure;
+        self.moving_scale = s.moving_scale;
+        let [hops, oversize, vals, iterations, block, val_map, map, batch] = s.settings;
+        let (g, v, p) = (
+            &mut self.settings.gates.gates,
+            &mut self.settings.vals,
+            &mut self.settings.per_vpl,
+        );
+        g.max_hops = hops as u32;
+        g.oversize = oversize;
+        v.vals.count = vals as u32;
+        v.vals.iterations = iterations as u32;
+        v.interleave.block = block as u32;
+        v.map_size = val_map as u32;
+        p.map_size = map as u32;
+        p.batch = batch as u32;
+    }
+
     /// Poses the scene at `t` seconds: geometry and lights on the GPU, the CPU tracer, and
     /// the light paths (made again on the next frame).
     fn set_time(&mut self, t: f64) {
@@ -592,7 +660,28 @@ impl ViewerApp {
     }
 }
 
+impl ViewerApp {
+    /// Saves the state when it changed, at most once a second (and at exit).
+    fn keep_state(&mut self, now: bool) {
+        if !self.start.persist {
+            return;
+        }
+        let s = self.saved();
+        let due = self.last_saved.as_ref().is_none_or(|(last, t)| {
+            *last != s && (now || t.elapsed() > std::time::Duration::from_secs(1))
+        });
+        if due {
+            state::save(&self.start.scene.name, s.clone());
+            self.last_saved = Some((s, std::time::Instant::now()));
+        }
+    }
+}
+
 impl eframe::App for ViewerApp {
+    fn on_exit(&mut self) {
+        self.keep_state(true);
+    }
+
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
         egui::Panel::left("settings")
             .default_size(280.0)
@@ -632,6 +721,7 @@ impl eframe::App for ViewerApp {
             }
         });
         self.screenshot_done(ui.ctx());
+        self.keep_state(false);
         if self.start.screenshot.is_some() {
             ui.ctx().request_repaint();
         }

@@ -39,6 +39,18 @@ impl FlyCamera {
         }
     }
 
+    /// A camera at `eye` (m) with yaw and pitch (rad), field of view (rad) and speed (m/s).
+    pub fn from_parts(eye: Vec3, yaw: f32, pitch: f32, fov_x: f32, speed: f32) -> FlyCamera {
+        FlyCamera {
+            eye,
+            yaw,
+            pitch: pitch.clamp(-MAX_PITCH, MAX_PITCH),
+            fov_x,
+            speed,
+            origin: None,
+        }
+    }
+
     /// Seeing the whole of the box `lo..hi` from above one corner, at a speed that crosses it
     /// in about ten seconds.
     pub fn framing(lo: Vec3, hi: Vec3) -> FlyCamera {

@@ -8,6 +8,7 @@ mod camera;
 mod compare;
 mod layers;
 mod panel;
+mod state;
 
 use std::path::PathBuf;
 
@@ -15,7 +16,9 @@ use anyhow::{Context, Result, bail};
 use clap::{Args, Parser};
 use visgate_formats::ImportOptions;
 use visgate_runtime::cpu::gates::GateLevel;
-use visgate_runtime::gpu::method;
+use visgate_runtime::gpu::{MethodInfo, method};
+
+use state::SavedView;
 use visgate_runtime::job::RenderJob;
 
 /// Options of `visgate view`.
@@ -70,6 +73,10 @@ pub struct ViewArgs {
     /// The benchmark's CSV: frame,pass,gpu_ms,cpu_wall_ms.
     #[arg(long)]
     pub benchmark_out: Option<PathBuf>,
+    /// Start from the defaults and the flags alone: neither read nor write the state kept
+    /// across runs (scripted runs, --screenshot and --benchmark, never do).
+    #[arg(long)]
+    pub fresh: bool,
     /// With no display, render this image headless instead (`visgate render` with the same
     /// scene, level, method and VPLs) rather than fail.
     #[arg(long)]
@@ -141,13 +148,18 @@ fn render_instead(args: &ViewArgs, mode: &str, out: &std::path::Path) -> Result<
     crate::render::run(Render::try_parse_from(argv)?.args)
 }
 
-pub fn run(args: ViewArgs) -> Result<()> {
-    let mode = match (&args.mode, &args.level) {
-        (Some(m), _) => m.clone(),
-        (None, Some(_)) => "gates".into(),
-        (None, None) => "none".into(),
+/// The method to start with: `--mode`, else the saved one, else `gates` with a level.
+fn start_mode(args: &ViewArgs, saved: Option<&SavedView>) -> Result<&'static MethodInfo> {
+    let saved = saved
+        .and_then(|s| method(&s.mode))
+        .filter(|m| !m.needs_level || args.level.is_some());
+    let mode = match (&args.mode, saved, &args.level) {
+        (Some(m), _, _) => m.as_str(),
+        (None, Some(m), _) => m.name,
+        (None, None, Some(_)) => "gates",
+        (None, None, None) => "none",
     };
-    let Some(info) = method(&mode) else {
+    let Some(info) = method(mode) else {
         bail!(
             "--mode {mode}: give one of {}",
             visgate_runtime::gpu::METHODS.map(|m| m.name).join(", ")
@@ -156,6 +168,10 @@ pub fn run(args: ViewArgs) -> Result<()> {
     if info.needs_level && args.level.is_none() {
         bail!("--mode {mode} needs --level LEVEL.vgate (bake one with `visgate bake`)");
     }
+    Ok(info)
+}
+
+pub fn run(args: ViewArgs) -> Result<()> {
     let size = args.render_size.as_deref().map(parse_size).transpose()?;
     if args.benchmark == Some(0) {
         bail!("--benchmark 0: give the number of frames of the path");
@@ -164,9 +180,10 @@ pub fn run(args: ViewArgs) -> Result<()> {
         bail!("--frames 0: render at least 1 frame before the screenshot");
     }
     if !has_display() {
+        let mode = start_mode(&args, None)?.name;
         if let Some(out) = &args.or_render {
             println!("no display: rendering {} headless instead", out.display());
-            return render_instead(&args, &mode, out);
+            return render_instead(&args, mode, out);
         }
         bail!(
             "no display to open a window on (DISPLAY and WAYLAND_DISPLAY are unset): use \
@@ -181,6 +198,9 @@ pub fn run(args: ViewArgs) -> Result<()> {
             load_textures: true,
         },
     )?;
+    let persist = !args.fresh && args.screenshot.is_none() && args.benchmark.is_none();
+    let saved = persist.then(|| state::load(&scene.name)).flatten();
+    let info = start_mode(&args, saved.as_ref())?;
     let level = match &args.level {
         Some(path) => {
             let l = visgate_formats::BakedLevel::read(path)
@@ -201,6 +221,17 @@ pub fn run(args: ViewArgs) -> Result<()> {
         None => (!scene.cameras.is_empty()).then_some(0),
     };
     let mut layers = layers::Layers::default();
+    if let (true, Some(s)) = (args.layers.is_empty(), &saved) {
+        let [clusters, gates, skeleton, vpls, indirect] = s.layers;
+        let lv = args.level.is_some();
+        layers = layers::Layers {
+            clusters: clusters && lv,
+            gates: gates && lv,
+            skeleton: skeleton && lv,
+            vpls,
+            indirect,
+        };
+    }
     for l in &args.layers {
         match l.as_str() {
             "clusters" => layers.clusters = true,
@@ -218,8 +249,8 @@ pub fn run(args: ViewArgs) -> Result<()> {
     let start = app::Start {
         level,
         mode: info.name,
-        vpls: args.vpls,
-        rsm: args.rsm,
+        vpls: args.vpls.or(saved.as_ref().map(|s| s.vpls)),
+        rsm: args.rsm || saved.as_ref().is_some_and(|s| s.rsm),
         size,
         g_max,
         camera,
@@ -229,6 +260,9 @@ pub fn run(args: ViewArgs) -> Result<()> {
         compare: args.compare,
         time: args.time,
         benchmark: args.benchmark.zip(args.benchmark_out.clone()),
+        // The saved camera only when no --camera was asked for.
+        restore: saved.filter(|_| args.camera.is_none()),
+        persist,
         scene,
     };
     if !args.time.is_finite() {
