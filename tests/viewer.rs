@@ -267,7 +267,7 @@ fn the_method_and_the_view_come_back_in_the_next_run_but_not_in_scripted_ones() 
     let run = |extra: &[&str]| {
         let mut c = Command::new("timeout");
         c.args([
-            "6",
+            "10",
             env!("CARGO_BIN_EXE_visgate"),
             "view",
             "builtin:cornell-box",
