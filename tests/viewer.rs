@@ -263,7 +263,8 @@ fn a_benchmark_walks_its_path_and_writes_every_frames_passes() {
 fn the_method_and_the_view_come_back_in_the_next_run_but_not_in_scripted_ones() {
     let x = Xvfb::start();
     let config = tempfile::tempdir().expect("tempdir");
-    // An interactive run (no --screenshot) stopped from outside after a few seconds.
+    // An interactive run (no --screenshot) stopped from outside after 10 s: the state is saved
+    // with the first frame and whenever it changes, not only at a clean exit.
     let run = |extra: &[&str]| {
         let mut c = Command::new("timeout");
         c.args([
