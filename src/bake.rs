@@ -222,6 +222,9 @@ pub fn run(args: BakeArgs) -> Result<()> {
     {
         eprintln!("warning: the closed scene leaks (baked anyway, --allow-leaks): {l}");
     }
+    if let Some(w) = most_dropped(&baked.report.empty_space, &baked.level.info.grid) {
+        eprintln!("warning: {w}");
+    }
     println!("wrote {}", args.output.display());
     if let Some(path) = &args.report {
         let json = serde_json::to_string_pretty(&baked.report)?;
@@ -234,4 +237,77 @@ pub fn run(args: BakeArgs) -> Result<()> {
         println!("wrote {} debug files into {}", files.len(), dir.display());
     }
     Ok(())
+}
+
+/// A warning when the bake dropped an enclosed part of the empty space larger than all it
+/// kept (the outside, which reaches the grid's bounds, is meant to go): that part, why, and
+/// what to do (the reason also sits in the JSON report).
+fn most_dropped(
+    empty_space: &serde_json::Value,
+    grid: &visgate_formats::vgate::GridMeta,
+) -> Option<String> {
+    let comps = empty_space["components"].as_array()?;
+    let voxels = |c: &serde_json::Value| c["voxels"].as_u64().unwrap_or(0);
+    let at = |c: &serde_json::Value, key: &str, a: usize| c[key][a].as_f64().unwrap_or(0.0);
+    let (o, vs) = (grid.origin_m, grid.voxel_size_m as f64);
+    // Within a voxel and a half of the grid's faces: next to its solid border, the outside.
+    let outside = |c: &serde_json::Value| {
+        (0..3).any(|a| {
+            at(c, "bounds_min_m", a) <= o[a] as f64 + 1.5 * vs
+                || at(c, "bounds_max_m", a) >= o[a] as f64 + (grid.dims[a] as f64 - 1.5) * vs
+        })
+    };
+    let kept: u64 = comps.iter().filter(|c| c["kept"] == true).map(voxels).sum();
+    let largest = comps
+        .iter()
+        .filter(|c| c["kept"] != true && !outside(c))
+        .max_by_key(|c| voxels(c))?;
+    (voxels(largest) > kept).then(|| {
+        format!(
+            "kept {kept} empty voxels, and dropped an enclosed part larger than that ({} voxels, \
+             {} .. {} m) as {}. If that is the level's inside, put a camera or a light in it (a \
+             scene file: see `visgate scenes export`), or check that the mesh's normals face \
+             into the rooms",
+            voxels(largest),
+            largest["bounds_min_m"],
+            largest["bounds_max_m"],
+            largest["reason"].as_str().unwrap_or("?")
+        )
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    #[test]
+    fn an_enclosed_part_dropped_and_larger_than_all_kept_is_named_and_the_outside_is_not() {
+        let grid = visgate_formats::vgate::GridMeta {
+            origin_m: [0.0; 3],
+            voxel_size_m: 1.0,
+            dims: [100, 40, 100],
+        };
+        let comp = |voxels: u64, lo: f32, hi: f32, kept: bool, reason: &str| {
+            json!({ "voxels": voxels, "bounds_min_m": [lo, lo, lo],
+                    "bounds_max_m": [hi, hi.min(38.0), hi], "kept": kept, "reason": reason })
+        };
+        // The outside (next to the grid's faces) dropped, rooms kept: nothing to say.
+        let fine = json!({ "components": [
+            comp(300_000, 1.0, 99.0, false, "outside the closed level"),
+            comp(5_000, 10.0, 30.0, true, "holds light 0"),
+        ]});
+        assert_eq!(most_dropped(&fine, &grid), None);
+        // The level's inside dropped as a wall's, four pockets kept: the warning names it.
+        let lost = json!({ "components": [
+            comp(60_000, 5.0, 90.0, false, "inside closed geometry: 12191 triangles turn their back to it, 10929 face it"),
+            comp(300, 40.0, 45.0, true, "large and faced by the geometry"),
+        ]});
+        let w = most_dropped(&lost, &grid).expect("a warning");
+        assert!(
+            w.contains("kept 300 empty voxels") && w.contains("60000 voxels"),
+            "{w}"
+        );
+        assert!(w.contains("12191 triangles turn their back"), "{w}");
+    }
 }
