@@ -61,7 +61,7 @@ fn save_to(p: &std::path::Path, name: &str, state: SavedView) {
         .map_or(Ok(()), std::fs::create_dir_all)
         .and_then(|()| {
             let text = serde_json::to_string_pretty(&all).map_err(std::io::Error::other)?;
-            std::fs::write(&p, text)
+            std::fs::write(p, text)
         });
     if let Err(e) = written {
         tracing::warn!("cannot save the viewer's state to {}: {e}", p.display());
