@@ -78,7 +78,7 @@ pub struct ViewArgs {
     #[arg(long)]
     pub fresh: bool,
     /// With no display, render this image headless instead (`visgate render` with the same
-    /// scene, level, method and VPLs) rather than fail.
+    /// scene, level, method, VPLs — 256 unless given — and --render-size) rather than fail.
     #[arg(long)]
     pub or_render: Option<PathBuf>,
 }
@@ -130,7 +130,8 @@ fn render_instead(args: &ViewArgs, mode: &str, out: &std::path::Path) -> Result<
         .iter()
         .map(|s| s.to_string())
         .collect();
-    argv.push(args.vpls.unwrap_or(1024).to_string());
+    // 256 light paths unless asked: a few seconds on a software adapter.
+    argv.push(args.vpls.unwrap_or(256).to_string());
     argv.extend(["--out".into(), out.display().to_string()]);
     if let Some(l) = &args.level {
         argv.extend(["--level".into(), l.display().to_string()]);
