@@ -18,11 +18,14 @@ use visgate_runtime::gpu::{
 use visgate_runtime::hdr::HdrImage;
 use visgate_runtime::vpl::{PathParams, Vpl, path_vpls};
 
+mod kept;
+mod scripted;
+
 use super::bench::Bench;
 use super::camera::FlyCamera;
 use super::compare::Compare;
 use super::layers::{self, Layers};
-use super::state::{self, SavedView};
+use super::state::SavedView;
 
 /// What the viewer starts with.
 pub struct Start {
@@ -486,58 +489,6 @@ impl ViewerApp {
         }
     }
 
-    /// What the next run takes back.
-    fn saved(&self) -> SavedView {
-        let (c, g, v, p) = (
-            &self.camera,
-            &self.settings.gates.gates,
-            &self.settings.vals,
-            &self.settings.per_vpl,
-        );
-        let l = &self.layers;
-        SavedView {
-            mode: self.start.mode.to_string(),
-            vpls: self.vpl_count,
-            rsm: self.start.rsm,
-            exposure: self.exposure,
-            moving_scale: self.moving_scale,
-            camera: [c.eye.x, c.eye.y, c.eye.z, c.yaw, c.pitch, c.fov_x, c.speed],
-            layers: [l.clusters, l.gates, l.skeleton, l.vpls, l.indirect],
-            settings: [
-                g.max_hops as f32,
-                g.oversize,
-                v.vals.count as f32,
-                v.vals.iterations as f32,
-                v.interleave.block as f32,
-                v.map_size as f32,
-                p.map_size as f32,
-                p.batch as f32,
-            ],
-        }
-    }
-
-    /// Takes back the camera, exposure and settings of a saved state.
-    fn restore(&mut self, s: &SavedView) {
-        let c = s.camera;
-        self.camera = FlyCamera::from_parts(Vec3::new(c[0], c[1], c[2]), c[3], c[4], c[5], c[6]);
-        self.exposure = s.exposure;
-        self.moving_scale = s.moving_scale;
-        let [hops, oversize, vals, iterations, block, val_map, map, batch] = s.settings;
-        let (g, v, p) = (
-            &mut self.settings.gates.gates,
-            &mut self.settings.vals,
-            &mut self.settings.per_vpl,
-        );
-        g.max_hops = hops as u32;
-        g.oversize = oversize;
-        v.vals.count = vals as u32;
-        v.vals.iterations = iterations as u32;
-        v.interleave.block = block as u32;
-        v.map_size = val_map as u32;
-        p.map_size = map as u32;
-        p.batch = batch as u32;
-    }
-
     /// Poses the scene at `t` seconds: geometry and lights on the GPU, the CPU tracer, and
     /// the light paths (made again on the next frame).
     fn set_time(&mut self, t: f64) {
@@ -567,32 +518,6 @@ impl ViewerApp {
         Some(out)
     }
 
-    /// Records a benchmark frame (if one was rendered since `before`); writes the CSV and
-    /// closes after the last.
-    fn bench_step(&mut self, ctx: &egui::Context, before: u32) {
-        let Some(b) = &mut self.bench else {
-            return;
-        };
-        if self.frames > before
-            && let Some((_, t)) = &self.last
-        {
-            b.record(t);
-        }
-        if b.done >= b.frames {
-            match b.finish() {
-                Ok(s) => println!("{s}"),
-                Err(e) => eprintln!("error: benchmark: {e}"),
-            }
-            self.bench = None;
-            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
-        } else if let Some(e) = &self.error {
-            eprintln!("error: benchmark frame {}: {e}", b.done);
-            self.bench = None;
-            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
-        }
-        ctx.request_repaint();
-    }
-
     /// Starts the reference of the last frame's view, with its VPLs.
     fn start_reference(&mut self) {
         let Some(view) = &self.last_view else {
@@ -608,72 +533,6 @@ impl ViewerApp {
         };
         self.compare
             .start(&self.posed, view, &vpls, self.start.g_max);
-    }
-
-    /// Writes the screenshot and closes the window once its frames are rendered.
-    fn screenshot_done(&mut self, ctx: &egui::Context) {
-        let Some((path, frames)) = &self.start.screenshot else {
-            return;
-        };
-        if self.frames < *frames || (self.start.compare && !self.compare.is_done()) {
-            return;
-        }
-        let outcome = match &self.last {
-            Some((img, _)) => img.write(path, self.exposure).map_err(|e| e.to_string()),
-            None => Err(self
-                .error
-                .clone()
-                .unwrap_or_else(|| "no frame rendered".into())),
-        };
-        match outcome {
-            Ok(()) => {
-                if let Some((img, times)) = &self.last {
-                    println!("last frame, {} x {}:", img.width, img.height);
-                    print!("{}", visgate_runtime::job::pass_table(times));
-                }
-                println!("wrote {} after {} frames", path.display(), self.frames)
-            }
-            Err(e) => eprintln!("error: screenshot {}: {e}", path.display()),
-        }
-        self.start.screenshot = None;
-        let Some(path) = self.start.window_shot.take() else {
-            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
-            return;
-        };
-        // The window as drawn, then close.
-        let c = ctx.clone();
-        ctx.request_screenshot(move |img| {
-            let rgba: Vec<u8> = img
-                .pixels
-                .iter()
-                .flat_map(|p| p.to_srgba_unmultiplied())
-                .collect();
-            let [w, h] = img.size;
-            match image::save_buffer(&path, &rgba, w as u32, h as u32, image::ColorType::Rgba8) {
-                Ok(()) => println!("wrote {} ({w} x {h}, the window)", path.display()),
-                Err(e) => eprintln!("error: window shot {}: {e}", path.display()),
-            }
-            c.send_viewport_cmd(egui::ViewportCommand::Close);
-            c.request_repaint();
-        });
-        ctx.request_repaint();
-    }
-}
-
-impl ViewerApp {
-    /// Saves the state when it changed, at most once a second (and at exit).
-    fn keep_state(&mut self, now: bool) {
-        if !self.start.persist {
-            return;
-        }
-        let s = self.saved();
-        let due = self.last_saved.as_ref().is_none_or(|(last, t)| {
-            *last != s && (now || t.elapsed() > std::time::Duration::from_secs(1))
-        });
-        if due {
-            state::save(&self.start.scene.name, s.clone());
-            self.last_saved = Some((s, std::time::Instant::now()));
-        }
     }
 }
 

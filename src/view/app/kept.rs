@@ -1,0 +1,77 @@
+//! What the viewer keeps across runs: its state as saved, taken back, and saved when it
+//! changes.
+
+use glam::Vec3;
+
+use super::ViewerApp;
+use crate::view::camera::FlyCamera;
+use crate::view::state::{self, SavedView};
+
+impl ViewerApp {
+    /// What the next run takes back.
+    pub(super) fn saved(&self) -> SavedView {
+        let (c, g, v, p) = (
+            &self.camera,
+            &self.settings.gates.gates,
+            &self.settings.vals,
+            &self.settings.per_vpl,
+        );
+        let l = &self.layers;
+        SavedView {
+            mode: self.start.mode.to_string(),
+            vpls: self.vpl_count,
+            rsm: self.start.rsm,
+            exposure: self.exposure,
+            moving_scale: self.moving_scale,
+            camera: [c.eye.x, c.eye.y, c.eye.z, c.yaw, c.pitch, c.fov_x, c.speed],
+            layers: [l.clusters, l.gates, l.skeleton, l.vpls, l.indirect],
+            settings: [
+                g.max_hops as f32,
+                g.oversize,
+                v.vals.count as f32,
+                v.vals.iterations as f32,
+                v.interleave.block as f32,
+                v.map_size as f32,
+                p.map_size as f32,
+                p.batch as f32,
+            ],
+        }
+    }
+
+    /// Takes back the camera, exposure and settings of a saved state.
+    pub(super) fn restore(&mut self, s: &SavedView) {
+        let c = s.camera;
+        self.camera = FlyCamera::from_parts(Vec3::new(c[0], c[1], c[2]), c[3], c[4], c[5], c[6]);
+        self.exposure = s.exposure;
+        self.moving_scale = s.moving_scale;
+        let [hops, oversize, vals, iterations, block, val_map, map, batch] = s.settings;
+        let (g, v, p) = (
+            &mut self.settings.gates.gates,
+            &mut self.settings.vals,
+            &mut self.settings.per_vpl,
+        );
+        g.max_hops = hops as u32;
+        g.oversize = oversize;
+        v.vals.count = vals as u32;
+        v.vals.iterations = iterations as u32;
+        v.interleave.block = block as u32;
+        v.map_size = val_map as u32;
+        p.map_size = map as u32;
+        p.batch = batch as u32;
+    }
+
+    /// Saves the state when it changed, at most once a second (and at exit).
+    pub(super) fn keep_state(&mut self, now: bool) {
+        if !self.start.persist {
+            return;
+        }
+        let s = self.saved();
+        let due = self.last_saved.as_ref().is_none_or(|(last, t)| {
+            *last != s && (now || t.elapsed() > std::time::Duration::from_secs(1))
+        });
+        if due {
+            state::save(&self.start.scene.name, s.clone());
+            self.last_saved = Some((s, std::time::Instant::now()));
+        }
+    }
+}
