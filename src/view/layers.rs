@@ -24,6 +24,34 @@ pub struct Layers {
     pub vpls: bool,
     /// The frame less its direct light.
     pub indirect: bool,
+    /// Each pixel's geometry cluster (screen tile × depth slice × visibility cluster).
+    pub geometry: bool,
+    /// Each pixel's light-list length, as a heat map.
+    pub lists: bool,
+}
+
+impl Layers {
+    /// The pixel layer shown (one at a time): list length, else geometry clusters, else
+    /// visibility clusters.
+    pub fn pixel_layer(&self) -> Option<PixelLayer> {
+        match (self.lists, self.geometry, self.clusters) {
+            (true, _, _) => Some(PixelLayer::Lists),
+            (false, true, _) => Some(PixelLayer::Geometry),
+            (false, false, true) => Some(PixelLayer::Clusters),
+            _ => None,
+        }
+    }
+}
+
+/// A layer with a colour per pixel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PixelLayer {
+    /// Visibility clusters.
+    Clusters,
+    /// Geometry clusters.
+    Geometry,
+    /// Light-list length.
+    Lists,
 }
 
 /// A distinct colour for id `k`.
@@ -61,6 +89,60 @@ pub fn pixel_clusters(view: &View, tracer: &Tracer, level: &GateLevel) -> Vec<Op
             level.cluster_at(s.position, s.normal)
         })
         .collect()
+}
+
+/// The geometry clusters or the light-list lengths of `view` as the clustered-gates twin
+/// (`cpu::clustered::assign`, which the GPU passes follow) finds them for `vpls`, with tiles of
+/// `tile_px` pixels of this view; lengths in false colour up to the longest list.
+pub fn clustered_image(
+    view: &View,
+    tracer: &Tracer,
+    level: &GateLevel,
+    vpls: &[Vpl],
+    gates: &GateParams,
+    tile_px: u32,
+    which: PixelLayer,
+) -> egui::ColorImage {
+    use visgate_runtime::cpu::clustered::{ClusterParams, PixelSurface, assign};
+    let [w, h] = view.size;
+    let pixels: Vec<Option<PixelSurface>> = (0..w * h)
+        .into_par_iter()
+        .map(|i| {
+            let p = glam::Vec2::new((i % w) as f32 + 0.5, (i / w) as f32 + 0.5);
+            let dir = view.ray_dir(p);
+            let s = tracer.trace(view.eye, dir)?;
+            let n = if s.normal.dot(dir) > 0.0 {
+                -s.normal
+            } else {
+                s.normal
+            };
+            Some(PixelSurface {
+                position: s.position,
+                normal: n,
+                depth: s.t * dir.dot(view.forward),
+                cluster: level.cluster_at(s.position, n),
+            })
+        })
+        .collect();
+    let params = ClusterParams {
+        tile_px,
+        ..ClusterParams::default()
+    };
+    let c = assign(&pixels, w, vpls, level, gates, &params);
+    let longest = c.lists.iter().map(Vec::len).max().unwrap_or(0).max(1);
+    let px: Vec<egui::Color32> = c
+        .pixel_cluster
+        .iter()
+        .map(|&g| match (g, which) {
+            (u32::MAX, _) => egui::Color32::from_gray(40),
+            (g, PixelLayer::Lists) => {
+                let t = c.lists[g as usize].len() as f32 / longest as f32;
+                egui::Color32::from(egui::ecolor::Hsva::new(0.66 * (1.0 - t), 0.9, 0.95, 1.0))
+            }
+            (g, _) => id_colour(g),
+        })
+        .collect();
+    egui::ColorImage::new([w as usize, h as usize], px)
 }
 
 /// The cluster image as an egui image.

@@ -58,8 +58,9 @@ pub struct ViewArgs {
     /// Also write the whole window (panels and debug layers) as PNG with --screenshot.
     #[arg(long, requires = "screenshot")]
     pub window_shot: Option<PathBuf>,
-    /// Debug layers on at the start, comma separated: clusters, gates, skeleton, vpls,
-    /// indirect (the frame less its direct light).
+    /// Debug layers on at the start, comma separated: clusters (visibility), geometry
+    /// (geometry clusters), lists (light-list length) — one of these shows at a time —, gates,
+    /// skeleton, vpls, indirect (the frame less its direct light).
     #[arg(long, value_delimiter = ',')]
     pub layers: Vec<String>,
     /// Render the exact CPU reference of the first view and show it beside the method (the
@@ -223,7 +224,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
     };
     let mut layers = layers::Layers::default();
     if let (true, Some(s)) = (args.layers.is_empty(), &saved) {
-        let [clusters, gates, skeleton, vpls, indirect] = s.layers;
+        let [clusters, gates, skeleton, vpls, indirect, geometry, lists] = s.layers;
         let lv = args.level.is_some();
         layers = layers::Layers {
             clusters: clusters && lv,
@@ -231,6 +232,8 @@ pub fn run(args: ViewArgs) -> Result<()> {
             skeleton: skeleton && lv,
             vpls,
             indirect,
+            geometry: geometry && lv,
+            lists: lists && lv,
         };
     }
     for l in &args.layers {
@@ -240,11 +243,18 @@ pub fn run(args: ViewArgs) -> Result<()> {
             "skeleton" => layers.skeleton = true,
             "vpls" => layers.vpls = true,
             "indirect" => layers.indirect = true,
-            _ => bail!("--layers {l}: give clusters, gates, skeleton, vpls or indirect"),
+            "geometry" => layers.geometry = true,
+            "lists" => layers.lists = true,
+            _ => bail!(
+                "--layers {l}: give clusters, geometry, lists, gates, skeleton, vpls or indirect"
+            ),
         }
     }
-    if (layers.clusters || layers.gates || layers.skeleton) && args.level.is_none() {
-        bail!("--layers clusters, gates and skeleton draw a baked level: give --level");
+    let needs_level = layers.clusters || layers.geometry || layers.lists;
+    if (needs_level || layers.gates || layers.skeleton) && args.level.is_none() {
+        bail!(
+            "--layers clusters, geometry, lists, gates and skeleton draw a baked level: give --level"
+        );
     }
     let g_max = RenderJob::default().for_scene(&scene)?.params.g_max;
     let start = app::Start {

@@ -18,8 +18,8 @@ pub struct SavedView {
     pub moving_scale: f32,
     /// Eye (m), yaw, pitch, horizontal field of view (rad), speed (m/s).
     pub camera: [f32; 7],
-    /// Cluster, gates, skeleton, VPLs, indirect.
-    pub layers: [bool; 5],
+    /// Clusters, gates, skeleton, VPLs, indirect, geometry clusters, list lengths.
+    pub layers: [bool; 7],
     /// Hops, oversize, VALs, iterations, interleave block, VAL map, per-VPL map, batch.
     pub settings: [f32; 8],
 }
@@ -83,7 +83,7 @@ mod tests {
             exposure: -1.0,
             moving_scale: 0.5,
             camera: [1.0, 2.0, 3.0, 0.5, -0.2, 1.2, 4.0],
-            layers: [true, false, true, false, true],
+            layers: [true, false, true, false, true, false, true],
             settings: [2.0, 1.5, 30.0, 8.0, 4.0, 128.0, 256.0, 32.0],
         };
         save_to(&p, "a", state("gates"));

@@ -24,7 +24,9 @@ impl ViewerApp {
             exposure: self.exposure,
             moving_scale: self.moving_scale,
             camera: [c.eye.x, c.eye.y, c.eye.z, c.yaw, c.pitch, c.fov_x, c.speed],
-            layers: [l.clusters, l.gates, l.skeleton, l.vpls, l.indirect],
+            layers: [
+                l.clusters, l.gates, l.skeleton, l.vpls, l.indirect, l.geometry, l.lists,
+            ],
             settings: [
                 g.max_hops as f32,
                 g.oversize,

@@ -88,7 +88,7 @@ pub struct ViewerApp {
     last_view: Option<View>,
     layers: Layers,
     /// The cluster layer and the view it was made for.
-    cluster_tex: Option<(View, egui::TextureHandle)>,
+    cluster_tex: Option<(View, layers::PixelLayer, egui::TextureHandle)>,
     compare: Compare,
     compare_started: bool,
     /// What the last frame was rendered with: a frame with nothing changed is not rendered again.
@@ -352,6 +352,11 @@ impl ViewerApp {
                 &mut self.layers.clusters,
                 "visibility cluster of each pixel",
             );
+            ui.checkbox(&mut self.layers.geometry, "geometry cluster of each pixel");
+            ui.checkbox(
+                &mut self.layers.lists,
+                "light-list length (blue short, red long)",
+            );
             ui.checkbox(&mut self.layers.gates, "gates");
             ui.checkbox(
                 &mut self.layers.skeleton,
@@ -438,15 +443,15 @@ impl ViewerApp {
             return;
         };
         let level = self.start.level.as_ref();
-        if let (true, Some(l)) = (self.layers.clusters, level) {
+        if let (Some(which), Some(l)) = (self.layers.pixel_layer(), level) {
             // At most 320 pixels wide: a CPU ray per pixel.
             let k = (view.size[0] as f32 / 320.0).max(1.0);
             let small = [
                 ((view.size[0] as f32 / k) as u32).max(1),
                 ((view.size[1] as f32 / k) as u32).max(1),
             ];
-            let fresh = self.cluster_tex.as_ref().is_some_and(|(v, _)| {
-                v.eye == view.eye && v.forward == view.forward && v.size == small
+            let fresh = self.cluster_tex.as_ref().is_some_and(|(v, w, _)| {
+                v.eye == view.eye && v.forward == view.forward && v.size == small && *w == which
             });
             let cam = visgate_formats::Camera {
                 name: "frame".into(),
@@ -456,14 +461,24 @@ impl ViewerApp {
                 fov_x_rad: view.fov_x_rad,
             };
             if !fresh && let Ok(sv) = View::new(&cam, small) {
-                let ids = layers::pixel_clusters(&sv, &self.tracer, l);
-                let img = layers::cluster_image(&sv, &ids);
+                let img = match which {
+                    layers::PixelLayer::Clusters => {
+                        layers::cluster_image(&sv, &layers::pixel_clusters(&sv, &self.tracer, l))
+                    }
+                    _ => {
+                        let vpls = self.vpls.as_ref().map_or(&[][..], |v| &v.1[..]);
+                        let g = &self.settings.gates;
+                        // The GPU's tiles, at this view's scale.
+                        let tile = ((g.clusters.tile_px as f32 / k).round() as u32).max(1);
+                        layers::clustered_image(&sv, &self.tracer, l, vpls, &g.gates, tile, which)
+                    }
+                };
                 let tex = ui
                     .ctx()
-                    .load_texture("clusters", img, egui::TextureOptions::NEAREST);
-                self.cluster_tex = Some((sv, tex));
+                    .load_texture("pixel layer", img, egui::TextureOptions::NEAREST);
+                self.cluster_tex = Some((sv, which, tex));
             }
-            if let Some((_, t)) = &self.cluster_tex {
+            if let Some((_, _, t)) = &self.cluster_tex {
                 let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
                 let tint = egui::Color32::from_white_alpha(150);
                 ui.painter().image(t.id(), rect, uv, tint);
