@@ -407,3 +407,51 @@ fn metrics_are_zero_for_equal_images_and_grow_with_the_difference() {
     assert!(fb > 0.0 && fc > fb && fc <= 1.0, "{fb} {fc}");
     assert!(errors(&HdrImage::new(3, 3), &a).is_err());
 }
+
+#[test]
+fn a_cancelled_reference_stops_with_an_error_and_an_uncancelled_one_is_render_with() {
+    use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+    use visgate_runtime::cpu::reference::{IndirectVisibility, render_cancellable, render_with};
+    let (scene, vpls, view) = four_rooms(32, [24, 16], 1.0);
+    let tracer = Tracer::new(&scene);
+    let p = ReferenceParams {
+        samples_per_pixel: 1,
+        ..ReferenceParams::default()
+    };
+    let exact = IndirectVisibility::Exact;
+    let (want, _) =
+        render_with(&tracer, &scene.lights, &vpls, &view, &p, exact, &|_, _| {}).expect("render");
+    let go = AtomicBool::new(false);
+    let (got, _) = render_cancellable(
+        &tracer,
+        &scene.lights,
+        &vpls,
+        &view,
+        &p,
+        exact,
+        &|_, _| {},
+        &go,
+    )
+    .expect("render");
+    assert_eq!(got.pixels, want.pixels);
+    // Set after the first rows: the rest are skipped and the call says it was cancelled.
+    let stop = AtomicBool::new(false);
+    let rows = AtomicU32::new(0);
+    let progress = |done: u32, _| {
+        rows.store(done, Ordering::Relaxed);
+        stop.store(true, Ordering::Relaxed);
+    };
+    let e = render_cancellable(
+        &tracer,
+        &scene.lights,
+        &vpls,
+        &view,
+        &p,
+        exact,
+        &progress,
+        &stop,
+    )
+    .expect_err("cancelled");
+    assert!(e.to_string().contains("cancelled"), "{e}");
+    assert!(rows.load(Ordering::Relaxed) < 16, "every row ran");
+}

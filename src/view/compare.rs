@@ -4,13 +4,13 @@
 //! result is dropped and the next one starts from the new view.
 
 use std::sync::Arc;
-use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use std::sync::mpsc::{Receiver, channel};
 
 use eframe::egui;
 use visgate_formats::Scene;
 use visgate_runtime::camera::View;
-use visgate_runtime::cpu::reference::{IndirectVisibility, ReferenceParams, render_with};
+use visgate_runtime::cpu::reference::{IndirectVisibility, ReferenceParams, render_cancellable};
 use visgate_runtime::cpu::tracer::Tracer;
 use visgate_runtime::hdr::{HdrImage, false_colour};
 use visgate_runtime::metrics::{ImageErrors, IndirectErrors, errors, indirect_errors};
@@ -21,7 +21,8 @@ type Pair = Result<(HdrImage, HdrImage), String>;
 
 /// A reference being rendered or done.
 pub struct Compare {
-    running: Option<(View, Receiver<Pair>, Arc<AtomicU32>)>,
+    /// The view, the result to come, rows done, and the flag that stops it.
+    running: Option<(View, Receiver<Pair>, Arc<AtomicU32>, Arc<AtomicBool>)>,
     done: Option<(View, HdrImage, HdrImage)>,
     /// Where the divider is, as a fraction of the image's width (method left, reference right).
     pub split: f32,
@@ -47,6 +48,13 @@ impl Compare {
         }
     }
 
+    /// Stops the reference being rendered, if any (its thread ends at its next row).
+    fn cancel(&mut self) {
+        if let Some((.., stop)) = self.running.take() {
+            stop.store(true, Ordering::Relaxed);
+        }
+    }
+
     /// Whether a reference is shown.
     pub fn is_done(&self) -> bool {
         self.done.is_some()
@@ -54,8 +62,11 @@ impl Compare {
 
     /// Starts the reference of `view` with `vpls` on a thread.
     pub fn start(&mut self, scene: &Scene, view: &View, vpls: &[Vpl], g_max: f32) {
+        self.cancel();
         let (tx, rx) = channel();
         let rows = Arc::new(AtomicU32::new(0));
+        let cancel = Arc::new(AtomicBool::new(false));
+        let cancel_t = cancel.clone();
         let (scene, view_t, vpls, rows_t) = (scene.clone(), *view, vpls.to_vec(), rows.clone());
         std::thread::spawn(move || {
             let tracer = Tracer::new(&scene);
@@ -66,7 +77,7 @@ impl Compare {
             };
             let progress = |done: u32, _| rows_t.store(done, Ordering::Relaxed);
             let run = |p: ReferenceParams| {
-                render_with(
+                render_cancellable(
                     &tracer,
                     &scene.lights,
                     &vpls,
@@ -74,6 +85,7 @@ impl Compare {
                     &p,
                     IndirectVisibility::Exact,
                     &progress,
+                    &cancel_t,
                 )
                 .map(|r| r.0)
                 .map_err(|e| e.to_string())
@@ -84,7 +96,7 @@ impl Compare {
             };
             let _ = tx.send(run(params).and_then(|r| Ok((r, run(direct)?))));
         });
-        self.running = Some((*view, rx, rows));
+        self.running = Some((*view, rx, rows, cancel));
         self.done = None;
         self.texture = None;
         self.error = None;
@@ -92,7 +104,7 @@ impl Compare {
 
     /// Takes a finished reference; drops one whose view is no longer `view`.
     pub fn poll(&mut self, view: Option<&View>) {
-        if let Some((v, rx, _)) = &self.running
+        if let Some((v, rx, _, _)) = &self.running
             && let Ok(r) = rx.try_recv()
         {
             match r {
@@ -106,8 +118,8 @@ impl Compare {
             self.done = None;
             self.texture = None;
         }
-        if self.running.as_ref().is_some_and(|(v, _, _)| stale(v)) {
-            self.running = None;
+        if self.running.as_ref().is_some_and(|(v, ..)| stale(v)) {
+            self.cancel();
         }
     }
 
@@ -116,7 +128,7 @@ impl Compare {
         let mut start = false;
         ui.label("Reference (exact CPU, the same VPLs)");
         match (&self.running, &self.done) {
-            (Some((v, _, rows)), _) => {
+            (Some((v, _, rows, _)), _) => {
                 let f = rows.load(Ordering::Relaxed) as f32 / v.size[1].max(1) as f32;
                 ui.add(egui::ProgressBar::new(f).text("rendering; moving cancels it"));
                 ui.ctx().request_repaint();

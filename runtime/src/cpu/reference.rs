@@ -97,6 +97,23 @@ pub fn render_with(
     vis: IndirectVisibility,
     progress: &(dyn Fn(u32, u32) + Sync),
 ) -> Result<(HdrImage, ReferenceStats), RenderError> {
+    let never = std::sync::atomic::AtomicBool::new(false);
+    render_cancellable(tracer, lights, vpls, view, params, vis, progress, &never)
+}
+
+/// [`render_with`] that stops, with an error, soon after `cancel` is set (rows not yet begun
+/// are skipped): for a viewer whose camera moved on.
+#[allow(clippy::too_many_arguments)]
+pub fn render_cancellable(
+    tracer: &Tracer,
+    lights: &[Light],
+    vpls: &[Vpl],
+    view: &View,
+    params: &ReferenceParams,
+    vis: IndirectVisibility,
+    progress: &(dyn Fn(u32, u32) + Sync),
+    cancel: &std::sync::atomic::AtomicBool,
+) -> Result<(HdrImage, ReferenceStats), RenderError> {
     if !(1..=4096).contains(&params.samples_per_pixel) {
         return Err(RenderError::Param(format!(
             "{} samples per pixel: give 1 to 4096",
@@ -126,6 +143,9 @@ pub fn render_with(
         .into_par_iter()
         .map(|y| {
             let mut row = Vec::with_capacity(w as usize);
+            if cancel.load(Ordering::Relaxed) {
+                return row;
+            }
             let mut rays = 0u64;
             for x in 0..w {
                 let mut sum = Vec3::ZERO;
@@ -199,6 +219,11 @@ pub fn render_with(
             row
         })
         .collect();
+    if cancel.load(Ordering::Relaxed) {
+        return Err(RenderError::Param(
+            "the reference render was cancelled".into(),
+        ));
+    }
     let img = HdrImage {
         width: w,
         height: h,
