@@ -19,10 +19,12 @@ use visgate_runtime::vpl::{GatherParams, Vpl};
 /// The reference and the direct light alone, of one view.
 type Pair = Result<(HdrImage, HdrImage), String>;
 
+/// A reference being rendered: its view, the result to come, rows done, the flag that stops it.
+type Running = (View, Receiver<Pair>, Arc<AtomicU32>, Arc<AtomicBool>);
+
 /// A reference being rendered or done.
 pub struct Compare {
-    /// The view, the result to come, rows done, and the flag that stops it.
-    running: Option<(View, Receiver<Pair>, Arc<AtomicU32>, Arc<AtomicBool>)>,
+    running: Option<Running>,
     done: Option<(View, HdrImage, HdrImage)>,
     /// Where the divider is, as a fraction of the image's width (method left, reference right).
     pub split: f32,
