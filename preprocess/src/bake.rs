@@ -8,13 +8,12 @@ use std::time::Instant;
 
 use glam::Vec3;
 use rayon::prelude::*;
-use serde::Serialize;
 use serde_json::{Value, json};
 use visgate_formats::Scene;
 use visgate_formats::scene::Light;
 use visgate_formats::vgate::{
-    BakeInfo, BakeParams, BakedLevel, Cluster, Gate, GatePlacement, GridMeta, Resolution,
-    SegNodeKind, Skeleton, SkeletonNode, Topology, VoxelValues,
+    BakeInfo, BakeParams, BakedLevel, Cluster, Gate, GatePlacement, SegNodeKind, Skeleton,
+    SkeletonNode, Topology, VoxelValues,
 };
 
 use crate::clusters::{
@@ -23,11 +22,13 @@ use crate::clusters::{
 };
 use crate::empty::{EmptySpace, EmptySpaceParams, Seed, empty_space};
 use crate::graph::{SkeletonGraph, nearest_node, skeleton_graph};
-use crate::neighbourhood::{Betti, Conn, betti, label_components};
+use crate::neighbourhood::{Conn, betti, label_components};
 use crate::segment::{SegmentParams, Segmented, segment};
 use crate::thin::{ThinParams, Thinned, extend_ends, thin};
 use crate::voxelize::{SolidGrid, grid_for, voxelize};
 use crate::{BakeError, distance};
+
+pub use crate::report::{BakeReport, StageReport, Summary};
 
 /// What the progress callback hears.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -64,69 +65,6 @@ impl Default for BakeOptions {
 /// fixed size in metres is pruned at any resolution: `2 + ceil(longest axis / 64)` steps.
 pub fn auto_persistence(dims: [u32; 3]) -> u32 {
     2 + dims.iter().max().copied().unwrap_or(0).div_ceil(64)
-}
-
-/// One timed stage.
-#[derive(Debug, Clone, Serialize)]
-pub struct StageReport {
-    /// Stage name.
-    pub name: &'static str,
-    /// Wall time. [Units: s]
-    pub seconds: f64,
-    /// What it produced.
-    pub counts: Value,
-}
-
-/// Headline counts of a bake.
-#[derive(Debug, Clone, Serialize, PartialEq)]
-pub struct Summary {
-    /// Grid voxels (border included).
-    pub voxels: u64,
-    /// Solid voxels after voxelization.
-    pub solid_voxels: u64,
-    /// Kept empty voxels (what the skeleton describes).
-    pub empty_voxels: u64,
-    /// Skeleton nodes.
-    pub skeleton_nodes: u64,
-    /// Segmented nodes: all, then topology / curvature / coverage / narrowing.
-    pub segmented_nodes: [u64; 5],
-    /// Visibility clusters.
-    pub clusters: u64,
-    /// Visibility gates.
-    pub gates: u64,
-    /// Independent cycles of the skeleton graph.
-    pub cycles: u64,
-    /// Components of the skeleton graph.
-    pub components: u64,
-}
-
-/// Everything a bake measured.
-#[derive(Debug, Clone, Serialize)]
-pub struct BakeReport {
-    /// Scene name.
-    pub scene: String,
-    /// Parameters used (resolved).
-    pub params: BakeParams,
-    /// The grid.
-    pub grid: GridMeta,
-    /// Rayon threads.
-    pub threads: usize,
-    /// Stages in order.
-    pub stages: Vec<StageReport>,
-    /// Total wall time. [Units: s]
-    pub total_seconds: f64,
-    /// Peak resident memory of the process, where the OS tells. [Units: bytes]
-    pub peak_memory_bytes: Option<u64>,
-    /// Headline counts.
-    pub summary: Summary,
-    /// Topology of the kept empty space, counted independently of the skeleton.
-    pub empty_topology: Betti,
-    /// Topology of the skeleton voxels, counted the same way.
-    pub skeleton_topology: Betti,
-    /// Empty components and their fate, leaks, hung objects.
-    pub empty_space: Value,
-    /// Gates under both placement rules, to compare.
-    pub gate_placements: Vec<Value>,
 }
 
 /// Intermediate grids, for debug exports.
@@ -743,86 +681,4 @@ pub fn bake(
             skeleton: thinned.skeleton,
         },
     })
-}
-
-impl BakeReport {
-    /// The timing tree and summary, as printed at the end of a bake.
-    pub fn text(&self) -> String {
-        let mut s = String::new();
-        let g = &self.grid;
-        s += &format!(
-            "bake of {} — {:.2} s on {} thread(s), peak memory {}\n",
-            self.scene,
-            self.total_seconds,
-            self.threads,
-            self.peak_memory_bytes
-                .map(|b| format!("{:.0} MiB", b as f64 / (1 << 20) as f64))
-                .unwrap_or_else(|| "unknown".into())
-        );
-        for (i, st) in self.stages.iter().enumerate() {
-            let branch = if i + 1 == self.stages.len() {
-                "└─"
-            } else {
-                "├─"
-            };
-            s += &format!(
-                "{branch} {:<18} {:>8.3} s {:>5.1} %\n",
-                st.name,
-                st.seconds,
-                100.0 * st.seconds / self.total_seconds.max(1e-9)
-            );
-        }
-        let m = &self.summary;
-        let res = match self.params.resolution {
-            Resolution::LongestAxisVoxels(n) => format!("{n} on the longest axis"),
-            Resolution::VoxelSizeM(v) => format!("{v} m voxels"),
-        };
-        s += &format!(
-            "grid {} x {} x {} ({res}), voxel {:.4} m\n",
-            g.dims[0], g.dims[1], g.dims[2], g.voxel_size_m
-        );
-        s += &format!(
-            "voxels {}  solid {}  empty (kept) {}\n",
-            m.voxels, m.solid_voxels, m.empty_voxels
-        );
-        s += &format!(
-            "skeleton nodes {}  segmented nodes {} (topology {}, curvature {}, coverage {}, narrowing {})\n",
-            m.skeleton_nodes,
-            m.segmented_nodes[0],
-            m.segmented_nodes[1],
-            m.segmented_nodes[2],
-            m.segmented_nodes[3],
-            m.segmented_nodes[4]
-        );
-        s += &format!(
-            "clusters {}  gates {}  cycles {}  components {}  (alpha {} against {:?}, \
-             persistence {}, gates at {:?}, max ball {:?}, curvature to {:?})\n",
-            m.clusters,
-            m.gates,
-            m.cycles,
-            m.components,
-            self.params.alpha,
-            self.params.alpha_rule,
-            self.params.persistence.unwrap_or(0),
-            self.params.gate_placement,
-            self.params.max_ball,
-            self.params.curvature_to
-        );
-        let (e, k) = (&self.empty_topology, &self.skeleton_topology);
-        s += &format!(
-            "topology: empty space {} components / {} cycles / {} cavities, skeleton {} / {} / {}{}\n",
-            e.components,
-            e.cycles,
-            e.cavities,
-            k.components,
-            k.cycles,
-            k.cavities,
-            if (e.components, e.cycles) == (k.components, k.cycles) {
-                " (preserved)"
-            } else {
-                " (CHANGED)"
-            }
-        );
-        s
-    }
 }

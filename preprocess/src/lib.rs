@@ -22,6 +22,7 @@ pub mod distance;
 pub mod empty;
 pub mod graph;
 pub mod neighbourhood;
+pub mod report;
 pub mod segment;
 pub mod thin;
 pub mod voxelize;

@@ -27,6 +27,14 @@ use serde::{Deserialize, Serialize};
 use crate::error::VgateError;
 use crate::scene::GeometryHash;
 
+mod params;
+mod values;
+
+pub use params::{
+    AlphaRule, BakeInfo, BakeParams, CurvatureTo, GatePlacement, MaxBall, Resolution,
+};
+pub use values::{Elem, VoxelValues};
+
 /// The first eight bytes of every `.vgate` file.
 pub const MAGIC: [u8; 8] = *b"VGATE\r\n\x1a";
 /// The format version this build writes and reads.
@@ -78,109 +86,6 @@ impl GridMeta {
     pub fn voxel_to_world(&self, v: [u32; 3]) -> [f32; 3] {
         std::array::from_fn(|a| self.origin_m[a] + (v[a] as f32 + 0.5) * self.voxel_size_m)
     }
-}
-
-/// How the bake's resolution was given.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub enum Resolution {
-    /// Voxels on the longest axis of the static bounds.
-    LongestAxisVoxels(u32),
-    /// Voxel edge length, metres.
-    VoxelSizeM(f32),
-}
-
-/// Where a gate sits on its segmented edge.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub enum GatePlacement {
-    /// At the narrowest point of the original skeleton line between the two nodes.
-    Narrowest,
-    /// At the middle of the segmented edge (the paper's rule, IV.C).
-    Midpoint,
-}
-
-/// What the max-ball radius of an empty voxel measures.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub enum MaxBall {
-    /// The ball contained in the empty space (the paper's, IV.B): the distance from the voxel's
-    /// centre to the nearest solid voxel's surface.
-    Contained,
-    /// The distance to the nearest solid voxel's centre: up to half a voxel larger.
-    SolidCentre,
-}
-
-/// What α compares in the cluster growth of IV.B.2 ("radius of maximal balls does not differ
-/// more than α % of the maximal radius contained in the cluster").
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub enum AlphaRule {
-    /// A neighbour joins when `|r(neighbour) − r(popped node)| ≤ α · r_max(cluster)`: a slowly
-    /// narrowing corridor can grow one cluster without end.
-    PoppedNode,
-    /// A neighbour joins when `r_max(cluster) − r(neighbour) ≤ α · r_max(cluster)` (and a wider
-    /// neighbour by no more than α · r_max): every node within α of the cluster's widest.
-    ClusterMax,
-}
-
-/// What a line node's curvature measures its distance to (IV.B.1).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub enum CurvatureTo {
-    /// The infinite straight line through the line's extrema (the paper's).
-    Line,
-    /// The segment between the extrema: larger where a line bends back past its ends.
-    Segment,
-}
-
-/// The bake parameters a file was made with.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct BakeParams {
-    /// Grid resolution.
-    pub resolution: Resolution,
-    /// Cluster growth tolerance α of IV.B.2. [Limit: [0, 1]]
-    pub alpha: f32,
-    /// Thinning persistence; `None` asks the bake to pick one for the grid (2 + ⌈n/64⌉ for n
-    /// voxels on the longest axis). A baked file always stores the value used. [Units: thinning
-    /// steps]
-    pub persistence: Option<u32>,
-    /// Empty components smaller than this, holding no camera or light, are dropped. [Units: vx]
-    pub min_component_voxels: u64,
-    /// Gate placement rule.
-    pub gate_placement: GatePlacement,
-    /// What the max-ball radius measures.
-    pub max_ball: MaxBall,
-    /// What the cluster growth's α compares.
-    pub alpha_rule: AlphaRule,
-    /// What curvature measures the distance to.
-    pub curvature_to: CurvatureTo,
-    /// Whether a leaking closed scene was baked anyway.
-    pub allow_leaks: bool,
-}
-
-impl Default for BakeParams {
-    fn default() -> Self {
-        BakeParams {
-            resolution: Resolution::LongestAxisVoxels(128),
-            alpha: 0.2,
-            persistence: None,
-            min_component_voxels: 64,
-            gate_placement: GatePlacement::Narrowest,
-            max_ball: MaxBall::SolidCentre,
-            alpha_rule: AlphaRule::PoppedNode,
-            curvature_to: CurvatureTo::Line,
-            allow_leaks: false,
-        }
-    }
-}
-
-/// What a file was baked from and with.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct BakeInfo {
-    /// The parameters used.
-    pub params: BakeParams,
-    /// Hash of the static geometry it was baked from.
-    pub geometry_hash: GeometryHash,
-    /// The voxel grid.
-    pub grid: GridMeta,
-    /// visgate version that baked it (informative).
-    pub tool_version: String,
 }
 
 /// A skeleton voxel: a node of the curvilinear skeleton graph.
@@ -283,158 +188,6 @@ pub struct Topology {
     pub clusters: Vec<Cluster>,
     /// Visibility gates.
     pub gates: Vec<Gate>,
-}
-
-/// One value per voxel, `None` stored as the element type's maximum.
-#[derive(Debug, Clone, PartialEq)]
-pub enum VoxelValues {
-    /// 8-bit values.
-    U8(Vec<u8>),
-    /// 16-bit values.
-    U16(Vec<u16>),
-    /// 32-bit values.
-    U32(Vec<u32>),
-}
-
-impl VoxelValues {
-    /// Packs u32 values (with [`NONE`]) into the smallest type that holds them.
-    pub fn pack(values: &[u32]) -> Self {
-        let max = values.iter().copied().filter(|&v| v != NONE).max();
-        match max {
-            Some(m) if m >= u32::from(u16::MAX) => VoxelValues::U32(values.to_vec()),
-            Some(m) if m >= u32::from(u8::MAX) => VoxelValues::U16(
-                values
-                    .iter()
-                    .map(|&v| if v == NONE { u16::MAX } else { v as u16 })
-                    .collect(),
-            ),
-            _ => VoxelValues::U8(
-                values
-                    .iter()
-                    .map(|&v| if v == NONE { u8::MAX } else { v as u8 })
-                    .collect(),
-            ),
-        }
-    }
-
-    /// Number of values.
-    pub fn len(&self) -> usize {
-        match self {
-            VoxelValues::U8(v) => v.len(),
-            VoxelValues::U16(v) => v.len(),
-            VoxelValues::U32(v) => v.len(),
-        }
-    }
-
-    /// Whether there are no values.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
-    /// The value at `i` widened to u32 ([`NONE`] for none); `None` past the end.
-    pub fn get(&self, i: usize) -> Option<u32> {
-        Some(match self {
-            VoxelValues::U8(v) => widen(u32::from(*v.get(i)?), u8::MAX.into()),
-            VoxelValues::U16(v) => widen(u32::from(*v.get(i)?), u16::MAX.into()),
-            VoxelValues::U32(v) => *v.get(i)?,
-        })
-    }
-
-    /// Element type.
-    pub fn elem(&self) -> Elem {
-        match self {
-            VoxelValues::U8(_) => Elem::U8,
-            VoxelValues::U16(_) => Elem::U16,
-            VoxelValues::U32(_) => Elem::U32,
-        }
-    }
-
-    fn max_value(&self) -> Option<u32> {
-        // Plain folds per type: this runs over every voxel on each load.
-        // Shift values up by one so that "none" becomes 0: a branch-free max that vectorises.
-        fn max_of<T: Copy + Into<u32>>(v: &[T], none: u32) -> Option<u32> {
-            let m = v
-                .iter()
-                .map(|&x| {
-                    let x: u32 = x.into();
-                    if x == none { 0 } else { u64::from(x) + 1 }
-                })
-                .max()
-                .unwrap_or(0);
-            (m > 0).then(|| (m - 1) as u32)
-        }
-        match self {
-            VoxelValues::U8(v) => max_of(v, u8::MAX.into()),
-            VoxelValues::U16(v) => max_of(v, u16::MAX.into()),
-            VoxelValues::U32(v) => max_of(v, NONE),
-        }
-    }
-
-    fn to_le_bytes(&self) -> Vec<u8> {
-        match self {
-            VoxelValues::U8(v) => v.clone(),
-            VoxelValues::U16(v) => {
-                let mut out = Vec::with_capacity(v.len() * 2);
-                for x in v {
-                    out.extend_from_slice(&x.to_le_bytes());
-                }
-                out
-            }
-            VoxelValues::U32(v) => {
-                let mut out = Vec::with_capacity(v.len() * 4);
-                for x in v {
-                    out.extend_from_slice(&x.to_le_bytes());
-                }
-                out
-            }
-        }
-    }
-
-    fn from_le_bytes(elem: Elem, bytes: &[u8]) -> Self {
-        match elem {
-            Elem::U8 | Elem::Structure => VoxelValues::U8(bytes.to_vec()),
-            Elem::U16 => VoxelValues::U16(
-                bytes
-                    .chunks_exact(2)
-                    .map(|c| u16::from_le_bytes([c[0], c[1]]))
-                    .collect(),
-            ),
-            Elem::U32 => VoxelValues::U32(
-                bytes
-                    .chunks_exact(4)
-                    .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
-                    .collect(),
-            ),
-        }
-    }
-}
-
-fn widen(v: u32, none: u32) -> u32 {
-    if v == none { NONE } else { v }
-}
-
-/// Element type of a blob section.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-pub enum Elem {
-    /// No elements: a postcard structure.
-    Structure,
-    /// u8.
-    U8,
-    /// u16 LE.
-    U16,
-    /// u32 LE.
-    U32,
-}
-
-impl Elem {
-    /// Bytes per element (1 for a structure, whose length is in bytes).
-    pub fn size(self) -> u64 {
-        match self {
-            Elem::Structure | Elem::U8 => 1,
-            Elem::U16 => 2,
-            Elem::U32 => 4,
-        }
-    }
 }
 
 /// The sections a file holds, in this order.

@@ -1,0 +1,109 @@
+//! The parameters a level was baked with, as the file records them.
+
+use serde::{Deserialize, Serialize};
+
+use super::GridMeta;
+use crate::scene::GeometryHash;
+
+/// How the bake's resolution was given.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub enum Resolution {
+    /// Voxels on the longest axis of the static bounds.
+    LongestAxisVoxels(u32),
+    /// Voxel edge length, metres.
+    VoxelSizeM(f32),
+}
+
+/// Where a gate sits on its segmented edge.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum GatePlacement {
+    /// At the narrowest point of the original skeleton line between the two nodes.
+    Narrowest,
+    /// At the middle of the segmented edge (the paper's rule, IV.C).
+    Midpoint,
+}
+
+/// What the max-ball radius of an empty voxel measures.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum MaxBall {
+    /// The ball contained in the empty space (the paper's, IV.B): the distance from the voxel's
+    /// centre to the nearest solid voxel's surface.
+    Contained,
+    /// The distance to the nearest solid voxel's centre: up to half a voxel larger.
+    SolidCentre,
+}
+
+/// What α compares in the cluster growth of IV.B.2 ("radius of maximal balls does not differ
+/// more than α % of the maximal radius contained in the cluster").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum AlphaRule {
+    /// A neighbour joins when `|r(neighbour) − r(popped node)| ≤ α · r_max(cluster)`: a slowly
+    /// narrowing corridor can grow one cluster without end.
+    PoppedNode,
+    /// A neighbour joins when `r_max(cluster) − r(neighbour) ≤ α · r_max(cluster)` (and a wider
+    /// neighbour by no more than α · r_max): every node within α of the cluster's widest.
+    ClusterMax,
+}
+
+/// What a line node's curvature measures its distance to (IV.B.1).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+pub enum CurvatureTo {
+    /// The infinite straight line through the line's extrema (the paper's).
+    Line,
+    /// The segment between the extrema: larger where a line bends back past its ends.
+    Segment,
+}
+
+/// The bake parameters a file was made with.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BakeParams {
+    /// Grid resolution.
+    pub resolution: Resolution,
+    /// Cluster growth tolerance α of IV.B.2. [Limit: [0, 1]]
+    pub alpha: f32,
+    /// Thinning persistence; `None` asks the bake to pick one for the grid (2 + ⌈n/64⌉ for n
+    /// voxels on the longest axis). A baked file always stores the value used. [Units: thinning
+    /// steps]
+    pub persistence: Option<u32>,
+    /// Empty components smaller than this, holding no camera or light, are dropped. [Units: vx]
+    pub min_component_voxels: u64,
+    /// Gate placement rule.
+    pub gate_placement: GatePlacement,
+    /// What the max-ball radius measures.
+    pub max_ball: MaxBall,
+    /// What the cluster growth's α compares.
+    pub alpha_rule: AlphaRule,
+    /// What curvature measures the distance to.
+    pub curvature_to: CurvatureTo,
+    /// Whether a leaking closed scene was baked anyway.
+    pub allow_leaks: bool,
+}
+
+impl Default for BakeParams {
+    fn default() -> Self {
+        BakeParams {
+            resolution: Resolution::LongestAxisVoxels(128),
+            alpha: 0.2,
+            persistence: None,
+            min_component_voxels: 64,
+            gate_placement: GatePlacement::Narrowest,
+            max_ball: MaxBall::SolidCentre,
+            alpha_rule: AlphaRule::PoppedNode,
+            curvature_to: CurvatureTo::Line,
+            allow_leaks: false,
+        }
+    }
+}
+
+/// What a file was baked from and with.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct BakeInfo {
+    /// The parameters used.
+    pub params: BakeParams,
+    /// Hash of the static geometry it was baked from.
+    pub geometry_hash: GeometryHash,
+    /// The voxel grid.
+    pub grid: GridMeta,
+    /// visgate version that baked it (informative).
+    pub tool_version: String,
+}

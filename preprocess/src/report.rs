@@ -1,0 +1,153 @@
+//! What a bake reports: each stage's time and counts, the summary, and the text printed at
+//! its end.
+
+use serde::Serialize;
+use serde_json::Value;
+use visgate_formats::vgate::{BakeParams, GridMeta, Resolution};
+
+use crate::neighbourhood::Betti;
+
+/// One timed stage.
+#[derive(Debug, Clone, Serialize)]
+pub struct StageReport {
+    /// Stage name.
+    pub name: &'static str,
+    /// Wall time. [Units: s]
+    pub seconds: f64,
+    /// What it produced.
+    pub counts: Value,
+}
+
+/// Headline counts of a bake.
+#[derive(Debug, Clone, Serialize, PartialEq)]
+pub struct Summary {
+    /// Grid voxels (border included).
+    pub voxels: u64,
+    /// Solid voxels after voxelization.
+    pub solid_voxels: u64,
+    /// Kept empty voxels (what the skeleton describes).
+    pub empty_voxels: u64,
+    /// Skeleton nodes.
+    pub skeleton_nodes: u64,
+    /// Segmented nodes: all, then topology / curvature / coverage / narrowing.
+    pub segmented_nodes: [u64; 5],
+    /// Visibility clusters.
+    pub clusters: u64,
+    /// Visibility gates.
+    pub gates: u64,
+    /// Independent cycles of the skeleton graph.
+    pub cycles: u64,
+    /// Components of the skeleton graph.
+    pub components: u64,
+}
+
+/// Everything a bake measured.
+#[derive(Debug, Clone, Serialize)]
+pub struct BakeReport {
+    /// Scene name.
+    pub scene: String,
+    /// Parameters used (resolved).
+    pub params: BakeParams,
+    /// The grid.
+    pub grid: GridMeta,
+    /// Rayon threads.
+    pub threads: usize,
+    /// Stages in order.
+    pub stages: Vec<StageReport>,
+    /// Total wall time. [Units: s]
+    pub total_seconds: f64,
+    /// Peak resident memory of the process, where the OS tells. [Units: bytes]
+    pub peak_memory_bytes: Option<u64>,
+    /// Headline counts.
+    pub summary: Summary,
+    /// Topology of the kept empty space, counted independently of the skeleton.
+    pub empty_topology: Betti,
+    /// Topology of the skeleton voxels, counted the same way.
+    pub skeleton_topology: Betti,
+    /// Empty components and their fate, leaks, hung objects.
+    pub empty_space: Value,
+    /// Gates under both placement rules, to compare.
+    pub gate_placements: Vec<Value>,
+}
+
+impl BakeReport {
+    /// The timing tree and summary, as printed at the end of a bake.
+    pub fn text(&self) -> String {
+        let mut s = String::new();
+        let g = &self.grid;
+        s += &format!(
+            "bake of {} — {:.2} s on {} thread(s), peak memory {}\n",
+            self.scene,
+            self.total_seconds,
+            self.threads,
+            self.peak_memory_bytes
+                .map(|b| format!("{:.0} MiB", b as f64 / (1 << 20) as f64))
+                .unwrap_or_else(|| "unknown".into())
+        );
+        for (i, st) in self.stages.iter().enumerate() {
+            let branch = if i + 1 == self.stages.len() {
+                "└─"
+            } else {
+                "├─"
+            };
+            s += &format!(
+                "{branch} {:<18} {:>8.3} s {:>5.1} %\n",
+                st.name,
+                st.seconds,
+                100.0 * st.seconds / self.total_seconds.max(1e-9)
+            );
+        }
+        let m = &self.summary;
+        let res = match self.params.resolution {
+            Resolution::LongestAxisVoxels(n) => format!("{n} on the longest axis"),
+            Resolution::VoxelSizeM(v) => format!("{v} m voxels"),
+        };
+        s += &format!(
+            "grid {} x {} x {} ({res}), voxel {:.4} m\n",
+            g.dims[0], g.dims[1], g.dims[2], g.voxel_size_m
+        );
+        s += &format!(
+            "voxels {}  solid {}  empty (kept) {}\n",
+            m.voxels, m.solid_voxels, m.empty_voxels
+        );
+        s += &format!(
+            "skeleton nodes {}  segmented nodes {} (topology {}, curvature {}, coverage {}, narrowing {})\n",
+            m.skeleton_nodes,
+            m.segmented_nodes[0],
+            m.segmented_nodes[1],
+            m.segmented_nodes[2],
+            m.segmented_nodes[3],
+            m.segmented_nodes[4]
+        );
+        s += &format!(
+            "clusters {}  gates {}  cycles {}  components {}  (alpha {} against {:?}, \
+             persistence {}, gates at {:?}, max ball {:?}, curvature to {:?})\n",
+            m.clusters,
+            m.gates,
+            m.cycles,
+            m.components,
+            self.params.alpha,
+            self.params.alpha_rule,
+            self.params.persistence.unwrap_or(0),
+            self.params.gate_placement,
+            self.params.max_ball,
+            self.params.curvature_to
+        );
+        let (e, k) = (&self.empty_topology, &self.skeleton_topology);
+        s += &format!(
+            "topology: empty space {} components / {} cycles / {} cavities, skeleton {} / {} / {}{}\n",
+            e.components,
+            e.cycles,
+            e.cavities,
+            k.components,
+            k.cycles,
+            k.cavities,
+            if (e.components, e.cycles) == (k.components, k.cycles) {
+                " (preserved)"
+            } else {
+                " (CHANGED)"
+            }
+        );
+        s
+    }
+}
