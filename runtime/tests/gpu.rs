@@ -460,33 +460,7 @@ fn gpu_samples_albedo_textures_as_the_reference_does() {
         fov_x_rad: 1.0,
     };
     let view = View::new(&cam, [40, 40]).expect("view");
-    let ctx = context();
-    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
-    let (img, _) = gpu
-        .render(
-            &ctx,
-            &view,
-            &[],
-            &GpuParams {
-                mode: GpuMode::DirectOnly,
-                ..GpuParams::default()
-            },
-        )
-        .expect("render");
-    let tracer = Tracer::new(&scene);
-    let (cpu, _) = render_reference(
-        &tracer,
-        &scene.lights,
-        &[],
-        &view,
-        &ReferenceParams {
-            samples_per_pixel: 1,
-            indirect: false,
-            ..ReferenceParams::default()
-        },
-        &|_, _| {},
-    )
-    .expect("cpu");
+    let (img, cpu) = direct_on_gpu_and_cpu(&context(), &scene, &view);
     // Both show the checker: red and blue dominate in different pixels.
     let red = img.pixels.iter().filter(|p| p.x > 3.0 * p.z).count();
     let blue = img.pixels.iter().filter(|p| p.z > 2.0 * p.x).count();
@@ -571,24 +545,7 @@ fn gpu_a_camera_ten_diagonals_away_sees_the_level_as_the_cpu_does() {
         fov_x_rad: 0.12,
     };
     let view = View::new(&cam, [48, 48]).expect("view");
-    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
-    let (img, _) = gpu
-        .render(&ctx, &view, &[], &GpuParams::with_mode(GpuMode::DirectOnly))
-        .expect("render");
-    let tracer = Tracer::new(&scene);
-    let (cpu, _) = render_reference(
-        &tracer,
-        &scene.lights,
-        &[],
-        &view,
-        &ReferenceParams {
-            samples_per_pixel: 1,
-            indirect: false,
-            ..ReferenceParams::default()
-        },
-        &|_, _| {},
-    )
-    .expect("reference");
+    let (img, cpu) = direct_on_gpu_and_cpu(&ctx, &scene, &view);
     let e = errors(&img, &cpu).expect("same size");
     eprintln!("10 diagonals away: {e:?}");
     assert!(
@@ -645,4 +602,28 @@ fn a_gpu_validation_error_comes_back_as_an_error_not_a_panic() {
     let view = View::new(scene.cameras.first().expect("camera"), [8, 8]).expect("view");
     gpu.render(&ctx, &view, &[], &GpuParams::default())
         .expect("render after an error");
+}
+
+/// Direct light alone of `view`: the GPU's `direct-only` frame and the CPU reference's.
+fn direct_on_gpu_and_cpu(
+    ctx: &GpuContext,
+    scene: &visgate_formats::Scene,
+    view: &View,
+) -> (
+    visgate_runtime::hdr::HdrImage,
+    visgate_runtime::hdr::HdrImage,
+) {
+    let mut gpu = GpuRenderer::new(ctx, scene).expect("upload");
+    let (img, _) = gpu
+        .render(ctx, view, &[], &GpuParams::with_mode(GpuMode::DirectOnly))
+        .expect("render");
+    let params = ReferenceParams {
+        samples_per_pixel: 1,
+        indirect: false,
+        ..ReferenceParams::default()
+    };
+    let tracer = Tracer::new(scene);
+    let (cpu, _) = render_reference(&tracer, &scene.lights, &[], view, &params, &|_, _| {})
+        .expect("reference");
+    (img, cpu)
 }
