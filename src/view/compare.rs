@@ -34,10 +34,6 @@ pub struct Compare {
     error: Option<String>,
 }
 
-fn same(a: &View, b: &View) -> bool {
-    a.eye == b.eye && a.forward == b.forward && a.size == b.size && a.fov_x_rad == b.fov_x_rad
-}
-
 impl Compare {
     pub fn new() -> Compare {
         Compare {
@@ -115,7 +111,7 @@ impl Compare {
             }
             self.running = None;
         }
-        let stale = |v: &View| view.is_none_or(|w| !same(v, w));
+        let stale = |v: &View| view != Some(v);
         if self.done.as_ref().is_some_and(|(v, _, _)| stale(v)) {
             self.done = None;
             self.texture = None;

@@ -77,8 +77,13 @@ pub fn project(view: &View, rect: egui::Rect, p: Vec3) -> Option<egui::Pos2> {
     ))
 }
 
-/// The cluster of every pixel of `view` (row-major; `None`: no surface or no cluster).
-pub fn pixel_clusters(view: &View, tracer: &Tracer, level: &GateLevel) -> Vec<Option<u32>> {
+/// The surface of every pixel of `view` as the G-buffer holds it (normal turned to the camera,
+/// view depth, visibility cluster); `None`: no surface.
+pub fn pixel_surfaces(
+    view: &View,
+    tracer: &Tracer,
+    level: &GateLevel,
+) -> Vec<Option<visgate_runtime::cpu::clustered::PixelSurface>> {
     let [w, h] = view.size;
     (0..w * h)
         .into_par_iter()
@@ -86,8 +91,26 @@ pub fn pixel_clusters(view: &View, tracer: &Tracer, level: &GateLevel) -> Vec<Op
             let p = glam::Vec2::new((i % w) as f32 + 0.5, (i / w) as f32 + 0.5);
             let dir = view.ray_dir(p);
             let s = tracer.trace(view.eye, dir)?;
-            level.cluster_at(s.position, s.normal)
+            let n = if s.normal.dot(dir) > 0.0 {
+                -s.normal
+            } else {
+                s.normal
+            };
+            Some(visgate_runtime::cpu::clustered::PixelSurface {
+                position: s.position,
+                normal: n,
+                depth: s.t * dir.dot(view.forward),
+                cluster: level.cluster_at(s.position, n),
+            })
         })
+        .collect()
+}
+
+/// The cluster of every pixel of `view` (row-major; `None`: no surface or no cluster).
+pub fn pixel_clusters(view: &View, tracer: &Tracer, level: &GateLevel) -> Vec<Option<u32>> {
+    pixel_surfaces(view, tracer, level)
+        .iter()
+        .map(|p| p.and_then(|p| p.cluster))
         .collect()
 }
 
@@ -103,27 +126,9 @@ pub fn clustered_image(
     tile_px: u32,
     which: PixelLayer,
 ) -> egui::ColorImage {
-    use visgate_runtime::cpu::clustered::{ClusterParams, PixelSurface, assign};
+    use visgate_runtime::cpu::clustered::{ClusterParams, assign};
     let [w, h] = view.size;
-    let pixels: Vec<Option<PixelSurface>> = (0..w * h)
-        .into_par_iter()
-        .map(|i| {
-            let p = glam::Vec2::new((i % w) as f32 + 0.5, (i / w) as f32 + 0.5);
-            let dir = view.ray_dir(p);
-            let s = tracer.trace(view.eye, dir)?;
-            let n = if s.normal.dot(dir) > 0.0 {
-                -s.normal
-            } else {
-                s.normal
-            };
-            Some(PixelSurface {
-                position: s.position,
-                normal: n,
-                depth: s.t * dir.dot(view.forward),
-                cluster: level.cluster_at(s.position, n),
-            })
-        })
-        .collect();
+    let pixels = pixel_surfaces(view, tracer, level);
     let params = ClusterParams {
         tile_px,
         ..ClusterParams::default()
@@ -238,7 +243,12 @@ pub fn probe(
         .collect();
     let exact = facing
         .iter()
-        .filter(|v| !tracer.occluded(x + n * 1e-4 * (1.0 + x.length()), v.position.into()))
+        .filter(|v| {
+            // Offset both ends as the exact reference does.
+            let from = x + s.geometric_normal * tracer.epsilon_m;
+            let to = Vec3::from(v.position) + Vec3::from(v.normal) * tracer.epsilon_m;
+            !tracer.occluded(from, to)
+        })
         .count();
     let mut out = format!(
         "({:.2}, {:.2}, {:.2}) m, normal ({:.2}, {:.2}, {:.2}); VPLs facing {}, unoccluded {}",

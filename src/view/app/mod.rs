@@ -16,6 +16,7 @@ use visgate_runtime::gpu::{
     VplInput, method,
 };
 use visgate_runtime::hdr::HdrImage;
+use visgate_runtime::job::RenderJob;
 use visgate_runtime::vpl::{PathParams, Vpl, path_vpls};
 
 mod kept;
@@ -194,12 +195,7 @@ impl ViewerApp {
             && !direct_only
             && self.vpls.as_ref().map(|v| v.0) != Some(self.vpl_count)
         {
-            let paths = PathParams {
-                paths: self.vpl_count,
-                bounces: 1,
-                seed: 1,
-            };
-            match path_vpls(&self.tracer, &self.posed.lights, &paths) {
+            match path_vpls(&self.tracer, &self.posed.lights, &self.path_params()) {
                 Ok(v) => self.vpls = Some((self.vpl_count, v)),
                 Err(e) => {
                     self.error = Some(e.to_string());
@@ -209,11 +205,7 @@ impl ViewerApp {
         }
         let input = match (self.start.rsm, direct_only, &self.vpls) {
             (_, true, _) => VplInput::Given(&[]),
-            (true, false, _) => VplInput::Rsm(RsmParams {
-                count: self.vpl_count,
-                rsm_size: 256,
-                seed: 1,
-            }),
+            (true, false, _) => VplInput::Rsm(self.rsm_params()),
             (false, false, Some((_, v))) => VplInput::Given(v),
             (false, false, None) => VplInput::Given(&[]),
         };
@@ -533,16 +525,42 @@ impl ViewerApp {
         Some(out)
     }
 
+    /// The light paths `visgate render` makes by default, `vpl_count` of them.
+    fn path_params(&self) -> PathParams {
+        let job = RenderJob::default();
+        PathParams {
+            paths: self.vpl_count,
+            bounces: job.bounces,
+            seed: job.seed,
+        }
+    }
+
+    /// The RSM VPLs `visgate render --vpl-source rsm` makes by default, `vpl_count` of them.
+    fn rsm_params(&self) -> RsmParams {
+        let job = RenderJob::default();
+        RsmParams {
+            count: self.vpl_count,
+            rsm_size: job.rsm_size,
+            seed: job.seed,
+        }
+    }
+
     /// Starts the reference of the last frame's view, with its VPLs.
     fn start_reference(&mut self) {
         let Some(view) = &self.last_view else {
             return;
         };
         let vpls = match (self.start.rsm, &self.vpls) {
-            (true, _) => self
-                .gpu
-                .rsm_vpls(&self.ctx, self.vpl_count, 256, 1)
-                .unwrap_or_default(),
+            (true, _) => {
+                let r = self.rsm_params();
+                match self.gpu.rsm_vpls(&self.ctx, r.count, r.rsm_size, r.seed) {
+                    Ok(v) => v,
+                    Err(e) => {
+                        self.error = Some(e.to_string());
+                        return;
+                    }
+                }
+            }
             (false, Some((_, v))) => v.clone(),
             (false, None) => Vec::new(),
         };
