@@ -80,6 +80,8 @@ pub struct ViewerApp {
     moving_scale: f32,
     exposure: f32,
     texture: Option<egui::TextureHandle>,
+    /// Frames rendered, exposure and whether the indirect layer showed when it was uploaded.
+    texture_key: Option<(u32, f32, bool)>,
     last: Option<(HdrImage, PassTimes)>,
     error: Option<String>,
     /// Recent frame times. [Units: ms]
@@ -153,6 +155,7 @@ impl ViewerApp {
             vpl_count,
             exposure: 0.0,
             texture: None,
+            texture_key: None,
             last: None,
             error: None,
             history: VecDeque::new(),
@@ -393,7 +396,11 @@ impl ViewerApp {
     fn show_image(&mut self, ui: &mut egui::Ui) -> egui::Response {
         let avail = ui.available_size();
         let shown = self.indirect.as_ref().or(self.last.as_ref().map(|l| &l.0));
-        if let Some(img) = shown {
+        // Converted and uploaded only when the frame, the exposure or the image shown changed
+        // (not on every repaint: a pointer move repaints too).
+        let key = (self.frames, self.exposure, self.indirect.is_some());
+        if let Some(img) = shown.filter(|_| self.texture_key != Some(key)) {
+            self.texture_key = Some(key);
             let rgb = img.to_srgb8(self.exposure);
             let colour =
                 egui::ColorImage::from_rgb([img.width as usize, img.height as usize], rgb.as_raw());
