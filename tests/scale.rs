@@ -93,3 +93,38 @@ fn every_method_gives_the_same_image_at_scales_1e_3_to_1e4_with_light_paths() {
 fn every_method_gives_the_same_image_at_scales_1e_3_to_1e4_with_rsm_vpls() {
     assert_same_at_every_scale(VplSource::Rsm, &[1e-3, 1e4]);
 }
+
+/// `none` at scale `s` with the geometry clamp `clamp`.
+fn none_at(s: f32, clamp: visgate_runtime::vpl::GeometryClamp) -> HdrImage {
+    let (scene, cam) = common::scaled_four_rooms(s);
+    let job = RenderJob {
+        renderer: Renderer::Gpu(visgate_runtime::gpu::GpuMode::None),
+        clamp,
+        vpls: 128,
+        size: [48, 32],
+        ..RenderJob::default()
+    };
+    let mut image = None;
+    job.run(&scene, &cam, None, &mut |_| {}, &|_, _| {}, &mut |f| {
+        image = Some(f.image);
+        Ok(())
+    })
+    .expect("render");
+    image.expect("a frame")
+}
+
+#[test]
+fn an_absolute_clamp_changes_the_image_with_the_scale() {
+    use visgate_runtime::vpl::GeometryClamp::PerSquareMetre;
+    let (one, small) = (
+        none_at(1.0, PerSquareMetre(10.0)),
+        none_at(1e-3, PerSquareMetre(10.0)),
+    );
+    let e = errors(&small, &one).expect("same size");
+    eprintln!(
+        "absolute 10 1/m², scale 1e-3 against 1: rel. MSE {:.3}",
+        e.rel_mse
+    );
+    // The README's figure: 0.30.
+    assert!(e.rel_mse > 0.1, "{e:?}");
+}
