@@ -14,7 +14,7 @@
 use glam::Vec3;
 use visgate_formats::Camera;
 use visgate_runtime::camera::View;
-use visgate_runtime::cpu::gates::{GateLevel, GateParams};
+use visgate_runtime::cpu::gates::{GateLevel, GateParams, GateShape};
 use visgate_runtime::cpu::reference::{IndirectVisibility, ReferenceParams, render_with};
 use visgate_runtime::cpu::tracer::Tracer;
 use visgate_runtime::metrics::{errors, flip, indirect_errors};
@@ -98,8 +98,22 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         println!("| method | MSE | rel. MSE | FLIP | indirect energy | black where lit |");
         println!("|---|---|---|---|---|---|");
         let gp = |oversize: f32, max_hops: u32| {
-            IndirectVisibility::Gates(&gates, GateParams { oversize, max_hops })
+            IndirectVisibility::Gates(
+                &gates,
+                GateParams {
+                    oversize,
+                    max_hops,
+                    ..GateParams::default()
+                },
+            )
         };
+        let portals = IndirectVisibility::Gates(
+            &gates,
+            GateParams {
+                shape: GateShape::Portal,
+                ..GateParams::default()
+            },
+        );
         for (name, vis, indirect) in [
             ("direct only", IndirectVisibility::Unoccluded, false),
             ("no visibility", IndirectVisibility::Unoccluded, true),
@@ -107,6 +121,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             ("gates, 2 hops", gp(1.0, 2), true),
             ("gates × 1.5, 2 hops", gp(1.5, 2), true),
             ("gates × 2, 2 hops", gp(2.0, 2), true),
+            ("portals (walk)", portals, true),
         ] {
             let img = run(vis, indirect)?;
             let e = errors(&img, &reference)?;

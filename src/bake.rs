@@ -46,6 +46,10 @@ pub struct BakeArgs {
     /// What a skeleton line node's curvature measures the distance to (default: line, the paper's).
     #[arg(long, value_enum)]
     pub curvature_to: Option<CurvatureArg>,
+    /// Edge of a portal's coverage-mask cell, voxels (0.25–8): finer follows the openings'
+    /// shapes more closely, coarser makes smaller files.
+    #[arg(long, default_value_t = 1.0)]
+    pub portal_cell: f32,
     /// Empty components with no camera or light and fewer voxels than this are dropped.
     #[arg(long, default_value_t = 64)]
     pub min_component_voxels: u64,
@@ -154,6 +158,7 @@ pub fn run(args: BakeArgs) -> Result<()> {
                 CurvatureArg::Segment => CurvatureTo::Segment,
             }),
         allow_leaks: args.allow_leaks,
+        portal_cell_voxels: args.portal_cell,
     };
     let options = BakeOptions {
         memory_limit_bytes: (args.memory_limit_gib * (1u64 << 30) as f64) as u64,

@@ -237,6 +237,7 @@ impl RenderArgs {
                 gates: GateParams {
                     oversize: self.gate_oversize,
                     max_hops: self.gate_hops,
+                    ..GateParams::default()
                 },
                 clusters: ClusterParams {
                     tile_px: self.tile_px,

@@ -140,6 +140,7 @@ fn inspect_a_baked_file_and_refuse_a_broken_one() {
                 bounds_max_m: [1.0; 3],
             }],
             gates: vec![],
+            portals: vec![],
         },
         voxel_node: VoxelValues::pack(&[0; 8]),
         voxel_cluster: VoxelValues::pack(&[0; 8]),

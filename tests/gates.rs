@@ -5,7 +5,7 @@ use glam::Vec3;
 use visgate_formats::vgate::BakeParams;
 use visgate_formats::vgate::Resolution;
 use visgate_preprocess::bake::{BakeOptions, bake};
-use visgate_runtime::cpu::gates::{GateLevel, GateParams};
+use visgate_runtime::cpu::gates::{GateLevel, GateParams, GateShape};
 use visgate_runtime::cpu::tracer::Tracer;
 use visgate_scenes::Builtin;
 
@@ -172,10 +172,19 @@ fn gpu_gates_agree_with_the_cpu_twin() {
             "gates without a level must be refused"
         );
         gpu.set_level(&ctx, &gates).expect("level upload");
-        for (clustered, hops) in [(true, 1), (true, 2), (false, 1), (false, 2)] {
+        for (clustered, hops, shape) in [
+            (true, 1, GateShape::Disk),
+            (true, 2, GateShape::Disk),
+            (false, 1, GateShape::Disk),
+            (false, 2, GateShape::Disk),
+            (true, 2, GateShape::Portal),
+            (false, 2, GateShape::Portal),
+        ] {
             let gp = GateParams {
                 oversize: 1.5,
                 max_hops: hops,
+                shape,
+                ..GateParams::default()
             };
             let mode = if clustered {
                 GpuMode::Gates(GatesParams {
@@ -202,7 +211,11 @@ fn gpu_gates_agree_with_the_cpu_twin() {
             )
             .expect("cpu");
             let e = errors(&img, &cpu).expect("same size");
-            eprintln!("{} {} {hops} hop(s): {e:?}", b.name(), mode.name());
+            eprintln!(
+                "{} {} {shape:?} {hops} hop(s): {e:?}",
+                b.name(),
+                mode.name()
+            );
             assert!(
                 e.rel_mse < 0.02,
                 "{} {} {hops}: {e:?}",
@@ -239,10 +252,16 @@ fn clustered_light_lists_give_exactly_the_per_point_gate_test() {
             GateParams {
                 oversize: 1.0,
                 max_hops: 1,
+                ..GateParams::default()
             },
             GateParams {
                 oversize: 1.5,
                 max_hops: 2,
+                ..GateParams::default()
+            },
+            GateParams {
+                shape: GateShape::Portal,
+                ..GateParams::default()
             },
         ] {
             let c = assign(&pixels, 64, &vpls, &gates, &gp, &ClusterParams::default());
@@ -255,16 +274,22 @@ fn clustered_light_lists_give_exactly_the_per_point_gate_test() {
                 let Some(p) = p else { continue };
                 let list = &c.lists[c.pixel_cluster[i] as usize];
                 for (j, v) in vpls.iter().enumerate() {
+                    // Portal lists drop the VPLs a point lies behind (they cannot light it).
+                    let behind =
+                        (p.position - Vec3::from(v.position)).dot(Vec3::from(v.normal)) < 0.0;
+                    if gp.shape == GateShape::Portal && behind {
+                        continue;
+                    }
                     let want = match (vpl_cluster[j], p.cluster) {
                         (Some(a), Some(bc)) => {
                             gates.visible(Vec3::from(v.position), a, p.position, bc, &gp)
                         }
                         _ => true,
                     };
-                    let got = list
-                        .iter()
-                        .filter(|e| e.vpl == j as u32)
-                        .any(|e| entry_reaches(e, v, p.position, &gates, &gp));
+                    let got = list.iter().filter(|e| e.vpl == j as u32).any(|e| {
+                        let here = p.cluster.unwrap_or(u32::MAX);
+                        entry_reaches(e, v, (p.position, here), &gates, &gp)
+                    });
                     assert_eq!(got, want, "{} pixel {i} VPL {j} {gp:?}", b.name());
                     lit_pairs += got as u64;
                 }
@@ -304,6 +329,7 @@ fn gpu_light_lists_equal_the_cpu_twin() {
                 GateParams {
                     oversize: 1.0,
                     max_hops: 1,
+                    ..GateParams::default()
                 },
                 ClusterParams::default(),
             ),
@@ -311,6 +337,7 @@ fn gpu_light_lists_equal_the_cpu_twin() {
                 GateParams {
                     oversize: 1.5,
                     max_hops: 2,
+                    ..GateParams::default()
                 },
                 ClusterParams {
                     tile_px: 8,

@@ -90,6 +90,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             node_cluster: vec![0, 1],
             clusters,
             gates: vec![],
+            portals: vec![],
         },
         voxel_node: VoxelValues::pack(&vn),
         voxel_cluster: VoxelValues::pack(&vc),

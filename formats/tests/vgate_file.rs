@@ -92,6 +92,17 @@ fn two_room_level(nx: u32) -> BakedLevel {
                 clusters: [0, 1],
                 seg_edge: 1,
             }],
+            portals: vec![Portal {
+                clusters: [0, 1],
+                origin_m: [gate_x[0], gate_x[1] - 0.2, gate_x[2] - 0.2],
+                normal: [1.0, 0.0, 0.0],
+                u: [0.0, 1.0, 0.0],
+                v: [0.0, 0.0, 1.0],
+                cell_m: 0.1,
+                size: [4, 4],
+                mask: vec![0b0110_1111_1111_0110],
+                faces: 12,
+            }],
         },
         voxel_node: VoxelValues::pack(&voxel_node),
         voxel_cluster: VoxelValues::pack(&voxel_cluster),
@@ -199,7 +210,7 @@ fn wrong_magic_and_other_versions_are_named() {
 #[test]
 fn indices_out_of_range_and_lengths_that_disagree_are_errors() {
     type Mutate = fn(&mut BakedLevel);
-    let cases: [(&str, Mutate); 12] = [
+    let cases: [(&str, Mutate); 15] = [
         ("skeleton edge", |l| l.topology.skeleton.edges[0] = [0, 999]),
         ("self edge", |l| l.topology.skeleton.edges[0] = [1, 1]),
         ("segmented node", |l| {
@@ -217,6 +228,13 @@ fn indices_out_of_range_and_lengths_that_disagree_are_errors() {
         }),
         ("gate clusters", |l| l.topology.gates[0].clusters = [0, 0]),
         ("gate radius", |l| l.topology.gates[0].radius_m = f32::NAN),
+        ("portal clusters", |l| {
+            l.topology.portals[0].clusters = [1, 7]
+        }),
+        ("portal mask length", |l| l.topology.portals[0].mask.push(0)),
+        ("portal normal", |l| {
+            l.topology.portals[0].normal = [0.0, 2.0, 0.0]
+        }),
         ("voxel_cluster value", |l| {
             l.voxel_cluster = VoxelValues::pack(&vec![3; 300])
         }),
@@ -375,6 +393,7 @@ fn arb_level() -> impl Strategy<Value = BakedLevel> {
                             })
                             .collect(),
                         gates,
+                        portals: vec![],
                     },
                     voxel_node: VoxelValues::pack(&vnode),
                     voxel_cluster: VoxelValues::pack(&vcluster),

@@ -127,6 +127,12 @@ fn check_params(p: &BakeParams) -> Result<(), BakeError> {
             p.alpha
         )));
     }
+    if !(p.portal_cell_voxels.is_finite() && (0.25..=8.0).contains(&p.portal_cell_voxels)) {
+        return Err(BakeError::Param(format!(
+            "portal cell {} voxels must be in 0.25..=8 (the mask's resolution, in voxels)",
+            p.portal_cell_voxels
+        )));
+    }
     if let Some(persistence) = p.persistence
         && persistence > 10_000
     {
@@ -522,6 +528,14 @@ pub fn bake(
         })
         .sum::<u64>();
     drop(piece);
+    // Then no cluster reaches around a wall: a voxel that does not see its cluster's seed
+    // takes the cluster of the nearest one that does.
+    let seed_at: Vec<Vec3> = seeds_of
+        .iter()
+        .map(|&seed| position[seg.skeleton.nodes[seed as usize].skeleton_node as usize])
+        .collect();
+    let voxels_by_sight =
+        crate::sightline::clusters_by_sight(&meta, &es.empty, &mut voxel_cluster, &seed_at);
     // Each cluster's box of empty voxels, in voxel coordinates, reduced over z slabs.
     let nc = seeds_of.len();
     let slab = (meta.dims[0] * meta.dims[1]) as usize;
@@ -605,7 +619,7 @@ pub fn bake(
             seg_edge: g.seg_edge,
         })
         .collect();
-    let level = BakedLevel {
+    let mut level = BakedLevel {
         info: BakeInfo {
             params: params.clone(),
             geometry_hash: hash,
@@ -618,6 +632,7 @@ pub fn bake(
             node_cluster,
             clusters: clusters_out,
             gates: gates_out,
+            portals: Vec::new(),
         },
         voxel_node: VoxelValues::pack(&voxel_node),
         voxel_cluster: VoxelValues::pack(&voxel_cluster),
@@ -625,11 +640,25 @@ pub fn bake(
     clock.end(json!({
         "nodes_moved_across_gates": nodes_moved.len(),
         "voxels_moved_to_their_piece": voxels_by_piece,
+        "voxels_moved_by_sight": voxels_by_sight,
         "pieces": pieces,
         "pieces_of_several_clusters": piece_cluster.iter().filter(|&&c| c == u32::MAX - 1).count(),
         "voxel_node_bytes": level.voxel_node.elem().size() * n_voxels as u64,
         "voxel_cluster_bytes": level.voxel_cluster.elem().size() * n_voxels as u64,
     }));
+    clock.start("portals", 0);
+    let portals =
+        crate::portals::portals(&meta, &es.empty, &voxel_cluster, params.portal_cell_voxels);
+    let (uncovered, interface_faces) =
+        crate::portals::uncovered_faces(&meta, &es.empty, &voxel_cluster, &portals);
+    clock.end(json!({
+        "portals": portals.len(),
+        "interface_faces": interface_faces,
+        "faces_no_portal_covers": uncovered,
+        "faces_off_every_plane": crate::portals::off_plane_faces(&portals, &meta, &es.empty, &voxel_cluster),
+        "mask_cells": portals.iter().map(|p| u64::from(p.size[0]) * u64::from(p.size[1])).sum::<u64>(),
+    }));
+    level.topology.portals = portals;
 
     // Topology check, counted independently of the graph.
     clock.start("topology check", 0);
@@ -650,6 +679,8 @@ pub fn bake(
         segmented_nodes: seg_counts,
         clusters: level.topology.clusters.len() as u64,
         gates: level.topology.gates.len() as u64,
+        portals: level.topology.portals.len() as u64,
+        uncovered_interface_faces: uncovered,
         cycles,
         components,
     };

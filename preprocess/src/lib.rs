@@ -22,8 +22,10 @@ pub mod distance;
 pub mod empty;
 pub mod graph;
 pub mod neighbourhood;
+pub mod portals;
 pub mod report;
 pub mod segment;
+pub mod sightline;
 pub mod thin;
 pub mod voxelize;
 

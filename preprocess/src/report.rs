@@ -35,6 +35,10 @@ pub struct Summary {
     pub clusters: u64,
     /// Visibility gates.
     pub gates: u64,
+    /// Portals (planar pieces of the interfaces between clusters).
+    pub portals: u64,
+    /// Interface faces no portal covers (0 unless the bake is wrong).
+    pub uncovered_interface_faces: u64,
     /// Independent cycles of the skeleton graph.
     pub cycles: u64,
     /// Components of the skeleton graph.
@@ -120,10 +124,11 @@ impl BakeReport {
             m.segmented_nodes[4]
         );
         s += &format!(
-            "clusters {}  gates {}  cycles {}  components {}  (alpha {} against {:?}, \
+            "clusters {}  gates {}  portals {}  cycles {}  components {}  (alpha {} against {:?}, \
              persistence {}, gates at {:?}, max ball {:?}, curvature to {:?})\n",
             m.clusters,
             m.gates,
+            m.portals,
             m.cycles,
             m.components,
             self.params.alpha,

@@ -404,6 +404,12 @@ pub fn check_cpu_gates(g: &GateParams) -> Result<(), RenderError> {
             g.max_hops
         )));
     }
+    if !(1..=1024).contains(&g.max_walk) {
+        return Err(RenderError::Param(format!(
+            "portal walk limit {} must be 1..=1024 portals",
+            g.max_walk
+        )));
+    }
     Ok(())
 }
 

@@ -10,6 +10,7 @@
 //! corridors 2.5 m high, doorways 1 m wide and 2.1 m high.
 
 pub mod level;
+pub mod quads;
 
 use std::path::{Path, PathBuf};
 
@@ -88,17 +89,23 @@ pub enum Builtin {
     FourRooms,
     /// McGuire's Cornell box (CC BY 3.0), open at the front.
     CornellBox,
+    /// Two rooms of zero-thickness walls joined by a door standing 20° ajar, with a table.
+    AjarDoor,
+    /// A 16 m hall with a row of six columns (six loops) and three side rooms.
+    PillaredHall,
 }
 
 impl Builtin {
     /// Every built-in scene.
-    pub const ALL: [Builtin; 6] = [
+    pub const ALL: [Builtin; 8] = [
         Builtin::EmptyBox,
         Builtin::TwoRooms,
         Builtin::RingCorridor,
         Builtin::LCorridor,
         Builtin::FourRooms,
         Builtin::CornellBox,
+        Builtin::AjarDoor,
+        Builtin::PillaredHall,
     ];
 
     /// The name used on the command line (`builtin:NAME`).
@@ -110,6 +117,8 @@ impl Builtin {
             Builtin::LCorridor => "l-corridor",
             Builtin::FourRooms => "four-rooms",
             Builtin::CornellBox => "cornell-box",
+            Builtin::AjarDoor => "ajar-door",
+            Builtin::PillaredHall => "pillared-hall",
         }
     }
 
@@ -124,6 +133,12 @@ impl Builtin {
                 "four rooms in a 2 x 2 block, a doorway in each inner wall (one loop)"
             }
             Builtin::CornellBox => "McGuire's Cornell box (CC BY 3.0), open front",
+            Builtin::AjarDoor => {
+                "two 4 x 3 x 4 m rooms, zero-thickness walls, a door 20 degrees ajar, a table"
+            }
+            Builtin::PillaredHall => {
+                "a 16 x 4 x 5 m hall with six 0.6 m columns and three 4 x 4 m side rooms"
+            }
         }
     }
 
@@ -161,7 +176,8 @@ impl Builtin {
                 cbox(15, 25, 0, 21, 40, 42),
                 cbox(57, 67, 0, 21, 40, 42),
             ],
-            Builtin::CornellBox => return None,
+            Builtin::PillaredHall => pillared_hall(),
+            Builtin::CornellBox | Builtin::AjarDoor => return None,
         };
         Some(BoxLevel {
             cell_m: CELL_M,
@@ -181,6 +197,16 @@ impl Builtin {
                     max_m: b.max.map(|c| c as f32 * CELL_M),
                 })
                 .collect(),
+            None if self == Builtin::AjarDoor => vec![
+                Opening {
+                    min_m: [0.0, 0.0, 0.0],
+                    max_m: [4.0, 3.0, 4.0],
+                },
+                Opening {
+                    min_m: [4.0, 0.0, 0.0],
+                    max_m: [8.0, 3.0, 4.0],
+                },
+            ],
             // The inside of the Cornell box (its walls are single planes).
             None => vec![Opening {
                 min_m: [-0.99, 0.0, -1.04],
@@ -261,6 +287,32 @@ impl Builtin {
                 rooms: vec![],
                 note: "one room, made only quasi-convex by the two boxes resting on the floor; no loop (the boxes touch the floor)",
             },
+            Builtin::AjarDoor => KnownAnswers {
+                components: 1,
+                cycles: 3,
+                clusters: [3, 12],
+                gates: [3, 16],
+                doorways: vec![],
+                rooms: vec![],
+                note: "the table's four legs join its top to the floor: three loops under it; the door's gap and the wedge behind the panel make room B non-convex; one room per side at least",
+            },
+            Builtin::PillaredHall => KnownAnswers {
+                components: 1,
+                cycles: 6,
+                clusters: [5, 30],
+                gates: [6, 40],
+                doorways: vec![
+                    m(cbox(15, 25, 0, 21, 50, 52)),
+                    m(cbox(135, 145, 0, 21, 50, 52)),
+                    m(cbox(75, 85, 0, 21, -2, 0)),
+                ],
+                rooms: rooms(&[
+                    cbox(0, 40, 0, 30, 52, 92),
+                    cbox(120, 160, 0, 30, 52, 92),
+                    cbox(60, 100, 0, 30, -42, -2),
+                ]),
+                note: "each column is a loop (six); the hall cannot be one quasi-convex cluster around them; each side room one cluster behind its doorway",
+            },
         }
     }
 
@@ -337,6 +389,48 @@ impl Builtin {
                 })],
                 vec![camera([0.0, 1.0, 3.5], [0.0, 1.0, 0.0], 45.0)],
             ),
+            // The light in room B, the cameras in room A looking at the door wall (the light
+            // reaches room A only through the door's gap) and one in room B.
+            Builtin::AjarDoor => (
+                true,
+                vec![point([6.6, 2.5, 3.3], 10.0)],
+                vec![
+                    camera([0.4, 1.6, 0.5], [4.0, 1.0, 2.2], 75.0),
+                    CameraDesc {
+                        name: "door".into(),
+                        ..camera([1.8, 1.3, 3.6], [4.0, 0.9, 1.8], 70.0)
+                    },
+                    CameraDesc {
+                        name: "light-room".into(),
+                        ..camera([7.6, 1.6, 0.4], [4.0, 1.0, 2.2], 75.0)
+                    },
+                ],
+            ),
+            // A light at the hall's west end, a spot into the south room; one camera down the
+            // hall along the columns, one in the north-east room looking out of its door.
+            Builtin::PillaredHall => (
+                true,
+                vec![
+                    point([1.0, 3.5, 1.0], 20.0),
+                    LightDesc::Spot(SpotLightDesc {
+                        position: [8.0, 2.8, -1.0],
+                        target: Some([8.0, 0.0, -3.0]),
+                        direction: None,
+                        intensity: [20.0, 18.0, 15.0],
+                        cutoff_deg: 45.0,
+                        beam_deg: 35.0,
+                        animate: vec![],
+                        orbit: None,
+                    }),
+                ],
+                vec![
+                    camera([15.5, 1.7, 1.0], [0.0, 1.2, 4.0], 75.0),
+                    CameraDesc {
+                        name: "side-room".into(),
+                        ..camera([15.5, 1.6, 9.0], [13.5, 1.0, 4.0], 75.0)
+                    },
+                ],
+            ),
         };
         SceneDesc {
             name: Some(self.name().into()),
@@ -367,25 +461,27 @@ impl Builtin {
 
     /// The level's mesh, as if imported from its OBJ.
     pub fn model(self) -> Result<ImportedModel, SceneError> {
-        match self.level() {
-            Some(level) => {
-                let meshes = level.meshes();
-                let triangles_read = meshes.iter().map(|m| m.triangles.len() as u64).sum();
-                Ok(ImportedModel {
-                    meshes,
-                    materials: MATERIALS
-                        .iter()
-                        .map(|(name, albedo)| Material {
-                            name: (*name).into(),
-                            albedo: Vec3::from(*albedo),
-                            texture: None,
-                        })
-                        .collect(),
-                    triangles_read,
-                    ..Default::default()
-                })
+        let generated = |meshes: Vec<visgate_formats::import::RawMesh>,
+                         materials: &[(&str, [f32; 3])]| {
+            let triangles_read = meshes.iter().map(|m| m.triangles.len() as u64).sum();
+            ImportedModel {
+                meshes,
+                materials: materials
+                    .iter()
+                    .map(|(name, albedo)| Material {
+                        name: (*name).into(),
+                        albedo: Vec3::from(*albedo),
+                        texture: None,
+                    })
+                    .collect(),
+                triangles_read,
+                ..Default::default()
             }
-            None => import_obj_str(Path::new("CornellBox-Original.obj"), CORNELL_OBJ, |lib| {
+        };
+        match (self, self.level()) {
+            (_, Some(level)) => Ok(generated(level.meshes(), &MATERIALS)),
+            (Builtin::AjarDoor, None) => Ok(generated(quads::ajar_door(), &quads::QUAD_MATERIALS)),
+            _ => import_obj_str(Path::new("CornellBox-Original.obj"), CORNELL_OBJ, |lib| {
                 (lib == Path::new("CornellBox-Original.mtl")).then(|| CORNELL_MTL.to_string())
             }),
         }
@@ -435,6 +531,29 @@ impl Builtin {
         )?;
         Ok(scene_path)
     }
+}
+
+/// The pillared hall's empty boxes, cells: a 16 × 4 × 5 m hall (x 0–160, z 0–50) around a row
+/// of six 0.6 m columns at z 22–28, two side rooms to the north and one to the south, each
+/// 4 × 3 × 4 m behind a 1 m doorway.
+fn pillared_hall() -> Vec<CellBox> {
+    let mut boxes = vec![cbox(0, 160, 0, 40, 0, 22), cbox(0, 160, 0, 40, 28, 50)];
+    let columns: Vec<i32> = (0..6).map(|i| 20 + 25 * i).collect();
+    let mut x = 0;
+    for c in &columns {
+        boxes.push(cbox(x, c - 3, 0, 40, 22, 28));
+        x = c + 3;
+    }
+    boxes.push(cbox(x, 160, 0, 40, 22, 28));
+    boxes.extend([
+        cbox(0, 40, 0, 30, 52, 92),
+        cbox(15, 25, 0, 21, 50, 52),
+        cbox(120, 160, 0, 30, 52, 92),
+        cbox(135, 145, 0, 21, 50, 52),
+        cbox(60, 100, 0, 30, -42, -2),
+        cbox(75, 85, 0, 21, -2, 0),
+    ]);
+    boxes
 }
 
 /// The built-in scene `name`, or an error that lists them.

@@ -57,13 +57,16 @@ fn vector_area(scene: &Scene) -> DVec3 {
 #[test]
 fn generated_levels_are_closed_surfaces_with_the_stated_floor_area() {
     for b in Builtin::ALL {
-        if b == Builtin::CornellBox {
+        // Single-sided walls: neither closed nor two-faced (by design).
+        if matches!(b, Builtin::CornellBox | Builtin::AjarDoor) {
             continue;
         }
         let scene = b.scene().expect("loads");
         let va = vector_area(&scene);
         assert!(
-            va.length() < 1e-6,
+            // f32 rounding over hundreds of m²; a missing face would leave at least one
+            // 0.1 m cell, 0.01 m².
+            va.length() < 1e-4,
             "{}: vector area {va} (the surface is not closed)",
             b.name()
         );
@@ -179,4 +182,45 @@ fn exported_scenes_load_from_disk_with_the_same_static_geometry() {
         m.dedup();
         assert_eq!(a, m, "{}", b.name());
     }
+}
+
+#[test]
+fn the_ajar_door_level_has_zero_thickness_walls_and_a_door_twenty_degrees_open() {
+    let scene = Builtin::AjarDoor.scene().expect("loads");
+    // The dividing wall: quads in the plane x = 4 facing room A (−x), none facing +x.
+    let divider: Vec<_> = scene
+        .static_triangles()
+        .filter(|t| t.iter().all(|p| (p.x - 4.0).abs() < 1e-6))
+        .map(|[a, b, c]| (b - a).cross(c - a))
+        .collect();
+    assert!(!divider.is_empty());
+    assert!(
+        divider.iter().all(|n| n.x < 0.0),
+        "one-sided, facing room A"
+    );
+    // The door: wood triangles whose normals are the panel's, turned 20° about +Y.
+    let wood = scene
+        .materials
+        .iter()
+        .position(|m| m.name == "wood")
+        .expect("wood") as u32;
+    let door_normal = scene
+        .meshes
+        .iter()
+        .flat_map(|m| {
+            m.triangles
+                .iter()
+                .zip(&m.material)
+                .map(move |(t, &k)| (m, t, k))
+        })
+        .filter(|(_, _, k)| *k == wood)
+        .map(|(m, t, _)| {
+            let [a, b, c] = t.map(|i| m.positions[i as usize]);
+            ((b - a).cross(c - a).normalize(), (a + b + c) / 3.0)
+        })
+        .find(|(n, p)| p.x > 4.0 && n.y.abs() < 1e-3 && n.x > 0.5)
+        .expect("the door's face towards room B")
+        .0;
+    let angle = door_normal.z.atan2(door_normal.x).to_degrees().abs();
+    assert!((angle - 20.0).abs() < 0.01, "{angle}°");
 }

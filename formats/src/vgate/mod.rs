@@ -10,7 +10,7 @@
 //! 16+H    4           CRC-32 of bytes [0, 16+H)
 //! ...                 sections, contiguous, in table order, up to the end of the file:
 //!                       topology      postcard(Topology): skeleton, segmented skeleton,
-//!                                     node→cluster, clusters, gates
+//!                                     node→cluster, clusters, gates, portals
 //!                       voxel_node    little-endian blob, one element per voxel (x fastest)
 //!                       voxel_cluster little-endian blob, one element per voxel
 //! ```
@@ -28,17 +28,19 @@ use crate::error::VgateError;
 use crate::scene::GeometryHash;
 
 mod params;
+mod portal;
 mod values;
 
 pub use params::{
     AlphaRule, BakeInfo, BakeParams, CurvatureTo, GatePlacement, MaxBall, Resolution,
 };
+pub use portal::{MAX_MASK_CELLS, Portal};
 pub use values::{Elem, VoxelValues};
 
 /// The first eight bytes of every `.vgate` file.
 pub const MAGIC: [u8; 8] = *b"VGATE\r\n\x1a";
 /// The format version this build writes and reads.
-pub const FORMAT_VERSION: u32 = 2;
+pub const FORMAT_VERSION: u32 = 3;
 /// "No node / no cluster" in a grid decoded to u32.
 pub const NONE: u32 = u32::MAX;
 
@@ -186,8 +188,10 @@ pub struct Topology {
     pub node_cluster: Vec<u32>,
     /// Visibility clusters.
     pub clusters: Vec<Cluster>,
-    /// Visibility gates.
+    /// Visibility gates (the paper's disks).
     pub gates: Vec<Gate>,
+    /// Portals: the planar pieces of every interface between adjacent clusters (format 3).
+    pub portals: Vec<Portal>,
 }
 
 /// The sections a file holds, in this order.
@@ -605,6 +609,10 @@ impl BakedLevel {
             {
                 return bad(format!("gate {i} centre/normal/radius"));
             }
+        }
+        for (i, p) in t.portals.iter().enumerate() {
+            p.check(n_clusters)
+                .or_else(|e| bad(format!("portal {i}: {e}")))?;
         }
         if let Some(m) = self.voxel_node.max_value()
             && m as usize >= n_nodes

@@ -77,6 +77,8 @@ pub struct BakeParams {
     pub curvature_to: CurvatureTo,
     /// Whether a leaking closed scene was baked anyway.
     pub allow_leaks: bool,
+    /// Edge of a portal's coverage-mask cell. [Limit: [0.25, 8]] [Units: voxels]
+    pub portal_cell_voxels: f32,
 }
 
 impl Default for BakeParams {
@@ -91,6 +93,7 @@ impl Default for BakeParams {
             alpha_rule: AlphaRule::PoppedNode,
             curvature_to: CurvatureTo::Line,
             allow_leaks: false,
+            portal_cell_voxels: 1.0,
         }
     }
 }

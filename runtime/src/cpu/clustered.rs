@@ -23,7 +23,7 @@ use std::collections::BTreeMap;
 
 use glam::Vec3;
 
-use crate::cpu::gates::{GateLevel, GateParams, segment_crosses_disk};
+use crate::cpu::gates::{GateLevel, GateParams, GateShape, Walk, segment_crosses_disk};
 use crate::vpl::Vpl;
 
 /// Parameters of geometry clusters.
@@ -81,8 +81,11 @@ impl GeometryCluster {
 pub struct LightEntry {
     /// The VPL.
     pub vpl: u32,
-    /// Gate indices in order from the VPL, at most `max_hops`.
+    /// Gate indices in order from the VPL, at most `max_hops` (disks).
     pub gates: Vec<u32>,
+    /// Portals: the VPL's cluster, where the walk to each point of the list starts (`None`:
+    /// the same cluster, or outside every cluster, so nothing to walk).
+    pub walk_from: Option<u32>,
 }
 
 /// Geometry clusters of an image and their light lists.
@@ -185,6 +188,17 @@ pub fn assign(
             for (j, v) in vpls.iter().enumerate() {
                 let a = Vec3::from(v.position);
                 match (vpl_cluster[j], gc.cluster) {
+                    // Portals: culled only when the cluster lies wholly behind the VPL's
+                    // surface; the walk runs per point.
+                    (Some(ca), Some(cb)) if ca != cb && gates.shape == GateShape::Portal => {
+                        if (s - a).dot(Vec3::from(v.normal)) >= -r {
+                            list.push(LightEntry {
+                                vpl: j as u32,
+                                gates: Vec::new(),
+                                walk_from: Some(ca),
+                            });
+                        }
+                    }
                     (Some(ca), Some(cb)) if ca != cb => {
                         for chain in level.chains(ca, cb, gates.max_hops) {
                             let g = level.gate(chain[0]);
@@ -192,6 +206,7 @@ pub fn assign(
                                 list.push(LightEntry {
                                     vpl: j as u32,
                                     gates: chain,
+                                    walk_from: None,
                                 });
                             }
                         }
@@ -200,6 +215,7 @@ pub fn assign(
                     _ => list.push(LightEntry {
                         vpl: j as u32,
                         gates: Vec::new(),
+                        walk_from: None,
                     }),
                 }
             }
@@ -255,15 +271,18 @@ pub fn cone_margin(
     angle - (half + spread)
 }
 
-/// Step 4 for one pixel: whether entry `e`'s light reaches point `p`.
+/// Step 4 for one pixel: whether entry `e`'s light reaches point `p` (of cluster `here`).
 pub fn entry_reaches(
     e: &LightEntry,
     vpl: &Vpl,
-    p: Vec3,
+    (p, here): (Vec3, u32),
     level: &GateLevel,
     gates: &GateParams,
 ) -> bool {
     let a = Vec3::from(vpl.position);
+    if let Some(ca) = e.walk_from {
+        return matches!(level.walk(a, ca, p, here, gates.max_walk), Walk::Visible(_));
+    }
     e.gates.iter().all(|&g| {
         let (c, n, r) = level.gate(g);
         segment_crosses_disk(a, p, c, n, r * gates.oversize)

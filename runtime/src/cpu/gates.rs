@@ -14,9 +14,34 @@ use visgate_formats::{BakedLevel, Scene};
 
 use crate::RenderError;
 
+/// What a gate is at runtime.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum GateShape {
+    /// The paper's disks, through chains of at most `max_hops` of them.
+    #[default]
+    Disk,
+    /// The baked portals (the true openings), walked cluster by cluster along the segment.
+    Portal,
+}
+
+/// The end of a portal walk.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Walk {
+    /// The segment reaches the point's cluster after this many portals.
+    Visible(u32),
+    /// The segment leaves a cluster through no portal of it: a wall is in the way.
+    Blocked,
+    /// The walk passed the step limit first (counted, treated as occluded).
+    Limit,
+}
+
 /// How light passes gates.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct GateParams {
+    /// Disks or portals.
+    pub shape: GateShape,
+    /// Portals a walk may pass before it is given up (and counted). [Limit: 1..=1024]
+    pub max_walk: u32,
     /// Gate disks are this many times their baked radius. [Limit: > 0] [Units: ratio]
     pub oversize: f32,
     /// Gates a VPL's light may pass on its way, in a chain through intermediate clusters.
@@ -27,6 +52,8 @@ pub struct GateParams {
 impl Default for GateParams {
     fn default() -> Self {
         GateParams {
+            shape: GateShape::Disk,
+            max_walk: 64,
             oversize: 1.0,
             max_hops: 2,
         }
@@ -39,6 +66,8 @@ pub struct GateLevel {
     level: BakedLevel,
     /// Gates of each cluster, as indices into the level's gates.
     cluster_gates: Vec<Vec<usize>>,
+    /// Portals of each cluster, as indices into the level's portals.
+    cluster_portals: Vec<Vec<usize>>,
 }
 
 impl GateLevel {
@@ -62,10 +91,19 @@ impl GateLevel {
                 }
             }
         }
+        let mut cluster_portals = vec![Vec::new(); clusters];
+        for (i, p) in level.topology.portals.iter().enumerate() {
+            for c in p.clusters {
+                if let Some(list) = cluster_portals.get_mut(c as usize) {
+                    list.push(i);
+                }
+            }
+        }
         Ok(GateLevel {
             grid: level.info.grid,
             level,
             cluster_gates,
+            cluster_portals,
         })
     }
 
@@ -92,12 +130,12 @@ impl GateLevel {
             .filter(|&c| c != u32::MAX)
     }
 
-    /// The visibility cluster of a surface point: that of the empty space it faces, looked up
-    /// half a voxel and then 1.5 voxels along its normal, then at the point itself (the bake's
-    /// grid reaches two voxels into the solid).
+    /// The visibility cluster of a surface point: that of the empty voxel it faces, looked up
+    /// 0.5, 1.5 and 2.5 voxels along its normal (a wall on a voxel face is two voxels thick),
+    /// then at the point itself (a dynamic mesh in empty space). Only empty voxels have one.
     pub fn cluster_at(&self, p: Vec3, n: Vec3) -> Option<u32> {
         let vs = self.grid.voxel_size_m;
-        [0.5, 1.5, 0.0]
+        [0.5, 1.5, 2.5, 0.0]
             .iter()
             .find_map(|&k| self.cluster_of_voxel(p + n * (k * vs)))
     }
@@ -149,12 +187,70 @@ impl GateLevel {
         out
     }
 
+    /// Number of portals.
+    pub fn portal_count(&self) -> usize {
+        self.level.topology.portals.len()
+    }
+
+    /// The portal walk: from `a` in cluster `ca`, the segment to `b` leaves each cluster it is
+    /// in through the portal of that cluster it crosses first (its plane hit inside its mask,
+    /// going out), until it is in `cb`. Endpoints may lie up to 1.5 voxels on the far side of
+    /// a portal's plane (the planes fit voxel faces). At most `max_walk` portals.
+    pub fn walk(&self, a: Vec3, ca: u32, b: Vec3, cb: u32, max_walk: u32) -> Walk {
+        if ca == cb {
+            return Walk::Visible(0);
+        }
+        let portals = &self.level.topology.portals;
+        let d = b - a;
+        let len = d.length();
+        if len <= 0.0 || !len.is_finite() {
+            return Walk::Blocked;
+        }
+        let slack = 1.5 * self.grid.voxel_size_m / len;
+        let (mut c, mut t0, mut last) = (ca, -slack, usize::MAX);
+        for step in 0..max_walk {
+            let mut best: Option<(f32, usize, u32)> = None;
+            for &pi in self.cluster_portals.get(c as usize).into_iter().flatten() {
+                let p = &portals[pi];
+                let (out, other) = if p.clusters[0] == c {
+                    (1.0, p.clusters[1])
+                } else {
+                    (-1.0, p.clusters[0])
+                };
+                let n = Vec3::from(p.normal) * out;
+                let den = d.dot(n);
+                if pi == last || den <= f32::EPSILON * len {
+                    continue;
+                }
+                let t = (Vec3::from(p.origin_m) - a).dot(n) / den;
+                if t < t0 || t > 1.0 + slack || best.is_some_and(|(bt, _, _)| bt <= t) {
+                    continue;
+                }
+                if p.covers((a + d * t).to_array()) {
+                    best = Some((t, pi, other));
+                }
+            }
+            let Some((t, pi, other)) = best else {
+                return Walk::Blocked;
+            };
+            if other == cb {
+                return Walk::Visible(step + 1);
+            }
+            (c, t0, last) = (other, t, pi);
+        }
+        Walk::Limit
+    }
+
     /// Whether light from `a` (cluster `ca`) reaches `b` (cluster `cb`) through the gates: same
-    /// cluster, or the segment passes through a chain of at most `max_hops` gate disks that
-    /// leads from `ca` to `cb`.
+    /// cluster, or (disks) the segment passes through a chain of at most `max_hops` gate disks
+    /// that leads from `ca` to `cb`, or (portals) the walk reaches `cb` (a walk over the limit
+    /// counts as occluded).
     pub fn visible(&self, a: Vec3, ca: u32, b: Vec3, cb: u32, params: &GateParams) -> bool {
         if ca == cb {
             return true;
+        }
+        if params.shape == GateShape::Portal {
+            return matches!(self.walk(a, ca, b, cb, params.max_walk), Walk::Visible(_));
         }
         let gates = &self.level.topology.gates;
         let mut frontier = vec![ca];
@@ -225,6 +321,8 @@ pub struct GateTables {
     pub gates: Vec<crate::gpu::layout::Gate>,
     /// `clusters + 1` offsets into the list that follows them, then the gate indices.
     pub cluster_gates: Vec<u32>,
+    /// The portals, packed ([`GateLevel::portal_words`]).
+    pub portal_words: Vec<u32>,
 }
 
 impl GateLevel {
@@ -279,6 +377,49 @@ impl GateLevel {
             voxel_words: words,
             gates,
             cluster_gates: starts,
+            portal_words: self.portal_words(),
         }
     }
+
+    /// The portals packed into words for portals.wgsl: `[clusters, record base, portals]`,
+    /// `clusters + 1` absolute offsets into the list of each cluster's portal indices, the
+    /// list, then [`PORTAL_RECORD_WORDS`] words per portal (origin, cell, normal, width, u,
+    /// height, v, mask offset, the two clusters, two zeros) and the masks.
+    pub fn portal_words(&self) -> Vec<u32> {
+        let portals = &self.level.topology.portals;
+        let clusters = self.cluster_portals.len() as u32;
+        let list_at = 3 + clusters + 1;
+        let list_len: usize = self.cluster_portals.iter().map(Vec::len).sum();
+        let records = list_at + list_len as u32;
+        let mut w = vec![clusters, records, portals.len() as u32];
+        let mut at = list_at;
+        for l in &self.cluster_portals {
+            w.push(at);
+            at += l.len() as u32;
+        }
+        w.push(at);
+        for l in &self.cluster_portals {
+            w.extend(l.iter().map(|&i| i as u32));
+        }
+        let mut mask_at = records + PORTAL_RECORD_WORDS * portals.len() as u32;
+        for p in portals {
+            let f = |v: [f32; 3]| v.map(f32::to_bits);
+            w.extend(f(p.origin_m));
+            w.push(p.cell_m.to_bits());
+            w.extend(f(p.normal));
+            w.push(p.size[0]);
+            w.extend(f(p.u));
+            w.push(p.size[1]);
+            w.extend(f(p.v));
+            w.extend([mask_at, p.clusters[0], p.clusters[1], 0, 0]);
+            mask_at += p.mask.len() as u32;
+        }
+        for p in portals {
+            w.extend(&p.mask);
+        }
+        w
+    }
 }
+
+/// Words per portal record in [`GateLevel::portal_words`].
+pub const PORTAL_RECORD_WORDS: u32 = 20;

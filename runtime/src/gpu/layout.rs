@@ -149,8 +149,10 @@ gpu_struct! {
         pub oversize: f32,
         /// Gates a VPL's light may pass (1 or 2 on the GPU).
         pub max_hops: u32,
-        /// Padding.
-        pub _pad0: [u32; 2],
+        /// 0: gate disks, 1: portals (walked).
+        pub shape: u32,
+        /// Portals a walk may pass before it is given up.
+        pub max_walk: u32,
     }
 }
 

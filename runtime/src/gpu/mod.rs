@@ -381,7 +381,8 @@ impl GpuRenderer {
             value_bytes: level.map_or(4, |l| l.dims[3]),
             oversize: gates.oversize,
             max_hops: gates.max_hops,
-            ..bytemuck::Zeroable::zeroed()
+            shape: u32::from(gates.shape == crate::cpu::gates::GateShape::Portal),
+            max_walk: gates.max_walk,
         };
         let uniform = wgpu::BufferUsages::UNIFORM;
         let pool = &mut self.pool;
@@ -582,6 +583,10 @@ impl GpuRenderer {
             .clustered
             .record(&frame, gates, pool, &mut rec, &g.views[0])?;
         rec.finish(pool)?;
-        b.read_back(ctx, &g)
+        b.read_back(
+            ctx,
+            &g,
+            gates.gates.shape == crate::cpu::gates::GateShape::Portal,
+        )
     }
 }

@@ -17,11 +17,12 @@
 use crate::RenderError;
 
 /// The include files (`gpu/shaders/`).
-const INCLUDES: [(&str, &str); 6] = [
+const INCLUDES: [(&str, &str); 7] = [
     ("globals.wgsl", include_str!("shaders/globals.wgsl")),
     ("vpl.wgsl", include_str!("shaders/vpl.wgsl")),
     ("grid.wgsl", include_str!("shaders/grid.wgsl")),
     ("gates.wgsl", include_str!("shaders/gates.wgsl")),
+    ("portals.wgsl", include_str!("shaders/portals.wgsl")),
     ("val.wgsl", include_str!("shaders/val.wgsl")),
     ("fullscreen.wgsl", include_str!("shaders/fullscreen.wgsl")),
 ];

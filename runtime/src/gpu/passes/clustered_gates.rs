@@ -58,6 +58,12 @@ pub fn check_gates(g: &GateParams) -> Result<(), RenderError> {
             g.max_hops
         )));
     }
+    if !(1..=1024).contains(&g.max_walk) {
+        return Err(RenderError::Param(format!(
+            "portal walk limit {} must be 1..=1024 portals",
+            g.max_walk
+        )));
+    }
     Ok(())
 }
 
@@ -94,6 +100,8 @@ pub struct LevelBuffers {
     pub gates: wgpu::Buffer,
     /// Each cluster's gates: offsets, then indices.
     pub cluster_gates: wgpu::Buffer,
+    /// The portals, packed (`GateLevel::portal_words`).
+    pub portal_words: wgpu::Buffer,
 }
 
 impl LevelBuffers {
@@ -137,6 +145,7 @@ impl LevelBuffers {
                 bytemuck::cast_slice(&t.cluster_gates),
                 storage,
             ),
+            portal_words: init_buffer(d, "portals", bytemuck::cast_slice(&t.portal_words), storage),
         })
     }
 }
@@ -489,6 +498,7 @@ impl ListBuffers {
         &self,
         ctx: &GpuContext,
         g: &GBufferOutput,
+        portals: bool,
     ) -> Result<(Vec<Option<PixelSurface>>, Clustered), RenderError> {
         let b = self;
         let c: Vec<u32> = bytemuck::cast_slice(&read_buffer(ctx, &b.counter)?).to_vec();
@@ -530,13 +540,22 @@ impl ListBuffers {
             .map(|r| {
                 pool[r.list[0] as usize..(r.list[0] + r.list[1]) as usize]
                     .iter()
-                    .map(|&[vpl, g]| LightEntry {
-                        vpl,
-                        gates: [g & 0xffff, g >> 16]
-                            .into_iter()
-                            .filter(|&x| x != 0)
-                            .map(|x| x - 1)
-                            .collect(),
+                    .map(|&[vpl, g]| match portals {
+                        // Portals: WALK_FROM | the VPL's cluster, or 0.
+                        true => LightEntry {
+                            vpl,
+                            gates: Vec::new(),
+                            walk_from: (g != 0).then_some(g & 0x7fff_ffff),
+                        },
+                        false => LightEntry {
+                            vpl,
+                            gates: [g & 0xffff, g >> 16]
+                                .into_iter()
+                                .filter(|&x| x != 0)
+                                .map(|x| x - 1)
+                                .collect(),
+                            walk_from: None,
+                        },
                     })
                     .collect()
             })

@@ -353,6 +353,17 @@ fn vpl_entries(j: u32, cb: u32, s: vec3<f32>, r: f32, write: bool, at: u32) -> u
         return 1u;
     }
     let a = vpls[j].position;
+    // Portals: the walk runs per fragment from the VPL's cluster; here only a cluster wholly
+    // behind the VPL's surface is culled.
+    if grid.shape == 1u {
+        if dot(s - a, vpls[j].normal) < -r {
+            return 0u;
+        }
+        if write {
+            entries[at] = vec2<u32>(j, 0x80000000u | ca);
+        }
+        return 1u;
+    }
     var n = 0u;
     for (var i = cluster_gates[ca]; i < cluster_gates[ca + 1u]; i++) {
         let gi = cluster_gates[i];

@@ -86,7 +86,7 @@ impl Shade {
         let level = f.scene.level.as_ref();
         let none = &f.scene.no_level;
         let maps = array_view(&shadows.maps);
-        let buffers: [(u32, &wgpu::Buffer); 11] = [
+        let buffers: [(u32, &wgpu::Buffer); 12] = [
             (0, &f.globals),
             (1, &shadows.lights),
             (2, &f.vpls),
@@ -98,6 +98,7 @@ impl Shade {
             (12, lists.map_or(none, |b| &b.pixel_cluster)),
             (13, lists.map_or(none, |b| &b.clusters)),
             (14, lists.map_or(none, |b| &b.entries)),
+            (15, level.map_or(none, |l| &l.portal_words)),
         ];
         let textures = [
             (4, &maps),

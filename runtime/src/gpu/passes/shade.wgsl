@@ -1,4 +1,4 @@
-//! include: globals.wgsl vpl.wgsl gates.wgsl fullscreen.wgsl
+//! include: globals.wgsl vpl.wgsl gates.wgsl portals.wgsl fullscreen.wgsl
 // Deferred shading: direct light from point and spot lights with shadow-map PCF (3 × 3), and
 // the indirect sum over VPLs without visibility (SHADE_ALL), through the gates of a baked
 // level per pixel (SHADE_GATES_PER_PIXEL) or by clustered light lists (SHADE_GATES_CLUSTERED),
@@ -50,12 +50,20 @@ struct GeometryCluster {
 
 @group(0) @binding(12) var<storage, read> pixel_cluster: array<u32>;
 @group(0) @binding(13) var<storage, read> geometry_clusters: array<GeometryCluster>;
-// (VPL, gates): gates (g0 + 1) | (g1 + 1) << 16, 0 for none.
+// (VPL, gates): disks: gates (g0 + 1) | (g1 + 1) << 16, 0 for none; portals: 0 for the same
+// cluster, else WALK_FROM | the VPL's cluster.
 @group(0) @binding(14) var<storage, read> light_entries: array<vec2<u32>>;
+// The portals (portals.wgsl).
+@group(0) @binding(15) var<storage, read> portal_words: array<u32>;
+
+const WALK_FROM: u32 = 0x80000000u;
 
 fn through_gates(a: vec3<f32>, ca: u32, b: vec3<f32>, cb: u32) -> bool {
     if ca == cb || ca == NONE || cb == NONE {
         return true;
+    }
+    if grid.shape == 1u {
+        return portal_walk(a, ca, b, cb) == WALK_VISIBLE;
     }
     for (var i = cluster_gates[ca]; i < cluster_gates[ca + 1u]; i++) {
         let g = gates[cluster_gates[i]];
@@ -169,7 +177,7 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     } else if mode == SHADE_GATES_PER_PIXEL {
         radiance += albedo / PI * gather_per_pixel(p, n, decode_cluster(pos.w));
     } else if mode == SHADE_GATES_CLUSTERED {
-        radiance += albedo / PI * clustered_gather(px, p, n);
+        radiance += albedo / PI * clustered_gather(px, p, n, decode_cluster(pos.w));
     }
     return vec4<f32>(radiance, 1.0);
 }
@@ -177,7 +185,7 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
 // SHADE_GATES_CLUSTERED: the VPL light at p through its geometry cluster's list (without albedo / π). An
 // entry with gates is tested here, per fragment; a VPL whose light passes by several chains
 // counts once (a list is sorted by VPL).
-fn clustered_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+fn clustered_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32) -> vec3<f32> {
     let width = textureDimensions(g_position).x;
     let gc = pixel_cluster[u32(px.x) + u32(px.y) * width];
     if gc == NONE {
@@ -196,13 +204,20 @@ fn clustered_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
         if all(l == vec3<f32>(0.0)) {
             continue;
         }
-        let g0 = entry.y & 0xffffu;
-        if g0 != 0u && !crosses(v.position, p, gates[g0 - 1u]) {
-            continue;
-        }
-        let g1 = entry.y >> 16u;
-        if g1 != 0u && !crosses(v.position, p, gates[g1 - 1u]) {
-            continue;
+        if grid.shape == 1u {
+            if entry.y != 0u
+                && portal_walk(v.position, entry.y & ~WALK_FROM, p, here) != WALK_VISIBLE {
+                continue;
+            }
+        } else {
+            let g0 = entry.y & 0xffffu;
+            if g0 != 0u && !crosses(v.position, p, gates[g0 - 1u]) {
+                continue;
+            }
+            let g1 = entry.y >> 16u;
+            if g1 != 0u && !crosses(v.position, p, gates[g1 - 1u]) {
+                continue;
+            }
         }
         last = entry.x;
         sum += l;

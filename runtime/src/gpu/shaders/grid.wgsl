@@ -15,7 +15,10 @@ struct Grid {
     oversize: f32,
     // Gates a VPL's light may pass (1 or 2).
     max_hops: u32,
-    pad0: vec2<u32>,
+    // 0: gate disks, 1: portals (walked).
+    shape: u32,
+    // Portals a walk may pass before it is given up.
+    max_walk: u32,
 };
 
 fn cluster_of(p: vec3<f32>) -> u32 {
@@ -37,13 +40,16 @@ fn cluster_of(p: vec3<f32>) -> u32 {
     return select(x, NONE, x == 0xffu);
 }
 
-// The cluster of the empty space a surface point faces: half a voxel, then 1.5 voxels along
-// its normal, then the point itself.
+// The cluster of the empty voxel a surface point faces: 0.5, 1.5 and 2.5 voxels along its
+// normal, then the point itself.
 fn cluster_at(p: vec3<f32>, n: vec3<f32>) -> u32 {
     let vs = grid.voxel_size;
     var c = cluster_of(p + n * (0.5 * vs));
     if c == NONE {
         c = cluster_of(p + n * (1.5 * vs));
+    }
+    if c == NONE {
+        c = cluster_of(p + n * (2.5 * vs));
     }
     if c == NONE {
         c = cluster_of(p);

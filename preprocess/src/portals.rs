@@ -1,0 +1,336 @@
+//! Portals: the interfaces between adjacent visibility clusters, made planar.
+//!
+//! Every voxel face between two empty voxels of different clusters is an interface face. The
+//! faces of one cluster pair are fitted with a plane whose normal is their summed signed normal
+//! (for a staircase of faces that approximates a slanted plane, the sum is that plane's normal
+//! times its area); a set that is not planar — its faces spread more than 1.5 voxels from the
+//! plane, or their normals cancel (a folded interface) — is split at the median of its longest
+//! extent, up to 64 pieces (a piece still not planar then is kept, and counted). Each piece stores the faces' orthographic projection onto its plane
+//! as a coverage mask. So every interface face belongs to a portal whose mask covers its
+//! projected centre ([`uncovered_faces`] checks it), and a cluster's boundary is its walls plus
+//! its portals.
+
+use std::collections::BTreeMap;
+
+use glam::Vec3;
+use visgate_formats::vgate::{GridMeta, MAX_MASK_CELLS, NONE, Portal};
+
+/// One interface face: the centre, its axis and the sign of the normal from the pair's lower
+/// cluster to the higher.
+#[derive(Debug, Clone, Copy)]
+struct Face {
+    centre: Vec3,
+    axis: usize,
+    sign: f32,
+}
+
+/// Spread of a planar piece's faces about its plane, voxels.
+const PLANAR_SPREAD_VOXELS: f32 = 1.5;
+/// Pieces of one pair, at most 2^MAX_DEPTH.
+const MAX_DEPTH: u32 = 6;
+
+/// The interface faces of every cluster pair (lower cluster first), in a deterministic order.
+fn interface_faces(
+    meta: &GridMeta,
+    empty: &[bool],
+    cluster: &[u32],
+) -> BTreeMap<(u32, u32), Vec<Face>> {
+    let [nx, ny, nz] = meta.dims.map(|d| d as usize);
+    let stride = [1, nx, nx * ny];
+    let mut out: BTreeMap<(u32, u32), Vec<Face>> = BTreeMap::new();
+    for z in 0..nz {
+        for y in 0..ny {
+            for x in 0..nx {
+                let i = x + nx * (y + ny * z);
+                let c = cluster[i];
+                if !empty[i] || c == NONE {
+                    continue;
+                }
+                let at = [x, y, z];
+                for axis in 0..3 {
+                    if at[axis] + 1 >= meta.dims[axis] as usize {
+                        continue;
+                    }
+                    let j = i + stride[axis];
+                    let d = cluster[j];
+                    if !empty[j] || d == NONE || d == c {
+                        continue;
+                    }
+                    let mut centre = Vec3::from(meta.voxel_to_world(at.map(|k| k as u32)));
+                    centre[axis] += 0.5 * meta.voxel_size_m;
+                    let key = (c.min(d), c.max(d));
+                    let sign = if c < d { 1.0 } else { -1.0 };
+                    out.entry(key)
+                        .or_default()
+                        .push(Face { centre, axis, sign });
+                }
+            }
+        }
+    }
+    out
+}
+
+fn axis_vec(axis: usize) -> Vec3 {
+    let mut v = Vec3::ZERO;
+    v[axis] = 1.0;
+    v
+}
+
+/// The unit normal of a set of faces and whether they form one planar piece.
+fn plane_of(faces: &[Face], vs: f32) -> (Vec3, Vec3, bool) {
+    let sum: Vec3 = faces.iter().map(|f| axis_vec(f.axis) * f.sign).sum();
+    let centroid = faces.iter().map(|f| f.centre).sum::<Vec3>() / faces.len() as f32;
+    let len = sum.length();
+    if len < 0.5 * faces.len() as f32 || len == 0.0 {
+        let n = if len > 0.0 { sum / len } else { Vec3::X };
+        return (centroid, n, false);
+    }
+    let n = sum / len;
+    let (lo, hi) = faces.iter().fold((f32::MAX, f32::MIN), |(lo, hi), f| {
+        let d = (f.centre - centroid).dot(n);
+        (lo.min(d), hi.max(d))
+    });
+    (centroid, n, hi - lo <= PLANAR_SPREAD_VOXELS * vs)
+}
+
+/// Splits `faces` into planar pieces.
+fn pieces(mut faces: Vec<Face>, vs: f32, depth: u32, out: &mut Vec<Vec<Face>>) {
+    let (_, _, planar) = plane_of(&faces, vs);
+    if planar || depth >= MAX_DEPTH || faces.len() < 8 {
+        out.push(faces);
+        return;
+    }
+    let (lo, hi) = faces.iter().fold((Vec3::MAX, Vec3::MIN), |(lo, hi), f| {
+        (lo.min(f.centre), hi.max(f.centre))
+    });
+    let ext = hi - lo;
+    let axis = if ext.x >= ext.y && ext.x >= ext.z {
+        0
+    } else if ext.y >= ext.z {
+        1
+    } else {
+        2
+    };
+    faces.sort_by(|a, b| a.centre[axis].total_cmp(&b.centre[axis]));
+    let rest = faces.split_off(faces.len() / 2);
+    pieces(faces, vs, depth + 1, out);
+    pieces(rest, vs, depth + 1, out);
+}
+
+/// A frame (u, v) perpendicular to `n`.
+fn frame(n: Vec3) -> (Vec3, Vec3) {
+    let a = n.abs();
+    let helper = if a.x <= a.y && a.x <= a.z {
+        Vec3::X
+    } else if a.y <= a.z {
+        Vec3::Y
+    } else {
+        Vec3::Z
+    };
+    let u = n.cross(helper).normalize();
+    (u, n.cross(u))
+}
+
+/// The corners of a face, metres.
+fn corners(f: &Face, vs: f32) -> [Vec3; 4] {
+    let (a, b) = ((f.axis + 1) % 3, (f.axis + 2) % 3);
+    let h = 0.5 * vs;
+    [(-h, -h), (h, -h), (h, h), (-h, h)].map(|(s, t)| f.centre + axis_vec(a) * s + axis_vec(b) * t)
+}
+
+/// One portal from a planar piece: the faces' projections rasterised, each face marking every
+/// cell its projected square's bounds touch.
+fn portal_of(pair: (u32, u32), faces: &[Face], vs: f32, cell_voxels: f32) -> Portal {
+    let (centroid, n, _) = plane_of(faces, vs);
+    let (u, v) = frame(n);
+    let uv = |p: Vec3| ((p - centroid).dot(u), (p - centroid).dot(v));
+    let bounds = |f: &Face| {
+        corners(f, vs).iter().fold(
+            (f32::MAX, f32::MAX, f32::MIN, f32::MIN),
+            |(a, b, c, d), &p| {
+                let (x, y) = uv(p);
+                (a.min(x), b.min(y), c.max(x), d.max(y))
+            },
+        )
+    };
+    let all = faces.iter().map(bounds).fold(
+        (f32::MAX, f32::MAX, f32::MIN, f32::MIN),
+        |(a, b, c, d), (e, f, g, h)| (a.min(e), b.min(f), c.max(g), d.max(h)),
+    );
+    let mut cell = cell_voxels * vs;
+    let cells = |cell: f32| {
+        [
+            (((all.2 - all.0) / cell).ceil() as u32).max(1),
+            (((all.3 - all.1) / cell).ceil() as u32).max(1),
+        ]
+    };
+    while u64::from(cells(cell)[0]) * u64::from(cells(cell)[1]) > MAX_MASK_CELLS {
+        cell *= 2.0;
+    }
+    let size = cells(cell);
+    let mut mask = vec![0u32; Portal::words_for(size)];
+    for f in faces {
+        // A face seen edge-on projects to a line: widen it a little so that its centre's own
+        // cell is marked whatever the rounding.
+        let (x0, y0, x1, y1) = bounds(f);
+        let e = 1e-3 * cell;
+        let (x0, y0, x1, y1) = (x0 - e, y0 - e, x1 + e, y1 + e);
+        let to_cell =
+            |t: f32, lo: f32, n: u32| (((t - lo) / cell).floor() as i64).clamp(0, i64::from(n) - 1);
+        for j in to_cell(y0, all.1, size[1])..=to_cell(y1, all.1, size[1]) {
+            for i in to_cell(x0, all.0, size[0])..=to_cell(x1, all.0, size[0]) {
+                let k = (j * i64::from(size[0]) + i) as usize;
+                mask[k / 32] |= 1 << (k % 32);
+            }
+        }
+    }
+    Portal {
+        clusters: [pair.0, pair.1],
+        origin_m: (centroid + u * all.0 + v * all.1).to_array(),
+        normal: n.to_array(),
+        u: u.to_array(),
+        v: v.to_array(),
+        cell_m: cell,
+        size,
+        mask,
+        faces: faces.len() as u32,
+    }
+}
+
+/// The portals of a level: `empty` marks its empty voxels, `cluster` holds each voxel's
+/// cluster ([`NONE`] for none).
+pub fn portals(meta: &GridMeta, empty: &[bool], cluster: &[u32], cell_voxels: f32) -> Vec<Portal> {
+    let vs = meta.voxel_size_m;
+    let mut out = Vec::new();
+    for (pair, faces) in interface_faces(meta, empty, cluster) {
+        let mut parts = Vec::new();
+        pieces(faces, vs, 0, &mut parts);
+        out.extend(parts.iter().map(|p| portal_of(pair, p, vs, cell_voxels)));
+    }
+    out
+}
+
+/// Interface faces farther than 1.5 voxels from their portal's plane (the pieces a folded
+/// interface keeps after the last split).
+pub fn off_plane_faces(
+    portals: &[Portal],
+    meta: &GridMeta,
+    empty: &[bool],
+    cluster: &[u32],
+) -> u64 {
+    let vs = meta.voxel_size_m;
+    let mut out = 0;
+    for (pair, faces) in interface_faces(meta, empty, cluster) {
+        let mine: Vec<&Portal> = portals
+            .iter()
+            .filter(|p| (p.clusters[0], p.clusters[1]) == pair)
+            .collect();
+        out += faces
+            .iter()
+            .filter(|f| {
+                mine.iter()
+                    .map(|p| p.distance(f.centre.to_array()).abs())
+                    .fold(f32::MAX, f32::min)
+                    > PLANAR_SPREAD_VOXELS * vs
+            })
+            .count() as u64;
+    }
+    out
+}
+
+/// Interface faces whose projected centre no portal of their pair covers, and the total
+/// number of interface faces: a level whose clusters are bounded by walls and portals alone
+/// has none uncovered.
+pub fn uncovered_faces(
+    meta: &GridMeta,
+    empty: &[bool],
+    cluster: &[u32],
+    portals: &[Portal],
+) -> (u64, u64) {
+    let mut uncovered = 0;
+    let mut total = 0;
+    for (pair, faces) in interface_faces(meta, empty, cluster) {
+        let mine: Vec<&Portal> = portals
+            .iter()
+            .filter(|p| (p.clusters[0], p.clusters[1]) == pair)
+            .collect();
+        for f in &faces {
+            total += 1;
+            let c = f.centre;
+            let hit = mine.iter().any(|p| {
+                let q = c - Vec3::from(p.normal) * p.distance(c.to_array());
+                p.covers(q.to_array())
+            });
+            uncovered += u64::from(!hit);
+        }
+    }
+    (uncovered, total)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn grid(dims: [u32; 3]) -> GridMeta {
+        GridMeta {
+            origin_m: [0.0; 3],
+            voxel_size_m: 0.1,
+            dims,
+        }
+    }
+
+    #[test]
+    fn a_slanted_interface_is_one_portal_with_the_slant_normal_covering_every_face() {
+        // 20 × 4 × 20 voxels, all empty; cluster 0 where x + z < 20, else 1.
+        let meta = grid([20, 4, 20]);
+        let n = 20 * 4 * 20;
+        let empty = vec![true; n];
+        let cluster: Vec<u32> = (0..n as u32)
+            .map(|i| {
+                let [x, _, z] = meta.coords(i);
+                u32::from(x + z >= 20)
+            })
+            .collect();
+        let ps = portals(&meta, &empty, &cluster, 1.0);
+        assert_eq!(ps.len(), 1, "{ps:?}");
+        let nrm = Vec3::from(ps[0].normal);
+        assert!(
+            (nrm - Vec3::new(1.0, 0.0, 1.0).normalize()).length() < 1e-4,
+            "{nrm}"
+        );
+        assert_eq!(
+            uncovered_faces(&meta, &empty, &cluster, &ps),
+            (0, ps[0].faces as u64)
+        );
+        // A point well inside cluster 0's half projects outside the opening's plane band.
+        assert!(ps[0].distance([0.3, 0.2, 0.3]) < 0.0);
+    }
+
+    #[test]
+    fn an_l_shaped_interface_splits_into_planar_pieces_and_solid_faces_are_not_interface() {
+        // Cluster 1 is the corner x >= 10 && z >= 10; a solid column splits nothing else.
+        let meta = grid([20, 3, 20]);
+        let n = 20 * 3 * 20;
+        let mut empty = vec![true; n];
+        let cluster: Vec<u32> = (0..n as u32)
+            .map(|i| {
+                let [x, _, z] = meta.coords(i);
+                u32::from(x >= 10 && z >= 10)
+            })
+            .collect();
+        // Solid voxels at x = 9, z >= 15: the faces beside them are walls, not portal.
+        for i in 0..n as u32 {
+            let [x, _, z] = meta.coords(i);
+            if x == 9 && z >= 15 {
+                empty[i as usize] = false;
+            }
+        }
+        let ps = portals(&meta, &empty, &cluster, 1.0);
+        assert!(ps.len() >= 2, "{}", ps.len());
+        let (uncovered, total) = uncovered_faces(&meta, &empty, &cluster, &ps);
+        assert_eq!(uncovered, 0);
+        // 10 × 3 faces across z = 10 and 5 × 3 across x = 10 (z 10..15; 15..20 is solid).
+        assert_eq!(total, 45);
+        assert_eq!(ps.iter().map(|p| u64::from(p.faces)).sum::<u64>(), total);
+    }
+}

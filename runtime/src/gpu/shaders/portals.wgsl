@@ -1,0 +1,85 @@
+//! include: grid.wgsl
+// The portal walk (runtime::cpu::gates::GateLevel::walk is its CPU twin): from a in cluster ca
+// the segment to b leaves each cluster through the portal of it that it crosses first (plane
+// hit inside the coverage mask, going out), until it is in cb. It reads the including pass's
+// `grid` (voxel size, walk limit) and `portal_words: array<u32>` (GateLevel::portal_words:
+// [clusters, record base, portals], offsets, index lists, 20-word records, masks).
+
+const PORTAL_RECORD: u32 = 20u;
+const WALK_BLOCKED: u32 = 0u;
+const WALK_VISIBLE: u32 = 1u;
+const WALK_LIMIT: u32 = 2u;
+
+fn pw(i: u32) -> u32 {
+    return portal_words[i];
+}
+
+fn pv(i: u32) -> vec3<f32> {
+    return bitcast<vec3<f32>>(vec3<u32>(portal_words[i], portal_words[i + 1u], portal_words[i + 2u]));
+}
+
+// Whether the point q of record r's plane falls in a set mask cell.
+fn portal_covers(r: u32, q: vec3<f32>) -> bool {
+    let rel = q - pv(r);
+    let cell = bitcast<f32>(pw(r + 3u));
+    let x = floor(dot(rel, pv(r + 8u)) / cell);
+    let y = floor(dot(rel, pv(r + 12u)) / cell);
+    let w = pw(r + 7u);
+    let h = pw(r + 11u);
+    if !(x >= 0.0 && y >= 0.0 && x < f32(w) && y < f32(h)) {
+        return false;
+    }
+    let k = u32(y) * w + u32(x);
+    return ((pw(pw(r + 15u) + k / 32u) >> (k % 32u)) & 1u) == 1u;
+}
+
+fn portal_walk(a: vec3<f32>, ca: u32, b: vec3<f32>, cb: u32) -> u32 {
+    if ca == cb {
+        return WALK_VISIBLE;
+    }
+    let d = b - a;
+    let len = length(d);
+    if !(len > 0.0) || ca >= pw(0u) || cb >= pw(0u) {
+        return WALK_BLOCKED;
+    }
+    let slack = 1.5 * grid.voxel_size / len;
+    let records = pw(1u);
+    var c = ca;
+    var t0 = -slack;
+    var last = NONE;
+    for (var step = 0u; step < grid.max_walk; step++) {
+        var best_t = 3.4e38;
+        var best = NONE;
+        var best_other = NONE;
+        for (var k = pw(3u + c); k < pw(4u + c); k++) {
+            let pi = pw(k);
+            let r = records + pi * PORTAL_RECORD;
+            let c0 = pw(r + 16u);
+            let own0 = c0 == c;
+            let n = pv(r + 4u) * select(-1.0, 1.0, own0);
+            let den = dot(d, n);
+            if pi == last || den <= 1.1920929e-7 * len {
+                continue;
+            }
+            let t = dot(pv(r) - a, n) / den;
+            if t < t0 || t > 1.0 + slack || t >= best_t {
+                continue;
+            }
+            if portal_covers(r, a + d * t) {
+                best_t = t;
+                best = pi;
+                best_other = select(c0, pw(r + 17u), own0);
+            }
+        }
+        if best == NONE {
+            return WALK_BLOCKED;
+        }
+        if best_other == cb {
+            return WALK_VISIBLE;
+        }
+        c = best_other;
+        t0 = best_t;
+        last = best;
+    }
+    return WALK_LIMIT;
+}

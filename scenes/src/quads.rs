@@ -1,0 +1,214 @@
+//! Levels built from single-sided quads and thin boxes, as many real levels are: walls of zero
+//! thickness, door panels and table tops thinner than a voxel, legs a few centimetres wide.
+//! The box-room generator ([`crate::level`]) gives every wall a real thickness; these levels
+//! are the ones that show where a bake or a runtime assumes it.
+
+use glam::{Vec2, Vec3};
+use visgate_formats::import::RawMesh;
+
+/// Materials of the quad levels: name and linear albedo.
+pub const QUAD_MATERIALS: [(&str, [f32; 3]); 5] = [
+    ("floor", [0.70, 0.68, 0.62]),
+    ("ceiling", [0.80, 0.80, 0.80]),
+    ("wall", [0.75, 0.72, 0.65]),
+    ("wood", [0.55, 0.38, 0.22]),
+    ("red", [0.70, 0.12, 0.10]),
+];
+
+/// Material indices into [`QUAD_MATERIALS`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Mat {
+    /// Floors.
+    Floor = 0,
+    /// Ceilings.
+    Ceiling = 1,
+    /// Walls.
+    Wall = 2,
+    /// Doors and furniture.
+    Wood = 3,
+    /// A coloured wall, so that colour bleeding shows.
+    Red = 4,
+}
+
+/// Collects quads into one mesh per material.
+pub struct QuadBuilder {
+    meshes: Vec<RawMesh>,
+}
+
+impl Default for QuadBuilder {
+    fn default() -> Self {
+        QuadBuilder {
+            meshes: QUAD_MATERIALS
+                .iter()
+                .enumerate()
+                .map(|(i, (name, _))| RawMesh {
+                    name: (*name).to_string(),
+                    positions: vec![],
+                    normals: vec![],
+                    uvs: vec![],
+                    triangles: vec![],
+                    material: i as u32,
+                })
+                .collect(),
+        }
+    }
+}
+
+impl QuadBuilder {
+    /// A quad `p0 p1 p2 p3`, counter-clockwise seen from the side its normal faces.
+    pub fn quad(&mut self, mat: Mat, p: [Vec3; 4]) {
+        let mesh = &mut self.meshes[mat as usize];
+        let n = (p[1] - p[0]).cross(p[3] - p[0]).normalize();
+        let base = mesh.positions.len() as u32;
+        let uv = [Vec2::ZERO, Vec2::X, Vec2::ONE, Vec2::Y];
+        for (q, t) in p.iter().zip(uv) {
+            mesh.positions.push(*q);
+            mesh.normals.push(n);
+            mesh.uvs.push(t);
+        }
+        mesh.triangles
+            .extend([[base, base + 1, base + 2], [base, base + 2, base + 3]]);
+    }
+
+    /// An axis-aligned rectangle on the plane `axis = at`, spanning `lo..hi` on the other two
+    /// axes (in the order (axis+1)%3, (axis+2)%3), its normal along +axis or −axis.
+    pub fn rect(&mut self, mat: Mat, axis: usize, at: f32, lo: [f32; 2], hi: [f32; 2], plus: bool) {
+        let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+        let point = |a: f32, b: f32| {
+            let mut p = Vec3::ZERO;
+            p[axis] = at;
+            p[u] = a;
+            p[v] = b;
+            p
+        };
+        // u × v = +axis, so (lo,lo) (hi,lo) (hi,hi) (lo,hi) faces +axis.
+        let ps = [
+            point(lo[0], lo[1]),
+            point(hi[0], lo[1]),
+            point(hi[0], hi[1]),
+            point(lo[0], hi[1]),
+        ];
+        self.quad(
+            mat,
+            if plus {
+                ps
+            } else {
+                [ps[0], ps[3], ps[2], ps[1]]
+            },
+        );
+    }
+
+    /// A closed box of half extents `half` centred at `centre`, turned by `yaw_deg` about +Y,
+    /// faces outward.
+    pub fn cuboid(&mut self, mat: Mat, centre: Vec3, half: Vec3, yaw_deg: f32) {
+        let (s, c) = yaw_deg.to_radians().sin_cos();
+        let at = |x: f32, y: f32, z: f32| {
+            let l = Vec3::new(x * half.x, y * half.y, z * half.z);
+            centre + Vec3::new(c * l.x + s * l.z, l.y, -s * l.x + c * l.z)
+        };
+        let corners = |axis: usize, sign: f32| {
+            // The face at local axis = sign, counter-clockwise seen from outside.
+            let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+            let pt = |a: f32, b: f32| {
+                let mut l = [0.0f32; 3];
+                l[axis] = sign;
+                l[u] = a;
+                l[v] = b;
+                at(l[0], l[1], l[2])
+            };
+            let ps = [pt(-1.0, -1.0), pt(1.0, -1.0), pt(1.0, 1.0), pt(-1.0, 1.0)];
+            if sign > 0.0 {
+                ps
+            } else {
+                [ps[0], ps[3], ps[2], ps[1]]
+            }
+        };
+        for axis in 0..3 {
+            for sign in [1.0, -1.0] {
+                self.quad(mat, corners(axis, sign));
+            }
+        }
+    }
+
+    /// The meshes that have triangles.
+    pub fn finish(self) -> Vec<RawMesh> {
+        self.meshes
+            .into_iter()
+            .filter(|m| !m.triangles.is_empty())
+            .collect()
+    }
+}
+
+/// The ajar-door level: two 4 × 3 × 4 m rooms side by side along x, every wall, the floor
+/// and the ceiling a single-sided quad facing the inside (zero thickness); the wall between
+/// them at x = 4 m has a 1 × 2.1 m doorway (z 1.5–2.5 m) whose 4 cm door panel, hinged at
+/// z = 1.5 m, stands open 20° into room B, leaving a gap of about 0.33 m at its free edge. Room
+/// A has a table (1.2 × 0.8 m top, 4 cm thick, at 0.76 m, on four 5 cm legs) and a red wall at
+/// z = 4 m.
+pub fn ajar_door() -> Vec<RawMesh> {
+    let mut b = QuadBuilder::default();
+    let (w, h, d) = (8.0f32, 3.0f32, 4.0f32);
+    b.rect(Mat::Floor, 1, 0.0, [0.0, 0.0], [d, w], true);
+    b.rect(Mat::Ceiling, 1, h, [0.0, 0.0], [d, w], false);
+    // Outer walls (axis x: lo/hi over (y, z); axis z: over (x, y)).
+    b.rect(Mat::Wall, 0, 0.0, [0.0, 0.0], [h, d], true);
+    b.rect(Mat::Wall, 0, w, [0.0, 0.0], [h, d], false);
+    b.rect(Mat::Wall, 2, 0.0, [0.0, 0.0], [w, h], true);
+    b.rect(Mat::Red, 2, d, [0.0, 0.0], [4.0, h], false);
+    b.rect(Mat::Wall, 2, d, [4.0, 0.0], [w, h], false);
+    // The dividing wall at x = 4, facing room A (−x): beside and above the doorway.
+    let (z0, z1, top) = (1.5f32, 2.5f32, 2.1f32);
+    b.rect(Mat::Wall, 0, 4.0, [0.0, 0.0], [h, z0], false);
+    b.rect(Mat::Wall, 0, 4.0, [0.0, z1], [h, d], false);
+    b.rect(Mat::Wall, 0, 4.0, [top, z0], [h, z1], false);
+    // The door: 0.95 × 2.05 × 0.04 m, hinged at (4, z0), open 20° into room B (+x).
+    let open = 20.0f32;
+    let (len, th) = (0.95f32, 0.04f32);
+    let dir = Vec3::new(open.to_radians().sin(), 0.0, open.to_radians().cos());
+    let across = Vec3::new(dir.z, 0.0, -dir.x);
+    let centre = Vec3::new(4.0, 1.025, z0) + dir * (0.5 * len + 0.01) + across * (0.5 * th);
+    // Local x is across the panel, local z along it: yaw turns local +z onto `dir`.
+    b.cuboid(
+        Mat::Wood,
+        centre,
+        Vec3::new(0.5 * th, 1.025, 0.5 * len),
+        open,
+    );
+    // The table in room A.
+    let (tx, tz, top_y) = (2.2f32, 1.6f32, 0.76f32);
+    b.cuboid(
+        Mat::Wood,
+        Vec3::new(tx, top_y - 0.02, tz),
+        Vec3::new(0.6, 0.02, 0.4),
+        0.0,
+    );
+    for (sx, sz) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+        b.cuboid(
+            Mat::Wood,
+            Vec3::new(tx + sx * 0.55, 0.5 * (top_y - 0.04), tz + sz * 0.35),
+            Vec3::new(0.025, 0.5 * (top_y - 0.04), 0.025),
+            0.0,
+        );
+    }
+    b.finish()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rect_and_cuboid_normals_face_the_stated_side() {
+        let mut b = QuadBuilder::default();
+        b.rect(Mat::Wall, 0, 4.0, [0.0, 0.0], [1.0, 1.0], false);
+        b.cuboid(Mat::Wood, Vec3::ZERO, Vec3::ONE, 30.0);
+        let m = b.finish();
+        assert_eq!(m[0].normals[0], Vec3::NEG_X);
+        // Each outward face's normal points away from the box's centre.
+        for (t, tri) in m[1].triangles.iter().enumerate() {
+            let [a, b2, c] = tri.map(|i| m[1].positions[i as usize]);
+            let n = (b2 - a).cross(c - a);
+            assert!(n.dot((a + b2 + c) / 3.0) > 0.0, "triangle {t} faces inward");
+        }
+    }
+}
