@@ -103,6 +103,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 GateParams {
                     oversize,
                     max_hops,
+                    shape: GateShape::Disk,
                     ..GateParams::default()
                 },
             )

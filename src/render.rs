@@ -8,7 +8,7 @@ use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 use visgate_formats::ImportOptions;
 use visgate_runtime::cpu::clustered::ClusterParams;
-use visgate_runtime::cpu::gates::{GateLevel, GateParams};
+use visgate_runtime::cpu::gates::{GateLevel, GateParams, GateShape};
 use visgate_runtime::cpu::val::ValParams;
 use visgate_runtime::gpu::{
     CssmParams, GatesParams, GpuMode, GpuParams, InterleaveParams, METHODS, MethodSettings,
@@ -30,8 +30,11 @@ Modes:
   per-vpl-shadow-maps
                GPU: one paraboloid shadow map per VPL, rendered and gathered in batches of
                --vpl-batch (the brute-force baseline that gates and virtual area lights beat)
-  gates        GPU: a VPL lights a point of another visibility cluster only through a chain
-               of at most --gate-hops gate disks (× --gate-oversize) of the baked --level, by
+  gates        GPU: a VPL lights a point of another visibility cluster only through the
+               baked --level's portals (--gate-shape portal, the default: the segment walks
+               from cluster to cluster through the openings, at most --max-walk of them) or
+               a chain of at most --gate-hops gate disks (× --gate-oversize; --gate-shape
+               disk, the paper's), by
                clustered shading (the paper's Table I passes: geometry pass, unique clusters
                of --tile-px tiles × --depth-slices slices × visibility cluster, light
                assignment into a pool of --light-entries, indirect lighting); GPU: ≤ 2 hops;
@@ -69,6 +72,15 @@ Examples:
   visgate diff none.exr cornell.exr --out diff.png";
 
 /// Where VPLs come from.
+/// `--gate-shape`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum GateShapeArg {
+    /// The baked portals (the true openings between clusters), walked along each segment.
+    Portal,
+    /// The paper's disks, through chains of at most --gate-hops of them.
+    Disk,
+}
+
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum VplSource {
     /// Light paths traced on the CPU (any number of bounces).
@@ -138,7 +150,14 @@ pub struct RenderArgs {
     /// The baked level (.vgate) for --mode gates; it must come from this scene's geometry.
     #[arg(long)]
     pub level: Option<PathBuf>,
-    /// Gate disks are this many times their baked radius (--mode gates).
+    /// What a gate is (--mode gates): the baked portals, walked, or the paper's disks.
+    #[arg(long, value_enum, default_value_t = GateShapeArg::Portal)]
+    pub gate_shape: GateShapeArg,
+    /// Portals one walk may pass before it is given up and counted as occluded (--gate-shape
+    /// portal), 1..=1024.
+    #[arg(long, default_value_t = 64)]
+    pub max_walk: u32,
+    /// Gate disks are this many times their baked radius (--gate-shape disk).
     #[arg(long, default_value_t = 1.0)]
     pub gate_oversize: f32,
     /// Gates a VPL's light may pass in a chain (--mode gates; the paper: 1).
@@ -237,7 +256,11 @@ impl RenderArgs {
                 gates: GateParams {
                     oversize: self.gate_oversize,
                     max_hops: self.gate_hops,
-                    ..GateParams::default()
+                    shape: match self.gate_shape {
+                        GateShapeArg::Portal => GateShape::Portal,
+                        GateShapeArg::Disk => GateShape::Disk,
+                    },
+                    max_walk: self.max_walk,
                 },
                 clusters: ClusterParams {
                     tile_px: self.tile_px,

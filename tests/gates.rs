@@ -65,7 +65,23 @@ fn two_rooms_a_vpl_in_a_lights_b_only_through_the_doorway_gates() {
     let mut lit = 0;
     let mut tested = 0;
     let mut exact_lit = 0;
-    let params = GateParams::default();
+    let (mut portal_lit, mut portal_wrong) = (0, 0);
+    let params = GateParams {
+        shape: GateShape::Disk,
+        ..GateParams::default()
+    };
+    let portals = GateParams::default();
+    // Where a segment crosses the doorway wall (x 4.0–4.2 m), its least distance from the
+    // doorway's frame (z 1.5–2.5, y 0–2.1), metres.
+    let outside_doorway = |a: Vec3, b: Vec3| {
+        [4.0, 4.1, 4.2]
+            .map(|x| {
+                let q = a.lerp(b, (x - a.x) / (b.x - a.x));
+                (1.5 - q.z).max(q.z - 2.5).max(q.y - 2.1).max(-q.y).abs()
+            })
+            .into_iter()
+            .fold(f32::MAX, f32::min)
+    };
     for i in 1..6 {
         for k in 1..6 {
             let t = Vec3::new(i as f32 / 6.0, 0.0, k as f32 / 6.0);
@@ -86,6 +102,19 @@ fn two_rooms_a_vpl_in_a_lights_b_only_through_the_doorway_gates() {
                         // Light through a gate disk (no wider than the doorway) is really seen.
                         assert!(seen, "gate lets light through a wall: {vpl} → {p}");
                     }
+                    // Portals: the walk's answer is the ray's but for segments that graze the
+                    // doorway's frame (crossing within a voxel of its edge, 0.0854 m).
+                    if gates.visible(vpl, ca, p, cb, &portals) {
+                        portal_lit += 1;
+                    }
+                    if gates.visible(vpl, ca, p, cb, &portals) != seen {
+                        portal_wrong += 1;
+                        assert!(
+                            outside_doorway(vpl, p).abs() < 0.0854,
+                            "portal walk {} but ray {seen}: {vpl} → {p}",
+                            !seen
+                        );
+                    }
                 }
             }
         }
@@ -96,7 +125,12 @@ fn two_rooms_a_vpl_in_a_lights_b_only_through_the_doorway_gates() {
         gates.cluster_count(),
         gates.gate_count()
     );
+    eprintln!("portals: {portal_lit} lit, {portal_wrong} disagree with the ray (all at the frame)");
     assert!(lit > 0 && lit <= exact_lit);
+    assert!(
+        portal_lit > lit && portal_wrong * 20 <= exact_lit,
+        "{portal_lit} {portal_wrong}"
+    );
     // Without the gates, room A lights nothing in room B.
     let mut closed = level.clone();
     closed.topology.gates.clear();
@@ -252,11 +286,13 @@ fn clustered_light_lists_give_exactly_the_per_point_gate_test() {
             GateParams {
                 oversize: 1.0,
                 max_hops: 1,
+                shape: GateShape::Disk,
                 ..GateParams::default()
             },
             GateParams {
                 oversize: 1.5,
                 max_hops: 2,
+                shape: GateShape::Disk,
                 ..GateParams::default()
             },
             GateParams {
@@ -329,6 +365,7 @@ fn gpu_light_lists_equal_the_cpu_twin() {
                 GateParams {
                     oversize: 1.0,
                     max_hops: 1,
+                    shape: GateShape::Disk,
                     ..GateParams::default()
                 },
                 ClusterParams::default(),
@@ -337,6 +374,7 @@ fn gpu_light_lists_equal_the_cpu_twin() {
                 GateParams {
                     oversize: 1.5,
                     max_hops: 2,
+                    shape: GateShape::Disk,
                     ..GateParams::default()
                 },
                 ClusterParams {
@@ -584,54 +622,62 @@ fn gpu_gates_give_the_same_image_at_scales_1e_3_to_1e4() {
     use visgate_runtime::metrics::errors;
     use visgate_runtime::vpl::{PathParams, path_vpls};
     let ctx = GpuContext::new().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"));
-    let mut images = Vec::new();
-    for s in [1e-3f32, 1.0, 1e4] {
-        let (scene, cam) = common::scaled_four_rooms(s);
-        let params = BakeParams {
-            resolution: Resolution::LongestAxisVoxels(96),
-            ..BakeParams::default()
-        };
-        let level = bake(&scene, &params, &BakeOptions::default(), &|_| {})
-            .expect("bake")
-            .level;
-        let gates = GateLevel::new(level, &scene).expect("level");
-        let tracer = Tracer::new(&scene);
-        let vpls = path_vpls(
-            &tracer,
-            &scene.lights,
-            &PathParams {
-                paths: 256,
-                bounces: 1,
-                seed: 4,
-            },
-        )
-        .expect("vpls");
-        let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
-        gpu.set_level(&ctx, &gates).expect("level");
-        let view = visgate_runtime::camera::View::new(&cam, [64, 48]).expect("view");
-        let (img, t) = gpu
-            .render(
-                &ctx,
-                &view,
-                &vpls,
-                &GpuParams {
-                    g_max: 10.0 / (s * s),
-                    ..GpuParams::with_mode(GpuMode::Gates(GatesParams::default()))
+    for shape in [GateShape::Portal, GateShape::Disk] {
+        let mut images = Vec::new();
+        for s in [1e-3f32, 1.0, 1e4] {
+            let (scene, cam) = common::scaled_four_rooms(s);
+            let params = BakeParams {
+                resolution: Resolution::LongestAxisVoxels(96),
+                ..BakeParams::default()
+            };
+            let level = bake(&scene, &params, &BakeOptions::default(), &|_| {})
+                .expect("bake")
+                .level;
+            let gates = GateLevel::new(level, &scene).expect("level");
+            let tracer = Tracer::new(&scene);
+            let vpls = path_vpls(
+                &tracer,
+                &scene.lights,
+                &PathParams {
+                    paths: 256,
+                    bounces: 1,
+                    seed: 4,
                 },
             )
-            .expect("render");
-        eprintln!(
-            "scale {s}: {} clusters, {} gates, {:?}, mean {}",
-            gates.cluster_count(),
-            gates.gate_count(),
-            t.lists,
-            img.mean()
-        );
-        images.push(img);
-    }
-    for img in [&images[0], &images[2]] {
-        let e = errors(img, &images[1]).expect("same size");
-        assert!(e.rel_mse < 1e-3, "{e:?}");
+            .expect("vpls");
+            let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+            gpu.set_level(&ctx, &gates).expect("level");
+            let view = visgate_runtime::camera::View::new(&cam, [64, 48]).expect("view");
+            let (img, t) = gpu
+                .render(
+                    &ctx,
+                    &view,
+                    &vpls,
+                    &GpuParams {
+                        g_max: 10.0 / (s * s),
+                        ..GpuParams::with_mode(GpuMode::Gates(GatesParams {
+                            gates: GateParams {
+                                shape,
+                                ..GateParams::default()
+                            },
+                            ..GatesParams::default()
+                        }))
+                    },
+                )
+                .expect("render");
+            eprintln!(
+                "scale {s}: {} clusters, {} gates, {:?}, mean {}",
+                gates.cluster_count(),
+                gates.gate_count(),
+                t.lists,
+                img.mean()
+            );
+            images.push(img);
+        }
+        for img in [&images[0], &images[2]] {
+            let e = errors(img, &images[1]).expect("same size");
+            assert!(e.rel_mse < 1e-3, "{shape:?}: {e:?}");
+        }
     }
 }
 

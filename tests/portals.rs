@@ -90,7 +90,10 @@ fn ajar_door_portal_visibility_agrees_with_shadow_rays() {
         shape: GateShape::Portal,
         ..GateParams::default()
     };
-    let disk = GateParams::default();
+    let disk = GateParams {
+        shape: GateShape::Disk,
+        ..GateParams::default()
+    };
     for camera in 0..3 {
         let [p, d] = agreement(Builtin::AjarDoor, 128, camera, &[portal, disk])[..] else {
             unreachable!()

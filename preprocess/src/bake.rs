@@ -288,6 +288,11 @@ pub fn bake(
         "cycles": cycles,
         "components": components,
     }));
+    // Each voxel's largest ball in whole voxels, kept (2 bytes a voxel) for the gates' cuts.
+    let radius_vx: Vec<u16> = dist2
+        .par_iter()
+        .map(|&d| distance::radius_vx(d, params.max_ball).min(f64::from(u16::MAX)) as u16)
+        .collect();
     drop(dist2);
 
     // 7. Segment.
@@ -452,51 +457,14 @@ pub fn bake(
             c
         })
         .collect();
-    // Then the gates cut the empty space: its pieces (6-connected, the voxels each gate's
-    // plane passes through within 3 radii of its centre removed) whose skeleton nodes all lie
+    // Then the gates cut the empty space: its pieces (6-connected, the voxels of each gate's
+    // plane within 3 radii of its centre, or along an opening as narrow as it, removed) whose skeleton nodes all lie
     // in one cluster take that cluster whole, so a room's voxels that reached a doorway's
     // node sideways join the room. Pieces that hold nodes of several clusters (a gate in open
     // space that does not close its opening) keep the per-voxel rule.
     let mut cut = es.empty.clone();
     for g in chosen {
-        let reach = 3.0 * g.radius + vs;
-        let half = 0.5 * vs * g.normal.abs().element_sum();
-        // Walk the plane over its two in-plane axes; along the dominant axis only the few
-        // voxels within `half` of the plane.
-        let ax = (0..3)
-            .max_by(|&i, &j| g.normal[i].abs().total_cmp(&g.normal[j].abs()))
-            .unwrap_or(0);
-        let (u, w) = ((ax + 1) % 3, (ax + 2) % 3);
-        let o = Vec3::from(meta.origin_m);
-        let to_vx = |x: f32, a: usize| ((x - o[a]) / vs - 0.5).round();
-        let dims = meta.dims.map(|d| d as i64);
-        let range = |a: usize| {
-            let lo = (to_vx(g.centre[a] - reach, a) as i64).max(0);
-            let hi = (to_vx(g.centre[a] + reach, a) as i64).min(dims[a] - 1);
-            lo..=hi
-        };
-        let slack = (half / g.normal[ax].abs() / vs).ceil() as i64 + 1;
-        for iu in range(u) {
-            for iw in range(w) {
-                let mut v = [0i64; 3];
-                v[u] = iu;
-                v[w] = iw;
-                let pu = o[u] + (iu as f32 + 0.5) * vs - g.centre[u];
-                let pw = o[w] + (iw as f32 + 0.5) * vs - g.centre[w];
-                // Where the plane crosses this column.
-                let t = g.centre[ax] - (g.normal[u] * pu + g.normal[w] * pw) / g.normal[ax];
-                let mid = to_vx(t, ax) as i64;
-                for ia in (mid - slack).max(0)..=(mid + slack).min(dims[ax] - 1) {
-                    v[ax] = ia;
-                    let vv = v.map(|c| c as u32);
-                    let p = Vec3::from(meta.voxel_to_world(vv)) - g.centre;
-                    let along = p.dot(g.normal);
-                    if along.abs() <= half && (p - along * g.normal).length() <= reach {
-                        cut[meta.index(vv)] = false;
-                    }
-                }
-            }
-        }
+        crate::cut::cut_gate(&meta, &radius_vx, g, &mut cut);
     }
     let (piece, pieces) = label_components(meta.dims, &cut, Conn::C6);
     drop(cut);
@@ -530,9 +498,11 @@ pub fn bake(
     drop(piece);
     // Then no cluster reaches around a wall: a voxel that does not see its cluster's seed
     // takes the cluster of the nearest one that does.
-    let seed_at: Vec<Vec3> = seeds_of
+    let seed_at: Vec<[u32; 3]> = seeds_of
         .iter()
-        .map(|&seed| position[seg.skeleton.nodes[seed as usize].skeleton_node as usize])
+        .map(|&seed| {
+            meta.coords(sg.voxels[seg.skeleton.nodes[seed as usize].skeleton_node as usize])
+        })
         .collect();
     let voxels_by_sight =
         crate::sightline::clusters_by_sight(&meta, &es.empty, &mut voxel_cluster, &seed_at);

@@ -17,6 +17,7 @@
 
 pub mod bake;
 pub mod clusters;
+pub mod cut;
 pub mod debug;
 pub mod distance;
 pub mod empty;

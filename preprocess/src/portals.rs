@@ -158,10 +158,12 @@ fn portal_of(pair: (u32, u32), faces: &[Face], vs: f32, cell_voxels: f32) -> Por
         |(a, b, c, d), (e, f, g, h)| (a.min(e), b.min(f), c.max(g), d.max(h)),
     );
     let mut cell = cell_voxels * vs;
+    // Cell counts and ranges a hair inside their bounds, so that a face edge lying on a cell
+    // boundary marks the same cells at every scale of the level (rounding goes either way).
     let cells = |cell: f32| {
         [
-            (((all.2 - all.0) / cell).ceil() as u32).max(1),
-            (((all.3 - all.1) / cell).ceil() as u32).max(1),
+            (((all.2 - all.0) / cell - 1e-3).ceil() as u32).max(1),
+            (((all.3 - all.1) / cell - 1e-3).ceil() as u32).max(1),
         ]
     };
     while u64::from(cells(cell)[0]) * u64::from(cells(cell)[1]) > MAX_MASK_CELLS {
@@ -169,20 +171,29 @@ fn portal_of(pair: (u32, u32), faces: &[Face], vs: f32, cell_voxels: f32) -> Por
     }
     let size = cells(cell);
     let mut mask = vec![0u32; Portal::words_for(size)];
+    let mut mark = |i: i64, j: i64| {
+        let i = i.clamp(0, i64::from(size[0]) - 1);
+        let j = j.clamp(0, i64::from(size[1]) - 1);
+        let k = (j * i64::from(size[0]) + i) as usize;
+        mask[k / 32] |= 1 << (k % 32);
+    };
     for f in faces {
-        // A face seen edge-on projects to a line: widen it a little so that its centre's own
-        // cell is marked whatever the rounding.
         let (x0, y0, x1, y1) = bounds(f);
-        let e = 1e-3 * cell;
-        let (x0, y0, x1, y1) = (x0 - e, y0 - e, x1 + e, y1 + e);
-        let to_cell =
-            |t: f32, lo: f32, n: u32| (((t - lo) / cell).floor() as i64).clamp(0, i64::from(n) - 1);
-        for j in to_cell(y0, all.1, size[1])..=to_cell(y1, all.1, size[1]) {
-            for i in to_cell(x0, all.0, size[0])..=to_cell(x1, all.0, size[0]) {
-                let k = (j * i64::from(size[0]) + i) as usize;
-                mask[k / 32] |= 1 << (k % 32);
+        let (cx, cy) = (((x0 - all.0) / cell), ((y0 - all.1) / cell));
+        let (ex, ey) = (((x1 - all.0) / cell), ((y1 - all.1) / cell));
+        let (i0, i1) = ((cx + 1e-3).floor() as i64, (ex - 1e-3).ceil() as i64 - 1);
+        let (j0, j1) = ((cy + 1e-3).floor() as i64, (ey - 1e-3).ceil() as i64 - 1);
+        for j in j0..=j1 {
+            for i in i0..=i1 {
+                mark(i, j);
             }
         }
+        // A face seen edge-on projects to a line, no cell wide: its centre's cell.
+        let (mx, my) = uv(f.centre);
+        mark(
+            ((mx - all.0) / cell).floor() as i64,
+            ((my - all.1) / cell).floor() as i64,
+        );
     }
     Portal {
         clusters: [pair.0, pair.1],

@@ -10,15 +10,15 @@ use std::collections::VecDeque;
 
 use glam::Vec3;
 use rayon::prelude::*;
+
 use visgate_formats::vgate::{GridMeta, NONE};
 
-/// Whether the voxels strictly between voxel `from` and the point `to` (inside the grid) are
-/// all empty: a 3D DDA (Amanatides & Woo) from the voxel's centre.
-fn sees(meta: &GridMeta, empty: &[bool], from: [u32; 3], to: Vec3) -> bool {
-    let vs = meta.voxel_size_m;
-    let o = Vec3::from(meta.origin_m);
-    let a = (Vec3::from(meta.voxel_to_world(from)) - o) / vs;
-    let b = (to - o) / vs;
+/// Whether the voxels strictly between voxels `from` and `to` are all empty: a 3D DDA
+/// (Amanatides & Woo) between their centres, in voxel units, so that a line through voxel
+/// edges and corners takes the same voxels at every scale of the level.
+fn sees(meta: &GridMeta, empty: &[bool], from: [u32; 3], to: [u32; 3]) -> bool {
+    let a = Vec3::from(from.map(|c| c as f32 + 0.5));
+    let b = Vec3::from(to.map(|c| c as f32 + 0.5));
     let d = b - a;
     let mut cell = from.map(|c| c as i64);
     let end = b.floor().as_i64vec3().to_array();
@@ -60,14 +60,14 @@ fn sees(meta: &GridMeta, empty: &[bool], from: [u32; 3], to: Vec3) -> bool {
     }
 }
 
-/// Reassigns the clusters of empty voxels that do not see their cluster's seed (positions in
+/// Reassigns the clusters of empty voxels that do not see their cluster's seed (its voxel in
 /// `seeds`, by cluster) and clears the cluster of voxels that are not empty. Returns how many
 /// empty voxels changed cluster.
 pub fn clusters_by_sight(
     meta: &GridMeta,
     empty: &[bool],
     cluster: &mut [u32],
-    seeds: &[Vec3],
+    seeds: &[[u32; 3]],
 ) -> u64 {
     let keep: Vec<bool> = cluster
         .par_iter()
@@ -152,7 +152,7 @@ mod tests {
                 u32::from(x >= 4)
             })
             .collect();
-        let seeds = [Vec3::new(2.5, 0.5, 2.5), Vec3::new(9.5, 0.5, 2.5)];
+        let seeds = [[2, 0, 2], [9, 0, 2]];
         let moved = clusters_by_sight(&meta, &empty, &mut cluster, &seeds);
         let at = |x: u32, z: u32| cluster[meta.index([x, 0, z])];
         // Behind the wall from cluster 1's seed, beside cluster 0: back to 0.

@@ -180,6 +180,16 @@ fn four_rooms_cycles_equal_their_loops_and_l_corridor_is_a_tree() {
 }
 
 #[test]
+fn ajar_door_and_pillared_hall_keep_their_loops_and_side_rooms() {
+    // The table's three loops survive zero-thickness walls and 4 cm boards; each side room of
+    // the hall is one cluster.
+    for res in [64, 128] {
+        check_known_answers(Builtin::AjarDoor, res, true);
+        check_known_answers(Builtin::PillaredHall, res, true);
+    }
+}
+
+#[test]
 fn rebaking_is_byte_identical_for_any_thread_count() {
     let scene = Builtin::FourRooms.scene().expect("scene");
     let bytes = |threads: usize| {

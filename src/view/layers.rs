@@ -201,6 +201,13 @@ pub fn draw_lines(
             }
             seg(c, c + n * r * 0.3, colour, 1.0);
         }
+        // The portals: the outline of each one's open mask cells, coloured by the pair it joins.
+        for p in &l.baked().topology.portals {
+            let colour = id_colour(p.clusters[0] * 7919 + p.clusters[1]);
+            for (a, b) in portal_outline(p) {
+                seg(a, b, colour, 1.0);
+            }
+        }
     }
     if on.vpls {
         let max = vpls
@@ -219,6 +226,34 @@ pub fn draw_lines(
             }
         }
     }
+}
+
+/// The edges between a portal's open mask cells and closed ones (or the mask's border), in
+/// metres.
+pub fn portal_outline(p: &visgate_formats::vgate::Portal) -> Vec<(Vec3, Vec3)> {
+    let (o, u, v) = (Vec3::from(p.origin_m), Vec3::from(p.u), Vec3::from(p.v));
+    let at = |i: i64, j: i64| o + (u * i as f32 + v * j as f32) * p.cell_m;
+    let mut out = Vec::new();
+    for j in 0..i64::from(p.size[1]) {
+        for i in 0..i64::from(p.size[0]) {
+            if !p.cell(i, j) {
+                continue;
+            }
+            if !p.cell(i - 1, j) {
+                out.push((at(i, j), at(i, j + 1)));
+            }
+            if !p.cell(i + 1, j) {
+                out.push((at(i + 1, j), at(i + 1, j + 1)));
+            }
+            if !p.cell(i, j - 1) {
+                out.push((at(i, j), at(i + 1, j)));
+            }
+            if !p.cell(i, j + 1) {
+                out.push((at(i, j + 1), at(i + 1, j + 1)));
+            }
+        }
+    }
+    out
 }
 
 /// What lies under image point `p` (pixels of `view`): a line of text.

@@ -4,6 +4,7 @@ use std::collections::VecDeque;
 
 use eframe::egui;
 use visgate_formats::Scene;
+use visgate_runtime::cpu::gates::GateShape;
 use visgate_runtime::gpu::{MethodSettings, PassTimes};
 use visgate_runtime::hdr::HdrImage;
 
@@ -13,8 +14,17 @@ use super::camera::FlyCamera;
 pub fn method_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
     match mode {
         "gates" | "gates-per-pixel" => {
-            ui.add(egui::Slider::new(&mut s.gates.gates.max_hops, 1..=2).text("gate hops"));
-            ui.add(egui::Slider::new(&mut s.gates.gates.oversize, 0.5..=3.0).text("gate oversize"));
+            let g = &mut s.gates.gates;
+            ui.horizontal(|ui| {
+                ui.radio_value(&mut g.shape, GateShape::Portal, "portals");
+                ui.radio_value(&mut g.shape, GateShape::Disk, "disks (paper)");
+            });
+            if g.shape == GateShape::Portal {
+                ui.add(egui::Slider::new(&mut g.max_walk, 1..=256).text("portals per walk"));
+            } else {
+                ui.add(egui::Slider::new(&mut g.max_hops, 1..=2).text("gate hops"));
+                ui.add(egui::Slider::new(&mut g.oversize, 0.5..=3.0).text("gate oversize"));
+            }
         }
         "val-hard" | "val-cssm" => {
             let v = &mut s.vals;

@@ -22,6 +22,9 @@ pub struct SavedView {
     pub layers: [bool; 7],
     /// Hops, oversize, VALs, iterations, interleave block, VAL map, per-VPL map, batch.
     pub settings: [f32; 8],
+    /// Gates as disks rather than portals (absent in older files: portals).
+    #[serde(default)]
+    pub disks: bool,
 }
 
 /// The state file: one entry per scene name.
@@ -85,6 +88,7 @@ mod tests {
             camera: [1.0, 2.0, 3.0, 0.5, -0.2, 1.2, 4.0],
             layers: [true, false, true, false, true, false, true],
             settings: [2.0, 1.5, 30.0, 8.0, 4.0, 128.0, 256.0, 32.0],
+            disks: mode == "gates",
         };
         save_to(&p, "a", state("gates"));
         save_to(&p, "b", state("val-cssm"));

@@ -34,7 +34,7 @@ mod values;
 pub use params::{
     AlphaRule, BakeInfo, BakeParams, CurvatureTo, GatePlacement, MaxBall, Resolution,
 };
-pub use portal::{MAX_MASK_CELLS, Portal};
+pub use portal::{EDGE_SLACK, MAX_MASK_CELLS, Portal};
 pub use values::{Elem, VoxelValues};
 
 /// The first eight bytes of every `.vgate` file.

@@ -29,6 +29,9 @@ pub struct Portal {
     pub faces: u32,
 }
 
+/// How far outside an open mask cell a point still counts as in it. [Units: cells]
+pub const EDGE_SLACK: f32 = 1e-3;
+
 /// Largest number of mask cells a portal may have.
 pub const MAX_MASK_CELLS: u64 = 1 << 20;
 
@@ -54,7 +57,9 @@ impl Portal {
             .is_some_and(|m| m >> (k % 32) & 1 == 1)
     }
 
-    /// Whether the point `p` of the plane (or its projection onto it) falls in the opening.
+    /// Whether the point `p` of the plane (or its projection onto it) falls in the opening: in
+    /// an open cell, or within [`EDGE_SLACK`] cells of one (so that a point on a cell's edge,
+    /// as a VPL on a doorway's jamb is, counts the same at every scale of the level).
     pub fn covers(&self, p: [f32; 3]) -> bool {
         let d = [
             p[0] - self.origin_m[0],
@@ -63,7 +68,13 @@ impl Portal {
         ];
         let x = dot(d, self.u) / self.cell_m;
         let y = dot(d, self.v) / self.cell_m;
-        x.is_finite() && y.is_finite() && self.cell(x.floor() as i64, y.floor() as i64)
+        if !(x.is_finite() && y.is_finite()) {
+            return false;
+        }
+        let e = EDGE_SLACK;
+        [(0.0, 0.0), (-e, 0.0), (e, 0.0), (0.0, -e), (0.0, e)]
+            .iter()
+            .any(|(dx, dy)| self.cell((x + dx).floor() as i64, (y + dy).floor() as i64))
     }
 
     /// Signed distance of `p` from the plane, along the normal, metres.

@@ -18,9 +18,9 @@ use crate::RenderError;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum GateShape {
     /// The paper's disks, through chains of at most `max_hops` of them.
-    #[default]
     Disk,
     /// The baked portals (the true openings), walked cluster by cluster along the segment.
+    #[default]
     Portal,
 }
 
@@ -52,7 +52,7 @@ pub struct GateParams {
 impl Default for GateParams {
     fn default() -> Self {
         GateParams {
-            shape: GateShape::Disk,
+            shape: GateShape::Portal,
             max_walk: 64,
             oversize: 1.0,
             max_hops: 2,
@@ -131,13 +131,49 @@ impl GateLevel {
     }
 
     /// The visibility cluster of a surface point: that of the empty voxel it faces, looked up
-    /// 0.5, 1.5 and 2.5 voxels along its normal (a wall on a voxel face is two voxels thick),
-    /// then at the point itself (a dynamic mesh in empty space). Only empty voxels have one.
+    /// 0.5, 1.5 and 2.5 voxels along its normal (a wall on a voxel face is two voxels thick);
+    /// for a point in a corner, whose normal runs along the other wall's solid voxels, the
+    /// voxel with a cluster nearest to the point one voxel out among the 27 around it that lie
+    /// in front of the surface; then the point's own voxel (a dynamic mesh in empty space).
+    /// Only empty voxels have a cluster. grid.wgsl's `cluster_at` is the GPU twin.
     pub fn cluster_at(&self, p: Vec3, n: Vec3) -> Option<u32> {
         let vs = self.grid.voxel_size_m;
-        [0.5, 1.5, 2.5, 0.0]
+        if let Some(c) = [0.5, 1.5, 2.5]
             .iter()
             .find_map(|&k| self.cluster_of_voxel(p + n * (k * vs)))
+        {
+            return Some(c);
+        }
+        let o = Vec3::from(self.grid.origin_m);
+        let q = p + n * vs;
+        let base = ((q - o) / vs).floor();
+        let dims = self.grid.dims.map(|d| d as f32);
+        let mut best: Option<(f32, u32)> = None;
+        for dz in -1..=1 {
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    let v = base + Vec3::new(dx as f32, dy as f32, dz as f32);
+                    if (0..3).any(|a| v[a] < 0.0 || v[a] >= dims[a]) {
+                        continue;
+                    }
+                    let vi = [v.x as u32, v.y as u32, v.z as u32];
+                    let Some(c) = self
+                        .level
+                        .voxel_cluster
+                        .get(self.grid.index(vi))
+                        .filter(|&c| c != u32::MAX)
+                    else {
+                        continue;
+                    };
+                    let centre = o + (v + 0.5) * vs;
+                    let d2 = (centre - q).length_squared();
+                    if (centre - p).dot(n) > 0.0 && best.is_none_or(|(bd, _)| d2 < bd) {
+                        best = Some((d2, c));
+                    }
+                }
+            }
+        }
+        best.map(|(_, c)| c).or_else(|| self.cluster_of_voxel(p))
     }
 
     /// Gate `i`: centre, unit normal, radius (m).

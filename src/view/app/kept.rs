@@ -37,6 +37,7 @@ impl ViewerApp {
                 p.map_size as f32,
                 p.batch as f32,
             ],
+            disks: g.shape == visgate_runtime::cpu::gates::GateShape::Disk,
         }
     }
 
@@ -53,6 +54,11 @@ impl ViewerApp {
             &mut self.settings.per_vpl,
         );
         g.max_hops = hops as u32;
+        g.shape = if s.disks {
+            visgate_runtime::cpu::gates::GateShape::Disk
+        } else {
+            visgate_runtime::cpu::gates::GateShape::Portal
+        };
         g.oversize = oversize;
         v.vals.count = vals as u32;
         v.vals.iterations = iterations as u32;

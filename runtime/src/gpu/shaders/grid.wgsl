@@ -41,7 +41,8 @@ fn cluster_of(p: vec3<f32>) -> u32 {
 }
 
 // The cluster of the empty voxel a surface point faces: 0.5, 1.5 and 2.5 voxels along its
-// normal, then the point itself.
+// normal; in a corner, the nearest voxel with a cluster to the point one voxel out among the
+// 27 around it in front of the surface; then the point itself (GateLevel::cluster_at).
 fn cluster_at(p: vec3<f32>, n: vec3<f32>) -> u32 {
     let vs = grid.voxel_size;
     var c = cluster_of(p + n * (0.5 * vs));
@@ -50,6 +51,25 @@ fn cluster_at(p: vec3<f32>, n: vec3<f32>) -> u32 {
     }
     if c == NONE {
         c = cluster_of(p + n * (2.5 * vs));
+    }
+    if c == NONE {
+        let q = p + n * vs;
+        let base = floor((q - grid.origin) / vs);
+        var best = 3.4e38;
+        for (var dz = -1; dz <= 1; dz++) {
+            for (var dy = -1; dy <= 1; dy++) {
+                for (var dx = -1; dx <= 1; dx++) {
+                    let v = base + vec3<f32>(f32(dx), f32(dy), f32(dz));
+                    let centre = grid.origin + (v + 0.5) * vs;
+                    let k = cluster_of(centre);
+                    let d2 = dot(centre - q, centre - q);
+                    if k != NONE && dot(centre - p, n) > 0.0 && d2 < best {
+                        best = d2;
+                        c = k;
+                    }
+                }
+            }
+        }
     }
     if c == NONE {
         c = cluster_of(p);

@@ -18,12 +18,8 @@ fn pv(i: u32) -> vec3<f32> {
     return bitcast<vec3<f32>>(vec3<u32>(portal_words[i], portal_words[i + 1u], portal_words[i + 2u]));
 }
 
-// Whether the point q of record r's plane falls in a set mask cell.
-fn portal_covers(r: u32, q: vec3<f32>) -> bool {
-    let rel = q - pv(r);
-    let cell = bitcast<f32>(pw(r + 3u));
-    let x = floor(dot(rel, pv(r + 8u)) / cell);
-    let y = floor(dot(rel, pv(r + 12u)) / cell);
+// Whether mask cell (x, y) of record r is set (false outside the mask).
+fn portal_cell(r: u32, x: f32, y: f32) -> bool {
     let w = pw(r + 7u);
     let h = pw(r + 11u);
     if !(x >= 0.0 && y >= 0.0 && x < f32(w) && y < f32(h)) {
@@ -31,6 +27,21 @@ fn portal_covers(r: u32, q: vec3<f32>) -> bool {
     }
     let k = u32(y) * w + u32(x);
     return ((pw(pw(r + 15u) + k / 32u) >> (k % 32u)) & 1u) == 1u;
+}
+
+// Whether the point q of record r's plane falls in a set mask cell or within EDGE_SLACK cells
+// of one (vgate::Portal::covers).
+const EDGE_SLACK: f32 = 1e-3;
+
+fn portal_covers(r: u32, q: vec3<f32>) -> bool {
+    let rel = q - pv(r);
+    let cell = bitcast<f32>(pw(r + 3u));
+    let x = dot(rel, pv(r + 8u)) / cell;
+    let y = dot(rel, pv(r + 12u)) / cell;
+    let e = EDGE_SLACK;
+    return portal_cell(r, floor(x), floor(y)) || portal_cell(r, floor(x - e), floor(y))
+        || portal_cell(r, floor(x + e), floor(y)) || portal_cell(r, floor(x), floor(y - e))
+        || portal_cell(r, floor(x), floor(y + e));
 }
 
 fn portal_walk(a: vec3<f32>, ca: u32, b: vec3<f32>, cb: u32) -> u32 {

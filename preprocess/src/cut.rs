@@ -1,0 +1,208 @@
+//! Gates cut the empty space along their planes, so that each side of an opening becomes a
+//! piece of its own. A gate's disk has the radius of the largest ball at the opening's
+//! narrowest place: for a round doorway it spans the opening, but a tall slot (a door standing
+//! ajar, a gap between a column and a wall) is much longer than its width, and the disk closes
+//! only a part of it. So the cut is the disk (three radii, as before) and, beyond it, the
+//! plane's voxels reached from the centre through voxels as narrow as the opening (largest
+//! ball at most 1.5 gate radii + 1 voxel): the whole slot, stopping where the space widens
+//! into the rooms. The plane is the gate's, turned to contain the slot's long axis when the
+//! opening is much longer than wide (a door ajar leaves a slot whose skeleton runs slanted
+//! through it; a plane along that slant would leave the slot's top and bottom uncut).
+
+use std::collections::VecDeque;
+
+use glam::Vec3;
+use visgate_formats::vgate::GridMeta;
+
+use crate::clusters::GateDisk;
+
+/// Voxels one gate's flood may visit.
+const MAX_FLOOD: usize = 1 << 20;
+
+/// The largest eigenvector of a symmetric 3×3 matrix (columns), by power iteration, and its
+/// eigenvalue.
+fn dominant(m: glam::Mat3) -> (Vec3, f32) {
+    let mut v = Vec3::new(0.577, 0.577, 0.577);
+    for _ in 0..64 {
+        let w = m * v;
+        let l = w.length();
+        if l <= f32::MIN_POSITIVE {
+            return (v, 0.0);
+        }
+        v = w / l;
+    }
+    (v, v.dot(m * v))
+}
+
+/// The cut plane's normal: the gate's, or, in a slot (the narrow voxels near the plane spread
+/// at least twice as far along one axis as along any other, that axis across the gate's
+/// normal), the gate's normal with its component along the slot removed.
+fn cut_normal(meta: &GridMeta, radius_vx: &[u16], g: &GateDisk, narrow: f32) -> Vec3 {
+    let vs = meta.voxel_size_m;
+    let band = 2.0 * g.radius + vs;
+    let pts = flood(meta, g.centre, |i, p| {
+        radius_vx[i] > 0
+            && f32::from(radius_vx[i]) <= narrow
+            && (p - g.centre).dot(g.normal).abs() <= band
+    });
+    if pts.len() < 8 {
+        return g.normal;
+    }
+    let mean = pts.iter().sum::<Vec3>() / pts.len() as f32;
+    let mut cov = glam::Mat3::ZERO;
+    for p in &pts {
+        let d = *p - mean;
+        cov += glam::Mat3::from_cols(d * d.x, d * d.y, d * d.z);
+    }
+    let (a, l1) = dominant(cov);
+    let deflated = cov - glam::Mat3::from_cols(a * a.x, a * a.y, a * a.z) * l1;
+    let (_, l2) = dominant(deflated);
+    if l1 < 4.0 * l2.max(0.0) || a.dot(g.normal).abs() > 0.6 {
+        return g.normal;
+    }
+    (g.normal - a * a.dot(g.normal)).normalize_or(g.normal)
+}
+
+/// The voxels reached from `from`'s voxel (26-connected) through voxels that `keep` (linear
+/// index, centre) accepts, as their centres; at most [`MAX_FLOOD`].
+fn flood(meta: &GridMeta, from: Vec3, keep: impl Fn(usize, Vec3) -> bool) -> Vec<Vec3> {
+    let dims = meta.dims.map(i64::from);
+    let o = Vec3::from(meta.origin_m);
+    let start = ((from - o) / meta.voxel_size_m)
+        .floor()
+        .as_i64vec3()
+        .to_array();
+    let mut out = Vec::new();
+    if (0..3).any(|a| start[a] < 0 || start[a] >= dims[a]) {
+        return out;
+    }
+    let index = |v: [i64; 3]| (v[0] + dims[0] * (v[1] + dims[1] * v[2])) as usize;
+    let mut seen = std::collections::HashSet::from([start]);
+    let mut queue = VecDeque::from([start]);
+    while let Some(v) = queue.pop_front() {
+        let p = Vec3::from(meta.voxel_to_world(v.map(|c| c as u32)));
+        if !keep(index(v), p) || out.len() >= MAX_FLOOD {
+            continue;
+        }
+        out.push(p);
+        for dz in -1..=1 {
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    let w = [v[0] + dx, v[1] + dy, v[2] + dz];
+                    if (0..3).all(|a| w[a] >= 0 && w[a] < dims[a]) && seen.insert(w) {
+                        queue.push_back(w);
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Clears, in `cut`, the voxels of gate `g`'s cut; `radius_vx` is each voxel's largest-ball
+/// radius in voxels (saturated).
+pub fn cut_gate(meta: &GridMeta, radius_vx: &[u16], g: &GateDisk, cut: &mut [bool]) {
+    let vs = meta.voxel_size_m;
+    // Thresholds a hair over their values, so that a distance equal to one in exact arithmetic
+    // counts the same at every scale of the level (voxel units round differently).
+    let reach = (3.0 * g.radius + vs) * (1.0 + 1e-4);
+    let narrow = (1.5 * g.radius / vs + 1.0 + 1e-3).floor();
+    let normal = cut_normal(meta, radius_vx, g, narrow);
+    // A voxel lies on the plane when the plane passes through its cube.
+    let half = 0.5 * vs * normal.abs().element_sum();
+    let dims = meta.dims.map(i64::from);
+    let o = Vec3::from(meta.origin_m);
+    let start = ((g.centre - o) / vs).floor().as_i64vec3().to_array();
+    if (0..3).any(|a| start[a] < 0 || start[a] >= dims[a]) {
+        return;
+    }
+    let index = |v: [i64; 3]| (v[0] + dims[0] * (v[1] + dims[1] * v[2])) as usize;
+    let mut seen = std::collections::HashSet::new();
+    let mut queue = VecDeque::from([start]);
+    seen.insert(start);
+    while let Some(v) = queue.pop_front() {
+        let i = index(v);
+        let p = Vec3::from(meta.voxel_to_world(v.map(|c| c as u32))) - g.centre;
+        let along = p.dot(normal);
+        let in_disk = (p - along * normal).length() <= reach;
+        let slot = f32::from(radius_vx[i]) <= narrow;
+        if along.abs() > half || !(in_disk || slot) {
+            continue;
+        }
+        if radius_vx[i] > 0 {
+            cut[i] = false;
+        } else if !in_disk {
+            continue; // solid: the flood does not pass walls beyond the disk
+        }
+        if seen.len() >= MAX_FLOOD {
+            continue;
+        }
+        for dz in -1..=1 {
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    let w = [v[0] + dx, v[1] + dy, v[2] + dz];
+                    if (0..3).any(|a| w[a] < 0 || w[a] >= dims[a]) || !seen.insert(w) {
+                        continue;
+                    }
+                    queue.push_back(w);
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_tall_slot_is_cut_whole_and_the_rooms_beside_it_are_not() {
+        // 20 × 30 × 20 voxels of 0.1 m: a wall at z = 10 with a slot x 9..12 (0.3 m wide), y
+        // 2..28 (2.6 m tall); the gate at the slot's middle, radius 0.15 m, normal +z.
+        let meta = GridMeta {
+            origin_m: [0.0; 3],
+            voxel_size_m: 0.1,
+            dims: [20, 30, 20],
+        };
+        let n = 20 * 30 * 20;
+        let empty: Vec<bool> = (0..n as u32)
+            .map(|i| {
+                let [x, y, z] = meta.coords(i);
+                let wall = z == 10 && !((9..12).contains(&x) && (2..28).contains(&y));
+                let border = x == 0 || y == 0 || z == 0 || x == 19 || y == 29 || z == 19;
+                !wall && !border
+            })
+            .collect();
+        // Largest ball: 1 in the slot, 5 in the rooms (a stand-in for the distance field).
+        let radius: Vec<u16> = (0..n as u32)
+            .map(|i| {
+                let [_, _, z] = meta.coords(i);
+                if !empty[i as usize] {
+                    0
+                } else if z == 10 {
+                    1
+                } else {
+                    5
+                }
+            })
+            .collect();
+        let g = GateDisk {
+            centre: Vec3::new(1.05, 1.5, 1.05),
+            normal: Vec3::Z,
+            radius: 0.15,
+            clusters: [0, 1],
+            seg_edge: 0,
+            path_index: 0,
+        };
+        let mut cut = empty.clone();
+        cut_gate(&meta, &radius, &g, &mut cut);
+        // Every slot voxel is cut, top to bottom; nothing off the plane is.
+        for y in 2..28 {
+            for x in 9..12 {
+                assert!(!cut[meta.index([x, y, 10])], "slot voxel ({x}, {y}) kept");
+            }
+        }
+        let removed = empty.iter().zip(&cut).filter(|(e, c)| **e && !**c).count();
+        assert_eq!(removed, 3 * 26);
+    }
+}
