@@ -1,14 +1,17 @@
 //! A timing table like Table I of the visibility-gates paper: GPU time per pass (timestamp
 //! queries) of mode gates — geometry pass, unique clusters, light assignment, indirect
-//! lighting — beside per-VPL shadow maps and no visibility, at 512 / 1024 / 2048 VPLs.
+//! lighting — with portals and with the paper's disks, beside val-hard, val-cssm, per-VPL
+//! shadow maps and no visibility, at 512 / 1024 / 2048 VPLs (`GATE_TIMINGS_VPLS=1024,4096`
+//! sets them; `GATE_TIMINGS_ONLY=gates,none` the modes).
 //!
 //! `cargo run --release --example gate_timings -- [SCENE] [LEVEL.vgate|-] [WxH] [CAMERA]`
 //!
-//! Without arguments: the built-in four rooms, baked here at 128, at 1024×512. The speedup is
-//! per-VPL shadow maps' total over gates' total at the same VPLs, measured in one run.
+//! Without arguments: the built-in four rooms, baked here at 128, at 1024×512. The total is
+//! the frame's GPU time (direct shadow maps included); the speedup is per-VPL shadow maps'
+//! total over the row's at the same VPLs, measured in one run.
 
 use visgate_runtime::camera::View;
-use visgate_runtime::cpu::gates::GateLevel;
+use visgate_runtime::cpu::gates::{GateLevel, GateShape};
 use visgate_runtime::cpu::tracer::Tracer;
 use visgate_runtime::gpu::{
     GpuContext, GpuMode, GpuParams, GpuRenderer, MethodSettings, PassTimes,
@@ -56,7 +59,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
          indirect) | VPL maps | VPL gather | total | per-VPL maps / this |"
     );
     println!("|---|---|---|---|---|---|---|---|---|---|");
-    for n in [512, 1024, 2048] {
+    let counts: Vec<u32> = match std::env::var("GATE_TIMINGS_VPLS") {
+        Ok(list) => list
+            .split(',')
+            .filter_map(|n| n.trim().parse().ok())
+            .collect(),
+        Err(_) => vec![512, 1024, 2048],
+    };
+    for n in counts {
         let vpls = path_vpls(
             &tracer,
             &scene.lights,
@@ -68,10 +78,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         )?;
         let mut rows: Vec<(&str, Stages, Option<u64>)> = Vec::new();
         let s = MethodSettings::default();
+        let mut disks = s.gates;
+        disks.gates.shape = GateShape::Disk;
         let modes = [
             ("none", GpuMode::None),
             ("gates", GpuMode::Gates(s.gates)),
+            ("gates-disk", GpuMode::Gates(disks)),
             ("gates per pixel", GpuMode::GatesPerPixel(s.gates.gates)),
+            ("val-hard", GpuMode::ValHard(s.vals)),
+            ("val-cssm", GpuMode::ValCssm(s.vals, s.cssm)),
             ("per-VPL shadow maps", GpuMode::PerVplShadowMaps(s.per_vpl)),
         ];
         let order: Vec<(&str, GpuMode)> = match &only {
@@ -86,9 +101,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let g = Stages::of(&t).ok_or("the adapter has no timestamp queries")?;
             rows.push((name, g, t.lists.map(|l| l.entries)));
         }
-        let total = |g: &Stages| {
-            g.gbuffer + g.unique_clusters + g.light_assignment + g.shade + g.vpl_maps + g.vpl_gather
-        };
+        let total = |g: &Stages| g.total;
         let base = rows
             .iter()
             .find(|r| r.0 == "per-VPL shadow maps")
@@ -122,11 +135,12 @@ struct Stages {
     shade: f64,
     vpl_maps: f64,
     vpl_gather: f64,
+    total: f64,
 }
 
 impl Stages {
     fn of(t: &PassTimes) -> Option<Stages> {
-        t.gpu_total()?;
+        let total = t.gpu_total()?;
         let g = |name: &str| t.gpu(name).unwrap_or(0.0);
         Some(Stages {
             gbuffer: g("geometry pass (G-buffer)"),
@@ -135,6 +149,7 @@ impl Stages {
             shade: g("shading: direct + indirect lighting") + g("shading: direct lighting"),
             vpl_maps: g("VPL paraboloid maps"),
             vpl_gather: g("VPL gather"),
+            total,
         })
     }
 }

@@ -55,6 +55,8 @@ struct BakedSummary {
     segmented_edges: usize,
     clusters: usize,
     gates: usize,
+    portals: usize,
+    portal_mask_cells: u64,
     voxel_node_bytes_per_voxel: u32,
     voxel_cluster_bytes_per_voxel: u32,
     read_seconds: f64,
@@ -199,6 +201,12 @@ fn inspect_baked(path: &Path, json: bool) -> Result<()> {
         segmented_edges: t.segmented.edges.len(),
         clusters: t.clusters.len(),
         gates: t.gates.len(),
+        portals: t.portals.len(),
+        portal_mask_cells: t
+            .portals
+            .iter()
+            .map(|p| u64::from(p.size[0]) * u64::from(p.size[1]))
+            .sum(),
         voxel_node_bytes_per_voxel: bytes_per(&level.voxel_node),
         voxel_cluster_bytes_per_voxel: bytes_per(&level.voxel_cluster),
         read_seconds,
@@ -233,6 +241,10 @@ fn inspect_baked(path: &Path, json: bool) -> Result<()> {
     );
     println!("clusters    {}", s.clusters);
     println!("gates       {}", s.gates);
+    println!(
+        "portals     {} ({} mask cells)",
+        s.portals, s.portal_mask_cells
+    );
     println!(
         "grids       voxel→node {} B/voxel, voxel→cluster {} B/voxel",
         s.voxel_node_bytes_per_voxel, s.voxel_cluster_bytes_per_voxel

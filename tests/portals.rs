@@ -7,9 +7,9 @@ use glam::{Vec2, Vec3};
 use visgate_formats::vgate::{BakeParams, Resolution};
 use visgate_preprocess::bake::{BakeOptions, bake};
 use visgate_runtime::camera::View;
-use visgate_runtime::cpu::gates::{GateLevel, GateParams, GateShape};
+use visgate_runtime::cpu::gates::{GateLevel, GateParams, GateShape, Walk};
 use visgate_runtime::cpu::tracer::Tracer;
-use visgate_runtime::vpl::{PathParams, path_vpls};
+use visgate_runtime::vpl::{PathParams, Vpl, path_vpls};
 use visgate_scenes::Builtin;
 
 fn baked(b: Builtin, res: u32) -> (visgate_formats::Scene, visgate_preprocess::bake::Baked) {
@@ -36,7 +36,9 @@ impl Agreement {
     }
 }
 
-fn agreement(b: Builtin, res: u32, camera: usize, params: &[GateParams]) -> Vec<Agreement> {
+/// A built-in baked at `res`, its gate level, tracer, 256 path VPLs and camera `camera`'s
+/// 64×48 view.
+fn fixture(b: Builtin, res: u32, camera: usize) -> (GateLevel, Tracer, Vec<Vpl>, View) {
     let (scene, baked) = baked(b, res);
     let gates = GateLevel::new(baked.level, &scene).expect("level");
     let tracer = Tracer::new(&scene);
@@ -51,6 +53,11 @@ fn agreement(b: Builtin, res: u32, camera: usize, params: &[GateParams]) -> Vec<
     )
     .expect("vpls");
     let view = View::new(&scene.cameras[camera], [64, 48]).expect("view");
+    (gates, tracer, vpls, view)
+}
+
+fn agreement(b: Builtin, res: u32, camera: usize, params: &[GateParams]) -> Vec<Agreement> {
+    let (gates, tracer, vpls, view) = fixture(b, res, camera);
     let mut out = vec![Agreement::default(); params.len()];
     for y in 0..48 {
         for x in 0..64 {
@@ -143,4 +150,35 @@ fn every_interface_face_of_every_builtin_belongs_to_a_portal() {
             b.name()
         );
     }
+}
+
+#[test]
+fn a_walk_over_its_limit_is_counted_and_occluded_never_visible() {
+    let (gates, tracer, vpls, view) = fixture(Builtin::AjarDoor, 128, 0);
+    // A pixel–VPL pair whose walk passes two portals or more.
+    let found = (0..64 * 48).find_map(|k| {
+        let dir = view.ray_dir(Vec2::new((k % 64) as f32 + 0.5, (k / 64) as f32 + 0.5));
+        let s = tracer.trace(view.eye, dir)?;
+        let here = gates.cluster_at(s.position, s.normal)?;
+        vpls.iter().find_map(|v| {
+            let (vp, vn) = (Vec3::from(v.position), Vec3::from(v.normal));
+            let there = gates.cluster_at(vp, vn)?;
+            match gates.walk(vp, there, s.position, here, 64) {
+                Walk::Visible(n) if n >= 2 => Some((vp, there, s.position, here, n)),
+                _ => None,
+            }
+        })
+    });
+    let (a, ca, b, cb, n) = found.expect("a walk through two portals on ajar-door");
+    assert_eq!(gates.walk(a, ca, b, cb, n - 1), Walk::Limit);
+    gates.take_walks_over_limit();
+    let short = GateParams {
+        shape: GateShape::Portal,
+        max_walk: n - 1,
+        ..GateParams::default()
+    };
+    assert!(!gates.visible(a, ca, b, cb, &short));
+    assert_eq!(gates.take_walks_over_limit(), 1);
+    assert!(gates.visible(a, ca, b, cb, &GateParams::default()));
+    assert_eq!(gates.take_walks_over_limit(), 0);
 }

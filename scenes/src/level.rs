@@ -50,6 +50,22 @@ enum Cell {
     Empty,
 }
 
+/// One empty mesh per material, named after it (the generators fill them).
+pub fn empty_meshes(materials: &[(&str, [f32; 3])]) -> Vec<RawMesh> {
+    materials
+        .iter()
+        .enumerate()
+        .map(|(i, (name, _))| RawMesh {
+            name: (*name).to_string(),
+            positions: vec![],
+            normals: vec![],
+            uvs: vec![],
+            triangles: vec![],
+            material: i as u32,
+        })
+        .collect()
+}
+
 impl BoxLevel {
     /// Generates the triangle meshes, one per material, in metres (+Y up), normals facing
     /// away from the wall.
@@ -132,18 +148,7 @@ impl BoxLevel {
             }
         };
 
-        let mut meshes: Vec<RawMesh> = MATERIALS
-            .iter()
-            .enumerate()
-            .map(|(i, (name, _))| RawMesh {
-                name: (*name).to_string(),
-                positions: vec![],
-                normals: vec![],
-                uvs: vec![],
-                triangles: vec![],
-                material: i as u32,
-            })
-            .collect();
+        let mut meshes = empty_meshes(&MATERIALS);
         for axis in 0..3 {
             let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
             let (nu, nv) = (dims[u], dims[v]);

@@ -38,18 +38,7 @@ pub struct QuadBuilder {
 impl Default for QuadBuilder {
     fn default() -> Self {
         QuadBuilder {
-            meshes: QUAD_MATERIALS
-                .iter()
-                .enumerate()
-                .map(|(i, (name, _))| RawMesh {
-                    name: (*name).to_string(),
-                    positions: vec![],
-                    normals: vec![],
-                    uvs: vec![],
-                    triangles: vec![],
-                    material: i as u32,
-                })
-                .collect(),
+            meshes: crate::level::empty_meshes(&QUAD_MATERIALS),
         }
     }
 }

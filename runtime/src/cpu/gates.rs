@@ -68,6 +68,8 @@ pub struct GateLevel {
     cluster_gates: Vec<Vec<usize>>,
     /// Portals of each cluster, as indices into the level's portals.
     cluster_portals: Vec<Vec<usize>>,
+    /// Walks through [`GateLevel::visible`] that reached the limit (counted as occluded).
+    walks_over_limit: std::sync::atomic::AtomicU64,
 }
 
 impl GateLevel {
@@ -104,6 +106,7 @@ impl GateLevel {
             level,
             cluster_gates,
             cluster_portals,
+            walks_over_limit: std::sync::atomic::AtomicU64::new(0),
         })
     }
 
@@ -223,6 +226,13 @@ impl GateLevel {
         out
     }
 
+    /// Walks that [`GateLevel::visible`] gave up at the limit since the level was made or this
+    /// was last called (each counted as occluded); resets the count.
+    pub fn take_walks_over_limit(&self) -> u64 {
+        self.walks_over_limit
+            .swap(0, std::sync::atomic::Ordering::Relaxed)
+    }
+
     /// Number of portals.
     pub fn portal_count(&self) -> usize {
         self.level.topology.portals.len()
@@ -286,7 +296,15 @@ impl GateLevel {
             return true;
         }
         if params.shape == GateShape::Portal {
-            return matches!(self.walk(a, ca, b, cb, params.max_walk), Walk::Visible(_));
+            return match self.walk(a, ca, b, cb, params.max_walk) {
+                Walk::Visible(_) => true,
+                Walk::Blocked => false,
+                Walk::Limit => {
+                    self.walks_over_limit
+                        .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                    false
+                }
+            };
         }
         let gates = &self.level.topology.gates;
         let mut frontier = vec![ca];
