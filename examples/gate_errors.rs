@@ -138,9 +138,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             row(name, &img, &reference, &direct, None)?;
             let over = gates.take_walks_over_limit();
             if over > 0 {
-                println!(
-                    "|   ({over} portal walks reached the limit of 64: counted as occluded) |"
-                );
+                let limit = GateParams::default().max_walk;
+                println!("|   ({over} portal walks reached the limit of {limit}: occluded) |");
             }
         }
         if let Some(ctx) = &ctx {
@@ -201,18 +200,20 @@ fn row(
 ) -> Result<(), Box<dyn std::error::Error>> {
     let e = errors(img, reference)?;
     let (f, _) = flip(img, reference, 0.0)?;
-    let mut same_direct = img.clone();
-    if let Some(own) = own_direct {
-        for ((p, o), d) in same_direct
-            .pixels
-            .iter_mut()
-            .zip(&own.pixels)
-            .zip(&direct.pixels)
-        {
-            *p = *p - *o + *d;
+    // The image's indirect light over the reference's direct light (a clone only then).
+    let net;
+    let with_reference_direct = match own_direct {
+        Some(own) => {
+            let mut m = img.clone();
+            for ((p, o), d) in m.pixels.iter_mut().zip(&own.pixels).zip(&direct.pixels) {
+                *p = *p - *o + *d;
+            }
+            net = m;
+            &net
         }
-    }
-    let i = indirect_errors(&same_direct, reference, direct)?;
+        None => img,
+    };
+    let i = indirect_errors(with_reference_direct, reference, direct)?;
     println!(
         "| {name} | {:.3e} | {:.3e} | {f:.4} | {:.3} | {:.1} % |",
         e.mse,

@@ -2,26 +2,22 @@
 //! against the exact ray-cast visibility.
 
 use glam::Vec3;
-use visgate_formats::vgate::BakeParams;
-use visgate_formats::vgate::Resolution;
-use visgate_preprocess::bake::{BakeOptions, bake};
 use visgate_runtime::cpu::gates::{GateLevel, GateParams, GateShape};
 use visgate_runtime::cpu::tracer::Tracer;
 use visgate_scenes::Builtin;
 
+#[path = "support/gates.rs"]
+mod gate_support;
+
+use gate_support::light_paths;
+
 fn baked(b: Builtin, res: u32) -> (visgate_formats::Scene, visgate_formats::BakedLevel) {
-    let scene = b.scene().expect("scene");
-    let params = BakeParams {
-        resolution: Resolution::LongestAxisVoxels(res),
-        ..BakeParams::default()
-    };
-    let level = bake(&scene, &params, &BakeOptions::default(), &|_| {})
-        .expect("bake")
-        .level;
-    (scene, level)
+    let (scene, baked) = gate_support::baked(b, res);
+    (scene, baked.level)
 }
 
-/// A built-in scene baked at `res`, its gate level, tracer, 256 path VPLs and a 64×48 view.
+/// A built-in scene baked at `res`, its gate level, tracer, 256 path VPLs and its first
+/// camera's 64×48 view.
 fn fixture(
     b: Builtin,
     res: u32,
@@ -32,23 +28,7 @@ fn fixture(
     Vec<visgate_runtime::vpl::Vpl>,
     visgate_runtime::camera::View,
 ) {
-    use visgate_runtime::vpl::{PathParams, path_vpls};
-    let (scene, level) = baked(b, res);
-    let gates = GateLevel::new(level, &scene).expect("level");
-    let tracer = Tracer::new(&scene);
-    let vpls = path_vpls(
-        &tracer,
-        &scene.lights,
-        &PathParams {
-            paths: 256,
-            bounces: 1,
-            seed: 4,
-        },
-    )
-    .expect("vpls");
-    let view = visgate_runtime::camera::View::new(scene.cameras.first().expect("camera"), [64, 48])
-        .expect("view");
-    (scene, gates, tracer, vpls, view)
+    gate_support::fixture(b, res, 0)
 }
 
 #[test]
@@ -620,60 +600,42 @@ fn gpu_gates_stay_stable_at_the_extremes() {
 fn gpu_gates_give_the_same_image_at_scales_1e_3_to_1e4() {
     use visgate_runtime::gpu::{GatesParams, GpuContext, GpuMode, GpuParams, GpuRenderer};
     use visgate_runtime::metrics::errors;
-    use visgate_runtime::vpl::{PathParams, path_vpls};
     let ctx = GpuContext::new().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"));
-    for shape in [GateShape::Portal, GateShape::Disk] {
-        let mut images = Vec::new();
-        for s in [1e-3f32, 1.0, 1e4] {
-            let (scene, cam) = common::scaled_four_rooms(s);
-            let params = BakeParams {
-                resolution: Resolution::LongestAxisVoxels(96),
-                ..BakeParams::default()
-            };
-            let level = bake(&scene, &params, &BakeOptions::default(), &|_| {})
-                .expect("bake")
-                .level;
-            let gates = GateLevel::new(level, &scene).expect("level");
-            let tracer = Tracer::new(&scene);
-            let vpls = path_vpls(
-                &tracer,
-                &scene.lights,
-                &PathParams {
-                    paths: 256,
-                    bounces: 1,
-                    seed: 4,
+    let shapes = [GateShape::Portal, GateShape::Disk];
+    // Each scale baked once; its image with each gate shape.
+    let mut images: [Vec<_>; 2] = Default::default();
+    for s in [1e-3f32, 1.0, 1e4] {
+        let (scene, cam) = common::scaled_four_rooms(s);
+        let gates = GateLevel::new(gate_support::bake_at(&scene, 96).level, &scene).expect("level");
+        let tracer = Tracer::new(&scene);
+        let vpls = light_paths(&tracer, &scene);
+        let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+        gpu.set_level(&ctx, &gates).expect("level");
+        let view = visgate_runtime::camera::View::new(&cam, [64, 48]).expect("view");
+        for (shape, out) in shapes.iter().zip(&mut images) {
+            let gates_mode = GatesParams {
+                gates: GateParams {
+                    shape: *shape,
+                    ..GateParams::default()
                 },
-            )
-            .expect("vpls");
-            let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
-            gpu.set_level(&ctx, &gates).expect("level");
-            let view = visgate_runtime::camera::View::new(&cam, [64, 48]).expect("view");
-            let (img, t) = gpu
-                .render(
-                    &ctx,
-                    &view,
-                    &vpls,
-                    &GpuParams {
-                        g_max: 10.0 / (s * s),
-                        ..GpuParams::with_mode(GpuMode::Gates(GatesParams {
-                            gates: GateParams {
-                                shape,
-                                ..GateParams::default()
-                            },
-                            ..GatesParams::default()
-                        }))
-                    },
-                )
-                .expect("render");
+                ..GatesParams::default()
+            };
+            let params = GpuParams {
+                g_max: 10.0 / (s * s),
+                ..GpuParams::with_mode(GpuMode::Gates(gates_mode))
+            };
+            let (img, t) = gpu.render(&ctx, &view, &vpls, &params).expect("render");
             eprintln!(
-                "scale {s}: {} clusters, {} gates, {:?}, mean {}",
+                "scale {s} {shape:?}: {} clusters, {} gates, {:?}, mean {}",
                 gates.cluster_count(),
                 gates.gate_count(),
                 t.lists,
                 img.mean()
             );
-            images.push(img);
+            out.push(img);
         }
+    }
+    for (shape, images) in shapes.iter().zip(&images) {
         for img in [&images[0], &images[2]] {
             let e = errors(img, &images[1]).expect("same size");
             assert!(e.rel_mse < 1e-3, "{shape:?}: {e:?}");

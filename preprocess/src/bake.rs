@@ -464,7 +464,7 @@ pub fn bake(
     // space that does not close its opening) keep the per-voxel rule.
     let mut cut = es.empty.clone();
     for g in chosen {
-        crate::cut::cut_gate(&meta, &radius_vx, g, &mut cut);
+        crate::cut::cut_gate(&meta, (&es.empty, &radius_vx), g, &mut cut);
     }
     let (piece, pieces) = label_components(meta.dims, &cut, Conn::C6);
     drop(cut);
@@ -617,18 +617,17 @@ pub fn bake(
         "voxel_cluster_bytes": level.voxel_cluster.elem().size() * n_voxels as u64,
     }));
     clock.start("portals", 0);
-    let portals =
+    let found =
         crate::portals::portals(&meta, &es.empty, &voxel_cluster, params.portal_cell_voxels);
-    let (uncovered, interface_faces) =
-        crate::portals::uncovered_faces(&meta, &es.empty, &voxel_cluster, &portals);
     clock.end(json!({
-        "portals": portals.len(),
-        "interface_faces": interface_faces,
-        "faces_no_portal_covers": uncovered,
-        "faces_off_every_plane": crate::portals::off_plane_faces(&portals, &meta, &es.empty, &voxel_cluster),
-        "mask_cells": portals.iter().map(|p| u64::from(p.size[0]) * u64::from(p.size[1])).sum::<u64>(),
+        "portals": found.portals.len(),
+        "interface_faces": found.interface_faces,
+        "faces_no_portal_covers": found.uncovered,
+        "faces_off_every_plane": found.off_plane,
+        "mask_cells": found.portals.iter().map(|p| u64::from(p.size[0]) * u64::from(p.size[1])).sum::<u64>(),
     }));
-    level.topology.portals = portals;
+    let uncovered = found.uncovered;
+    level.topology.portals = found.portals;
 
     // Topology check, counted independently of the graph.
     clock.start("topology check", 0);

@@ -37,14 +37,15 @@ fn dominant(m: glam::Mat3) -> (Vec3, f32) {
 /// The cut plane's normal: the gate's, or, in a slot (the narrow voxels near the plane spread
 /// at least twice as far along one axis as along any other, that axis across the gate's
 /// normal), the gate's normal with its component along the slot removed.
-fn cut_normal(meta: &GridMeta, radius_vx: &[u16], g: &GateDisk, narrow: f32) -> Vec3 {
+fn cut_normal(meta: &GridMeta, (empty, radius_vx): Space, g: &GateDisk, narrow: f32) -> Vec3 {
     let vs = meta.voxel_size_m;
     let band = 2.0 * g.radius + vs;
-    let pts = flood(meta, g.centre, |i, p| {
-        radius_vx[i] > 0
-            && f32::from(radius_vx[i]) <= narrow
-            && (p - g.centre).dot(g.normal).abs() <= band
-    });
+    let pts: Vec<Vec3> = flood(meta, g.centre, |i, p| {
+        empty[i] && f32::from(radius_vx[i]) <= narrow && (p - g.centre).dot(g.normal).abs() <= band
+    })
+    .into_iter()
+    .map(|i| centre(meta, i))
+    .collect();
     if pts.len() < 8 {
         return g.normal;
     }
@@ -63,9 +64,16 @@ fn cut_normal(meta: &GridMeta, radius_vx: &[u16], g: &GateDisk, narrow: f32) -> 
     (g.normal - a * a.dot(g.normal)).normalize_or(g.normal)
 }
 
+/// The empty voxels and each voxel's largest-ball radius in whole voxels (saturated).
+type Space<'a> = (&'a [bool], &'a [u16]);
+
+fn centre(meta: &GridMeta, i: usize) -> Vec3 {
+    Vec3::from(meta.voxel_to_world(meta.coords(i as u32)))
+}
+
 /// The voxels reached from `from`'s voxel (26-connected) through voxels that `keep` (linear
-/// index, centre) accepts, as their centres; at most [`MAX_FLOOD`].
-fn flood(meta: &GridMeta, from: Vec3, keep: impl Fn(usize, Vec3) -> bool) -> Vec<Vec3> {
+/// index, centre) accepts, as linear indices; at most [`MAX_FLOOD`].
+fn flood(meta: &GridMeta, from: Vec3, keep: impl Fn(usize, Vec3) -> bool) -> Vec<usize> {
     let dims = meta.dims.map(i64::from);
     let o = Vec3::from(meta.origin_m);
     let start = ((from - o) / meta.voxel_size_m)
@@ -80,11 +88,11 @@ fn flood(meta: &GridMeta, from: Vec3, keep: impl Fn(usize, Vec3) -> bool) -> Vec
     let mut seen = std::collections::HashSet::from([start]);
     let mut queue = VecDeque::from([start]);
     while let Some(v) = queue.pop_front() {
-        let p = Vec3::from(meta.voxel_to_world(v.map(|c| c as u32)));
-        if !keep(index(v), p) || out.len() >= MAX_FLOOD {
+        let i = index(v);
+        if !keep(i, centre(meta, i)) || out.len() >= MAX_FLOOD {
             continue;
         }
-        out.push(p);
+        out.push(i);
         for dz in -1..=1 {
             for dy in -1..=1 {
                 for dx in -1..=1 {
@@ -99,58 +107,29 @@ fn flood(meta: &GridMeta, from: Vec3, keep: impl Fn(usize, Vec3) -> bool) -> Vec
     out
 }
 
-/// Clears, in `cut`, the voxels of gate `g`'s cut; `radius_vx` is each voxel's largest-ball
-/// radius in voxels (saturated).
-pub fn cut_gate(meta: &GridMeta, radius_vx: &[u16], g: &GateDisk, cut: &mut [bool]) {
+/// Clears, in `cut`, the empty voxels of gate `g`'s cut: the plane's voxels reached from the
+/// gate's centre through the disk (solid or not) or through empty voxels as narrow as the
+/// opening; `radius_vx` is each voxel's largest-ball radius in whole voxels (saturated).
+pub fn cut_gate(meta: &GridMeta, (empty, radius_vx): Space, g: &GateDisk, cut: &mut [bool]) {
     let vs = meta.voxel_size_m;
     // Thresholds a hair over their values, so that a distance equal to one in exact arithmetic
     // counts the same at every scale of the level (voxel units round differently).
     let reach = (3.0 * g.radius + vs) * (1.0 + 1e-4);
     let narrow = (1.5 * g.radius / vs + 1.0 + 1e-3).floor();
-    let normal = cut_normal(meta, radius_vx, g, narrow);
+    let normal = cut_normal(meta, (empty, radius_vx), g, narrow);
     // A voxel lies on the plane when the plane passes through its cube.
     let half = 0.5 * vs * normal.abs().element_sum();
-    let dims = meta.dims.map(i64::from);
-    let o = Vec3::from(meta.origin_m);
-    let start = ((g.centre - o) / vs).floor().as_i64vec3().to_array();
-    if (0..3).any(|a| start[a] < 0 || start[a] >= dims[a]) {
-        return;
-    }
-    let index = |v: [i64; 3]| (v[0] + dims[0] * (v[1] + dims[1] * v[2])) as usize;
-    let mut seen = std::collections::HashSet::new();
-    let mut queue = VecDeque::from([start]);
-    seen.insert(start);
-    while let Some(v) = queue.pop_front() {
-        let i = index(v);
-        let p = Vec3::from(meta.voxel_to_world(v.map(|c| c as u32))) - g.centre;
-        let along = p.dot(normal);
-        let in_disk = (p - along * normal).length() <= reach;
-        let slot = f32::from(radius_vx[i]) <= narrow;
-        if along.abs() > half || !(in_disk || slot) {
-            continue;
-        }
-        if radius_vx[i] > 0 {
-            cut[i] = false;
-        } else if !in_disk {
-            continue; // solid: the flood does not pass walls beyond the disk
-        }
-        if seen.len() >= MAX_FLOOD {
-            continue;
-        }
-        for dz in -1..=1 {
-            for dy in -1..=1 {
-                for dx in -1..=1 {
-                    let w = [v[0] + dx, v[1] + dy, v[2] + dz];
-                    if (0..3).any(|a| w[a] < 0 || w[a] >= dims[a]) || !seen.insert(w) {
-                        continue;
-                    }
-                    queue.push_back(w);
-                }
-            }
-        }
+    let on_cut = |i: usize, p: Vec3| {
+        let d = p - g.centre;
+        let along = d.dot(normal);
+        let in_disk = (d - along * normal).length() <= reach;
+        let slot = empty[i] && f32::from(radius_vx[i]) <= narrow;
+        along.abs() <= half && (in_disk || slot)
+    };
+    for i in flood(meta, g.centre, on_cut) {
+        cut[i] = false;
     }
 }
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -195,7 +174,7 @@ mod tests {
             path_index: 0,
         };
         let mut cut = empty.clone();
-        cut_gate(&meta, &radius, &g, &mut cut);
+        cut_gate(&meta, (&empty, &radius), &g, &mut cut);
         // Every slot voxel is cut, top to bottom; nothing off the plane is.
         for y in 2..28 {
             for x in 9..12 {

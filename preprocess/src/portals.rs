@@ -7,7 +7,7 @@
 //! plane, or their normals cancel (a folded interface) — is split at the median of its longest
 //! extent, up to 64 pieces (a piece still not planar then is kept, and counted). Each piece stores the faces' orthographic projection onto its plane
 //! as a coverage mask. So every interface face belongs to a portal whose mask covers its
-//! projected centre ([`uncovered_faces`] checks it), and a cluster's boundary is its walls plus
+//! projected centre ([`Portals::uncovered`] counts the faces that break it), and a cluster's boundary is its walls plus
 //! its portals.
 
 use std::collections::BTreeMap;
@@ -208,74 +208,50 @@ fn portal_of(pair: (u32, u32), faces: &[Face], vs: f32, cell_voxels: f32) -> Por
     }
 }
 
+/// A level's portals and the check of its interfaces against them.
+#[derive(Debug, Clone, Default)]
+pub struct Portals {
+    /// The portals, by cluster pair.
+    pub portals: Vec<Portal>,
+    /// Interface voxel faces.
+    pub interface_faces: u64,
+    /// Interface faces whose projected centre no portal of their pair covers: a level whose
+    /// clusters are bounded by walls and portals alone has none.
+    pub uncovered: u64,
+    /// Interface faces farther than 1.5 voxels from every plane of their pair (the pieces a
+    /// folded interface keeps after the last split).
+    pub off_plane: u64,
+}
+
 /// The portals of a level: `empty` marks its empty voxels, `cluster` holds each voxel's
-/// cluster ([`NONE`] for none).
-pub fn portals(meta: &GridMeta, empty: &[bool], cluster: &[u32], cell_voxels: f32) -> Vec<Portal> {
+/// cluster ([`NONE`] for none); each interface face is checked against its pair's portals.
+pub fn portals(meta: &GridMeta, empty: &[bool], cluster: &[u32], cell_voxels: f32) -> Portals {
     let vs = meta.voxel_size_m;
-    let mut out = Vec::new();
+    let mut out = Portals::default();
     for (pair, faces) in interface_faces(meta, empty, cluster) {
         let mut parts = Vec::new();
-        pieces(faces, vs, 0, &mut parts);
-        out.extend(parts.iter().map(|p| portal_of(pair, p, vs, cell_voxels)));
-    }
-    out
-}
-
-/// Interface faces farther than 1.5 voxels from their portal's plane (the pieces a folded
-/// interface keeps after the last split).
-pub fn off_plane_faces(
-    portals: &[Portal],
-    meta: &GridMeta,
-    empty: &[bool],
-    cluster: &[u32],
-) -> u64 {
-    let vs = meta.voxel_size_m;
-    let mut out = 0;
-    for (pair, faces) in interface_faces(meta, empty, cluster) {
-        let mine: Vec<&Portal> = portals
+        pieces(faces.clone(), vs, 0, &mut parts);
+        let mine: Vec<Portal> = parts
             .iter()
-            .filter(|p| (p.clusters[0], p.clusters[1]) == pair)
-            .collect();
-        out += faces
-            .iter()
-            .filter(|f| {
-                mine.iter()
-                    .map(|p| p.distance(f.centre.to_array()).abs())
-                    .fold(f32::MAX, f32::min)
-                    > PLANAR_SPREAD_VOXELS * vs
-            })
-            .count() as u64;
-    }
-    out
-}
-
-/// Interface faces whose projected centre no portal of their pair covers, and the total
-/// number of interface faces: a level whose clusters are bounded by walls and portals alone
-/// has none uncovered.
-pub fn uncovered_faces(
-    meta: &GridMeta,
-    empty: &[bool],
-    cluster: &[u32],
-    portals: &[Portal],
-) -> (u64, u64) {
-    let mut uncovered = 0;
-    let mut total = 0;
-    for (pair, faces) in interface_faces(meta, empty, cluster) {
-        let mine: Vec<&Portal> = portals
-            .iter()
-            .filter(|p| (p.clusters[0], p.clusters[1]) == pair)
+            .map(|p| portal_of(pair, p, vs, cell_voxels))
             .collect();
         for f in &faces {
-            total += 1;
-            let c = f.centre;
-            let hit = mine.iter().any(|p| {
-                let q = c - Vec3::from(p.normal) * p.distance(c.to_array());
+            let c = f.centre.to_array();
+            let covered = mine.iter().any(|p| {
+                let q = f.centre - Vec3::from(p.normal) * p.distance(c);
                 p.covers(q.to_array())
             });
-            uncovered += u64::from(!hit);
+            let nearest = mine
+                .iter()
+                .map(|p| p.distance(c).abs())
+                .fold(f32::MAX, f32::min);
+            out.uncovered += u64::from(!covered);
+            out.off_plane += u64::from(nearest > PLANAR_SPREAD_VOXELS * vs);
         }
+        out.interface_faces += faces.len() as u64;
+        out.portals.extend(mine);
     }
-    (uncovered, total)
+    out
 }
 
 #[cfg(test)]
@@ -302,7 +278,8 @@ mod tests {
                 u32::from(x + z >= 20)
             })
             .collect();
-        let ps = portals(&meta, &empty, &cluster, 1.0);
+        let out = portals(&meta, &empty, &cluster, 1.0);
+        let ps = &out.portals;
         assert_eq!(ps.len(), 1, "{ps:?}");
         let nrm = Vec3::from(ps[0].normal);
         assert!(
@@ -310,8 +287,8 @@ mod tests {
             "{nrm}"
         );
         assert_eq!(
-            uncovered_faces(&meta, &empty, &cluster, &ps),
-            (0, ps[0].faces as u64)
+            (out.uncovered, out.interface_faces),
+            (0, u64::from(ps[0].faces))
         );
         // A point well inside cluster 0's half projects outside the opening's plane band.
         assert!(ps[0].distance([0.3, 0.2, 0.3]) < 0.0);
@@ -336,9 +313,10 @@ mod tests {
                 empty[i as usize] = false;
             }
         }
-        let ps = portals(&meta, &empty, &cluster, 1.0);
+        let out = portals(&meta, &empty, &cluster, 1.0);
+        let ps = &out.portals;
         assert!(ps.len() >= 2, "{}", ps.len());
-        let (uncovered, total) = uncovered_faces(&meta, &empty, &cluster, &ps);
+        let (uncovered, total) = (out.uncovered, out.interface_faces);
         assert_eq!(uncovered, 0);
         // 10 × 3 faces across z = 10 and 5 × 3 across x = 10 (z 10..15; 15..20 is solid).
         assert_eq!(total, 45);

@@ -162,14 +162,27 @@ pub fn cluster_image(view: &View, clusters: &[Option<u32>]) -> egui::ColorImage 
     egui::ColorImage::new([view.size[0] as usize, view.size[1] as usize], px)
 }
 
-/// Draws the line layers (gates, skeleton, VPLs) over `rect`.
+/// A segment in metres and its colour.
+pub type Line = (Vec3, Vec3, egui::Color32);
+
+/// Every portal's outline ([`portal_outline`]), coloured by the pair of clusters it joins.
+pub fn portal_lines(level: &GateLevel) -> Vec<Line> {
+    let mut out = Vec::new();
+    for p in &level.baked().topology.portals {
+        let colour = id_colour(p.clusters[0] * 7919 + p.clusters[1]);
+        out.extend(portal_outline(p).into_iter().map(|(a, b)| (a, b, colour)));
+    }
+    out
+}
+
+/// Draws the line layers (gates with the level's `portals` outlines, skeleton, VPLs) over
+/// `rect`.
 pub fn draw_lines(
     painter: &egui::Painter,
     rect: egui::Rect,
     view: &View,
     on: Layers,
-    level: Option<&GateLevel>,
-    vpls: &[Vpl],
+    (level, vpls, portals): (Option<&GateLevel>, &[Vpl], &[Line]),
 ) {
     let seg = |a: Vec3, b: Vec3, colour: egui::Color32, width: f32| {
         if let (Some(p), Some(q)) = (project(view, rect, a), project(view, rect, b)) {
@@ -201,12 +214,8 @@ pub fn draw_lines(
             }
             seg(c, c + n * r * 0.3, colour, 1.0);
         }
-        // The portals: the outline of each one's open mask cells, coloured by the pair it joins.
-        for p in &l.baked().topology.portals {
-            let colour = id_colour(p.clusters[0] * 7919 + p.clusters[1]);
-            for (a, b) in portal_outline(p) {
-                seg(a, b, colour, 1.0);
-            }
+        for &(a, b, colour) in portals {
+            seg(a, b, colour, 1.0);
         }
     }
     if on.vpls {

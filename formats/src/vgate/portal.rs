@@ -61,11 +61,7 @@ impl Portal {
     /// an open cell, or within [`EDGE_SLACK`] cells of one (so that a point on a cell's edge,
     /// as a VPL on a doorway's jamb is, counts the same at every scale of the level).
     pub fn covers(&self, p: [f32; 3]) -> bool {
-        let d = [
-            p[0] - self.origin_m[0],
-            p[1] - self.origin_m[1],
-            p[2] - self.origin_m[2],
-        ];
+        let d = self.offset(p);
         let x = dot(d, self.u) / self.cell_m;
         let y = dot(d, self.v) / self.cell_m;
         if !(x.is_finite() && y.is_finite()) {
@@ -79,14 +75,11 @@ impl Portal {
 
     /// Signed distance of `p` from the plane, along the normal, metres.
     pub fn distance(&self, p: [f32; 3]) -> f32 {
-        dot(
-            [
-                p[0] - self.origin_m[0],
-                p[1] - self.origin_m[1],
-                p[2] - self.origin_m[2],
-            ],
-            self.normal,
-        )
+        dot(self.offset(p), self.normal)
+    }
+
+    fn offset(&self, p: [f32; 3]) -> [f32; 3] {
+        std::array::from_fn(|a| p[a] - self.origin_m[a])
     }
 
     /// Set mask cells.

@@ -150,25 +150,14 @@ impl GateLevel {
         let o = Vec3::from(self.grid.origin_m);
         let q = p + n * vs;
         let base = ((q - o) / vs).floor();
-        let dims = self.grid.dims.map(|d| d as f32);
         let mut best: Option<(f32, u32)> = None;
         for dz in -1..=1 {
             for dy in -1..=1 {
                 for dx in -1..=1 {
-                    let v = base + Vec3::new(dx as f32, dy as f32, dz as f32);
-                    if (0..3).any(|a| v[a] < 0.0 || v[a] >= dims[a]) {
-                        continue;
-                    }
-                    let vi = [v.x as u32, v.y as u32, v.z as u32];
-                    let Some(c) = self
-                        .level
-                        .voxel_cluster
-                        .get(self.grid.index(vi))
-                        .filter(|&c| c != u32::MAX)
-                    else {
+                    let centre = o + (base + Vec3::new(dx as f32, dy as f32, dz as f32) + 0.5) * vs;
+                    let Some(c) = self.cluster_of_voxel(centre) else {
                         continue;
                     };
-                    let centre = o + (v + 0.5) * vs;
                     let d2 = (centre - q).length_squared();
                     if (centre - p).dot(n) > 0.0 && best.is_none_or(|(bd, _)| d2 < bd) {
                         best = Some((d2, c));
@@ -231,11 +220,6 @@ impl GateLevel {
     pub fn take_walks_over_limit(&self) -> u64 {
         self.walks_over_limit
             .swap(0, std::sync::atomic::Ordering::Relaxed)
-    }
-
-    /// Number of portals.
-    pub fn portal_count(&self) -> usize {
-        self.level.topology.portals.len()
     }
 
     /// The portal walk: from `a` in cluster `ca`, the segment to `b` leaves each cluster it is

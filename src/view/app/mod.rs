@@ -92,6 +92,8 @@ pub struct ViewerApp {
     layers: Layers,
     /// The cluster layer and the view it was made for.
     cluster_tex: Option<(View, layers::PixelLayer, egui::TextureHandle)>,
+    /// The level's portal outlines, made once (the level does not change).
+    portal_lines: Vec<layers::Line>,
     compare: Compare,
     compare_started: bool,
     /// What the last frame was rendered with: a frame with nothing changed is not rendered again.
@@ -163,6 +165,10 @@ impl ViewerApp {
             last_view: None,
             layers: start.layers,
             cluster_tex: None,
+            portal_lines: start
+                .level
+                .as_ref()
+                .map_or_else(Vec::new, layers::portal_lines),
             compare: Compare::new(),
             compare_started: false,
             last_key: String::new(),
@@ -485,7 +491,8 @@ impl ViewerApp {
         }
         let vpls = self.vpls.as_ref().map_or(&[][..], |v| &v.1[..]);
         let painter = ui.painter().with_clip_rect(rect);
-        layers::draw_lines(&painter, rect, &view, self.layers, level, vpls);
+        let lines = (level, vpls, &self.portal_lines[..]);
+        layers::draw_lines(&painter, rect, &view, self.layers, lines);
         if let Some(pos) = response.hover_pos().filter(|p| rect.contains(*p)) {
             let p = glam::Vec2::new(
                 (pos.x - rect.left()) / rect.width() * view.size[0] as f32,

@@ -545,7 +545,7 @@ impl ListBuffers {
                         true => LightEntry {
                             vpl,
                             gates: Vec::new(),
-                            walk_from: (g != 0).then_some(g & 0x7fff_ffff),
+                            walk_from: (g != 0).then_some(g & !crate::gpu::shaders::WALK_FROM),
                         },
                         false => LightEntry {
                             vpl,

@@ -360,7 +360,7 @@ fn vpl_entries(j: u32, cb: u32, s: vec3<f32>, r: f32, write: bool, at: u32) -> u
             return 0u;
         }
         if write {
-            entries[at] = vec2<u32>(j, 0x80000000u | ca);
+            entries[at] = vec2<u32>(j, WALK_FROM | ca);
         }
         return 1u;
     }

@@ -56,8 +56,6 @@ struct GeometryCluster {
 // The portals (portals.wgsl).
 @group(0) @binding(15) var<storage, read> portal_words: array<u32>;
 
-const WALK_FROM: u32 = 0x80000000u;
-
 fn through_gates(a: vec3<f32>, ca: u32, b: vec3<f32>, cb: u32) -> bool {
     if ca == cb || ca == NONE || cb == NONE {
         return true;

@@ -5,7 +5,6 @@
 // `grid` (voxel size, walk limit) and `portal_words: array<u32>` (GateLevel::portal_words:
 // [clusters, record base, portals], offsets, index lists, 20-word records, masks).
 
-const PORTAL_RECORD: u32 = 20u;
 const WALK_BLOCKED: u32 = 0u;
 const WALK_VISIBLE: u32 = 1u;
 const WALK_LIMIT: u32 = 2u;
@@ -30,8 +29,7 @@ fn portal_cell(r: u32, x: f32, y: f32) -> bool {
 }
 
 // Whether the point q of record r's plane falls in a set mask cell or within EDGE_SLACK cells
-// of one (vgate::Portal::covers).
-const EDGE_SLACK: f32 = 1e-3;
+// of one (vgate::Portal::covers; PORTAL_RECORD and EDGE_SLACK are injected from Rust).
 
 fn portal_covers(r: u32, q: vec3<f32>) -> bool {
     let rel = q - pv(r);
