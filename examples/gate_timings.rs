@@ -56,7 +56,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     );
     println!(
         "| VPLs | mode | geometry pass | unique clusters | light assignment | shading (direct + \
-         indirect) | VPL maps | VPL gather | total | per-VPL maps / this |"
+         indirect) | VPL maps | indirect gather (+ blur) | total | per-VPL maps / this |"
     );
     println!("|---|---|---|---|---|---|---|---|---|---|");
     let counts: Vec<u32> = match std::env::var("GATE_TIMINGS_VPLS") {
@@ -148,7 +148,7 @@ impl Stages {
             light_assignment: g("light assignment"),
             shade: g("shading: direct + indirect lighting") + g("shading: direct lighting"),
             vpl_maps: g("VPL paraboloid maps"),
-            vpl_gather: g("VPL gather"),
+            vpl_gather: g("VPL gather") + g("indirect lighting") + g("blur + compose"),
             total,
         })
     }

@@ -196,9 +196,9 @@ pub struct RenderArgs {
     /// self-shadowing under wide filter kernels, smaller keeps contact shadows.
     #[arg(long, default_value_t = 3.0)]
     pub cssm_normal_offset: f32,
-    /// VAL modes: interleaved sampling in blocks of this side (each pixel lights itself with
-    /// one of side² VPL subsets, then a geometry-aware blur over the block); 1: every VPL
-    /// at every pixel.
+    /// VAL modes and gates: interleaved sampling in blocks of this side (each pixel lights
+    /// itself with one of side² VPL subsets, then a geometry-aware blur over the block); 1:
+    /// every VPL at every pixel (the CPU twins, --cpu, always gather every VPL).
     #[arg(long, default_value_t = 8)]
     pub interleave: u32,
     /// Blur: leave out neighbours farther than this fraction of the scene's size.
@@ -245,6 +245,15 @@ fn parse_size(s: &str) -> Result<[u32; 2]> {
 }
 
 impl RenderArgs {
+    /// Interleaving and blur from the flags (VAL modes and gates alike).
+    fn interleave_params(&self) -> InterleaveParams {
+        InterleaveParams {
+            block: self.interleave,
+            blur_distance: self.blur_distance,
+            blur_normal: self.blur_normal,
+        }
+    }
+
     /// Every method's settings from the flags.
     fn settings(&self) -> MethodSettings {
         MethodSettings {
@@ -267,6 +276,7 @@ impl RenderArgs {
                     depth_slices: self.depth_slices,
                 },
                 light_entries: self.light_entries,
+                interleave: self.interleave_params(),
             },
             vals: ValModeParams {
                 vals: ValParams {
@@ -277,11 +287,7 @@ impl RenderArgs {
                     ..ValParams::default()
                 },
                 map_size: self.val_map_size,
-                interleave: InterleaveParams {
-                    block: self.interleave,
-                    blur_distance: self.blur_distance,
-                    blur_normal: self.blur_normal,
-                },
+                interleave: self.interleave_params(),
             },
             cssm: CssmParams {
                 terms: self.cssm_terms,

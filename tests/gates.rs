@@ -203,7 +203,7 @@ fn gpu_gates_agree_with_the_cpu_twin() {
             let mode = if clustered {
                 GpuMode::Gates(GatesParams {
                     gates: gp,
-                    ..GatesParams::default()
+                    ..every_vpl_at_every_pixel()
                 })
             } else {
                 GpuMode::GatesPerPixel(gp)
@@ -248,7 +248,14 @@ fn gpu_gates_agree_with_the_cpu_twin() {
 fn clustered_light_lists_give_exactly_the_per_point_gate_test() {
     use glam::Vec2;
     use visgate_runtime::cpu::clustered::{ClusterParams, PixelSurface, assign, entry_reaches};
-    for (b, res) in [(Builtin::FourRooms, 128), (Builtin::TwoRooms, 96)] {
+    // The thin walls, ajar door and table of the ajar door, the columns and loops of the
+    // pillared hall: the portal cull must keep every pair a walk lights there too.
+    for (b, res) in [
+        (Builtin::FourRooms, 128),
+        (Builtin::TwoRooms, 96),
+        (Builtin::AjarDoor, 128),
+        (Builtin::PillaredHall, 128),
+    ] {
         let (_scene, gates, tracer, vpls, view) = fixture(b, res);
         let pixels: Vec<Option<PixelSurface>> = (0..48u32)
             .flat_map(|y| (0..64u32).map(move |x| (x, y)))
@@ -280,7 +287,14 @@ fn clustered_light_lists_give_exactly_the_per_point_gate_test() {
                 ..GateParams::default()
             },
         ] {
-            let c = assign(&pixels, 64, &vpls, &gates, &gp, &ClusterParams::default());
+            let c = assign(
+                &pixels,
+                64,
+                &vpls,
+                &gates,
+                &gp,
+                (&ClusterParams::default(), 1),
+            );
             let vpl_cluster: Vec<_> = vpls
                 .iter()
                 .map(|v| gates.cluster_at(Vec3::from(v.position), Vec3::from(v.normal)))
@@ -333,7 +347,9 @@ fn clustered_light_lists_give_exactly_the_per_point_gate_test() {
 
 #[test]
 fn gpu_light_lists_equal_the_cpu_twin() {
-    use visgate_runtime::cpu::clustered::{CONE_SLACK, ClusterParams, assign, cone_margin};
+    use visgate_runtime::cpu::clustered::{
+        CONE_SLACK, ClusterParams, LightEntry, assign, cone_margin,
+    };
     use visgate_runtime::gpu::{GatesParams, GpuContext, GpuRenderer};
     let ctx = GpuContext::new().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"));
     for (b, res) in [(Builtin::FourRooms, 128), (Builtin::TwoRooms, 96)] {
@@ -387,7 +403,8 @@ fn gpu_light_lists_equal_the_cpu_twin() {
                 surfaces.len()
             );
             // The CPU twin on the same G-buffer gives the same clusters, boxes and lists.
-            let want = assign(&pixels, view.size[0], &vpls, &gates, &gp, &cp);
+            let subsets = params.interleave.subsets();
+            let want = assign(&pixels, view.size[0], &vpls, &gates, &gp, (&cp, subsets));
             assert_eq!(got.pixel_cluster, want.pixel_cluster, "{}", b.name());
             assert_eq!(got.clusters.len(), want.clusters.len());
             for (g, w) in got.clusters.iter().zip(&want.clusters) {
@@ -395,9 +412,15 @@ fn gpu_light_lists_equal_the_cpu_twin() {
                 assert_eq!(g.bounds, w.bounds, "{} cluster {:?}", b.name(), g.tile);
             }
             // Equal lists, but for entries whose cone test lies within float rounding of its
-            // edge (the GPU's asin / acos differ from the CPU's in the last bits).
+            // edge (the GPU's asin / acos differ from the CPU's in the last bits), each in the
+            // order of the interleaving subsets (VPL mod B, VPL).
             let mut borderline = 0;
             for (k, (g, w)) in got.lists.iter().zip(&want.lists).enumerate() {
+                let key = |e: &LightEntry| (e.vpl % subsets, e.vpl);
+                assert!(
+                    g.is_sorted_by_key(key) && w.is_sorted_by_key(key),
+                    "list {k} order"
+                );
                 let (s, r) = got.clusters[k].sphere();
                 let odd = g
                     .iter()
@@ -444,6 +467,18 @@ fn gpu_light_lists_equal_the_cpu_twin() {
 #[path = "../runtime/tests/common/mod.rs"]
 mod common;
 
+/// Clustered gates without interleaving (what the CPU twin computes).
+fn every_vpl_at_every_pixel() -> visgate_runtime::gpu::GatesParams {
+    use visgate_runtime::gpu::{GatesParams, InterleaveParams};
+    GatesParams {
+        interleave: InterleaveParams {
+            block: 1,
+            ..InterleaveParams::default()
+        },
+        ..GatesParams::default()
+    }
+}
+
 /// GPU gates (clustered) and the CPU twin on `vpls`, relative MSE of the GPU image.
 fn gpu_vs_twin(
     gpu: &mut visgate_runtime::gpu::GpuRenderer,
@@ -455,14 +490,14 @@ fn gpu_vs_twin(
     view: &visgate_runtime::camera::View,
 ) -> (visgate_runtime::hdr::HdrImage, f64) {
     use visgate_runtime::cpu::reference::{IndirectVisibility, ReferenceParams, render_with};
-    use visgate_runtime::gpu::{GatesParams, GpuMode, GpuParams};
+    use visgate_runtime::gpu::{GpuMode, GpuParams};
     use visgate_runtime::metrics::errors;
     let (img, _) = gpu
         .render(
             ctx,
             view,
             vpls,
-            &GpuParams::with_mode(GpuMode::Gates(GatesParams::default())),
+            &GpuParams::with_mode(GpuMode::Gates(every_vpl_at_every_pixel())),
         )
         .expect("gpu");
     assert!(img.pixels.iter().all(|p| p.is_finite()), "finite");
@@ -687,4 +722,51 @@ fn the_pass_report_counts_pixels_and_vpls_outside_every_cluster() {
     assert_eq!(lists.pixels_outside as usize, outside);
     assert!(outside > 100, "{outside} pixels outside every cluster");
     eprintln!("outside: {outside} pixels, {want_vpls} VPLs");
+}
+
+#[test]
+fn interleaved_gates_keep_the_light_of_every_vpl_gather() {
+    use visgate_runtime::gpu::InterleaveParams;
+    use visgate_runtime::gpu::{GatesParams, GpuContext, GpuMode, GpuParams, GpuRenderer};
+    use visgate_runtime::metrics::errors;
+    let ctx = GpuContext::new().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"));
+    let (scene, gates, _, vpls, _) = fixture(Builtin::FourRooms, 128);
+    let view = visgate_runtime::camera::View::new(&scene.cameras[0], [128, 96]).expect("view");
+    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    gpu.set_level(&ctx, &gates).expect("level");
+    let render = |gpu: &mut GpuRenderer, mode| {
+        gpu.render(&ctx, &view, &vpls, &GpuParams::with_mode(mode))
+            .expect("render")
+    };
+    let (direct, _) = render(&mut gpu, GpuMode::DirectOnly);
+    let (full, _) = render(&mut gpu, GpuMode::Gates(every_vpl_at_every_pixel()));
+    let indirect = |img: &visgate_runtime::hdr::HdrImage| (img.mean() - direct.mean()).x;
+    for block in [2, 4, 8] {
+        let params = GatesParams {
+            interleave: InterleaveParams {
+                block,
+                ..InterleaveParams::default()
+            },
+            ..GatesParams::default()
+        };
+        let (img, t) = render(&mut gpu, GpuMode::Gates(params));
+        // Each pixel gathered its subset alone (a pass of its own), then the blur.
+        let names: Vec<&str> = t.passes.iter().map(|p| p.name).collect();
+        assert!(
+            names.contains(&"indirect lighting") && names.contains(&"blur + compose"),
+            "{names:?}"
+        );
+        let ratio = indirect(&img) / indirect(&full);
+        let e = errors(&img, &full).expect("same size");
+        eprintln!(
+            "block {block}: indirect energy {ratio:.3} of every VPL's, rel. MSE {:.2e}",
+            e.rel_mse
+        );
+        assert!(
+            (ratio - 1.0).abs() < 0.05,
+            "block {block}: energy ratio {ratio}"
+        );
+        assert!(e.rel_mse < 0.05, "block {block}: rel. MSE {}", e.rel_mse);
+        assert!(e.rel_mse > 0.0, "block {block}: the image did not change");
+    }
 }

@@ -133,7 +133,7 @@ pub fn clustered_image(
         tile_px,
         ..ClusterParams::default()
     };
-    let c = assign(&pixels, w, vpls, level, gates, &params);
+    let c = assign(&pixels, w, vpls, level, gates, (&params, 1));
     let longest = c.lists.iter().map(Vec::len).max().unwrap_or(0).max(1);
     let px: Vec<egui::Color32> = c
         .pixel_cluster

@@ -10,7 +10,8 @@ use visgate_runtime::hdr::HdrImage;
 
 use super::camera::FlyCamera;
 
-/// The settings of method `mode` (by its registry name).
+/// The settings of method `mode` (by its registry name). Clustered gates and the VAL modes
+/// share one interleaving block, so that their speed compares like with like.
 pub fn method_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
     match mode {
         "gates" | "gates-per-pixel" => {
@@ -25,12 +26,15 @@ pub fn method_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
                 ui.add(egui::Slider::new(&mut g.max_hops, 1..=2).text("gate hops"));
                 ui.add(egui::Slider::new(&mut g.oversize, 0.5..=3.0).text("gate oversize"));
             }
+            if mode == "gates" {
+                ui.add(interleave_block(&mut s.vals.interleave.block));
+            }
         }
         "val-hard" | "val-cssm" => {
             let v = &mut s.vals;
             ui.add(egui::Slider::new(&mut v.vals.count, 1..=256).text("VALs"));
             ui.add(egui::Slider::new(&mut v.vals.iterations, 0..=64).text("k-means iterations"));
-            ui.add(egui::Slider::new(&mut v.interleave.block, 1..=8).text("interleave block"));
+            ui.add(interleave_block(&mut v.interleave.block));
             ui.add(egui::Slider::new(&mut v.map_size, 32..=512).text("VAL map size"));
         }
         "per-vpl-shadow-maps" => {
@@ -39,6 +43,12 @@ pub fn method_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
         }
         _ => {}
     }
+    s.gates.interleave = s.vals.interleave;
+}
+
+/// The interleaving block's slider.
+fn interleave_block(b: &mut u32) -> egui::Slider<'_> {
+    egui::Slider::new(b, 1..=8).text("interleave block")
 }
 
 /// The camera: speed, field of view, the scene's cameras as bookmarks, framing the level.

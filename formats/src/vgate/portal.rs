@@ -68,7 +68,15 @@ impl Portal {
             return false;
         }
         let e = EDGE_SLACK;
-        [(0.0, 0.0), (-e, 0.0), (e, 0.0), (0.0, -e), (0.0, e)]
+        let (i, j) = (x.floor(), y.floor());
+        if self.cell(i as i64, j as i64) {
+            return true;
+        }
+        // Off a cell's edge by more than the slack, the neighbours' cells cannot count.
+        if x - i > e && x - i < 1.0 - e && y - j > e && y - j < 1.0 - e {
+            return false;
+        }
+        [(-e, 0.0), (e, 0.0), (0.0, -e), (0.0, e)]
             .iter()
             .any(|(dx, dy)| self.cell((x + dx).floor() as i64, (y + dy).floor() as i64))
     }

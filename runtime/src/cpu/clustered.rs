@@ -95,7 +95,7 @@ pub struct Clustered {
     pub pixel_cluster: Vec<u32>,
     /// The unique geometry clusters, in key order (tile y, tile x, slice, visibility cluster).
     pub clusters: Vec<GeometryCluster>,
-    /// Each geometry cluster's light list, sorted by VPL.
+    /// Each geometry cluster's light list, ordered by (VPL mod subsets, VPL).
     pub lists: Vec<Vec<LightEntry>>,
 }
 
@@ -106,15 +106,18 @@ impl Clustered {
     }
 }
 
-/// Steps 1–3: geometry clusters of `pixels` (`width` per row), bounds, and light lists.
+/// Steps 1–3: geometry clusters of `pixels` (`width` per row), bounds, and light lists, each
+/// ordered by (VPL mod `subsets`, VPL) — with interleaved sampling a pixel reads the run of
+/// its subset (1: VPL order).
 pub fn assign(
     pixels: &[Option<PixelSurface>],
     width: u32,
     vpls: &[Vpl],
     level: &GateLevel,
     gates: &GateParams,
-    params: &ClusterParams,
+    (params, subsets): (&ClusterParams, u32),
 ) -> Clustered {
+    let subsets = subsets.max(1);
     let tile = params.tile_px.max(1);
     let slices = params.depth_slices.max(1);
     let (mut near, mut far) = (f32::INFINITY, 0f32);
@@ -219,6 +222,7 @@ pub fn assign(
                     }),
                 }
             }
+            list.sort_by_key(|e| (e.vpl % subsets, e.vpl));
             list
         })
         .collect();

@@ -12,6 +12,7 @@ use glam::Vec3;
 use visgate_formats::vgate::GridMeta;
 use visgate_formats::{BakedLevel, Scene};
 
+use super::portal_walk::{PortalGroup, portal_groups};
 use crate::RenderError;
 
 /// What a gate is at runtime.
@@ -66,8 +67,8 @@ pub struct GateLevel {
     level: BakedLevel,
     /// Gates of each cluster, as indices into the level's gates.
     cluster_gates: Vec<Vec<usize>>,
-    /// Portals of each cluster, as indices into the level's portals.
-    cluster_portals: Vec<Vec<usize>>,
+    /// Portals of each cluster, grouped by neighbour.
+    portal_groups: Vec<Vec<PortalGroup>>,
     /// Walks through [`GateLevel::visible`] that reached the limit (counted as occluded).
     walks_over_limit: std::sync::atomic::AtomicU64,
 }
@@ -93,19 +94,12 @@ impl GateLevel {
                 }
             }
         }
-        let mut cluster_portals = vec![Vec::new(); clusters];
-        for (i, p) in level.topology.portals.iter().enumerate() {
-            for c in p.clusters {
-                if let Some(list) = cluster_portals.get_mut(c as usize) {
-                    list.push(i);
-                }
-            }
-        }
+        let portal_groups = portal_groups(&level.topology.portals, clusters);
         Ok(GateLevel {
             grid: level.info.grid,
             level,
             cluster_gates,
-            cluster_portals,
+            portal_groups,
             walks_over_limit: std::sync::atomic::AtomicU64::new(0),
         })
     }
@@ -118,6 +112,23 @@ impl GateLevel {
     /// Number of visibility clusters.
     pub fn cluster_count(&self) -> usize {
         self.cluster_gates.len()
+    }
+
+    /// Cluster `c`'s portal groups (none for a cluster out of range).
+    pub fn portal_groups(&self, c: u32) -> &[PortalGroup] {
+        self.portal_groups
+            .get(c as usize)
+            .map_or(&[], Vec::as_slice)
+    }
+
+    /// Every cluster's portal groups.
+    pub fn all_portal_groups(&self) -> &[Vec<PortalGroup>] {
+        &self.portal_groups
+    }
+
+    /// Voxel edge of the level's grid. [Units: m]
+    pub fn voxel_size(&self) -> f32 {
+        self.grid.voxel_size_m
     }
 
     /// Number of gates.
@@ -220,55 +231,6 @@ impl GateLevel {
     pub fn take_walks_over_limit(&self) -> u64 {
         self.walks_over_limit
             .swap(0, std::sync::atomic::Ordering::Relaxed)
-    }
-
-    /// The portal walk: from `a` in cluster `ca`, the segment to `b` leaves each cluster it is
-    /// in through the portal of that cluster it crosses first (its plane hit inside its mask,
-    /// going out), until it is in `cb`. Endpoints may lie up to 1.5 voxels on the far side of
-    /// a portal's plane (the planes fit voxel faces). At most `max_walk` portals.
-    pub fn walk(&self, a: Vec3, ca: u32, b: Vec3, cb: u32, max_walk: u32) -> Walk {
-        if ca == cb {
-            return Walk::Visible(0);
-        }
-        let portals = &self.level.topology.portals;
-        let d = b - a;
-        let len = d.length();
-        if len <= 0.0 || !len.is_finite() {
-            return Walk::Blocked;
-        }
-        let slack = 1.5 * self.grid.voxel_size_m / len;
-        let (mut c, mut t0, mut last) = (ca, -slack, usize::MAX);
-        for step in 0..max_walk {
-            let mut best: Option<(f32, usize, u32)> = None;
-            for &pi in self.cluster_portals.get(c as usize).into_iter().flatten() {
-                let p = &portals[pi];
-                let (out, other) = if p.clusters[0] == c {
-                    (1.0, p.clusters[1])
-                } else {
-                    (-1.0, p.clusters[0])
-                };
-                let n = Vec3::from(p.normal) * out;
-                let den = d.dot(n);
-                if pi == last || den <= f32::EPSILON * len {
-                    continue;
-                }
-                let t = (Vec3::from(p.origin_m) - a).dot(n) / den;
-                if t < t0 || t > 1.0 + slack || best.is_some_and(|(bt, _, _)| bt <= t) {
-                    continue;
-                }
-                if p.covers((a + d * t).to_array()) {
-                    best = Some((t, pi, other));
-                }
-            }
-            let Some((t, pi, other)) = best else {
-                return Walk::Blocked;
-            };
-            if other == cb {
-                return Walk::Visible(step + 1);
-            }
-            (c, t0, last) = (other, t, pi);
-        }
-        Walk::Limit
     }
 
     /// Whether light from `a` (cluster `ca`) reaches `b` (cluster `cb`) through the gates: same
@@ -418,46 +380,4 @@ impl GateLevel {
             portal_words: self.portal_words(),
         }
     }
-
-    /// The portals packed into words for portals.wgsl: `[clusters, record base, portals]`,
-    /// `clusters + 1` absolute offsets into the list of each cluster's portal indices, the
-    /// list, then [`PORTAL_RECORD_WORDS`] words per portal (origin, cell, normal, width, u,
-    /// height, v, mask offset, the two clusters, two zeros) and the masks.
-    pub fn portal_words(&self) -> Vec<u32> {
-        let portals = &self.level.topology.portals;
-        let clusters = self.cluster_portals.len() as u32;
-        let list_at = 3 + clusters + 1;
-        let list_len: usize = self.cluster_portals.iter().map(Vec::len).sum();
-        let records = list_at + list_len as u32;
-        let mut w = vec![clusters, records, portals.len() as u32];
-        let mut at = list_at;
-        for l in &self.cluster_portals {
-            w.push(at);
-            at += l.len() as u32;
-        }
-        w.push(at);
-        for l in &self.cluster_portals {
-            w.extend(l.iter().map(|&i| i as u32));
-        }
-        let mut mask_at = records + PORTAL_RECORD_WORDS * portals.len() as u32;
-        for p in portals {
-            let f = |v: [f32; 3]| v.map(f32::to_bits);
-            w.extend(f(p.origin_m));
-            w.push(p.cell_m.to_bits());
-            w.extend(f(p.normal));
-            w.push(p.size[0]);
-            w.extend(f(p.u));
-            w.push(p.size[1]);
-            w.extend(f(p.v));
-            w.extend([mask_at, p.clusters[0], p.clusters[1], 0, 0]);
-            mask_at += p.mask.len() as u32;
-        }
-        for p in portals {
-            w.extend(&p.mask);
-        }
-        w
-    }
 }
-
-/// Words per portal record in [`GateLevel::portal_words`].
-pub const PORTAL_RECORD_WORDS: u32 = 20;

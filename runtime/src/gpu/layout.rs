@@ -119,8 +119,9 @@ gpu_struct! {
         pub shadow_normal_offset: f32,
         /// Depth bias of shadow lookups. [Units: texels]
         pub shadow_bias: f32,
-        /// Padding.
-        pub _pad0: f32,
+        /// Interleaving block b of clustered gates (≤ 1: every VPL at every pixel; else a
+        /// pixel takes the VPLs of its subset, VPL mod b² = its place in the b × b block).
+        pub interleave_block: u32,
         /// VPLs in the VPL buffer.
         pub vpl_count: u32,
         /// Lights in the light buffer.
@@ -248,8 +249,8 @@ gpu_struct! {
     pub struct ClusterFrame {
         /// Eye. [Units: m]
         pub eye: [f32; 3],
-        /// Padding.
-        pub _pad0: f32,
+        /// Interleaving subsets B: a light list is ordered by (VPL mod B, VPL). [Limit: ≥ 1]
+        pub subsets: u32,
         /// Unit view axis.
         pub forward: [f32; 3],
         /// Padding.

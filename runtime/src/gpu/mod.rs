@@ -198,16 +198,21 @@ fn record_passes(
         _ => None,
     };
     let shading = match f.params.mode {
+        GpuMode::Gates(gp) if gp.interleave.block > 1 => "shading: direct lighting",
         GpuMode::None | GpuMode::Gates(_) | GpuMode::GatesPerPixel(_) => {
             "shading: direct + indirect lighting"
         }
         _ => "shading: direct lighting",
     };
-    let hdr = p
-        .shade
-        .record(f, pool, rec, (&shadows, &g, lists.as_ref()), shading);
+    let inputs = (&shadows, &g, lists.as_ref());
+    let hdr = p.shade.record(f, pool, rec, inputs, shading);
     let mut val_state = None;
     match &f.params.mode {
+        GpuMode::Gates(gp) if gp.interleave.block > 1 => {
+            let indirect = p.shade.record_gates_indirect(f, pool, rec, inputs);
+            let uniform = InterleaveBlur::uniform(f, &gp.interleave, pool);
+            p.blur.record(f, pool, rec, (&g, &uniform, &indirect, &hdr));
+        }
         GpuMode::PerVplShadowMaps(pv) => p.maps.record(f, pv, pool, rec, (&g, &hdr)),
         GpuMode::ValHard(v) | GpuMode::ValCssm(v, _) => {
             let cssm = match &f.params.mode {
@@ -366,11 +371,14 @@ impl GpuRenderer {
             g_max: params.g_max,
             shadow_normal_offset: params.shadows.normal_offset,
             shadow_bias: params.shadows.bias,
+            interleave_block: match params.mode {
+                GpuMode::Gates(gp) => gp.interleave.block,
+                _ => 1,
+            },
             vpl_count,
             light_count: scene.lights.len() as u32,
             shade_mode: shade_mode as u32,
             shadow_size: params.shadows.size,
-            ..bytemuck::Zeroable::zeroed()
         };
         let level = scene.level.as_ref();
         let gates = params.mode.gates().unwrap_or_default();

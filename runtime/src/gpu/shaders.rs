@@ -105,7 +105,11 @@ pub fn constants() -> String {
     s += &format!("const CSSM_DEPTH_SCALE: f32 = {CSSM_DEPTH_SCALE:?};\n");
     s += &format!("const CSSM_EMPTY_DEPTH: f32 = {CSSM_EMPTY_DEPTH:?};\n");
     s += &u("WALK_FROM", WALK_FROM);
-    s += &u("PORTAL_RECORD", crate::cpu::gates::PORTAL_RECORD_WORDS);
+    s += &u(
+        "PORTAL_RECORD",
+        crate::cpu::portal_walk::PORTAL_RECORD_WORDS,
+    );
+    s += &u("PORTAL_GROUP", crate::cpu::portal_walk::GROUP_WORDS);
     s += &format!(
         "const EDGE_SLACK: f32 = {:?};\n",
         visgate_formats::vgate::EDGE_SLACK

@@ -66,6 +66,7 @@ impl ViewerApp {
         v.map_size = val_map as u32;
         p.map_size = map as u32;
         p.batch = batch as u32;
+        self.settings.gates.interleave = self.settings.vals.interleave;
     }
 
     /// Saves the state when it changed, at most once a second (and at exit).

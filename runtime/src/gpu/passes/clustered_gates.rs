@@ -9,6 +9,7 @@ use crate::RenderError;
 use glam::Vec3;
 
 use super::gbuffer::GBufferOutput;
+use super::interleave_blur::InterleaveParams;
 use crate::cpu::clustered::{
     ClusterParams, Clustered, GeometryCluster as CpuGeometryCluster, LightEntry, PixelSurface,
 };
@@ -36,6 +37,9 @@ pub struct GatesParams {
     /// Capacity of the light-list pool, in (VPL, gates) entries of 8 bytes; a frame that needs
     /// more fails with the count it needs. [Limit: 1..=storage limit / 8]
     pub light_entries: u32,
+    /// Interleaved sampling and the geometry-aware blur, as the VAL modes have them (the same
+    /// defaults: 8 × 8 blocks); block 1 gathers every VPL at every pixel.
+    pub interleave: InterleaveParams,
 }
 
 impl Default for GatesParams {
@@ -44,6 +48,7 @@ impl Default for GatesParams {
             gates: GateParams::default(),
             clusters: ClusterParams::default(),
             light_entries: 1 << 23,
+            interleave: InterleaveParams::default(),
         }
     }
 }
@@ -71,6 +76,7 @@ impl GatesParams {
     /// Checks the limits (the pool's size against the adapter's at render time).
     pub fn check(&self) -> Result<(), RenderError> {
         check_gates(&self.gates)?;
+        self.interleave.check()?;
         let cp = self.clusters;
         if !(1..=WG_TILE).contains(&cp.tile_px) || !(1..=256).contains(&cp.depth_slices) {
             return Err(RenderError::Param(format!(
@@ -367,6 +373,7 @@ impl Scratch {
         let [w, h] = f.view.size;
         let frame = ClusterFrame {
             eye: f.view.eye.to_array(),
+            subsets: p.interleave.subsets(),
             forward: f.view.forward.to_array(),
             width: w,
             height: h,

@@ -18,12 +18,14 @@
 //                 chain of at most 2 gates leading to this cluster whose first disk's cone from
 //                 the VPL meets the cluster's bounding sphere adds (VPL, chain). Lists are
 //                 counted first, then filled in VPL order into one pool; a list that does not
-//                 fit is flagged, never cut.
+//                 fit is flagged, never cut. A list is ordered by (VPL mod B, VPL) for B
+//                 interleaving subsets, so that a pixel finds its subset's run.
 
 // As runtime::gpu::layout::ClusterFrame.
 struct ClusterFrame {
     eye: vec3<f32>,
-    pad0: f32,
+    // Interleaving subsets B: a list is ordered by (VPL mod B, VPL).
+    subsets: u32,
     // Unit view axis.
     forward: vec3<f32>,
     pad1: f32,
@@ -437,13 +439,17 @@ fn assign(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index)
     if base == NONE {
         return;
     }
-    // Fill in VPL order, 64 VPLs at a time.
+    // Fill in the order (VPL mod B, VPL), 64 places at a time: place m is VPL
+    // (m mod per)·B + m / per, per = ⌈VPLs / B⌉ (the list of a subset is one run).
     var run = 0u;
-    let chunks = (vpl_count + 63u) / 64u;
+    let subsets = max(frame.subsets, 1u);
+    let per = (vpl_count + subsets - 1u) / subsets;
+    let chunks = (per * subsets + 63u) / 64u;
     for (var c = 0u; c < chunks; c++) {
-        let j = c * 64u + li;
+        let m = c * 64u + li;
+        let j = (m % per) * subsets + m / per;
         var k = 0u;
-        if j < vpl_count {
+        if j < vpl_count && m < per * subsets {
             k = vpl_entries(j, cb, s, r, false, 0u);
         }
         part[li] = k;

@@ -7,6 +7,7 @@ use super::gbuffer::GBufferOutput;
 use super::shade::{HDR, frame_target, fullscreen};
 use crate::RenderError;
 use crate::gpu::context::{Pool, bind_group, render_pipeline};
+use crate::gpu::layout::ValGather;
 use crate::gpu::timing::Recorder;
 use crate::gpu::{Frame, shaders};
 
@@ -35,6 +36,11 @@ impl Default for InterleaveParams {
 }
 
 impl InterleaveParams {
+    /// The VPL subsets B = b².
+    pub fn subsets(&self) -> u32 {
+        self.block * self.block
+    }
+
     /// Checks the limits.
     pub fn check(&self) -> Result<(), RenderError> {
         if !(1..=16).contains(&self.block) {
@@ -65,6 +71,26 @@ impl InterleaveBlur {
         let module = shaders::module(d, "blur.wgsl")?;
         let pipeline = render_pipeline(d, "blur", &module, ("vs", "fs_compose"), &[], &[HDR], None);
         Ok(InterleaveBlur { pipeline })
+    }
+
+    /// The blur's constants (a `ValGather` with only the interleaving's fields) for a mode
+    /// without a VAL gather of its own.
+    pub fn uniform(f: &Frame, p: &InterleaveParams, pool: &mut Pool) -> wgpu::Buffer {
+        let constants = ValGather {
+            vpl_count: f.vpl_count,
+            g_max: f.params.g_max,
+            block: p.block,
+            subsets: p.subsets(),
+            blur_distance: p.blur_distance * f.scene.far_m / 4.0,
+            blur_normal: p.blur_normal,
+            ..bytemuck::Zeroable::zeroed()
+        };
+        pool.upload(
+            f.ctx,
+            "blur",
+            bytemuck::bytes_of(&constants),
+            wgpu::BufferUsages::UNIFORM,
+        )
     }
 
     /// Records the blur of `indirect` composed onto `out`, with the gather's constants

@@ -13,9 +13,10 @@ use crate::gpu::{Frame, shaders};
 /// The HDR target's format.
 pub const HDR: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
-/// The shading pipeline.
+/// The shading pipelines: direct + the mode's indirect, and interleaved gates' indirect alone.
 pub struct Shade {
     pipeline: wgpu::RenderPipeline,
+    gates_indirect: wgpu::RenderPipeline,
 }
 
 /// A fullscreen triangle into `target` (cleared to black) with `pipeline` and `bind_group`.
@@ -64,12 +65,28 @@ pub fn frame_target(f: &Frame, pool: &mut Pool, label: &'static str) -> wgpu::Te
     )
 }
 
+/// The bindings of shade.wgsl's `fs_gates_indirect` (an automatic layout holds only what an
+/// entry point uses).
+const GATES_INDIRECT_BINDINGS: [u32; 10] = [0, 2, 5, 6, 8, 10, 12, 13, 14, 15];
+
 impl Shade {
-    /// Builds the pipeline.
+    /// Builds the pipelines.
     pub fn new(d: &wgpu::Device) -> Result<Shade, RenderError> {
         let module = shaders::module(d, "shade.wgsl")?;
         let pipeline = render_pipeline(d, "shade", &module, ("vs", "fs"), &[], &[HDR], None);
-        Ok(Shade { pipeline })
+        let gates_indirect = render_pipeline(
+            d,
+            "gates indirect (interleaved)",
+            &module,
+            ("vs", "fs_gates_indirect"),
+            &[],
+            &[HDR],
+            None,
+        );
+        Ok(Shade {
+            pipeline,
+            gates_indirect,
+        })
     }
 
     /// Records the shading pass; returns the frame's HDR image so far.
@@ -78,11 +95,40 @@ impl Shade {
         f: &Frame,
         pool: &mut Pool,
         rec: &mut Recorder,
-        (shadows, g, lists): (&ShadowOutput, &GBufferOutput, Option<&ListBuffers>),
+        inputs: (&ShadowOutput, &GBufferOutput, Option<&ListBuffers>),
         name: &'static str,
     ) -> wgpu::Texture {
-        let d = &f.ctx.device;
         let out = frame_target(f, pool, "hdr");
+        self.draw(f, rec, inputs, (&self.pipeline, None), (&out, name));
+        out
+    }
+
+    /// Records interleaved clustered gates' indirect irradiance (each pixel its subset's, × B)
+    /// into a target of its own, for the blur to compose.
+    pub fn record_gates_indirect(
+        &self,
+        f: &Frame,
+        pool: &mut Pool,
+        rec: &mut Recorder,
+        inputs: (&ShadowOutput, &GBufferOutput, Option<&ListBuffers>),
+    ) -> wgpu::Texture {
+        let out = frame_target(f, pool, "indirect irradiance");
+        let pipeline = (&self.gates_indirect, Some(&GATES_INDIRECT_BINDINGS[..]));
+        self.draw(f, rec, inputs, pipeline, (&out, "indirect lighting"));
+        out
+    }
+
+    /// A fullscreen pass of shade.wgsl with `pipeline` (and the bindings it uses, all if
+    /// `None`) into `out`, timed as `name`.
+    fn draw(
+        &self,
+        f: &Frame,
+        rec: &mut Recorder,
+        (shadows, g, lists): (&ShadowOutput, &GBufferOutput, Option<&ListBuffers>),
+        (pipeline, used): (&wgpu::RenderPipeline, Option<&[u32]>),
+        (out, name): (&wgpu::Texture, &'static str),
+    ) {
+        let d = &f.ctx.device;
         let level = f.scene.level.as_ref();
         let none = &f.scene.no_level;
         let maps = array_view(&shadows.maps);
@@ -114,23 +160,18 @@ impl Shade {
                     .iter()
                     .map(|&(k, v)| (k, wgpu::BindingResource::TextureView(v))),
             )
+            .filter(|(k, _)| used.is_none_or(|u| u.contains(k)))
             .collect();
-        let bg = bind_group(
-            d,
-            &self.pipeline.get_bind_group_layout(0),
-            "shade",
-            resources,
-        );
+        let bg = bind_group(d, &pipeline.get_bind_group_layout(0), name, resources);
         let span = rec.begin(name);
         fullscreen(
             &mut rec.enc,
-            "shade",
+            name,
             &out.create_view(&Default::default()),
-            &self.pipeline,
+            pipeline,
             &bg,
             span.render(true, true),
         );
         rec.end();
-        out
     }
 }

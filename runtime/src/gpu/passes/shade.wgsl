@@ -174,7 +174,7 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
         radiance += albedo / PI * gather_all(p, n);
     } else if mode == SHADE_GATES_PER_PIXEL {
         radiance += albedo / PI * gather_per_pixel(p, n, decode_cluster(pos.w));
-    } else if mode == SHADE_GATES_CLUSTERED {
+    } else if mode == SHADE_GATES_CLUSTERED && globals.interleave_block <= 1u {
         radiance += albedo / PI * clustered_gather(px, p, n, decode_cluster(pos.w));
     }
     return vec4<f32>(radiance, 1.0);
@@ -182,7 +182,8 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
 
 // SHADE_GATES_CLUSTERED: the VPL light at p through its geometry cluster's list (without albedo / π). An
 // entry with gates is tested here, per fragment; a VPL whose light passes by several chains
-// counts once (a list is sorted by VPL).
+// counts once (a list is ordered by (VPL mod B, VPL)). With interleaving (B = b² subsets) the
+// pixel takes only its subset's run of the list, found by binary search, and the sum is × B.
 fn clustered_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32) -> vec3<f32> {
     let width = textureDimensions(g_position).x;
     let gc = pixel_cluster[u32(px.x) + u32(px.y) * width];
@@ -190,9 +191,18 @@ fn clustered_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32) -> vec
         return vec3<f32>(0.0);
     }
     let list = geometry_clusters[gc].list;
+    var first = list.x;
+    var end = list.x + list.y;
+    let b = max(globals.interleave_block, 1u);
+    let subsets = b * b;
+    let j = u32(px.x) % b + b * (u32(px.y) % b);
+    if subsets > 1u {
+        first = subset_start(first, end, subsets, j);
+        end = subset_start(first, end, subsets, j + 1u);
+    }
     var sum = vec3<f32>(0.0);
     var last = NONE;
-    for (var e = list.x; e < list.x + list.y; e++) {
+    for (var e = first; e < end; e++) {
         let entry = light_entries[e];
         if entry.x == last {
             continue;
@@ -220,7 +230,35 @@ fn clustered_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32) -> vec
         last = entry.x;
         sum += l;
     }
-    return sum;
+    return sum * f32(subsets);
+}
+
+// The first entry of [first, end) whose VPL is in subset j or later (VPL mod B >= j).
+fn subset_start(first: u32, end: u32, subsets: u32, j: u32) -> u32 {
+    var lo = first;
+    var hi = end;
+    while lo < hi {
+        let mid = (lo + hi) / 2u;
+        if light_entries[mid].x % subsets < j {
+            lo = mid + 1u;
+        } else {
+            hi = mid;
+        }
+    }
+    return lo;
+}
+
+// Interleaved clustered gates: this pixel's subset's irradiance × B alone (no albedo / π), into
+// the indirect target that blur.wgsl composes.
+@fragment
+fn fs_gates_indirect(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
+    let px = vec2<i32>(frag.xy);
+    let pos = textureLoad(g_position, px, 0);
+    if pos.w == 0.0 {
+        return vec4<f32>(0.0);
+    }
+    let n = normalize(textureLoad(g_normal, px, 0).xyz);
+    return vec4<f32>(clustered_gather(px, pos.xyz, n, decode_cluster(pos.w)), 1.0);
 }
 
 // SHADE_ALL: every VPL, no visibility.

@@ -7,7 +7,8 @@ struct Globals {
     // Shadow lookups: normal offset and bias, in texels.
     shadow_normal_offset: f32,
     shadow_bias: f32,
-    pad0: f32,
+    // Interleaving block of clustered gates (<= 1: none).
+    interleave_block: u32,
     vpl_count: u32,
     light_count: u32,
     // SHADE_ALL, SHADE_DIRECT, SHADE_GATES_PER_PIXEL or SHADE_GATES_CLUSTERED.

@@ -3,7 +3,9 @@
 // the segment to b leaves each cluster through the portal of it that it crosses first (plane
 // hit inside the coverage mask, going out), until it is in cb. It reads the including pass's
 // `grid` (voxel size, walk limit) and `portal_words: array<u32>` (GateLevel::portal_words:
-// [clusters, record base, portals], offsets, index lists, 20-word records, masks).
+// [clusters, record base, portals], offsets, each cluster's groups of portals by neighbour with
+// their boxes, index lists, 20-word records, masks). A group's portals are tested only where
+// the segment meets its box.
 
 const WALK_BLOCKED: u32 = 0u;
 const WALK_VISIBLE: u32 = 1u;
@@ -37,9 +39,44 @@ fn portal_covers(r: u32, q: vec3<f32>) -> bool {
     let x = dot(rel, pv(r + 8u)) / cell;
     let y = dot(rel, pv(r + 12u)) / cell;
     let e = EDGE_SLACK;
-    return portal_cell(r, floor(x), floor(y)) || portal_cell(r, floor(x - e), floor(y))
+    let i = floor(x);
+    let j = floor(y);
+    if portal_cell(r, i, j) {
+        return true;
+    }
+    // Off a cell's edge by more than the slack, the neighbours' cells cannot count.
+    if x - i > e && x - i < 1.0 - e && y - j > e && y - j < 1.0 - e {
+        return false;
+    }
+    return portal_cell(r, floor(x - e), floor(y))
         || portal_cell(r, floor(x + e), floor(y)) || portal_cell(r, floor(x), floor(y - e))
         || portal_cell(r, floor(x), floor(y + e));
+}
+
+// The reciprocal of d per axis, 0 on an axis it does not move along (portal_walk::inverse).
+fn inverse(d: vec3<f32>) -> vec3<f32> {
+    let safe = select(d, vec3<f32>(1.0), abs(d) < vec3<f32>(1e-30));
+    return select(1.0 / safe, vec3<f32>(0.0), abs(d) < vec3<f32>(1e-30));
+}
+
+// Whether a + d·t for some t in [t0, t1] lies in the box [lo, hi], inv = inverse(d)
+// (portal_walk::segment_box).
+fn segment_box(a: vec3<f32>, inv: vec3<f32>, t0: f32, t1: f32, lo: vec3<f32>, hi: vec3<f32>) -> bool {
+    var near = t0;
+    var far = t1;
+    for (var k = 0; k < 3; k++) {
+        if inv[k] == 0.0 {
+            if a[k] < lo[k] || a[k] > hi[k] {
+                return false;
+            }
+            continue;
+        }
+        let ta = (lo[k] - a[k]) * inv[k];
+        let tb = (hi[k] - a[k]) * inv[k];
+        near = max(near, min(ta, tb));
+        far = min(far, max(ta, tb));
+    }
+    return near <= far;
 }
 
 fn portal_walk(a: vec3<f32>, ca: u32, b: vec3<f32>, cb: u32) -> u32 {
@@ -52,6 +89,7 @@ fn portal_walk(a: vec3<f32>, ca: u32, b: vec3<f32>, cb: u32) -> u32 {
         return WALK_BLOCKED;
     }
     let slack = 1.5 * grid.voxel_size / len;
+    let inv = inverse(d);
     let records = pw(1u);
     var c = ca;
     var t0 = -slack;
@@ -60,24 +98,29 @@ fn portal_walk(a: vec3<f32>, ca: u32, b: vec3<f32>, cb: u32) -> u32 {
         var best_t = 3.4e38;
         var best = NONE;
         var best_other = NONE;
-        for (var k = pw(3u + c); k < pw(4u + c); k++) {
-            let pi = pw(k);
-            let r = records + pi * PORTAL_RECORD;
-            let c0 = pw(r + 16u);
-            let own0 = c0 == c;
-            let n = pv(r + 4u) * select(-1.0, 1.0, own0);
-            let den = dot(d, n);
-            if pi == last || den <= 1.1920929e-7 * len {
+        for (var gi = pw(3u + c); gi < pw(4u + c); gi += PORTAL_GROUP) {
+            let t1 = select(1.0 + slack, best_t, best != NONE);
+            if !segment_box(a, inv, t0, t1, pv(gi), pv(gi + 3u)) {
                 continue;
             }
-            let t = dot(pv(r) - a, n) / den;
-            if t < t0 || t > 1.0 + slack || t >= best_t {
-                continue;
-            }
-            if portal_covers(r, a + d * t) {
-                best_t = t;
-                best = pi;
-                best_other = select(c0, pw(r + 17u), own0);
+            let other = pw(gi + 6u);
+            for (var k = pw(gi + 7u); k < pw(gi + 8u); k++) {
+                let pi = pw(k);
+                let r = records + pi * PORTAL_RECORD;
+                let n = pv(r + 4u) * select(1.0, -1.0, pw(r + 17u) == c);
+                let den = dot(d, n);
+                if pi == last || den <= 1.1920929e-7 * len {
+                    continue;
+                }
+                let t = dot(pv(r) - a, n) / den;
+                if t < t0 || t > 1.0 + slack || t >= best_t {
+                    continue;
+                }
+                if portal_covers(r, a + d * t) {
+                    best_t = t;
+                    best = pi;
+                    best_other = other;
+                }
             }
         }
         if best == NONE {
