@@ -212,9 +212,14 @@ pub fn run(args: BakeArgs) -> Result<()> {
             }
         }
     };
-    let baked = pool
-        .install(|| bake(&scene, &params, &options, &progress))
-        .with_context(|| format!("cannot bake {}", args.scene))?;
+    let baked = pool.install(|| bake(&scene, &params, &options, &progress));
+    // A leak stops the bake; its paths still go where the user asked for debug files.
+    if let (Err(visgate_preprocess::BakeError::Leak { openings, .. }), Some(dir)) =
+        (&baked, &args.debug_dir)
+    {
+        write_leak_ply(dir, openings)?;
+    }
+    let baked = baked.with_context(|| format!("cannot bake {}", args.scene))?;
     baked
         .level
         .write(&args.output)
@@ -226,6 +231,14 @@ pub fn run(args: BakeArgs) -> Result<()> {
         .flatten()
     {
         eprintln!("warning: the closed scene leaks (baked anyway, --allow-leaks): {l}");
+    }
+    let openings: Vec<visgate_preprocess::leak::LeakPath> =
+        serde_json::from_value(baked.report.empty_space["openings"].clone()).unwrap_or_default();
+    for o in &openings {
+        eprintln!("warning: leak: {}", o.describe());
+    }
+    if let (Some(dir), false) = (&args.debug_dir, openings.is_empty()) {
+        write_leak_ply(dir, &openings)?;
     }
     if let Some(w) = most_dropped(&baked.report.empty_space, &baked.level.info.grid) {
         eprintln!("warning: {w}");
@@ -241,6 +254,23 @@ pub fn run(args: BakeArgs) -> Result<()> {
             .with_context(|| format!("cannot write debug exports into {}", dir.display()))?;
         println!("wrote {} debug files into {}", files.len(), dir.display());
     }
+    Ok(())
+}
+
+/// Writes the leaks' paths into `dir` as leak.ply.
+fn write_leak_ply(
+    dir: &std::path::Path,
+    openings: &[visgate_preprocess::leak::LeakPath],
+) -> Result<()> {
+    let path = dir.join("leak.ply");
+    let write = || -> std::io::Result<()> {
+        std::fs::create_dir_all(dir)?;
+        let mut w = std::io::BufWriter::new(std::fs::File::create(&path)?);
+        visgate_preprocess::leak::write_ply(&mut w, openings)?;
+        std::io::Write::flush(&mut w)
+    };
+    write().with_context(|| format!("cannot write {}", path.display()))?;
+    eprintln!("wrote {} (the paths to the outside)", path.display());
     Ok(())
 }
 

@@ -169,10 +169,11 @@ pub struct RenderArgs {
     /// Exponential depth slices of geometry clusters (--mode gates), 1..=256.
     #[arg(long, default_value_t = 24)]
     pub depth_slices: u32,
-    /// Capacity of the light-list pool (--mode gates), entries of 8 bytes; a frame that needs
-    /// more stops with the count it needs.
-    #[arg(long, default_value_t = 1 << 23)]
-    pub light_entries: u32,
+    /// Capacity of the light-list pool (--mode gates), entries of 8 bytes: a frame that needs
+    /// more stops with the count it needs. Unset, the pool grows to what a frame needs, up to
+    /// the adapter's storage binding limit.
+    #[arg(long)]
+    pub light_entries: Option<u32>,
     /// Virtual area lights (--mode val-hard): the VPLs are clustered into this many.
     #[arg(long, default_value_t = 30)]
     pub vals: u32,

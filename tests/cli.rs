@@ -269,6 +269,97 @@ fn bake_writes_the_level_report_and_debug_exports() {
     assert!(stdout(&o).contains("gates       1"), "{}", stdout(&o));
 }
 
+/// A closed room (4 × 3 × 4 m, zero-thickness walls) with a 0.6 m window in its +x wall
+/// centred at (4, 1.5, 2), a ground outside, and a lamp inside, as an OBJ and a scene file.
+fn leaky_room(dir: &std::path::Path) -> std::path::PathBuf {
+    let mut obj = String::new();
+    let mut quad = |p: [[f32; 3]; 4]| {
+        for v in p {
+            obj += &format!("v {} {} {}\n", v[0], v[1], v[2]);
+        }
+        obj += "f -4 -3 -2 -1\n";
+    };
+    quad([[0., 0., 0.], [0., 0., 4.], [4., 0., 4.], [4., 0., 0.]]);
+    quad([[0., 3., 0.], [4., 3., 0.], [4., 3., 4.], [0., 3., 4.]]);
+    quad([[0., 0., 0.], [0., 3., 0.], [0., 3., 4.], [0., 0., 4.]]);
+    quad([[0., 0., 0.], [4., 0., 0.], [4., 3., 0.], [0., 3., 0.]]);
+    quad([[0., 0., 4.], [0., 3., 4.], [4., 3., 4.], [4., 0., 4.]]);
+    quad([[4., 0., 0.], [4., 0., 4.], [8., 0., 4.], [8., 0., 0.]]);
+    for (y0, y1, z0, z1) in [
+        (0., 1.2, 0., 4.),
+        (1.8, 3., 0., 4.),
+        (1.2, 1.8, 0., 1.7),
+        (1.2, 1.8, 2.3, 4.),
+    ] {
+        quad([[4., y0, z0], [4., y0, z1], [4., y1, z1], [4., y1, z0]]);
+    }
+    std::fs::write(dir.join("room.obj"), obj).expect("obj");
+    let toml = "name = \"leaky\"\nclosed = true\n[[mesh]]\npath = \"room.obj\"\n\
+                [[light]]\ntype = \"point\"\nposition = [2.0, 1.5, 2.0]\nintensity = [5, 5, 5]\n";
+    let path = dir.join("leaky.toml");
+    std::fs::write(&path, toml).expect("toml");
+    path
+}
+
+#[test]
+fn a_leak_is_printed_where_it_is_and_written_as_a_path() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let scene = leaky_room(dir.path());
+    let (out, debug, report) = (
+        dir.path().join("l.vgate"),
+        dir.path().join("debug"),
+        dir.path().join("bake.json"),
+    );
+    let path = |p: &std::path::Path| p.to_str().expect("utf-8").to_string();
+    let args = [
+        "bake".to_string(),
+        path(&scene),
+        "-o".into(),
+        path(&out),
+        "--resolution".into(),
+        "64".into(),
+        "--debug-dir".into(),
+        path(&debug),
+        "--report".into(),
+        path(&report),
+    ];
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let o = visgate(&args);
+    assert!(!o.status.success());
+    let err = stderr(&o);
+    assert!(
+        err.contains("point light 0")
+            && err.contains("reaches the outside through an opening near (4."),
+        "{err}"
+    );
+    assert!(
+        err.contains("--allow-leaks") && !err.contains("panicked"),
+        "{err}"
+    );
+    let ply = std::fs::read_to_string(debug.join("leak.ply")).expect("leak.ply");
+    assert!(
+        ply.starts_with("ply") && ply.contains("element edge"),
+        "{ply}"
+    );
+    // Baked anyway: a warning with the place, and the openings in the report.
+    let mut anyway = args.clone();
+    anyway.push("--allow-leaks");
+    let o = visgate(&anyway);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("warning: leak: point light 0"),
+        "{}",
+        stderr(&o)
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).expect("report")).expect("json");
+    let openings = json["empty_space"]["openings"]
+        .as_array()
+        .expect("openings");
+    assert_eq!(openings.len(), 1, "{openings:?}");
+    assert!(openings[0]["path_m"].as_array().expect("path").len() > 5);
+}
+
 #[test]
 fn bake_takes_the_papers_readings_and_records_them_in_the_file() {
     let dir = tempfile::tempdir().expect("tempdir");

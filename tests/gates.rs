@@ -572,7 +572,7 @@ fn gpu_gates_stay_stable_at_the_extremes() {
             &view,
             &vpls,
             &params(GpuMode::Gates(GatesParams {
-                light_entries: 1000,
+                light_entries: Some(1000),
                 ..GatesParams::default()
             })),
         )
@@ -769,4 +769,53 @@ fn interleaved_gates_keep_the_light_of_every_vpl_gather() {
         assert!(e.rel_mse < 0.05, "block {block}: rel. MSE {}", e.rel_mse);
         assert!(e.rel_mse > 0.0, "block {block}: the image did not change");
     }
+}
+
+#[test]
+fn the_light_list_pool_grows_to_what_a_frame_needs() {
+    use visgate_runtime::gpu::{GatesParams, GpuContext, GpuMode, GpuParams, GpuRenderer};
+    use visgate_runtime::vpl::{PathParams, path_vpls};
+    let ctx = GpuContext::new().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"));
+    let (scene, gates, tracer, _, _) = fixture(Builtin::FourRooms, 96);
+    let view = visgate_runtime::camera::View::new(&scene.cameras[0], [96, 72]).expect("view");
+    let paths = PathParams {
+        paths: 32768,
+        bounces: 1,
+        seed: 3,
+    };
+    let vpls = path_vpls(&tracer, &scene.lights, &paths).expect("vpls");
+    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    gpu.set_level(&ctx, &gates).expect("level");
+    let (grown, t) = gpu
+        .render(
+            &ctx,
+            &view,
+            &vpls,
+            &GpuParams::with_mode(GpuMode::Gates(GatesParams::default())),
+        )
+        .expect("the pool grows");
+    let lists = t.lists.expect("lists");
+    eprintln!("{} entries in a pool of {}", lists.entries, lists.capacity);
+    let start = visgate_runtime::gpu::passes::clustered_gates::AUTO_LIGHT_ENTRIES;
+    assert!(
+        lists.entries > u64::from(start),
+        "{} entries: the test needs more",
+        lists.entries
+    );
+    assert!(u64::from(lists.capacity) >= lists.entries);
+    // The same image as a pool of fixed size that holds them; one too small still fails.
+    let fixed = |n: u64| {
+        GpuParams::with_mode(GpuMode::Gates(GatesParams {
+            light_entries: Some(n as u32),
+            ..GatesParams::default()
+        }))
+    };
+    let (img, _) = gpu
+        .render(&ctx, &view, &vpls, &fixed(lists.entries))
+        .expect("fixed");
+    assert_eq!(img.pixels, grown.pixels);
+    let e = gpu
+        .render(&ctx, &view, &vpls, &fixed(lists.entries - 1))
+        .expect_err("too small");
+    assert!(e.to_string().contains("--light-entries"), "{e}");
 }

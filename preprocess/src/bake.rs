@@ -667,6 +667,7 @@ pub fn bake(
         empty_space: json!({
             "components": es.components,
             "leaks": es.leaks,
+            "openings": es.openings,
             "hung_objects": es.threads,
             "seeds_outside_grid": es.seeds_outside,
         }),

@@ -98,6 +98,9 @@ pub struct EmptySpace {
     pub components: Vec<ComponentReport>,
     /// Leaks of a closed scene (empty when not closed or sealed).
     pub leaks: Vec<Leak>,
+    /// Where they leak: the shortest paths from the cameras and lights to the outside, and
+    /// the openings they pass.
+    pub openings: Vec<crate::leak::LeakPath>,
     /// Floating objects that were hung.
     pub threads: Vec<Thread>,
     /// Seeds that fell outside the grid or in solid with no empty voxel next to them.
@@ -147,6 +150,7 @@ pub fn empty_space(
     // Seeds: the voxel of the point, or an empty voxel next to it.
     let mut seeds_in: Vec<Vec<String>> = vec![Vec::new(); n];
     let mut seeds_outside = Vec::new();
+    let mut seed_voxels = Vec::new();
     for s in seeds {
         let found = meta.world_to_voxel(s.position_m).and_then(|v| {
             // The voxel itself first, then its 26 neighbours in a fixed order.
@@ -159,11 +163,14 @@ pub fn empty_space(
                         return None;
                     }
                     let i = w[0] as usize + nx * (w[1] as usize + ny * w[2] as usize);
-                    (label[i] != u32::MAX).then_some(label[i])
+                    (label[i] != u32::MAX).then_some((label[i], i))
                 })
         });
         match found {
-            Some(l) => seeds_in[l as usize].push(s.what.clone()),
+            Some((l, i)) => {
+                seeds_in[l as usize].push(s.what.clone());
+                seed_voxels.push((s.what.clone(), s.position_m, i));
+            }
             None => seeds_outside.push(s.what.clone()),
         }
     }
@@ -206,6 +213,13 @@ pub fn empty_space(
                         params.min_component_voxels
                     ),
                 )
+            } else if params.closed && faced[c] == [0, 0] {
+                (
+                    false,
+                    "inside closed geometry: a closed level's space that no triangle faces or \
+                     turns its back to (a void within a thick wall)"
+                        .to_string(),
+                )
             } else if faced[c][1] > faced[c][0] {
                 (
                     false,
@@ -234,8 +248,9 @@ pub fn empty_space(
             *e = false;
         }
     }
-    // Leaks: kept empty voxels next to the border ring.
+    // Leaks: kept empty voxels next to the border ring, and the openings they pass.
     let mut leaks = Vec::new();
+    let mut openings = Vec::new();
     if params.closed {
         const SIDES: [&str; 6] = ["-x", "+x", "-y", "+y", "-z", "+z"];
         let mut acc: Vec<(u64, [u32; 3], [u32; 3])> = vec![(0, [u32::MAX; 3], [0; 3]); 6];
@@ -271,6 +286,9 @@ pub fn empty_space(
                 });
             }
         }
+        if !leaks.is_empty() {
+            openings = crate::leak::find_openings(meta, &empty, &seed_voxels);
+        }
         if !leaks.is_empty() && !params.allow_leaks {
             let list: Vec<String> = leaks
                 .iter()
@@ -288,7 +306,10 @@ pub fn empty_space(
                     )
                 })
                 .collect();
-            return Err(BakeError::Leak(list.join("; ")));
+            return Err(BakeError::Leak {
+                openings,
+                sides: list.join("; "),
+            });
         }
     }
     components.sort_by_key(|c| std::cmp::Reverse(c.voxels));
@@ -304,6 +325,7 @@ pub fn empty_space(
         empty_voxels,
         components,
         leaks,
+        openings,
         threads,
         seeds_outside,
     })

@@ -22,6 +22,7 @@ pub mod debug;
 pub mod distance;
 pub mod empty;
 pub mod graph;
+pub mod leak;
 pub mod neighbourhood;
 pub mod portals;
 pub mod report;
@@ -44,9 +45,15 @@ pub enum BakeError {
     NoGeometry,
     /// A closed scene's empty space reaches its bounds.
     #[error(
-        "the scene is declared closed but its empty space reaches the bounds ({0}); close the geometry there, or bake anyway with --allow-leaks"
+        "the scene is declared closed but its empty space reaches the outside{}; close the geometry there, or bake anyway with --allow-leaks (--debug-dir writes the paths as leak.ply) [sides of the bounds reached: {sides}]",
+        leak::describe_all(openings)
     )]
-    Leak(String),
+    Leak {
+        /// The paths to the outside and their openings.
+        openings: Vec<leak::LeakPath>,
+        /// The sides of the bounds reached, with boxes.
+        sides: String,
+    },
     /// The grids would not fit in the memory limit; nothing was allocated.
     #[error(
         "a {:.0} x {:.0} x {:.0} voxel grid needs about {:.1} GiB for the bake, over the limit of {:.1} GiB; lower --resolution or raise --voxel-size",

@@ -3,7 +3,11 @@
 //! Every voxel that a static triangle touches (closed box, separating-axis test of
 //! Akenine-Möller) is solid, so a wall thinner than a voxel still closes the space behind it.
 //! The grid covers the static bounds plus one voxel on every side; that border ring is solid
-//! by convention (it closes open roofs), so the empty space never touches the grid's edge.
+//! by convention (it closes open roofs), so the empty space never touches the grid's edge. No
+//! triangle marks the ring itself: a voxel of the ring that a triangle touches marks its
+//! neighbour inside instead, so that a wall lying exactly on the bounds closes the level at
+//! every resolution and scale whatever the rounding puts where (and empty space next to the
+//! ring is truly beyond the geometry: a leak).
 
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -141,6 +145,14 @@ pub fn voxelize(meta: GridMeta, triangles: &[[Vec3; 3]]) -> SolidGrid {
                                 let c = origin
                                     + (DVec3::new(x as f64, y as f64, z as f64) + 0.5) * size;
                                 if tri_box_overlap(c, half, v) {
+                                    // Geometry never falls into the border ring: a wall on
+                                    // the bounds (rounding may put it in the ring alone)
+                                    // marks the first voxel inside instead.
+                                    let (x, y, z) = (
+                                        x.clamp(1, nx - 2),
+                                        y.clamp(1, ny - 2),
+                                        z.clamp(1, nz - 2),
+                                    );
                                     let i = x + nx * (y + ny * z);
                                     bits[i / 64] |= 1 << (i % 64);
                                 }

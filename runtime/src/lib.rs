@@ -49,6 +49,24 @@ pub enum RenderError {
     /// The GPU failed at something it should do.
     #[error("GPU: {0}")]
     Gpu(String),
+    /// The light lists of mode gates need more entries than a pool of fixed capacity holds
+    /// (the light is never cut: the frame fails).
+    #[error(
+        "the light lists of {clusters} geometry clusters need {needed} entries, more than the \
+         pool's {capacity} ({lists} lists did not fit): raise --light-entries \
+         (GatesParams::light_entries) to at least {needed}, leave it unset to let the pool \
+         grow, or use fewer VPLs"
+    )]
+    LightListsFull {
+        /// Entries the frame needs.
+        needed: u64,
+        /// The pool's capacity.
+        capacity: u32,
+        /// Lists that did not fit.
+        lists: u32,
+        /// Geometry clusters in view.
+        clusters: u32,
+    },
     /// Reading or writing a file.
     #[error("{path}: {message}")]
     Io {

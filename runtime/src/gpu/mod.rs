@@ -172,6 +172,8 @@ pub struct GpuRenderer {
     pool: Pool,
     /// VALs clustered last frame (their centres are in the pool): a warm start's condition.
     val_warm: Option<u32>,
+    /// The light-list pool's capacity when it grows on its own (mode gates).
+    light_entries: u32,
 }
 
 /// What [`record_passes`] leaves: the image, and the light lists of mode gates.
@@ -274,6 +276,7 @@ impl GpuRenderer {
             pipelines: Pipelines::new(d)?,
             pool: Pool::default(),
             val_warm: None,
+            light_entries: passes::clustered_gates::AUTO_LIGHT_ENTRIES,
         })
     }
 
@@ -418,7 +421,39 @@ impl GpuRenderer {
         vpls: VplInput,
         params: &GpuParams,
     ) -> Result<(HdrImage, PassTimes), RenderError> {
-        context::scoped(ctx, || self.frame_unscoped(ctx, view, vpls, params))
+        let GpuMode::Gates(g) = params.mode else {
+            return context::scoped(ctx, || self.frame_unscoped(ctx, view, vpls, params));
+        };
+        if g.light_entries.is_some() {
+            return context::scoped(ctx, || self.frame_unscoped(ctx, view, vpls, params));
+        }
+        // A pool that grows: the frame again with the capacity it needed (a quarter more,
+        // for the next frames' changes), up to the adapter's limit.
+        let max = (ctx.device.limits().max_storage_buffer_binding_size / 8).min(u32::MAX as u64);
+        for _ in 0..2 {
+            let mut p = *params;
+            p.mode = GpuMode::Gates(GatesParams {
+                light_entries: Some(self.light_entries),
+                ..g
+            });
+            match context::scoped(ctx, || self.frame_unscoped(ctx, view, vpls, &p)) {
+                Err(RenderError::LightListsFull { needed, .. }) if needed <= max => {
+                    self.light_entries = (needed + needed / 4).min(max) as u32;
+                }
+                Err(RenderError::LightListsFull { needed, .. }) => {
+                    return Err(RenderError::Param(format!(
+                        "the light lists need {needed} entries ({} bytes), more than the \
+                         adapter's storage binding limit allows ({max} entries): use fewer VPLs, \
+                         a smaller image or larger tiles (--tile-px)",
+                        needed * 8
+                    )));
+                }
+                r => return r,
+            }
+        }
+        Err(RenderError::Gpu(
+            "the light lists kept outgrowing their pool".into(),
+        ))
     }
 
     /// [`GpuRenderer::render_frame`] without the error scope.

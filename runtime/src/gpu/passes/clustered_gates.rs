@@ -27,30 +27,24 @@ pub const MAX_GATES: usize = 0xfffe;
 /// Keys hold a visibility cluster in [`CLUSTER_BITS`] bits, the all-ones value meaning "none".
 pub const MAX_CLUSTERS: usize = (1 << CLUSTER_BITS) - 2;
 
+/// The light-list pool's first capacity when it grows on its own. [Units: entries]
+pub const AUTO_LIGHT_ENTRIES: u32 = 1 << 22;
+
 /// Parameters of mode `gates` (clustered shading).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct GatesParams {
     /// How light passes gates (`max_hops` 1 or 2 on the GPU).
     pub gates: GateParams,
     /// Geometry clusters (`tile_px` 1..=16 on the GPU).
     pub clusters: ClusterParams,
     /// Capacity of the light-list pool, in (VPL, gates) entries of 8 bytes; a frame that needs
-    /// more fails with the count it needs. [Limit: 1..=storage limit / 8]
-    pub light_entries: u32,
+    /// more fails with the count it needs. `None`: the pool starts at [`AUTO_LIGHT_ENTRIES`]
+    /// and grows to what a frame needs (that frame is rendered again), up to the adapter's
+    /// storage binding limit. [Limit: 1..=storage limit / 8]
+    pub light_entries: Option<u32>,
     /// Interleaved sampling and the geometry-aware blur, as the VAL modes have them (the same
     /// defaults: 8 × 8 blocks); block 1 gathers every VPL at every pixel.
     pub interleave: InterleaveParams,
-}
-
-impl Default for GatesParams {
-    fn default() -> Self {
-        GatesParams {
-            gates: GateParams::default(),
-            clusters: ClusterParams::default(),
-            light_entries: 1 << 23,
-            interleave: InterleaveParams::default(),
-        }
-    }
 }
 
 /// Checks gate parameters against what the GPU's test does (≤ 2 hops).
@@ -85,7 +79,7 @@ impl GatesParams {
                 cp.tile_px, cp.depth_slices
             )));
         }
-        if self.light_entries == 0 {
+        if self.light_entries == Some(0) {
             return Err(RenderError::Param(
                 "the light-entry pool (--light-entries) must hold at least 1 entry".into(),
             ));
@@ -195,12 +189,12 @@ impl ListBuffers {
             vpls_outside: c[4],
         };
         if c[1] > 0 {
-            return Err(RenderError::Param(format!(
-                "the light lists of {} geometry clusters need {} entries, more than the pool's {} \
-                 ({} lists did not fit): raise --light-entries (GatesParams::light_entries) to at \
-                 least {}, or use fewer VPLs",
-                stats.geometry_clusters, stats.entries, self.capacity, c[1], stats.entries
-            )));
+            return Err(RenderError::LightListsFull {
+                needed: stats.entries,
+                capacity: self.capacity,
+                lists: c[1],
+                clusters: stats.geometry_clusters,
+            });
         }
         Ok(stats)
     }
@@ -248,7 +242,7 @@ impl ClusteredGates {
         let max_binding = limits
             .max_storage_buffer_binding_size
             .min(limits.max_buffer_size);
-        let capacity = p.light_entries;
+        let capacity = p.light_entries.unwrap_or(AUTO_LIGHT_ENTRIES);
         let sizes = [
             ("geometry clusters", pixels * 64, "a smaller image"),
             (

@@ -1,0 +1,212 @@
+//! Where a closed level leaks: the openings through which its kept empty space reaches the
+//! outside, found as Quake's map compiler finds them for its point file — a path through the
+//! empty voxels from a camera or light that keeps the space to the grid's bounds.
+//!
+//! The path is the **widest** one out (the one whose narrowest point is widest: a bottleneck
+//! search over the clearance of each voxel, its distance to the nearest voxel that is not
+//! empty; the outside beyond the bounds counts as empty), so it runs through the middle of the
+//! largest opening. Its narrowest voxel, the one
+//! nearest the outside among equals, is the **opening** — a window, a gap under a door, a
+//! missing wall — about twice its clearance less a voxel wide. Separate openings are found one
+//! after another: each found opening is closed (a ball of its clearance and two voxels more)
+//! and the search runs again, up to [`MAX_OPENINGS`].
+
+use std::cmp::Reverse;
+use std::collections::BinaryHeap;
+use std::io::{self, Write};
+
+use serde::{Deserialize, Serialize};
+use visgate_formats::vgate::GridMeta;
+
+/// Openings listed at most.
+pub const MAX_OPENINGS: usize = 8;
+
+/// A path from a camera or light to the outside and the opening it passes.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct LeakPath {
+    /// The camera or light it starts from, e.g. `light 1`.
+    pub from: String,
+    /// Where that is, metres.
+    pub from_m: [f32; 3],
+    /// The opening: the path's narrowest voxel's centre, metres.
+    pub opening_m: [f32; 3],
+    /// About how wide the opening is, metres.
+    pub width_m: f32,
+    /// The path's voxel centres from the seed to the bounds, metres.
+    pub path_m: Vec<[f32; 3]>,
+}
+
+impl LeakPath {
+    /// One line for the terminal.
+    pub fn describe(&self) -> String {
+        let p = |v: [f32; 3]| format!("({:.2}, {:.2}, {:.2})", v[0], v[1], v[2]);
+        format!(
+            "{} at {} m reaches the outside through an opening near {} m, about {:.2} m wide",
+            self.from,
+            p(self.from_m),
+            p(self.opening_m),
+            self.width_m
+        )
+    }
+}
+
+/// The openings as a clause for a message: `: leak: …; leak: …` (nothing when there are none).
+pub fn describe_all(openings: &[LeakPath]) -> String {
+    openings
+        .iter()
+        .map(|o| format!("; leak: {}", o.describe()))
+        .collect::<String>()
+        .replacen(';', ":", 1)
+}
+
+/// Whether voxel `v` lies next to the grid's solid border ring (the bounds).
+fn at_bounds(v: [usize; 3], dims: [usize; 3]) -> bool {
+    (0..3).any(|a| v[a] == 1 || v[a] + 2 == dims[a])
+}
+
+fn coords(i: usize, dims: [usize; 3]) -> [usize; 3] {
+    [
+        i % dims[0],
+        (i / dims[0]) % dims[1],
+        i / (dims[0] * dims[1]),
+    ]
+}
+
+/// The openings through which the `empty` voxels (`true`: kept empty space) reach the bounds
+/// from the `seeds` (a name, its position and its voxel index).
+pub fn find_openings(
+    meta: &GridMeta,
+    empty: &[bool],
+    seeds: &[(String, [f32; 3], usize)],
+) -> Vec<LeakPath> {
+    let dims = meta.dims.map(|d| d as usize);
+    // The border ring stands for the outside beyond the bounds: open, not an obstacle.
+    let ring = |i: usize| {
+        let v = coords(i, dims);
+        (0..3).any(|a| v[a] == 0 || v[a] + 1 == dims[a])
+    };
+    let not_empty: Vec<bool> = (0..empty.len()).map(|i| !empty[i] && !ring(i)).collect();
+    let d2 = crate::distance::squared_distance(meta.dims, &not_empty);
+    let mut open = empty.to_vec();
+    let mut out = Vec::new();
+    while out.len() < MAX_OPENINGS {
+        let Some((path, seed)) = widest_path_out(&open, &d2, dims, seeds) else {
+            break;
+        };
+        // The narrowest voxel, the one nearest the outside among equals.
+        let k = (0..path.len())
+            .rev()
+            .min_by_key(|&k| d2[path[k]])
+            .expect("a path has a voxel");
+        let clearance = (d2[path[k]] as f32).sqrt();
+        let centre = |i: usize| {
+            let v = coords(i, dims);
+            std::array::from_fn(|a| meta.origin_m[a] + (v[a] as f32 + 0.5) * meta.voxel_size_m)
+        };
+        out.push(LeakPath {
+            from: seeds[seed].0.clone(),
+            from_m: seeds[seed].1,
+            opening_m: centre(path[k]),
+            width_m: (2.0 * clearance - 1.0).max(1.0) * meta.voxel_size_m,
+            path_m: path.iter().map(|&i| centre(i)).collect(),
+        });
+        close_ball(&mut open, dims, path[k], clearance + 2.0);
+    }
+    out
+}
+
+/// The widest 26-connected path through `open` voxels from a seed to a voxel next to the
+/// bounds — the one whose smallest squared clearance `d2` is largest (a bottleneck search:
+/// voxels taken widest reach first) — seed first, and which seed it starts from.
+fn widest_path_out(
+    open: &[bool],
+    d2: &[u64],
+    dims: [usize; 3],
+    seeds: &[(String, [f32; 3], usize)],
+) -> Option<(Vec<usize>, usize)> {
+    const NONE: u32 = u32::MAX;
+    let mut parent = vec![NONE; open.len()];
+    // (the path's smallest clearance so far, nearer first among equals, voxel)
+    let mut heap = BinaryHeap::new();
+    for &(_, _, i) in seeds {
+        if open.get(i) == Some(&true) && parent[i] == NONE {
+            parent[i] = i as u32;
+            heap.push((d2[i], Reverse(0u32), i));
+        }
+    }
+    while let Some((reach, Reverse(steps), i)) = heap.pop() {
+        let v = coords(i, dims);
+        if at_bounds(v, dims) {
+            let (mut path, mut c) = (vec![i], i);
+            while parent[c] as usize != c {
+                c = parent[c] as usize;
+                path.push(c);
+            }
+            path.reverse();
+            let seed = seeds.iter().position(|s| s.2 == path[0]).unwrap_or(0);
+            return Some((path, seed));
+        }
+        for k in 0..27 {
+            if k == 13 {
+                continue;
+            }
+            let o = [k % 3, (k / 3) % 3, k / 9];
+            // The border ring is solid, so a voxel inside it has every neighbour in the grid.
+            let w: [usize; 3] = std::array::from_fn(|a| v[a] + o[a] - 1);
+            let j = w[0] + dims[0] * (w[1] + dims[1] * w[2]);
+            if open[j] && parent[j] == NONE {
+                parent[j] = i as u32;
+                heap.push((reach.min(d2[j]), Reverse(steps + 1), j));
+            }
+        }
+    }
+    None
+}
+
+/// Makes the ball of `radius` voxels about voxel `i` not open.
+fn close_ball(open: &mut [bool], dims: [usize; 3], i: usize, radius: f32) {
+    let v = coords(i, dims).map(|c| c as i64);
+    let r = radius.ceil() as i64;
+    for dz in -r..=r {
+        for dy in -r..=r {
+            for dx in -r..=r {
+                let w = [v[0] + dx, v[1] + dy, v[2] + dz];
+                if (0..3).any(|a| w[a] < 0 || w[a] >= dims[a] as i64)
+                    || ((dx * dx + dy * dy + dz * dz) as f32) > radius * radius
+                {
+                    continue;
+                }
+                open[w[0] as usize + dims[0] * (w[1] as usize + dims[1] * w[2] as usize)] = false;
+            }
+        }
+    }
+}
+
+/// Writes `paths` as a PLY of polylines (vertices and edges), each opening a vertex of its own
+/// (property `opening` 1), to open beside the level in Blender or MeshLab.
+pub fn write_ply(w: &mut dyn Write, paths: &[LeakPath]) -> io::Result<()> {
+    let vertices: usize = paths.iter().map(|p| p.path_m.len() + 1).sum();
+    let edges: usize = paths.iter().map(|p| p.path_m.len().saturating_sub(1)).sum();
+    writeln!(
+        w,
+        "ply\nformat ascii 1.0\ncomment visgate leaks: the path from a camera or light to the \
+         outside, and its opening\nelement vertex {vertices}\nproperty float x\nproperty float \
+         y\nproperty float z\nproperty uchar opening\nelement edge {edges}\nproperty int \
+         vertex1\nproperty int vertex2\nend_header"
+    )?;
+    for p in paths {
+        for v in &p.path_m {
+            writeln!(w, "{} {} {} 0", v[0], v[1], v[2])?;
+        }
+        let o = p.opening_m;
+        writeln!(w, "{} {} {} 1", o[0], o[1], o[2])?;
+    }
+    let mut base = 0;
+    for p in paths {
+        for k in 1..p.path_m.len() {
+            writeln!(w, "{} {}", base + k - 1, base + k)?;
+        }
+        base += p.path_m.len() + 1;
+    }
+    Ok(())
+}
