@@ -169,7 +169,8 @@ pub struct RenderArgs {
     /// Exponential depth slices of geometry clusters (--mode gates), 1..=256.
     #[arg(long, default_value_t = 24)]
     pub depth_slices: u32,
-    /// Capacity of the light-list pool (--mode gates), entries of 8 bytes: a frame that needs
+    /// Capacity of the light-list pool (--mode gates with --gate-shape disk; portals keep no
+    /// lists: a pixel walks every VPL of its subset), entries of 8 bytes: a frame that needs
     /// more stops with the count it needs. Unset, the pool grows to what a frame needs, up to
     /// the adapter's storage binding limit.
     #[arg(long)]

@@ -596,9 +596,10 @@ fn render_gates_uses_a_baked_level_and_refuses_a_missing_or_stale_one() {
     ] {
         assert!(stdout(&o).contains(pass), "{pass}: {}", stdout(&o));
     }
-    // A pool too small: the error names the setting and what it needs.
+    // A pool too small (disks keep lists; portals none): the error names the setting and
+    // what it needs.
     let mut small = a.clone();
-    small.extend(["--light-entries", "10"]);
+    small.extend(["--light-entries", "10", "--gate-shape", "disk"]);
     let o = visgate(&small);
     assert!(!o.status.success());
     assert!(

@@ -467,6 +467,15 @@ fn gpu_light_lists_equal_the_cpu_twin() {
 #[path = "../runtime/tests/common/mod.rs"]
 mod common;
 
+/// Clustered gates with the paper's disks, the shape that keeps light lists (portals walk each
+/// pixel's VPL subset without lists).
+fn disk_lists() -> visgate_runtime::gpu::GatesParams {
+    use visgate_runtime::gpu::GatesParams;
+    let mut p = GatesParams::default();
+    p.gates.shape = GateShape::Disk;
+    p
+}
+
 /// Clustered gates without interleaving (what the CPU twin computes).
 fn every_vpl_at_every_pixel() -> visgate_runtime::gpu::GatesParams {
     use visgate_runtime::gpu::{GatesParams, InterleaveParams};
@@ -573,7 +582,7 @@ fn gpu_gates_stay_stable_at_the_extremes() {
             &vpls,
             &params(GpuMode::Gates(GatesParams {
                 light_entries: Some(1000),
-                ..GatesParams::default()
+                ..disk_lists()
             })),
         )
         .expect_err("overflow");
@@ -591,7 +600,7 @@ fn gpu_gates_stay_stable_at_the_extremes() {
     let (_, rel) = gpu_vs_twin(&mut gpu, &ctx, &scene, &tracer, &gates, &one, &view);
     assert!(rel < 0.02, "one cluster: {rel}");
     let (_, lists) = gpu
-        .light_lists(&ctx, &view, &one, &GatesParams::default())
+        .light_lists(&ctx, &view, &one, &disk_lists())
         .expect("lists");
     for (c, l) in lists.clusters.iter().zip(&lists.lists) {
         if c.cluster == Some(home) {
@@ -773,6 +782,7 @@ fn interleaved_gates_keep_the_light_of_every_vpl_gather() {
 
 #[test]
 fn the_light_list_pool_grows_to_what_a_frame_needs() {
+    // Disks keep lists; portals keep none (their pool stays at one entry).
     use visgate_runtime::gpu::{GatesParams, GpuContext, GpuMode, GpuParams, GpuRenderer};
     use visgate_runtime::vpl::{PathParams, path_vpls};
     let ctx = GpuContext::new().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"));
@@ -791,7 +801,7 @@ fn the_light_list_pool_grows_to_what_a_frame_needs() {
             &ctx,
             &view,
             &vpls,
-            &GpuParams::with_mode(GpuMode::Gates(GatesParams::default())),
+            &GpuParams::with_mode(GpuMode::Gates(disk_lists())),
         )
         .expect("the pool grows");
     let lists = t.lists.expect("lists");
@@ -807,7 +817,7 @@ fn the_light_list_pool_grows_to_what_a_frame_needs() {
     let fixed = |n: u64| {
         GpuParams::with_mode(GpuMode::Gates(GatesParams {
             light_entries: Some(n as u32),
-            ..GatesParams::default()
+            ..disk_lists()
         }))
     };
     let (img, _) = gpu
@@ -818,4 +828,15 @@ fn the_light_list_pool_grows_to_what_a_frame_needs() {
         .render(&ctx, &view, &vpls, &fixed(lists.entries - 1))
         .expect_err("too small");
     assert!(e.to_string().contains("--light-entries"), "{e}");
+    // Portals: no lists at all, however many VPLs.
+    let (_, t) = gpu
+        .render(
+            &ctx,
+            &view,
+            &vpls,
+            &GpuParams::with_mode(GpuMode::Gates(GatesParams::default())),
+        )
+        .expect("portals");
+    let l = t.lists.expect("stats");
+    assert_eq!((l.entries, l.capacity), (0, 1));
 }

@@ -8,6 +8,7 @@
 //! | `segmented.ply` | segmented nodes coloured by class (topology red, curvature green, coverage blue, narrowing yellow), edges straight |
 //! | `clusters.ply` | kept empty voxels (every 2nd in each axis) coloured by cluster |
 //! | `gates.ply` | gates as 32-sided disks, coloured like their first cluster |
+//! | `leak.ply` | a leaking closed scene's paths to the outside (written by the CLI, also when the bake stops; [`crate::leak::write_ply`]) |
 //! | `solid.npy`, `skeleton.npy` | uint8 `[nx, ny, nz]`, C order, indexed `[x, y, z]`, 1 = solid / skeleton voxel, border included |
 
 use std::io::{self, BufWriter, Write};

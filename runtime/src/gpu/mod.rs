@@ -607,7 +607,8 @@ impl GpuRenderer {
     /// and reads back what they built, as the CPU twin [`crate::cpu::clustered::assign`] gives
     /// it: each pixel's surface (the G-buffer's position, normal, visibility cluster, and the
     /// GPU's view depth), the geometry clusters with their boxes, and each cluster's light
-    /// list. For tests and inspection; slow (reads all back).
+    /// list (empty with portals, which keep none). For tests and inspection; slow (reads all
+    /// back).
     pub fn light_lists(
         &mut self,
         ctx: &GpuContext,
@@ -626,10 +627,6 @@ impl GpuRenderer {
             .clustered
             .record(&frame, gates, pool, &mut rec, &g.views[0])?;
         rec.finish(pool)?;
-        b.read_back(
-            ctx,
-            &g,
-            gates.gates.shape == crate::cpu::gates::GateShape::Portal,
-        )
+        b.read_back(ctx, &g)
     }
 }

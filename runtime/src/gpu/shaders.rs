@@ -78,9 +78,6 @@ pub const CSSM_DEPTH_SCALE: f32 = 0.9;
 /// than 1 from each (no wrap-around).
 pub const CSSM_EMPTY_DEPTH: f32 = 0.95;
 
-/// The bit a portal-mode light-list entry sets beside the VPL's cluster: walk from there.
-pub const WALK_FROM: u32 = 0x8000_0000;
-
 /// The constants every composed shader starts with, generated from the Rust definitions.
 pub fn constants() -> String {
     let u = |name: &str, v: u32| format!("const {name}: u32 = {v}u;\n");
@@ -104,7 +101,6 @@ pub fn constants() -> String {
     s += "const LIGHT_POINT: f32 = 0.0;\nconst LIGHT_SPOT: f32 = 1.0;\n";
     s += &format!("const CSSM_DEPTH_SCALE: f32 = {CSSM_DEPTH_SCALE:?};\n");
     s += &format!("const CSSM_EMPTY_DEPTH: f32 = {CSSM_EMPTY_DEPTH:?};\n");
-    s += &u("WALK_FROM", WALK_FROM);
     s += &u(
         "PORTAL_RECORD",
         crate::cpu::portal_walk::PORTAL_RECORD_WORDS,

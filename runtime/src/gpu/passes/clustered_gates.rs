@@ -13,7 +13,7 @@ use super::interleave_blur::InterleaveParams;
 use crate::cpu::clustered::{
     ClusterParams, Clustered, GeometryCluster as CpuGeometryCluster, LightEntry, PixelSurface,
 };
-use crate::cpu::gates::{GateLevel, GateParams};
+use crate::cpu::gates::{GateLevel, GateParams, GateShape};
 use crate::gpu::context::{
     Pool, bind_group, compute_pipelines, init_buffer, read_buffer, read_texture,
 };
@@ -175,6 +175,8 @@ pub struct ListBuffers {
     pub entries: wgpu::Buffer,
     /// The pool's capacity.
     pub capacity: u32,
+    /// Each VPL's visibility cluster (`u32::MAX`: none).
+    pub vpl_cluster: wgpu::Buffer,
 }
 
 impl ListBuffers {
@@ -242,7 +244,11 @@ impl ClusteredGates {
         let max_binding = limits
             .max_storage_buffer_binding_size
             .min(limits.max_buffer_size);
-        let capacity = p.light_entries.unwrap_or(AUTO_LIGHT_ENTRIES);
+        // Portals keep no lists: a pixel walks every VPL of its subset (clusters.wgsl).
+        let capacity = match p.gates.shape {
+            GateShape::Portal => 1,
+            GateShape::Disk => p.light_entries.unwrap_or(AUTO_LIGHT_ENTRIES),
+        };
         let sizes = [
             ("geometry clusters", pixels * 64, "a smaller image"),
             (
@@ -272,6 +278,7 @@ impl ClusteredGates {
             ),
             entries: pool.buffer(d, "light entries", capacity as u64 * 8, rw),
             capacity,
+            vpl_cluster: pool.buffer(d, "vpl cluster", f.vpl_count as u64 * 4, rw),
         })
     }
 
@@ -336,9 +343,12 @@ impl ClusteredGates {
                 pass.set_bind_group(0, &vpl_bg, &[]);
                 pass.dispatch_workgroups(vpl_groups, 1, 1);
             }
-            pass.set_pipeline(&self.assign);
-            pass.set_bind_group(0, &assign_bg, &[]);
-            pass.dispatch_workgroups_indirect(&s.dispatch, 0);
+            // Portals keep no lists (the shading pass walks each pixel's VPL subset).
+            if p.gates.shape == GateShape::Disk {
+                pass.set_pipeline(&self.assign);
+                pass.set_bind_group(0, &assign_bg, &[]);
+                pass.dispatch_workgroups_indirect(&s.dispatch, 0);
+            }
         }
         rec.end();
         Ok(b)
@@ -350,7 +360,6 @@ struct Scratch {
     frame: wgpu::Buffer,
     depth_range: wgpu::Buffer,
     tile_buf: wgpu::Buffer,
-    vpl_cluster: wgpu::Buffer,
     dispatch: wgpu::Buffer,
 }
 
@@ -386,7 +395,6 @@ impl Scratch {
         let depth_range = pool.upload(f.ctx, "depth range", bytemuck::cast_slice(&range), rw);
         let n_tiles = tiles[0] as u64 * tiles[1] as u64;
         let tile_buf = pool.buffer(d, "tile clusters", (n_tiles + 1) * 4, rw);
-        let vpl_cluster = pool.buffer(d, "vpl cluster", f.vpl_count as u64 * 4, rw);
         let dispatch = pool.buffer(
             d,
             "assignment dispatch",
@@ -397,7 +405,6 @@ impl Scratch {
             frame: frame_buf,
             depth_range,
             tile_buf,
-            vpl_cluster,
             dispatch,
         }
     }
@@ -471,7 +478,7 @@ impl ClusteredGates {
                 (8, res(&f.grid)),
                 (9, res(&level.voxel_words)),
                 (12, res(&f.vpls)),
-                (13, res(&s.vpl_cluster)),
+                (13, res(&b.vpl_cluster)),
             ],
         );
         let assign_bg = bind(
@@ -484,7 +491,7 @@ impl ClusteredGates {
                 (10, res(&level.gates)),
                 (11, res(&level.cluster_gates)),
                 (12, res(&f.vpls)),
-                (13, res(&s.vpl_cluster)),
+                (13, res(&b.vpl_cluster)),
                 (14, res(&b.entries)),
             ],
         );
@@ -499,7 +506,6 @@ impl ListBuffers {
         &self,
         ctx: &GpuContext,
         g: &GBufferOutput,
-        portals: bool,
     ) -> Result<(Vec<Option<PixelSurface>>, Clustered), RenderError> {
         let b = self;
         let c: Vec<u32> = bytemuck::cast_slice(&read_buffer(ctx, &b.counter)?).to_vec();
@@ -541,22 +547,14 @@ impl ListBuffers {
             .map(|r| {
                 pool[r.list[0] as usize..(r.list[0] + r.list[1]) as usize]
                     .iter()
-                    .map(|&[vpl, g]| match portals {
-                        // Portals: WALK_FROM | the VPL's cluster, or 0.
-                        true => LightEntry {
-                            vpl,
-                            gates: Vec::new(),
-                            walk_from: (g != 0).then_some(g & !crate::gpu::shaders::WALK_FROM),
-                        },
-                        false => LightEntry {
-                            vpl,
-                            gates: [g & 0xffff, g >> 16]
-                                .into_iter()
-                                .filter(|&x| x != 0)
-                                .map(|x| x - 1)
-                                .collect(),
-                            walk_from: None,
-                        },
+                    .map(|&[vpl, g]| LightEntry {
+                        vpl,
+                        gates: [g & 0xffff, g >> 16]
+                            .into_iter()
+                            .filter(|&x| x != 0)
+                            .map(|x| x - 1)
+                            .collect(),
+                        walk_from: None,
                     })
                     .collect()
             })

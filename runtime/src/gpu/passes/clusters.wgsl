@@ -19,7 +19,10 @@
 //                 the VPL meets the cluster's bounding sphere adds (VPL, chain). Lists are
 //                 counted first, then filled in VPL order into one pool; a list that does not
 //                 fit is flagged, never cut. A list is ordered by (VPL mod B, VPL) for B
-//                 interleaving subsets, so that a pixel finds its subset's run.
+//                 interleaving subsets, so that a pixel finds its subset's run. Portals keep no
+//                 lists (empty): the shading pass walks every VPL of a pixel's subset (a list
+//                 would hold nearly all of them: a cull through the portals' bounds was
+//                 measured to cost more than it saves).
 
 // As runtime::gpu::layout::ClusterFrame.
 struct ClusterFrame {
@@ -347,6 +350,10 @@ fn cone_meets_sphere(apex: vec3<f32>, dc: vec3<f32>, dr: f32, c: vec3<f32>, r: f
 // The entries of VPL j for a geometry cluster of visibility cluster cb and sphere (s, r);
 // written from `at` when `write`. Returns how many.
 fn vpl_entries(j: u32, cb: u32, s: vec3<f32>, r: f32, write: bool, at: u32) -> u32 {
+    // Portals keep no lists: the shading pass walks every VPL of a pixel's subset.
+    if grid.shape == 1u {
+        return 0u;
+    }
     let ca = vpl_cluster[j];
     if ca == NONE || cb == NONE || ca == cb {
         if write {
@@ -355,17 +362,6 @@ fn vpl_entries(j: u32, cb: u32, s: vec3<f32>, r: f32, write: bool, at: u32) -> u
         return 1u;
     }
     let a = vpls[j].position;
-    // Portals: the walk runs per fragment from the VPL's cluster; here only a cluster wholly
-    // behind the VPL's surface is culled.
-    if grid.shape == 1u {
-        if dot(s - a, vpls[j].normal) < -r {
-            return 0u;
-        }
-        if write {
-            entries[at] = vec2<u32>(j, WALK_FROM | ca);
-        }
-        return 1u;
-    }
     var n = 0u;
     for (var i = cluster_gates[ca]; i < cluster_gates[ca + 1u]; i++) {
         let gi = cluster_gates[i];

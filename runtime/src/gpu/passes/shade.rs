@@ -67,7 +67,7 @@ pub fn frame_target(f: &Frame, pool: &mut Pool, label: &'static str) -> wgpu::Te
 
 /// The bindings of shade.wgsl's `fs_gates_indirect` (an automatic layout holds only what an
 /// entry point uses).
-const GATES_INDIRECT_BINDINGS: [u32; 10] = [0, 2, 5, 6, 8, 10, 12, 13, 14, 15];
+const GATES_INDIRECT_BINDINGS: [u32; 11] = [0, 2, 5, 6, 8, 10, 12, 13, 14, 15, 16];
 
 impl Shade {
     /// Builds the pipelines.
@@ -132,7 +132,7 @@ impl Shade {
         let level = f.scene.level.as_ref();
         let none = &f.scene.no_level;
         let maps = array_view(&shadows.maps);
-        let buffers: [(u32, &wgpu::Buffer); 12] = [
+        let buffers: [(u32, &wgpu::Buffer); 13] = [
             (0, &f.globals),
             (1, &shadows.lights),
             (2, &f.vpls),
@@ -145,6 +145,7 @@ impl Shade {
             (13, lists.map_or(none, |b| &b.clusters)),
             (14, lists.map_or(none, |b| &b.entries)),
             (15, level.map_or(none, |l| &l.portal_words)),
+            (16, lists.map_or(none, |b| &b.vpl_cluster)),
         ];
         let textures = [
             (4, &maps),

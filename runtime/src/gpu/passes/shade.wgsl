@@ -50,11 +50,12 @@ struct GeometryCluster {
 
 @group(0) @binding(12) var<storage, read> pixel_cluster: array<u32>;
 @group(0) @binding(13) var<storage, read> geometry_clusters: array<GeometryCluster>;
-// (VPL, gates): disks: gates (g0 + 1) | (g1 + 1) << 16, 0 for none; portals: 0 for the same
-// cluster, else WALK_FROM | the VPL's cluster.
+// (VPL, gates) of disks: gates (g0 + 1) | (g1 + 1) << 16, 0 for none (portals keep no lists).
 @group(0) @binding(14) var<storage, read> light_entries: array<vec2<u32>>;
 // The portals (portals.wgsl).
 @group(0) @binding(15) var<storage, read> portal_words: array<u32>;
+// Each VPL's visibility cluster (clusters.wgsl's vpl_clusters).
+@group(0) @binding(16) var<storage, read> vpl_cluster: array<u32>;
 
 fn through_gates(a: vec3<f32>, ca: u32, b: vec3<f32>, cb: u32) -> bool {
     if ca == cb || ca == NONE || cb == NONE {
@@ -190,12 +191,15 @@ fn clustered_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32) -> vec
     if gc == NONE {
         return vec3<f32>(0.0);
     }
-    let list = geometry_clusters[gc].list;
-    var first = list.x;
-    var end = list.x + list.y;
     let b = max(globals.interleave_block, 1u);
     let subsets = b * b;
     let j = u32(px.x) % b + b * (u32(px.y) % b);
+    if grid.shape == 1u {
+        return portal_gather(p, n, here, j, subsets);
+    }
+    let list = geometry_clusters[gc].list;
+    var first = list.x;
+    var end = list.x + list.y;
     if subsets > 1u {
         first = subset_start(first, end, subsets, j);
         end = subset_start(first, end, subsets, j + 1u);
@@ -212,22 +216,34 @@ fn clustered_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32) -> vec
         if all(l == vec3<f32>(0.0)) {
             continue;
         }
-        if grid.shape == 1u {
-            if entry.y != 0u
-                && portal_walk(v.position, entry.y & ~WALK_FROM, p, here) != WALK_VISIBLE {
-                continue;
-            }
-        } else {
-            let g0 = entry.y & 0xffffu;
-            if g0 != 0u && !crosses(v.position, p, gates[g0 - 1u]) {
-                continue;
-            }
-            let g1 = entry.y >> 16u;
-            if g1 != 0u && !crosses(v.position, p, gates[g1 - 1u]) {
-                continue;
-            }
+        let g0 = entry.y & 0xffffu;
+        if g0 != 0u && !crosses(v.position, p, gates[g0 - 1u]) {
+            continue;
+        }
+        let g1 = entry.y >> 16u;
+        if g1 != 0u && !crosses(v.position, p, gates[g1 - 1u]) {
+            continue;
         }
         last = entry.x;
+        sum += l;
+    }
+    return sum * f32(subsets);
+}
+
+// Portals: the VPLs of subset j (VPL mod B = j), each walked from its cluster to p, × B.
+fn portal_gather(p: vec3<f32>, n: vec3<f32>, here: u32, j: u32, subsets: u32) -> vec3<f32> {
+    var sum = vec3<f32>(0.0);
+    for (var k = j; k < globals.vpl_count; k += subsets) {
+        let v = vpls[k];
+        let l = vpl_light(v, p, n, globals.g_max);
+        if all(l == vec3<f32>(0.0)) {
+            continue;
+        }
+        let ca = vpl_cluster[k];
+        if ca != NONE && here != NONE && ca != here
+            && portal_walk(v.position, ca, p, here) != WALK_VISIBLE {
+            continue;
+        }
         sum += l;
     }
     return sum * f32(subsets);
