@@ -232,13 +232,11 @@ pub fn run(args: BakeArgs) -> Result<()> {
     {
         eprintln!("warning: the closed scene leaks (baked anyway, --allow-leaks): {l}");
     }
-    let openings: Vec<visgate_preprocess::leak::LeakPath> =
-        serde_json::from_value(baked.report.empty_space["openings"].clone()).unwrap_or_default();
-    for o in &openings {
+    for o in &baked.openings {
         eprintln!("warning: leak: {}", o.describe());
     }
-    if let (Some(dir), false) = (&args.debug_dir, openings.is_empty()) {
-        write_leak_ply(dir, &openings)?;
+    if let (Some(dir), false) = (&args.debug_dir, baked.openings.is_empty()) {
+        write_leak_ply(dir, &baked.openings)?;
     }
     if let Some(w) = most_dropped(&baked.report.empty_space, &baked.level.info.grid) {
         eprintln!("warning: {w}");

@@ -87,6 +87,8 @@ pub struct Baked {
     pub report: BakeReport,
     /// Grids for debug exports.
     pub grids: BakeGrids,
+    /// Where a closed scene baked with `allow_leaks` leaks (also in the report).
+    pub openings: Vec<crate::leak::LeakPath>,
 }
 
 struct Clock<'a> {
@@ -676,6 +678,7 @@ pub fn bake(
     Ok(Baked {
         level,
         report,
+        openings: es.openings,
         grids: BakeGrids {
             solid,
             empty: es.empty,

@@ -142,8 +142,8 @@ pub fn empty_space(
                 for a in 0..3 {
                     lo[c][a] = lo[c][a].min(v[a]);
                     hi[c][a] = hi[c][a].max(v[a]);
-                    at_bounds[c] |= v[a] == 1 || v[a] + 2 == dims[a];
                 }
+                at_bounds[c] |= crate::leak::next_to_ring(v, dims);
             }
         }
     }

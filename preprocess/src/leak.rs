@@ -15,14 +15,14 @@ use std::cmp::Reverse;
 use std::collections::BinaryHeap;
 use std::io::{self, Write};
 
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 use visgate_formats::vgate::GridMeta;
 
 /// Openings listed at most.
 pub const MAX_OPENINGS: usize = 8;
 
 /// A path from a camera or light to the outside and the opening it passes.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct LeakPath {
     /// The camera or light it starts from, e.g. `light 1`.
     pub from: String,
@@ -59,17 +59,10 @@ pub fn describe_all(openings: &[LeakPath]) -> String {
         .replacen(';', ":", 1)
 }
 
-/// Whether voxel `v` lies next to the grid's solid border ring (the bounds).
-fn at_bounds(v: [usize; 3], dims: [usize; 3]) -> bool {
+/// Whether voxel `v` lies next to the grid's solid border ring (the bounds): where kept empty
+/// space of a closed scene leaks.
+pub fn next_to_ring(v: [u32; 3], dims: [u32; 3]) -> bool {
     (0..3).any(|a| v[a] == 1 || v[a] + 2 == dims[a])
-}
-
-fn coords(i: usize, dims: [usize; 3]) -> [usize; 3] {
-    [
-        i % dims[0],
-        (i / dims[0]) % dims[1],
-        i / (dims[0] * dims[1]),
-    ]
 }
 
 /// The openings through which the `empty` voxels (`true`: kept empty space) reach the bounds
@@ -79,10 +72,10 @@ pub fn find_openings(
     empty: &[bool],
     seeds: &[(String, [f32; 3], usize)],
 ) -> Vec<LeakPath> {
-    let dims = meta.dims.map(|d| d as usize);
+    let dims = meta.dims;
     // The border ring stands for the outside beyond the bounds: open, not an obstacle.
     let ring = |i: usize| {
-        let v = coords(i, dims);
+        let v = meta.coords(i as u32);
         (0..3).any(|a| v[a] == 0 || v[a] + 1 == dims[a])
     };
     let not_empty: Vec<bool> = (0..empty.len()).map(|i| !empty[i] && !ring(i)).collect();
@@ -90,7 +83,7 @@ pub fn find_openings(
     let mut open = empty.to_vec();
     let mut out = Vec::new();
     while out.len() < MAX_OPENINGS {
-        let Some((path, seed)) = widest_path_out(&open, &d2, dims, seeds) else {
+        let Some((path, seed)) = widest_path_out(meta, &open, &d2, seeds) else {
             break;
         };
         // The narrowest voxel, the one nearest the outside among equals.
@@ -99,10 +92,7 @@ pub fn find_openings(
             .min_by_key(|&k| d2[path[k]])
             .expect("a path has a voxel");
         let clearance = (d2[path[k]] as f32).sqrt();
-        let centre = |i: usize| {
-            let v = coords(i, dims);
-            std::array::from_fn(|a| meta.origin_m[a] + (v[a] as f32 + 0.5) * meta.voxel_size_m)
-        };
+        let centre = |i: usize| meta.voxel_to_world(meta.coords(i as u32));
         out.push(LeakPath {
             from: seeds[seed].0.clone(),
             from_m: seeds[seed].1,
@@ -110,7 +100,7 @@ pub fn find_openings(
             width_m: (2.0 * clearance - 1.0).max(1.0) * meta.voxel_size_m,
             path_m: path.iter().map(|&i| centre(i)).collect(),
         });
-        close_ball(&mut open, dims, path[k], clearance + 2.0);
+        close_ball(meta, &mut open, path[k], clearance + 2.0);
     }
     out
 }
@@ -119,9 +109,9 @@ pub fn find_openings(
 /// bounds — the one whose smallest squared clearance `d2` is largest (a bottleneck search:
 /// voxels taken widest reach first) — seed first, and which seed it starts from.
 fn widest_path_out(
+    meta: &GridMeta,
     open: &[bool],
     d2: &[u64],
-    dims: [usize; 3],
     seeds: &[(String, [f32; 3], usize)],
 ) -> Option<(Vec<usize>, usize)> {
     const NONE: u32 = u32::MAX;
@@ -135,8 +125,8 @@ fn widest_path_out(
         }
     }
     while let Some((reach, Reverse(steps), i)) = heap.pop() {
-        let v = coords(i, dims);
-        if at_bounds(v, dims) {
+        let v = meta.coords(i as u32);
+        if next_to_ring(v, meta.dims) {
             let (mut path, mut c) = (vec![i], i);
             while parent[c] as usize != c {
                 c = parent[c] as usize;
@@ -152,8 +142,7 @@ fn widest_path_out(
             }
             let o = [k % 3, (k / 3) % 3, k / 9];
             // The border ring is solid, so a voxel inside it has every neighbour in the grid.
-            let w: [usize; 3] = std::array::from_fn(|a| v[a] + o[a] - 1);
-            let j = w[0] + dims[0] * (w[1] + dims[1] * w[2]);
+            let j = meta.index(std::array::from_fn(|a| v[a] + o[a] - 1));
             if open[j] && parent[j] == NONE {
                 parent[j] = i as u32;
                 heap.push((reach.min(d2[j]), Reverse(steps + 1), j));
@@ -164,19 +153,19 @@ fn widest_path_out(
 }
 
 /// Makes the ball of `radius` voxels about voxel `i` not open.
-fn close_ball(open: &mut [bool], dims: [usize; 3], i: usize, radius: f32) {
-    let v = coords(i, dims).map(|c| c as i64);
+fn close_ball(meta: &GridMeta, open: &mut [bool], i: usize, radius: f32) {
+    let v = meta.coords(i as u32).map(i64::from);
     let r = radius.ceil() as i64;
     for dz in -r..=r {
         for dy in -r..=r {
             for dx in -r..=r {
                 let w = [v[0] + dx, v[1] + dy, v[2] + dz];
-                if (0..3).any(|a| w[a] < 0 || w[a] >= dims[a] as i64)
+                if (0..3).any(|a| w[a] < 0 || w[a] >= i64::from(meta.dims[a]))
                     || ((dx * dx + dy * dy + dz * dz) as f32) > radius * radius
                 {
                     continue;
                 }
-                open[w[0] as usize + dims[0] * (w[1] as usize + dims[1] * w[2] as usize)] = false;
+                open[meta.index(w.map(|c| c as u32))] = false;
             }
         }
     }

@@ -14,6 +14,10 @@
 //!    exactly (the segment to the pixel's point crosses every disk of the chain). A VPL with
 //!    several passing chains counts once.
 //!
+//! With portals the GPU keeps no lists: each pixel walks every VPL of its interleaving subset.
+//! This twin still lists them (less the clusters wholly behind a VPL's surface, which light
+//! nothing there), so the image is the same and the viewer can draw them.
+//!
 //! The assignment is conservative (the cone through a disk lies inside the cone through the
 //! disk's bounding sphere), so the gather gives exactly the per-point gate test
 //! ([`GateLevel::visible`]) — the tests check that — while the lists hold far fewer entries

@@ -41,7 +41,7 @@ use crate::RenderError;
 use crate::camera::View;
 use crate::cpu::clustered::Clustered;
 use crate::cpu::clustered::PixelSurface;
-use crate::cpu::gates::GateLevel;
+use crate::cpu::gates::{GateLevel, GateShape};
 use crate::cpu::val::{Clustering, ValParams, scale_of};
 use crate::hdr::HdrImage;
 use crate::vpl::Vpl;
@@ -392,7 +392,7 @@ impl GpuRenderer {
             value_bytes: level.map_or(4, |l| l.dims[3]),
             oversize: gates.oversize,
             max_hops: gates.max_hops,
-            shape: u32::from(gates.shape == crate::cpu::gates::GateShape::Portal),
+            shape: u32::from(gates.shape == GateShape::Portal),
             max_walk: gates.max_walk,
         };
         let uniform = wgpu::BufferUsages::UNIFORM;
@@ -421,12 +421,11 @@ impl GpuRenderer {
         vpls: VplInput,
         params: &GpuParams,
     ) -> Result<(HdrImage, PassTimes), RenderError> {
-        let GpuMode::Gates(g) = params.mode else {
-            return context::scoped(ctx, || self.frame_unscoped(ctx, view, vpls, params));
+        // Only disks keep lists; a pool of a set size fails when full.
+        let g = match params.mode {
+            GpuMode::Gates(g) if g.light_entries.is_none() && g.gates.shape == GateShape::Disk => g,
+            _ => return context::scoped(ctx, || self.frame_unscoped(ctx, view, vpls, params)),
         };
-        if g.light_entries.is_some() {
-            return context::scoped(ctx, || self.frame_unscoped(ctx, view, vpls, params));
-        }
         // A pool that grows: the frame again with the capacity it needed (a quarter more,
         // for the next frames' changes), up to the adapter's limit.
         let max = (ctx.device.limits().max_storage_buffer_binding_size / 8).min(u32::MAX as u64);

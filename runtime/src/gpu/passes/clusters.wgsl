@@ -350,10 +350,6 @@ fn cone_meets_sphere(apex: vec3<f32>, dc: vec3<f32>, dr: f32, c: vec3<f32>, r: f
 // The entries of VPL j for a geometry cluster of visibility cluster cb and sphere (s, r);
 // written from `at` when `write`. Returns how many.
 fn vpl_entries(j: u32, cb: u32, s: vec3<f32>, r: f32, write: bool, at: u32) -> u32 {
-    // Portals keep no lists: the shading pass walks every VPL of a pixel's subset.
-    if grid.shape == 1u {
-        return 0u;
-    }
     let ca = vpl_cluster[j];
     if ca == NONE || cb == NONE || ca == cb {
         if write {

@@ -41,6 +41,11 @@ impl InterleaveParams {
         self.block * self.block
     }
 
+    /// The blur's distance threshold in metres for frame `f` (a fraction of the scene's size).
+    pub fn blur_distance_m(&self, f: &Frame) -> f32 {
+        self.blur_distance * f.scene.far_m / 4.0
+    }
+
     /// Checks the limits.
     pub fn check(&self) -> Result<(), RenderError> {
         if !(1..=16).contains(&self.block) {
@@ -81,7 +86,7 @@ impl InterleaveBlur {
             g_max: f.params.g_max,
             block: p.block,
             subsets: p.subsets(),
-            blur_distance: p.blur_distance * f.scene.far_m / 4.0,
+            blur_distance: p.blur_distance_m(f),
             blur_normal: p.blur_normal,
             ..bytemuck::Zeroable::zeroed()
         };

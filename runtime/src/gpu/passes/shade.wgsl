@@ -186,16 +186,16 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
 // counts once (a list is ordered by (VPL mod B, VPL)). With interleaving (B = b² subsets) the
 // pixel takes only its subset's run of the list, found by binary search, and the sum is × B.
 fn clustered_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32) -> vec3<f32> {
+    let b = max(globals.interleave_block, 1u);
+    let subsets = b * b;
+    let j = interleave_subset(px, b);
+    if grid.shape == 1u {
+        return portal_gather(p, n, here, j, subsets);
+    }
     let width = textureDimensions(g_position).x;
     let gc = pixel_cluster[u32(px.x) + u32(px.y) * width];
     if gc == NONE {
         return vec3<f32>(0.0);
-    }
-    let b = max(globals.interleave_block, 1u);
-    let subsets = b * b;
-    let j = u32(px.x) % b + b * (u32(px.y) % b);
-    if grid.shape == 1u {
-        return portal_gather(p, n, here, j, subsets);
     }
     let list = geometry_clusters[gc].list;
     var first = list.x;

@@ -157,8 +157,8 @@ impl ValGathers {
             sharpness: c.sharpness,
             cssm_normal_offset: c.normal_offset,
             block,
-            subsets: block * block,
-            blur_distance: il.blur_distance * f.scene.far_m / 4.0,
+            subsets: il.subsets(),
+            blur_distance: il.blur_distance_m(f),
             blur_normal: il.blur_normal,
             ..bytemuck::Zeroable::zeroed()
         };

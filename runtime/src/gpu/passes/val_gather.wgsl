@@ -63,7 +63,7 @@ fn surface(frag: vec4<f32>) -> Surface {
     s.p = pos.xyz;
     s.n = normalize(textureLoad(g_normal, px, 0).xyz);
     let b = gather.block;
-    s.j = u32(px.x) % b + b * (u32(px.y) % b);
+    s.j = interleave_subset(px, b);
     return s;
 }
 

@@ -11,6 +11,12 @@ struct Vpl {
 };
 
 
+// Interleaved sampling: the VPL subset of pixel px in blocks of side b (VPL i lights the
+// pixels of subset i mod b²; blur.wgsl blurs over the block).
+fn interleave_subset(px: vec2<i32>, b: u32) -> u32 {
+    return u32(px.x) % b + b * (u32(px.y) % b);
+}
+
 // The light of VPL v at p (normal n) without albedo / π, as runtime::vpl::gather_one:
 // Φ/π · min(cos θ_v cos θ_x / d², g_max); zero behind either surface.
 fn vpl_light(v: Vpl, p: vec3<f32>, n: vec3<f32>, g_max: f32) -> vec3<f32> {
