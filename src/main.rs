@@ -2,8 +2,10 @@
 //! scenes, meshes and baked levels, and list or export the built-in scenes.
 
 mod bake;
+mod compare;
 mod inspect;
 mod render;
+mod settings;
 mod view;
 
 use std::path::PathBuf;
@@ -53,6 +55,10 @@ enum Command {
     /// Walk through a scene in a window, switching the visibility method live.
     #[command(after_help = view::VIEW_HELP)]
     View(view::ViewArgs),
+    /// Every method against the CPU reference on one level: times, errors, a Pareto plot, a
+    /// report (Markdown, HTML, JSON) and the answer to a time budget or an error bound.
+    #[command(after_help = compare::COMPARE_HELP)]
+    Compare(compare::CompareArgs),
     /// Compare an image with a reference: MSE, relative MSE, FLIP, and an error map.
     Diff(render::DiffArgs),
     /// Print a summary of a scene, a mesh file or a baked .vgate level.
@@ -110,6 +116,7 @@ fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Bake(args) => bake::run(args),
         Command::Render(args) => render::run(args),
+        Command::Compare(args) => compare::run_compare(args),
         Command::View(args) => view::run(args),
         Command::Diff(args) => render::diff(args),
         Command::Inspect {

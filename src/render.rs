@@ -4,21 +4,16 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::{Context, Result, bail};
-use clap::{Args, ValueEnum};
+use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
 use visgate_formats::ImportOptions;
-use visgate_runtime::cpu::clustered::ClusterParams;
-use visgate_runtime::cpu::gates::{GateLevel, GateParams, GateShape};
-use visgate_runtime::cpu::val::ValParams;
-use visgate_runtime::gpu::{
-    CssmParams, GatesParams, GpuMode, GpuParams, InterleaveParams, METHODS, MethodSettings,
-    PerVplParams, ShadowParams, ValModeParams, method,
-};
+
+use crate::settings::{LightArgs, MethodArgs};
+use visgate_runtime::cpu::gates::GateLevel;
+use visgate_runtime::gpu::{METHODS, method};
 use visgate_runtime::hdr::{HdrImage, false_colour};
-use visgate_runtime::job::{
-    FrameStats, JobFrame, RenderJob, Renderer, VplSource as JobVpls, pass_table,
-};
-use visgate_runtime::metrics::{errors, flip};
+use visgate_runtime::job::{FrameStats, JobFrame, RenderJob, Renderer, pass_table};
+use visgate_runtime::metrics::{errors, flip, indirect_errors, rebase_direct};
 use visgate_runtime::vpl::GeometryClamp;
 
 pub const RENDER_HELP: &str = "\
@@ -71,24 +66,6 @@ Examples:
   visgate render builtin:four-rooms --mode gates --level four-rooms.vgate --out gates.png
   visgate diff none.exr cornell.exr --out diff.png";
 
-/// Where VPLs come from.
-/// `--gate-shape`.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum GateShapeArg {
-    /// The baked portals (the true openings between clusters), walked along each segment.
-    Portal,
-    /// The paper's disks, through chains of at most --gate-hops of them.
-    Disk,
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum VplSource {
-    /// Light paths traced on the CPU (any number of bounces).
-    Paths,
-    /// Reflective shadow maps of the lights, sampled at Halton points on the GPU (one bounce).
-    Rsm,
-}
-
 /// `--mode`'s values: `reference` and every GPU method of the runtime's registry.
 fn mode_names() -> Vec<&'static str> {
     std::iter::once("reference")
@@ -109,32 +86,9 @@ pub struct RenderArgs {
     /// Light paths traced from the lights (VPLs: one per path and bounce that hits).
     #[arg(long, default_value_t = 1024)]
     pub vpls: u32,
-    /// Where the VPLs come from.
-    #[arg(long, value_enum, default_value_t = VplSource::Paths)]
-    pub vpl_source: VplSource,
-    /// RSM size per layer (cube face or spot), texels, for --vpl-source rsm.
-    #[arg(long, default_value_t = 256)]
-    pub rsm_size: u32,
-    /// VPL generations per path (1: one-bounce indirect light).
-    #[arg(long, default_value_t = 1)]
-    pub bounces: u32,
-    /// Seed of the VPLs' low-discrepancy sequence.
-    #[arg(long, default_value_t = 1)]
-    pub seed: u64,
     /// Image size, WIDTHxHEIGHT.
     #[arg(long, default_value = "512x512")]
     pub size: String,
-    /// Pixel samples (jittered).
-    #[arg(long, default_value_t = 4)]
-    pub spp: u32,
-    /// Upper bound of the VPL geometry term cos·cos/d², 1/m² (against spikes near VPLs);
-    /// absolute, so the image changes with the scene's scale. Default: from --clamp-distance.
-    #[arg(long, conflicts_with = "clamp_distance")]
-    pub g_max: Option<f32>,
-    /// The geometry-term clamp starts at this fraction of the scene's bounding diagonal
-    /// (g_max = 1 / (F·diagonal)²): the same image, up to scale, at any scale of the level.
-    #[arg(long, default_value_t = 0.025)]
-    pub clamp_distance: f32,
     /// Exposure of the PNG, in stops.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub exposure: f32,
@@ -144,77 +98,9 @@ pub struct RenderArgs {
     /// Run none/direct-only on the CPU twin instead of the GPU.
     #[arg(long)]
     pub cpu: bool,
-    /// Shadow map size per layer (GPU), texels.
-    #[arg(long, default_value_t = 1024)]
-    pub shadow_size: u32,
     /// The baked level (.vgate) for --mode gates; it must come from this scene's geometry.
     #[arg(long)]
     pub level: Option<PathBuf>,
-    /// What a gate is (--mode gates): the baked portals, walked, or the paper's disks.
-    #[arg(long, value_enum, default_value_t = GateShapeArg::Portal)]
-    pub gate_shape: GateShapeArg,
-    /// Portals one walk may pass before it is given up and counted as occluded (--gate-shape
-    /// portal), 1..=1024.
-    #[arg(long, default_value_t = 64)]
-    pub max_walk: u32,
-    /// Gate disks are this many times their baked radius (--gate-shape disk).
-    #[arg(long, default_value_t = 1.0)]
-    pub gate_oversize: f32,
-    /// Gates a VPL's light may pass in a chain (--mode gates; the paper: 1).
-    #[arg(long, default_value_t = 2)]
-    pub gate_hops: u32,
-    /// Screen tile side of geometry clusters (--mode gates), pixels, 1..=16 on the GPU.
-    #[arg(long, default_value_t = 16)]
-    pub tile_px: u32,
-    /// Exponential depth slices of geometry clusters (--mode gates), 1..=256.
-    #[arg(long, default_value_t = 24)]
-    pub depth_slices: u32,
-    /// Capacity of the light-list pool (--mode gates with --gate-shape disk; portals keep no
-    /// lists: a pixel walks every VPL of its subset), entries of 8 bytes: a frame that needs
-    /// more stops with the count it needs. Unset, the pool grows to what a frame needs, up to
-    /// the adapter's storage binding limit.
-    #[arg(long)]
-    pub light_entries: Option<u32>,
-    /// Virtual area lights (--mode val-hard): the VPLs are clustered into this many.
-    #[arg(long, default_value_t = 30)]
-    pub vals: u32,
-    /// Most k-means iterations of the VAL clustering (it stops earlier where the assignment
-    /// repeats itself; the pass report says whether it converged).
-    #[arg(long, default_value_t = 8)]
-    pub val_iterations: u32,
-    /// Weight of the position term of the VAL clustering distance (the paper: 0.7).
-    #[arg(long, default_value_t = 0.7, allow_hyphen_values = true)]
-    pub val_w_x: f32,
-    /// Weight of the normal-angle term of the VAL clustering distance (the paper: 0.3).
-    #[arg(long, default_value_t = 0.3, allow_hyphen_values = true)]
-    pub val_w_alpha: f32,
-    /// Paraboloid shadow map size per VAL, texels.
-    #[arg(long, default_value_t = 256)]
-    pub val_map_size: u32,
-    /// Fourier terms of the convolution soft shadow maps (--mode val-cssm), 1..=16.
-    #[arg(long, default_value_t = 4)]
-    pub cssm_terms: u32,
-    /// Normal offset of CSSM lookups, texels (slope-scaled up to 2×): larger avoids
-    /// self-shadowing under wide filter kernels, smaller keeps contact shadows.
-    #[arg(long, default_value_t = 3.0)]
-    pub cssm_normal_offset: f32,
-    /// VAL modes and gates: interleaved sampling in blocks of this side (each pixel lights
-    /// itself with one of side² VPL subsets, then a geometry-aware blur over the block); 1:
-    /// every VPL at every pixel (the CPU twins, --cpu, always gather every VPL).
-    #[arg(long, default_value_t = 8)]
-    pub interleave: u32,
-    /// Blur: leave out neighbours farther than this fraction of the scene's size.
-    #[arg(long, default_value_t = 0.1)]
-    pub blur_distance: f32,
-    /// Blur: leave out neighbours whose normals' cosine is below this.
-    #[arg(long, default_value_t = 0.8, allow_hyphen_values = true)]
-    pub blur_normal: f32,
-    /// Per-VPL paraboloid map size (GPU), texels.
-    #[arg(long, default_value_t = 128)]
-    pub vpl_map_size: u32,
-    /// Per-VPL maps rendered and gathered per batch (bounds their memory).
-    #[arg(long, default_value_t = 128)]
-    pub vpl_batch: u32,
     /// Time of the (first) frame, seconds: dynamic meshes and lights of the scene file are
     /// posed there (their keyframes or orbits).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
@@ -229,9 +115,17 @@ pub struct RenderArgs {
     /// Rayon threads (default: all cores).
     #[arg(long)]
     pub threads: Option<usize>,
+    /// GPU frames rendered and dropped before the one kept, so that its pass times are of a
+    /// warm device (pipelines compiled, light-list pools grown).
+    #[arg(long, default_value_t = 0)]
+    pub warmup: u32,
+    #[command(flatten)]
+    pub light: LightArgs,
+    #[command(flatten)]
+    pub method: MethodArgs,
 }
 
-fn parse_size(s: &str) -> Result<[u32; 2]> {
+pub fn parse_size(s: &str) -> Result<[u32; 2]> {
     let (w, h) = s
         .split_once(['x', 'X'])
         .with_context(|| format!("--size {s}: write WIDTHxHEIGHT, e.g. 512x512"))?;
@@ -247,92 +141,22 @@ fn parse_size(s: &str) -> Result<[u32; 2]> {
 }
 
 impl RenderArgs {
-    /// Interleaving and blur from the flags (VAL modes and gates alike).
-    fn interleave_params(&self) -> InterleaveParams {
-        InterleaveParams {
-            block: self.interleave,
-            blur_distance: self.blur_distance,
-            blur_normal: self.blur_normal,
-        }
-    }
-
-    /// Every method's settings from the flags.
-    fn settings(&self) -> MethodSettings {
-        MethodSettings {
-            per_vpl: PerVplParams {
-                map_size: self.vpl_map_size,
-                batch: self.vpl_batch,
-            },
-            gates: GatesParams {
-                gates: GateParams {
-                    oversize: self.gate_oversize,
-                    max_hops: self.gate_hops,
-                    shape: match self.gate_shape {
-                        GateShapeArg::Portal => GateShape::Portal,
-                        GateShapeArg::Disk => GateShape::Disk,
-                    },
-                    max_walk: self.max_walk,
-                },
-                clusters: ClusterParams {
-                    tile_px: self.tile_px,
-                    depth_slices: self.depth_slices,
-                },
-                light_entries: self.light_entries,
-                interleave: self.interleave_params(),
-            },
-            vals: ValModeParams {
-                vals: ValParams {
-                    count: self.vals,
-                    iterations: self.val_iterations,
-                    w_x: self.val_w_x,
-                    w_alpha: self.val_w_alpha,
-                    ..ValParams::default()
-                },
-                map_size: self.val_map_size,
-                interleave: self.interleave_params(),
-            },
-            cssm: CssmParams {
-                terms: self.cssm_terms,
-                normal_offset: self.cssm_normal_offset,
-                ..CssmParams::default()
-            },
-        }
-    }
-
     /// The job the flags describe.
     fn job(&self) -> Result<RenderJob> {
         let renderer = match method(&self.mode) {
             None => Renderer::Reference,
-            Some(m) if self.cpu => Renderer::CpuTwin((m.make)(&self.settings())),
-            Some(m) => Renderer::Gpu((m.make)(&self.settings())),
+            Some(m) if self.cpu => Renderer::CpuTwin((m.make)(&self.method.settings())),
+            Some(m) => Renderer::Gpu((m.make)(&self.method.settings())),
         };
         Ok(RenderJob {
             renderer,
-            params: GpuParams {
-                mode: GpuMode::None,
-                g_max: GpuParams::default().g_max,
-                shadows: ShadowParams {
-                    size: self.shadow_size,
-                    ..ShadowParams::default()
-                },
-            },
-            clamp: match self.g_max {
-                Some(g) => GeometryClamp::PerSquareMetre(g),
-                None => GeometryClamp::DiagonalFraction(self.clamp_distance),
-            },
             vpls: self.vpls,
-            vpl_source: match self.vpl_source {
-                VplSource::Paths => JobVpls::Paths,
-                VplSource::Rsm => JobVpls::Rsm,
-            },
-            rsm_size: self.rsm_size,
-            bounces: self.bounces,
-            seed: self.seed,
             size: parse_size(&self.size)?,
-            spp: self.spp,
             time: self.time,
             frames: self.frames,
             fps: self.fps,
+            warmup: self.warmup,
+            ..self.light.job(&self.method)
         })
     }
 }
@@ -436,13 +260,13 @@ fn print_frame(args: &RenderArgs, scene: &str, f: &JobFrame, load_s: f64, setup:
         args.size,
         match f.stats {
             FrameStats::Gpu(_) => " (GPU)".to_string(),
-            FrameStats::Cpu(_) if args.cpu => format!(" spp {} (CPU twin)", args.spp),
-            FrameStats::Cpu(_) => format!(" spp {} (CPU)", args.spp),
+            FrameStats::Cpu(_) if args.cpu => format!(" spp {} (CPU twin)", args.light.spp),
+            FrameStats::Cpu(_) => format!(" spp {} (CPU)", args.light.spp),
         },
         f.vpl_count,
-        args.vpl_source,
+        args.light.vpl_source,
         args.vpls,
-        args.bounces
+        args.light.bounces
     );
     println!("times: load {load_s:.3} s, BVH {bvh_s:.3} s, VPLs {vpl_s:.3} s {setup}");
     match &f.stats {
@@ -492,6 +316,15 @@ pub struct DiffArgs {
     /// Exposure both are tone mapped at for FLIP, in stops.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub exposure: f32,
+    /// The reference's direct light alone (.exr, e.g. `render --mode direct-only --cpu`): also
+    /// print the indirect energy ratio and the share of pixels black where the reference's
+    /// indirect light is.
+    #[arg(long)]
+    pub direct: Option<PathBuf>,
+    /// The image's own direct light (.exr, e.g. `render --mode direct-only`), taken out of it
+    /// instead of --direct's (GPU shadow maps and CPU rays differ a little at shadow edges).
+    #[arg(long, requires = "direct")]
+    pub image_direct: Option<PathBuf>,
 }
 
 pub fn diff(args: DiffArgs) -> Result<()> {
@@ -513,6 +346,22 @@ pub fn diff(args: DiffArgs) -> Result<()> {
         e.reference_mean,
         100.0 * (e.image_mean / e.reference_mean.max(f64::MIN_POSITIVE) - 1.0)
     );
+    if let Some(d) = &args.direct {
+        let direct = HdrImage::read(d)?;
+        let own = match &args.image_direct {
+            Some(p) => rebase_direct(&a, &HdrImage::read(p)?, &direct)?,
+            None => a.clone(),
+        };
+        let i = indirect_errors(&own, &r, &direct)?;
+        println!(
+            "indirect energy  {:.6}  (mean indirect light over the reference's)",
+            i.energy_ratio
+        );
+        println!(
+            "black where lit  {:.6} %  (of the pixels the reference lights indirectly)",
+            i.black_where_lit * 100.0
+        );
+    }
     if let Some(out) = &args.out {
         false_colour(&map, a.width, a.height, 1.0)
             .save(out)

@@ -67,6 +67,9 @@ pub struct RenderJob {
     pub frames: u32,
     /// Frames per second of a sequence. [Limit: > 0]
     pub fps: f64,
+    /// GPU frames rendered and dropped before each frame that is kept, so that its pass times
+    /// are of a warm device (pipelines compiled, buffers grown). [Limit: ≤ 16]
+    pub warmup: u32,
 }
 
 impl Default for RenderJob {
@@ -85,6 +88,7 @@ impl Default for RenderJob {
             time: 0.0,
             frames: 1,
             fps: 30.0,
+            warmup: 0,
         }
     }
 }
@@ -150,6 +154,12 @@ impl RenderJob {
             return Err(RenderError::Param(format!(
                 "--fps {}: give a number of frames per second > 0",
                 self.fps
+            )));
+        }
+        if self.warmup > 16 {
+            return Err(RenderError::Param(format!(
+                "--warmup {}: at most 16 frames",
+                self.warmup
             )));
         }
         if !self.time.is_finite() {
@@ -333,6 +343,9 @@ impl RenderJob {
             (VplSource::Rsm, false) => VplInput::Rsm(rsm),
             _ => VplInput::Given(&vpls),
         };
+        for _ in 0..self.warmup {
+            gpu.render_frame(ctx, view, input, &params)?;
+        }
         let (image, times) = gpu.render_frame(ctx, view, input, &params)?;
         let vpl_count = match input {
             VplInput::Given(v) => v.len(),

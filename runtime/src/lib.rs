@@ -27,6 +27,7 @@
 //! frame.
 
 pub mod camera;
+pub mod compare;
 pub mod cpu;
 pub mod gpu;
 pub mod hdr;

@@ -102,6 +102,28 @@ pub fn indirect_errors(
     })
 }
 
+/// `image` with its own direct light `own` replaced by `reference_direct`: its indirect light
+/// over the reference's direct light, so that [`indirect_errors`] sees the method's indirect
+/// light alone (GPU shadow maps and CPU shadow rays differ a little at shadow edges).
+pub fn rebase_direct(
+    image: &HdrImage,
+    own: &HdrImage,
+    reference_direct: &HdrImage,
+) -> Result<HdrImage, RenderError> {
+    same_size(image, own)?;
+    same_size(image, reference_direct)?;
+    let mut m = image.clone();
+    for ((p, o), d) in m
+        .pixels
+        .iter_mut()
+        .zip(&own.pixels)
+        .zip(&reference_direct.pixels)
+    {
+        *p = *p - *o + *d;
+    }
+    Ok(m)
+}
+
 /// Per-pixel absolute error, averaged over channels.
 pub fn abs_error_map(a: &HdrImage, r: &HdrImage) -> Result<Vec<f32>, RenderError> {
     same_size(a, r)?;

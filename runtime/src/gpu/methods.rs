@@ -145,6 +145,41 @@ impl GpuMode {
         }
     }
 
+    /// The method's settings in a few words, for reports ("portals, walk ≤ 64, 8×8
+    /// interleaved"); empty for methods without any.
+    pub fn describe(&self) -> String {
+        use crate::cpu::gates::GateShape;
+        let il = |i: &InterleaveParams| match i.block {
+            1 => "every VPL per pixel".to_string(),
+            b => format!("{b}×{b} interleaved"),
+        };
+        let gates = |g: &GateParams| match g.shape {
+            GateShape::Portal => format!("portals, walk ≤ {}", g.max_walk),
+            GateShape::Disk => format!("disks ×{}, {} hop(s)", g.oversize, g.max_hops),
+        };
+        match self {
+            GpuMode::None | GpuMode::DirectOnly => String::new(),
+            GpuMode::PerVplShadowMaps(p) => {
+                format!("{0}² maps, batches of {1}", p.map_size, p.batch)
+            }
+            GpuMode::Gates(p) => format!("{}, {}", gates(&p.gates), il(&p.interleave)),
+            GpuMode::GatesPerPixel(g) => gates(g),
+            GpuMode::ValHard(v) => format!(
+                "{} VALs, {}² maps, {}",
+                v.vals.count,
+                v.map_size,
+                il(&v.interleave)
+            ),
+            GpuMode::ValCssm(v, c) => format!(
+                "{} VALs, {}² maps, {} terms, {}",
+                v.vals.count,
+                v.map_size,
+                c.terms,
+                il(&v.interleave)
+            ),
+        }
+    }
+
     /// Checks the method's parameters against their limits (the adapter's limits are checked
     /// when a frame is rendered).
     pub fn check(&self) -> Result<(), RenderError> {

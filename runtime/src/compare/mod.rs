@@ -1,0 +1,609 @@
+//! `visgate compare`: the speed/accuracy trade-off of every method on one level. Every mode is
+//! rendered at every VPL count from every camera through the same [`RenderJob`] that `visgate
+//! render` runs, beside the exact CPU reference with the very same VPLs; each is measured (pass
+//! times, MSE, relative MSE, FLIP, indirect energy ratio, black-where-lit share, speed-up over
+//! per-VPL shadow maps), the non-dominated settings are found ([`pareto`]), and the report is
+//! written as Markdown, HTML and JSON with a Pareto plot and image panels ([`report`],
+//! [`plot`]).
+//!
+//! Every render is kept in the output folder (`renders/CAMERA/NAME.exr` and its `.json` with
+//! the settings' key and the pass times), so that a run that was stopped resumes where it was:
+//! a render whose key matches is read back, not redone.
+
+pub mod pareto;
+pub mod plot;
+pub mod report;
+mod stability;
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+use visgate_formats::{Camera, Scene};
+
+use crate::RenderError;
+use crate::cpu::gates::GateLevel;
+use crate::gpu::GpuMode;
+use crate::hdr::HdrImage;
+use crate::job::{FrameStats, JobFrame, RenderJob, Renderer};
+use crate::metrics::{errors, flip, indirect_errors, rebase_direct};
+
+pub use stability::StabilityRow;
+
+/// The error the plot, `--budget-ms` and `--max-error` go by.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum ErrorMetric {
+    /// Mean squared error. [Units: radiance²]
+    Mse,
+    /// Relative MSE (scale-free; see [`crate::metrics::ImageErrors::rel_mse`]).
+    RelMse,
+    /// Mean LDR-FLIP (perceptual, 0 … 1).
+    Flip,
+}
+
+impl ErrorMetric {
+    /// Its name in reports.
+    pub fn name(&self) -> &'static str {
+        match self {
+            ErrorMetric::Mse => "MSE",
+            ErrorMetric::RelMse => "relative MSE",
+            ErrorMetric::Flip => "FLIP",
+        }
+    }
+
+    /// A row's value of it.
+    pub fn of(&self, row: &Row) -> f64 {
+        match self {
+            ErrorMetric::Mse => row.mse,
+            ErrorMetric::RelMse => row.rel_mse,
+            ErrorMetric::Flip => row.flip,
+        }
+    }
+}
+
+/// One method with its settings, under the label reports give it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CompareMode {
+    /// Its name in tables and files (`gates`, `gates-disk`, …). Unique in a run.
+    pub label: String,
+    /// The method and its parameters.
+    pub mode: GpuMode,
+}
+
+/// What to compare.
+#[derive(Debug, Clone)]
+pub struct CompareSpec {
+    /// The scene as the user named it.
+    pub scene: String,
+    /// What identifies the baked level (a gate render is redone when it changes).
+    pub level_key: String,
+    /// The methods.
+    pub modes: Vec<CompareMode>,
+    /// Light paths (or RSM VPLs) per render, ascending. [Limit: ≥ 1 each]
+    pub vpls: Vec<u32>,
+    /// The views.
+    pub cameras: Vec<Camera>,
+    /// Size, samples, seed, VPL source, clamp, shadows and warm-up frames of every render (its
+    /// renderer and VPL count are set per render).
+    pub base: RenderJob,
+    /// The error of the plot and the answers.
+    pub metric: ErrorMetric,
+    /// Most frame time allowed: the most accurate setting within it is the answer. [Units: ms]
+    pub budget_ms: Option<f64>,
+    /// Most error allowed: the fastest setting within it is the answer.
+    pub max_error: Option<f64>,
+    /// Independent images (a path tracer's), one per camera in order, or none.
+    pub ground_truth: Vec<HdrImage>,
+    /// Frames of the temporal-stability sequence of an animated scene (0 or 1: none).
+    pub stability_frames: u32,
+    /// Exposure of the PNGs and of FLIP. [Units: stops]
+    pub exposure: f32,
+    /// The command line that made the report, written into it.
+    pub command: String,
+}
+
+/// A pass's time.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PassMs {
+    /// The pass.
+    pub name: String,
+    /// Its time (GPU timestamps, or CPU wall time where the adapter has none). [Units: ms]
+    pub ms: f64,
+}
+
+/// One method at one VPL count from one camera.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Row {
+    /// The camera.
+    pub camera: String,
+    /// The method's label.
+    pub mode: String,
+    /// Its settings in words.
+    pub settings: String,
+    /// Light paths asked.
+    pub vpls: u32,
+    /// VPLs made.
+    pub vpl_count: usize,
+    /// Pass times in frame order.
+    pub passes: Vec<PassMs>,
+    /// The frame. [Units: ms]
+    pub total_ms: f64,
+    /// Whether the times are GPU timestamps (else CPU wall time per pass).
+    pub gpu_timed: bool,
+    /// MSE against the reference.
+    pub mse: f64,
+    /// Relative MSE against the reference.
+    pub rel_mse: f64,
+    /// Mean LDR-FLIP against the reference.
+    pub flip: f64,
+    /// Mean indirect light over the reference's.
+    pub energy_ratio: f64,
+    /// Share of the reference's lit pixels that are black in indirect light.
+    pub black_where_lit: f64,
+    /// Per-VPL shadow maps' frame time over this one's (same camera and VPLs).
+    pub speedup: Option<f64>,
+    /// Relative MSE against the camera's ground truth.
+    pub ground_truth_rel_mse: Option<f64>,
+    /// Whether no other setting is both faster and more accurate (over the cameras).
+    pub pareto: bool,
+    /// The answers this row is (`budget`, `max-error`).
+    pub answers: Vec<String>,
+    /// The image, relative to the report.
+    pub image: String,
+    /// Reference | method | error map, relative to the report.
+    pub panel: String,
+}
+
+/// The CPU reference of one camera at one VPL count.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ReferenceRow {
+    /// The camera.
+    pub camera: String,
+    /// Light paths asked.
+    pub vpls: u32,
+    /// VPLs made.
+    pub vpl_count: usize,
+    /// Render time. [Units: s]
+    pub seconds: f64,
+    /// Shadow rays cast.
+    pub shadow_rays: u64,
+    /// Relative MSE against the camera's ground truth: the VPL approximation's own error.
+    pub ground_truth_rel_mse: Option<f64>,
+    /// The image, relative to the report.
+    pub image: String,
+}
+
+/// A render that failed (the run goes on).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Failure {
+    /// The camera.
+    pub camera: String,
+    /// The method's label.
+    pub mode: String,
+    /// Light paths asked.
+    pub vpls: u32,
+    /// Why.
+    pub error: String,
+}
+
+/// Everything `compare` measured.
+#[derive(Debug, Clone, Serialize)]
+pub struct CompareReport {
+    /// The scene as named.
+    pub scene: String,
+    /// The command line.
+    pub command: String,
+    /// The GPU adapter.
+    pub adapter: String,
+    /// Image size. [Units: px]
+    pub size: [u32; 2],
+    /// CPU pixel samples.
+    pub spp: u32,
+    /// The error the plot and answers go by.
+    pub metric: ErrorMetric,
+    /// The cameras, in order.
+    pub cameras: Vec<String>,
+    /// Every method × VPL count × camera that rendered.
+    pub rows: Vec<Row>,
+    /// The references.
+    pub references: Vec<ReferenceRow>,
+    /// Those that failed.
+    pub failures: Vec<Failure>,
+    /// Means over the cameras per method and VPL count: the plot's points.
+    pub points: Vec<pareto::Point>,
+    /// The answers to `--budget-ms` and `--max-error`.
+    pub answers: Vec<pareto::Answer>,
+    /// Frame-to-frame change of animated scenes.
+    pub stability: Vec<StabilityRow>,
+    /// Renders read back from an earlier run, and made in this one.
+    pub resumed: [u32; 2],
+}
+
+/// How far a run is.
+#[derive(Debug, Clone, Copy)]
+pub enum Step<'a> {
+    /// Render `index` of `total` begins (`what` says which).
+    Render {
+        /// 0-based.
+        index: u32,
+        /// Renders in the run.
+        total: u32,
+        /// "CAMERA: MODE at N VPLs".
+        what: &'a str,
+    },
+    /// Rows done of a CPU render.
+    Rows(u32, u32),
+}
+
+/// A render as kept in the folder: what identifies it and what it took.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct Kept {
+    key: String,
+    vpl_count: usize,
+    passes: Vec<PassMs>,
+    total_ms: f64,
+    gpu_timed: bool,
+    shadow_rays: u64,
+    frames: u32,
+}
+
+/// Where renders go and what was reused.
+struct Store<'a> {
+    dir: &'a Path,
+    spec: &'a CompareSpec,
+    scene: &'a Scene,
+    level: Option<&'a GateLevel>,
+    done: u32,
+    total: u32,
+    resumed: [u32; 2],
+    progress: &'a (dyn Fn(Step) + Sync),
+}
+
+impl Store<'_> {
+    /// The frames of `job` from `camera`, kept as `renders/CAMERA/NAME(-i).exr`: read back when
+    /// kept with the same key, else rendered and kept.
+    fn render(
+        &mut self,
+        camera: &Camera,
+        name: &str,
+        job: &RenderJob,
+    ) -> Result<(Vec<HdrImage>, Kept, PathBuf), RenderError> {
+        let rel = Path::new("renders")
+            .join(file_name(&camera.name))
+            .join(name);
+        let path = self.dir.join(&rel);
+        let key = format!(
+            "{}|{camera:?}|{job:?}|{}",
+            self.spec.scene, self.spec.level_key
+        );
+        let exr = |i: u32| match job.frames {
+            1 => path.with_extension("exr"),
+            _ => path.with_file_name(format!("{name}-{i:03}.exr")),
+        };
+        let what = format!("{}: {name}", camera.name);
+        (self.progress)(Step::Render {
+            index: self.done,
+            total: self.total,
+            what: &what,
+        });
+        self.done += 1;
+        if let Some(kept) = read_kept(&path.with_extension("json"), &key) {
+            let images: Result<Vec<_>, _> =
+                (0..kept.frames).map(|i| HdrImage::read(&exr(i))).collect();
+            if let Ok(images) = images {
+                self.resumed[0] += 1;
+                return Ok((images, kept, rel.with_extension("exr")));
+            }
+        }
+        std::fs::create_dir_all(path.parent().unwrap_or(self.dir))
+            .map_err(|e| RenderError::io(&path, e))?;
+        let mut frames: Vec<JobFrame> = Vec::new();
+        let progress = |d: u32, t: u32| (self.progress)(Step::Rows(d, t));
+        job.run(
+            self.scene,
+            camera,
+            self.level,
+            &mut |_| {},
+            &progress,
+            &mut |f| {
+                frames.push(f);
+                Ok(())
+            },
+        )?;
+        let kept = kept_of(&frames, key)?;
+        for (i, f) in frames.iter().enumerate() {
+            f.image.write_exr(&exr(i as u32))?;
+        }
+        let json = path.with_extension("json");
+        let text = serde_json::to_string_pretty(&kept).map_err(|e| RenderError::io(&json, e))?;
+        std::fs::write(&json, text).map_err(|e| RenderError::io(&json, e))?;
+        self.resumed[1] += 1;
+        let images = frames.into_iter().map(|f| f.image).collect();
+        Ok((images, kept, rel.with_extension("exr")))
+    }
+}
+
+/// A kept render's record at `path`, if it has `key`.
+fn read_kept(path: &Path, key: &str) -> Option<Kept> {
+    let text = std::fs::read_to_string(path).ok()?;
+    let kept: Kept = serde_json::from_str(&text).ok()?;
+    (kept.key == key).then_some(kept)
+}
+
+/// The record of `frames` (times of the first frame).
+fn kept_of(frames: &[JobFrame], key: String) -> Result<Kept, RenderError> {
+    let first = frames
+        .first()
+        .ok_or_else(|| RenderError::Param("a render gave no frame".into()))?;
+    let (passes, total_ms, gpu_timed, shadow_rays) = match &first.stats {
+        FrameStats::Gpu(t) => {
+            let gpu_timed = t.passes.iter().any(|p| p.gpu_s.is_some());
+            let passes = t
+                .by_name()
+                .into_iter()
+                .map(|(name, gpu, cpu)| PassMs {
+                    name: name.to_string(),
+                    ms: gpu.or(cpu).unwrap_or(0.0) * 1e3,
+                })
+                .collect();
+            let total = t.gpu_total().unwrap_or(t.frame_s) * 1e3;
+            (passes, total, gpu_timed, 0)
+        }
+        FrameStats::Cpu(s) => (Vec::new(), s.seconds * 1e3, false, s.shadow_rays),
+    };
+    Ok(Kept {
+        key,
+        vpl_count: first.vpl_count,
+        passes,
+        total_ms,
+        gpu_timed,
+        shadow_rays,
+        frames: frames.len() as u32,
+    })
+}
+
+/// A name safe in a file path (letters, digits, `-`, `_`; the rest become `_`).
+pub fn file_name(s: &str) -> String {
+    s.chars()
+        .map(|c| match c {
+            'a'..='z' | 'A'..='Z' | '0'..='9' | '-' | '_' => c,
+            _ => '_',
+        })
+        .collect()
+}
+
+impl CompareSpec {
+    /// Checks the settings before anything is rendered.
+    pub fn check(&self, has_level: bool) -> Result<(), RenderError> {
+        let param = |s: String| Err(RenderError::Param(s));
+        if self.modes.is_empty() {
+            return param("no mode to compare: give --modes".into());
+        }
+        if self.vpls.is_empty() || self.vpls.contains(&0) {
+            return param("--vpls: give one or more counts ≥ 1, e.g. 256,1024,4096".into());
+        }
+        if self.cameras.is_empty() {
+            return param("no camera: the scene has none, or --cameras named none of them".into());
+        }
+        if !self.ground_truth.is_empty() && self.ground_truth.len() != self.cameras.len() {
+            return param(format!(
+                "{} ground-truth images for {} cameras: give one per camera, in order",
+                self.ground_truth.len(),
+                self.cameras.len()
+            ));
+        }
+        let [w, h] = self.base.size;
+        for gt in &self.ground_truth {
+            if (gt.width, gt.height) != (w, h) {
+                return param(format!(
+                    "a ground-truth image is {}x{}, the renders {w}x{h}: give --size {}x{}",
+                    gt.width, gt.height, gt.width, gt.height
+                ));
+            }
+        }
+        for m in &self.modes {
+            let job = RenderJob {
+                renderer: Renderer::Gpu(m.mode),
+                ..self.base.clone()
+            };
+            job.check(has_level)?;
+        }
+        Ok(())
+    }
+}
+
+/// Renders and measures everything `spec` asks on `scene` (with `level` for the gate modes),
+/// keeping every render in `dir`, and returns the report (not yet written: see
+/// [`report::write`]).
+pub fn run(
+    spec: &CompareSpec,
+    scene: &Scene,
+    level: Option<&GateLevel>,
+    dir: &Path,
+    progress: &(dyn Fn(Step) + Sync),
+) -> Result<CompareReport, RenderError> {
+    spec.check(level.is_some())?;
+    let per_camera = 2 + spec.vpls.len() as u32 * (1 + spec.modes.len() as u32);
+    let mut store = Store {
+        dir,
+        spec,
+        scene,
+        level,
+        done: 0,
+        total: per_camera * spec.cameras.len() as u32 + stability::renders(spec, scene),
+        resumed: [0, 0],
+        progress,
+    };
+    let adapter = crate::gpu::GpuContext::new()
+        .map(|c| format!("{} ({:?})", c.adapter_info.name, c.adapter_info.backend))?;
+    let mut report = CompareReport {
+        scene: spec.scene.clone(),
+        command: spec.command.clone(),
+        adapter,
+        size: spec.base.size,
+        spp: spec.base.spp,
+        metric: spec.metric,
+        cameras: spec.cameras.iter().map(|c| c.name.clone()).collect(),
+        rows: Vec::new(),
+        references: Vec::new(),
+        failures: Vec::new(),
+        points: Vec::new(),
+        answers: Vec::new(),
+        stability: Vec::new(),
+        resumed: [0, 0],
+    };
+    for (ci, camera) in spec.cameras.iter().enumerate() {
+        camera_rows(&mut store, &mut report, camera, spec.ground_truth.get(ci))?;
+    }
+    report.stability = stability::measure(&mut store)?;
+    report.resumed = store.resumed;
+    pareto::mark(&mut report, spec);
+    Ok(report)
+}
+
+/// The direct light of one camera, on the CPU (the reference's) and on the GPU (the methods').
+struct Direct {
+    cpu: HdrImage,
+    gpu: HdrImage,
+}
+
+/// Renders one camera's references and methods into `report`.
+fn camera_rows(
+    store: &mut Store,
+    report: &mut CompareReport,
+    camera: &Camera,
+    ground_truth: Option<&HdrImage>,
+) -> Result<(), RenderError> {
+    let spec = store.spec;
+    let job = |renderer, vpls| RenderJob {
+        renderer,
+        vpls,
+        frames: 1,
+        ..spec.base.clone()
+    };
+    let one = |v: Vec<HdrImage>| v.into_iter().next().unwrap_or_else(|| HdrImage::new(1, 1));
+    let direct = Direct {
+        cpu: one(store
+            .render(
+                camera,
+                "direct-cpu",
+                &job(Renderer::CpuTwin(GpuMode::DirectOnly), 0),
+            )?
+            .0),
+        gpu: one(store
+            .render(
+                camera,
+                "direct-gpu",
+                &job(Renderer::Gpu(GpuMode::DirectOnly), 0),
+            )?
+            .0),
+    };
+    for &vpls in &spec.vpls {
+        let (images, kept, rel) = store.render(
+            camera,
+            &format!("reference-{vpls}"),
+            &job(Renderer::Reference, vpls),
+        )?;
+        let reference = one(images);
+        reference.write_png(&store.dir.join(rel.with_extension("png")), spec.exposure)?;
+        let gt = ground_truth.map(|g| errors(&reference, g)).transpose()?;
+        report.references.push(ReferenceRow {
+            camera: camera.name.clone(),
+            vpls,
+            vpl_count: kept.vpl_count,
+            seconds: kept.total_ms / 1e3,
+            shadow_rays: kept.shadow_rays,
+            ground_truth_rel_mse: gt.map(|e| e.rel_mse),
+            image: path_string(&rel.with_extension("png")),
+        });
+        for m in &spec.modes {
+            let name = format!("{}-{vpls}", file_name(&m.label));
+            match store.render(camera, &name, &job(Renderer::Gpu(m.mode), vpls)) {
+                Ok((images, kept, rel)) => {
+                    let row = measure(
+                        store,
+                        camera,
+                        m,
+                        vpls,
+                        (&one(images), kept, rel),
+                        &reference,
+                        &direct,
+                        ground_truth,
+                    )?;
+                    report.rows.push(row);
+                }
+                Err(e) => report.failures.push(Failure {
+                    camera: camera.name.clone(),
+                    mode: m.label.clone(),
+                    vpls,
+                    error: e.to_string(),
+                }),
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A method's row: its errors against the reference, its PNG and its panel.
+#[allow(clippy::too_many_arguments)]
+fn measure(
+    store: &Store,
+    camera: &Camera,
+    m: &CompareMode,
+    vpls: u32,
+    (image, kept, rel): (&HdrImage, Kept, PathBuf),
+    reference: &HdrImage,
+    direct: &Direct,
+    ground_truth: Option<&HdrImage>,
+) -> Result<Row, RenderError> {
+    let exposure = store.spec.exposure;
+    let e = errors(image, reference)?;
+    let (f, flip_map) = flip(image, reference, exposure)?;
+    let i = indirect_errors(
+        &rebase_direct(image, &direct.gpu, &direct.cpu)?,
+        reference,
+        &direct.cpu,
+    )?;
+    let png = rel.with_extension("png");
+    image.write_png(&store.dir.join(&png), exposure)?;
+    let panel = Path::new("panels").join(format!(
+        "{}-{}-{vpls}.png",
+        file_name(&camera.name),
+        file_name(&m.label)
+    ));
+    let title = format!("{} · {} · {vpls} VPLs", camera.name, m.label);
+    plot::panel(reference, image, &flip_map, exposure, &title)?
+        .save(store.dir.join(&panel))
+        .map_err(|e| RenderError::io(&store.dir.join(&panel), e))?;
+    Ok(Row {
+        camera: camera.name.clone(),
+        mode: m.label.clone(),
+        settings: m.mode.describe(),
+        vpls,
+        vpl_count: kept.vpl_count,
+        passes: kept.passes,
+        total_ms: kept.total_ms,
+        gpu_timed: kept.gpu_timed,
+        mse: e.mse,
+        rel_mse: e.rel_mse,
+        flip: f as f64,
+        energy_ratio: i.energy_ratio,
+        black_where_lit: i.black_where_lit,
+        speedup: None,
+        ground_truth_rel_mse: ground_truth
+            .map(|g| errors(image, g))
+            .transpose()?
+            .map(|e| e.rel_mse),
+        pareto: false,
+        answers: Vec::new(),
+        image: path_string(&png),
+        panel: path_string(&panel),
+    })
+}
+
+/// A relative path with `/` separators, for Markdown and HTML.
+fn path_string(p: &Path) -> String {
+    p.components()
+        .map(|c| c.as_os_str().to_string_lossy().into_owned())
+        .collect::<Vec<_>>()
+        .join("/")
+}

@@ -1,0 +1,189 @@
+//! The pictures of a comparison: the Pareto plot (frame time against error, log-log, a curve
+//! per method over its VPL counts, the non-dominated points filled, the answers ringed) and
+//! the panels (reference | method | false-colour FLIP map), drawn with plotters into PNG
+//! bitmaps, text in egui's own font so nothing is looked up on the system.
+
+use std::sync::Once;
+
+use image::RgbImage;
+use plotters::prelude::*;
+
+use super::pareto::{Answer, Point};
+use crate::RenderError;
+use crate::hdr::{HdrImage, false_colour};
+
+const FONT: &str = "sans-serif";
+
+/// Registers the font once (plotters' ab_glyph backend has none of its own).
+fn font() {
+    static ONCE: Once = Once::new();
+    ONCE.call_once(|| {
+        // The bytes are a valid TTF shipped with egui; a failure leaves text undrawn.
+        let _ = plotters::style::register_font(
+            FONT,
+            FontStyle::Normal,
+            epaint_default_fonts::UBUNTU_LIGHT,
+        );
+    });
+}
+
+fn drawing<E: std::error::Error + Send + Sync>(e: DrawingAreaErrorKind<E>) -> RenderError {
+    RenderError::Param(format!("drawing a plot: {e}"))
+}
+
+/// A log axis' label: only at 1, 2 and 5 times a power of ten (the others stay unlabelled
+/// grid lines), in plain or scientific notation.
+fn tick(v: f64, scientific: bool) -> String {
+    let e = v.log10().floor();
+    let m = v / 10f64.powf(e);
+    if ![1.0, 2.0, 5.0, 10.0]
+        .iter()
+        .any(|k| (m - k).abs() < 1e-6 * k)
+    {
+        return String::new();
+    }
+    match (scientific, v) {
+        (true, _) => format!("{v:.0e}"),
+        (false, v) if v >= 1.0 => format!("{v:.0}"),
+        (false, v) => format!("{v}"),
+    }
+}
+
+/// The Pareto plot of `points` (`metric` names the error axis), `w × h` pixels.
+pub fn pareto(
+    points: &[Point],
+    answers: &[Answer],
+    title: &str,
+    metric: &str,
+    [w, h]: [u32; 2],
+) -> Result<RgbImage, RenderError> {
+    font();
+    let mut buf = vec![255u8; (w * h * 3) as usize];
+    let modes: Vec<&str> = points.iter().fold(Vec::new(), |mut v, p| {
+        if !v.contains(&p.mode.as_str()) {
+            v.push(&p.mode);
+        }
+        v
+    });
+    let range = |f: &dyn Fn(&Point) -> f64| {
+        let (lo, hi) = points
+            .iter()
+            .map(|p| f(p).max(1e-12))
+            .fold((f64::INFINITY, 0f64), |(l, h), v| (l.min(v), h.max(v)));
+        match lo.is_finite() {
+            true => (lo / 1.6)..(hi * 1.6),
+            false => 0.1..10.0,
+        }
+    };
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area();
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, (FONT, 20))
+            .margin(14)
+            .x_label_area_size(44)
+            .y_label_area_size(78)
+            .build_cartesian_2d(
+                range(&|p| p.ms).log_scale(),
+                range(&|p| p.error).log_scale(),
+            )
+            .map_err(drawing)?;
+        chart
+            .configure_mesh()
+            .x_desc("frame time (ms), mean over the cameras")
+            .y_desc(format!("{metric}, mean over the cameras"))
+            .x_label_formatter(&|v| tick(*v, false))
+            .y_label_formatter(&|v| tick(*v, true))
+            .label_style((FONT, 13))
+            .axis_desc_style((FONT, 15))
+            .light_line_style(TRANSPARENT)
+            .draw()
+            .map_err(drawing)?;
+        for (i, mode) in modes.iter().enumerate() {
+            let colour = Palette99::pick(i).to_rgba();
+            let mut pts: Vec<&Point> = points.iter().filter(|p| p.mode == *mode).collect();
+            pts.sort_by_key(|p| p.vpls);
+            let xy = |p: &Point| (p.ms.max(1e-12), p.error.max(1e-12));
+            chart
+                .draw_series(LineSeries::new(
+                    pts.iter().map(|p| xy(p)),
+                    colour.stroke_width(2),
+                ))
+                .map_err(drawing)?
+                .label(*mode)
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 22, y)], colour.stroke_width(3))
+                });
+            chart
+                .draw_series(pts.iter().map(|p| {
+                    let style = match p.pareto {
+                        true => colour.filled(),
+                        false => WHITE.filled(),
+                    };
+                    EmptyElement::at(xy(p))
+                        + Circle::new((0, 0), 6, style)
+                        + Circle::new((0, 0), 6, colour.stroke_width(2))
+                        + Text::new(format!("{}", p.vpls), (8, -16), (FONT, 12))
+                }))
+                .map_err(drawing)?;
+        }
+        for a in answers {
+            let Some(p) = &a.point else { continue };
+            chart
+                .draw_series(std::iter::once(
+                    EmptyElement::at((p.ms.max(1e-12), p.error.max(1e-12)))
+                        + Circle::new((0, 0), 12, BLACK.stroke_width(2))
+                        + Text::new(a.kind.clone(), (12, 6), (FONT, 14)),
+                ))
+                .map_err(drawing)?;
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font((FONT, 14))
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
+            .map_err(drawing)?;
+        root.present().map_err(drawing)?;
+    }
+    RgbImage::from_raw(w, h, buf).ok_or_else(|| RenderError::Param("plot buffer size".into()))
+}
+
+/// Reference | method | FLIP map (black 0 … white 1) side by side under `title`, both images
+/// tone mapped at `exposure` stops.
+pub fn panel(
+    reference: &HdrImage,
+    image: &HdrImage,
+    flip_map: &[f32],
+    exposure: f32,
+    title: &str,
+) -> Result<RgbImage, RenderError> {
+    font();
+    let (w, h) = (image.width, image.height);
+    let (gap, top) = (6u32, 44u32);
+    let tiles = [
+        reference.to_srgb8(exposure),
+        image.to_srgb8(exposure),
+        false_colour(flip_map, w, h, 1.0),
+    ];
+    let (pw, ph) = (3 * w + 2 * gap, h + top);
+    let mut out = RgbImage::from_pixel(pw, ph, image::Rgb([255, 255, 255]));
+    for (i, t) in tiles.iter().enumerate() {
+        image::imageops::replace(&mut out, t, (i as u32 * (w + gap)) as i64, top as i64);
+    }
+    let mut buf = out.into_raw();
+    {
+        let root = BitMapBackend::with_buffer(&mut buf, (pw, ph)).into_drawing_area();
+        let style = (FONT, 14).into_font().color(&BLACK);
+        root.draw_text(title, &style, (2, 2)).map_err(drawing)?;
+        for (i, label) in ["reference", "method", "FLIP error (black 0 … white 1)"]
+            .iter()
+            .enumerate()
+        {
+            let x = (i as u32 * (w + gap)) as i32 + 2;
+            root.draw_text(label, &style, (x, 22)).map_err(drawing)?;
+        }
+        root.present().map_err(drawing)?;
+    }
+    RgbImage::from_raw(pw, ph, buf).ok_or_else(|| RenderError::Param("panel buffer size".into()))
+}

@@ -1,0 +1,346 @@
+//! The report of a comparison: `report.json` (everything measured), `report.md` and
+//! `report.html` (the same tables, the Pareto plot and the panels inline), `pareto.png`.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use super::{CompareReport, Row};
+use crate::RenderError;
+
+/// The Pareto plot's file in the folder.
+pub const PLOT: &str = "pareto.png";
+
+/// Writes the report's files into `dir`.
+pub fn write(report: &CompareReport, dir: &Path) -> Result<(), RenderError> {
+    let put = |name: &str, text: String| {
+        let p = dir.join(name);
+        std::fs::write(&p, text).map_err(|e| RenderError::io(&p, e))
+    };
+    let json = serde_json::to_string_pretty(report)
+        .map_err(|e| RenderError::io(&dir.join("report.json"), e))?;
+    put("report.json", json)?;
+    let plot = super::plot::pareto(
+        &report.points,
+        &report.answers,
+        &format!("{}: frame time vs error", report.scene),
+        report.metric.name(),
+        [960, 640],
+    )?;
+    plot.save(dir.join(PLOT))
+        .map_err(|e| RenderError::io(&dir.join(PLOT), e))?;
+    put("report.md", markdown(report))?;
+    put("report.html", html(report))
+}
+
+/// `x` with three significant digits in scientific notation.
+fn sci(x: f64) -> String {
+    format!("{x:.3e}")
+}
+
+/// The pass times in a cell.
+fn passes(r: &Row) -> String {
+    r.passes
+        .iter()
+        .filter(|p| p.ms >= 0.005)
+        .map(|p| format!("{} {:.2}", p.name, p.ms))
+        .collect::<Vec<_>>()
+        .join(" · ")
+}
+
+/// The marks of a row: on the front, the answers.
+fn marks(r: &Row) -> String {
+    let mut m = Vec::new();
+    if r.pareto {
+        m.push("◆ front".to_string());
+    }
+    m.extend(r.answers.iter().map(|a| format!("★ {a}")));
+    m.join(", ")
+}
+
+/// The cells of a row's line, in [`HEADER`]'s order (the last only with ground truth).
+fn cells(r: &Row, ground_truth: bool) -> Vec<String> {
+    let mut c = vec![
+        r.mode.clone(),
+        r.settings.clone(),
+        r.vpl_count.to_string(),
+        passes(r),
+        format!("{:.2}", r.total_ms),
+        r.speedup.map_or("-".into(), |s| format!("{s:.1}×")),
+        sci(r.mse),
+        sci(r.rel_mse),
+        format!("{:.4}", r.flip),
+        format!("{:.3}", r.energy_ratio),
+        format!("{:.1} %", r.black_where_lit * 100.0),
+    ];
+    if ground_truth {
+        c.push(r.ground_truth_rel_mse.map_or("-".into(), sci));
+    }
+    c.push(marks(r));
+    c
+}
+
+const HEADER: [&str; 11] = [
+    "mode",
+    "settings",
+    "VPLs",
+    "passes (ms)",
+    "total (ms)",
+    "× per-VPL maps",
+    "MSE",
+    "rel. MSE",
+    "FLIP",
+    "indirect energy",
+    "black where lit",
+];
+
+/// The header of a camera's table.
+fn header(ground_truth: bool) -> Vec<String> {
+    let mut h: Vec<String> = HEADER.iter().map(|s| s.to_string()).collect();
+    if ground_truth {
+        h.push("rel. MSE vs ground truth".into());
+    }
+    h.push("".into());
+    h
+}
+
+/// What the figures mean, for both formats.
+const LEGEND: &str = "Every method renders the very VPLs of the CPU reference (a shadow ray \
+per VPL and pixel sample), so each error is the method's visibility alone. Times: GPU \
+timestamps per pass after a warm-up frame (CPU wall time per pass where the adapter has none); \
+the total is the frame. Indirect energy: the method's mean indirect light over the reference's \
+(its own direct light taken out). Black where lit: of the pixels the reference lights \
+indirectly at ≥ 0.1 of its mean, the share where the method gives < 0.1 of the reference. \
+◆ front: no other setting is both faster and more accurate (means over the cameras). \
+× per-VPL maps: per-VPL shadow maps' frame time over this one's.";
+
+/// The summary lines above the tables.
+fn summary(r: &CompareReport) -> Vec<String> {
+    let mut s = vec![
+        format!("`{}`", r.command),
+        format!(
+            "{}×{} px, {} spp for the CPU renders, on {}; error metric of the plot and the \
+             answers: {}.",
+            r.size[0],
+            r.size[1],
+            r.spp,
+            r.adapter,
+            r.metric.name()
+        ),
+        format!(
+            "{} renders made, {} read back from an earlier run.",
+            r.resumed[1], r.resumed[0]
+        ),
+    ];
+    s.extend(
+        r.answers
+            .iter()
+            .map(|a| format!("**Answer ({})**: {}.", a.kind, a.text)),
+    );
+    let front: Vec<String> = r
+        .points
+        .iter()
+        .filter(|p| p.pareto)
+        .map(|p| {
+            format!(
+                "{} at {} VPLs ({:.2} ms, {:.3e})",
+                p.mode, p.vpls, p.ms, p.error
+            )
+        })
+        .collect();
+    s.push(format!(
+        "On the front, fastest first: {}.",
+        front.join("; ")
+    ));
+    s
+}
+
+fn markdown(r: &CompareReport) -> String {
+    let mut md = format!("# visgate compare: {}\n\n", r.scene);
+    for line in summary(r) {
+        let _ = writeln!(md, "{line}\n");
+    }
+    let _ = writeln!(md, "![Pareto plot]({})\n\n{LEGEND}\n", super::report::PLOT);
+    let gt = r.rows.iter().any(|x| x.ground_truth_rel_mse.is_some());
+    for cam in &r.cameras {
+        let _ = writeln!(md, "## Camera {cam}\n");
+        for rf in r.references.iter().filter(|x| &x.camera == cam) {
+            let _ = write!(
+                md,
+                "- reference at {} VPLs: {:.2} s on the CPU, {} shadow rays",
+                rf.vpl_count, rf.seconds, rf.shadow_rays
+            );
+            if let Some(g) = rf.ground_truth_rel_mse {
+                let _ = write!(md, "; its rel. MSE against the ground truth {}", sci(g));
+            }
+            md.push('\n');
+        }
+        let h = header(gt);
+        let _ = writeln!(md, "\n| {} |", h.join(" | "));
+        let _ = writeln!(md, "|{}", "---|".repeat(h.len()));
+        for row in r.rows.iter().filter(|x| &x.camera == cam) {
+            let _ = writeln!(md, "| {} |", cells(row, gt).join(" | "));
+        }
+        md.push('\n');
+        for row in r.rows.iter().filter(|x| &x.camera == cam) {
+            let _ = writeln!(
+                md,
+                "![{} at {} VPLs: reference, method, FLIP]({})\n",
+                row.mode, row.vpls, row.panel
+            );
+        }
+    }
+    if !r.stability.is_empty() {
+        md += "## Temporal stability\n\nMean absolute frame-to-frame change of the indirect \
+               light; ratio 1: as steady as the reference; excess: the change that is the \
+               method's alone, over the reference's mean indirect light.\n\n| camera | mode | \
+               VPLs | frames | change | reference's | ratio | excess |\n|---|---|---|---|---|---|---|---|\n";
+        for s in &r.stability {
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {} | {} | {} | {:.2} | {:.3} |",
+                s.camera,
+                s.mode,
+                s.vpls,
+                s.frames,
+                sci(s.change),
+                sci(s.reference_change),
+                s.ratio,
+                s.excess
+            );
+        }
+        md.push('\n');
+    }
+    if !r.failures.is_empty() {
+        md += "## Failed\n\n";
+        for f in &r.failures {
+            let _ = writeln!(
+                md,
+                "- {} at {} VPLs, camera {}: {}",
+                f.mode, f.vpls, f.camera, f.error
+            );
+        }
+    }
+    md
+}
+
+/// `s` safe in HTML text.
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}
+
+/// Markdown's `**x**` and `` `x` `` as HTML, the rest escaped.
+fn inline(s: &str) -> String {
+    let mut out = String::new();
+    let (mut bold, mut code) = (false, false);
+    let mut rest = esc(s);
+    while let Some(i) = rest.find(['*', '`']) {
+        out += &rest[..i];
+        if rest[i..].starts_with("**") {
+            out += if bold { "</b>" } else { "<b>" };
+            bold = !bold;
+            rest = rest[i + 2..].to_string();
+        } else if rest[i..].starts_with('`') {
+            out += if code { "</code>" } else { "<code>" };
+            code = !code;
+            rest = rest[i + 1..].to_string();
+        } else {
+            out.push('*');
+            rest = rest[i + 1..].to_string();
+        }
+    }
+    out + &rest
+}
+
+fn html(r: &CompareReport) -> String {
+    let mut h = format!(
+        "<!doctype html><html><head><meta charset=\"utf-8\"><title>visgate compare: {0}</title>\
+         <style>body{{font-family:sans-serif;margin:2em;max-width:110em}}table{{border-collapse:\
+         collapse;font-size:90%}}td,th{{border:1px solid #ccc;padding:3px 6px}}img{{max-width:\
+         100%}}</style></head><body><h1>visgate compare: {0}</h1>\n",
+        esc(&r.scene)
+    );
+    for line in summary(r) {
+        let _ = writeln!(h, "<p>{}</p>", inline(&line));
+    }
+    let _ = writeln!(
+        h,
+        "<img src=\"{}\" alt=\"Pareto plot\"><p>{}</p>",
+        super::report::PLOT,
+        esc(LEGEND)
+    );
+    let gt = r.rows.iter().any(|x| x.ground_truth_rel_mse.is_some());
+    for cam in &r.cameras {
+        let _ = writeln!(h, "<h2>Camera {}</h2><ul>", esc(cam));
+        for rf in r.references.iter().filter(|x| &x.camera == cam) {
+            let _ = writeln!(
+                h,
+                "<li>reference at {} VPLs: {:.2} s on the CPU, {} shadow rays{}</li>",
+                rf.vpl_count,
+                rf.seconds,
+                rf.shadow_rays,
+                rf.ground_truth_rel_mse.map_or(String::new(), |g| format!(
+                    "; rel. MSE against the ground truth {}",
+                    sci(g)
+                ))
+            );
+        }
+        h += "</ul><table><tr>";
+        for c in header(gt) {
+            let _ = write!(h, "<th>{}</th>", esc(&c));
+        }
+        h += "</tr>\n";
+        for row in r.rows.iter().filter(|x| &x.camera == cam) {
+            h += "<tr>";
+            for c in cells(row, gt) {
+                let _ = write!(h, "<td>{}</td>", esc(&c));
+            }
+            h += "</tr>\n";
+        }
+        h += "</table>\n";
+        for row in r.rows.iter().filter(|x| &x.camera == cam) {
+            let _ = writeln!(
+                h,
+                "<p><img src=\"{}\" alt=\"{} at {} VPLs\"></p>",
+                esc(&row.panel),
+                esc(&row.mode),
+                row.vpls
+            );
+        }
+    }
+    if !r.stability.is_empty() {
+        h += "<h2>Temporal stability</h2><table><tr><th>camera</th><th>mode</th><th>VPLs</th>\
+              <th>frames</th><th>change</th><th>reference's</th><th>ratio</th><th>excess</th></tr>\n";
+        for s in &r.stability {
+            let _ = writeln!(
+                h,
+                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{:.2}</td><td>{:.3}</td></tr>",
+                esc(&s.camera),
+                esc(&s.mode),
+                s.vpls,
+                s.frames,
+                sci(s.change),
+                sci(s.reference_change),
+                s.ratio,
+                s.excess
+            );
+        }
+        h += "</table>\n";
+    }
+    if !r.failures.is_empty() {
+        h += "<h2>Failed</h2><ul>";
+        for f in &r.failures {
+            let _ = writeln!(
+                h,
+                "<li>{} at {} VPLs, camera {}: {}</li>",
+                esc(&f.mode),
+                f.vpls,
+                esc(&f.camera),
+                esc(&f.error)
+            );
+        }
+        h += "</ul>";
+    }
+    h + "</body></html>\n"
+}

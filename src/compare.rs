@@ -1,0 +1,297 @@
+//! `visgate compare`: every method against the CPU reference, one report.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result, bail};
+use clap::{Args, ValueEnum};
+use indicatif::{ProgressBar, ProgressStyle};
+use visgate_formats::vgate::{BakeParams, Resolution};
+use visgate_formats::{BakedLevel, ImportOptions, Scene};
+use visgate_runtime::compare::{CompareMode, CompareSpec, ErrorMetric, Step, report, run};
+use visgate_runtime::cpu::gates::{GateLevel, GateShape};
+use visgate_runtime::gpu::{GpuMode, METHODS, method};
+use visgate_runtime::hdr::HdrImage;
+
+use crate::settings::{LightArgs, MethodArgs};
+
+pub const COMPARE_HELP: &str = "\
+Modes (--modes, comma-separated, or all): every GPU method of `visgate render --mode`
+(none, per-vpl-shadow-maps, gates, gates-per-pixel, val-hard, val-cssm, direct-only) and
+gates-disk (mode gates with the paper's disks instead of portals). `all`: every one but
+direct-only; the gate modes only with a level (given, or baked here).
+
+Every mode renders at every --vpls count from every camera, beside the CPU reference with the
+very same VPLs (a shadow ray per VPL and pixel sample; --spp samples). OUT/report.md and
+OUT/report.html hold a table per camera (pass times, MSE, relative MSE, FLIP, indirect energy
+ratio, black-where-lit share, speed-up over per-VPL shadow maps), the Pareto plot (frame time
+against --metric, log-log) and a panel per render (reference | method | FLIP map);
+OUT/report.json holds every figure. Renders are kept in OUT/renders: run the same command
+again after a stop and it resumes, redoing only what changed.
+
+A level: --level LEVEL.vgate, or --bake-resolution N to bake one here; with neither, a gate
+mode makes the level be baked here at 128 voxels (and is left out, with a warning, if the
+scene does not bake).
+
+Examples:
+  visgate compare builtin:ajar-door --vpls 256,1024 --size 320x240 --out cmp
+  visgate compare scenes/shared/crytek-sponza.toml --bake-resolution 128 --modes none,gates,val-hard --out sponza
+  visgate compare builtin:four-rooms --budget-ms 50 --max-error 0.05 --metric flip --out fr";
+
+/// `--metric`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum MetricArg {
+    /// Mean squared error (the papers' measure).
+    Mse,
+    /// Relative MSE (scale-free; weighs dark pixels as much as bright ones, so light leaking
+    /// into dark rooms counts heavily).
+    RelMse,
+    /// Mean LDR-FLIP (perceptual).
+    Flip,
+}
+
+#[derive(Debug, Args)]
+pub struct CompareArgs {
+    /// The scene: a .toml, .obj, .gltf/.glb file or builtin:NAME.
+    pub scene: String,
+    /// Output folder: the report, the plot, the panels and every render (kept for resuming).
+    #[arg(long, short)]
+    pub out: PathBuf,
+    /// The baked level for the gate modes.
+    #[arg(long, conflicts_with = "bake_resolution")]
+    pub level: Option<PathBuf>,
+    /// Bake the level here at this many voxels on the longest axis.
+    #[arg(long)]
+    pub bake_resolution: Option<u32>,
+    /// Modes to compare, comma-separated (see below), or all.
+    #[arg(long, value_delimiter = ',', default_value = "all")]
+    pub modes: Vec<String>,
+    /// Light paths per render (or RSM VPLs), comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "256,1024,4096")]
+    pub vpls: Vec<u32>,
+    /// Cameras by name, comma-separated, or all.
+    #[arg(long, value_delimiter = ',', default_value = "all")]
+    pub cameras: Vec<String>,
+    /// Image size, WIDTHxHEIGHT.
+    #[arg(long, default_value = "320x240")]
+    pub size: String,
+    /// An independent image per camera (a path tracer's EXR, same size), in camera order: each
+    /// method's and the reference's error against it.
+    #[arg(long)]
+    pub ground_truth: Vec<PathBuf>,
+    /// Frame-time budget, ms: the report names the most accurate setting within it.
+    #[arg(long)]
+    pub budget_ms: Option<f64>,
+    /// Error bound (in --metric): the report names the fastest setting within it.
+    #[arg(long)]
+    pub max_error: Option<f64>,
+    /// The error of the plot and the answers.
+    #[arg(long, value_enum, default_value_t = MetricArg::Mse)]
+    pub metric: MetricArg,
+    /// Frames of the temporal-stability sequence of an animated scene (0: none).
+    #[arg(long, default_value_t = 8)]
+    pub stability_frames: u32,
+    /// Exposure of the PNGs and of FLIP, in stops.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub exposure: f32,
+    /// GPU frames rendered and dropped before each timed one.
+    #[arg(long, default_value_t = 1)]
+    pub warmup: u32,
+    /// Time the scene is posed at (the first frame of a sequence), seconds.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub time: f64,
+    #[command(flatten)]
+    pub light: LightArgs,
+    #[command(flatten)]
+    pub method: MethodArgs,
+}
+
+/// The modes `names` ask for (`all` expanded; `gates-disk` is gates with disks).
+fn modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMode>> {
+    let s = settings.settings();
+    let mut disk = s.gates;
+    disk.gates.shape = GateShape::Disk;
+    let mut portal = s.gates;
+    portal.gates.shape = GateShape::Portal;
+    let named = |name: &str| -> Result<CompareMode> {
+        let mode = match (name, method(name)) {
+            ("gates-disk", _) => GpuMode::Gates(disk),
+            ("gates", _) => GpuMode::Gates(portal),
+            (_, Some(m)) => (m.make)(&s),
+            (_, None) => bail!(
+                "--modes {name}: give all or some of {}, gates-disk",
+                METHODS.map(|m| m.name).join(", ")
+            ),
+        };
+        Ok(CompareMode {
+            label: name.to_string(),
+            mode,
+        })
+    };
+    let mut out = Vec::new();
+    for n in names {
+        if n == "all" {
+            for m in METHODS.iter().filter(|m| m.name != "direct-only") {
+                out.push(named(m.name)?);
+                if m.name == "gates" {
+                    out.push(named("gates-disk")?);
+                }
+            }
+        } else {
+            out.push(named(n)?);
+        }
+    }
+    out.dedup_by(|a, b| a.label == b.label);
+    if out.is_empty() {
+        bail!("--modes: give at least one mode, or all");
+    }
+    Ok(out)
+}
+
+/// The level for the gate modes: read, baked at the asked resolution, or baked at 128 when a
+/// gate mode wants one (left out if the scene does not bake); and its key.
+fn level(
+    args: &CompareArgs,
+    scene: &Scene,
+    modes: &mut Vec<CompareMode>,
+) -> Result<Option<(GateLevel, String)>> {
+    if !modes.iter().any(|m| m.mode.gates().is_some()) {
+        return Ok(None);
+    }
+    let baked = match (&args.level, args.bake_resolution) {
+        (Some(p), _) => {
+            BakedLevel::read(p).with_context(|| format!("cannot read the level {}", p.display()))?
+        }
+        (None, n) => {
+            let voxels = n.unwrap_or(128);
+            println!("baking the level at {voxels} voxels on the longest axis");
+            let params = BakeParams {
+                resolution: Resolution::LongestAxisVoxels(voxels),
+                ..BakeParams::default()
+            };
+            let opts = visgate_preprocess::bake::BakeOptions::default();
+            match visgate_preprocess::bake::bake(scene, &params, &opts, &|_| {}) {
+                Ok(b) => b.level,
+                Err(e) if n.is_none() => {
+                    eprintln!(
+                        "warning: the scene does not bake ({e}); the gate modes are left out"
+                    );
+                    modes.retain(|m| m.mode.gates().is_none());
+                    return Ok(None);
+                }
+                Err(e) => return Err(e).context("cannot bake the level"),
+            }
+        }
+    };
+    let key = format!("{:?}", baked.info);
+    Ok(Some((GateLevel::new(baked, scene)?, key)))
+}
+
+pub fn run_compare(args: CompareArgs) -> Result<()> {
+    let scene = crate::load_scene(
+        &args.scene,
+        &ImportOptions {
+            load_textures: true,
+        },
+    )?;
+    let cameras = if args.cameras.iter().any(|c| c == "all") {
+        scene.cameras.clone()
+    } else {
+        args.cameras
+            .iter()
+            .map(|c| crate::camera_of(&scene, &args.scene, Some(c)))
+            .collect::<Result<_>>()?
+    };
+    if cameras.is_empty() {
+        crate::camera_of(&scene, &args.scene, None)?;
+    }
+    let mut modes = modes(&args.modes, &args.method)?;
+    let level = level(&args, &scene, &mut modes)?;
+    let ground_truth = args
+        .ground_truth
+        .iter()
+        .map(|p| HdrImage::read(p).with_context(|| format!("cannot read {}", p.display())))
+        .collect::<Result<_>>()?;
+    let mut base = args.light.job(&args.method);
+    base.size = crate::render::parse_size(&args.size)?;
+    base.time = args.time;
+    base.warmup = args.warmup;
+    let spec = CompareSpec {
+        scene: args.scene.clone(),
+        level_key: level.as_ref().map_or(String::new(), |l| l.1.clone()),
+        modes,
+        vpls: args.vpls.clone(),
+        cameras,
+        base,
+        metric: match args.metric {
+            MetricArg::RelMse => ErrorMetric::RelMse,
+            MetricArg::Mse => ErrorMetric::Mse,
+            MetricArg::Flip => ErrorMetric::Flip,
+        },
+        budget_ms: args.budget_ms,
+        max_error: args.max_error,
+        ground_truth,
+        stability_frames: args.stability_frames,
+        exposure: args.exposure,
+        command: std::env::args().collect::<Vec<_>>().join(" "),
+    };
+    spec.check(level.is_some())?;
+    std::fs::create_dir_all(args.out.join("panels"))
+        .with_context(|| format!("cannot create {}", args.out.display()))?;
+    let bar = ProgressBar::new(1).with_style(
+        ProgressStyle::with_template("compare {bar:30} {pos}/{len} renders {elapsed}<{eta} {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let what = std::sync::Mutex::new(String::new());
+    let progress = |s: Step| match s {
+        Step::Render {
+            index,
+            total,
+            what: w,
+        } => {
+            bar.set_length(total as u64);
+            bar.set_position(index as u64);
+            w.clone_into(&mut what.lock().unwrap_or_else(|e| e.into_inner()));
+            bar.set_message(w.to_string());
+        }
+        Step::Rows(d, t) => {
+            let w = what.lock().unwrap_or_else(|e| e.into_inner()).clone();
+            bar.set_message(format!("{w} (rows {d}/{t})"));
+        }
+    };
+    let report = run(
+        &spec,
+        &scene,
+        level.as_ref().map(|l| &l.0),
+        &args.out,
+        &progress,
+    )?;
+    bar.finish_and_clear();
+    report::write(&report, &args.out)?;
+    println!(
+        "{}: {} renders made, {} read back; {} failed",
+        args.scene,
+        report.resumed[1],
+        report.resumed[0],
+        report.failures.len()
+    );
+    for f in &report.failures {
+        println!(
+            "  failed: {} at {} VPLs, camera {}: {}",
+            f.mode, f.vpls, f.camera, f.error
+        );
+    }
+    for a in &report.answers {
+        println!("{}: {}", a.kind, a.text);
+    }
+    println!("on the front ({}), fastest first:", spec.metric.name());
+    let mut front: Vec<_> = report.points.iter().filter(|p| p.pareto).collect();
+    front.sort_by(|a, b| a.ms.total_cmp(&b.ms));
+    for p in front {
+        println!(
+            "  {:<22} {:>6} VPLs {:>10.2} ms  {:.3e}",
+            p.mode, p.vpls, p.ms, p.error
+        );
+    }
+    println!("wrote {}", args.out.join("report.md").display());
+    Ok(())
+}

@@ -1,0 +1,218 @@
+//! The flags `render`, `compare` and the viewer share: where the VPLs come from and how the
+//! image is sampled ([`LightArgs`]), and every method's settings ([`MethodArgs`]).
+
+use clap::{Args, ValueEnum};
+use visgate_runtime::cpu::clustered::ClusterParams;
+use visgate_runtime::cpu::gates::{GateParams, GateShape};
+use visgate_runtime::cpu::val::ValParams;
+use visgate_runtime::gpu::{
+    CssmParams, GatesParams, GpuMode, GpuParams, InterleaveParams, MethodSettings, PerVplParams,
+    ShadowParams, ValModeParams,
+};
+use visgate_runtime::job::{RenderJob, VplSource as JobVpls};
+use visgate_runtime::vpl::GeometryClamp;
+
+/// `--gate-shape`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum GateShapeArg {
+    /// The baked portals (the true openings between clusters), walked along each segment.
+    Portal,
+    /// The paper's disks, through chains of at most --gate-hops of them.
+    Disk,
+}
+
+/// `--vpl-source`: where VPLs come from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum VplSource {
+    /// Light paths traced on the CPU (any number of bounces).
+    Paths,
+    /// Reflective shadow maps of the lights, sampled at Halton points on the GPU (one bounce).
+    Rsm,
+}
+
+/// VPLs, pixel samples and the geometry-term clamp.
+#[derive(Debug, Clone, Args)]
+#[command(next_help_heading = "VPLs and sampling")]
+pub struct LightArgs {
+    /// Where the VPLs come from.
+    #[arg(long, value_enum, default_value_t = VplSource::Paths)]
+    pub vpl_source: VplSource,
+    /// RSM size per layer (cube face or spot), texels, for --vpl-source rsm.
+    #[arg(long, default_value_t = 256)]
+    pub rsm_size: u32,
+    /// VPL generations per path (1: one-bounce indirect light).
+    #[arg(long, default_value_t = 1)]
+    pub bounces: u32,
+    /// Seed of the VPLs' low-discrepancy sequence.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Pixel samples (jittered).
+    #[arg(long, default_value_t = 4)]
+    pub spp: u32,
+    /// Upper bound of the VPL geometry term cos·cos/d², 1/m² (against spikes near VPLs);
+    /// absolute, so the image changes with the scene's scale. Default: from --clamp-distance.
+    #[arg(long, conflicts_with = "clamp_distance")]
+    pub g_max: Option<f32>,
+    /// The geometry-term clamp starts at this fraction of the scene's bounding diagonal
+    /// (g_max = 1 / (F·diagonal)²): the same image, up to scale, at any scale of the level.
+    #[arg(long, default_value_t = 0.025)]
+    pub clamp_distance: f32,
+}
+
+impl LightArgs {
+    /// A job with these VPLs, samples and clamp, and `method`'s shadow maps (renderer, VPL
+    /// count, size and frames at their defaults).
+    pub fn job(&self, method: &MethodArgs) -> RenderJob {
+        RenderJob {
+            params: GpuParams {
+                mode: GpuMode::None,
+                g_max: GpuParams::default().g_max,
+                shadows: ShadowParams {
+                    size: method.shadow_size,
+                    ..ShadowParams::default()
+                },
+            },
+            clamp: match self.g_max {
+                Some(g) => GeometryClamp::PerSquareMetre(g),
+                None => GeometryClamp::DiagonalFraction(self.clamp_distance),
+            },
+            vpl_source: match self.vpl_source {
+                VplSource::Paths => JobVpls::Paths,
+                VplSource::Rsm => JobVpls::Rsm,
+            },
+            rsm_size: self.rsm_size,
+            bounces: self.bounces,
+            seed: self.seed,
+            spp: self.spp,
+            ..RenderJob::default()
+        }
+    }
+}
+
+/// Every method's settings (each method takes its part).
+#[derive(Debug, Clone, Args)]
+#[command(next_help_heading = "Method settings")]
+pub struct MethodArgs {
+    /// Shadow map size per layer (GPU), texels.
+    #[arg(long, default_value_t = 1024)]
+    pub shadow_size: u32,
+    /// What a gate is (--mode gates): the baked portals, walked, or the paper's disks.
+    #[arg(long, value_enum, default_value_t = GateShapeArg::Portal)]
+    pub gate_shape: GateShapeArg,
+    /// Portals one walk may pass before it is given up and counted as occluded (--gate-shape
+    /// portal), 1..=1024.
+    #[arg(long, default_value_t = 64)]
+    pub max_walk: u32,
+    /// Gate disks are this many times their baked radius (--gate-shape disk).
+    #[arg(long, default_value_t = 1.0)]
+    pub gate_oversize: f32,
+    /// Gates a VPL's light may pass in a chain (--mode gates; the paper: 1).
+    #[arg(long, default_value_t = 2)]
+    pub gate_hops: u32,
+    /// Screen tile side of geometry clusters (--mode gates), pixels, 1..=16 on the GPU.
+    #[arg(long, default_value_t = 16)]
+    pub tile_px: u32,
+    /// Exponential depth slices of geometry clusters (--mode gates), 1..=256.
+    #[arg(long, default_value_t = 24)]
+    pub depth_slices: u32,
+    /// Capacity of the light-list pool (--mode gates with --gate-shape disk; portals keep no
+    /// lists: a pixel walks every VPL of its subset), entries of 8 bytes: a frame that needs
+    /// more stops with the count it needs. Unset, the pool grows to what a frame needs, up to
+    /// the adapter's storage binding limit.
+    #[arg(long)]
+    pub light_entries: Option<u32>,
+    /// Virtual area lights (--mode val-hard): the VPLs are clustered into this many.
+    #[arg(long, default_value_t = 30)]
+    pub vals: u32,
+    /// Most k-means iterations of the VAL clustering (it stops earlier where the assignment
+    /// repeats itself; the pass report says whether it converged).
+    #[arg(long, default_value_t = 8)]
+    pub val_iterations: u32,
+    /// Weight of the position term of the VAL clustering distance (the paper: 0.7).
+    #[arg(long, default_value_t = 0.7, allow_hyphen_values = true)]
+    pub val_w_x: f32,
+    /// Weight of the normal-angle term of the VAL clustering distance (the paper: 0.3).
+    #[arg(long, default_value_t = 0.3, allow_hyphen_values = true)]
+    pub val_w_alpha: f32,
+    /// Paraboloid shadow map size per VAL, texels.
+    #[arg(long, default_value_t = 256)]
+    pub val_map_size: u32,
+    /// Fourier terms of the convolution soft shadow maps (--mode val-cssm), 1..=16.
+    #[arg(long, default_value_t = 4)]
+    pub cssm_terms: u32,
+    /// Normal offset of CSSM lookups, texels (slope-scaled up to 2×): larger avoids
+    /// self-shadowing under wide filter kernels, smaller keeps contact shadows.
+    #[arg(long, default_value_t = 3.0)]
+    pub cssm_normal_offset: f32,
+    /// VAL modes and gates: interleaved sampling in blocks of this side (each pixel lights
+    /// itself with one of side² VPL subsets, then a geometry-aware blur over the block); 1:
+    /// every VPL at every pixel (the CPU twins, --cpu, always gather every VPL).
+    #[arg(long, default_value_t = 8)]
+    pub interleave: u32,
+    /// Blur: leave out neighbours farther than this fraction of the scene's size.
+    #[arg(long, default_value_t = 0.1)]
+    pub blur_distance: f32,
+    /// Blur: leave out neighbours whose normals' cosine is below this.
+    #[arg(long, default_value_t = 0.8, allow_hyphen_values = true)]
+    pub blur_normal: f32,
+    /// Per-VPL paraboloid map size (GPU), texels.
+    #[arg(long, default_value_t = 128)]
+    pub vpl_map_size: u32,
+    /// Per-VPL maps rendered and gathered per batch (bounds their memory).
+    #[arg(long, default_value_t = 128)]
+    pub vpl_batch: u32,
+}
+
+impl MethodArgs {
+    /// Interleaving and blur from the flags (VAL modes and gates alike).
+    fn interleave_params(&self) -> InterleaveParams {
+        InterleaveParams {
+            block: self.interleave,
+            blur_distance: self.blur_distance,
+            blur_normal: self.blur_normal,
+        }
+    }
+
+    /// Every method's settings from the flags.
+    pub fn settings(&self) -> MethodSettings {
+        MethodSettings {
+            per_vpl: PerVplParams {
+                map_size: self.vpl_map_size,
+                batch: self.vpl_batch,
+            },
+            gates: GatesParams {
+                gates: GateParams {
+                    oversize: self.gate_oversize,
+                    max_hops: self.gate_hops,
+                    shape: match self.gate_shape {
+                        GateShapeArg::Portal => GateShape::Portal,
+                        GateShapeArg::Disk => GateShape::Disk,
+                    },
+                    max_walk: self.max_walk,
+                },
+                clusters: ClusterParams {
+                    tile_px: self.tile_px,
+                    depth_slices: self.depth_slices,
+                },
+                light_entries: self.light_entries,
+                interleave: self.interleave_params(),
+            },
+            vals: ValModeParams {
+                vals: ValParams {
+                    count: self.vals,
+                    iterations: self.val_iterations,
+                    w_x: self.val_w_x,
+                    w_alpha: self.val_w_alpha,
+                    ..ValParams::default()
+                },
+                map_size: self.val_map_size,
+                interleave: self.interleave_params(),
+            },
+            cssm: CssmParams {
+                terms: self.cssm_terms,
+                normal_offset: self.cssm_normal_offset,
+                ..CssmParams::default()
+            },
+        }
+    }
+}

@@ -1,0 +1,225 @@
+//! `visgate compare`: the report holds every table, the plot and the panels; its figures are
+//! those `visgate render` + `visgate diff` give on the same settings; a second run resumes.
+
+mod support;
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+use serde_json::Value;
+
+fn visgate(args: &[&str]) -> Output {
+    let o = Command::new(env!("CARGO_BIN_EXE_visgate"))
+        .args(args)
+        .env("RUST_LOG", "error")
+        .output()
+        .expect("runs visgate");
+    assert!(
+        o.status.success(),
+        "visgate {args:?} failed:\n{}\n{}",
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    );
+    o
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// The number after `label` on its line of `text`.
+fn figure(text: &str, label: &str) -> f64 {
+    let line = text
+        .lines()
+        .find(|l| l.starts_with(label))
+        .unwrap_or_else(|| panic!("no '{label}' in:\n{text}"));
+    line[label.len()..]
+        .split_whitespace()
+        .next()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no number in '{line}'"))
+}
+
+/// Equal to the digits `diff` prints: six significant digits, FLIP five decimals.
+fn close(a: f64, b: f64, what: &str) {
+    let printed = if what == "FLIP" { 6e-6 } else { 1e-12 };
+    assert!(
+        (a - b).abs() <= 1e-5 * a.abs().max(b.abs()) + printed,
+        "{what}: compare {a} vs render + diff {b}"
+    );
+}
+
+const SETTINGS: [&str; 6] = ["--size", "48x36", "--spp", "1", "--camera", "main"];
+
+#[test]
+fn the_report_holds_every_table_plot_and_panel_with_the_figures_of_render_and_diff() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("cmp");
+    let out_s = out.to_str().expect("utf-8");
+    let args = [
+        "compare",
+        "builtin:two-rooms",
+        "--modes",
+        "none,val-hard",
+        "--vpls",
+        "16,64",
+        "--size",
+        "48x36",
+        "--spp",
+        "1",
+        "--cameras",
+        "main",
+        "--budget-ms",
+        "100000",
+        "--out",
+        out_s,
+    ];
+    let first = stdout(&visgate(&args));
+    assert!(first.contains("8 renders made, 0 read back"), "{first}");
+    let json: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).expect("json"))
+            .expect("parses");
+    let rows = json["rows"].as_array().expect("rows");
+    assert_eq!(rows.len(), 4, "2 modes × 2 VPL counts × 1 camera");
+    let md = std::fs::read_to_string(out.join("report.md")).expect("md");
+    let html = std::fs::read_to_string(out.join("report.html")).expect("html");
+    assert!(md.contains("## Camera main") && md.contains("| mode | settings | VPLs |"));
+    assert!(md.contains("![Pareto plot](pareto.png)") && html.contains("src=\"pareto.png\""));
+    assert!(md.contains("**Answer (budget)**"), "{md}");
+    let plot = image::open(out.join("pareto.png")).expect("plot").to_rgb8();
+    assert_eq!(plot.dimensions(), (960, 640));
+    let ink = plot.pixels().filter(|p| p.0 != [255, 255, 255]).count();
+    assert!(ink > 10_000, "the plot is blank: {ink} pixels drawn");
+    for r in rows {
+        let panel = r["panel"].as_str().expect("panel");
+        assert!(
+            md.contains(panel) && html.contains(panel),
+            "{panel} not in the report"
+        );
+        let p = image::open(out.join(panel)).expect("panel png").to_rgb8();
+        assert_eq!(p.dimensions(), (3 * 48 + 12, 36 + 44));
+        let cells = ["mode", "total_ms", "mse", "rel_mse", "flip", "energy_ratio"];
+        assert!(cells.iter().all(|c| !r[c].is_null()), "{r}");
+        assert_eq!(
+            md.matches(&format!("| {} |", r["mode"].as_str().expect("mode")))
+                .count(),
+            2
+        );
+    }
+    // The same settings through render + diff give the same figures.
+    let p = |n: &str| dir.path().join(n).to_str().expect("utf-8").to_string();
+    let render = |mode: &str, vpls: &str, out: &str, cpu: bool| {
+        let mut a = vec![
+            "render",
+            "builtin:two-rooms",
+            "--mode",
+            mode,
+            "--vpls",
+            vpls,
+            "--out",
+            out,
+        ];
+        a.extend(SETTINGS);
+        if cpu {
+            a.push("--cpu");
+        }
+        visgate(&a);
+    };
+    render("val-hard", "64", &p("m.exr"), false);
+    render("reference", "64", &p("r.exr"), false);
+    render("direct-only", "64", &p("d.exr"), true);
+    render("direct-only", "64", &p("dg.exr"), false);
+    let diff = stdout(&visgate(&[
+        "diff",
+        &p("m.exr"),
+        &p("r.exr"),
+        "--direct",
+        &p("d.exr"),
+        "--image-direct",
+        &p("dg.exr"),
+    ]));
+    let row = rows
+        .iter()
+        .find(|r| r["mode"] == "val-hard" && r["vpls"] == 64)
+        .expect("val-hard at 64");
+    let f = |k: &str| row[k].as_f64().expect("number");
+    close(f("mse"), figure(&diff, "MSE"), "MSE");
+    close(f("rel_mse"), figure(&diff, "rel. MSE"), "rel. MSE");
+    close(f("flip"), figure(&diff, "FLIP mean"), "FLIP");
+    close(
+        f("energy_ratio"),
+        figure(&diff, "indirect energy"),
+        "energy",
+    );
+    close(
+        f("black_where_lit") * 100.0,
+        figure(&diff, "black where lit"),
+        "black where lit",
+    );
+    // Stopped or not, a second run reads every render back.
+    let again = stdout(&visgate(&args));
+    assert!(again.contains("0 renders made, 8 read back"), "{again}");
+    // A changed setting redoes only the renders it touches (the VAL count: val-hard).
+    let mut more = args.to_vec();
+    more.extend(["--vals", "8"]);
+    let changed = stdout(&visgate(&more));
+    assert!(changed.contains("2 renders made, 6 read back"), "{changed}");
+}
+
+#[test]
+fn an_animated_scene_gets_a_stability_table_and_bad_requests_are_refused() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let scene = support::dynamic_scene(dir.path());
+    let out = dir.path().join("cmp");
+    let s = |p: &Path| p.to_str().expect("utf-8").to_string();
+    let (scene, out) = (s(&scene), s(&out));
+    let base = [
+        "compare", &scene, "--vpls", "32", "--size", "32x24", "--spp", "1",
+    ];
+    let mut args = base.to_vec();
+    args.extend([
+        "--modes",
+        "none,val-hard",
+        "--stability-frames",
+        "3",
+        "--out",
+        &out,
+    ]);
+    visgate(&args);
+    let json: Value = serde_json::from_str(
+        &std::fs::read_to_string(Path::new(&out).join("report.json")).expect("json"),
+    )
+    .expect("parses");
+    let st = json["stability"].as_array().expect("stability");
+    assert_eq!(st.len(), 2, "{st:?}");
+    for r in st {
+        let (c, rc) = (r["change"].as_f64(), r["reference_change"].as_f64());
+        assert!(
+            c.is_some_and(|c| c > 0.0) && rc.is_some_and(|c| c > 0.0),
+            "{r}"
+        );
+        assert_eq!(r["frames"], 3);
+    }
+    let md = std::fs::read_to_string(Path::new(&out).join("report.md")).expect("md");
+    assert!(md.contains("## Temporal stability"));
+    // Bad requests say what to give.
+    for (extra, says) in [
+        (vec!["--modes", "nope"], "gates-disk"),
+        (vec!["--vpls", "0"], "--vpls"),
+        (vec!["--cameras", "nowhere"], "no camera 'nowhere'"),
+        (
+            vec!["--modes", "gates", "--level", "/no/such.vgate"],
+            "cannot read the level",
+        ),
+    ] {
+        let mut a = base.to_vec();
+        a.extend(extra);
+        a.extend(["--out", &out]);
+        let o = Command::new(env!("CARGO_BIN_EXE_visgate"))
+            .args(&a)
+            .output()
+            .expect("runs");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success() && err.contains(says), "{a:?}: {err}");
+    }
+}
