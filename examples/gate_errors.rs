@@ -7,8 +7,8 @@
 //!
 //! `cargo run --release --example gate_errors -- [SCENE] [LEVEL.vgate] [CAMERA|x,y,z:tx,ty,tz]`
 //!
-//! With a GPU adapter, the GPU methods follow on the same VPLs and view: none, gates with disks
-//! and with portals, val-hard, val-cssm, per-VPL shadow maps.
+//! The GPU methods on the same VPLs and views are `visgate compare`'s (its report has every
+//! mode's MSE, FLIP, indirect energy and black-where-lit share beside its pass times).
 //!
 //! Light configurations: each of the scene's lights alone (all of them when there is one).
 //! Without arguments: the built-in four rooms (a point light in one room, a spot in the room
@@ -20,10 +20,6 @@ use visgate_runtime::camera::View;
 use visgate_runtime::cpu::gates::{GateLevel, GateParams, GateShape};
 use visgate_runtime::cpu::reference::{IndirectVisibility, ReferenceParams, render_with};
 use visgate_runtime::cpu::tracer::Tracer;
-use visgate_runtime::gpu::{
-    CssmParams, GatesParams, GpuContext, GpuMode, GpuParams, GpuRenderer, PerVplParams,
-    ValModeParams,
-};
 use visgate_runtime::hdr::HdrImage;
 use visgate_runtime::metrics::{errors, flip, indirect_errors};
 use visgate_runtime::vpl::{PathParams, path_vpls};
@@ -60,8 +56,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
     let gates = GateLevel::new(level, &scene)?;
     let tracer = Tracer::new(&scene);
-    // The GPU methods beside the CPU twins, on the same VPLs and view (none without an adapter).
-    let ctx = GpuContext::new().ok();
     println!(
         "{}: {} clusters, {} gates, 1024 light paths per configuration, 128×96, 1 spp",
         scene.name,
@@ -135,85 +129,28 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             ("portals (walk)", portals, true),
         ] {
             let img = run(vis, indirect)?;
-            row(name, &img, &reference, &direct, None)?;
+            row(name, &img, &reference, &direct)?;
             let over = gates.take_walks_over_limit();
             if over > 0 {
                 let limit = GateParams::default().max_walk;
                 println!("|   ({over} portal walks reached the limit of {limit}: occluded) |");
             }
         }
-        if let Some(ctx) = &ctx {
-            // The configuration's lights alone, as the CPU rows.
-            let mut alone = scene.clone();
-            alone.lights = lights.clone();
-            let mut gpu = GpuRenderer::new(ctx, &alone)?;
-            gpu.set_level(ctx, &gates)?;
-            let mut render = |mode: GpuMode| {
-                gpu.render(ctx, &view, &vpls, &GpuParams::with_mode(mode))
-                    .map(|r| r.0)
-            };
-            // GPU direct light (shadow maps, PCF) differs a little from the CPU's rays: the
-            // indirect figures of GPU rows take the GPU's own direct light out (MSE, relative
-            // MSE and FLIP are of the whole image, as a user sees it).
-            let gpu_direct = render(GpuMode::DirectOnly)?;
-            let disk = GateParams {
-                shape: GateShape::Disk,
-                ..GateParams::default()
-            };
-            for (name, mode) in [
-                ("GPU none", GpuMode::None),
-                (
-                    "GPU gates, disks (2 hops)",
-                    GpuMode::Gates(GatesParams {
-                        gates: disk,
-                        ..GatesParams::default()
-                    }),
-                ),
-                ("GPU gates, portals", GpuMode::Gates(GatesParams::default())),
-                ("GPU val-hard", GpuMode::ValHard(ValModeParams::new())),
-                (
-                    "GPU val-cssm",
-                    GpuMode::ValCssm(ValModeParams::new(), CssmParams::default()),
-                ),
-                (
-                    "GPU per-VPL shadow maps",
-                    GpuMode::PerVplShadowMaps(PerVplParams::default()),
-                ),
-            ] {
-                let img = render(mode)?;
-                row(name, &img, &reference, &direct, Some(&gpu_direct))?;
-            }
-        }
     }
     Ok(())
 }
 
-/// One table row: MSE, relative MSE, FLIP, indirect energy ratio, black where lit; the
-/// indirect light is the image less `own_direct` (its method's direct light) where given, less
-/// the reference's `direct` otherwise.
+/// One table row: MSE, relative MSE, FLIP, indirect energy ratio, black where lit (the
+/// indirect light is the image less the reference's `direct`: the CPU twins share its rays).
 fn row(
     name: &str,
     img: &HdrImage,
     reference: &HdrImage,
     direct: &HdrImage,
-    own_direct: Option<&HdrImage>,
 ) -> Result<(), Box<dyn std::error::Error>> {
     let e = errors(img, reference)?;
     let (f, _) = flip(img, reference, 0.0)?;
-    // The image's indirect light over the reference's direct light (a clone only then).
-    let net;
-    let with_reference_direct = match own_direct {
-        Some(own) => {
-            let mut m = img.clone();
-            for ((p, o), d) in m.pixels.iter_mut().zip(&own.pixels).zip(&direct.pixels) {
-                *p = *p - *o + *d;
-            }
-            net = m;
-            &net
-        }
-        None => img,
-    };
-    let i = indirect_errors(with_reference_direct, reference, direct)?;
+    let i = indirect_errors(img, reference, direct)?;
     println!(
         "| {name} | {:.3e} | {:.3e} | {f:.4} | {:.3} | {:.1} % |",
         e.mse,

@@ -40,7 +40,10 @@ Examples:
 /// `--metric`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum MetricArg {
-    /// Mean squared error (the papers' measure).
+    /// MSE of the indirect light alone: each image with its own direct light replaced by the
+    /// reference's (the direct light's shadow-map vs shadow-ray differences left out).
+    IndirectMse,
+    /// Mean squared error of the whole image (the papers' measure).
     Mse,
     /// Relative MSE (scale-free; weighs dark pixels as much as bright ones, so light leaking
     /// into dark rooms counts heavily).
@@ -85,7 +88,7 @@ pub struct CompareArgs {
     #[arg(long)]
     pub max_error: Option<f64>,
     /// The error of the plot and the answers.
-    #[arg(long, value_enum, default_value_t = MetricArg::Mse)]
+    #[arg(long, value_enum, default_value_t = MetricArg::IndirectMse)]
     pub metric: MetricArg,
     /// Frames of the temporal-stability sequence of an animated scene (0: none).
     #[arg(long, default_value_t = 8)]
@@ -223,6 +226,7 @@ pub fn run_compare(args: CompareArgs) -> Result<()> {
         cameras,
         base,
         metric: match args.metric {
+            MetricArg::IndirectMse => ErrorMetric::IndirectMse,
             MetricArg::RelMse => ErrorMetric::RelMse,
             MetricArg::Mse => ErrorMetric::Mse,
             MetricArg::Flip => ErrorMetric::Flip,
@@ -232,7 +236,10 @@ pub fn run_compare(args: CompareArgs) -> Result<()> {
         ground_truth,
         stability_frames: args.stability_frames,
         exposure: args.exposure,
-        command: std::env::args().collect::<Vec<_>>().join(" "),
+        command: std::iter::once("visgate".to_string())
+            .chain(std::env::args().skip(1))
+            .collect::<Vec<_>>()
+            .join(" "),
     };
     spec.check(level.is_some())?;
     std::fs::create_dir_all(args.out.join("panels"))

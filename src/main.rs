@@ -3,6 +3,7 @@
 
 mod bake;
 mod compare;
+mod export;
 mod inspect;
 mod render;
 mod settings;
@@ -59,6 +60,12 @@ enum Command {
     /// report (Markdown, HTML, JSON) and the answer to a time budget or an error bound.
     #[command(after_help = compare::COMPARE_HELP)]
     Compare(compare::CompareArgs),
+    /// Write a scene for another renderer (Mitsuba 3: an independent ground truth).
+    #[command(after_help = export::EXPORT_HELP)]
+    Export {
+        #[command(subcommand)]
+        action: export::ExportAction,
+    },
     /// Compare an image with a reference: MSE, relative MSE, FLIP, and an error map.
     Diff(render::DiffArgs),
     /// Print a summary of a scene, a mesh file or a baked .vgate level.
@@ -117,6 +124,7 @@ fn run(cli: Cli) -> Result<()> {
         Command::Bake(args) => bake::run(args),
         Command::Render(args) => render::run(args),
         Command::Compare(args) => compare::run_compare(args),
+        Command::Export { action } => export::run(action),
         Command::View(args) => view::run(args),
         Command::Diff(args) => render::diff(args),
         Command::Inspect {

@@ -353,6 +353,12 @@ pub fn diff(args: DiffArgs) -> Result<()> {
             None => a.clone(),
         };
         let i = indirect_errors(&own, &r, &direct)?;
+        if args.image_direct.is_some() {
+            println!(
+                "indirect MSE     {:.6e}  (its direct light replaced by the reference's)",
+                errors(&own, &r)?.mse
+            );
+        }
         println!(
             "indirect energy  {:.6}  (mean indirect light over the reference's)",
             i.energy_ratio

@@ -96,9 +96,17 @@ fn the_report_holds_every_table_plot_and_panel_with_the_figures_of_render_and_di
             md.contains(panel) && html.contains(panel),
             "{panel} not in the report"
         );
-        let p = image::open(out.join(panel)).expect("panel png").to_rgb8();
+        let p = image::open(out.join(panel)).expect("panel jpeg").to_rgb8();
         assert_eq!(p.dimensions(), (3 * 48 + 12, 36 + 44));
-        let cells = ["mode", "total_ms", "mse", "rel_mse", "flip", "energy_ratio"];
+        let cells = [
+            "mode",
+            "total_ms",
+            "mse",
+            "indirect_mse",
+            "rel_mse",
+            "flip",
+            "energy_ratio",
+        ];
         assert!(cells.iter().all(|c| !r[c].is_null()), "{r}");
         assert_eq!(
             md.matches(&format!("| {} |", r["mode"].as_str().expect("mode")))
@@ -145,6 +153,11 @@ fn the_report_holds_every_table_plot_and_panel_with_the_figures_of_render_and_di
     let f = |k: &str| row[k].as_f64().expect("number");
     close(f("mse"), figure(&diff, "MSE"), "MSE");
     close(f("rel_mse"), figure(&diff, "rel. MSE"), "rel. MSE");
+    close(
+        f("indirect_mse"),
+        figure(&diff, "indirect MSE"),
+        "indirect MSE",
+    );
     close(f("flip"), figure(&diff, "FLIP mean"), "FLIP");
     close(
         f("energy_ratio"),
@@ -222,4 +235,114 @@ fn an_animated_scene_gets_a_stability_table_and_bad_requests_are_refused() {
         let err = String::from_utf8_lossy(&o.stderr);
         assert!(!o.status.success() && err.contains(says), "{a:?}: {err}");
     }
+}
+
+#[test]
+fn the_mitsuba_export_spells_out_visgates_conventions() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let w = |n: &str, t: &[u8]| std::fs::write(dir.path().join(n), t).expect("write");
+    // A textured quad (2 × 2 texels), a spot light and a camera.
+    w(
+        "quad.obj",
+        b"mtllib quad.mtl\nv 0 0 0\nv 2 0 0\nv 2 0 2\nv 0 0 2\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\n\
+          usemtl tiles\nf 1/1 4/4 3/3 2/2\n",
+    );
+    w(
+        "quad.mtl",
+        b"newmtl tiles\nKd 0.5 0.5 0.5\nmap_Kd tiles.png\n",
+    );
+    let mut tex = image::RgbaImage::new(2, 2);
+    tex.put_pixel(0, 0, image::Rgba([255, 128, 0, 255]));
+    tex.save(dir.path().join("tiles.png")).expect("png");
+    w(
+        "scene.toml",
+        br#"
+[[mesh]]
+path = "quad.obj"
+
+[[light]]
+type = "spot"
+position = [1, 2, 1]
+target = [1, 0, 1]
+cutoff_deg = 40
+beam_deg = 30
+intensity = [5, 5, 5]
+
+[[camera]]
+name = "top"
+eye = [1, 3, 3]
+target = [1, 0, 1]
+fov_deg = 60
+"#,
+    );
+    let out = dir.path().join("mi");
+    let s = |p: &Path| p.to_str().expect("utf-8").to_string();
+    let printed = stdout(&visgate(&[
+        "export",
+        "mitsuba",
+        &s(&dir.path().join("scene.toml")),
+        &s(&out),
+        "--size",
+        "64x48",
+        "--spp",
+        "16",
+    ]));
+    assert!(
+        printed.contains("1 shapes, 1 textures; sensors in order: top"),
+        "{printed}"
+    );
+    let xml = std::fs::read_to_string(out.join("scene.xml")).expect("xml");
+    for want in [
+        "<integer name=\"max_depth\" value=\"3\"/>",
+        "<integer name=\"rr_depth\" value=\"4\"/>",
+        "<string name=\"fov_axis\" value=\"x\"/>",
+        "<float name=\"fov\" value=\"60",
+        "<rfilter type=\"box\"/>",
+        "<integer name=\"width\" value=\"64\"/>",
+        "<integer name=\"sample_count\" value=\"16\"/>",
+        "<bsdf type=\"twosided\" id=\"mat0\">",
+        "<string name=\"filter_type\" value=\"nearest\"/>",
+        "<emitter type=\"spot\">",
+        "<float name=\"cutoff_angle\" value=\"40",
+        "<float name=\"beam_width\" value=\"30",
+        "<rgb name=\"intensity\" value=\"5, 5, 5\"/>",
+    ] {
+        assert!(xml.contains(want), "no {want} in:\n{xml}");
+    }
+    // The texture is the albedo × the sRGB-decoded texels, linear.
+    let t = image::open(out.join("textures/mat0.exr"))
+        .expect("exr")
+        .to_rgb32f();
+    let p = t.get_pixel(0, 0).0;
+    let want = [0.5, 0.5 * 0.2158605, 0.0];
+    assert!(
+        p.iter().zip(want).all(|(a, b)| (a - b).abs() < 1e-4),
+        "{p:?}"
+    );
+    // One OBJ: the quad's two triangles, a normal and texture coordinates (in OBJ's convention)
+    // with every vertex.
+    let obj = std::fs::read_to_string(out.join("meshes/0-0.obj")).expect("obj");
+    let count = |p: &str| obj.lines().filter(|l| l.starts_with(p)).count();
+    assert_eq!(count("f "), 2, "{obj}");
+    assert!(count("v ") >= 4 && count("vn ") == count("v ") && count("vt ") == count("v "));
+    assert!(
+        obj.contains("vt 0 0\n") && obj.contains("vt 1 1\n"),
+        "{obj}"
+    );
+    // Bad requests say what to give.
+    let o = Command::new(env!("CARGO_BIN_EXE_visgate"))
+        .args([
+            "export",
+            "mitsuba",
+            "builtin:cornell-box",
+            &s(&out),
+            "--max-depth",
+            "1",
+        ])
+        .output()
+        .expect("runs");
+    assert!(
+        !o.status.success() && String::from_utf8_lossy(&o.stderr).contains("--max-depth"),
+        "{o:?}"
+    );
 }

@@ -18,6 +18,7 @@ pub mod error;
 pub mod export;
 pub mod import;
 pub mod load;
+pub mod mitsuba;
 pub mod scene;
 pub mod vgate;
 

@@ -1,6 +1,6 @@
 //! The pictures of a comparison: the Pareto plot (frame time against error, log-log, a curve
 //! per method over its VPL counts, the non-dominated points filled, the answers ringed) and
-//! the panels (reference | method | false-colour FLIP map), drawn with plotters into PNG
+//! the panels (reference | method | false-colour FLIP map, JPEG), drawn with plotters into
 //! bitmaps, text in egui's own font so nothing is looked up on the system.
 
 use std::sync::Once;
@@ -126,13 +126,21 @@ pub fn pareto(
                 }))
                 .map_err(drawing)?;
         }
+        // One ring per answered point, its answers named together.
+        let mut answered: Vec<(&Point, Vec<&str>)> = Vec::new();
         for a in answers {
             let Some(p) = &a.point else { continue };
+            match answered.iter_mut().find(|(q, _)| *q == p) {
+                Some((_, kinds)) => kinds.push(&a.kind),
+                None => answered.push((p, vec![&a.kind])),
+            }
+        }
+        for (p, kinds) in answered {
             chart
                 .draw_series(std::iter::once(
                     EmptyElement::at((p.ms.max(1e-12), p.error.max(1e-12)))
                         + Circle::new((0, 0), 12, BLACK.stroke_width(2))
-                        + Text::new(a.kind.clone(), (12, 6), (FONT, 14)),
+                        + Text::new(kinds.join(" + "), (-14, 16), (FONT, 14)),
                 ))
                 .map_err(drawing)?;
         }
@@ -186,4 +194,13 @@ pub fn panel(
         root.present().map_err(drawing)?;
     }
     RgbImage::from_raw(pw, ph, buf).ok_or_else(|| RenderError::Param("panel buffer size".into()))
+}
+
+/// Writes `picture` as a JPEG of quality 90 (a fifth of the PNG's size for rendered images,
+/// so that reports with dozens of panels stay small enough to keep in a repository).
+pub fn write_jpeg(picture: &RgbImage, path: &std::path::Path) -> Result<(), RenderError> {
+    let file = std::fs::File::create(path).map_err(|e| RenderError::io(path, e))?;
+    image::codecs::jpeg::JpegEncoder::new_with_quality(std::io::BufWriter::new(file), 90)
+        .encode_image(picture)
+        .map_err(|e| RenderError::io(path, e))
 }

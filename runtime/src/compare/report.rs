@@ -67,6 +67,7 @@ fn cells(r: &Row, ground_truth: bool) -> Vec<String> {
         format!("{:.2}", r.total_ms),
         r.speedup.map_or("-".into(), |s| format!("{s:.1}×")),
         sci(r.mse),
+        sci(r.indirect_mse),
         sci(r.rel_mse),
         format!("{:.4}", r.flip),
         format!("{:.3}", r.energy_ratio),
@@ -79,7 +80,7 @@ fn cells(r: &Row, ground_truth: bool) -> Vec<String> {
     c
 }
 
-const HEADER: [&str; 11] = [
+const HEADER: [&str; 12] = [
     "mode",
     "settings",
     "VPLs",
@@ -87,6 +88,7 @@ const HEADER: [&str; 11] = [
     "total (ms)",
     "× per-VPL maps",
     "MSE",
+    "indirect MSE",
     "rel. MSE",
     "FLIP",
     "indirect energy",
@@ -108,7 +110,9 @@ const LEGEND: &str = "Every method renders the very VPLs of the CPU reference (a
 per VPL and pixel sample), so each error is the method's visibility alone. Times: GPU \
 timestamps per pass after a warm-up frame (CPU wall time per pass where the adapter has none); \
 the total is the frame. Indirect energy: the method's mean indirect light over the reference's \
-(its own direct light taken out). Black where lit: of the pixels the reference lights \
+(its own direct light taken out). Indirect MSE: the MSE of the image with its own direct light \
+replaced by the reference's, the error of the indirect light alone (GPU shadow maps and CPU \
+shadow rays differ at shadow edges alike for every method). Black where lit: of the pixels the reference lights \
 indirectly at ≥ 0.1 of its mean, the share where the method gives < 0.1 of the reference. \
 ◆ front: no other setting is both faster and more accurate (means over the cameras). \
 × per-VPL maps: per-VPL shadow maps' frame time over this one's.";
