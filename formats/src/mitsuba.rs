@@ -174,10 +174,14 @@ fn meshes(scene: &Scene, dir: &Path, xml: &mut String) -> std::io::Result<usize>
                 if mesh.material.get(t) != Some(&mat) {
                     continue;
                 }
+                // Mitsuba refuses a zero normal: such a vertex takes its triangle's.
+                let [a, b, c] = tri.map(|v| mesh.positions[v as usize]);
+                let face = (b - a).cross(c - a).normalize_or(glam::Vec3::Y);
                 let ids = tri.map(|v| {
                     let r = &mut remap[v as usize];
                     if *r == u32::MAX {
-                        let (p, n) = (mesh.positions[v as usize], mesh.normals[v as usize]);
+                        let p = mesh.positions[v as usize];
+                        let n = mesh.normals[v as usize].try_normalize().unwrap_or(face);
                         let uv = mesh.uvs.get(v as usize).copied().unwrap_or_default();
                         let _ = writeln!(
                             verts,

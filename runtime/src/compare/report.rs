@@ -140,10 +140,10 @@ fn summary(r: &CompareReport) -> Vec<String> {
             .iter()
             .map(|a| format!("**Answer ({})**: {}.", a.kind, a.text)),
     );
-    let front: Vec<String> = r
-        .points
+    let mut on: Vec<_> = r.points.iter().filter(|p| p.pareto).collect();
+    on.sort_by(|a, b| a.ms.total_cmp(&b.ms));
+    let front: Vec<String> = on
         .iter()
-        .filter(|p| p.pareto)
         .map(|p| {
             format!(
                 "{} at {} VPLs ({:.2} ms, {:.3e})",
