@@ -158,6 +158,36 @@ fn summary(r: &CompareReport) -> Vec<String> {
     s
 }
 
+/// What the stability table means.
+const STABILITY: &str = "Mean absolute frame-to-frame change of the indirect light; ratio 1: \
+as steady as the reference; excess: the change that is the method's alone, over the \
+reference's mean indirect light.";
+
+const STABILITY_HEADER: [&str; 8] = [
+    "camera",
+    "mode",
+    "VPLs",
+    "frames",
+    "change",
+    "reference's",
+    "ratio",
+    "excess",
+];
+
+/// The cells of a stability row, in [`STABILITY_HEADER`]'s order.
+fn stability_cells(s: &super::StabilityRow) -> Vec<String> {
+    vec![
+        s.camera.clone(),
+        s.mode.clone(),
+        s.vpls.to_string(),
+        s.frames.to_string(),
+        sci(s.change),
+        sci(s.reference_change),
+        format!("{:.2}", s.ratio),
+        format!("{:.3}", s.excess),
+    ]
+}
+
 fn markdown(r: &CompareReport) -> String {
     let mut md = format!("# visgate compare: {}\n\n", r.scene);
     for line in summary(r) {
@@ -194,23 +224,15 @@ fn markdown(r: &CompareReport) -> String {
         }
     }
     if !r.stability.is_empty() {
-        md += "## Temporal stability\n\nMean absolute frame-to-frame change of the indirect \
-               light; ratio 1: as steady as the reference; excess: the change that is the \
-               method's alone, over the reference's mean indirect light.\n\n| camera | mode | \
-               VPLs | frames | change | reference's | ratio | excess |\n|---|---|---|---|---|---|---|---|\n";
+        let _ = writeln!(md, "## Temporal stability\n\n{STABILITY}\n");
+        let _ = writeln!(
+            md,
+            "| {} |\n|{}",
+            STABILITY_HEADER.join(" | "),
+            "---|".repeat(8)
+        );
         for s in &r.stability {
-            let _ = writeln!(
-                md,
-                "| {} | {} | {} | {} | {} | {} | {:.2} | {:.3} |",
-                s.camera,
-                s.mode,
-                s.vpls,
-                s.frames,
-                sci(s.change),
-                sci(s.reference_change),
-                s.ratio,
-                s.excess
-            );
+            let _ = writeln!(md, "| {} |", stability_cells(s).join(" | "));
         }
         md.push('\n');
     }
@@ -314,21 +336,18 @@ fn html(r: &CompareReport) -> String {
         }
     }
     if !r.stability.is_empty() {
-        h += "<h2>Temporal stability</h2><table><tr><th>camera</th><th>mode</th><th>VPLs</th>\
-              <th>frames</th><th>change</th><th>reference's</th><th>ratio</th><th>excess</th></tr>\n";
+        let _ = write!(
+            h,
+            "<h2>Temporal stability</h2><p>{}</p><table><tr>",
+            esc(STABILITY)
+        );
+        for c in STABILITY_HEADER {
+            let _ = write!(h, "<th>{}</th>", esc(c));
+        }
+        h += "</tr>\n";
         for s in &r.stability {
-            let _ = writeln!(
-                h,
-                "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{:.2}</td><td>{:.3}</td></tr>",
-                esc(&s.camera),
-                esc(&s.mode),
-                s.vpls,
-                s.frames,
-                sci(s.change),
-                sci(s.reference_change),
-                s.ratio,
-                s.excess
-            );
+            let cells: Vec<String> = stability_cells(s).iter().map(|c| esc(c)).collect();
+            let _ = writeln!(h, "<tr><td>{}</td></tr>", cells.join("</td><td>"));
         }
         h += "</table>\n";
     }
