@@ -17,7 +17,8 @@ use crate::settings::{LightArgs, MethodArgs};
 pub const COMPARE_HELP: &str = "\
 Modes (--modes, comma-separated, or all): every GPU method of `visgate render --mode`
 (none, per-vpl-shadow-maps, gates, gates-per-pixel, val-hard, val-cssm, direct-only) and
-gates-disk (mode gates with the paper's disks instead of portals). `all`: every one but
+gates-disk (mode gates with the paper's disks, whatever --gate-shape says; gates takes
+--gate-shape, portals by default). `all`: every one but
 direct-only; the gate modes only with a level (given, or baked here).
 
 Every mode renders at every --vpls count from every camera, beside the CPU reference with the
@@ -113,12 +114,9 @@ fn modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMode>> {
     let s = settings.settings();
     let mut disk = s.gates;
     disk.gates.shape = GateShape::Disk;
-    let mut portal = s.gates;
-    portal.gates.shape = GateShape::Portal;
     let named = |name: &str| -> Result<CompareMode> {
         let mode = match (name, method(name)) {
             ("gates-disk", _) => GpuMode::Gates(disk),
-            ("gates", _) => GpuMode::Gates(portal),
             (_, Some(m)) => (m.make)(&s),
             (_, None) => bail!(
                 "--modes {name}: give all or some of {}, gates-disk",

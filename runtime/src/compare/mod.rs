@@ -246,6 +246,9 @@ pub enum Step<'a> {
 #[derive(Debug, Clone, Serialize, Deserialize)]
 struct Kept {
     key: String,
+    /// The GPU adapter that made it (empty for a CPU render).
+    #[serde(default)]
+    adapter: String,
     vpl_count: usize,
     passes: Vec<PassMs>,
     total_ms: f64,
@@ -263,6 +266,8 @@ struct Store<'a> {
     done: u32,
     total: u32,
     resumed: [u32; 2],
+    /// The adapter of the GPU renders (made or read back).
+    adapter: String,
     progress: &'a (dyn Fn(Step) + Sync),
 }
 
@@ -299,25 +304,28 @@ impl Store<'_> {
                 (0..kept.frames).map(|i| HdrImage::read(&exr(i))).collect();
             if let Ok(images) = images {
                 self.resumed[0] += 1;
+                self.note_adapter(&kept.adapter);
                 return Ok((images, kept, rel.with_extension("exr")));
             }
         }
         std::fs::create_dir_all(path.parent().unwrap_or(self.dir))
             .map_err(|e| RenderError::io(&path, e))?;
         let mut frames: Vec<JobFrame> = Vec::new();
+        let mut adapter = String::new();
         let progress = |d: u32, t: u32| (self.progress)(Step::Rows(d, t));
         job.run(
             self.scene,
             camera,
             self.level,
-            &mut |_| {},
+            &mut |s| adapter = s.adapter.clone().unwrap_or_default(),
             &progress,
             &mut |f| {
                 frames.push(f);
                 Ok(())
             },
         )?;
-        let kept = kept_of(&frames, key)?;
+        let kept = kept_of(&frames, key, adapter)?;
+        self.note_adapter(&kept.adapter);
         for (i, f) in frames.iter().enumerate() {
             f.image.write_exr(&exr(i as u32))?;
         }
@@ -330,6 +338,15 @@ impl Store<'_> {
     }
 }
 
+impl Store<'_> {
+    /// Records the adapter of a GPU render (the first one named stands for the report).
+    fn note_adapter(&mut self, adapter: &str) {
+        if self.adapter.is_empty() {
+            adapter.clone_into(&mut self.adapter);
+        }
+    }
+}
+
 /// A kept render's record at `path`, if it has `key`.
 fn read_kept(path: &Path, key: &str) -> Option<Kept> {
     let text = std::fs::read_to_string(path).ok()?;
@@ -338,7 +355,7 @@ fn read_kept(path: &Path, key: &str) -> Option<Kept> {
 }
 
 /// The record of `frames` (times of the first frame).
-fn kept_of(frames: &[JobFrame], key: String) -> Result<Kept, RenderError> {
+fn kept_of(frames: &[JobFrame], key: String, adapter: String) -> Result<Kept, RenderError> {
     let first = frames
         .first()
         .ok_or_else(|| RenderError::Param("a render gave no frame".into()))?;
@@ -360,6 +377,7 @@ fn kept_of(frames: &[JobFrame], key: String) -> Result<Kept, RenderError> {
     };
     Ok(Kept {
         key,
+        adapter,
         vpl_count: first.vpl_count,
         passes,
         total_ms,
@@ -439,14 +457,13 @@ pub fn run(
         done: 0,
         total: per_camera * spec.cameras.len() as u32 + stability::renders(spec, scene),
         resumed: [0, 0],
+        adapter: String::new(),
         progress,
     };
-    let adapter = crate::gpu::GpuContext::new()
-        .map(|c| format!("{} ({:?})", c.adapter_info.name, c.adapter_info.backend))?;
     let mut report = CompareReport {
         scene: spec.scene.clone(),
         command: spec.command.clone(),
-        adapter,
+        adapter: String::new(),
         size: spec.base.size,
         spp: spec.base.spp,
         metric: spec.metric,
@@ -464,6 +481,10 @@ pub fn run(
     }
     report.stability = stability::measure(&mut store)?;
     report.resumed = store.resumed;
+    report.adapter = match store.adapter.is_empty() {
+        true => "an adapter not recorded (renders read back from an older run)".into(),
+        false => store.adapter,
+    };
     pareto::mark(&mut report, spec);
     Ok(report)
 }

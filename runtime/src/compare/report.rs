@@ -193,7 +193,7 @@ fn markdown(r: &CompareReport) -> String {
     for line in summary(r) {
         let _ = writeln!(md, "{line}\n");
     }
-    let _ = writeln!(md, "![Pareto plot]({})\n\n{LEGEND}\n", super::report::PLOT);
+    let _ = writeln!(md, "![Pareto plot]({})\n\n{LEGEND}\n", PLOT);
     let gt = r.rows.iter().any(|x| x.ground_truth_rel_mse.is_some());
     for cam in &r.cameras {
         let _ = writeln!(md, "## Camera {cam}\n");
@@ -293,7 +293,7 @@ fn html(r: &CompareReport) -> String {
     let _ = writeln!(
         h,
         "<img src=\"{}\" alt=\"Pareto plot\"><p>{}</p>",
-        super::report::PLOT,
+        PLOT,
         esc(LEGEND)
     );
     let gt = r.rows.iter().any(|x| x.ground_truth_rel_mse.is_some());
