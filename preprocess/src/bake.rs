@@ -465,8 +465,16 @@ pub fn bake(
     // node sideways join the room. Pieces that hold nodes of several clusters (a gate in open
     // space that does not close its opening) keep the per-voxel rule.
     let mut cut = es.empty.clone();
-    for g in chosen {
-        crate::cut::cut_gate(&meta, (&es.empty, &radius_vx), g, &mut cut);
+    // Gates are independent: flooded in parallel, a few dozen at a time (a cut can hold a
+    // whole plane of a 512³ grid).
+    for gates in chosen.chunks(64) {
+        let cuts: Vec<Vec<usize>> = gates
+            .par_iter()
+            .map(|g| crate::cut::gate_cut(&meta, (&es.empty, &radius_vx), g))
+            .collect();
+        for i in cuts.into_iter().flatten() {
+            cut[i] = false;
+        }
     }
     let (piece, pieces) = label_components(meta.dims, &cut, Conn::C6);
     drop(cut);

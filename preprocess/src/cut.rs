@@ -72,7 +72,7 @@ fn centre(meta: &GridMeta, i: usize) -> Vec3 {
 }
 
 /// The voxels reached from `from`'s voxel (26-connected) through voxels that `keep` (linear
-/// index, centre) accepts, as linear indices; at most [`MAX_FLOOD`].
+/// index, centre) accepts, as linear indices in breadth-first order; at most [`MAX_FLOOD`].
 fn flood(meta: &GridMeta, from: Vec3, keep: impl Fn(usize, Vec3) -> bool) -> Vec<usize> {
     let dims = meta.dims.map(i64::from);
     let o = Vec3::from(meta.origin_m);
@@ -85,7 +85,16 @@ fn flood(meta: &GridMeta, from: Vec3, keep: impl Fn(usize, Vec3) -> bool) -> Vec
         return out;
     }
     let index = |v: [i64; 3]| (v[0] + dims[0] * (v[1] + dims[1] * v[2])) as usize;
-    let mut seen = std::collections::HashSet::from([start]);
+    // One bit a voxel (zeroed pages cost nothing until touched): a set of grid coordinates
+    // hashed 26 times a voxel made the floods the bake's slowest step.
+    let mut seen = vec![0u64; (dims.iter().product::<i64>() as usize).div_ceil(64)];
+    let mut insert = |i: usize| {
+        let (w, bit) = (i / 64, 1u64 << (i % 64));
+        let new = seen[w] & bit == 0;
+        seen[w] |= bit;
+        new
+    };
+    insert(index(start));
     let mut queue = VecDeque::from([start]);
     while let Some(v) = queue.pop_front() {
         let i = index(v);
@@ -97,7 +106,7 @@ fn flood(meta: &GridMeta, from: Vec3, keep: impl Fn(usize, Vec3) -> bool) -> Vec
             for dy in -1..=1 {
                 for dx in -1..=1 {
                     let w = [v[0] + dx, v[1] + dy, v[2] + dz];
-                    if (0..3).all(|a| w[a] >= 0 && w[a] < dims[a]) && seen.insert(w) {
+                    if (0..3).all(|a| w[a] >= 0 && w[a] < dims[a]) && insert(index(w)) {
                         queue.push_back(w);
                     }
                 }
@@ -107,10 +116,11 @@ fn flood(meta: &GridMeta, from: Vec3, keep: impl Fn(usize, Vec3) -> bool) -> Vec
     out
 }
 
-/// Clears, in `cut`, the empty voxels of gate `g`'s cut: the plane's voxels reached from the
-/// gate's centre through the disk (solid or not) or through empty voxels as narrow as the
-/// opening; `radius_vx` is each voxel's largest-ball radius in whole voxels (saturated).
-pub fn cut_gate(meta: &GridMeta, (empty, radius_vx): Space, g: &GateDisk, cut: &mut [bool]) {
+/// The voxels of gate `g`'s cut (linear indices; the caller clears them from the empty
+/// space): the plane's voxels reached from the gate's centre through the disk (solid or not)
+/// or through empty voxels as narrow as the opening; `radius_vx` is each voxel's largest-ball
+/// radius in whole voxels (saturated).
+pub fn gate_cut(meta: &GridMeta, (empty, radius_vx): Space, g: &GateDisk) -> Vec<usize> {
     let vs = meta.voxel_size_m;
     // Thresholds a hair over their values, so that a distance equal to one in exact arithmetic
     // counts the same at every scale of the level (voxel units round differently).
@@ -126,9 +136,7 @@ pub fn cut_gate(meta: &GridMeta, (empty, radius_vx): Space, g: &GateDisk, cut: &
         let slot = empty[i] && f32::from(radius_vx[i]) <= narrow;
         along.abs() <= half && (in_disk || slot)
     };
-    for i in flood(meta, g.centre, on_cut) {
-        cut[i] = false;
-    }
+    flood(meta, g.centre, on_cut)
 }
 #[cfg(test)]
 mod tests {
@@ -174,7 +182,9 @@ mod tests {
             path_index: 0,
         };
         let mut cut = empty.clone();
-        cut_gate(&meta, (&empty, &radius), &g, &mut cut);
+        for i in gate_cut(&meta, (&empty, &radius), &g) {
+            cut[i] = false;
+        }
         // Every slot voxel is cut, top to bottom; nothing off the plane is.
         for y in 2..28 {
             for x in 9..12 {
