@@ -340,7 +340,11 @@ gpu_struct! {
         /// Interleaving subsets (block²).
         pub subsets: u32,
         /// Padding.
-        pub _pad1: [u32; 2],
+        /// Layout of the interleaved indirect target: 0 pixel order, 1 deinterleaved (each
+        /// VPL subset's pixels side by side; `vpl.wgsl`'s `deinterleaved`).
+        pub deinterleaved: u32,
+        /// Padding.
+        pub _pad1: u32,
         /// Blur: neighbours farther than this are left out. [Units: m]
         pub blur_distance: f32,
         /// Blur: neighbours whose normals' cosine is below this are left out.

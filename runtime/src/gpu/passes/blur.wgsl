@@ -1,4 +1,4 @@
-//! include: val.wgsl fullscreen.wgsl
+//! include: val.wgsl vpl.wgsl fullscreen.wgsl
 // Interleaving's other half: the interleaved indirect irradiance (val_gather.wgsl) blurred over
 // the b × b block where the geometry agrees (Laine et al.: positions closer than a fraction of
 // the scene, normals closer than a cosine), times albedo / π, added onto the image so far
@@ -39,7 +39,8 @@ fn fs_compose(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
             if length(qp.xyz - pos.xyz) > gather.blur_distance || dot(qn, n) < gather.blur_normal {
                 continue;
             }
-            sum += textureLoad(indirect, q, 0).xyz;
+            let at = select(q, deinterleaved(q, gather.block, vec2<u32>(size)), gather.deinterleaved == 1u);
+            sum += textureLoad(indirect, at, 0).xyz;
             weight += 1.0;
         }
     }

@@ -79,7 +79,7 @@ impl InterleaveBlur {
     }
 
     /// The blur's constants (a `ValGather` with only the interleaving's fields) for a mode
-    /// without a VAL gather of its own.
+    /// without a VAL gather of its own, whose indirect target is deinterleaved (the gates').
     pub fn uniform(f: &Frame, p: &InterleaveParams, pool: &mut Pool) -> wgpu::Buffer {
         let constants = ValGather {
             vpl_count: f.vpl_count,
@@ -88,6 +88,7 @@ impl InterleaveBlur {
             subsets: p.subsets(),
             blur_distance: p.blur_distance_m(f),
             blur_normal: p.blur_normal,
+            deinterleaved: 1,
             ..bytemuck::Zeroable::zeroed()
         };
         pool.upload(

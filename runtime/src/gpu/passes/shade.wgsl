@@ -264,11 +264,13 @@ fn subset_start(first: u32, end: u32, subsets: u32, j: u32) -> u32 {
     return lo;
 }
 
-// Interleaved clustered gates: this pixel's subset's irradiance × B alone (no albedo / π), into
-// the indirect target that blur.wgsl composes.
+// Interleaved clustered gates: a pixel's subset's irradiance × B alone (no albedo / π), into
+// the indirect target that blur.wgsl composes, deinterleaved: the fragment at s shades the
+// pixel that s holds, so that a GPU's neighbouring lanes walk the same VPLs.
 @fragment
 fn fs_gates_indirect(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
-    let px = vec2<i32>(frag.xy);
+    let b = max(globals.interleave_block, 1u);
+    let px = interleaved(vec2<i32>(frag.xy), b, textureDimensions(g_position));
     let pos = textureLoad(g_position, px, 0);
     if pos.w == 0.0 {
         return vec4<f32>(0.0);

@@ -53,7 +53,9 @@ struct ValGather {
     // Interleaving block side b (1: none) and subsets B = b².
     block: u32,
     subsets: u32,
-    pad1: vec2<u32>,
+    // Layout of the interleaved indirect target: 0 pixel order, 1 deinterleaved.
+    deinterleaved: u32,
+    pad1: u32,
     // Blur thresholds: distance (m) and normal cosine.
     blur_distance: f32,
     blur_normal: f32,

@@ -17,6 +17,37 @@ fn interleave_subset(px: vec2<i32>, b: u32) -> u32 {
     return u32(px.x) % b + b * (u32(px.y) % b);
 }
 
+// The deinterleaved layout (Segovia et al.) of an n-pixel axis: the pixels x ≡ r (mod b) side
+// by side, residue after residue, so that neighbouring fragments light with one VPL subset and
+// walk alike (a GPU runs 32 neighbours in lockstep; interleaved, each took another path). A
+// bijection of [0, n) for every n: residues below n mod b hold one pixel more.
+fn deinterleave_axis(x: u32, b: u32, n: u32) -> u32 {
+    let q = n / b;
+    let m = n % b;
+    let r = x % b;
+    return r * q + min(r, m) + x / b;
+}
+
+fn interleave_axis(s: u32, b: u32, n: u32) -> u32 {
+    let q = n / b;
+    let m = n % b;
+    let wide = m * (q + 1u);
+    if s < wide {
+        return (s % (q + 1u)) * b + s / (q + 1u);
+    }
+    return ((s - wide) % q) * b + m + (s - wide) / q;
+}
+
+// Where pixel px lies in the deinterleaved target of size n, and which pixel a position of it
+// holds.
+fn deinterleaved(px: vec2<i32>, b: u32, n: vec2<u32>) -> vec2<i32> {
+    return vec2<i32>(vec2<u32>(deinterleave_axis(u32(px.x), b, n.x), deinterleave_axis(u32(px.y), b, n.y)));
+}
+
+fn interleaved(s: vec2<i32>, b: u32, n: vec2<u32>) -> vec2<i32> {
+    return vec2<i32>(vec2<u32>(interleave_axis(u32(s.x), b, n.x), interleave_axis(u32(s.y), b, n.y)));
+}
+
 // The light of VPL v at p (normal n) without albedo / π, as runtime::vpl::gather_one:
 // Φ/π · min(cos θ_v cos θ_x / d², g_max); zero behind either surface.
 fn vpl_light(v: Vpl, p: vec3<f32>, n: vec3<f32>, g_max: f32) -> vec3<f32> {
