@@ -64,13 +64,11 @@ for set in "$@"; do
         r --mode direct-only --out "$w-d.exr"
         r --mode direct-only --cpu --out "$w-dc.exr"
         for n in 512 1024 2048 4096; do
-            for m in gates-per-pixel gates; do
-                r --mode $m --vpls $n --out "$w-g.exr"
-                r --mode $m --vpls $n --cpu --out "$w-c.exr" 2>/dev/null ||
-                    r --mode gates --vpls $n --cpu --out "$w-c.exr"
-                echo "$n $m: $("$bin" diff "$w-g.exr" "$w-c.exr" --direct "$w-dc.exr" \
-                    --image-direct "$w-d.exr" | grep 'indirect energy')"
-            done
+            # The CPU twin of the gates walks every VPL at every pixel, as gates-per-pixel.
+            r --mode gates-per-pixel --vpls $n --out "$w-g.exr"
+            r --mode gates --vpls $n --cpu --out "$w-c.exr"
+            echo "$n: $("$bin" diff "$w-g.exr" "$w-c.exr" --direct "$w-dc.exr" \
+                --image-direct "$w-d.exr" | grep 'indirect energy')"
         done
         rm -f "$lv" "$w"-*.exr
         ;;
