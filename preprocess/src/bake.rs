@@ -12,17 +12,16 @@ use serde_json::{Value, json};
 use visgate_formats::Scene;
 use visgate_formats::scene::Light;
 use visgate_formats::vgate::{
-    BakeInfo, BakeParams, BakedLevel, Cluster, Gate, GatePlacement, SegNodeKind, Skeleton,
-    SkeletonNode, Topology, VoxelValues,
+    BakeInfo, BakeParams, BakedLevel, Gate, GatePlacement, SegNodeKind, Skeleton, SkeletonNode,
+    Topology, VoxelValues,
 };
 
 use crate::clusters::{
     ClusterParams, GateDisk, cluster_radius, clusters, find_sliver, gates, merge_cluster,
-    skeleton_clusters,
 };
 use crate::empty::{EmptySpace, EmptySpaceParams, Seed, empty_space};
 use crate::graph::{SkeletonGraph, nearest_node, skeleton_graph};
-use crate::neighbourhood::{Conn, betti, label_components};
+use crate::neighbourhood::betti;
 use crate::segment::{SegmentParams, Segmented, segment};
 use crate::thin::{ThinParams, Thinned, extend_ends, thin};
 use crate::voxelize::{SolidGrid, grid_for, voxelize};
@@ -390,192 +389,19 @@ pub fn bake(
     // 10. Flatten.
     clock.start("flatten", 0);
     let n_voxels = es.empty.len();
-    let mut skel_cluster =
-        skeleton_clusters(&seg.skeleton, &seg.node_segment, &node_cluster, chosen);
-    // A voxel whose node lies across a gate of the node's cluster takes the gate's other
-    // cluster, so that cluster borders follow the gates' planes (a doorway node's voxels would
-    // otherwise reach sideways into the rooms).
-    let mut cluster_gates: Vec<Vec<usize>> = vec![Vec::new(); seeds_of.len()];
-    for (i, g) in chosen.iter().enumerate() {
-        for c in g.clusters {
-            cluster_gates[c as usize].push(i);
-        }
-    }
-    // A skeleton node that lies past a gate of its own cluster, within the gate's reach (a
-    // doorway's end node a little inside the next room, when the narrowest place lies beyond
-    // the segmented node), takes the cluster on the gate's other side.
-    let across = |c: u32, p: Vec3| -> Option<u32> {
-        cluster_gates[c as usize].iter().find_map(|&gi| {
-            let g = &chosen[gi];
-            let own_side = if g.clusters[0] == c { -1.0 } else { 1.0 };
-            let beyond = (p - g.centre).dot(g.normal) * own_side < -0.5 * vs;
-            let near = (p - g.centre).length() <= g.radius + vs;
-            (beyond && near).then(|| g.clusters[(g.clusters[0] == c) as usize])
-        })
-    };
-    let nodes_moved = (0..skel_cluster.len())
-        .filter_map(|n| across(skel_cluster[n], position[n]).map(|c| (n, c)))
-        .collect::<Vec<_>>();
-    for &(n, c) in &nodes_moved {
-        skel_cluster[n] = c;
-    }
-    // The gates of its cluster each node lies near, on its own side (the normal points from
-    // clusters[0]'s side to clusters[1]'s): only those can cut through its voxels.
-    let own_side = |g: &GateDisk, c: u32| if g.clusters[0] == c { -1.0 } else { 1.0 };
-    let node_gates: Vec<Vec<usize>> = (0..skel_cluster.len())
-        .into_par_iter()
-        .map(|n| {
-            let c = skel_cluster[n];
-            cluster_gates[c as usize]
-                .iter()
-                .copied()
-                .filter(|&gi| {
-                    let g = &chosen[gi];
-                    let side_n = (position[n] - g.centre).dot(g.normal) * own_side(g, c);
-                    side_n > -0.5 * vs && side_n <= g.radius + vs
-                })
-                .collect()
-        })
-        .collect();
-    let mut voxel_cluster: Vec<u32> = voxel_node
-        .par_iter()
-        .enumerate()
-        .map(|(v, &n)| {
-            if n == u32::MAX {
-                return u32::MAX;
-            }
-            let c = skel_cluster[n as usize];
-            let near = &node_gates[n as usize];
-            if near.is_empty() {
-                return c;
-            }
-            let p = Vec3::from(meta.voxel_to_world(meta.coords(v as u32)));
-            for &gi in near {
-                let g = &chosen[gi];
-                if (p - g.centre).dot(g.normal) * own_side(g, c) < -0.5 * vs {
-                    return g.clusters[(g.clusters[0] == c) as usize];
-                }
-            }
-            c
-        })
-        .collect();
-    // Then the gates cut the empty space: its pieces (6-connected, the voxels of each gate's
-    // plane within 3 radii of its centre, or along an opening as narrow as it, removed) whose skeleton nodes all lie
-    // in one cluster take that cluster whole, so a room's voxels that reached a doorway's
-    // node sideways join the room. Pieces that hold nodes of several clusters (a gate in open
-    // space that does not close its opening) keep the per-voxel rule.
-    let mut cut = es.empty.clone();
-    // Gates are independent: flooded in parallel, a few dozen at a time (a cut can hold a
-    // whole plane of a 512³ grid).
-    for gates in chosen.chunks(64) {
-        let cuts: Vec<Vec<usize>> = gates
-            .par_iter()
-            .map(|g| crate::cut::gate_cut(&meta, (&es.empty, &radius_vx), g))
-            .collect();
-        for i in cuts.into_iter().flatten() {
-            cut[i] = false;
-        }
-    }
-    let (piece, pieces) = label_components(meta.dims, &cut, Conn::C6);
-    drop(cut);
-    // Cluster of each piece's nodes: u32::MAX none yet, u32::MAX - 1 several.
-    let mut piece_cluster = vec![u32::MAX; pieces as usize];
-    for (n, &v) in sg.voxels.iter().enumerate() {
-        let p = piece[v as usize];
-        if p == u32::MAX {
-            continue;
-        }
-        let pc = &mut piece_cluster[p as usize];
-        *pc = match *pc {
-            u32::MAX => skel_cluster[n],
-            c if c == skel_cluster[n] => c,
-            _ => u32::MAX - 1,
-        };
-    }
-    let voxels_by_piece = voxel_cluster
-        .par_iter_mut()
-        .zip(piece.par_iter())
-        .filter(|(c, p)| **p != u32::MAX && **c != u32::MAX)
-        .map(|(c, &p)| {
-            let pc = piece_cluster[p as usize];
-            let changed = pc < u32::MAX - 1 && *c != pc;
-            if changed {
-                *c = pc;
-            }
-            changed as u64
-        })
-        .sum::<u64>();
-    drop(piece);
-    // Then no cluster reaches around a wall: a voxel that does not see its cluster's seed
-    // takes the cluster of the nearest one that does.
-    let seed_at: Vec<[u32; 3]> = seeds_of
-        .iter()
-        .map(|&seed| {
-            meta.coords(sg.voxels[seg.skeleton.nodes[seed as usize].skeleton_node as usize])
-        })
-        .collect();
-    let voxels_by_sight =
-        crate::sightline::clusters_by_sight(&meta, &es.empty, &mut voxel_cluster, &seed_at);
-    // Each cluster's box of empty voxels, in voxel coordinates, reduced over z slabs.
-    let nc = seeds_of.len();
-    let slab = (meta.dims[0] * meta.dims[1]) as usize;
-    let (vlo, vhi) = voxel_cluster
-        .par_chunks(slab)
-        .zip(es.empty.par_chunks(slab))
-        .enumerate()
-        .fold(
-            || (vec![[u32::MAX; 3]; nc], vec![[0u32; 3]; nc]),
-            |(mut lo, mut hi), (z, (cs, es))| {
-                for (i, (&c, &e)) in cs.iter().zip(es).enumerate() {
-                    if c == u32::MAX || !e {
-                        continue;
-                    }
-                    let v = [i as u32 % meta.dims[0], i as u32 / meta.dims[0], z as u32];
-                    for a in 0..3 {
-                        lo[c as usize][a] = lo[c as usize][a].min(v[a]);
-                        hi[c as usize][a] = hi[c as usize][a].max(v[a]);
-                    }
-                }
-                (lo, hi)
-            },
-        )
-        .reduce(
-            || (vec![[u32::MAX; 3]; nc], vec![[0u32; 3]; nc]),
-            |(mut lo, mut hi), (l2, h2)| {
-                for c in 0..nc {
-                    for a in 0..3 {
-                        lo[c][a] = lo[c][a].min(l2[c][a]);
-                        hi[c][a] = hi[c][a].max(h2[c][a]);
-                    }
-                }
-                (lo, hi)
-            },
-        );
-    let (lo, hi): (Vec<[f32; 3]>, Vec<[f32; 3]>) = (0..nc)
-        .map(|c| {
-            if vlo[c][0] == u32::MAX {
-                return ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-            }
-            let (a, b) = (meta.voxel_to_world(vlo[c]), meta.voxel_to_world(vhi[c]));
-            (a.map(|x| x - 0.5 * vs), b.map(|x| x + 0.5 * vs))
-        })
-        .unzip();
-    let clusters_out: Vec<Cluster> = seeds_of
-        .iter()
-        .enumerate()
-        .map(|(c, &seed)| {
-            // A cluster owns at least its seed's voxel, so its bounds are finite.
-            let p = position[seg.skeleton.nodes[seed as usize].skeleton_node as usize];
-            let fix = |v: [f32; 3], d: f32| -> [f32; 3] {
-                std::array::from_fn(|a| if v[a].is_finite() { v[a] } else { p[a] + d })
-            };
-            Cluster {
-                seed,
-                bounds_min_m: fix(lo[c], -0.5 * vs),
-                bounds_max_m: fix(hi[c], 0.5 * vs),
-            }
-        })
-        .collect();
+    let flat = crate::flatten::flatten(&crate::flatten::FlattenInput {
+        meta: &meta,
+        empty: &es.empty,
+        radius_vx: &radius_vx,
+        voxel_node: &voxel_node,
+        graph: &sg,
+        position: &position,
+        seg: &seg,
+        node_cluster: &node_cluster,
+        seeds_of: &seeds_of,
+        gates: chosen,
+    });
+    drop(radius_vx);
     let skeleton = Skeleton {
         nodes: sg
             .voxels
@@ -610,25 +436,24 @@ pub fn bake(
             skeleton,
             segmented: seg.skeleton.clone(),
             node_cluster,
-            clusters: clusters_out,
+            clusters: flat.clusters,
             gates: gates_out,
             portals: Vec::new(),
         },
         voxel_node: VoxelValues::pack(&voxel_node),
-        voxel_cluster: VoxelValues::pack(&voxel_cluster),
+        voxel_cluster: VoxelValues::pack(&flat.voxel_cluster),
     };
-    clock.end(json!({
-        "nodes_moved_across_gates": nodes_moved.len(),
-        "voxels_moved_to_their_piece": voxels_by_piece,
-        "voxels_moved_by_sight": voxels_by_sight,
-        "pieces": pieces,
-        "pieces_of_several_clusters": piece_cluster.iter().filter(|&&c| c == u32::MAX - 1).count(),
-        "voxel_node_bytes": level.voxel_node.elem().size() * n_voxels as u64,
-        "voxel_cluster_bytes": level.voxel_cluster.elem().size() * n_voxels as u64,
-    }));
+    let mut counts = flat.counts;
+    counts["voxel_node_bytes"] = json!(level.voxel_node.elem().size() * n_voxels as u64);
+    counts["voxel_cluster_bytes"] = json!(level.voxel_cluster.elem().size() * n_voxels as u64);
+    clock.end(counts);
     clock.start("portals", 0);
-    let found =
-        crate::portals::portals(&meta, &es.empty, &voxel_cluster, params.portal_cell_voxels);
+    let found = crate::portals::portals(
+        &meta,
+        &es.empty,
+        &flat.voxel_cluster,
+        params.portal_cell_voxels,
+    );
     clock.end(json!({
         "portals": found.portals.len(),
         "interface_faces": found.interface_faces,

@@ -21,6 +21,7 @@ pub mod cut;
 pub mod debug;
 pub mod distance;
 pub mod empty;
+pub mod flatten;
 pub mod graph;
 pub mod leak;
 pub mod neighbourhood;
