@@ -12,13 +12,11 @@ use serde_json::{Value, json};
 use visgate_formats::Scene;
 use visgate_formats::scene::Light;
 use visgate_formats::vgate::{
-    BakeInfo, BakeParams, BakedLevel, Gate, GatePlacement, SegNodeKind, Skeleton, SkeletonNode,
-    Topology, VoxelValues,
+    BakeInfo, BakeParams, BakedLevel, Gate, SegNodeKind, Skeleton, SkeletonNode, Topology,
+    VoxelValues,
 };
 
-use crate::clusters::{
-    ClusterParams, GateDisk, cluster_radius, clusters, find_sliver, gates, merge_cluster,
-};
+use crate::clusters::{ClusterParams, clusters};
 use crate::empty::{EmptySpace, EmptySpaceParams, Seed, empty_space};
 use crate::graph::{SkeletonGraph, nearest_node, skeleton_graph};
 use crate::neighbourhood::betti;
@@ -320,7 +318,7 @@ pub fn bake(
 
     // 8. Clusters.
     clock.start("clusters", 0);
-    let (mut node_cluster, mut seeds_of) = clusters(
+    let (node_cluster, seeds_of) = clusters(
         &seg.skeleton,
         &position,
         &radius,
@@ -334,55 +332,23 @@ pub fn bake(
 
     // 9. Gates (both rules; the chosen one is stored), after merging slivers.
     clock.start("gates", 0);
-    let gates_by = |placement: GatePlacement, node_cluster: &[u32]| {
-        gates(
-            &seg.skeleton,
-            &adjacency,
-            node_cluster,
-            &position,
-            &radius,
-            placement,
-        )
-    };
-    let mut slivers_merged = 0u64;
-    loop {
-        // Slivers are found with the narrowest-place gates whatever rule is stored, so both
-        // rules see the same clusters.
-        let g = gates_by(GatePlacement::Narrowest, &node_cluster);
-        let cr = cluster_radius(&seg.skeleton, &node_cluster, &radius, seeds_of.len());
-        let Some((from, into)) = find_sliver(&g, &cr, params.alpha) else {
-            break;
-        };
-        merge_cluster(&mut node_cluster, &mut seeds_of, from, into);
-        slivers_merged += 1;
-    }
-    let both: Vec<Vec<GateDisk>> = [GatePlacement::Narrowest, GatePlacement::Midpoint]
-        .iter()
-        .map(|&p| gates_by(p, &node_cluster))
-        .collect();
-    let chosen = match params.gate_placement {
-        GatePlacement::Narrowest => &both[0],
-        GatePlacement::Midpoint => &both[1],
-    };
-    let gate_placements: Vec<Value> = both[0]
-        .iter()
-        .zip(&both[1])
-        .map(|(n, m)| {
-            json!({
-                "clusters": n.clusters,
-                "narrowest": {
-                    "centre_m": n.centre.to_array(), "normal": n.normal.to_array(), "radius_m": n.radius,
-                },
-                "midpoint": {
-                    "centre_m": m.centre.to_array(), "normal": m.normal.to_array(), "radius_m": m.radius,
-                },
-                "apart_m": (n.centre - m.centre).length(),
-            })
-        })
-        .collect();
+    let step = crate::gate_step::gate_step(
+        &crate::gate_step::GateInput {
+            seg: &seg,
+            adjacency: &adjacency,
+            position: &position,
+            radius: &radius,
+        },
+        node_cluster,
+        seeds_of,
+        params.alpha,
+    );
+    let chosen = step.chosen(params.gate_placement);
+    let gate_placements = step.placements_json();
+    let (node_cluster, seeds_of) = (&step.node_cluster, &step.seeds_of);
     clock.end(json!({
         "gates": chosen.len(),
-        "slivers_merged": slivers_merged,
+        "slivers_merged": step.slivers_merged,
         "clusters": seeds_of.len(),
     }));
 
@@ -397,8 +363,8 @@ pub fn bake(
         graph: &sg,
         position: &position,
         seg: &seg,
-        node_cluster: &node_cluster,
-        seeds_of: &seeds_of,
+        node_cluster,
+        seeds_of,
         gates: chosen,
     });
     drop(radius_vx);
@@ -435,7 +401,7 @@ pub fn bake(
         topology: Topology {
             skeleton,
             segmented: seg.skeleton.clone(),
-            node_cluster,
+            node_cluster: node_cluster.clone(),
             clusters: flat.clusters,
             gates: gates_out,
             portals: Vec::new(),

@@ -22,6 +22,7 @@ pub mod debug;
 pub mod distance;
 pub mod empty;
 pub mod flatten;
+pub mod gate_step;
 pub mod graph;
 pub mod leak;
 pub mod neighbourhood;

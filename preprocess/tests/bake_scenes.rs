@@ -14,6 +14,10 @@ use visgate_preprocess::voxelize::BAKE_BYTES_PER_VOXEL;
 use visgate_scenes::level::{BoxLevel, cbox};
 use visgate_scenes::{Builtin, Opening};
 
+const RECORDED_AJAR_DOOR: (&str, u64, usize) = ("ajar-door", 0xfa47_6c6a_a73f_bba3, 137_093);
+const RECORDED_PILLARED_HALL: (&str, u64, usize) =
+    ("pillared-hall", 0xf98f_d25d_b1c0_7006, 156_178);
+
 fn params(res: u32) -> BakeParams {
     BakeParams {
         resolution: Resolution::LongestAxisVoxels(res),
@@ -208,6 +212,34 @@ fn rebaking_is_byte_identical_for_any_thread_count() {
     let one = bytes(1);
     assert_eq!(one, bytes(3));
     assert_eq!(one, bytes(1));
+}
+
+/// FNV-1a, 64 bits.
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    })
+}
+
+/// The bytes of these bakes, recorded: a change to the bake that should not change its output
+/// (a stage moved to a file of its own, a faster flood) must leave them as they are. A change
+/// that means to change the output updates them, saying why in its commit.
+#[test]
+fn the_bake_writes_the_recorded_bytes() {
+    let got: Vec<(&str, u64, usize)> = [Builtin::AjarDoor, Builtin::PillaredHall]
+        .into_iter()
+        .map(|b| {
+            let scene = b.scene().expect("scene");
+            let bytes = bake_scene(&scene, &params(64))
+                .expect("bake")
+                .level
+                .to_bytes()
+                .expect("encode");
+            (b.name(), fnv1a(&bytes), bytes.len())
+        })
+        .collect();
+    let want = [RECORDED_AJAR_DOOR, RECORDED_PILLARED_HALL];
+    assert_eq!(got, want, "got {got:#x?}");
 }
 
 fn custom(name: &str, model: ImportedModel, closed: bool, eye: [f64; 3], mpu: f64) -> Scene {
