@@ -39,9 +39,14 @@ fn sees(meta: &GridMeta, empty: &[bool], from: [u32; 3], to: [u32; 3]) -> bool {
     }
     let dims = meta.dims.map(i64::from);
     loop {
-        let k = (0..3)
-            .min_by(|&i, &j| t_max[i].total_cmp(&t_max[j]))
-            .unwrap_or(0);
+        // The axis whose boundary comes first, the lowest on a tie (as `min_by` would).
+        let k = if t_max[0] <= t_max[1] {
+            if t_max[0] <= t_max[2] { 0 } else { 2 }
+        } else if t_max[1] <= t_max[2] {
+            1
+        } else {
+            2
+        };
         if t_max[k] > 1.0 {
             return true;
         }
