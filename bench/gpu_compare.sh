@@ -12,7 +12,7 @@
 # the repository (see README), as the tests do.
 set -euo pipefail
 if [ $# -lt 3 ]; then
-    sed -n 2,11p "$0" | sed 's/^# \{0,1\}//'
+    sed -n '2,/^set /p' "$0" | grep '^#' | sed 's/^# \{0,1\}//'
     exit 2
 fi
 bin=$1 out=$2

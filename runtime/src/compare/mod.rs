@@ -336,9 +336,7 @@ impl Store<'_> {
         let images = frames.into_iter().map(|f| f.image).collect();
         Ok((images, kept, rel.with_extension("exr")))
     }
-}
 
-impl Store<'_> {
     /// Records the adapter of a GPU render (the first one named stands for the report).
     fn note_adapter(&mut self, adapter: &str) {
         if self.adapter.is_empty() {
@@ -481,9 +479,10 @@ pub fn run(
     }
     report.stability = stability::measure(&mut store)?;
     report.resumed = store.resumed;
-    report.adapter = match store.adapter.is_empty() {
-        true => "an adapter not recorded (renders read back from an older run)".into(),
-        false => store.adapter,
+    report.adapter = if store.adapter.is_empty() {
+        "an adapter not recorded (renders read back from an older run)".into()
+    } else {
+        store.adapter
     };
     pareto::mark(&mut report, spec);
     Ok(report)

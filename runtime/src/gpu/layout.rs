@@ -339,7 +339,6 @@ gpu_struct! {
         pub block: u32,
         /// Interleaving subsets (block²).
         pub subsets: u32,
-        /// Padding.
         /// Layout of the interleaved indirect target: 0 pixel order, 1 deinterleaved (each
         /// VPL subset's pixels side by side; `vpl.wgsl`'s `deinterleaved`).
         pub deinterleaved: u32,
