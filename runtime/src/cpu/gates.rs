@@ -12,7 +12,7 @@ use glam::Vec3;
 use visgate_formats::vgate::GridMeta;
 use visgate_formats::{BakedLevel, Scene};
 
-use super::portal_walk::{PortalGroup, portal_groups};
+use super::portal_walk::PortalBvh;
 use crate::RenderError;
 
 /// What a gate is at runtime.
@@ -67,8 +67,8 @@ pub struct GateLevel {
     level: BakedLevel,
     /// Gates of each cluster, as indices into the level's gates.
     cluster_gates: Vec<Vec<usize>>,
-    /// Portals of each cluster, grouped by neighbour.
-    portal_groups: Vec<Vec<PortalGroup>>,
+    /// Each cluster's portals in a bounding-volume hierarchy.
+    portal_bvh: PortalBvh,
     /// Walks through [`GateLevel::visible`] that reached the limit (counted as occluded).
     walks_over_limit: std::sync::atomic::AtomicU64,
 }
@@ -94,12 +94,12 @@ impl GateLevel {
                 }
             }
         }
-        let portal_groups = portal_groups(&level.topology.portals, clusters);
+        let portal_bvh = PortalBvh::new(&level.topology.portals, clusters);
         Ok(GateLevel {
             grid: level.info.grid,
             level,
             cluster_gates,
-            portal_groups,
+            portal_bvh,
             walks_over_limit: std::sync::atomic::AtomicU64::new(0),
         })
     }
@@ -114,16 +114,9 @@ impl GateLevel {
         self.cluster_gates.len()
     }
 
-    /// Cluster `c`'s portal groups (none for a cluster out of range).
-    pub fn portal_groups(&self, c: u32) -> &[PortalGroup] {
-        self.portal_groups
-            .get(c as usize)
-            .map_or(&[], Vec::as_slice)
-    }
-
-    /// Every cluster's portal groups.
-    pub fn all_portal_groups(&self) -> &[Vec<PortalGroup>] {
-        &self.portal_groups
+    /// Every cluster's portal hierarchy.
+    pub fn portal_bvh(&self) -> &PortalBvh {
+        &self.portal_bvh
     }
 
     /// Voxel edge of the level's grid. [Units: m]

@@ -2,29 +2,59 @@
 //! cluster, the segment to a point of another leaves each cluster it is in through the portal
 //! of that cluster it crosses first, until it reaches the other point's cluster.
 //!
-//! A cluster's portals are grouped by the neighbour they lead to, each group with the box of
-//! its portals' open cells: the walk tests a group's portals only where the segment meets the
-//! box (a slab test), so a step costs a few box tests, not a test of every piece of every
-//! interface of the cluster. The box is padded well past the masks' edge slack, so the walk's
-//! answer is the same with or without it.
+//! A cluster's portals (the planar pieces of its interfaces, up to ~900 of them on a large
+//! cluster of Crytek Sponza) sit in a bounding-volume hierarchy of their open cells' boxes: a
+//! step descends, nearer child first, only into boxes that the segment meets before the
+//! nearest portal found so far, so it costs a few box tests, not a test of every piece. The
+//! boxes are padded well past the masks' edge slack, so the walk's answer is the same with or
+//! without them.
 
 use glam::Vec3;
 use visgate_formats::vgate::Portal;
 
 use super::gates::{GateLevel, Walk};
 
-/// The portals of one cluster that lead to one neighbour, and the box of their open cells.
-#[derive(Debug, Clone, PartialEq)]
-pub struct PortalGroup {
-    /// The neighbour cluster.
-    pub neighbour: u32,
+/// A node of a cluster's portal hierarchy.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PortalNode {
     /// Box corners (padded). [Units: m]
     pub bounds: [Vec3; 2],
-    /// Indices into the level's portals.
-    pub portals: Vec<usize>,
+    /// What the box holds.
+    pub kind: NodeKind,
 }
 
-/// Padding of a group's box: a hundredth of a mask cell (ten times the masks' edge slack), and
+/// An inner node's children or a leaf's portals.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NodeKind {
+    /// Children `first` and `first + 1` (node indices), split along `axis` (the first child
+    /// holds the lower centres).
+    Inner {
+        /// Index of the first child.
+        first: u32,
+        /// 0, 1 or 2 (x, y, z).
+        axis: u32,
+    },
+    /// Portal indices `indices[first..first + count]`.
+    Leaf {
+        /// Into [`PortalBvh::indices`].
+        first: u32,
+        /// 1..=[`LEAF_PORTALS`].
+        count: u32,
+    },
+}
+
+/// Every cluster's portal hierarchy, in one node array.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PortalBvh {
+    /// Each cluster's root node (`u32::MAX`: the cluster has no portal).
+    pub roots: Vec<u32>,
+    /// The nodes; children are adjacent.
+    pub nodes: Vec<PortalNode>,
+    /// Portal indices of the leaves.
+    pub indices: Vec<u32>,
+}
+
+/// Padding of a portal's box: a hundredth of a mask cell (ten times the masks' edge slack), and
 /// a millionth of the coordinates' size for the rounding of far-off levels.
 fn pad(p: &Portal, corner: Vec3) -> f32 {
     p.cell_m * 0.01 + corner.abs().max_element() * 1e-6
@@ -52,69 +82,97 @@ pub fn portal_bounds(p: &Portal) -> [Vec3; 2] {
     [lo - e, hi + e]
 }
 
-/// Portals per group at most: an interface of many planar pieces is split into groups of
-/// nearby pieces, each with its own box, so that a walk tests the pieces near its segment.
-pub const GROUP_PORTALS: usize = 8;
+/// Portals per leaf at most.
+pub const LEAF_PORTALS: usize = 4;
 
-/// Each cluster's portal groups (of `clusters`): per neighbour, in increasing order, its
-/// portals split at the median of their centres along the longest axis until a group holds at
-/// most [`GROUP_PORTALS`].
-pub fn portal_groups(portals: &[Portal], clusters: usize) -> Vec<Vec<PortalGroup>> {
-    let bounds: Vec<[Vec3; 2]> = portals.iter().map(portal_bounds).collect();
-    let mut by_pair: Vec<std::collections::BTreeMap<u32, Vec<usize>>> =
-        vec![Default::default(); clusters];
-    for (i, p) in portals.iter().enumerate() {
-        for (k, &c) in p.clusters.iter().enumerate() {
-            if let Some(m) = by_pair.get_mut(c as usize) {
-                m.entry(p.clusters[1 - k]).or_default().push(i);
+/// Depth of a hierarchy at most (median splits halve a node: 2^30 portals would fit), the size
+/// of the walk's stack.
+pub const MAX_DEPTH: usize = 31;
+
+impl PortalBvh {
+    /// The hierarchies of `clusters` clusters' portals: each node's portals split at the median
+    /// of their centres along the longest axis of the centres until a leaf holds at most
+    /// [`LEAF_PORTALS`].
+    pub fn new(portals: &[Portal], clusters: usize) -> PortalBvh {
+        let bounds: Vec<[Vec3; 2]> = portals.iter().map(portal_bounds).collect();
+        let mut of_cluster = vec![Vec::new(); clusters];
+        for (i, p) in portals.iter().enumerate() {
+            for c in p.clusters {
+                if let Some(l) = of_cluster.get_mut(c as usize) {
+                    l.push(i as u32);
+                }
             }
         }
-    }
-    by_pair
-        .into_iter()
-        .map(|m| {
-            let mut groups = Vec::new();
-            for (neighbour, list) in m {
-                split_group(neighbour, list, &bounds, &mut groups);
+        let mut bvh = PortalBvh::default();
+        for list in of_cluster {
+            if list.is_empty() {
+                bvh.roots.push(u32::MAX);
+                continue;
             }
-            groups
-        })
-        .collect()
+            bvh.roots.push(bvh.nodes.len() as u32);
+            bvh.nodes.push(hull(&list, &bounds));
+            bvh.split(bvh.nodes.len() - 1, list, &bounds);
+        }
+        bvh
+    }
+
+    /// Makes node `at` (whose box is set) hold `list`: a leaf, or two children that split it.
+    fn split(&mut self, at: usize, mut list: Vec<u32>, bounds: &[[Vec3; 2]]) {
+        if list.len() <= LEAF_PORTALS {
+            let first = self.indices.len() as u32;
+            let count = list.len() as u32;
+            self.indices.extend(list);
+            self.nodes[at].kind = NodeKind::Leaf { first, count };
+            return;
+        }
+        let centre = |i: u32| (bounds[i as usize][0] + bounds[i as usize][1]) * 0.5;
+        let [lo, hi] = list
+            .iter()
+            .fold([Vec3::INFINITY, Vec3::NEG_INFINITY], |[lo, hi], &i| {
+                [lo.min(centre(i)), hi.max(centre(i))]
+            });
+        let axis = (hi - lo).max_position();
+        list.sort_by(|&x, &y| centre(x)[axis].total_cmp(&centre(y)[axis]).then(x.cmp(&y)));
+        let rest = list.split_off(list.len() / 2);
+        let first = self.nodes.len() as u32;
+        self.nodes[at].kind = NodeKind::Inner {
+            first,
+            axis: axis as u32,
+        };
+        self.nodes.push(hull(&list, bounds));
+        self.nodes.push(hull(&rest, bounds));
+        self.split(first as usize, list, bounds);
+        self.split(first as usize + 1, rest, bounds);
+    }
+
+    /// The depth of the deepest leaf (a root alone: 1).
+    pub fn depth(&self) -> usize {
+        fn depth(b: &PortalBvh, n: u32) -> usize {
+            match b.nodes[n as usize].kind {
+                NodeKind::Leaf { .. } => 1,
+                NodeKind::Inner { first, .. } => 1 + depth(b, first).max(depth(b, first + 1)),
+            }
+        }
+        self.roots
+            .iter()
+            .filter(|&&r| r != u32::MAX)
+            .map(|&r| depth(self, r))
+            .max()
+            .unwrap_or(0)
+    }
 }
 
-/// `list`'s portals as groups of at most [`GROUP_PORTALS`], split at the median along the
-/// longest axis of their centres, appended to `out`.
-fn split_group(
-    neighbour: u32,
-    mut list: Vec<usize>,
-    bounds: &[[Vec3; 2]],
-    out: &mut Vec<PortalGroup>,
-) {
-    let hull = |l: &[usize]| {
-        l.iter()
-            .fold([Vec3::INFINITY, Vec3::NEG_INFINITY], |[lo, hi], &i| {
-                [lo.min(bounds[i][0]), hi.max(bounds[i][1])]
-            })
-    };
-    if list.len() <= GROUP_PORTALS {
-        out.push(PortalGroup {
-            neighbour,
-            bounds: hull(&list),
-            portals: list,
-        });
-        return;
-    }
-    let centre = |i: usize| (bounds[i][0] + bounds[i][1]) * 0.5;
-    let [lo, hi] = list
+/// The box of `list`'s portals, as a node without children yet.
+fn hull(list: &[u32], bounds: &[[Vec3; 2]]) -> PortalNode {
+    let bounds = list
         .iter()
         .fold([Vec3::INFINITY, Vec3::NEG_INFINITY], |[lo, hi], &i| {
-            [lo.min(centre(i)), hi.max(centre(i))]
+            [lo.min(bounds[i as usize][0]), hi.max(bounds[i as usize][1])]
         });
-    let axis = (hi - lo).max_position();
-    list.sort_by(|&x, &y| centre(x)[axis].total_cmp(&centre(y)[axis]).then(x.cmp(&y)));
-    let rest = list.split_off(list.len() / 2);
-    split_group(neighbour, list, bounds, out);
-    split_group(neighbour, rest, bounds, out);
+    PortalNode {
+        bounds,
+        kind: NodeKind::Leaf { first: 0, count: 0 },
+    }
 }
 
 /// The reciprocal of a direction per axis for [`segment_box`] (0 on an axis it does not move
@@ -154,7 +212,6 @@ impl GateLevel {
         if ca == cb {
             return Walk::Visible(0);
         }
-        let portals = &self.baked().topology.portals;
         let d = b - a;
         let len = d.length();
         if len <= 0.0 || !len.is_finite() {
@@ -164,31 +221,14 @@ impl GateLevel {
         let inv = inverse(d);
         let (mut c, mut t0, mut last) = (ca, -slack, usize::MAX);
         for step in 0..max_walk {
-            let mut best: Option<(f32, usize, u32)> = None;
-            for g in self.portal_groups(c) {
-                let t1 = best.map_or(1.0 + slack, |(bt, _, _)| bt);
-                if !segment_box(a, inv, (t0, t1), g.bounds) {
-                    continue;
-                }
-                for &pi in &g.portals {
-                    let p = &portals[pi];
-                    let out = if p.clusters[0] == c { 1.0 } else { -1.0 };
-                    let n = Vec3::from(p.normal) * out;
-                    let den = d.dot(n);
-                    if pi == last || den <= f32::EPSILON * len {
-                        continue;
-                    }
-                    let t = (Vec3::from(p.origin_m) - a).dot(n) / den;
-                    if t < t0 || t > 1.0 + slack || best.is_some_and(|(bt, _, _)| bt <= t) {
-                        continue;
-                    }
-                    if p.covers((a + d * t).to_array()) {
-                        best = Some((t, pi, g.neighbour));
-                    }
-                }
-            }
-            let Some((t, pi, other)) = best else {
+            let Some((t, pi)) = self.first_exit(a, d, inv, c, (t0, 1.0 + slack), last) else {
                 return Walk::Blocked;
+            };
+            let p = &self.baked().topology.portals[pi];
+            let other = if p.clusters[0] == c {
+                p.clusters[1]
+            } else {
+                p.clusters[0]
             };
             if other == cb {
                 return Walk::Visible(step + 1);
@@ -198,39 +238,98 @@ impl GateLevel {
         Walk::Limit
     }
 
+    /// The portal of cluster `c` that `a + d·t` leaves it through first for t in `range`
+    /// (plane crossed going out, inside the mask), other than `last`: (t, portal index).
+    fn first_exit(
+        &self,
+        a: Vec3,
+        d: Vec3,
+        inv: Vec3,
+        c: u32,
+        (t0, t_end): (f32, f32),
+        last: usize,
+    ) -> Option<(f32, usize)> {
+        let portals = &self.baked().topology.portals;
+        let bvh = self.portal_bvh();
+        let len = d.length();
+        let mut best: Option<(f32, usize)> = None;
+        let mut stack = [0u32; MAX_DEPTH + 1];
+        let mut top = 0;
+        if let Some(&root) = bvh.roots.get(c as usize).filter(|&&r| r != u32::MAX) {
+            stack[0] = root;
+            top = 1;
+        }
+        while top > 0 {
+            top -= 1;
+            let node = bvh.nodes[stack[top] as usize];
+            let t1 = best.map_or(t_end, |(bt, _)| bt);
+            if !segment_box(a, inv, (t0, t1), node.bounds) {
+                continue;
+            }
+            let (first, count) = match node.kind {
+                NodeKind::Inner { first, axis } => {
+                    // The nearer child last, so that it is taken first.
+                    let up = d[axis as usize] >= 0.0;
+                    stack[top] = first + u32::from(up);
+                    stack[top + 1] = first + u32::from(!up);
+                    top += 2;
+                    continue;
+                }
+                NodeKind::Leaf { first, count } => (first as usize, count as usize),
+            };
+            for &pi in &bvh.indices[first..first + count] {
+                let pi = pi as usize;
+                let p = &portals[pi];
+                let out = if p.clusters[0] == c { 1.0 } else { -1.0 };
+                let n = Vec3::from(p.normal) * out;
+                let den = d.dot(n);
+                if pi == last || den <= f32::EPSILON * len {
+                    continue;
+                }
+                let t = (Vec3::from(p.origin_m) - a).dot(n) / den;
+                if t < t0 || t > t_end || best.is_some_and(|(bt, _)| bt <= t) {
+                    continue;
+                }
+                if p.covers((a + d * t).to_array()) {
+                    best = Some((t, pi));
+                }
+            }
+        }
+        best
+    }
+
     /// The portals packed into words for portals.wgsl: `[clusters, record base, portals]`,
-    /// `clusters + 1` absolute offsets of each cluster's first group, the groups
-    /// ([`GROUP_WORDS`] each: box minimum, box maximum, neighbour, absolute offsets of the
-    /// first and past the last of its portal indices, a zero), the portal indices, then
-    /// [`PORTAL_RECORD_WORDS`] words per portal (origin, cell, normal, width, u, height, v,
-    /// mask offset, the two clusters, two zeros) and the masks.
+    /// each cluster's root node (absolute offset; `u32::MAX` for none), the nodes
+    /// ([`NODE_WORDS`] each: box minimum, box maximum, then for an inner node the absolute
+    /// offset of its first child and `INNER | axis`, for a leaf the absolute offset of its
+    /// first portal index and its count), the portal indices, then [`PORTAL_RECORD_WORDS`]
+    /// words per portal (origin, cell, normal, width, u, height, v, mask offset, the two
+    /// clusters, two zeros) and the masks.
     pub fn portal_words(&self) -> Vec<u32> {
         let portals = &self.baked().topology.portals;
-        let groups = self.all_portal_groups();
-        let clusters = groups.len() as u32;
-        let group_count: usize = groups.iter().map(Vec::len).sum();
-        let index_at = 3 + clusters + 1 + GROUP_WORDS * group_count as u32;
-        let index_len: usize = groups.iter().flatten().map(|g| g.portals.len()).sum();
-        let records = index_at + index_len as u32;
+        let bvh = self.portal_bvh();
+        let clusters = bvh.roots.len() as u32;
+        let nodes_at = 3 + clusters;
+        let index_at = nodes_at + NODE_WORDS * bvh.nodes.len() as u32;
+        let records = index_at + bvh.indices.len() as u32;
         let mut w = vec![clusters, records, portals.len() as u32];
-        let mut at = 3 + clusters + 1;
-        for l in groups {
-            w.push(at);
-            at += GROUP_WORDS * l.len() as u32;
-        }
-        w.push(at);
+        w.extend(bvh.roots.iter().map(|&r| {
+            if r == u32::MAX {
+                r
+            } else {
+                nodes_at + NODE_WORDS * r
+            }
+        }));
         let f = |v: Vec3| v.to_array().map(f32::to_bits);
-        let mut first = index_at;
-        for g in groups.iter().flatten() {
-            let end = first + g.portals.len() as u32;
-            w.extend(f(g.bounds[0]));
-            w.extend(f(g.bounds[1]));
-            w.extend([g.neighbour, first, end, 0]);
-            first = end;
+        for n in &bvh.nodes {
+            w.extend(f(n.bounds[0]));
+            w.extend(f(n.bounds[1]));
+            w.extend(match n.kind {
+                NodeKind::Inner { first, axis } => [nodes_at + NODE_WORDS * first, INNER | axis],
+                NodeKind::Leaf { first, count } => [index_at + first, count],
+            });
         }
-        for g in groups.iter().flatten() {
-            w.extend(g.portals.iter().map(|&i| i as u32));
-        }
+        w.extend(&bvh.indices);
         let mut mask_at = records + PORTAL_RECORD_WORDS * portals.len() as u32;
         for p in portals {
             let f = |v: [f32; 3]| v.map(f32::to_bits);
@@ -251,8 +350,11 @@ impl GateLevel {
     }
 }
 
-/// Words per portal group in [`GateLevel::portal_words`].
-pub const GROUP_WORDS: u32 = 10;
+/// Words per hierarchy node in [`GateLevel::portal_words`].
+pub const NODE_WORDS: u32 = 8;
+
+/// The flag of an inner node in its last word ([`GateLevel::portal_words`]).
+pub const INNER: u32 = 1 << 31;
 
 /// Words per portal record in [`GateLevel::portal_words`].
 pub const PORTAL_RECORD_WORDS: u32 = 20;

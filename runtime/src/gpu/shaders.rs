@@ -105,7 +105,12 @@ pub fn constants() -> String {
         "PORTAL_RECORD",
         crate::cpu::portal_walk::PORTAL_RECORD_WORDS,
     );
-    s += &u("PORTAL_GROUP", crate::cpu::portal_walk::GROUP_WORDS);
+    s += &u("PORTAL_NODE", crate::cpu::portal_walk::NODE_WORDS);
+    s += &u("PORTAL_INNER", crate::cpu::portal_walk::INNER);
+    s += &u(
+        "PORTAL_STACK",
+        crate::cpu::portal_walk::MAX_DEPTH as u32 + 1,
+    );
     s += &format!(
         "const EDGE_SLACK: f32 = {:?};\n",
         visgate_formats::vgate::EDGE_SLACK

@@ -3,9 +3,9 @@
 // the segment to b leaves each cluster through the portal of it that it crosses first (plane
 // hit inside the coverage mask, going out), until it is in cb. It reads the including pass's
 // `grid` (voxel size, walk limit) and `portal_words: array<u32>` (GateLevel::portal_words:
-// [clusters, record base, portals], offsets, each cluster's groups of portals by neighbour with
-// their boxes, index lists, 20-word records, masks). A group's portals are tested only where
-// the segment meets its box.
+// [clusters, record base, portals], each cluster's root node, the nodes of each cluster's
+// hierarchy of portal boxes, index lists, 20-word records, masks). A step descends, nearer
+// child first, into the boxes the segment meets before the nearest portal found so far.
 
 const WALK_BLOCKED: u32 = 0u;
 const WALK_VISIBLE: u32 = 1u;
@@ -79,6 +79,58 @@ fn segment_box(a: vec3<f32>, inv: vec3<f32>, t0: f32, t1: f32, lo: vec3<f32>, hi
     return near <= far;
 }
 
+// The portal of cluster c that a + d·t leaves it through first for t in [t0, t_end] (plane
+// crossed going out, inside the mask), other than `last`: (bits of t, portal index), index
+// NONE for none (portal_walk::GateLevel::first_exit).
+fn first_exit(a: vec3<f32>, d: vec3<f32>, inv: vec3<f32>, c: u32, t0: f32, t_end: f32, last: u32) -> vec2<u32> {
+    let len = length(d);
+    let records = pw(1u);
+    var best_t = t_end;
+    var best = NONE;
+    var stack: array<u32, PORTAL_STACK>;
+    var top = 0u;
+    let root = pw(3u + c);
+    if root != NONE {
+        stack[0] = root;
+        top = 1u;
+    }
+    while top > 0u {
+        top--;
+        let node = stack[top];
+        if !segment_box(a, inv, t0, best_t, pv(node), pv(node + 3u)) {
+            continue;
+        }
+        let first = pw(node + 6u);
+        let kind = pw(node + 7u);
+        if kind >= PORTAL_INNER {
+            // The nearer child last, so that it is taken first.
+            let up = d[kind - PORTAL_INNER] >= 0.0;
+            stack[top] = first + select(0u, PORTAL_NODE, up);
+            stack[top + 1u] = first + select(PORTAL_NODE, 0u, up);
+            top += 2u;
+            continue;
+        }
+        for (var k = first; k < first + kind; k++) {
+            let pi = pw(k);
+            let r = records + pi * PORTAL_RECORD;
+            let n = pv(r + 4u) * select(1.0, -1.0, pw(r + 17u) == c);
+            let den = dot(d, n);
+            if pi == last || den <= 1.1920929e-7 * len {
+                continue;
+            }
+            let t = dot(pv(r) - a, n) / den;
+            if t < t0 || t > t_end || (best != NONE && t >= best_t) {
+                continue;
+            }
+            if portal_covers(r, a + d * t) {
+                best_t = t;
+                best = pi;
+            }
+        }
+    }
+    return vec2<u32>(bitcast<u32>(best_t), best);
+}
+
 fn portal_walk(a: vec3<f32>, ca: u32, b: vec3<f32>, cb: u32) -> u32 {
     if ca == cb {
         return WALK_VISIBLE;
@@ -95,42 +147,18 @@ fn portal_walk(a: vec3<f32>, ca: u32, b: vec3<f32>, cb: u32) -> u32 {
     var t0 = -slack;
     var last = NONE;
     for (var step = 0u; step < grid.max_walk; step++) {
-        var best_t = 3.4e38;
-        var best = NONE;
-        var best_other = NONE;
-        for (var gi = pw(3u + c); gi < pw(4u + c); gi += PORTAL_GROUP) {
-            let t1 = select(1.0 + slack, best_t, best != NONE);
-            if !segment_box(a, inv, t0, t1, pv(gi), pv(gi + 3u)) {
-                continue;
-            }
-            let other = pw(gi + 6u);
-            for (var k = pw(gi + 7u); k < pw(gi + 8u); k++) {
-                let pi = pw(k);
-                let r = records + pi * PORTAL_RECORD;
-                let n = pv(r + 4u) * select(1.0, -1.0, pw(r + 17u) == c);
-                let den = dot(d, n);
-                if pi == last || den <= 1.1920929e-7 * len {
-                    continue;
-                }
-                let t = dot(pv(r) - a, n) / den;
-                if t < t0 || t > 1.0 + slack || t >= best_t {
-                    continue;
-                }
-                if portal_covers(r, a + d * t) {
-                    best_t = t;
-                    best = pi;
-                    best_other = other;
-                }
-            }
-        }
+        let hit = first_exit(a, d, inv, c, t0, 1.0 + slack, last);
+        let best = hit.y;
         if best == NONE {
             return WALK_BLOCKED;
         }
-        if best_other == cb {
+        let r = records + best * PORTAL_RECORD;
+        let other = select(pw(r + 16u), pw(r + 17u), pw(r + 16u) == c);
+        if other == cb {
             return WALK_VISIBLE;
         }
-        c = best_other;
-        t0 = best_t;
+        c = other;
+        t0 = bitcast<f32>(hit.x);
         last = best;
     }
     return WALK_LIMIT;
