@@ -299,3 +299,90 @@ fn the_method_and_the_view_come_back_in_the_next_run_but_not_in_scripted_ones() 
             .contains("\"val-hard\"")
     );
 }
+
+#[test]
+fn shaders_from_a_folder_draw_and_a_broken_one_is_named_while_the_last_good_draws() {
+    let x = Xvfb::start();
+    let dir = tempfile::tempdir().expect("tempdir");
+    let shaders = dir.path().join("gpu");
+    std::fs::create_dir_all(shaders.join("passes")).expect("mkdir");
+    let shade = include_str!("../runtime/src/gpu/passes/shade.wgsl");
+    let end = "    return vec4<f32>(radiance, 1.0);";
+    assert_eq!(shade.matches(end).count(), 1, "the shading pass's return");
+    let file = shaders.join("passes/shade.wgsl");
+    let want = dir.path().join("render.exr");
+    let o = visgate(
+        &[
+            "render",
+            "builtin:cornell-box",
+            "--mode",
+            "direct-only",
+            "--size",
+            "64x48",
+            "--out",
+            want.to_str().expect("utf-8"),
+        ],
+        None,
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    let shot = dir.path().join("shot.exr");
+    let view = |display: &str| {
+        visgate(
+            &[
+                "view",
+                "builtin:cornell-box",
+                "--mode",
+                "direct-only",
+                "--render-size",
+                "64x48",
+                "--frames",
+                "2",
+                "--shader-dir",
+                shaders.to_str().expect("utf-8"),
+                "--screenshot",
+                shot.to_str().expect("utf-8"),
+            ],
+            Some(display),
+        )
+    };
+    // The shading pass halved: the viewer draws with it.
+    std::fs::write(
+        &file,
+        shade.replace(end, "    return vec4<f32>(radiance * 0.5, 1.0);"),
+    )
+    .expect("write");
+    let o = view(&x.1);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(text(&o).contains("1 file(s) from"), "{}", text(&o));
+    let (img, reference) = (read(&shot), read(&want));
+    let ratio = img.mean().x / reference.mean().x;
+    assert!((ratio - 0.5).abs() < 1e-4, "{ratio}");
+    // Broken on line 40: named, and the built-in shaders (the last good) draw.
+    let mut lines: Vec<&str> = shade.lines().collect();
+    lines[39] = "this is not WGSL";
+    std::fs::write(&file, lines.join("\n")).expect("write");
+    let o = view(&x.1);
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(
+        text(&o).contains("shader error") && text(&o).contains("shade.wgsl:40:"),
+        "{}",
+        text(&o)
+    );
+    let e = errors(&read(&shot), &reference).expect("same size");
+    assert!(e.rel_mse < 1e-9, "{e:?}");
+    // Not a folder of shaders: refused before a window opens.
+    let o = visgate(
+        &[
+            "view",
+            "builtin:cornell-box",
+            "--shader-dir",
+            dir.path().to_str().expect("utf-8"),
+        ],
+        Some(&x.1),
+    );
+    assert!(
+        !o.status.success() && text(&o).contains("holds none of visgate's shaders"),
+        "{}",
+        text(&o)
+    );
+}

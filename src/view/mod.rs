@@ -8,6 +8,7 @@ mod camera;
 mod compare;
 mod layers;
 mod panel;
+mod shader_watch;
 mod state;
 
 use std::path::PathBuf;
@@ -78,6 +79,12 @@ pub struct ViewArgs {
     /// across runs (scripted runs, --screenshot and --benchmark, never do).
     #[arg(long)]
     pub fresh: bool,
+    /// Read the WGSL shaders from this folder (flat, or with passes/ and shaders/ as in the
+    /// repository's runtime/src/gpu; files it lacks stay built in) and rebuild the pipelines
+    /// whenever one changes: a compile error shows in the panel with its file and line, and
+    /// the last good shaders keep drawing.
+    #[arg(long)]
+    pub shader_dir: Option<PathBuf>,
     /// With no display, render this image headless instead (`visgate render` with the same
     /// scene, level, method, VPLs — 256 unless given — and --render-size) rather than fail.
     #[arg(long)]
@@ -96,7 +103,8 @@ Examples:
   visgate bake builtin:four-rooms -o four-rooms.vgate
   visgate view builtin:four-rooms --level four-rooms.vgate
   visgate view builtin:cornell-box --mode val-cssm --rsm --vpls 4096
-  visgate view builtin:cornell-box --render-size 320x240 --screenshot shot.png --frames 3";
+  visgate view builtin:cornell-box --render-size 320x240 --screenshot shot.png --frames 3
+  visgate view builtin:four-rooms --level four-rooms.vgate --shader-dir runtime/src/gpu";
 
 /// `--render-size` or `--size` as `[w, h]`.
 fn parse_size(s: &str) -> Result<[u32; 2]> {
@@ -274,6 +282,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
         // The saved camera only when no --camera was asked for.
         restore: saved.filter(|_| args.camera.is_none()),
         persist,
+        shader_dir: args.shader_dir.clone(),
         scene,
     };
     if !args.time.is_finite() {

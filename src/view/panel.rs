@@ -166,3 +166,23 @@ pub fn pass_times(ui: &mut egui::Ui, img: &HdrImage, t: &PassTimes, history: &Ve
         history.len()
     ));
 }
+
+/// `--shader-dir`: where the shaders come from, or the error that keeps the last good ones.
+pub fn shader_status(ui: &mut egui::Ui, w: &super::shader_watch::ShaderWatch) {
+    match &w.error {
+        Some(e) => {
+            ui.colored_label(
+                egui::Color32::LIGHT_RED,
+                format!("shader error, the last good shaders draw on:\n{e}"),
+            );
+        }
+        None => {
+            ui.label(format!(
+                "shaders: {} file(s) from {} (compiled {} time(s); saved changes reload)",
+                w.files,
+                w.dir().display(),
+                w.reloads
+            ));
+        }
+    }
+}

@@ -59,6 +59,7 @@ use passes::shadow_maps::ShadowMaps;
 use passes::val_gather::{ValGathers, ValPasses};
 use passes::vals::{ValClustering, ValInput};
 use shaders::ShadeIndirect;
+pub use shaders::ShaderSources;
 use timing::Recorder;
 
 pub use context::GpuContext;
@@ -149,18 +150,18 @@ pub struct Pipelines {
 }
 
 impl Pipelines {
-    fn new(d: &wgpu::Device) -> Result<Pipelines, RenderError> {
+    fn new(d: &wgpu::Device, s: &ShaderSources) -> Result<Pipelines, RenderError> {
         Ok(Pipelines {
-            shadow_maps: ShadowMaps::new(d)?,
-            gbuffer: GBuffer::new(d)?,
-            shade: Shade::new(d)?,
-            rsm: RsmVpls::new(d)?,
-            maps: ParaboloidMaps::new(d)?,
-            clustered: ClusteredGates::new(d)?,
-            vals: ValClustering::new(d)?,
-            cssm: Cssm::new(d)?,
-            val_gather: ValGathers::new(d)?,
-            blur: InterleaveBlur::new(d)?,
+            shadow_maps: ShadowMaps::new(d, s)?,
+            gbuffer: GBuffer::new(d, s)?,
+            shade: Shade::new(d, s)?,
+            rsm: RsmVpls::new(d, s)?,
+            maps: ParaboloidMaps::new(d, s)?,
+            clustered: ClusteredGates::new(d, s)?,
+            vals: ValClustering::new(d, s)?,
+            cssm: Cssm::new(d, s)?,
+            val_gather: ValGathers::new(d, s)?,
+            blur: InterleaveBlur::new(d, s)?,
         })
     }
 }
@@ -273,11 +274,27 @@ impl GpuRenderer {
                     wgpu::BufferUsages::UNIFORM,
                 ),
             },
-            pipelines: Pipelines::new(d)?,
+            pipelines: Pipelines::new(d, &ShaderSources::builtin())?,
             pool: Pool::default(),
             val_warm: None,
             light_entries: passes::clustered_gates::AUTO_LIGHT_ENTRIES,
         })
+    }
+
+    /// Rebuilds every pipeline from `sources` (shader hot reload): they are validated first
+    /// (naga, as the GPU's compiler; the error names the file and line) and built under an
+    /// error scope, and only when all of them build do they replace the current ones — on an
+    /// error the last good pipelines keep drawing.
+    pub fn reload_shaders(
+        &mut self,
+        ctx: &GpuContext,
+        sources: &ShaderSources,
+    ) -> Result<(), RenderError> {
+        sources.validate()?;
+        let pipelines = context::scoped(ctx, || Pipelines::new(&ctx.device, sources))?;
+        self.pipelines = pipelines;
+        self.val_warm = None;
+        Ok(())
     }
 
     /// Replaces the geometry and the lights with those of `scene` posed at another time (the

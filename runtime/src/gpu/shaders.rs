@@ -167,6 +167,133 @@ pub fn compose_with(
     Ok(out)
 }
 
+/// The WGSL the pipelines are built from: the built-in files, each replaceable by a copy read
+/// from disk (`visgate view --shader-dir`, for the people who work on the methods).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ShaderSources {
+    /// Files read from disk, by name (`shade.wgsl`, `portals.wgsl`), and where they came from.
+    files: std::collections::BTreeMap<String, (std::path::PathBuf, String)>,
+}
+
+impl ShaderSources {
+    /// The built-in shaders alone.
+    pub fn builtin() -> ShaderSources {
+        ShaderSources::default()
+    }
+
+    /// Every shader file name: the pass shaders, then the includes.
+    pub fn names() -> impl Iterator<Item = &'static str> {
+        SOURCES.iter().chain(INCLUDES.iter()).map(|(n, _)| *n)
+    }
+
+    /// The built-in shaders, with each file that `dir` holds — as `dir/NAME`,
+    /// `dir/passes/NAME` or `dir/shaders/NAME`, so both a flat folder and a copy of (or the
+    /// repository's own) `runtime/src/gpu` work — read in its place. A folder that holds none
+    /// of them is refused: it is the wrong folder.
+    pub fn read_dir(dir: &std::path::Path) -> Result<ShaderSources, RenderError> {
+        let mut files = std::collections::BTreeMap::new();
+        for name in ShaderSources::names() {
+            let Some(path) = ShaderSources::path_in(dir, name) else {
+                continue;
+            };
+            let text = std::fs::read_to_string(&path)
+                .map_err(|e| RenderError::Param(format!("{}: {e}", path.display())))?;
+            files.insert(name.to_string(), (path, text));
+        }
+        if files.is_empty() {
+            return Err(RenderError::Param(format!(
+                "{} holds none of visgate's shaders (looked for {} in it and in its passes/ and \
+                 shaders/ folders; the repository's are in runtime/src/gpu)",
+                dir.display(),
+                ShaderSources::names().collect::<Vec<_>>().join(", ")
+            )));
+        }
+        Ok(ShaderSources { files })
+    }
+
+    /// Where `dir` holds shader `name`, if it does.
+    pub fn path_in(dir: &std::path::Path, name: &str) -> Option<std::path::PathBuf> {
+        [
+            dir.join(name),
+            dir.join("passes").join(name),
+            dir.join("shaders").join(name),
+        ]
+        .into_iter()
+        .find(|p| p.is_file())
+    }
+
+    /// The files read from disk: name and path.
+    pub fn overridden(&self) -> impl Iterator<Item = (&str, &std::path::Path)> {
+        self.files
+            .iter()
+            .map(|(n, (p, _))| (n.as_str(), p.as_path()))
+    }
+
+    /// The text of shader file `name` (read from disk, else built in).
+    pub fn text(&self, name: &str) -> Option<String> {
+        if let Some((_, t)) = self.files.get(name) {
+            return Some(t.clone());
+        }
+        SOURCES
+            .iter()
+            .chain(INCLUDES.iter())
+            .find(|(n, _)| *n == name)
+            .map(|(_, s)| s.to_string())
+    }
+
+    /// Pass shader `name`, composed.
+    pub fn compose(&self, name: &str) -> Result<String, RenderError> {
+        if !SOURCES.iter().any(|(n, _)| *n == name) {
+            return Err(RenderError::Param(format!("no shader {name}")));
+        }
+        let source = self.text(name).unwrap_or_default();
+        compose_with(name, &source, &|n| {
+            INCLUDES
+                .iter()
+                .any(|(i, _)| *i == n)
+                .then(|| self.text(n))?
+        })
+    }
+
+    /// Parses and validates every pass shader with naga, as the GPU's compiler will: the
+    /// first error, at its file and line (`shade.wgsl:120:9: …`).
+    pub fn validate(&self) -> Result<(), RenderError> {
+        for (name, _) in SOURCES {
+            let src = self.compose(name)?;
+            let fail = |message: String, at: Option<wgpu::naga::SourceLocation>| {
+                let place = at.map_or_else(|| name.to_string(), |l| source_line(&src, l));
+                RenderError::Param(format!("{place}: {message}"))
+            };
+            let module = wgpu::naga::front::wgsl::parse_str(&src)
+                .map_err(|e| fail(e.message().to_string(), e.location(&src)))?;
+            wgpu::naga::valid::Validator::new(
+                wgpu::naga::valid::ValidationFlags::all(),
+                wgpu::naga::valid::Capabilities::all(),
+            )
+            .validate(&module)
+            .map_err(|e| fail(e.as_inner().to_string(), e.location(&src)))?;
+        }
+        Ok(())
+    }
+}
+
+/// `file:line:column` of a place in a composed shader: the file whose `// ---- NAME` marker
+/// comes last before it (the constants before the first marker are `constants`).
+fn source_line(composed: &str, at: wgpu::naga::SourceLocation) -> String {
+    let mut file = ("constants", 0u32);
+    for (i, line) in composed.lines().enumerate().take(at.line_number as usize) {
+        if let Some(name) = line.strip_prefix("// ---- ") {
+            file = (name, i as u32 + 1);
+        }
+    }
+    format!(
+        "{}:{}:{}",
+        file.0,
+        at.line_number - file.1,
+        at.line_position
+    )
+}
+
 /// A built-in include's text.
 pub fn include(name: &str) -> Option<String> {
     INCLUDES
@@ -177,11 +304,7 @@ pub fn include(name: &str) -> Option<String> {
 
 /// The built-in pass shader `name`, composed.
 pub fn compose(name: &str) -> Result<String, RenderError> {
-    let (_, source) = SOURCES
-        .iter()
-        .find(|(n, _)| *n == name)
-        .ok_or_else(|| RenderError::Param(format!("no shader {name}")))?;
-    compose_with(name, source, &include)
+    ShaderSources::builtin().compose(name)
 }
 
 /// Every pass shader, composed (for validation without a GPU).
@@ -192,9 +315,13 @@ pub fn all() -> Vec<(&'static str, String)> {
         .collect()
 }
 
-/// A shader module of the built-in pass shader `name`.
-pub fn module(d: &wgpu::Device, name: &str) -> Result<wgpu::ShaderModule, RenderError> {
-    let source = compose(name)?;
+/// A shader module of pass shader `name` from `sources`.
+pub fn module(
+    d: &wgpu::Device,
+    sources: &ShaderSources,
+    name: &str,
+) -> Result<wgpu::ShaderModule, RenderError> {
+    let source = sources.compose(name)?;
     Ok(d.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some(name),
         source: wgpu::ShaderSource::Wgsl(source.into()),

@@ -26,6 +26,7 @@ use super::bench::Bench;
 use super::camera::FlyCamera;
 use super::compare::Compare;
 use super::layers::{self, Layers};
+use super::shader_watch::ShaderWatch;
 use super::state::SavedView;
 
 /// What the viewer starts with.
@@ -62,6 +63,8 @@ pub struct Start {
     pub restore: Option<SavedView>,
     /// Save the state when the window closes.
     pub persist: bool,
+    /// Read the shaders from this folder and reload them when they change.
+    pub shader_dir: Option<PathBuf>,
 }
 
 /// The viewer's state.
@@ -113,6 +116,8 @@ pub struct ViewerApp {
     indirect: Option<HdrImage>,
     /// The state last saved, and when.
     last_saved: Option<(SavedView, std::time::Instant)>,
+    /// `--shader-dir`: the watched folder of shaders.
+    shaders: Option<ShaderWatch>,
 }
 
 impl ViewerApp {
@@ -133,6 +138,14 @@ impl ViewerApp {
         if let Some(l) = &start.level {
             gpu.set_level(&ctx, l)?;
         }
+        let shaders = match &start.shader_dir {
+            Some(dir) => {
+                let mut w = ShaderWatch::new(dir)?;
+                w.reload(&ctx, &mut gpu);
+                Some(w)
+            }
+            None => None,
+        };
         let (lo, hi) = start.scene.bounds().unwrap_or((Vec3::ZERO, Vec3::ONE));
         let speed = FlyCamera::speed_for(lo, hi);
         let camera = match start.camera.and_then(|i| start.scene.cameras.get(i)) {
@@ -148,6 +161,7 @@ impl ViewerApp {
             pivot: None,
             indirect: None,
             last_saved: None,
+            shaders,
             ctx,
             gpu,
             vpls: None,
@@ -387,6 +401,9 @@ impl ViewerApp {
             });
         }
         ui.separator();
+        if let Some(w) = &self.shaders {
+            super::panel::shader_status(ui, w);
+        }
         if let Some(e) = &self.error {
             ui.colored_label(
                 egui::Color32::LIGHT_RED,
@@ -583,6 +600,20 @@ impl ViewerApp {
     }
 }
 
+impl ViewerApp {
+    /// `--shader-dir`: rebuilds the pipelines when a shader file changed (the next frame is
+    /// rendered again), and looks again soon.
+    fn watch_shaders(&mut self, ctx: &egui::Context) {
+        let Some(w) = &mut self.shaders else {
+            return;
+        };
+        if w.changed() && w.reload(&self.ctx, &mut self.gpu) {
+            self.last_key.clear();
+        }
+        ctx.request_repaint_after(super::shader_watch::POLL);
+    }
+}
+
 impl eframe::App for ViewerApp {
     fn on_exit(&mut self) {
         self.keep_state(true);
@@ -614,6 +645,7 @@ impl eframe::App for ViewerApp {
             if let Some(b) = &self.bench {
                 self.camera = FlyCamera::from_camera(&b.camera(b.done), self.camera.speed);
             }
+            self.watch_shaders(ui.ctx());
             let before = self.frames;
             self.render(size);
             self.bench_step(ui.ctx(), before);

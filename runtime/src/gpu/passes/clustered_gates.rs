@@ -18,6 +18,7 @@ use crate::gpu::context::{
     Pool, bind_group, compute_pipelines, init_buffer, read_buffer, read_texture,
 };
 use crate::gpu::layout::{ClusterFrame, GeometryCluster};
+use crate::gpu::shaders::ShaderSources;
 use crate::gpu::shaders::{self, CLUSTER_BITS, WG_LINEAR, WG_TILE};
 use crate::gpu::timing::{LightListStats, Recorder};
 use crate::gpu::{Frame, GpuContext};
@@ -204,8 +205,8 @@ impl ListBuffers {
 
 impl ClusteredGates {
     /// Builds the pipelines.
-    pub fn new(d: &wgpu::Device) -> Result<ClusteredGates, RenderError> {
-        let module = shaders::module(d, "clusters.wgsl")?;
+    pub fn new(d: &wgpu::Device, s: &ShaderSources) -> Result<ClusteredGates, RenderError> {
+        let module = shaders::module(d, s, "clusters.wgsl")?;
         let [
             depths,
             tile_count,

@@ -7,6 +7,7 @@ use crate::RenderError;
 use crate::gpu::GpuContext;
 use crate::gpu::context::{Pool, array_view, bind_group, compute_pipelines, slice};
 use crate::gpu::layout::{CssmFrame, UNIFORM_STRIDE, strided};
+use crate::gpu::shaders::ShaderSources;
 use crate::gpu::shaders::{self, WG_CSSM};
 use crate::gpu::timing::Recorder;
 
@@ -68,8 +69,8 @@ pub struct CssmBasis {
 
 impl Cssm {
     /// Builds the pipelines.
-    pub fn new(d: &wgpu::Device) -> Result<Cssm, RenderError> {
-        let module = shaders::module(d, "cssm.wgsl")?;
+    pub fn new(d: &wgpu::Device, s: &ShaderSources) -> Result<Cssm, RenderError> {
+        let module = shaders::module(d, s, "cssm.wgsl")?;
         let [ranges, basis, downsample] =
             compute_pipelines(d, &module, ["ranges_of", "basis", "downsample"]);
         Ok(Cssm {

@@ -5,6 +5,7 @@
 use crate::RenderError;
 use crate::gpu::context::{Pool, bind_group, render_pipeline};
 use crate::gpu::geometry::VERTEX_STRIDE;
+use crate::gpu::shaders::ShaderSources;
 use crate::gpu::timing::Recorder;
 use crate::gpu::{Frame, SceneGpu, shaders};
 
@@ -42,8 +43,8 @@ pub struct GBufferOutput {
 
 impl GBuffer {
     /// Builds the pipeline.
-    pub fn new(d: &wgpu::Device) -> Result<GBuffer, RenderError> {
-        let module = shaders::module(d, "gbuffer.wgsl")?;
+    pub fn new(d: &wgpu::Device, s: &ShaderSources) -> Result<GBuffer, RenderError> {
+        let module = shaders::module(d, s, "gbuffer.wgsl")?;
         let attrs = wgpu::vertex_attr_array![
             0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 3 => Float32x3
         ];

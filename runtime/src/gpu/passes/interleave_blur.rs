@@ -8,6 +8,7 @@ use super::shade::{HDR, frame_target, fullscreen};
 use crate::RenderError;
 use crate::gpu::context::{Pool, bind_group, render_pipeline};
 use crate::gpu::layout::ValGather;
+use crate::gpu::shaders::ShaderSources;
 use crate::gpu::timing::Recorder;
 use crate::gpu::{Frame, shaders};
 
@@ -72,8 +73,8 @@ pub struct InterleaveBlur {
 
 impl InterleaveBlur {
     /// Builds the pipeline.
-    pub fn new(d: &wgpu::Device) -> Result<InterleaveBlur, RenderError> {
-        let module = shaders::module(d, "blur.wgsl")?;
+    pub fn new(d: &wgpu::Device, s: &ShaderSources) -> Result<InterleaveBlur, RenderError> {
+        let module = shaders::module(d, s, "blur.wgsl")?;
         let pipeline = render_pipeline(d, "blur", &module, ("vs", "fs_compose"), &[], &[HDR], None);
         Ok(InterleaveBlur { pipeline })
     }

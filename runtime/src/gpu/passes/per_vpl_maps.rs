@@ -11,6 +11,7 @@ use crate::RenderError;
 use crate::gpu::context::{Pool, array_view, bind_group, layer_view, render_pipeline, slice};
 use crate::gpu::geometry::positions;
 use crate::gpu::layout::{Batch, MapParams, UNIFORM_STRIDE, strided};
+use crate::gpu::shaders::ShaderSources;
 use crate::gpu::timing::Recorder;
 use crate::gpu::{Frame, shaders};
 
@@ -56,10 +57,10 @@ pub struct ParaboloidMaps {
 
 impl ParaboloidMaps {
     /// Builds the pipelines.
-    pub fn new(d: &wgpu::Device) -> Result<ParaboloidMaps, RenderError> {
-        let maps = shaders::module(d, "vpl_shadow.wgsl")?;
+    pub fn new(d: &wgpu::Device, s: &ShaderSources) -> Result<ParaboloidMaps, RenderError> {
+        let maps = shaders::module(d, s, "vpl_shadow.wgsl")?;
         let r32 = [wgpu::TextureFormat::R32Float];
-        let gather = shaders::module(d, "gather_batch.wgsl")?;
+        let gather = shaders::module(d, s, "gather_batch.wgsl")?;
         Ok(ParaboloidMaps {
             vpl: render_pipeline(
                 d,

@@ -13,6 +13,7 @@ use super::shadow_maps::light_views;
 use crate::RenderError;
 use crate::gpu::context::{Pool, array_view, bind_group, compute_pipelines, layer_view, slice};
 use crate::gpu::layout::{Globals, Light, RsmSample, ShadowView, UNIFORM_STRIDE, Vpl, strided};
+use crate::gpu::shaders::ShaderSources;
 use crate::gpu::shaders::{self, WG_LINEAR};
 use crate::gpu::timing::Recorder;
 use crate::gpu::{GpuContext, SceneGpu};
@@ -106,8 +107,8 @@ fn samples(
 
 impl RsmVpls {
     /// Builds the pipeline.
-    pub fn new(d: &wgpu::Device) -> Result<RsmVpls, RenderError> {
-        let module = shaders::module(d, "rsm_vpls.wgsl")?;
+    pub fn new(d: &wgpu::Device, s: &ShaderSources) -> Result<RsmVpls, RenderError> {
+        let module = shaders::module(d, s, "rsm_vpls.wgsl")?;
         let [pipeline] = compute_pipelines(d, &module, ["main"]);
         Ok(RsmVpls { pipeline })
     }

@@ -7,6 +7,7 @@ use super::gbuffer::GBufferOutput;
 use super::shadow_maps::ShadowOutput;
 use crate::RenderError;
 use crate::gpu::context::{Pool, array_view, bind_group, render_pipeline};
+use crate::gpu::shaders::ShaderSources;
 use crate::gpu::timing::Recorder;
 use crate::gpu::{Frame, shaders};
 
@@ -71,8 +72,8 @@ const GATES_INDIRECT_BINDINGS: [u32; 11] = [0, 2, 5, 6, 8, 10, 12, 13, 14, 15, 1
 
 impl Shade {
     /// Builds the pipelines.
-    pub fn new(d: &wgpu::Device) -> Result<Shade, RenderError> {
-        let module = shaders::module(d, "shade.wgsl")?;
+    pub fn new(d: &wgpu::Device, s: &ShaderSources) -> Result<Shade, RenderError> {
+        let module = shaders::module(d, s, "shade.wgsl")?;
         let pipeline = render_pipeline(d, "shade", &module, ("vs", "fs"), &[], &[HDR], None);
         let gates_indirect = render_pipeline(
             d,

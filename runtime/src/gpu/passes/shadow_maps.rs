@@ -11,6 +11,7 @@ use crate::camera::{look_to, perspective};
 use crate::gpu::context::{Pool, bind_group, layer_view, render_pipeline, slice};
 use crate::gpu::geometry::{VERTEX_STRIDE, positions};
 use crate::gpu::layout::{Light, ShadowView, UNIFORM_STRIDE, strided};
+use crate::gpu::shaders::ShaderSources;
 use crate::gpu::timing::Recorder;
 use crate::gpu::{Frame, shaders};
 
@@ -170,8 +171,8 @@ pub struct ShadowOutput {
 
 impl ShadowMaps {
     /// Builds the pipeline.
-    pub fn new(d: &wgpu::Device) -> Result<ShadowMaps, RenderError> {
-        let module = shaders::module(d, "shadow.wgsl")?;
+    pub fn new(d: &wgpu::Device, s: &ShaderSources) -> Result<ShadowMaps, RenderError> {
+        let module = shaders::module(d, s, "shadow.wgsl")?;
         let pipeline = render_pipeline(
             d,
             "shadow",

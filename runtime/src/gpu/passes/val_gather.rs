@@ -14,6 +14,7 @@ use crate::RenderError;
 use crate::cpu::val::ValParams;
 use crate::gpu::context::{Pool, array_view, bind_group, render_pipeline};
 use crate::gpu::layout::ValGather;
+use crate::gpu::shaders::ShaderSources;
 use crate::gpu::timing::Recorder;
 use crate::gpu::{Frame, shaders};
 
@@ -73,8 +74,8 @@ pub struct ValPasses<'a> {
 
 impl ValGathers {
     /// Builds the pipelines.
-    pub fn new(d: &wgpu::Device) -> Result<ValGathers, RenderError> {
-        let m = shaders::module(d, "val_gather.wgsl")?;
+    pub fn new(d: &wgpu::Device, s: &ShaderSources) -> Result<ValGathers, RenderError> {
+        let m = shaders::module(d, s, "val_gather.wgsl")?;
         Ok(ValGathers {
             hard: render_pipeline(
                 d,

@@ -8,6 +8,7 @@ use crate::cpu::val::{ValParams, scale_of};
 use crate::gpu::GpuContext;
 use crate::gpu::context::{Pool, bind_group, compute_pipelines};
 use crate::gpu::layout::{Val, ValFrame, Vpl};
+use crate::gpu::shaders::ShaderSources;
 use crate::gpu::shaders::{self, WG_LINEAR};
 use crate::gpu::timing::Recorder;
 
@@ -49,8 +50,8 @@ pub struct ValInput<'a> {
 
 impl ValClustering {
     /// Builds the pipelines.
-    pub fn new(d: &wgpu::Device) -> Result<ValClustering, RenderError> {
-        let module = shaders::module(d, "vals.wgsl")?;
+    pub fn new(d: &wgpu::Device, s: &ShaderSources) -> Result<ValClustering, RenderError> {
+        let module = shaders::module(d, s, "vals.wgsl")?;
         let [
             scale,
             init,
