@@ -30,6 +30,7 @@ pub mod portals;
 pub mod report;
 pub mod segment;
 pub mod sightline;
+pub mod stages;
 pub mod thin;
 pub mod voxelize;
 

@@ -15,26 +15,6 @@ use visgate_formats::vgate::{GridMeta, Resolution};
 
 use crate::BakeError;
 
-/// Parameters of [`voxelize`].
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct VoxelizeParams {
-    /// Voxels on the longest axis of the static bounds [Limit: 8..=2048] [Units: vx], or the
-    /// voxel edge [Limit: > 0] [Units: m].
-    pub resolution: Resolution,
-    /// The bake is refused before allocating if its grids would need more than this.
-    /// [Units: bytes]
-    pub memory_limit_bytes: u64,
-}
-
-impl Default for VoxelizeParams {
-    fn default() -> Self {
-        VoxelizeParams {
-            resolution: Resolution::LongestAxisVoxels(128),
-            memory_limit_bytes: 16 << 30,
-        }
-    }
-}
-
 /// Bytes per voxel that a whole bake holds at its peak (solid flags, squared distance,
 /// labels, nearest-node and cluster grids, thinning state), used to refuse a resolution that
 /// would not fit before anything is allocated.
