@@ -386,3 +386,85 @@ fn shaders_from_a_folder_draw_and_a_broken_one_is_named_while_the_last_good_draw
         text(&o)
     );
 }
+
+#[test]
+fn a_recorded_camera_path_is_what_the_benchmark_plays() {
+    let x = Xvfb::start();
+    let dir = tempfile::tempdir().expect("tempdir");
+    let scene = visgate_scenes::Builtin::CornellBox.scene().expect("scene");
+    let c = &scene.cameras[0];
+    let key = |eye: glam::Vec3| {
+        serde_json::json!({ "eye": eye.to_array(), "target": c.target.to_array(),
+            "fov_deg": c.fov_x_rad.to_degrees() })
+    };
+    // Two frames: from a step back to the scene's camera, which the last frame shows.
+    let path = dir.path().join("path.json");
+    let file = serde_json::json!({ "scene": "cornell-box",
+        "cameras": [key(c.eye + (c.eye - c.target) * 0.5), key(c.eye)] });
+    std::fs::write(&path, file.to_string()).expect("write");
+    let (csv, shot, want) = (
+        dir.path().join("t.csv"),
+        dir.path().join("shot.exr"),
+        dir.path().join("want.exr"),
+    );
+    let p = |f: &PathBuf| f.to_str().expect("utf-8").to_string();
+    let o = visgate(
+        &[
+            "view",
+            "builtin:cornell-box",
+            "--mode",
+            "direct-only",
+            "--render-size",
+            "48x36",
+            "--benchmark",
+            "2",
+            "--benchmark-out",
+            &p(&csv),
+            "--benchmark-path",
+            &p(&path),
+            "--screenshot",
+            &p(&shot),
+            "--frames",
+            "2",
+        ],
+        Some(&x.1),
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    assert!(text(&o).contains("benchmark: 2 frames"), "{}", text(&o));
+    let o = visgate(
+        &[
+            "render",
+            "builtin:cornell-box",
+            "--mode",
+            "direct-only",
+            "--size",
+            "48x36",
+            "--out",
+            &p(&want),
+        ],
+        None,
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    let e = errors(&read(&shot), &read(&want)).expect("same size");
+    assert!(e.rel_mse < 1e-6, "{e:?}");
+    // A path that is not one: refused before a window opens.
+    std::fs::write(&path, r#"{"cameras": []}"#).expect("write");
+    let o = visgate(
+        &[
+            "view",
+            "builtin:cornell-box",
+            "--benchmark",
+            "2",
+            "--benchmark-out",
+            &p(&csv),
+            "--benchmark-path",
+            &p(&path),
+        ],
+        Some(&x.1),
+    );
+    assert!(
+        !o.status.success() && text(&o).contains("two at least"),
+        "{}",
+        text(&o)
+    );
+}

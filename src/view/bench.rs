@@ -1,5 +1,6 @@
-//! The viewer's benchmark: a camera path through the scene's cameras (in order, eye and target
-//! linear between them; with fewer than two, a turn about the level's framing), played at a
+//! The viewer's benchmark: a camera path — recorded in the viewer (`--benchmark-path`), else
+//! through the scene's cameras (in order, eye and target linear between them; with fewer than
+//! two, a turn about the level's framing) — played at a
 //! fixed step, each frame's pass times written as CSV rows `frame,pass,gpu_ms,cpu_wall_ms`,
 //! so that methods and commits are compared on the same walk.
 
@@ -25,9 +26,12 @@ pub struct Bench {
 }
 
 impl Bench {
-    /// A benchmark of `frames` frames through `scene`'s cameras, writing `out`.
-    pub fn new(scene: &Scene, frames: u32, out: PathBuf) -> Bench {
-        let path = if scene.cameras.len() >= 2 {
+    /// A benchmark of `frames` frames through `path` (a recorded one), else `scene`'s
+    /// cameras, writing `out`.
+    pub fn new(scene: &Scene, frames: u32, out: PathBuf, path: Option<Vec<Camera>>) -> Bench {
+        let path = if let Some(p) = path.filter(|p| p.len() >= 2) {
+            p
+        } else if scene.cameras.len() >= 2 {
             scene.cameras.clone()
         } else {
             let (lo, hi) = scene.bounds().unwrap_or((Vec3::ZERO, Vec3::ONE));
@@ -127,12 +131,12 @@ mod tests {
             fov_x_rad: 1.0,
         };
         scene.cameras = vec![cam(0.0), cam(2.0), cam(6.0)];
-        let b = Bench::new(&scene, 5, PathBuf::from("x.csv"));
+        let b = Bench::new(&scene, 5, PathBuf::from("x.csv"), None);
         let xs: Vec<f32> = (0..5).map(|i| b.camera(i).eye.x).collect();
         assert_eq!(xs, vec![0.0, 1.0, 2.0, 4.0, 6.0]);
         // One camera: a turn about the level, back where it started.
         scene.cameras.truncate(1);
-        let b = Bench::new(&scene, 9, PathBuf::from("x.csv"));
+        let b = Bench::new(&scene, 9, PathBuf::from("x.csv"), None);
         assert!(b.camera(0).eye.distance(b.camera(8).eye) < 1e-3);
         assert!(b.camera(0).eye.distance(b.camera(4).eye) > 1.0);
     }

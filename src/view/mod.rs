@@ -8,6 +8,7 @@ mod camera;
 mod compare;
 mod layers;
 mod panel;
+mod path;
 mod shader_watch;
 mod state;
 
@@ -75,6 +76,13 @@ pub struct ViewArgs {
     /// The benchmark's CSV: frame,pass,gpu_ms,cpu_wall_ms.
     #[arg(long)]
     pub benchmark_out: Option<PathBuf>,
+    /// Play this camera path (JSON, as the panel's "record camera path" saves it) instead of
+    /// the scene's cameras.
+    #[arg(long, requires = "benchmark")]
+    pub benchmark_path: Option<PathBuf>,
+    /// Where the panel's "record camera path" saves the path.
+    #[arg(long, default_value = "camera-path.json")]
+    pub record_path: PathBuf,
     /// Start from the defaults and the flags alone: neither read nor write the state kept
     /// across runs (scripted runs, --screenshot and --benchmark, never do).
     #[arg(long)]
@@ -104,7 +112,9 @@ Examples:
   visgate view builtin:four-rooms --level four-rooms.vgate
   visgate view builtin:cornell-box --mode val-cssm --rsm --vpls 4096
   visgate view builtin:cornell-box --render-size 320x240 --screenshot shot.png --frames 3
-  visgate view builtin:four-rooms --level four-rooms.vgate --shader-dir runtime/src/gpu";
+  visgate view builtin:four-rooms --level four-rooms.vgate --shader-dir runtime/src/gpu
+  visgate view builtin:four-rooms --benchmark 300 --benchmark-out times.csv
+      --benchmark-path camera-path.json   (a path the panel's \"record camera path\" saved)";
 
 /// `--render-size` or `--size` as `[w, h]`.
 fn parse_size(s: &str) -> Result<[u32; 2]> {
@@ -183,6 +193,7 @@ fn start_mode(args: &ViewArgs, saved: Option<&SavedView>) -> Result<&'static Met
 
 pub fn run(args: ViewArgs) -> Result<()> {
     let size = args.render_size.as_deref().map(parse_size).transpose()?;
+    let benchmark_path = args.benchmark_path.as_deref().map(path::read).transpose()?;
     if args.benchmark == Some(0) {
         bail!("--benchmark 0: give the number of frames of the path");
     }
@@ -279,6 +290,8 @@ pub fn run(args: ViewArgs) -> Result<()> {
         compare: args.compare,
         time: args.time,
         benchmark: args.benchmark.zip(args.benchmark_out.clone()),
+        benchmark_path,
+        record_path: args.record_path.clone(),
         // The saved camera only when no --camera was asked for.
         restore: saved.filter(|_| args.camera.is_none()),
         persist,

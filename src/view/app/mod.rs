@@ -26,6 +26,7 @@ use super::bench::Bench;
 use super::camera::FlyCamera;
 use super::compare::Compare;
 use super::layers::{self, Layers};
+use super::path::Recorder;
 use super::shader_watch::ShaderWatch;
 use super::state::SavedView;
 
@@ -59,6 +60,10 @@ pub struct Start {
     pub compare: bool,
     /// Play a benchmark path of this many frames, write its CSV here, then close.
     pub benchmark: Option<(u32, PathBuf)>,
+    /// The benchmark's path (else the scene's cameras).
+    pub benchmark_path: Option<Vec<visgate_formats::Camera>>,
+    /// Where a recorded camera path is saved.
+    pub record_path: PathBuf,
     /// The state of the last run to take the camera, exposure and settings from.
     pub restore: Option<SavedView>,
     /// Save the state when the window closes.
@@ -118,6 +123,9 @@ pub struct ViewerApp {
     last_saved: Option<(SavedView, std::time::Instant)>,
     /// `--shader-dir`: the watched folder of shaders.
     shaders: Option<ShaderWatch>,
+    /// The camera path being recorded, and what the last recording did.
+    recorder: Option<Recorder>,
+    record_note: Option<String>,
 }
 
 impl ViewerApp {
@@ -162,6 +170,8 @@ impl ViewerApp {
             indirect: None,
             last_saved: None,
             shaders,
+            recorder: None,
+            record_note: None,
             ctx,
             gpu,
             vpls: None,
@@ -189,7 +199,7 @@ impl ViewerApp {
             bench: start
                 .benchmark
                 .clone()
-                .map(|(n, out)| Bench::new(&start.scene, n, out)),
+                .map(|(n, out)| Bench::new(&start.scene, n, out, start.benchmark_path.clone())),
             start,
         };
         if let Some(saved) = app.start.restore.take() {
@@ -387,6 +397,7 @@ impl ViewerApp {
         }
         ui.separator();
         super::panel::camera_controls(ui, &mut self.camera, &self.start.scene);
+        self.record_controls(ui);
         if self.start.scene.is_animated() {
             ui.separator();
             ui.horizontal(|ui| {
@@ -614,6 +625,46 @@ impl ViewerApp {
     }
 }
 
+impl ViewerApp {
+    /// Records the camera's path and saves it for `--benchmark-path`.
+    fn record_controls(&mut self, ui: &mut egui::Ui) {
+        let file = self.start.record_path.clone();
+        match &self.recorder {
+            None => {
+                if ui.button("● record camera path").clicked() {
+                    self.recorder = Some(Recorder::default());
+                }
+            }
+            Some(r) => {
+                let n = r.cameras.len();
+                if ui
+                    .button(format!("■ stop and save ({n} cameras)"))
+                    .clicked()
+                {
+                    let scene = &self.start.scene.name;
+                    self.record_note = Some(match super::path::write(&file, scene, &r.cameras) {
+                        Ok(()) if n >= 2 => format!(
+                            "saved {n} cameras to {}: replay with --benchmark 300 \
+                             --benchmark-path {0} --benchmark-out times.csv",
+                            file.display()
+                        ),
+                        Ok(()) => format!(
+                            "saved {n} camera(s) to {}: move while recording, a path needs two",
+                            file.display()
+                        ),
+                        Err(e) => format!("not saved: {e:#}"),
+                    });
+                    println!("{}", self.record_note.as_deref().unwrap_or_default());
+                    self.recorder = None;
+                }
+            }
+        }
+        if let Some(note) = &self.record_note {
+            ui.label(note);
+        }
+    }
+}
+
 impl eframe::App for ViewerApp {
     fn on_exit(&mut self) {
         self.keep_state(true);
@@ -646,6 +697,10 @@ impl eframe::App for ViewerApp {
                 self.camera = FlyCamera::from_camera(&b.camera(b.done), self.camera.speed);
             }
             self.watch_shaders(ui.ctx());
+            if let Some(r) = &mut self.recorder {
+                r.push(self.camera.camera(), std::time::Instant::now());
+                ui.ctx().request_repaint_after(Recorder::STEP);
+            }
             let before = self.frames;
             self.render(size);
             self.bench_step(ui.ctx(), before);
