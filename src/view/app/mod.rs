@@ -631,14 +631,14 @@ impl ViewerApp {
         let file = self.start.record_path.clone();
         match &self.recorder {
             None => {
-                if ui.button("● record camera path").clicked() {
+                if ui.button("record camera path").clicked() {
                     self.recorder = Some(Recorder::default());
                 }
             }
             Some(r) => {
                 let n = r.cameras.len();
                 if ui
-                    .button(format!("■ stop and save ({n} cameras)"))
+                    .button(format!("stop recording and save ({n} cameras)"))
                     .clicked()
                 {
                     let scene = &self.start.scene.name;
