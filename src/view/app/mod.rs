@@ -21,6 +21,8 @@ use visgate_runtime::vpl::{PathParams, Vpl, path_vpls};
 
 mod kept;
 mod scripted;
+#[cfg(test)]
+mod snapshots;
 
 use super::bench::Bench;
 use super::camera::FlyCamera;
@@ -671,6 +673,14 @@ impl eframe::App for ViewerApp {
     }
 
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        self.draw(ui);
+    }
+}
+
+impl ViewerApp {
+    /// One frame of the window: the side panel, the image (rendered again if anything
+    /// changed), the scripted runs' steps.
+    pub fn draw(&mut self, ui: &mut egui::Ui) {
         egui::Panel::left("settings")
             .default_size(280.0)
             .show(ui, |ui| {

@@ -1,0 +1,132 @@
+//! Snapshot tests of the viewer's window, rendered headless by egui_kittest with wgpu
+//! (lavapipe in CI): the four rooms with a level baked at 64, one snapshot per debug layer and
+//! one of the split comparison with the reference. The goldens are `tests/snapshots/*.png`;
+//! they change only when asked (`UPDATE_SNAPSHOTS=1 cargo test --bin visgate snapshots`), and a
+//! failure writes the new image and the difference beside them (`*.new.png`, `*.diff.png`).
+
+use egui_kittest::{Harness, SnapshotOptions};
+use visgate_formats::vgate::{BakeParams, Resolution};
+use visgate_preprocess::bake::{BakeOptions, bake};
+use visgate_runtime::cpu::gates::GateLevel;
+use visgate_runtime::job::RenderJob;
+use visgate_scenes::Builtin;
+
+use super::{Start, ViewerApp};
+use crate::view::layers::Layers;
+
+/// The viewer of the four rooms (baked at 64), its first camera, 32 light paths, a 240×150
+/// frame, with `layers` and, if `compare`, the reference beside the method.
+fn viewer(layers: Layers, compare: bool) -> ViewerApp {
+    let scene = Builtin::FourRooms.scene().expect("scene");
+    let params = BakeParams {
+        resolution: Resolution::LongestAxisVoxels(64),
+        ..BakeParams::default()
+    };
+    let baked = bake(&scene, &params, &BakeOptions::default(), &|_| {}).expect("bake");
+    let level = GateLevel::new(baked.level, &scene).expect("level");
+    let g_max = RenderJob::default()
+        .for_scene(&scene)
+        .expect("job")
+        .params
+        .g_max;
+    let start = Start {
+        time: 0.0,
+        level: Some(level),
+        mode: "gates",
+        vpls: Some(32),
+        rsm: false,
+        size: Some([240, 150]),
+        g_max,
+        camera: Some(0),
+        screenshot: None,
+        window_shot: None,
+        layers,
+        compare,
+        benchmark: None,
+        benchmark_path: None,
+        record_path: "camera-path.json".into(),
+        restore: None,
+        persist: false,
+        shader_dir: None,
+        scene,
+    };
+    ViewerApp::new(start).expect("viewer")
+}
+
+/// Renders the window until the frame (and the reference, if asked) is drawn, then checks it
+/// against golden `name`.
+fn snapshot(name: &str, layers: Layers, compare: bool) {
+    let mut harness = Harness::builder()
+        .with_size([900.0, 560.0])
+        .wgpu()
+        .build_ui_state(
+            |ui, app: &mut ViewerApp| app.draw(ui),
+            viewer(layers, compare),
+        );
+    for _ in 0..600 {
+        harness.step();
+        let app = harness.state();
+        if app.frames > 0 && (!compare || app.compare.is_done()) {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    // Two more steps: the layers and the reference are drawn the frame after they are ready.
+    harness.run_steps(2);
+    assert!(harness.state().frames > 0, "{name}: no frame");
+    harness.snapshot_options(name, &SnapshotOptions::new().threshold(2.0));
+}
+
+// One test per snapshot: kittest keeps one harness's results per test.
+
+#[test]
+fn the_viewer_with_clusters_and_gates() {
+    let layers = Layers {
+        clusters: true,
+        gates: true,
+        ..Layers::default()
+    };
+    snapshot("viewer_clusters_gates", layers, false);
+}
+
+#[test]
+fn the_viewer_with_the_skeleton_and_vpls() {
+    let layers = Layers {
+        skeleton: true,
+        vpls: true,
+        ..Layers::default()
+    };
+    snapshot("viewer_skeleton_vpls", layers, false);
+}
+
+#[test]
+fn the_viewer_with_geometry_clusters() {
+    let layers = Layers {
+        geometry: true,
+        ..Layers::default()
+    };
+    snapshot("viewer_geometry_clusters", layers, false);
+}
+
+#[test]
+fn the_viewer_with_light_list_lengths() {
+    let layers = Layers {
+        lists: true,
+        ..Layers::default()
+    };
+    snapshot("viewer_light_lists", layers, false);
+}
+
+#[test]
+fn the_viewer_with_the_indirect_light_alone() {
+    let layers = Layers {
+        indirect: true,
+        ..Layers::default()
+    };
+    snapshot("viewer_indirect", layers, false);
+}
+
+#[test]
+fn the_viewer_beside_the_reference() {
+    snapshot("viewer_compare", Layers::default(), true);
+}
