@@ -36,7 +36,8 @@ scene does not bake).
 Examples:
   visgate compare builtin:ajar-door --vpls 256,1024 --size 320x240 --out cmp
   visgate compare scenes/shared/crytek-sponza.toml --bake-resolution 128 --modes none,gates,val-hard --out sponza
-  visgate compare builtin:four-rooms --budget-ms 50 --max-error 0.05 --metric flip --out fr";
+  visgate compare builtin:four-rooms --budget-ms 50 --max-error 0.05 --metric flip --out fr
+  visgate compare builtin:cornell-box --modes val-cssm,val-hard --val-counts 2,8,30,64 --vpls 1024 --out m";
 
 /// `--metric`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -72,6 +73,10 @@ pub struct CompareArgs {
     /// Light paths per render (or RSM VPLs), comma-separated.
     #[arg(long, value_delimiter = ',', default_value = "256,1024,4096")]
     pub vpls: Vec<u32>,
+    /// VAL counts M, comma-separated: each VAL mode is compared at each (as `val-hard-m16`, …;
+    /// the paper's Fig. 10). Default: --vals alone.
+    #[arg(long, value_delimiter = ',')]
+    pub val_counts: Vec<u32>,
     /// Cameras by name, comma-separated, or all.
     #[arg(long, value_delimiter = ',', default_value = "all")]
     pub cameras: Vec<String>,
@@ -109,8 +114,33 @@ pub struct CompareArgs {
     pub method: MethodArgs,
 }
 
+/// The modes `names` ask for (`all` expanded; `gates-disk` is gates with disks), each VAL mode
+/// once per count of `val_counts` (labelled `val-hard-m16`, …) when it is given.
+fn modes(names: &[String], settings: &MethodArgs, val_counts: &[u32]) -> Result<Vec<CompareMode>> {
+    let mut out = Vec::new();
+    for m in named_modes(names, settings)? {
+        if val_counts.is_empty() || !matches!(m.mode, GpuMode::ValHard(_) | GpuMode::ValCssm(..)) {
+            out.push(m);
+            continue;
+        }
+        for &count in val_counts {
+            let mut mode = m.mode;
+            if let GpuMode::ValHard(v) | GpuMode::ValCssm(v, _) = &mut mode {
+                v.vals.count = count;
+            }
+            mode.check()
+                .map_err(|e| anyhow::anyhow!("--val-counts {count}: {e}"))?;
+            out.push(CompareMode {
+                label: format!("{}-m{count}", m.label),
+                mode,
+            });
+        }
+    }
+    Ok(out)
+}
+
 /// The modes `names` ask for (`all` expanded; `gates-disk` is gates with disks).
-fn modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMode>> {
+fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMode>> {
     let s = settings.settings();
     let mut disk = s.gates;
     disk.gates.shape = GateShape::Disk;
@@ -205,7 +235,7 @@ pub fn run_compare(args: CompareArgs) -> Result<()> {
     if cameras.is_empty() {
         crate::camera_of(&scene, &args.scene, None)?;
     }
-    let mut modes = modes(&args.modes, &args.method)?;
+    let mut modes = modes(&args.modes, &args.method, &args.val_counts)?;
     let level = level(&args, &scene, &mut modes)?;
     let ground_truth = args
         .ground_truth

@@ -346,3 +346,69 @@ fov_deg = 60
         "{o:?}"
     );
 }
+
+#[test]
+fn val_counts_compare_each_val_mode_at_each_count() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("vals");
+    let out_s = out.to_str().expect("utf-8");
+    visgate(&[
+        "compare",
+        "builtin:cornell-box",
+        "--modes",
+        "none,val-hard",
+        "--val-counts",
+        "2,30",
+        "--vpls",
+        "256",
+        "--size",
+        "40x30",
+        "--spp",
+        "1",
+        "--out",
+        out_s,
+    ]);
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).expect("json"))
+            .expect("parses");
+    let rows = report["rows"].as_array().expect("rows");
+    let row = |mode: &str| {
+        rows.iter()
+            .find(|r| r["mode"] == mode)
+            .unwrap_or_else(|| panic!("no row {mode}: {rows:?}"))
+    };
+    assert_eq!(rows.len(), 3, "none, val-hard at M = 2 and 30");
+    let (m2, m30) = (row("val-hard-m2"), row("val-hard-m30"));
+    assert!(
+        m2["settings"]
+            .as_str()
+            .expect("settings")
+            .starts_with("2 VALs")
+    );
+    assert!(
+        m30["settings"]
+            .as_str()
+            .expect("settings")
+            .starts_with("30 VALs")
+    );
+    // Two VALs for a whole room cast coarser shadows: a larger error.
+    let e = |r: &Value| r["indirect_mse"].as_f64().expect("error");
+    assert!(e(m2) > e(m30), "M = 2 {} vs M = 30 {}", e(m2), e(m30));
+    assert!(row("none")["mode"] == "none");
+    // A count out of range is refused with the limit.
+    let o = Command::new(env!("CARGO_BIN_EXE_visgate"))
+        .args([
+            "compare",
+            "builtin:cornell-box",
+            "--modes",
+            "val-hard",
+            "--val-counts",
+            "0",
+            "--out",
+            out_s,
+        ])
+        .output()
+        .expect("runs");
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--val-counts 0"));
+}
