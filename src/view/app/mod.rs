@@ -23,6 +23,7 @@ mod kept;
 mod scripted;
 #[cfg(test)]
 mod snapshots;
+mod tools;
 
 use super::bench::Bench;
 use super::camera::FlyCamera;
@@ -610,60 +611,6 @@ impl ViewerApp {
         };
         self.compare
             .start(&self.posed, view, &vpls, self.start.g_max);
-    }
-}
-
-impl ViewerApp {
-    /// `--shader-dir`: rebuilds the pipelines when a shader file changed (the next frame is
-    /// rendered again), and looks again soon.
-    fn watch_shaders(&mut self, ctx: &egui::Context) {
-        let Some(w) = &mut self.shaders else {
-            return;
-        };
-        if w.changed() && w.reload(&self.ctx, &mut self.gpu) {
-            self.last_key.clear();
-        }
-        ctx.request_repaint_after(super::shader_watch::POLL);
-    }
-}
-
-impl ViewerApp {
-    /// Records the camera's path and saves it for `--benchmark-path`.
-    fn record_controls(&mut self, ui: &mut egui::Ui) {
-        let file = self.start.record_path.clone();
-        match &self.recorder {
-            None => {
-                if ui.button("record camera path").clicked() {
-                    self.recorder = Some(Recorder::default());
-                }
-            }
-            Some(r) => {
-                let n = r.cameras.len();
-                if ui
-                    .button(format!("stop recording and save ({n} cameras)"))
-                    .clicked()
-                {
-                    let scene = &self.start.scene.name;
-                    self.record_note = Some(match super::path::write(&file, scene, &r.cameras) {
-                        Ok(()) if n >= 2 => format!(
-                            "saved {n} cameras to {}: replay with --benchmark 300 \
-                             --benchmark-path {0} --benchmark-out times.csv",
-                            file.display()
-                        ),
-                        Ok(()) => format!(
-                            "saved {n} camera(s) to {}: move while recording, a path needs two",
-                            file.display()
-                        ),
-                        Err(e) => format!("not saved: {e:#}"),
-                    });
-                    println!("{}", self.record_note.as_deref().unwrap_or_default());
-                    self.recorder = None;
-                }
-            }
-        }
-        if let Some(note) = &self.record_note {
-            ui.label(note);
-        }
     }
 }
 
