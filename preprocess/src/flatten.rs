@@ -62,10 +62,7 @@ pub fn flatten(input: &FlattenInput) -> Flattened {
     let seed_at: Vec<[u32; 3]> = input
         .seeds_of
         .iter()
-        .map(|&seed| {
-            let node = input.seg.skeleton.nodes[seed as usize].skeleton_node as usize;
-            meta.coords(input.graph.voxels[node])
-        })
+        .map(|&seed| meta.coords(input.graph.voxels[seed_node(input, seed)]))
         .collect();
     let voxels_by_sight =
         crate::sightline::clusters_by_sight(meta, input.empty, &mut voxel_cluster, &seed_at);
@@ -81,6 +78,11 @@ pub fn flatten(input: &FlattenInput) -> Flattened {
             "pieces_of_several_clusters": pieces.of_several,
         }),
     }
+}
+
+/// The skeleton node of segmented node `seed` (a cluster's seed).
+fn seed_node(input: &FlattenInput, seed: u32) -> usize {
+    input.seg.skeleton.nodes[seed as usize].skeleton_node as usize
 }
 
 /// The gates of each cluster (indices into `gates`).
@@ -286,8 +288,7 @@ fn cluster_boxes(input: &FlattenInput, voxel_cluster: &[u32]) -> Vec<Cluster> {
         .iter()
         .enumerate()
         .map(|(c, &seed)| {
-            let node = input.seg.skeleton.nodes[seed as usize].skeleton_node as usize;
-            let p = input.position[node];
+            let p = input.position[seed_node(input, seed)];
             // No empty voxel of its own (infinite box): the seed's voxel.
             let (lo, hi) = if vlo[c][0] == u32::MAX {
                 ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3])

@@ -8,6 +8,7 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant, SystemTime};
 
 use anyhow::{Result, bail};
+use visgate_runtime::RenderError;
 use visgate_runtime::gpu::{GpuContext, GpuRenderer, ShaderSources};
 
 /// How often the folder is looked at.
@@ -39,20 +40,23 @@ fn stamps(dir: &Path) -> Vec<Option<SystemTime>> {
 }
 
 impl ShaderWatch {
-    /// Watches `dir`; refuses a path that is not a folder of visgate's shaders.
-    pub fn new(dir: &Path) -> Result<ShaderWatch> {
+    /// Watches `dir` and builds `gpu`'s pipelines from it (a compile error is kept and shown,
+    /// the built-in shaders drawing); refuses a path that is not a folder of visgate's shaders.
+    pub fn start(dir: &Path, ctx: &GpuContext, gpu: &mut GpuRenderer) -> Result<ShaderWatch> {
         if !dir.is_dir() {
             bail!("--shader-dir {}: not a folder", dir.display());
         }
-        ShaderSources::read_dir(dir)?;
-        Ok(ShaderWatch {
+        let sources = ShaderSources::read_dir(dir)?;
+        let mut w = ShaderWatch {
             dir: dir.to_path_buf(),
             stamps: stamps(dir),
             checked: Instant::now(),
             error: None,
             files: 0,
             reloads: 0,
-        })
+        };
+        w.apply(Ok(sources), ctx, gpu);
+        Ok(w)
     }
 
     /// The folder.
@@ -76,8 +80,18 @@ impl ShaderWatch {
     /// Reads the folder and rebuilds `gpu`'s pipelines from it; prints and keeps the outcome.
     /// Whether the new shaders draw.
     pub fn reload(&mut self, ctx: &GpuContext, gpu: &mut GpuRenderer) -> bool {
-        let result = ShaderSources::read_dir(&self.dir)
-            .and_then(|s| gpu.reload_shaders(ctx, &s).map(|()| s.overridden().count()));
+        self.apply(ShaderSources::read_dir(&self.dir), ctx, gpu)
+    }
+
+    /// Rebuilds `gpu`'s pipelines from `sources` (as read); prints and keeps the outcome.
+    fn apply(
+        &mut self,
+        sources: Result<ShaderSources, RenderError>,
+        ctx: &GpuContext,
+        gpu: &mut GpuRenderer,
+    ) -> bool {
+        let result =
+            sources.and_then(|s| gpu.reload_shaders(ctx, &s).map(|()| s.overridden().count()));
         match result {
             Ok(files) => {
                 self.reloads += 1;

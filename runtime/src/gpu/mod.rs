@@ -438,11 +438,6 @@ impl GpuRenderer {
         vpls: VplInput,
         params: &GpuParams,
     ) -> Result<(HdrImage, PassTimes), RenderError> {
-        let count = match vpls {
-            VplInput::Given(v) => v.len() as u32,
-            VplInput::Rsm(r) => r.count,
-        };
-        methods::warn_software_loop_limit(&ctx.adapter_info.name, &params.mode, count);
         // Only disks keep lists; a pool of a set size fails when full.
         let g = match params.mode {
             GpuMode::Gates(g) if g.light_entries.is_none() && g.gates.shape == GateShape::Disk => g,
@@ -506,6 +501,7 @@ impl GpuRenderer {
         });
         let mut rec = Recorder::new(ctx, &mut self.pool);
         let (vpl_buf, count) = self.frame_vpls(ctx, &vpls, &mut rec)?;
+        methods::warn_software_loop_limit(&ctx.adapter_info.name, &params.mode, count);
         let cpu = match vpls {
             VplInput::Given(v) => Some(v),
             VplInput::Rsm(_) => None,

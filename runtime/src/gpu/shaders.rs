@@ -294,14 +294,6 @@ fn source_line(composed: &str, at: wgpu::naga::SourceLocation) -> String {
     )
 }
 
-/// A built-in include's text.
-pub fn include(name: &str) -> Option<String> {
-    INCLUDES
-        .iter()
-        .find(|(n, _)| *n == name)
-        .map(|(_, s)| s.to_string())
-}
-
 /// The built-in pass shader `name`, composed.
 pub fn compose(name: &str) -> Result<String, RenderError> {
     ShaderSources::builtin().compose(name)

@@ -150,11 +150,7 @@ impl ViewerApp {
             gpu.set_level(&ctx, l)?;
         }
         let shaders = match &start.shader_dir {
-            Some(dir) => {
-                let mut w = ShaderWatch::new(dir)?;
-                w.reload(&ctx, &mut gpu);
-                Some(w)
-            }
+            Some(dir) => Some(ShaderWatch::start(dir, &ctx, &mut gpu)?),
             None => None,
         };
         let (lo, hi) = start.scene.bounds().unwrap_or((Vec3::ZERO, Vec3::ONE));
