@@ -220,7 +220,7 @@ pub fn bake(
     let radius_vx = field.whole_radii();
     drop(field);
     let sg = cx.stage("segment", 0, |_| Ok(stages::segmentation(&sk, &params)))?;
-    let step = stages::clusters_and_gates(&sk, &sg, &params, &mut cx)?;
+    let step = stages::clusters_and_gates(&meta, &es, &sk, &sg, &params, &mut cx)?;
     let info = BakeInfo {
         params: params.clone(),
         geometry_hash: input.hash,

@@ -17,6 +17,7 @@
 
 pub mod bake;
 pub mod clusters;
+pub mod convex;
 pub mod cut;
 pub mod debug;
 pub mod distance;

@@ -16,7 +16,7 @@ use visgate_formats::vgate::{GridMeta, NONE};
 /// Whether the voxels strictly between voxels `from` and `to` are all empty: a 3D DDA
 /// (Amanatides & Woo) between their centres, in voxel units, so that a line through voxel
 /// edges and corners takes the same voxels at every scale of the level.
-fn sees(meta: &GridMeta, empty: &[bool], from: [u32; 3], to: [u32; 3]) -> bool {
+pub(crate) fn sees(meta: &GridMeta, empty: &[bool], from: [u32; 3], to: [u32; 3]) -> bool {
     let a = Vec3::from(from.map(|c| c as f32 + 0.5));
     let b = Vec3::from(to.map(|c| c as f32 + 0.5));
     let d = b - a;

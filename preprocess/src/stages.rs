@@ -14,6 +14,7 @@ use visgate_formats::vgate::{
 
 use crate::bake::{BakeContext, scene_seeds};
 use crate::clusters::{ClusterParams, clusters};
+use crate::convex::{SplitInput, split_unseen};
 use crate::empty::{EmptySpace, EmptySpaceParams, empty_space};
 use crate::gate_step::{GateInput, GateStep, gate_step};
 use crate::graph::{SkeletonGraph, nearest_node, skeleton_graph};
@@ -259,13 +260,15 @@ pub fn segmentation(sk: &SkeletonStage, params: &BakeParams) -> Counted<SegmentS
 /// Stages 8 and 9: the greedy clusters (IV.B.2), then the gates (both rules) after merging
 /// slivers.
 pub fn clusters_and_gates(
+    meta: &GridMeta,
+    es: &EmptySpace,
     sk: &SkeletonStage,
     sg: &SegmentStage,
     params: &BakeParams,
     cx: &mut BakeContext,
 ) -> Result<GateStep, BakeError> {
     let (node_cluster, seeds_of) = cx.stage("clusters", 0, |_| {
-        let found = clusters(
+        let (grown, grown_seeds) = clusters(
             &sg.seg.skeleton,
             &sk.position,
             &sk.radius,
@@ -274,8 +277,21 @@ pub fn clusters_and_gates(
                 rule: params.alpha_rule,
             },
         );
-        let counts = json!({ "clusters": found.1.len(), "alpha": params.alpha });
-        Ok((found, counts))
+        let input = SplitInput {
+            meta,
+            empty: &es.empty,
+            seg: &sg.seg.skeleton,
+            node_voxel: &sk.graph.voxels,
+            radius: &sk.radius,
+        };
+        let (node_cluster, seeds, added) = split_unseen(&input, &grown, &grown_seeds);
+        let counts = json!({
+            "clusters": seeds.len(),
+            "grown": grown_seeds.len(),
+            "split_off_unseen": added,
+            "alpha": params.alpha,
+        });
+        Ok(((node_cluster, seeds), counts))
     })?;
     cx.stage("gates", 0, |_| {
         let input = GateInput {
