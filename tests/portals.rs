@@ -100,9 +100,9 @@ fn ajar_door_portal_visibility_agrees_with_shadow_rays() {
         let [p, d] = found[..] else { unreachable!() };
         print("ajar-door", camera, &p, &d);
         assert!(p.pairs > 10_000, "{p:?}");
-        // Measured 96.0, 93.7 and 98.3 % (disks 93.8, 86.7, 97.0 %; 95.9 and 92.3 % before
-        // clusters were split where their nodes do not see each other); the target is
-        // 99 %.
+        // Measured 95.6, 93.2 and 98.2 % (disks 93.8, 86.8, 97.0 %; 95.9, 92.3 and 98.3 %
+        // before clusters were split where their nodes do not see each other and a voxel kept
+        // its cluster where it sees its own node); the target is 99 %.
         assert!(p.rate() >= 0.93, "camera {camera}: {p:?}");
         assert!(
             p.rate() > d.rate(),
@@ -125,13 +125,12 @@ fn four_rooms_portal_visibility_agrees_with_shadow_rays_on_99_percent_of_pairs()
 fn pillared_hall_portal_visibility_agrees_with_shadow_rays_past_the_columns() {
     // A row of columns down the hall: the grown hall cluster wrapped them, and light passed a
     // column inside one cluster. Clusters whose nodes do not see each other are now split
-    // (convex.rs): measured 82.9 and 93.4 % of pairs agree (78.0 and 76.9 % before; disks
-    // 84.4 and 96.8 %).
-    // What is left on the main camera is the interface between the hall's two halves, which
-    // cuts the gaps between the columns at a slant: from the part of a gap on one side, a
-    // segment can reach the column's flank inside that side's cluster.
+    // (convex.rs), and the gaps between the columns are cut at the gates (a voxel keeps its
+    // cluster where it sees its own node, flatten.rs): measured 85.4 and 93.8 % of pairs agree
+    // (78.0 and 76.9 % before; disks 84.6 and 96.8 %). What is left: from the part of a gap on
+    // one side of its gate, a segment can reach the column's flank inside that side's cluster.
     let cameras = agreement(Builtin::PillaredHall, 128, &shapes());
-    let floor = [0.82, 0.93];
+    let floor = [0.85, 0.93];
     for (camera, found) in cameras.iter().enumerate() {
         let [p, d] = found[..] else { unreachable!() };
         print("pillared-hall", camera, &p, &d);

@@ -3,8 +3,9 @@
 //! In order: skeleton nodes that lie past a gate of their cluster move across it; each voxel
 //! takes its nearest node's cluster, or the other side's where it lies past a gate near that
 //! node; the gates cut the empty space into pieces and a piece whose nodes are all of one
-//! cluster takes it whole; a voxel that does not see its cluster's seed takes the cluster of the
-//! nearest voxel that does (sightline.rs); then the clusters' boxes.
+//! cluster takes it whole; a voxel that sees neither its cluster's seed nor its own segmented
+//! node (when that is of its cluster) takes the cluster of the nearest voxel that does
+//! (sightline.rs); then the clusters' boxes.
 
 use glam::Vec3;
 use rayon::prelude::*;
@@ -64,8 +65,26 @@ pub fn flatten(input: &FlattenInput) -> Flattened {
         .iter()
         .map(|&seed| meta.coords(input.graph.voxels[seed_node(input, seed)]))
         .collect();
-    let voxels_by_sight =
-        crate::sightline::clusters_by_sight(meta, input.empty, &mut voxel_cluster, &seed_at);
+    // A voxel also stays where it sees the segmented node its skeleton line ends at, when that
+    // node is of its cluster: the seed of a long cluster hides behind a column from the part of
+    // a gap that is the cluster's, and the gap would be cut along the seed's shadow instead of
+    // the gate.
+    let anchor = |i: usize| -> Option<(u32, [u32; 3])> {
+        let n = *input.voxel_node.get(i)?;
+        if n == u32::MAX {
+            return None;
+        }
+        let s = input.seg.node_segment[n as usize] as usize;
+        let node = input.seg.skeleton.nodes[s].skeleton_node as usize;
+        Some((input.node_cluster[s], meta.coords(input.graph.voxels[node])))
+    };
+    let voxels_by_sight = crate::sightline::clusters_by_sight(
+        meta,
+        input.empty,
+        &mut voxel_cluster,
+        &seed_at,
+        &anchor,
+    );
     let clusters = cluster_boxes(input, &voxel_cluster);
     Flattened {
         voxel_cluster,

@@ -1,9 +1,10 @@
 //! Clusters that do not reach around walls. The nearest-node rule gives a doorway node's
 //! cluster the voxels on both sides of a thin wall beside the doorway, so a cluster wraps
 //! around the wall's edge and stops being quasi-convex: light then "passes" the wall inside
-//! one cluster. Here an empty voxel keeps its cluster only if it sees the cluster's seed (the
-//! centre of its largest ball) along a line of empty voxels; the others take the cluster of
-//! the nearest voxel that keeps one (breadth-first through empty space). Voxels that are not
+//! one cluster. Here an empty voxel keeps its cluster only if it sees, along a line of empty
+//! voxels, the cluster's seed (the centre of its largest ball) or its own segmented node when
+//! that node is of its cluster; the others take the cluster of the nearest voxel that keeps
+//! one (breadth-first through empty space). Voxels that are not
 //! empty get no cluster: a surface point takes the cluster of the empty voxel its side faces.
 
 use std::collections::VecDeque;
@@ -65,24 +66,28 @@ pub(crate) fn sees(meta: &GridMeta, empty: &[bool], from: [u32; 3], to: [u32; 3]
     }
 }
 
-/// Reassigns the clusters of empty voxels that do not see their cluster's seed (its voxel in
-/// `seeds`, by cluster) and clears the cluster of voxels that are not empty. Returns how many
-/// empty voxels changed cluster.
+/// Reassigns the clusters of empty voxels that see neither their cluster's seed (its voxel in
+/// `seeds`, by cluster) nor their `anchor` (a cluster and a voxel: the voxel's own segmented
+/// node, which counts only when of the voxel's cluster), and clears the cluster of voxels that
+/// are not empty. Returns how many empty voxels changed cluster.
 pub fn clusters_by_sight(
     meta: &GridMeta,
     empty: &[bool],
     cluster: &mut [u32],
     seeds: &[[u32; 3]],
+    anchor: &(dyn Fn(usize) -> Option<(u32, [u32; 3])> + Sync),
 ) -> u64 {
     let keep: Vec<bool> = cluster
         .par_iter()
         .enumerate()
         .map(|(i, &c)| {
+            let at = meta.coords(i as u32);
             empty[i]
                 && c != NONE
-                && seeds
+                && (seeds
                     .get(c as usize)
-                    .is_some_and(|&s| sees(meta, empty, meta.coords(i as u32), s))
+                    .is_some_and(|&s| sees(meta, empty, at, s))
+                    || anchor(i).is_some_and(|(ac, v)| ac == c && sees(meta, empty, at, v)))
         })
         .collect();
     let old: Vec<u32> = cluster.to_vec();
@@ -158,7 +163,7 @@ mod tests {
             })
             .collect();
         let seeds = [[2, 0, 2], [9, 0, 2]];
-        let moved = clusters_by_sight(&meta, &empty, &mut cluster, &seeds);
+        let moved = clusters_by_sight(&meta, &empty, &mut cluster, &seeds, &|_| None);
         let at = |x: u32, z: u32| cluster[meta.index([x, 0, z])];
         // Behind the wall from cluster 1's seed, beside cluster 0: back to 0.
         assert_eq!(at(5, 2), 0);
@@ -167,5 +172,38 @@ mod tests {
         assert_eq!(at(8, 5), 1);
         assert_eq!(at(6, 3), NONE);
         assert!(moved >= 2 * 9, "{moved}");
+    }
+
+    #[test]
+    fn a_voxel_hidden_from_its_seed_stays_where_it_sees_its_own_node() {
+        // 12 × 1 × 12 voxels, a column at x 5..7, z 5..7. Cluster 1 is the strip x = 11 (seed
+        // at its end), cluster 0 the rest (seed at (1, 0, 1)). The voxels the column hides from
+        // cluster 0's seed see cluster 0's node at (10, 0, 10): with that node as their own
+        // they stay; without it the strip's cluster floods in.
+        let meta = GridMeta {
+            origin_m: [0.0; 3],
+            voxel_size_m: 1.0,
+            dims: [12, 1, 12],
+        };
+        let empty: Vec<bool> = (0..144u32)
+            .map(|i| {
+                let [x, _, z] = meta.coords(i);
+                !((5..7).contains(&x) && (5..7).contains(&z))
+            })
+            .collect();
+        let start: Vec<u32> = (0..144u32)
+            .map(|i| u32::from(meta.coords(i)[0] == 11))
+            .collect();
+        let seeds = [[1, 0, 1], [11, 0, 0]];
+        let corner = meta.index([10, 0, 10]);
+        let mut cluster = start.clone();
+        let own = |i: usize| Some((start[i], [10, 0, 10])).filter(|c| c.0 == 0);
+        assert_eq!(
+            clusters_by_sight(&meta, &empty, &mut cluster, &seeds, &own),
+            0
+        );
+        let mut cluster = start.clone();
+        let moved = clusters_by_sight(&meta, &empty, &mut cluster, &seeds, &|_| None);
+        assert!(moved > 0 && cluster[corner] == 1, "{moved}");
     }
 }

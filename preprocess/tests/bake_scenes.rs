@@ -14,9 +14,9 @@ use visgate_preprocess::voxelize::BAKE_BYTES_PER_VOXEL;
 use visgate_scenes::level::{BoxLevel, cbox};
 use visgate_scenes::{Builtin, Opening};
 
-const RECORDED_AJAR_DOOR: (&str, u64, usize) = ("ajar-door", 0x99a0_ae92_5825_056d, 128_408);
+const RECORDED_AJAR_DOOR: (&str, u64, usize) = ("ajar-door", 0x6ab9_76be_2acd_bd3c, 128_409);
 const RECORDED_PILLARED_HALL: (&str, u64, usize) =
-    ("pillared-hall", 0x6ed2_256d_f57b_7659, 153_311);
+    ("pillared-hall", 0x4731_e3b2_eebf_ddc6, 153_312);
 
 fn params(res: u32) -> BakeParams {
     BakeParams {
