@@ -106,3 +106,45 @@ fn crytek_sponza_obj_and_glb_give_the_same_triangles() {
     );
     assert_eq!(obj.bounds(), glb.bounds());
 }
+
+#[test]
+fn dabrovic_sponzas_80_arcade_lights_cluster_into_fewer_as_the_minimum_distance_grows() {
+    use visgate_runtime::camera::View;
+    use visgate_runtime::cpu::lightcluster::{CULLED, LightClusterParams, cluster_lights};
+    if shared_scenes().is_none() {
+        return;
+    }
+    let toml = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes/shared/dabrovic-sponza-80-lights.toml");
+    let scene = load(&toml);
+    assert_eq!(scene.lights.len(), 80);
+    let (lo, hi) = scene.static_bounds().expect("bounds");
+    let diagonal = (hi - lo).length();
+    for camera in &scene.cameras {
+        let view = View::new(camera, [1920, 1080]).expect("view");
+        let mut counts = Vec::new();
+        for d in [0.0, 0.25, 0.5, 1.0, 2.0, 4.0, 1e3] {
+            let params = LightClusterParams {
+                min_distance_m: d,
+                max_clusters: 256,
+                ..LightClusterParams::default()
+            };
+            let c = cluster_lights(&scene.lights, &view, diagonal, &params).expect("clusters");
+            let live = c.light_cluster.iter().filter(|&&k| k != CULLED).count();
+            if d == 0.0 {
+                assert_eq!(
+                    c.centres.len(),
+                    live,
+                    "no minimum distance: a cluster a light"
+                );
+            }
+            counts.push((d, c.centres.len(), c.culled));
+        }
+        println!(
+            "{}: (min distance m, clusters, culled) {counts:?}",
+            camera.name
+        );
+        assert!(counts.windows(2).all(|w| w[0].1 >= w[1].1), "{counts:?}");
+        assert_eq!(counts.last().map(|c| c.1), Some(1));
+    }
+}

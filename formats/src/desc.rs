@@ -128,6 +128,9 @@ pub struct SceneDesc {
     /// Primary lights.
     #[serde(default, rename = "light")]
     pub lights: Vec<LightDesc>,
+    /// Rows of equal point lights (torches along an arcade), made into `lights` when read.
+    #[serde(default, rename = "light_line", skip_serializing_if = "Vec::is_empty")]
+    pub light_lines: Vec<LightLineDesc>,
     /// Named cameras.
     #[serde(default, rename = "camera")]
     pub cameras: Vec<CameraDesc>,
@@ -224,6 +227,60 @@ pub enum LightDesc {
     Spot(SpotLightDesc),
 }
 
+/// `count` equal point lights evenly spaced from `from` to `to` (both ends included; one light
+/// sits at `from`): many lights at once, as a level's torches or lamps.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LightLineDesc {
+    /// First light's position, scene units.
+    pub from: [f64; 3],
+    /// Last light's position, scene units.
+    pub to: [f64; 3],
+    /// Lights on the line. [Limit: 1..=65536]
+    pub count: u32,
+    /// Radiant intensity of each, W/sr per RGB channel. [Limit: >= 0, finite]
+    pub intensity: [f32; 3],
+}
+
+/// Most lights one `light_line` makes.
+pub const MAX_LINE_LIGHTS: u32 = 65_536;
+
+impl LightLineDesc {
+    /// The line's point lights, or what is wrong with it.
+    fn lights(&self) -> Result<Vec<LightDesc>, String> {
+        let finite = |v: &[f64; 3]| v.iter().all(|x| x.is_finite());
+        if !(finite(&self.from) && finite(&self.to)) {
+            return Err("from and to must be finite".into());
+        }
+        if !(1..=MAX_LINE_LIGHTS).contains(&self.count) {
+            return Err(format!(
+                "count = {} must be 1..={MAX_LINE_LIGHTS}",
+                self.count
+            ));
+        }
+        if self.intensity.iter().any(|x| !(x.is_finite() && *x >= 0.0)) {
+            return Err(format!(
+                "intensity {:?} W/sr must be finite and >= 0",
+                self.intensity
+            ));
+        }
+        let steps = f64::from(self.count.max(2) - 1);
+        Ok((0..self.count)
+            .map(|k| {
+                let t = f64::from(k) / steps;
+                LightDesc::Point(PointLightDesc {
+                    position: std::array::from_fn(|a| {
+                        self.from[a] + (self.to[a] - self.from[a]) * t
+                    }),
+                    intensity: self.intensity,
+                    animate: vec![],
+                    orbit: None,
+                })
+            })
+            .collect())
+    }
+}
+
 /// An isotropic point light.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -302,16 +359,24 @@ impl SceneDesc {
             }],
             materials: vec![],
             lights: vec![],
+            light_lines: vec![],
             cameras: vec![],
         }
     }
 
     /// Parses and validates a description from TOML text; `file` names it in errors.
     pub fn from_toml(text: &str, file: &Path) -> Result<Self, SceneError> {
-        let desc: SceneDesc = toml::from_str(text).map_err(|e| SceneError::Parse {
+        let mut desc: SceneDesc = toml::from_str(text).map_err(|e| SceneError::Parse {
             file: file.to_path_buf(),
             message: e.to_string(),
         })?;
+        for (i, line) in std::mem::take(&mut desc.light_lines).iter().enumerate() {
+            let lights = line.lights().map_err(|what| SceneError::Invalid {
+                file: file.to_path_buf(),
+                what: format!("light_line {}: {what}", i + 1),
+            })?;
+            desc.lights.extend(lights);
+        }
         desc.validate(file)?;
         Ok(desc)
     }

@@ -369,3 +369,52 @@ fn bad_animations_are_errors_naming_what_to_fix() {
     );
     assert!(e.contains("key 2"), "{e}");
 }
+
+#[test]
+fn a_light_line_makes_evenly_spaced_point_lights() {
+    let text = r#"
+[[light]]
+type = "point"
+position = [0, 3, 0]
+intensity = [5, 5, 5]
+
+[[light_line]]
+from = [0, 2, 0]
+to = [8, 2, 4]
+count = 5
+intensity = [1, 0.5, 0.25]
+"#;
+    let desc = SceneDesc::from_toml(text, Path::new("lines.toml")).expect("parse");
+    assert!(desc.light_lines.is_empty(), "made into lights when read");
+    assert_eq!(desc.lights.len(), 6);
+    let at: Vec<[f64; 3]> = desc.lights[1..]
+        .iter()
+        .map(|l| match l {
+            LightDesc::Point(p) => {
+                assert_eq!(p.intensity, [1.0, 0.5, 0.25]);
+                p.position
+            }
+            LightDesc::Spot(_) => panic!("a line makes point lights"),
+        })
+        .collect();
+    assert_eq!(
+        at,
+        [
+            [0.0, 2.0, 0.0],
+            [2.0, 2.0, 1.0],
+            [4.0, 2.0, 2.0],
+            [6.0, 2.0, 3.0],
+            [8.0, 2.0, 4.0]
+        ]
+    );
+    // One light sits at `from`; none, or a negative intensity, is refused with the line named.
+    let one = text.replace("count = 5", "count = 1");
+    let desc = SceneDesc::from_toml(&one, Path::new("lines.toml")).expect("parse");
+    assert_eq!(desc.lights.len(), 2);
+    let none = text.replace("count = 5", "count = 0");
+    let e = SceneDesc::from_toml(&none, Path::new("lines.toml")).expect_err("refused");
+    assert!(e.to_string().contains("light_line 1: count = 0"), "{e}");
+    let dark = text.replace("[1, 0.5, 0.25]", "[1, -0.5, 0.25]");
+    let e = SceneDesc::from_toml(&dark, Path::new("lines.toml")).expect_err("refused");
+    assert!(e.to_string().contains("light_line 1: intensity"), "{e}");
+}

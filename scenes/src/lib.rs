@@ -445,6 +445,7 @@ impl Builtin {
             }],
             materials: vec![],
             lights,
+            light_lines: vec![],
             cameras,
         }
     }

@@ -5,6 +5,7 @@
 pub mod clustered;
 pub mod cssm;
 pub mod gates;
+pub mod lightcluster;
 pub mod portal_walk;
 pub mod reference;
 pub mod tracer;
