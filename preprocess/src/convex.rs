@@ -68,15 +68,14 @@ pub fn split_unseen(
     let mut placed = vec![false; n];
     // A node that was tried for the group being grown (`tried[x] == group's first node`).
     let mut tried = vec![u32::MAX; n];
+    // Each cluster's nodes, in that order.
+    let mut members: Vec<Vec<u32>> = vec![Vec::new(); seeds.len()];
+    for &s in &order {
+        members[node_cluster[s as usize] as usize].push(s);
+    }
     for c in 0..seeds.len() as u32 {
-        let members = || {
-            order
-                .iter()
-                .copied()
-                .filter(|&s| node_cluster[s as usize] == c)
-        };
         // The cluster's own seed first, so that an unsplit cluster keeps it.
-        let starts = std::iter::once(seeds[c as usize]).chain(members());
+        let starts = std::iter::once(seeds[c as usize]).chain(members[c as usize].iter().copied());
         for start in starts {
             if placed[start as usize] {
                 continue;
