@@ -253,6 +253,11 @@ pub fn bake(
         skeleton_nodes: sk.graph.voxels.len() as u64,
         segmented_nodes: sg.counts,
         clusters: level.topology.clusters.len() as u64,
+        clusters_grown_split_merged: [
+            step.clusters_grown,
+            step.clusters_split_off,
+            step.slivers_merged,
+        ],
         gates: level.topology.gates.len() as u64,
         portals: level.topology.portals.len() as u64,
         uncovered_interface_faces: uncovered,

@@ -33,6 +33,9 @@ pub struct Summary {
     pub segmented_nodes: [u64; 5],
     /// Visibility clusters.
     pub clusters: u64,
+    /// Clusters the greedy growth made, split off where their nodes did not see each other,
+    /// and merged as slivers: `clusters = grown + split off − merged`.
+    pub clusters_grown_split_merged: [u64; 3],
     /// Visibility gates.
     pub gates: u64,
     /// Portals (planar pieces of the interfaces between clusters).
@@ -123,9 +126,12 @@ impl BakeReport {
             m.segmented_nodes[3],
             m.segmented_nodes[4]
         );
+        let [grown, split, merged] = m.clusters_grown_split_merged;
         s += &format!(
             "clusters {}  gates {}  portals {}  cycles {}  components {}  (alpha {} against {:?}, \
-             persistence {}, gates at {:?}, max ball {:?}, curvature to {:?})\n",
+             persistence {}, gates at {:?}, max ball {:?}, curvature to {:?})\n\
+             clusters: {grown} grown, {split} split off where their nodes did not see each other, \
+             {merged} merged as slivers\n",
             m.clusters,
             m.gates,
             m.portals,

@@ -267,7 +267,7 @@ pub fn clusters_and_gates(
     params: &BakeParams,
     cx: &mut BakeContext,
 ) -> Result<GateStep, BakeError> {
-    let (node_cluster, seeds_of) = cx.stage("clusters", 0, |_| {
+    let (node_cluster, seeds_of, grown, split_off) = cx.stage("clusters", 0, |_| {
         let (grown, grown_seeds) = clusters(
             &sg.seg.skeleton,
             &sk.position,
@@ -291,7 +291,10 @@ pub fn clusters_and_gates(
             "split_off_unseen": added,
             "alpha": params.alpha,
         });
-        Ok(((node_cluster, seeds), counts))
+        Ok((
+            (node_cluster, seeds, grown_seeds.len() as u64, added as u64),
+            counts,
+        ))
     })?;
     cx.stage("gates", 0, |_| {
         let input = GateInput {
@@ -300,7 +303,8 @@ pub fn clusters_and_gates(
             position: &sk.position,
             radius: &sk.radius,
         };
-        let step = gate_step(&input, node_cluster, seeds_of, params.alpha);
+        let mut step = gate_step(&input, node_cluster, seeds_of, params.alpha);
+        (step.clusters_grown, step.clusters_split_off) = (grown, split_off);
         let counts = json!({
             "gates": step.chosen(params.gate_placement).len(),
             "slivers_merged": step.slivers_merged,

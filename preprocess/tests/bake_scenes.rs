@@ -63,6 +63,19 @@ fn check_known_answers(b: Builtin, res: u32, rooms: bool) {
     );
     let n_clusters = r.summary.clusters as u32;
     let n_gates = r.summary.gates as u32;
+    // The clusters' account: grown, plus split off, less merged as slivers; and the text says so.
+    let [grown, split, merged] = r.summary.clusters_grown_split_merged;
+    assert_eq!(grown + split - merged, r.summary.clusters, "{ctx}");
+    assert!(
+        r.text()
+            .contains(&format!("clusters: {grown} grown, {split} split off")),
+        "{ctx}"
+    );
+    // The grown hall wraps the columns; its nodes on either side of a column do not see each
+    // other, so it is split.
+    if b == Builtin::PillaredHall {
+        assert!(split >= 1, "{ctx}");
+    }
     assert!(
         (ka.clusters[0]..=ka.clusters[1]).contains(&n_clusters),
         "clusters, {ctx}"
