@@ -220,7 +220,8 @@ pub fn bake(
     let radius_vx = field.whole_radii();
     drop(field);
     let sg = cx.stage("segment", 0, |_| Ok(stages::segmentation(&sk, &params)))?;
-    let step = stages::clusters_and_gates(&meta, &es, &sk, &sg, &params, &mut cx)?;
+    let (step, cluster_account) =
+        stages::clusters_and_gates(&meta, &es, &sk, &sg, &params, &mut cx)?;
     let info = BakeInfo {
         params: params.clone(),
         geometry_hash: input.hash,
@@ -253,11 +254,7 @@ pub fn bake(
         skeleton_nodes: sk.graph.voxels.len() as u64,
         segmented_nodes: sg.counts,
         clusters: level.topology.clusters.len() as u64,
-        clusters_grown_split_merged: [
-            step.clusters_grown,
-            step.clusters_split_off,
-            step.slivers_merged,
-        ],
+        clusters_grown_split_merged: cluster_account,
         gates: level.topology.gates.len() as u64,
         portals: level.topology.portals.len() as u64,
         uncovered_interface_faces: uncovered,

@@ -33,10 +33,6 @@ pub struct GateStep {
     pub midpoint: Vec<GateDisk>,
     /// Clusters merged as slivers.
     pub slivers_merged: u64,
-    /// Clusters the greedy growth made, before the split and the merges.
-    pub clusters_grown: u64,
-    /// Clusters split off because their nodes did not see each other (convex.rs).
-    pub clusters_split_off: u64,
 }
 
 impl GateStep {
@@ -106,7 +102,5 @@ pub fn gate_step(
         node_cluster,
         seeds_of,
         slivers_merged,
-        clusters_grown: 0,
-        clusters_split_off: 0,
     }
 }

@@ -257,8 +257,9 @@ pub fn segmentation(sk: &SkeletonStage, params: &BakeParams) -> Counted<SegmentS
     (stage, counts)
 }
 
-/// Stages 8 and 9: the greedy clusters (IV.B.2), then the gates (both rules) after merging
-/// slivers.
+/// Stages 8 and 9: the greedy clusters (IV.B.2) split where their nodes do not see each other,
+/// then the gates (both rules) after merging slivers; with the clusters' account (grown, split
+/// off, merged as slivers).
 pub fn clusters_and_gates(
     meta: &GridMeta,
     es: &EmptySpace,
@@ -266,7 +267,7 @@ pub fn clusters_and_gates(
     sg: &SegmentStage,
     params: &BakeParams,
     cx: &mut BakeContext,
-) -> Result<GateStep, BakeError> {
+) -> Result<(GateStep, [u64; 3]), BakeError> {
     let (node_cluster, seeds_of, grown, split_off) = cx.stage("clusters", 0, |_| {
         let (grown, grown_seeds) = clusters(
             &sg.seg.skeleton,
@@ -303,14 +304,14 @@ pub fn clusters_and_gates(
             position: &sk.position,
             radius: &sk.radius,
         };
-        let mut step = gate_step(&input, node_cluster, seeds_of, params.alpha);
-        (step.clusters_grown, step.clusters_split_off) = (grown, split_off);
+        let step = gate_step(&input, node_cluster, seeds_of, params.alpha);
         let counts = json!({
             "gates": step.chosen(params.gate_placement).len(),
             "slivers_merged": step.slivers_merged,
             "clusters": step.seeds_of.len(),
         });
-        Ok((step, counts))
+        let account = [grown, split_off, step.slivers_merged];
+        Ok(((step, account), counts))
     })
 }
 
