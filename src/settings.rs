@@ -4,10 +4,11 @@
 use clap::{Args, ValueEnum};
 use visgate_runtime::cpu::clustered::ClusterParams;
 use visgate_runtime::cpu::gates::{GateParams, GateShape};
+use visgate_runtime::cpu::lightcluster::LightClusterParams;
 use visgate_runtime::cpu::val::ValParams;
 use visgate_runtime::gpu::{
-    CssmParams, GatesParams, GpuMode, GpuParams, InterleaveParams, MethodSettings, PerVplParams,
-    ShadowParams, ValModeParams,
+    CssmParams, DirectLight, GatesParams, GpuMode, GpuParams, InterleaveParams,
+    LightClusterGpuParams, MethodSettings, PcssParams, PerVplParams, ShadowParams, ValModeParams,
 };
 use visgate_runtime::job::{RenderJob, VplSource as JobVpls};
 use visgate_runtime::vpl::GeometryClamp;
@@ -19,6 +20,17 @@ pub enum GateShapeArg {
     Portal,
     /// The paper's disks, through chains of at most --gate-hops of them.
     Disk,
+}
+
+/// `--direct`: how the direct lights are shadowed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum DirectArg {
+    /// Each light's own cube (or spot) shadow map, 3 × 3 PCF: exact hard shadows, one map
+    /// per light.
+    PerLight,
+    /// LightCluster: lights in view clustered by a minimum distance, one cube map per
+    /// cluster, soft shadows by PCSS with the cluster as a disk (see the --lc-* flags).
+    Lightcluster,
 }
 
 /// `--vpl-source`: where VPLs come from.
@@ -71,6 +83,7 @@ impl LightArgs {
                     size: method.shadow_size,
                     ..ShadowParams::default()
                 },
+                direct: method.direct(),
             },
             clamp: match self.g_max {
                 Some(g) => GeometryClamp::PerSquareMetre(g),
@@ -96,6 +109,37 @@ pub struct MethodArgs {
     /// Shadow map size per layer (GPU), texels.
     #[arg(long, default_value_t = 1024)]
     pub shadow_size: u32,
+    /// How the direct lights are shadowed (GPU; every --mode): each light's own maps, or
+    /// LightCluster's soft shadow per cluster of lights.
+    #[arg(long, value_enum, default_value_t = DirectArg::PerLight)]
+    pub direct: DirectArg,
+    /// LightCluster: minimum distance between cluster centres at the eye, metres (0: every
+    /// light in view is its own cluster, hard shadows); also each cluster's disk radius.
+    #[arg(long, default_value_t = 1.0)]
+    pub lc_min_distance: f32,
+    /// LightCluster: growth of the minimum distance with a light's distance d from the eye,
+    /// per metre (min distance · (1 + S·d): clusters are smaller near the camera).
+    #[arg(long, default_value_t = 0.1)]
+    pub lc_distance_scale: f32,
+    /// LightCluster: most clusters (cube shadow maps) a frame, 1..=256; lights past them join
+    /// the nearest cluster.
+    #[arg(long, default_value_t = 64)]
+    pub lc_max_clusters: u32,
+    /// LightCluster: a light's range ends where its irradiance falls below this fraction of
+    /// what the brightest light gives at a tenth of the scene's diagonal; lights whose range
+    /// misses the view are culled (not shaded), (0, 1].
+    #[arg(long, default_value_t = 1e-3)]
+    pub lc_cutoff: f32,
+    /// LightCluster: side of each cluster's cube face, texels, 16..=2048 (the atlas holds
+    /// 6 × --lc-max-clusters faces).
+    #[arg(long, default_value_t = 256)]
+    pub lc_map_size: u32,
+    /// LightCluster: PCSS blocker-search samples per cluster and pixel, 1..=64.
+    #[arg(long, default_value_t = 16)]
+    pub pcss_blocker_samples: u32,
+    /// LightCluster: PCSS filter (PCF) samples per cluster and pixel in a penumbra, 1..=128.
+    #[arg(long, default_value_t = 32)]
+    pub pcss_filter_samples: u32,
     /// What a gate is (--mode gates): the baked portals, walked, or the paper's disks.
     #[arg(long, value_enum, default_value_t = GateShapeArg::Portal)]
     pub gate_shape: GateShapeArg,
@@ -164,6 +208,26 @@ pub struct MethodArgs {
 }
 
 impl MethodArgs {
+    /// The direct lights' visibility from the flags.
+    pub fn direct(&self) -> DirectLight {
+        match self.direct {
+            DirectArg::PerLight => DirectLight::PerLight,
+            DirectArg::Lightcluster => DirectLight::LightCluster(LightClusterGpuParams {
+                clustering: LightClusterParams {
+                    min_distance_m: self.lc_min_distance,
+                    distance_scale: self.lc_distance_scale,
+                    max_clusters: self.lc_max_clusters,
+                    cutoff: self.lc_cutoff,
+                },
+                map_size: self.lc_map_size,
+                pcss: PcssParams {
+                    blocker_samples: self.pcss_blocker_samples,
+                    filter_samples: self.pcss_filter_samples,
+                },
+            }),
+        }
+    }
+
     /// Interleaving and blur from the flags (VAL modes and gates alike).
     fn interleave_params(&self) -> InterleaveParams {
         InterleaveParams {

@@ -370,15 +370,22 @@ impl SceneDesc {
             file: file.to_path_buf(),
             message: e.to_string(),
         })?;
-        for (i, line) in std::mem::take(&mut desc.light_lines).iter().enumerate() {
+        desc.expand_light_lines(file)?;
+        desc.validate(file)?;
+        Ok(desc)
+    }
+
+    /// Replaces every `[[light_line]]` by its point lights (after the listed lights);
+    /// `file` names the scene in errors.
+    pub fn expand_light_lines(&mut self, file: &Path) -> Result<(), SceneError> {
+        for (i, line) in std::mem::take(&mut self.light_lines).iter().enumerate() {
             let lights = line.lights().map_err(|what| SceneError::Invalid {
                 file: file.to_path_buf(),
                 what: format!("light_line {}: {what}", i + 1),
             })?;
-            desc.lights.extend(lights);
+            self.lights.extend(lights);
         }
-        desc.validate(file)?;
-        Ok(desc)
+        Ok(())
     }
 
     /// Reads, parses and validates a scene TOML file.

@@ -49,6 +49,15 @@ impl Scene {
         models: Vec<ImportedModel>,
         file: &Path,
     ) -> Result<Scene, SceneError> {
+        // A description built in code may still hold its light lines.
+        let mut expanded;
+        let desc = if desc.light_lines.is_empty() {
+            desc
+        } else {
+            expanded = desc.clone();
+            expanded.expand_light_lines(file)?;
+            &expanded
+        };
         if models.len() != desc.meshes.len() {
             return Err(SceneError::Invalid {
                 file: file.to_path_buf(),

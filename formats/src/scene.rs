@@ -82,6 +82,15 @@ pub enum Light {
     },
 }
 
+impl Light {
+    /// Where the light is. [Units: m]
+    pub fn position(&self) -> Vec3 {
+        match *self {
+            Light::Point { position, .. } | Light::Spot { position, .. } => position,
+        }
+    }
+}
+
 /// A look-at camera, in world space.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Camera {

@@ -458,6 +458,14 @@ pub fn pass_table(t: &PassTimes) -> String {
             ),
         };
     }
+    if let Some(c) = t.direct_clusters {
+        s += &format!(
+            "LightCluster: {} lights in {} clusters (cube shadow maps), {} culled by range\n",
+            c.lights - c.culled,
+            c.clusters,
+            c.culled
+        );
+    }
     if t.passes.iter().all(|p| p.gpu_s.is_none()) {
         s += "(the adapter has no timestamp queries: each pass was submitted and waited for \
               alone, for its CPU wall time)\n";

@@ -17,7 +17,8 @@ use std::path::{Path, PathBuf};
 use glam::Vec3;
 use serde::Serialize;
 use visgate_formats::desc::{
-    CameraDesc, LightDesc, MeshDesc, PointLightDesc, Scale, SceneDesc, SpotLightDesc, UpAxis,
+    CameraDesc, LightDesc, LightLineDesc, MeshDesc, PointLightDesc, Scale, SceneDesc,
+    SpotLightDesc, UpAxis,
 };
 use visgate_formats::import::{ImportedModel, import_obj_str};
 use visgate_formats::{Material, Scene, SceneError};
@@ -93,11 +94,14 @@ pub enum Builtin {
     AjarDoor,
     /// A 16 m hall with a row of six columns (six loops) and three side rooms.
     PillaredHall,
+    /// The pillared hall lit by 51 lamps: a row of 24 on each side of the columns, one in each
+    /// side room (LightCluster's many lights).
+    LampHall,
 }
 
 impl Builtin {
     /// Every built-in scene.
-    pub const ALL: [Builtin; 8] = [
+    pub const ALL: [Builtin; 9] = [
         Builtin::EmptyBox,
         Builtin::TwoRooms,
         Builtin::RingCorridor,
@@ -106,6 +110,7 @@ impl Builtin {
         Builtin::CornellBox,
         Builtin::AjarDoor,
         Builtin::PillaredHall,
+        Builtin::LampHall,
     ];
 
     /// The name used on the command line (`builtin:NAME`).
@@ -119,6 +124,7 @@ impl Builtin {
             Builtin::CornellBox => "cornell-box",
             Builtin::AjarDoor => "ajar-door",
             Builtin::PillaredHall => "pillared-hall",
+            Builtin::LampHall => "lamp-hall",
         }
     }
 
@@ -139,6 +145,7 @@ impl Builtin {
             Builtin::PillaredHall => {
                 "a 16 x 4 x 5 m hall with six 0.6 m columns and three 4 x 4 m side rooms"
             }
+            Builtin::LampHall => "the pillared hall lit by 51 lamps (two rows of 24, one a room)",
         }
     }
 
@@ -176,7 +183,7 @@ impl Builtin {
                 cbox(15, 25, 0, 21, 40, 42),
                 cbox(57, 67, 0, 21, 40, 42),
             ],
-            Builtin::PillaredHall => pillared_hall(),
+            Builtin::PillaredHall | Builtin::LampHall => pillared_hall(),
             Builtin::CornellBox | Builtin::AjarDoor => return None,
         };
         Some(BoxLevel {
@@ -296,7 +303,7 @@ impl Builtin {
                 rooms: vec![],
                 note: "the table's four legs join its top to the floor: three loops under it; the door's gap and the wedge behind the panel make room B non-convex; one room per side at least",
             },
-            Builtin::PillaredHall => KnownAnswers {
+            Builtin::PillaredHall | Builtin::LampHall => KnownAnswers {
                 components: 1,
                 cycles: 6,
                 clusters: [4, 30],
@@ -403,6 +410,27 @@ impl Builtin {
                     },
                 ],
             ),
+            // One lamp in each side room (the rows are light lines); the cameras of the
+            // pillared hall, and one along the south row.
+            Builtin::LampHall => (
+                true,
+                vec![
+                    point([2.0, 2.5, 7.2], 3.0),
+                    point([14.0, 2.5, 7.2], 3.0),
+                    point([8.0, 2.5, -2.2], 3.0),
+                ],
+                vec![
+                    camera([15.5, 1.7, 1.0], [0.0, 1.2, 4.0], 75.0),
+                    CameraDesc {
+                        name: "side-room".into(),
+                        ..camera([15.5, 1.6, 9.0], [13.5, 1.0, 4.0], 75.0)
+                    },
+                    CameraDesc {
+                        name: "south-row".into(),
+                        ..camera([0.5, 1.5, 0.5], [16.0, 2.0, 1.5], 70.0)
+                    },
+                ],
+            ),
             // A light at the hall's west end, a spot into the south room; one camera down the
             // hall along the columns, one in the north-east room looking out of its door.
             Builtin::PillaredHall => (
@@ -445,7 +473,18 @@ impl Builtin {
             }],
             materials: vec![],
             lights,
-            light_lines: vec![],
+            light_lines: match self {
+                // Two rows of 24 lamps 3.2 m up, 1 m either side of the columns.
+                Builtin::LampHall => [1.2, 3.8]
+                    .map(|z| LightLineDesc {
+                        from: [0.4, 3.2, z],
+                        to: [15.6, 3.2, z],
+                        count: 24,
+                        intensity: [1.5, 1.3, 1.0],
+                    })
+                    .to_vec(),
+                _ => vec![],
+            },
             cameras,
         }
     }

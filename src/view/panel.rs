@@ -128,6 +128,14 @@ pub fn pass_times(ui: &mut egui::Ui, img: &HdrImage, t: &PassTimes, history: &Ve
             l.vpls_outside
         ));
     }
+    if let Some(c) = &t.direct_clusters {
+        ui.label(format!(
+            "LightCluster: {} lights in {} clusters, {} culled",
+            c.lights - c.culled,
+            c.clusters,
+            c.culled
+        ));
+    }
     if let Some(v) = &t.vals {
         ui.label(format!(
             "VAL clustering: {} of at most {} iterations{}",

@@ -53,7 +53,8 @@ impl Default for LightClusterParams {
 }
 
 impl LightClusterParams {
-    fn check(&self) -> Result<(), RenderError> {
+    /// Checks every limit.
+    pub fn check(&self) -> Result<(), RenderError> {
         let bad = |what: &str| Err(RenderError::Param(format!("LightCluster: {what}")));
         if !(self.min_distance_m.is_finite() && self.min_distance_m >= 0.0) {
             return bad("the minimum distance must be finite and >= 0 m");
@@ -84,12 +85,6 @@ pub struct LightClusters {
     pub culled: u32,
 }
 
-fn position(l: &Light) -> Vec3 {
-    match *l {
-        Light::Point { position, .. } | Light::Spot { position, .. } => position,
-    }
-}
-
 fn intensity(l: &Light) -> f32 {
     match *l {
         Light::Point { intensity, .. } | Light::Spot { intensity, .. } => intensity.max_element(),
@@ -99,10 +94,22 @@ fn intensity(l: &Light) -> f32 {
 /// A light's range (see the module notes): `diagonal_m` is the level's diagonal, `brightest`
 /// the largest intensity of any light. [Units: m]
 pub fn light_range(intensity: f32, brightest: f32, diagonal_m: f32, cutoff: f32) -> f32 {
+    range_scale(brightest, diagonal_m, cutoff) * intensity.max(0.0).sqrt()
+}
+
+/// `range_scale · sqrt(I)` is a light's range (as the GPU computes it).
+fn range_scale(brightest: f32, diagonal_m: f32, cutoff: f32) -> f32 {
     if brightest <= 0.0 {
         return 0.0;
     }
-    0.1 * diagonal_m * (intensity.max(0.0) / (cutoff * brightest)).sqrt()
+    0.1 * diagonal_m / (cutoff * brightest).sqrt()
+}
+
+/// The factor of `sqrt(I)` in every range of `lights` (I the largest RGB channel of a
+/// light's intensity) in a level of diagonal `diagonal_m`. [Units: m / sqrt(W/sr)]
+pub fn light_range_scale(lights: &[Light], diagonal_m: f32, cutoff: f32) -> f32 {
+    let brightest = lights.iter().map(intensity).fold(0.0f32, f32::max);
+    range_scale(brightest, diagonal_m, cutoff)
 }
 
 /// Whether the sphere at `p` of radius `r` meets `view`'s frustum (no far plane).
@@ -127,23 +134,23 @@ pub fn cluster_lights(
     params: &LightClusterParams,
 ) -> Result<LightClusters, RenderError> {
     params.check()?;
-    let brightest = lights.iter().map(intensity).fold(0.0f32, f32::max);
+    let scale = light_range_scale(lights, diagonal_m, params.cutoff);
     let mut out = LightClusters {
         light_cluster: vec![CULLED; lights.len()],
         ..LightClusters::default()
     };
     let mut live: Vec<(f32, u32)> = Vec::new();
     for (i, l) in lights.iter().enumerate() {
-        let range = light_range(intensity(l), brightest, diagonal_m, params.cutoff);
-        if range > 0.0 && sphere_in_view(view, position(l), range) {
-            live.push(((position(l) - view.eye).length(), i as u32));
+        let range = scale * intensity(l).max(0.0).sqrt();
+        if range > 0.0 && sphere_in_view(view, l.position(), range) {
+            live.push(((l.position() - view.eye).length(), i as u32));
         } else {
             out.culled += 1;
         }
     }
     live.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
     let min_distance = |d: f32| params.min_distance_m * (1.0 + params.distance_scale * d);
-    let at = |i: u32| position(&lights[i as usize]);
+    let at = |i: u32| lights[i as usize].position();
     for &(d, i) in &live {
         if out.centres.len() >= params.max_clusters as usize {
             break;
@@ -281,8 +288,8 @@ mod tests {
         assert!(c.radius_m.windows(2).all(|w| w[0] <= w[1]));
         // Every light joined the nearest centre.
         for (i, &k) in c.light_cluster.iter().enumerate() {
-            let p = position(&lights[i]);
-            let d = |c: u32| position(&lights[c as usize]).distance(p);
+            let p = lights[i].position();
+            let d = |c: u32| lights[c as usize].position().distance(p);
             let best = c
                 .centres
                 .iter()

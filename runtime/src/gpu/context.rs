@@ -41,6 +41,8 @@ impl GpuContext {
         let adapter_info = adapter.get_info();
         let limits = wgpu::Limits {
             max_texture_array_layers: adapter.limits().max_texture_array_layers,
+            // LightCluster's shadow atlas (6 faces a cluster in one texture).
+            max_texture_dimension_2d: adapter.limits().max_texture_dimension_2d,
             max_storage_buffer_binding_size: adapter.limits().max_storage_buffer_binding_size,
             max_storage_buffers_per_shader_stage: adapter
                 .limits()

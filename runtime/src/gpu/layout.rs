@@ -131,6 +131,15 @@ gpu_struct! {
         pub shade_mode: u32,
         /// Shadow map layer size. [Units: texels]
         pub shadow_size: u32,
+        /// Direct lights' visibility: `DIRECT_PER_LIGHT` (each light's shadow maps) or
+        /// `DIRECT_LIGHTCLUSTER` (its cluster's PCSS visibility texture).
+        pub direct_mode: u32,
+        /// Padding.
+        pub _pad0: u32,
+        /// Padding.
+        pub _pad1: u32,
+        /// Padding.
+        pub _pad2: u32,
     }
 }
 
@@ -289,6 +298,55 @@ gpu_struct! {
 }
 
 gpu_struct! {
+    /// Per-frame constants of LightCluster (light_cluster.wgsl): the view for the culling,
+    /// the clustering's parameters, the cluster shadow atlas and the PCSS settings.
+    pub struct LcFrame {
+        /// Eye position (xyz, m), w unused.
+        pub eye: [f32; 4],
+        /// Camera right, up and forward (xyz, unit), w unused.
+        pub right: [f32; 4],
+        /// See `right`.
+        pub up: [f32; 4],
+        /// See `right`.
+        pub forward: [f32; 4],
+        /// cos and sin of the horizontal, then the vertical half field of view.
+        pub half_fov: [f32; 4],
+        /// Lights in the light buffer.
+        pub light_count: u32,
+        /// Most clusters (at most [`crate::gpu::passes::light_cluster::MAX_LC_CLUSTERS`]).
+        pub max_clusters: u32,
+        /// Side of one cube face's tile. [Units: texels]
+        pub map_size: u32,
+        /// Tiles per row of the atlas.
+        pub tiles_per_row: u32,
+        /// Minimum distance between centres at the eye. [Units: m]
+        pub min_distance_m: f32,
+        /// Its growth with the distance from the eye. [Units: 1/m]
+        pub distance_scale: f32,
+        /// A light's range is `range_scale · sqrt(intensity)`. [Units: m / sqrt(W/sr)]
+        pub range_scale: f32,
+        /// Near distance of the cube faces. [Units: m]
+        pub near_m: f32,
+        /// Far distance of the cube faces (the atlas holds distance / far). [Units: m]
+        pub far_m: f32,
+        /// Normal offset of the lookups. [Units: texels]
+        pub normal_offset: f32,
+        /// Depth bias of the lookups. [Units: texels]
+        pub bias: f32,
+        /// PCSS blocker-search samples.
+        pub blocker_samples: u32,
+        /// PCSS filter (PCF) samples.
+        pub filter_samples: u32,
+        /// Frame width. [Units: px]
+        pub width: u32,
+        /// Frame height. [Units: px]
+        pub height: u32,
+        /// Vertices of the scene (the shadow draw's vertex count).
+        pub vertex_count: u32,
+    }
+}
+
+gpu_struct! {
     /// Per-frame constants of the VAL clustering (vals.wgsl).
     pub struct ValFrame {
         /// VPLs.
@@ -391,6 +449,7 @@ pub fn all() -> Vec<StructLayout> {
         ValFrame::layout(),
         ValGather::layout(),
         CssmFrame::layout(),
+        LcFrame::layout(),
     ]
 }
 

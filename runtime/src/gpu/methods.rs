@@ -11,6 +11,7 @@ use crate::cpu::gates::GateParams;
 pub use super::passes::clustered_gates::GatesParams;
 pub use super::passes::cssm::CssmParams;
 pub use super::passes::interleave_blur::InterleaveParams;
+pub use super::passes::light_cluster::{DirectLight, LightClusterGpuParams, PcssParams};
 pub use super::passes::per_vpl_maps::PerVplParams;
 pub use super::passes::val_gather::ValModeParams;
 
@@ -246,6 +247,8 @@ pub struct GpuParams {
     /// The lights' shadow maps (their normal offset and bias also serve the per-VPL and VAL
     /// maps' hard lookups).
     pub shadows: ShadowParams,
+    /// The direct lights' visibility: their own shadow maps, or LightCluster.
+    pub direct: DirectLight,
 }
 
 impl Default for GpuParams {
@@ -254,6 +257,7 @@ impl Default for GpuParams {
             mode: GpuMode::None,
             g_max: 10.0,
             shadows: ShadowParams::default(),
+            direct: DirectLight::PerLight,
         }
     }
 }
@@ -280,6 +284,9 @@ impl GpuParams {
                 "shadow map size {} must be 16..=4096",
                 self.shadows.size
             )));
+        }
+        if let DirectLight::LightCluster(p) = &self.direct {
+            p.check()?;
         }
         self.mode.check()
     }

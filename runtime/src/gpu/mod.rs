@@ -42,6 +42,7 @@ use crate::camera::View;
 use crate::cpu::clustered::Clustered;
 use crate::cpu::clustered::PixelSurface;
 use crate::cpu::gates::{GateLevel, GateShape};
+use crate::cpu::lightcluster::LightClusters;
 use crate::cpu::val::{Clustering, ValParams, scale_of};
 use crate::hdr::HdrImage;
 use crate::vpl::Vpl;
@@ -52,6 +53,7 @@ use passes::clustered_gates::{ClusteredGates, LevelBuffers, ListBuffers};
 use passes::cssm::Cssm;
 use passes::gbuffer::GBuffer;
 use passes::interleave_blur::InterleaveBlur;
+use passes::light_cluster::LightCluster;
 use passes::per_vpl_maps::ParaboloidMaps;
 use passes::rsm_vpls::RsmVpls;
 use passes::shade::Shade;
@@ -65,12 +67,14 @@ use timing::Recorder;
 pub use context::GpuContext;
 pub use geometry::{MAX_TEXTURE_SIZE, VPL_SHADOW_MAX_EDGE};
 pub use methods::{
-    CssmParams, GatesParams, GpuMode, GpuParams, InterleaveParams, METHODS, MethodInfo,
-    MethodSettings, PerVplParams, ShadowParams, ValModeParams, method,
+    CssmParams, DirectLight, GatesParams, GpuMode, GpuParams, InterleaveParams,
+    LightClusterGpuParams, METHODS, MethodInfo, MethodSettings, PcssParams, PerVplParams,
+    ShadowParams, ValModeParams, method,
 };
 pub use passes::clustered_gates::{MAX_CLUSTERS, MAX_GATES};
+pub use passes::light_cluster::{MAX_LC_CLUSTERS, MAX_LC_LIGHTS};
 pub use passes::rsm_vpls::RsmParams;
-pub use timing::{LightListStats, PassTime, PassTimes, ValIterations};
+pub use timing::{DirectClusters, LightListStats, PassTime, PassTimes, ValIterations};
 
 /// Where a frame's VPLs come from.
 #[derive(Debug, Clone, Copy)]
@@ -92,6 +96,8 @@ pub struct SceneGpu {
     /// Far distance of the lights' shadow and paraboloid maps (4 diagonals; the camera has no
     /// far plane). [Units: m]
     pub far_m: f32,
+    /// The first scene's bounding diagonal (LightCluster's light ranges). [Units: m]
+    pub diagonal_m: f32,
     /// Albedo textures as one array.
     pub albedo_maps: wgpu::TextureView,
     /// Nearest, repeating.
@@ -102,6 +108,8 @@ pub struct SceneGpu {
     pub no_level: wgpu::Buffer,
     /// A grid of no voxels (the lights' views need no clusters).
     pub no_grid: wgpu::Buffer,
+    /// Bound where LightCluster's visibility is not (1 texel, 1 layer).
+    pub no_visibility: wgpu::Texture,
 }
 
 impl SceneGpu {
@@ -147,6 +155,7 @@ pub struct Pipelines {
     cssm: Cssm,
     val_gather: ValGathers,
     blur: InterleaveBlur,
+    light_cluster: LightCluster,
 }
 
 impl Pipelines {
@@ -162,6 +171,7 @@ impl Pipelines {
             cssm: Cssm::new(d, s)?,
             val_gather: ValGathers::new(d, s)?,
             blur: InterleaveBlur::new(d, s)?,
+            light_cluster: LightCluster::new(d, s)?,
         })
     }
 }
@@ -183,6 +193,8 @@ struct Recorded {
     lists: Option<ListBuffers>,
     /// The VAL clustering's convergence words, in the VAL modes.
     val_state: Option<wgpu::Buffer>,
+    /// LightCluster's args (its counts), with `--direct lightcluster`.
+    lc_args: Option<wgpu::Buffer>,
 }
 
 /// The frame as its passes (after the VPLs): shadow maps, G-buffer, the mode's passes,
@@ -194,8 +206,19 @@ fn record_passes(
     rec: &mut Recorder,
     warm: bool,
 ) -> Result<Recorded, RenderError> {
-    let shadows = p.shadow_maps.record(f, pool, rec)?;
+    let lc_params = match f.params.direct {
+        DirectLight::LightCluster(lp) => Some(lp),
+        DirectLight::PerLight => None,
+    };
+    let shadows = p.shadow_maps.record(f, pool, rec, lc_params.is_none())?;
     let g = p.gbuffer.record(f, pool, rec);
+    let lc = match &lc_params {
+        Some(lp) => Some(
+            p.light_cluster
+                .record(f, lp, &shadows.lights, &g, pool, rec)?,
+        ),
+        None => None,
+    };
     let lists = match &f.params.mode {
         GpuMode::Gates(gp) => Some(p.clustered.record(f, gp, pool, rec, &g.views[0])?),
         _ => None,
@@ -207,7 +230,7 @@ fn record_passes(
         }
         _ => "shading: direct lighting",
     };
-    let inputs = (&shadows, &g, lists.as_ref());
+    let inputs = (&shadows, &g, lists.as_ref(), lc.as_ref());
     let hdr = p.shade.record(f, pool, rec, inputs, shading);
     let mut val_state = None;
     match &f.params.mode {
@@ -238,6 +261,7 @@ fn record_passes(
         hdr,
         lists,
         val_state,
+        lc_args: lc.map(|o| o.clusters.args),
     })
 }
 
@@ -263,10 +287,25 @@ impl GpuRenderer {
                 lights: scene.lights.clone(),
                 near_m: size * 1e-4,
                 far_m: size * 4.0,
+                diagonal_m: size,
                 albedo_maps,
                 albedo_sampler,
                 level: None,
                 no_level: init_buffer(d, "no level", &[], wgpu::BufferUsages::STORAGE),
+                no_visibility: d.create_texture(&wgpu::TextureDescriptor {
+                    label: Some("no lightcluster visibility"),
+                    size: wgpu::Extent3d {
+                        width: 1,
+                        height: 1,
+                        depth_or_array_layers: 1,
+                    },
+                    mip_level_count: 1,
+                    sample_count: 1,
+                    dimension: wgpu::TextureDimension::D2,
+                    format: wgpu::TextureFormat::Rgba8Unorm,
+                    usage: wgpu::TextureUsages::TEXTURE_BINDING,
+                    view_formats: &[],
+                }),
                 no_grid: init_buffer(
                     d,
                     "no grid",
@@ -399,6 +438,13 @@ impl GpuRenderer {
             light_count: scene.lights.len() as u32,
             shade_mode: shade_mode as u32,
             shadow_size: params.shadows.size,
+            direct_mode: match params.direct {
+                DirectLight::PerLight => 0,
+                DirectLight::LightCluster(_) => 1,
+            },
+            _pad0: 0,
+            _pad1: 0,
+            _pad2: 0,
         };
         let level = scene.level.as_ref();
         let gates = params.mode.gates().unwrap_or_default();
@@ -530,6 +576,7 @@ impl GpuRenderer {
             (out.lists.as_ref()).map(|l| read_back("light list counter readback", &l.counter, 32));
         let state_read =
             (out.val_state.as_ref()).map(|s| read_back("val convergence readback", s, 16));
+        let lc_read = (out.lc_args.as_ref()).map(|a| read_back("lc args readback", a, 64));
         let mut times = rec.finish(pool)?;
         let t1 = Instant::now();
         if let (Some(l), Some(r)) = (&out.lists, &counter_read) {
@@ -543,6 +590,15 @@ impl GpuRenderer {
                 iterations: c[2],
                 max: v.vals.iterations,
                 converged: c[1] != 0,
+            });
+        }
+        if let Some(r) = &lc_read {
+            let c: Vec<u32> = bytemuck::cast_slice(&map_read(ctx, r)?).to_vec();
+            let at = passes::light_cluster::ARGS_COUNTS as usize;
+            times.direct_clusters = Some(DirectClusters {
+                clusters: c[at],
+                culled: c[at + 1],
+                lights: self.scene.lights.len() as u32,
             });
         }
         let px = texels(&map_read(ctx, &read)?, w, h, false);
@@ -617,6 +673,49 @@ impl GpuRenderer {
             scale_m: scale_of(vpls),
             iterations: state[2],
             converged: vpls.is_empty() || state[1] != 0,
+        })
+    }
+
+    /// Runs LightCluster's culling and clustering of the scene's lights for `view` on the GPU
+    /// and reads back what they made, as the CPU twin
+    /// [`crate::cpu::lightcluster::cluster_lights`] gives it (for tests and inspection).
+    pub fn cluster_direct_lights(
+        &mut self,
+        ctx: &GpuContext,
+        view: &View,
+        params: &LightClusterGpuParams,
+    ) -> Result<LightClusters, RenderError> {
+        params.check()?;
+        let (lights, _) = passes::shadow_maps::light_views(&self.scene.lights, 1.0, 2.0);
+        let lights_buf = self.pool.upload(
+            ctx,
+            "lights",
+            bytemuck::cast_slice(&lights),
+            wgpu::BufferUsages::STORAGE,
+        );
+        let frame = passes::light_cluster::lc_frame(&self.scene, view, params, (0.0, 0.0));
+        let mut rec = Recorder::new(ctx, &mut self.pool);
+        let c = self.pipelines.light_cluster.record_clustering(
+            ctx,
+            &frame,
+            &lights_buf,
+            &mut self.pool,
+            &mut rec,
+        )?;
+        rec.finish(&mut self.pool)?;
+        let words = |b: &wgpu::Buffer| -> Result<Vec<u32>, RenderError> {
+            Ok(bytemuck::cast_slice(&read_buffer(ctx, b)?).to_vec())
+        };
+        let args = words(&c.args)?;
+        let at = passes::light_cluster::ARGS_COUNTS as usize;
+        let (count, culled) = (args[at] as usize, args[at + 1]);
+        let clusters: Vec<f32> = bytemuck::cast_slice(&read_buffer(ctx, &c.clusters)?).to_vec();
+        let n = self.scene.lights.len();
+        Ok(LightClusters {
+            centres: words(&c.centres)?[..count].to_vec(),
+            radius_m: (0..count).map(|k| clusters[4 * k + 3]).collect(),
+            light_cluster: words(&c.light_cluster)?[..n].to_vec(),
+            culled,
         })
     }
 

@@ -17,18 +17,20 @@
 use crate::RenderError;
 
 /// The include files (`gpu/shaders/`).
-const INCLUDES: [(&str, &str); 7] = [
+const INCLUDES: [(&str, &str); 9] = [
     ("globals.wgsl", include_str!("shaders/globals.wgsl")),
+    ("lights.wgsl", include_str!("shaders/lights.wgsl")),
     ("vpl.wgsl", include_str!("shaders/vpl.wgsl")),
     ("grid.wgsl", include_str!("shaders/grid.wgsl")),
     ("gates.wgsl", include_str!("shaders/gates.wgsl")),
     ("portals.wgsl", include_str!("shaders/portals.wgsl")),
     ("val.wgsl", include_str!("shaders/val.wgsl")),
     ("fullscreen.wgsl", include_str!("shaders/fullscreen.wgsl")),
+    ("lc.wgsl", include_str!("shaders/lc.wgsl")),
 ];
 
 /// The pass shaders (`gpu/passes/`), before composition.
-pub const SOURCES: [(&str, &str); 11] = [
+pub const SOURCES: [(&str, &str); 13] = [
     ("gbuffer.wgsl", include_str!("passes/gbuffer.wgsl")),
     ("shadow.wgsl", include_str!("passes/shadow.wgsl")),
     ("shade.wgsl", include_str!("passes/shade.wgsl")),
@@ -43,6 +45,11 @@ pub const SOURCES: [(&str, &str); 11] = [
     ("val_gather.wgsl", include_str!("passes/val_gather.wgsl")),
     ("blur.wgsl", include_str!("passes/blur.wgsl")),
     ("cssm.wgsl", include_str!("passes/cssm.wgsl")),
+    (
+        "light_cluster.wgsl",
+        include_str!("passes/light_cluster.wgsl"),
+    ),
+    ("lc_shadows.wgsl", include_str!("passes/lc_shadows.wgsl")),
 ];
 
 /// What the shading pass adds to the direct light (`Globals::shade_mode`).
@@ -97,6 +104,12 @@ pub fn constants() -> String {
     s += &u(
         "SHADE_GATES_CLUSTERED",
         ShadeIndirect::GatesClustered as u32,
+    );
+    s += &u("DIRECT_PER_LIGHT", 0);
+    s += &u("DIRECT_LIGHTCLUSTER", 1);
+    s += &u(
+        "MAX_LC_CLUSTERS",
+        super::passes::light_cluster::MAX_LC_CLUSTERS,
     );
     s += "const LIGHT_POINT: f32 = 0.0;\nconst LIGHT_SPOT: f32 = 1.0;\n";
     s += &format!("const CSSM_DEPTH_SCALE: f32 = {CSSM_DEPTH_SCALE:?};\n");

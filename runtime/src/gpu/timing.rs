@@ -56,6 +56,19 @@ pub struct PassTimes {
     pub lists: Option<LightListStats>,
     /// The VAL modes: how the clustering converged.
     pub vals: Option<ValIterations>,
+    /// `--direct lightcluster`: the lights' clusters.
+    pub direct_clusters: Option<DirectClusters>,
+}
+
+/// How LightCluster clustered a frame's lights.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct DirectClusters {
+    /// Clusters (cube shadow maps) made.
+    pub clusters: u32,
+    /// Lights culled by range and frustum (not shaded).
+    pub culled: u32,
+    /// Lights in the scene.
+    pub lights: u32,
 }
 
 /// How the VAL clustering's iterations went.
@@ -240,6 +253,7 @@ impl<'c> Recorder<'c> {
             readback_s: t0.elapsed().as_secs_f64(),
             lists: None,
             vals: None,
+            direct_clusters: None,
         })
     }
 }

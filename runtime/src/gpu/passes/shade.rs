@@ -4,6 +4,7 @@
 
 use super::clustered_gates::ListBuffers;
 use super::gbuffer::GBufferOutput;
+use super::light_cluster::LcOutput;
 use super::shadow_maps::ShadowOutput;
 use crate::RenderError;
 use crate::gpu::context::{Pool, array_view, bind_group, render_pipeline};
@@ -66,6 +67,15 @@ pub fn frame_target(f: &Frame, pool: &mut Pool, label: &'static str) -> wgpu::Te
     )
 }
 
+/// What shading reads: the lights (and their maps), the G-buffer, mode gates' light lists,
+/// LightCluster's visibility.
+pub type Inputs<'a> = (
+    &'a ShadowOutput,
+    &'a GBufferOutput,
+    Option<&'a ListBuffers>,
+    Option<&'a LcOutput>,
+);
+
 /// The bindings of shade.wgsl's `fs_gates_indirect` (an automatic layout holds only what an
 /// entry point uses).
 const GATES_INDIRECT_BINDINGS: [u32; 11] = [0, 2, 5, 6, 8, 10, 12, 13, 14, 15, 16];
@@ -96,7 +106,7 @@ impl Shade {
         f: &Frame,
         pool: &mut Pool,
         rec: &mut Recorder,
-        inputs: (&ShadowOutput, &GBufferOutput, Option<&ListBuffers>),
+        inputs: Inputs,
         name: &'static str,
     ) -> wgpu::Texture {
         let out = frame_target(f, pool, "hdr");
@@ -111,7 +121,7 @@ impl Shade {
         f: &Frame,
         pool: &mut Pool,
         rec: &mut Recorder,
-        inputs: (&ShadowOutput, &GBufferOutput, Option<&ListBuffers>),
+        inputs: Inputs,
     ) -> wgpu::Texture {
         let out = frame_target(f, pool, "indirect irradiance");
         let pipeline = (&self.gates_indirect, Some(&GATES_INDIRECT_BINDINGS[..]));
@@ -125,7 +135,7 @@ impl Shade {
         &self,
         f: &Frame,
         rec: &mut Recorder,
-        (shadows, g, lists): (&ShadowOutput, &GBufferOutput, Option<&ListBuffers>),
+        (shadows, g, lists, lc): Inputs,
         (pipeline, used): (&wgpu::RenderPipeline, Option<&[u32]>),
         (out, name): (&wgpu::Texture, &'static str),
     ) {
@@ -133,7 +143,15 @@ impl Shade {
         let level = f.scene.level.as_ref();
         let none = &f.scene.no_level;
         let maps = array_view(&shadows.maps);
-        let buffers: [(u32, &wgpu::Buffer); 13] = [
+        let no_vis = f
+            .scene
+            .no_visibility
+            .create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                ..Default::default()
+            });
+        let vis = lc.map_or(no_vis, |o| array_view(&o.visibility));
+        let buffers: [(u32, &wgpu::Buffer); 14] = [
             (0, &f.globals),
             (1, &shadows.lights),
             (2, &f.vpls),
@@ -147,12 +165,14 @@ impl Shade {
             (14, lists.map_or(none, |b| &b.entries)),
             (15, level.map_or(none, |l| &l.portal_words)),
             (16, lists.map_or(none, |b| &b.vpl_cluster)),
+            (18, lc.map_or(none, |o| &o.clusters.light_cluster)),
         ];
         let textures = [
             (4, &maps),
             (5, &g.views[0]),
             (6, &g.views[1]),
             (7, &g.views[2]),
+            (17, &vis),
         ];
         let resources = buffers
             .iter()

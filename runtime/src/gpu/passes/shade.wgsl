@@ -1,4 +1,4 @@
-//! include: globals.wgsl vpl.wgsl gates.wgsl portals.wgsl fullscreen.wgsl
+//! include: globals.wgsl lights.wgsl vpl.wgsl gates.wgsl portals.wgsl fullscreen.wgsl
 // Deferred shading: direct light from point and spot lights with shadow-map PCF (3 × 3), and
 // the indirect sum over VPLs without visibility (SHADE_ALL), through the gates of a baked
 // level per pixel (SHADE_GATES_PER_PIXEL) or by clustered light lists (SHADE_GATES_CLUSTERED),
@@ -6,18 +6,6 @@
 //
 // Radiometry as the CPU reference: L = ρ/π · I · falloff · cos θ / d² for lights, and
 // ρ/π · Φ/π · min(cos θ_v cos θ_x / d², g_max) for VPLs.
-
-// As runtime::gpu::layout::Light.
-struct Light {
-    // xyz position (m), w kind (LIGHT_POINT or LIGHT_SPOT).
-    position: vec4<f32>,
-    // rgb intensity (W/sr), w beam half-angle (rad).
-    intensity: vec4<f32>,
-    // xyz unit axis, w cutoff half-angle (rad).
-    direction: vec4<f32>,
-    // x first shadow layer, y layers, z, w unused.
-    layers: vec4<u32>,
-};
 
 @group(0) @binding(0) var<uniform> globals: Globals;
 @group(0) @binding(1) var<storage, read> lights: array<Light>;
@@ -56,6 +44,22 @@ struct GeometryCluster {
 @group(0) @binding(15) var<storage, read> portal_words: array<u32>;
 // Each VPL's visibility cluster (clusters.wgsl's vpl_clusters).
 @group(0) @binding(16) var<storage, read> vpl_cluster: array<u32>;
+// LightCluster (DIRECT_LIGHTCLUSTER): each cluster's visibility (layer k / 4, channel k % 4)
+// and each light's cluster (NONE: culled, not shaded).
+@group(0) @binding(17) var lc_visibility: texture_2d_array<f32>;
+@group(0) @binding(18) var<storage, read> lc_light_cluster: array<u32>;
+
+// Light i's visibility at pixel px (p, normal n): its shadow maps, or its cluster's PCSS.
+fn direct_visibility(i: u32, l: Light, p: vec3<f32>, n: vec3<f32>, px: vec2<i32>) -> f32 {
+    if globals.direct_mode == DIRECT_LIGHTCLUSTER {
+        let c = lc_light_cluster[i];
+        if c == NONE {
+            return 0.0;
+        }
+        return textureLoad(lc_visibility, px, i32(c / 4u), 0)[c % 4u];
+    }
+    return shadow(l, p, n);
+}
 
 fn through_gates(a: vec3<f32>, ca: u32, b: vec3<f32>, cb: u32) -> bool {
     if ca == cb || ca == NONE || cb == NONE {
@@ -84,16 +88,6 @@ fn through_gates(a: vec3<f32>, ca: u32, b: vec3<f32>, cb: u32) -> bool {
         }
     }
     return false;
-}
-
-fn spot_falloff(angle: f32, beam: f32, cutoff: f32) -> f32 {
-    if angle <= beam {
-        return 1.0;
-    }
-    if angle >= cutoff || cutoff <= beam {
-        return 0.0;
-    }
-    return (cutoff - angle) / (cutoff - beam);
 }
 
 // Visibility of `p` (normal `n`) from light `l`: 3 × 3 PCF of distance comparisons.
@@ -166,7 +160,7 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
         if all(intensity == vec3<f32>(0.0)) {
             continue;
         }
-        radiance += albedo / PI * intensity * cos_x / d2 * shadow(l, p, n);
+        radiance += albedo / PI * intensity * cos_x / d2 * direct_visibility(i, l, p, n, px);
     }
     // One loop per mode: a software rasterizer (lavapipe) runs a loop that carries another
     // mode's branch several times slower.

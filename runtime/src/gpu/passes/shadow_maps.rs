@@ -185,15 +185,20 @@ impl ShadowMaps {
         Ok(ShadowMaps { pipeline })
     }
 
-    /// Records every light's layers.
+    /// Records every light's layers; with `draw` false (LightCluster shadows the direct light)
+    /// only uploads the lights, beside a 1-texel stand-in for the maps.
     pub fn record(
         &self,
         f: &Frame,
         pool: &mut Pool,
         rec: &mut Recorder,
+        draw: bool,
     ) -> Result<ShadowOutput, RenderError> {
         let d = &f.ctx.device;
-        let (lights, views) = light_views(&f.scene.lights, f.scene.near_m, f.scene.far_m);
+        let (lights, mut views) = light_views(&f.scene.lights, f.scene.near_m, f.scene.far_m);
+        if !draw {
+            views.clear();
+        }
         let layers = views.len().max(1) as u32;
         if layers > d.limits().max_texture_array_layers {
             return Err(RenderError::Param(format!(
@@ -202,7 +207,7 @@ impl ShadowMaps {
                 d.limits().max_texture_array_layers
             )));
         }
-        let s = f.params.shadows.size;
+        let s = if draw { f.params.shadows.size } else { 1 };
         let rt = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
         let maps = pool.texture(
             d,
@@ -234,6 +239,9 @@ impl ShadowMaps {
                 storage,
             ),
         };
+        if views.is_empty() {
+            return Ok(out);
+        }
         let depth_view = depth.create_view(&Default::default());
         let span = rec.begin("shadow maps");
         let layout = self.pipeline.get_bind_group_layout(0);

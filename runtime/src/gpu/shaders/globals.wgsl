@@ -15,4 +15,9 @@ struct Globals {
     shade_mode: u32,
     // Shadow map layer side (texels).
     shadow_size: u32,
+    // DIRECT_PER_LIGHT or DIRECT_LIGHTCLUSTER.
+    direct_mode: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 };

@@ -1,0 +1,146 @@
+//! include: lc.wgsl
+// LightCluster's shadows: each cluster's cube shadow map as 6 tiles of one depth atlas (a
+// depth-only draw per tile), then each cluster's PCSS visibility at every pixel (see light_cluster.wgsl
+// for the whole method). Read-only: the clustering passes wrote what is bound here.
+
+@group(0) @binding(0) var<uniform> frame: LcFrame;
+// Each cluster's centre (xyz) and disk radius (w).
+@group(0) @binding(1) var<storage, read> clusters: array<vec4<f32>>;
+// Each cluster's reach (m, as f32 bits).
+@group(0) @binding(2) var<storage, read> reach: array<u32>;
+// light_cluster.wgsl's args: word 3 the clusters.
+@group(0) @binding(3) var<storage, read> args: array<u32>;
+@group(0) @binding(4) var atlas: texture_depth_2d;
+@group(0) @binding(5) var g_position: texture_2d<f32>;
+@group(0) @binding(6) var g_normal: texture_2d<f32>;
+// Four clusters a texel: cluster k in layer k / 4, channel k % 4.
+@group(0) @binding(7) var visibility: texture_storage_2d_array<rgba8unorm, write>;
+
+// Tile `tile` (cluster tile / 6, face tile % 6) of the atlas, drawn into its own viewport:
+// reversed depth without a far plane, near / (distance along the face's axis).
+@vertex
+fn vs_atlas(@location(0) position: vec3<f32>, @location(1) tile: u32) -> @builtin(position) vec4<f32> {
+    let v = face_view(tile % 6u, position - clusters[tile / 6u].xyz);
+    return vec4<f32>(v.x, v.y, frame.near_m, v.z);
+}
+
+// Distance from cluster k's centre to the nearest surface along direction `dir` (its texel's
+// depth along the face's axis, over dir's cosine to that axis); "very far" where none.
+fn stored_distance(k: u32, dir: vec3<f32>) -> f32 {
+    let f = face_of(dir);
+    let v = face_view(f, dir);
+    let depth = textureLoad(atlas, atlas_texel(6u * k + f, v.xy / v.z), 0);
+    if depth <= 0.0 {
+        return 3.4e38;
+    }
+    return frame.near_m / depth * length(dir) / v.z;
+}
+
+// Distance from `c` along unit `w` to the receiver's plane (through q, normal n): what a
+// lookup in direction w compares with, so that a sloped receiver does not shadow itself.
+// `fallback` where w runs along or away from the plane.
+fn plane_distance(c: vec3<f32>, w: vec3<f32>, q: vec3<f32>, n: vec3<f32>, fallback: f32) -> f32 {
+    let den = dot(w, n);
+    if den > -1e-3 {
+        return fallback;
+    }
+    return dot(q - c, n) / den;
+}
+
+// Point i of n of a Vogel (golden-angle) disk of unit radius, turned by `turn` (rad); point 0
+// at the centre where `centre` (the blocker search: the ray to the disk's centre is always
+// looked at).
+fn vogel(i: u32, n: u32, turn: f32, centre: bool) -> vec2<f32> {
+    let r = sqrt((f32(i) + select(0.5, 0.0, centre)) / f32(n));
+    let a = f32(i) * 2.39996323 + turn;
+    return r * vec2<f32>(cos(a), sin(a));
+}
+
+// Interleaved gradient noise (Jimenez 2014): a per-pixel turn of the sample disks.
+fn pixel_noise(px: vec2<u32>) -> f32 {
+    let p = vec2<f32>(px);
+    return fract(52.9829189 * fract(0.06711056 * p.x + 0.00583715 * p.y));
+}
+
+// Whether the surface at distance `z` along direction w0 + offset `o` (tangent units)
+// occludes part of the disk of radius `radius` seen from a receiver at distance `dr`: it lies
+// in the cone from the receiver to the disk.
+fn in_cone(o: vec2<f32>, z: f32, radius: f32, dr: f32) -> bool {
+    return z < dr && length(o) * dr * z <= radius * (dr - z);
+}
+
+// Cluster k's visibility at p (normal n): PCSS (Fernando 2005) with the cluster as a disk of
+// its radius at its centre — the blocker search over the cone from p to the disk (see
+// `nearest`; at most 45° off), the penumbra width from the blockers' mean distance, PCF over
+// it. Radius 0: one hard lookup.
+fn pcss(k: u32, p: vec3<f32>, n: vec3<f32>, px: vec2<u32>) -> f32 {
+    let c = clusters[k];
+    let dist = length(p - c.xyz);
+    if dist <= 1e-6 || dist > bitcast<f32>(reach[k]) {
+        return 1.0;
+    }
+    let size = f32(frame.map_size);
+    // A cube texel's footprint at distance d is at most 2·d / size.
+    let q = p + n * (2.0 * dist / size) * frame.normal_offset;
+    let dq = q - c.xyz;
+    let dr = length(dq);
+    let w0 = dq / dr;
+    let bias = 2.0 / size * frame.bias;
+    let radius = c.w;
+    if radius <= 0.0 {
+        return select(0.0, 1.0, stored_distance(k, w0) >= dr * (1.0 - bias));
+    }
+    let t1 = normalize(cross(w0, select(vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(1.0, 0.0, 0.0), abs(w0.y) > 0.9)));
+    let t2 = cross(w0, t1);
+    let turn = 6.2831853 * pixel_noise(px);
+    // Blockers are looked for no nearer the centre than the radius (nearer is inside the
+    // light) nor than a quarter of the way: the search cone widens as 1 / that distance, and
+    // a sparse search of a wide cone misses the narrow cone a far blocker casts.
+    let nearest = min(max(radius, 0.25 * dr), 0.5 * dr);
+    let search = min(radius * (dr - nearest) / (dr * nearest), 1.0);
+    var sum = 0.0;
+    var found = 0.0;
+    for (var i = 0u; i < frame.blocker_samples; i++) {
+        let o = vogel(i, frame.blocker_samples, turn, true) * search;
+        let w = normalize(w0 + t1 * o.x + t2 * o.y);
+        let z = stored_distance(k, w);
+        let zr = plane_distance(c.xyz, w, q, n, dr);
+        if z < zr * (1.0 - bias) && in_cone(o, z, radius, dr) {
+            sum += z;
+            found += 1.0;
+        }
+    }
+    if found == 0.0 {
+        return 1.0;
+    }
+    let zb = max(sum / found, 1e-4);
+    let width = min(radius * max(dr - zb, 0.0) / (dr * zb), 1.0);
+    var lit = 0.0;
+    for (var i = 0u; i < frame.filter_samples; i++) {
+        let o = vogel(i, frame.filter_samples, turn, false) * width;
+        let w = normalize(w0 + t1 * o.x + t2 * o.y);
+        let zr = plane_distance(c.xyz, w, q, n, dr);
+        lit += select(0.0, 1.0, stored_distance(k, w) >= zr * (1.0 - bias));
+    }
+    return lit / f32(frame.filter_samples);
+}
+
+@compute @workgroup_size(8, 8)
+fn pcss_pass(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x >= frame.width || id.y >= frame.height {
+        return;
+    }
+    let px = vec2<i32>(id.xy);
+    let pos = textureLoad(g_position, px, 0);
+    var out = vec4<f32>(1.0);
+    if pos.w != 0.0 {
+        let n = normalize(textureLoad(g_normal, px, 0).xyz);
+        for (var j = 0u; j < 4u; j++) {
+            let k = 4u * id.z + j;
+            if k < args[3] {
+                out[j] = pcss(k, pos.xyz, n, id.xy);
+            }
+        }
+    }
+    textureStore(visibility, px, i32(id.z), out);
+}

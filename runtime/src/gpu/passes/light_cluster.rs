@@ -1,0 +1,490 @@
+//! LightCluster for the direct light (`--direct lightcluster`; the paper in
+//! `../shared/papers/lightcluster-pcss.txt`): the lights culled by range and clustered on the
+//! GPU each frame exactly as [`crate::cpu::lightcluster`] does (light_cluster.wgsl), a cube
+//! shadow map per cluster as six tiles of one depth atlas drawn in one instanced indirect draw,
+//! and each cluster's PCSS visibility written once into a screen-sized layer (lc_shadows.wgsl),
+//! which the shading pass reads for every light of the cluster. The per-light shadow maps are
+//! not drawn.
+
+use glam::Vec3;
+
+use crate::RenderError;
+use crate::camera::View;
+use crate::cpu::lightcluster::{LightClusterParams, light_range_scale};
+use crate::gpu::context::{Pool, bind_group, compute_pipelines};
+use crate::gpu::geometry::{VERTEX_STRIDE, positions};
+use crate::gpu::layout::LcFrame;
+use crate::gpu::passes::gbuffer::GBufferOutput;
+use crate::gpu::shaders::{self, ShaderSources, WG_LINEAR};
+use crate::gpu::timing::Recorder;
+use crate::gpu::{Frame, SceneGpu};
+
+/// Most clusters a frame can have (the centre pass keeps them in workgroup memory).
+pub const MAX_LC_CLUSTERS: u32 = 256;
+/// Most lights LightCluster takes (its one-workgroup ranking walks every pair).
+pub const MAX_LC_LIGHTS: u32 = 2048;
+
+/// PCSS sampling of each cluster's visibility.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PcssParams {
+    /// Blocker-search samples. [Limit: 1..=64]
+    pub blocker_samples: u32,
+    /// Filter (PCF) samples. [Limit: 1..=128]
+    pub filter_samples: u32,
+}
+
+impl Default for PcssParams {
+    fn default() -> Self {
+        PcssParams {
+            blocker_samples: 16,
+            filter_samples: 32,
+        }
+    }
+}
+
+/// LightCluster's settings on the GPU.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct LightClusterGpuParams {
+    /// The clustering (its `max_clusters` at most [`MAX_LC_CLUSTERS`]).
+    pub clustering: LightClusterParams,
+    /// Side of each cluster's cube face. [Units: texels] [Limit: 16..=2048; 0 for the
+    /// default, 256]
+    pub map_size: u32,
+    /// PCSS sampling.
+    pub pcss: PcssParams,
+}
+
+impl LightClusterGpuParams {
+    /// The face side in use (0 means 256).
+    pub fn face_size(&self) -> u32 {
+        if self.map_size == 0 {
+            256
+        } else {
+            self.map_size
+        }
+    }
+
+    /// Checks every limit.
+    pub fn check(&self) -> Result<(), RenderError> {
+        self.clustering.check()?;
+        let bad = |what: String| Err(RenderError::Param(format!("LightCluster: {what}")));
+        if self.clustering.max_clusters > MAX_LC_CLUSTERS {
+            return bad(format!(
+                "at most {MAX_LC_CLUSTERS} clusters (max clusters {})",
+                self.clustering.max_clusters
+            ));
+        }
+        if !(16..=2048).contains(&self.face_size()) {
+            return bad(format!(
+                "cube face size {} must be 16..=2048 texels",
+                self.face_size()
+            ));
+        }
+        if !(1..=64).contains(&self.pcss.blocker_samples) {
+            return bad("PCSS blocker samples must be 1..=64".into());
+        }
+        if !(1..=128).contains(&self.pcss.filter_samples) {
+            return bad("PCSS filter samples must be 1..=128".into());
+        }
+        Ok(())
+    }
+
+    /// (tiles per row, rows) of the shadow atlas.
+    pub fn atlas_tiles(&self) -> (u32, u32) {
+        let tiles = 6 * self.clustering.max_clusters;
+        let per_row = (tiles as f64).sqrt().ceil() as u32;
+        (per_row, tiles.div_ceil(per_row))
+    }
+}
+
+/// The direct lights' visibility.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum DirectLight {
+    /// Each light's own shadow maps, 3 × 3 PCF (the reference of LightCluster's paper).
+    #[default]
+    PerLight,
+    /// LightCluster: a soft shadow per cluster of lights.
+    LightCluster(LightClusterGpuParams),
+}
+
+impl DirectLight {
+    /// The name on the command line and in reports.
+    pub fn name(&self) -> &'static str {
+        match self {
+            DirectLight::PerLight => "per-light",
+            DirectLight::LightCluster(_) => "lightcluster",
+        }
+    }
+}
+
+/// The pipelines.
+pub struct LightCluster {
+    cull: wgpu::ComputePipeline,
+    centres: wgpu::ComputePipeline,
+    assign: wgpu::ComputePipeline,
+    atlas: wgpu::RenderPipeline,
+    pcss: wgpu::ComputePipeline,
+}
+
+/// What the clustering leaves on the GPU.
+pub struct LcClusters {
+    /// The frame's constants.
+    pub frame: wgpu::Buffer,
+    /// Each light's cluster (`NONE` where culled).
+    pub light_cluster: wgpu::Buffer,
+    /// Each cluster's centre and radius.
+    pub clusters: wgpu::Buffer,
+    /// Each cluster's centre light.
+    pub centres: wgpu::Buffer,
+    /// Each cluster's reach (f32 bits).
+    pub reach: wgpu::Buffer,
+    /// Draw args, dispatch args, clusters, culled lights (u32 each).
+    pub args: wgpu::Buffer,
+}
+
+/// What the shading pass reads.
+pub struct LcOutput {
+    /// The clusters.
+    pub clusters: LcClusters,
+    /// Each cluster's visibility: layer k / 4, channel k % 4.
+    pub visibility: wgpu::Texture,
+}
+
+/// Where in `args` the clusters' and the culled lights' counts are (u32 words).
+pub const ARGS_COUNTS: u64 = 3;
+/// Where in `args` the atlas tiles' draw args start. [Units: bytes]
+const ARGS_DRAWS: u64 = 32;
+
+/// The frame constants of the clustering for `view`.
+pub fn lc_frame(
+    scene: &SceneGpu,
+    view: &View,
+    p: &LightClusterGpuParams,
+    (normal_offset, bias): (f32, f32),
+) -> LcFrame {
+    let half_x = 0.5 * view.fov_x_rad;
+    let half_y = (half_x.tan() * view.size[1] as f32 / view.size[0] as f32).atan();
+    let (per_row, _) = p.atlas_tiles();
+    let v4 = |v: Vec3| v.extend(0.0).to_array();
+    LcFrame {
+        eye: v4(view.eye),
+        right: v4(view.right),
+        up: v4(view.up),
+        forward: v4(view.forward),
+        half_fov: [half_x.cos(), half_x.sin(), half_y.cos(), half_y.sin()],
+        light_count: scene.lights.len() as u32,
+        max_clusters: p.clustering.max_clusters,
+        map_size: p.face_size(),
+        tiles_per_row: per_row,
+        min_distance_m: p.clustering.min_distance_m,
+        distance_scale: p.clustering.distance_scale,
+        range_scale: light_range_scale(&scene.lights, scene.diagonal_m, p.clustering.cutoff),
+        near_m: scene.near_m,
+        far_m: scene.far_m,
+        normal_offset,
+        bias,
+        blocker_samples: p.pcss.blocker_samples,
+        filter_samples: p.pcss.filter_samples,
+        width: view.size[0],
+        height: view.size[1],
+        vertex_count: scene.geometry.vertex_count,
+    }
+}
+
+/// The atlas pipeline: positions and a per-instance tile index in, reversed depth out (test
+/// "greater", cleared to 0), no fragment stage.
+fn depth_only_pipeline(d: &wgpu::Device, module: &wgpu::ShaderModule) -> wgpu::RenderPipeline {
+    let tile = wgpu::VertexBufferLayout {
+        array_stride: 4,
+        step_mode: wgpu::VertexStepMode::Instance,
+        attributes: &[wgpu::VertexAttribute {
+            format: wgpu::VertexFormat::Uint32,
+            offset: 0,
+            shader_location: 1,
+        }],
+    };
+    d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("lightcluster atlas"),
+        layout: None,
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs_atlas"),
+            buffers: &[Some(positions(VERTEX_STRIDE)), Some(tile)],
+            compilation_options: Default::default(),
+        },
+        primitive: wgpu::PrimitiveState::default(),
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: wgpu::TextureFormat::Depth32Float,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Greater),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: wgpu::MultisampleState::default(),
+        fragment: None,
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+impl LightCluster {
+    /// Builds the pipelines.
+    pub fn new(d: &wgpu::Device, s: &ShaderSources) -> Result<LightCluster, RenderError> {
+        let module = shaders::module(d, s, "light_cluster.wgsl")?;
+        let [cull, centres, assign] =
+            compute_pipelines(d, &module, ["cull", "centres_pass", "assign"]);
+        let shadows = shaders::module(d, s, "lc_shadows.wgsl")?;
+        let atlas = depth_only_pipeline(d, &shadows);
+        let [pcss] = compute_pipelines(d, &shadows, ["pcss_pass"]);
+        Ok(LightCluster {
+            cull,
+            centres,
+            assign,
+            atlas,
+            pcss,
+        })
+    }
+
+    /// Records the culling and the clustering of `scene`'s lights (uploaded in `lights`) for
+    /// `frame`.
+    pub fn record_clustering(
+        &self,
+        ctx: &crate::gpu::GpuContext,
+        frame: &LcFrame,
+        lights: &wgpu::Buffer,
+        pool: &mut Pool,
+        rec: &mut Recorder,
+    ) -> Result<LcClusters, RenderError> {
+        let n = frame.light_count;
+        if n > MAX_LC_LIGHTS {
+            return Err(RenderError::Param(format!(
+                "LightCluster takes at most {MAX_LC_LIGHTS} lights; the scene has {n} (use \
+                 --direct per-light)"
+            )));
+        }
+        let d = &ctx.device;
+        let rw = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
+        let words = |k: u32| 4 * u64::from(k.max(1));
+        let m = frame.max_clusters;
+        let out = LcClusters {
+            frame: pool.upload(
+                ctx,
+                "lc frame",
+                bytemuck::bytes_of(frame),
+                wgpu::BufferUsages::UNIFORM,
+            ),
+            light_cluster: pool.buffer(d, "lc light cluster", words(n), rw),
+            clusters: pool.buffer(d, "lc clusters", 4 * words(m), rw),
+            centres: pool.buffer(d, "lc centres", words(m), rw),
+            reach: pool.buffer(d, "lc reach", words(m), rw),
+            args: pool.buffer(
+                d,
+                "lc args",
+                ARGS_DRAWS + 16 * 6 * u64::from(m),
+                rw | wgpu::BufferUsages::INDIRECT,
+            ),
+        };
+        let key = pool.buffer(d, "lc light key", words(n), rw);
+        let order = pool.buffer(d, "lc order", words(n), rw);
+        let all: [(u32, &wgpu::Buffer); 9] = [
+            (0, &out.frame),
+            (1, lights),
+            (2, &key),
+            (3, &out.light_cluster),
+            (4, &order),
+            (5, &out.clusters),
+            (6, &out.centres),
+            (7, &out.reach),
+            (8, &out.args),
+        ];
+        let group = |pipeline: &wgpu::ComputePipeline, used: &[u32]| {
+            let resources = all
+                .iter()
+                .filter(|(k, _)| used.contains(k))
+                .map(|&(k, b)| (k, b.as_entire_binding()))
+                .collect();
+            bind_group(d, &pipeline.get_bind_group_layout(0), "lc", resources)
+        };
+        let steps = [
+            (
+                &self.cull,
+                group(&self.cull, &[0, 1, 2, 3]),
+                n.div_ceil(WG_LINEAR),
+            ),
+            (
+                &self.centres,
+                group(&self.centres, &[0, 1, 2, 3, 4, 5, 6, 7, 8]),
+                1,
+            ),
+            (
+                &self.assign,
+                group(&self.assign, &[0, 1, 2, 3, 5, 7, 8]),
+                n.div_ceil(WG_LINEAR),
+            ),
+        ];
+        for (i, (pipeline, bg, groups)) in steps.iter().enumerate() {
+            let span = rec.begin(if i == 0 {
+                "light culling"
+            } else {
+                "light clustering"
+            });
+            {
+                let mut pass = rec.enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("lightcluster clustering"),
+                    timestamp_writes: span.compute(),
+                });
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, bg, &[]);
+                pass.dispatch_workgroups((*groups).max(1), 1, 1);
+            }
+            rec.end();
+        }
+        Ok(out)
+    }
+
+    /// Records the cube faces of every cluster into `atlas`: a depth-only draw per tile, in its
+    /// viewport, drawn where the clustering made its cluster (indirect: 0 instances else).
+    fn record_atlas(
+        &self,
+        f: &Frame,
+        p: &LightClusterGpuParams,
+        clusters: &LcClusters,
+        atlas: &wgpu::TextureView,
+        pool: &mut Pool,
+        rec: &mut Recorder,
+    ) {
+        let d = &f.ctx.device;
+        let tiles = 6 * p.clustering.max_clusters;
+        let index: Vec<u32> = (0..tiles).collect();
+        let index_buf = pool.upload(
+            f.ctx,
+            "lc tiles",
+            bytemuck::cast_slice(&index),
+            wgpu::BufferUsages::VERTEX,
+        );
+        let bg = bind_group(
+            d,
+            &self.atlas.get_bind_group_layout(0),
+            "lc atlas",
+            vec![
+                (0, clusters.frame.as_entire_binding()),
+                (1, clusters.clusters.as_entire_binding()),
+            ],
+        );
+        let (per_row, _) = p.atlas_tiles();
+        let side = p.face_size();
+        let span = rec.begin("cluster shadow maps");
+        let mut pass = rec.enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("lightcluster atlas"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: atlas,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(0.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: span.render(true, true),
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&self.atlas);
+        pass.set_bind_group(0, &bg, &[]);
+        pass.set_vertex_buffer(0, f.scene.geometry.vertices.slice(..));
+        for t in 0..tiles {
+            let (x, y) = ((t % per_row) * side, (t / per_row) * side);
+            pass.set_viewport(x as f32, y as f32, side as f32, side as f32, 0.0, 1.0);
+            pass.set_scissor_rect(x, y, side, side);
+            let at = u64::from(t) * 4;
+            pass.set_vertex_buffer(1, index_buf.slice(at..at + 4));
+            pass.draw_indirect(&clusters.args, ARGS_DRAWS + 16 * u64::from(t));
+        }
+        drop(pass);
+        rec.end();
+    }
+
+    /// Records the whole method for frame `f`: clustering, the cluster shadow atlas and the
+    /// PCSS visibility of every cluster at every pixel of `g`.
+    pub fn record(
+        &self,
+        f: &Frame,
+        p: &LightClusterGpuParams,
+        lights: &wgpu::Buffer,
+        g: &GBufferOutput,
+        pool: &mut Pool,
+        rec: &mut Recorder,
+    ) -> Result<LcOutput, RenderError> {
+        p.check()?;
+        let d = &f.ctx.device;
+        let shadows = &f.params.shadows;
+        let frame = lc_frame(f.scene, f.view, p, (shadows.normal_offset, shadows.bias));
+        let (per_row, rows) = p.atlas_tiles();
+        let side = p.face_size();
+        let max_dim = d.limits().max_texture_dimension_2d;
+        if per_row * side > max_dim || rows * side > max_dim {
+            return Err(RenderError::Param(format!(
+                "LightCluster's shadow atlas ({} × {} texels: {} clusters × 6 faces of {side}²) \
+                 exceeds the adapter's {max_dim}: lower the cube face size or the most clusters",
+                per_row * side,
+                rows * side,
+                p.clustering.max_clusters
+            )));
+        }
+        let clusters = self.record_clustering(f.ctx, &frame, lights, pool, rec)?;
+        let atlas = pool.texture(
+            d,
+            "lc atlas",
+            [per_row * side, rows * side, 1],
+            1,
+            wgpu::TextureFormat::Depth32Float,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        );
+        let atlas_view = atlas.create_view(&Default::default());
+        let [w, h] = f.view.size;
+        let layers = p.clustering.max_clusters.div_ceil(4);
+        let visibility = pool.texture(
+            d,
+            "lc visibility",
+            [w, h, layers],
+            1,
+            wgpu::TextureFormat::Rgba8Unorm,
+            wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
+        );
+        self.record_atlas(f, p, &clusters, &atlas_view, pool, rec);
+        let span = rec.begin("PCSS visibility");
+        let vis_view = visibility.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..Default::default()
+        });
+        let bg = bind_group(
+            d,
+            &self.pcss.get_bind_group_layout(0),
+            "lc pcss",
+            vec![
+                (0, clusters.frame.as_entire_binding()),
+                (1, clusters.clusters.as_entire_binding()),
+                (2, clusters.reach.as_entire_binding()),
+                (3, clusters.args.as_entire_binding()),
+                (4, wgpu::BindingResource::TextureView(&atlas_view)),
+                (5, wgpu::BindingResource::TextureView(&g.views[0])),
+                (6, wgpu::BindingResource::TextureView(&g.views[1])),
+                (7, wgpu::BindingResource::TextureView(&vis_view)),
+            ],
+        );
+        {
+            let mut pass = rec.enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("lightcluster pcss"),
+                timestamp_writes: span.compute(),
+            });
+            pass.set_pipeline(&self.pcss);
+            pass.set_bind_group(0, &bg, &[]);
+            pass.dispatch_workgroups_indirect(&clusters.args, 0);
+        }
+        rec.end();
+        Ok(LcOutput {
+            clusters,
+            visibility,
+        })
+    }
+}
