@@ -9,7 +9,7 @@ use visgate_formats::vgate::{BakeParams, Resolution};
 use visgate_formats::{BakedLevel, ImportOptions, Scene};
 use visgate_runtime::compare::{CompareMode, CompareSpec, ErrorMetric, Step, report, run};
 use visgate_runtime::cpu::gates::{GateLevel, GateShape};
-use visgate_runtime::gpu::{GpuMode, METHODS, method};
+use visgate_runtime::gpu::{DirectLight, GpuMode, METHODS, method};
 use visgate_runtime::hdr::HdrImage;
 
 use crate::settings::{LightArgs, MethodArgs};
@@ -77,6 +77,12 @@ pub struct CompareArgs {
     /// the paper's Fig. 10). Default: --vals alone.
     #[arg(long, value_delimiter = ',')]
     pub val_counts: Vec<u32>,
+    /// LightCluster's minimum distances, metres, comma-separated: each mode is compared with
+    /// its lights' own shadow maps and once with LightCluster at each (as `direct-only-lc0.5`,
+    /// …: its trade curve; the other --lc-* flags apply). Compare with --metric mse: the
+    /// indirect-only error takes each image's direct light out.
+    #[arg(long, value_delimiter = ',')]
+    pub lc_min_distances: Vec<f32>,
     /// Cameras by name, comma-separated, or all.
     #[arg(long, value_delimiter = ',', default_value = "all")]
     pub cameras: Vec<String>,
@@ -133,8 +139,47 @@ fn modes(names: &[String], settings: &MethodArgs, val_counts: &[u32]) -> Result<
             out.push(CompareMode {
                 label: format!("{}-m{count}", m.label),
                 mode,
+                direct: m.direct,
             });
         }
+    }
+    Ok(out)
+}
+
+/// Each of `modes` with its lights' own shadow maps, then with LightCluster at each of
+/// `min_distances` (labelled `-lc0.5`, …); `modes` as they are without distances.
+fn lightcluster_modes(
+    modes: Vec<CompareMode>,
+    settings: &MethodArgs,
+    min_distances: &[f32],
+) -> Result<Vec<CompareMode>> {
+    if min_distances.is_empty() {
+        return Ok(modes);
+    }
+    let mut out = Vec::new();
+    for m in modes {
+        for &d in min_distances {
+            let mut args = settings.clone();
+            args.direct = crate::settings::DirectArg::Lightcluster;
+            args.lc_min_distance = d;
+            let direct = args.direct();
+            if let DirectLight::LightCluster(p) = &direct {
+                p.check()
+                    .map_err(|e| anyhow::anyhow!("--lc-min-distances {d}: {e}"))?;
+            }
+            out.push(CompareMode {
+                label: format!("{}-lc{d}", m.label),
+                mode: m.mode,
+                direct,
+            });
+        }
+        out.insert(
+            out.len() - min_distances.len(),
+            CompareMode {
+                direct: DirectLight::PerLight,
+                ..m
+            },
+        );
     }
     Ok(out)
 }
@@ -156,6 +201,7 @@ fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMod
         Ok(CompareMode {
             label: name.to_string(),
             mode,
+            direct: settings.direct(),
         })
     };
     let mut out = Vec::new();
@@ -236,6 +282,7 @@ pub fn run_compare(args: CompareArgs) -> Result<()> {
         crate::camera_of(&scene, &args.scene, None)?;
     }
     let mut modes = modes(&args.modes, &args.method, &args.val_counts)?;
+    modes = lightcluster_modes(modes, &args.method, &args.lc_min_distances)?;
     let level = level(&args, &scene, &mut modes)?;
     let ground_truth = args
         .ground_truth

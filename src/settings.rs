@@ -7,7 +7,7 @@ use visgate_runtime::cpu::gates::{GateParams, GateShape};
 use visgate_runtime::cpu::lightcluster::LightClusterParams;
 use visgate_runtime::cpu::val::ValParams;
 use visgate_runtime::gpu::{
-    CssmParams, DirectLight, GatesParams, GpuMode, GpuParams, InterleaveParams,
+    CssmParams, DirectLight, GatesParams, GpuMode, GpuParams, InterleaveParams, LcDisk,
     LightClusterGpuParams, MethodSettings, PcssParams, PerVplParams, ShadowParams, ValModeParams,
 };
 use visgate_runtime::job::{RenderJob, VplSource as JobVpls};
@@ -31,6 +31,16 @@ pub enum DirectArg {
     /// LightCluster: lights in view clustered by a minimum distance, one cube map per
     /// cluster, soft shadows by PCSS with the cluster as a disk (see the --lc-* flags).
     Lightcluster,
+}
+
+/// `--lc-disk`: the radius of a cluster's disk.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum LcDiskArg {
+    /// The farthest light of the cluster from its centre: a light alone keeps its hard
+    /// shadow, a disk is no wider than its lights.
+    Extent,
+    /// The cluster's minimum distance (the paper); also wider than the lights it stands for.
+    MinDistance,
 }
 
 /// `--vpl-source`: where VPLs come from.
@@ -130,6 +140,9 @@ pub struct MethodArgs {
     /// misses the view are culled (not shaded), (0, 1].
     #[arg(long, default_value_t = 1e-3)]
     pub lc_cutoff: f32,
+    /// LightCluster: each cluster's disk, whose radius scales PCSS's penumbra.
+    #[arg(long, value_enum, default_value_t = LcDiskArg::Extent)]
+    pub lc_disk: LcDiskArg,
     /// LightCluster: side of each cluster's cube face, texels, 16..=2048 (the atlas holds
     /// 6 × --lc-max-clusters faces).
     #[arg(long, default_value_t = 256)]
@@ -218,6 +231,10 @@ impl MethodArgs {
                     distance_scale: self.lc_distance_scale,
                     max_clusters: self.lc_max_clusters,
                     cutoff: self.lc_cutoff,
+                },
+                disk: match self.lc_disk {
+                    LcDiskArg::Extent => LcDisk::Extent,
+                    LcDiskArg::MinDistance => LcDisk::MinDistance,
                 },
                 map_size: self.lc_map_size,
                 pcss: PcssParams {

@@ -9,7 +9,8 @@ use visgate_runtime::cpu::lightcluster::{LightClusterParams, cluster_lights};
 use visgate_runtime::cpu::reference::{ReferenceParams, render_reference};
 use visgate_runtime::cpu::tracer::Tracer;
 use visgate_runtime::gpu::{
-    DirectLight, GpuContext, GpuMode, GpuParams, GpuRenderer, LightClusterGpuParams, MAX_LC_LIGHTS,
+    DirectLight, GpuContext, GpuMode, GpuParams, GpuRenderer, LcDisk, LightClusterGpuParams,
+    MAX_LC_LIGHTS,
 };
 use visgate_runtime::hdr::HdrImage;
 use visgate_scenes::Builtin;
@@ -32,6 +33,8 @@ fn lc(min_distance_m: f32, distance_scale: f32, max_clusters: u32) -> LightClust
             max_clusters,
             ..LightClusterParams::default()
         },
+        // The paper's disk: its radius is the minimum distance (PCSS at every radius).
+        disk: LcDisk::MinDistance,
         ..LightClusterGpuParams::default()
     }
 }
@@ -80,15 +83,23 @@ fn check_twin(ctx: &GpuContext, scene: &Scene, cameras: &[Camera], settings: &[(
         let view = View::new(cam, [320, 180]).expect("view");
         for &(d, s, m) in settings {
             let p = lc(d, s, m);
-            let got = gpu.cluster_direct_lights(ctx, &view, &p).expect("GPU");
+            let mut got = gpu.cluster_direct_lights(ctx, &view, &p).expect("GPU");
             let want = cluster_lights(&scene.lights, &view, diagonal, &p.clustering).expect("CPU");
-            assert_eq!(
-                got,
-                want,
+            let what = format!(
                 "{} lights, camera {}, min distance {d} m, scale {s}, max {m}",
                 scene.lights.len(),
                 cam.name
             );
+            // Extents are square roots the GPU may round otherwise: within 1e-5 m.
+            assert_eq!(got.extent_m.len(), want.extent_m.len(), "{what}");
+            for (g, w) in got.extent_m.iter().zip(&want.extent_m) {
+                assert!(
+                    (g - w).abs() <= 1e-5 * w.max(1.0),
+                    "{what}: extent {g} vs {w}"
+                );
+            }
+            got.extent_m.clone_from(&want.extent_m);
+            assert_eq!(got, want, "{what}");
         }
     }
 }
@@ -213,6 +224,13 @@ fn pcss_with_radius_zero_is_the_hard_shadow_map() {
     let mut p = lc(0.0, 0.0, 1);
     p.map_size = 1024;
     let pcss = render(&ctx, &scene, &view, DirectLight::LightCluster(p));
+    // A light alone under visgate's disk (its cluster's extent) is hard at any minimum
+    // distance.
+    let mut alone = lc(5.0, 0.1, 1);
+    alone.disk = LcDisk::Extent;
+    alone.map_size = 1024;
+    let extent = render(&ctx, &scene, &view, DirectLight::LightCluster(alone));
+    assert_eq!(extent.pixels, pcss.pixels);
     let differ = hard
         .pixels
         .iter()

@@ -22,7 +22,7 @@ use visgate_formats::{Camera, Scene};
 
 use crate::RenderError;
 use crate::cpu::gates::GateLevel;
-use crate::gpu::GpuMode;
+use crate::gpu::{DirectLight, GpuMode};
 use crate::hdr::HdrImage;
 use crate::job::{FrameStats, JobFrame, RenderJob, Renderer};
 use crate::metrics::{errors, flip, indirect_errors, rebase_direct};
@@ -73,6 +73,39 @@ pub struct CompareMode {
     pub label: String,
     /// The method and its parameters.
     pub mode: GpuMode,
+    /// The direct lights' shadows (per light, or LightCluster at some setting).
+    pub direct: DirectLight,
+}
+
+impl CompareMode {
+    /// The method's settings in words, LightCluster's included.
+    pub fn describe(&self) -> String {
+        let mode = self.mode.describe();
+        let DirectLight::LightCluster(p) = &self.direct else {
+            return mode;
+        };
+        let c = &p.clustering;
+        let lc = format!(
+            "LightCluster {} m × (1 + {}·d), ≤ {} clusters, {}² faces",
+            c.min_distance_m,
+            c.distance_scale,
+            c.max_clusters,
+            p.face_size()
+        );
+        if mode.is_empty() {
+            lc
+        } else {
+            format!("{mode}; {lc}")
+        }
+    }
+
+    /// `job` rendering this method.
+    fn job(&self, job: &RenderJob) -> RenderJob {
+        let mut j = job.clone();
+        j.renderer = Renderer::Gpu(self.mode);
+        j.params.direct = self.direct;
+        j
+    }
 }
 
 /// What to compare.
@@ -425,11 +458,7 @@ impl CompareSpec {
             }
         }
         for m in &self.modes {
-            let job = RenderJob {
-                renderer: Renderer::Gpu(m.mode),
-                ..self.base.clone()
-            };
-            job.check(has_level)?;
+            m.job(&self.base).check(has_level)?;
         }
         Ok(())
     }
@@ -446,7 +475,14 @@ pub fn run(
     progress: &(dyn Fn(Step) + Sync),
 ) -> Result<CompareReport, RenderError> {
     spec.check(level.is_some())?;
-    let per_camera = 2 + spec.vpls.len() as u32 * (1 + spec.modes.len() as u32);
+    // Direct light on the CPU and GPU, then per VPL count the reference, each method, and the
+    // own direct light of each method shadowed otherwise than the run.
+    let own_direct = spec
+        .modes
+        .iter()
+        .filter(|m| m.direct != spec.base.params.direct && m.mode != GpuMode::DirectOnly)
+        .count() as u32;
+    let per_camera = 2 + spec.vpls.len() as u32 * (1 + spec.modes.len() as u32 + own_direct);
     let mut store = Store {
         dir,
         spec,
@@ -545,7 +581,21 @@ fn camera_rows(
         });
         for m in &spec.modes {
             let name = format!("{}-{vpls}", file_name(&m.label));
-            match store.render(camera, &name, &job(Renderer::Gpu(m.mode), vpls)) {
+            let mode_job = m.job(&job(Renderer::Gpu(m.mode), vpls));
+            // A method with other direct shadows than the run's: its own direct light, to
+            // take out of its image.
+            let mut own = None;
+            if m.direct != spec.base.params.direct && m.mode != GpuMode::DirectOnly {
+                let mut dj = job(Renderer::Gpu(GpuMode::DirectOnly), 0);
+                dj.params.direct = m.direct;
+                let label = format!("direct-gpu-{}", file_name(&m.label));
+                own = Some(one(store.render(camera, &label, &dj)?.0));
+            }
+            let direct = Direct {
+                cpu: direct.cpu.clone(),
+                gpu: own.unwrap_or_else(|| direct.gpu.clone()),
+            };
+            match store.render(camera, &name, &mode_job) {
                 Ok((images, kept, rel)) => {
                     let row = measure(
                         store,
@@ -584,11 +634,20 @@ fn measure(
     ground_truth: Option<&HdrImage>,
 ) -> Result<Row, RenderError> {
     let exposure = store.spec.exposure;
+    // Direct light alone is measured against the reference's direct light alone (shadow
+    // rays): every error, the energy and black-where-lit are then the direct light's.
+    let direct_only = m.mode == GpuMode::DirectOnly;
+    let reference = if direct_only { &direct.cpu } else { reference };
     let e = errors(image, reference)?;
     let (f, flip_map) = flip(image, reference, exposure)?;
-    let rebased = rebase_direct(image, &direct.gpu, &direct.cpu)?;
-    let i = indirect_errors(&rebased, reference, &direct.cpu)?;
-    let indirect_mse = errors(&rebased, reference)?.mse;
+    let (i, indirect_mse) = if direct_only {
+        let black = HdrImage::new(image.width, image.height);
+        (indirect_errors(image, reference, &black)?, e.mse)
+    } else {
+        let rebased = rebase_direct(image, &direct.gpu, &direct.cpu)?;
+        let i = indirect_errors(&rebased, reference, &direct.cpu)?;
+        (i, errors(&rebased, reference)?.mse)
+    };
     let png = rel.with_extension("png");
     image.write_png(&store.dir.join(&png), exposure)?;
     let panel = Path::new("panels").join(format!(
@@ -602,7 +661,7 @@ fn measure(
     Ok(Row {
         camera: camera.name.clone(),
         mode: m.label.clone(),
-        settings: m.mode.describe(),
+        settings: m.describe(),
         vpls,
         vpl_count: kept.vpl_count,
         passes: kept.passes,

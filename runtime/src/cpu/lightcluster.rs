@@ -15,7 +15,9 @@
 //!
 //! Each cluster is then shadowed as a disk-shaped area light at its centre light, of radius its
 //! centre's minimum distance (the paper: "the radius of the area light source is given by the
-//! minimum distance of the cluster").
+//! minimum distance of the cluster") or — visgate's default — its extent, the distance of its
+//! farthest light from the centre, so that a light alone keeps its hard shadow and a disk is
+//! no wider than the lights it stands for.
 
 use glam::Vec3;
 use visgate_formats::scene::Light;
@@ -79,6 +81,9 @@ pub struct LightClusters {
     pub centres: Vec<u32>,
     /// Each cluster's disk radius: its centre's minimum distance. [Units: m]
     pub radius_m: Vec<f32>,
+    /// Each cluster's extent: its farthest light from its centre (0 for a light alone).
+    /// [Units: m]
+    pub extent_m: Vec<f32>,
     /// Each light's cluster, or [`CULLED`].
     pub light_cluster: Vec<u32>,
     /// Lights culled by range and frustum.
@@ -160,6 +165,7 @@ pub fn cluster_lights(
             out.light_cluster[i as usize] = out.centres.len() as u32;
             out.centres.push(i);
             out.radius_m.push(r);
+            out.extent_m.push(0.0);
         }
     }
     for &(_, i) in &live {
@@ -174,6 +180,8 @@ pub fn cluster_lights(
             })
             .expect("a live light makes a centre");
         out.light_cluster[i as usize] = nearest as u32;
+        let d = at(out.centres[nearest]).distance(at(i));
+        out.extent_m[nearest] = out.extent_m[nearest].max(d);
     }
     Ok(out)
 }

@@ -343,6 +343,14 @@ gpu_struct! {
         pub height: u32,
         /// Vertices of the scene (the shadow draw's vertex count).
         pub vertex_count: u32,
+        /// A cluster's disk: 0 its minimum distance (the paper), 1 its lights' extent.
+        pub disk_extent: u32,
+        /// Padding.
+        pub _pad0: u32,
+        /// Padding.
+        pub _pad1: u32,
+        /// Padding.
+        pub _pad2: u32,
     }
 }
 

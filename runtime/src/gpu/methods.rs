@@ -11,7 +11,7 @@ use crate::cpu::gates::GateParams;
 pub use super::passes::clustered_gates::GatesParams;
 pub use super::passes::cssm::CssmParams;
 pub use super::passes::interleave_blur::InterleaveParams;
-pub use super::passes::light_cluster::{DirectLight, LightClusterGpuParams, PcssParams};
+pub use super::passes::light_cluster::{DirectLight, LcDisk, LightClusterGpuParams, PcssParams};
 pub use super::passes::per_vpl_maps::PerVplParams;
 pub use super::passes::val_gather::ValModeParams;
 

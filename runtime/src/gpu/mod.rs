@@ -67,7 +67,7 @@ use timing::Recorder;
 pub use context::GpuContext;
 pub use geometry::{MAX_TEXTURE_SIZE, VPL_SHADOW_MAX_EDGE};
 pub use methods::{
-    CssmParams, DirectLight, GatesParams, GpuMode, GpuParams, InterleaveParams,
+    CssmParams, DirectLight, GatesParams, GpuMode, GpuParams, InterleaveParams, LcDisk,
     LightClusterGpuParams, METHODS, MethodInfo, MethodSettings, PcssParams, PerVplParams,
     ShadowParams, ValModeParams, method,
 };
@@ -710,10 +710,12 @@ impl GpuRenderer {
         let at = passes::light_cluster::ARGS_COUNTS as usize;
         let (count, culled) = (args[at] as usize, args[at + 1]);
         let clusters: Vec<f32> = bytemuck::cast_slice(&read_buffer(ctx, &c.clusters)?).to_vec();
+        let extent: Vec<f32> = bytemuck::cast_slice(&read_buffer(ctx, &c.extent)?).to_vec();
         let n = self.scene.lights.len();
         Ok(LightClusters {
             centres: words(&c.centres)?[..count].to_vec(),
             radius_m: (0..count).map(|k| clusters[4 * k + 3]).collect(),
+            extent_m: extent[..count].to_vec(),
             light_cluster: words(&c.light_cluster)?[..n].to_vec(),
             culled,
         })

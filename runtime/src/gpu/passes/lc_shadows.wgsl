@@ -15,6 +15,8 @@
 @group(0) @binding(6) var g_normal: texture_2d<f32>;
 // Four clusters a texel: cluster k in layer k / 4, channel k % 4.
 @group(0) @binding(7) var visibility: texture_storage_2d_array<rgba8unorm, write>;
+// Each cluster's extent (m, as f32 bits).
+@group(0) @binding(8) var<storage, read> extent: array<u32>;
 
 // Tile `tile` (cluster tile / 6, face tile % 6) of the atlas, drawn into its own viewport:
 // reversed depth without a far plane, near / (distance along the face's axis).
@@ -86,7 +88,7 @@ fn pcss(k: u32, p: vec3<f32>, n: vec3<f32>, px: vec2<u32>) -> f32 {
     let dr = length(dq);
     let w0 = dq / dr;
     let bias = 2.0 / size * frame.bias;
-    let radius = c.w;
+    let radius = select(c.w, bitcast<f32>(extent[k]), frame.disk_extent == 1u);
     if radius <= 0.0 {
         return select(0.0, 1.0, stored_distance(k, w0) >= dr * (1.0 - bias));
     }

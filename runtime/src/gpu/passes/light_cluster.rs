@@ -42,11 +42,25 @@ impl Default for PcssParams {
     }
 }
 
+/// The disk each cluster's soft shadow is cast from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LcDisk {
+    /// Radius: the cluster's minimum distance (the paper). A cluster of one light is a disk
+    /// too, and a disk wider than the room around its lights reaches through ceilings.
+    MinDistance,
+    /// Radius: the cluster's farthest light from its centre (0 for a light alone: its hard
+    /// shadow).
+    #[default]
+    Extent,
+}
+
 /// LightCluster's settings on the GPU.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct LightClusterGpuParams {
     /// The clustering (its `max_clusters` at most [`MAX_LC_CLUSTERS`]).
     pub clustering: LightClusterParams,
+    /// Each cluster's disk.
+    pub disk: LcDisk,
     /// Side of each cluster's cube face. [Units: texels] [Limit: 16..=2048; 0 for the
     /// default, 256]
     pub map_size: u32,
@@ -138,6 +152,8 @@ pub struct LcClusters {
     pub centres: wgpu::Buffer,
     /// Each cluster's reach (f32 bits).
     pub reach: wgpu::Buffer,
+    /// Each cluster's extent (f32 bits).
+    pub extent: wgpu::Buffer,
     /// Draw args, dispatch args, clusters, culled lights (u32 each).
     pub args: wgpu::Buffer,
 }
@@ -188,6 +204,10 @@ pub fn lc_frame(
         width: view.size[0],
         height: view.size[1],
         vertex_count: scene.geometry.vertex_count,
+        disk_extent: u32::from(p.disk == LcDisk::Extent),
+        _pad0: 0,
+        _pad1: 0,
+        _pad2: 0,
     }
 }
 
@@ -277,6 +297,7 @@ impl LightCluster {
             clusters: pool.buffer(d, "lc clusters", 4 * words(m), rw),
             centres: pool.buffer(d, "lc centres", words(m), rw),
             reach: pool.buffer(d, "lc reach", words(m), rw),
+            extent: pool.buffer(d, "lc extent", words(m), rw),
             args: pool.buffer(
                 d,
                 "lc args",
@@ -286,7 +307,7 @@ impl LightCluster {
         };
         let key = pool.buffer(d, "lc light key", words(n), rw);
         let order = pool.buffer(d, "lc order", words(n), rw);
-        let all: [(u32, &wgpu::Buffer); 9] = [
+        let all: [(u32, &wgpu::Buffer); 10] = [
             (0, &out.frame),
             (1, lights),
             (2, &key),
@@ -296,6 +317,7 @@ impl LightCluster {
             (6, &out.centres),
             (7, &out.reach),
             (8, &out.args),
+            (9, &out.extent),
         ];
         let group = |pipeline: &wgpu::ComputePipeline, used: &[u32]| {
             let resources = all
@@ -313,12 +335,12 @@ impl LightCluster {
             ),
             (
                 &self.centres,
-                group(&self.centres, &[0, 1, 2, 3, 4, 5, 6, 7, 8]),
+                group(&self.centres, &[0, 1, 2, 3, 4, 5, 6, 7, 8, 9]),
                 1,
             ),
             (
                 &self.assign,
-                group(&self.assign, &[0, 1, 2, 3, 5, 7, 8]),
+                group(&self.assign, &[0, 1, 2, 3, 5, 7, 8, 9]),
                 n.div_ceil(WG_LINEAR),
             ),
         ];
@@ -470,6 +492,7 @@ impl LightCluster {
                 (5, wgpu::BindingResource::TextureView(&g.views[0])),
                 (6, wgpu::BindingResource::TextureView(&g.views[1])),
                 (7, wgpu::BindingResource::TextureView(&vis_view)),
+                (8, clusters.extent.as_entire_binding()),
             ],
         );
         {

@@ -9,7 +9,8 @@
 //    within min_distance · (1 + distance_scale · d); it writes the clusters, the indirect draw
 //    of their cube faces and the indirect dispatch of the PCSS pass;
 // 3. `assign` (a thread per light): every other kept light joins its nearest centre, and
-//    widens its cluster's reach (the farthest point any of its lights lights);
+//    widens its cluster's reach (the farthest point any of its lights lights) and extent (its
+//    farthest light from the centre);
 // 4. `vs_atlas`: a depth-only draw of the scene per atlas tile (a cluster's cube face, drawn
 //    where the cluster exists: indirect), reversed depth near / z without a far plane;
 // 5. `pcss` (8 × 8 pixels × 4 clusters): each cluster's visibility at each pixel, PCSS with
@@ -34,6 +35,8 @@
 // draw's args (vertices, instances 0 or 1, 0, 0) per atlas tile (cluster k's face f: tile
 // 6k + f).
 @group(0) @binding(8) var<storage, read_write> args: array<u32>;
+// Each cluster's extent: its farthest light from its centre (m, as f32 bits).
+@group(0) @binding(9) var<storage, read_write> extent: array<atomic<u32>>;
 
 fn light_range(l: Light) -> f32 {
     let i = max(max(l.intensity.x, l.intensity.y), l.intensity.z);
@@ -134,6 +137,7 @@ fn centres_pass(@builtin(local_invocation_index) t: u32) {
     for (var k = t; k < c; k += WG_WIDE) {
         clusters[k] = centre_at[k];
         atomicStore(&reach[k], bitcast<u32>(light_range(lights[centres[k]])));
+        atomicStore(&extent[k], 0u);
     }
     for (var tile = t; tile < 6u * frame.max_clusters; tile += WG_WIDE) {
         args[8u + 4u * tile] = frame.vertex_count;
@@ -168,5 +172,7 @@ fn assign(@builtin(global_invocation_id) id: vec3<u32>) {
         }
     }
     light_cluster[i] = best;
-    atomicMax(&reach[best], bitcast<u32>(sqrt(best_d2) + light_range(lights[i])));
+    let d = sqrt(best_d2);
+    atomicMax(&reach[best], bitcast<u32>(d + light_range(lights[i])));
+    atomicMax(&extent[best], bitcast<u32>(d));
 }

@@ -24,6 +24,11 @@ struct LcFrame {
     width: u32,
     height: u32,
     vertex_count: u32,
+    // A cluster's disk: 0 its minimum distance (the paper), 1 its lights' extent.
+    disk_extent: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 };
 
 // The six 90° cube faces (axis, up), as runtime::gpu::passes::shadow_maps::CUBE_FACES.
