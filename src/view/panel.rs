@@ -5,7 +5,7 @@ use std::collections::VecDeque;
 use eframe::egui;
 use visgate_formats::Scene;
 use visgate_runtime::cpu::gates::GateShape;
-use visgate_runtime::gpu::{MethodSettings, PassTimes};
+use visgate_runtime::gpu::{DirectLight, LcDisk, LightClusterGpuParams, MethodSettings, PassTimes};
 use visgate_runtime::hdr::HdrImage;
 
 use super::camera::FlyCamera;
@@ -44,6 +44,49 @@ pub fn method_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
         _ => {}
     }
     s.gates.interleave = s.vals.interleave;
+}
+
+/// The direct lights' shadows: each light's maps, or LightCluster with its clustering, disk
+/// and PCSS sampling.
+pub fn direct_settings(ui: &mut egui::Ui, direct: &mut DirectLight) {
+    let mut lc = matches!(direct, DirectLight::LightCluster(_));
+    ui.horizontal(|ui| {
+        ui.label("direct shadows");
+        ui.radio_value(&mut lc, false, "per light");
+        ui.radio_value(&mut lc, true, "LightCluster");
+    });
+    match (lc, &mut *direct) {
+        (false, _) => *direct = DirectLight::PerLight,
+        (true, DirectLight::PerLight) => {
+            *direct = DirectLight::LightCluster(LightClusterGpuParams::default());
+        }
+        (true, DirectLight::LightCluster(p)) => {
+            let c = &mut p.clustering;
+            ui.add(
+                egui::Slider::new(&mut c.min_distance_m, 0.0..=20.0)
+                    .logarithmic(true)
+                    .text("min distance (m)"),
+            );
+            ui.add(
+                egui::Slider::new(&mut c.distance_scale, 0.0..=1.0).text("distance scale (1/m)"),
+            );
+            ui.add(egui::Slider::new(&mut c.max_clusters, 1..=256).text("max clusters"));
+            ui.horizontal(|ui| {
+                ui.radio_value(&mut p.disk, LcDisk::Extent, "disk: extent");
+                ui.radio_value(
+                    &mut p.disk,
+                    LcDisk::MinDistance,
+                    "disk: min distance (paper)",
+                );
+            });
+            ui.add(
+                egui::Slider::new(&mut p.pcss.blocker_samples, 1..=64).text("PCSS blocker samples"),
+            );
+            ui.add(
+                egui::Slider::new(&mut p.pcss.filter_samples, 1..=128).text("PCSS filter samples"),
+            );
+        }
+    }
 }
 
 /// The interleaving block's slider.

@@ -12,8 +12,8 @@ use visgate_runtime::camera::View;
 use visgate_runtime::cpu::gates::GateLevel;
 use visgate_runtime::cpu::tracer::Tracer;
 use visgate_runtime::gpu::{
-    GpuContext, GpuMode, GpuParams, GpuRenderer, METHODS, MethodSettings, PassTimes, RsmParams,
-    VplInput, method,
+    DirectLight, GpuContext, GpuMode, GpuParams, GpuRenderer, METHODS, MethodSettings, PassTimes,
+    RsmParams, VplInput, method,
 };
 use visgate_runtime::hdr::HdrImage;
 use visgate_runtime::job::RenderJob;
@@ -87,6 +87,8 @@ pub struct ViewerApp {
     vpls: Option<(u32, Vec<Vpl>)>,
     camera: FlyCamera,
     settings: MethodSettings,
+    /// The direct lights' shadows (per light, or LightCluster).
+    direct: DirectLight,
     /// Render at this fraction of the panel while the camera moves.
     moving_scale: f32,
     exposure: f32,
@@ -176,6 +178,7 @@ impl ViewerApp {
             vpls: None,
             camera,
             settings: MethodSettings::default(),
+            direct: DirectLight::PerLight,
             moving_scale: if software { 0.25 } else { 0.5 },
             vpl_count,
             exposure: 0.0,
@@ -220,6 +223,7 @@ impl ViewerApp {
         let params = GpuParams {
             mode,
             g_max: self.start.g_max,
+            direct: self.direct,
             ..GpuParams::default()
         };
         let direct_only = mode == GpuMode::DirectOnly;
@@ -361,6 +365,7 @@ impl ViewerApp {
                 }
             });
         super::panel::method_settings(ui, self.start.mode, &mut self.settings);
+        super::panel::direct_settings(ui, &mut self.direct);
         ui.add(
             egui::Slider::new(&mut self.vpl_count, 1..=16384)
                 .logarithmic(true)
@@ -552,6 +557,7 @@ impl ViewerApp {
         let params = GpuParams {
             mode: GpuMode::DirectOnly,
             g_max: self.start.g_max,
+            direct: self.direct,
             ..GpuParams::default()
         };
         let (direct, _) = self

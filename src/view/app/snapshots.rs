@@ -130,3 +130,29 @@ fn the_viewer_with_the_indirect_light_alone() {
 fn the_viewer_beside_the_reference() {
     snapshot("viewer_compare", Layers::default(), true);
 }
+
+#[test]
+fn the_viewer_renders_lightcluster_direct_shadows() {
+    use visgate_runtime::gpu::{DirectLight, LightClusterGpuParams};
+    let mut app = viewer(Layers::default(), false);
+    app.direct = DirectLight::LightCluster(LightClusterGpuParams::default());
+    let mut harness = Harness::builder()
+        .with_size([900.0, 560.0])
+        .wgpu()
+        .build_ui_state(|ui, app: &mut ViewerApp| app.draw(ui), app);
+    for _ in 0..600 {
+        harness.step();
+        if harness.state().frames > 0 {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let app = harness.state();
+    assert_eq!(app.error, None);
+    let (_, times) = app.last.as_ref().expect("a frame");
+    let c = times.direct_clusters.expect("LightCluster's counts");
+    // The four rooms' point light and spot.
+    assert_eq!(c.lights, 2);
+    assert!((1..=2).contains(&c.clusters), "{c:?}");
+    assert!(times.passes.iter().any(|p| p.name == "PCSS visibility"));
+}
