@@ -44,7 +44,18 @@ Modes:
   val-cssm     GPU: as val-hard with convolution soft shadow maps per VAL (Dong et al.):
                --cssm-terms Fourier terms of the depth, mip-mapped, filtered over the
                penumbra each VAL's size and the average blocker depth give
+  vpl-clusters GPU: the VPLs clustered as LightCluster clusters lights (--lc-min-distance,
+               --lc-distance-scale, --lc-max-clusters; beyond its paper): a cube shadow map
+               per cluster (--lc-map-size), every VPL shadowed by its cluster's PCSS soft
+               shadow (--pcss-*), every VPL at every pixel (at most 16,384 VPLs)
   direct-only  GPU: direct light alone
+Direct light (GPU, every mode): --direct per-light shadows each light with its own cube or spot
+maps (exact hard shadows); --direct lightcluster clusters the lights in view each frame
+(LightCluster: --lc-min-distance metres between cluster centres at the eye, growing by
+--lc-distance-scale per metre of distance, at most --lc-max-clusters; lights whose range misses
+the view are culled), renders one cube map per cluster and a PCSS soft shadow per cluster, its
+disk's radius its lights' extent (--lc-disk). The pass report names each pass and counts the
+clusters.
 With --cpu, none and direct-only run on the CPU twin (shadow rays for direct light), and
 per-vpl-shadow-maps is the reference (exact shadow rays).
 

@@ -225,23 +225,29 @@ impl MethodArgs {
     pub fn direct(&self) -> DirectLight {
         match self.direct {
             DirectArg::PerLight => DirectLight::PerLight,
-            DirectArg::Lightcluster => DirectLight::LightCluster(LightClusterGpuParams {
-                clustering: LightClusterParams {
-                    min_distance_m: self.lc_min_distance,
-                    distance_scale: self.lc_distance_scale,
-                    max_clusters: self.lc_max_clusters,
-                    cutoff: self.lc_cutoff,
-                },
-                disk: match self.lc_disk {
-                    LcDiskArg::Extent => LcDisk::Extent,
-                    LcDiskArg::MinDistance => LcDisk::MinDistance,
-                },
-                map_size: self.lc_map_size,
-                pcss: PcssParams {
-                    blocker_samples: self.pcss_blocker_samples,
-                    filter_samples: self.pcss_filter_samples,
-                },
-            }),
+            DirectArg::Lightcluster => DirectLight::LightCluster(self.light_cluster()),
+        }
+    }
+
+    /// LightCluster's settings from the --lc-* and --pcss-* flags (direct lights and mode
+    /// vpl-clusters alike).
+    pub fn light_cluster(&self) -> LightClusterGpuParams {
+        LightClusterGpuParams {
+            clustering: LightClusterParams {
+                min_distance_m: self.lc_min_distance,
+                distance_scale: self.lc_distance_scale,
+                max_clusters: self.lc_max_clusters,
+                cutoff: self.lc_cutoff,
+            },
+            disk: match self.lc_disk {
+                LcDiskArg::Extent => LcDisk::Extent,
+                LcDiskArg::MinDistance => LcDisk::MinDistance,
+            },
+            map_size: self.lc_map_size,
+            pcss: PcssParams {
+                blocker_samples: self.pcss_blocker_samples,
+                filter_samples: self.pcss_filter_samples,
+            },
         }
     }
 
@@ -289,6 +295,7 @@ impl MethodArgs {
                 map_size: self.val_map_size,
                 interleave: self.interleave_params(),
             },
+            vpl_clusters: self.light_cluster(),
             cssm: CssmParams {
                 terms: self.cssm_terms,
                 normal_offset: self.cssm_normal_offset,

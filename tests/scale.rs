@@ -29,7 +29,12 @@ fn images_at(s: f32, source: VplSource) -> Vec<(String, HdrImage)> {
     let mut renderers: Vec<(String, Renderer)> = METHODS
         .iter()
         .map(|m| {
-            let mode = (m.make)(&MethodSettings::default());
+            // LightCluster's distances are metres: the level's scale scales them.
+            let mut settings = MethodSettings::default();
+            let c = &mut settings.vpl_clusters.clustering;
+            c.min_distance_m *= s;
+            c.distance_scale /= s;
+            let mode = (m.make)(&settings);
             (m.name.to_string(), Renderer::Gpu(mode))
         })
         .collect();

@@ -204,9 +204,12 @@ impl RenderJob {
                     "--mode gates-per-pixel runs on the GPU; the CPU twin is --mode gates --cpu"
                         .into(),
                 )),
-                GpuMode::ValHard(_) | GpuMode::ValCssm(..) => Err(RenderError::Param(
-                    "the VAL modes run on the GPU; their reference is --mode reference".into(),
-                )),
+                GpuMode::ValHard(_) | GpuMode::ValCssm(..) | GpuMode::VplClusters(_) => {
+                    Err(RenderError::Param(format!(
+                        "--mode {} runs on the GPU; its reference is --mode reference",
+                        m.name()
+                    )))
+                }
             },
         }
     }
@@ -461,6 +464,14 @@ pub fn pass_table(t: &PassTimes) -> String {
     if let Some(c) = t.direct_clusters {
         s += &format!(
             "LightCluster: {} lights in {} clusters (cube shadow maps), {} culled by range\n",
+            c.lights - c.culled,
+            c.clusters,
+            c.culled
+        );
+    }
+    if let Some(c) = t.vpl_clusters {
+        s += &format!(
+            "VPL clusters: {} VPLs in {} clusters (cube shadow maps), {} of no flux left out\n",
             c.lights - c.culled,
             c.clusters,
             c.culled

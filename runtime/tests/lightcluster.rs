@@ -320,7 +320,7 @@ fn no_lights_many_lights_too_many_lights_and_a_light_inside_geometry() {
     let err = gpu
         .render(&ctx, &view, &[], &params)
         .expect_err("too many lights");
-    assert!(err.to_string().contains("at most 2048 lights"), "{err}");
+    assert!(err.to_string().contains("at most 16384 lights"), "{err}");
     // A light sealed in a 1 m box inside the room lights nothing outside it, clustered
     // alone or with an open light 0.8 m away (then the sealed one is the centre: the cluster's
     // shadow is the box's).
@@ -347,4 +347,54 @@ fn no_lights_many_lights_too_many_lights_and_a_light_inside_geometry() {
         shared.mean(),
         own.mean()
     );
+}
+
+#[test]
+fn vpl_clusters_shadow_indirect_light_close_to_the_reference() {
+    use visgate_runtime::cpu::tracer::Tracer;
+    use visgate_runtime::metrics::{errors, indirect_errors};
+    use visgate_runtime::vpl::{PathParams, path_vpls};
+    let ctx = context();
+    let scene = Builtin::FourRooms.scene().expect("scene");
+    let tracer = Tracer::new(&scene);
+    let paths = PathParams {
+        paths: 256,
+        bounces: 1,
+        seed: 3,
+    };
+    let vpls = path_vpls(&tracer, &scene.lights, &paths).expect("vpls");
+    let view = View::new(scene.cameras.first().expect("camera"), [96, 72]).expect("view");
+    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    let mode = GpuMode::VplClusters(LightClusterGpuParams::default());
+    let (img, times) = gpu
+        .render(&ctx, &view, &vpls, &GpuParams::with_mode(mode))
+        .expect("frame");
+    let c = times.vpl_clusters.expect("the VPLs' clusters");
+    assert_eq!(c.lights, vpls.len() as u32);
+    assert!(c.clusters >= 1 && c.clusters <= 64, "{c:?}");
+    let (direct, _) = gpu
+        .render(&ctx, &view, &[], &GpuParams::with_mode(GpuMode::DirectOnly))
+        .expect("direct");
+    let params = ReferenceParams {
+        samples_per_pixel: 1,
+        gather: visgate_runtime::vpl::GatherParams::default(),
+        ..ReferenceParams::default()
+    };
+    let (reference, _) =
+        render_reference(&tracer, &scene.lights, &vpls, &view, &params, &|_, _| {})
+            .expect("reference");
+    let i = indirect_errors(&img, &reference, &direct).expect("sizes");
+    let e = errors(&img, &reference).expect("sizes");
+    eprintln!(
+        "vpl-clusters, four rooms, {} VPLs in {} clusters: rel. MSE {:.3e}, indirect energy \
+         {:.3}, black where lit {:.1} %",
+        vpls.len(),
+        c.clusters,
+        e.rel_mse,
+        i.energy_ratio,
+        i.black_where_lit * 100.0
+    );
+    assert!((0.9..=1.1).contains(&i.energy_ratio), "{}", i.energy_ratio);
+    assert!(i.black_where_lit < 0.01, "{}", i.black_where_lit);
+    assert!(e.rel_mse < 5e-3, "{}", e.rel_mse);
 }

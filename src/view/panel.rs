@@ -37,6 +37,7 @@ pub fn method_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
             ui.add(interleave_block(&mut v.interleave.block));
             ui.add(egui::Slider::new(&mut v.map_size, 32..=512).text("VAL map size"));
         }
+        "vpl-clusters" => lc_controls(ui, &mut s.vpl_clusters),
         "per-vpl-shadow-maps" => {
             ui.add(egui::Slider::new(&mut s.per_vpl.map_size, 16..=512).text("map size"));
             ui.add(egui::Slider::new(&mut s.per_vpl.batch, 1..=256).text("VPLs per batch"));
@@ -60,33 +61,31 @@ pub fn direct_settings(ui: &mut egui::Ui, direct: &mut DirectLight) {
         (true, DirectLight::PerLight) => {
             *direct = DirectLight::LightCluster(LightClusterGpuParams::default());
         }
-        (true, DirectLight::LightCluster(p)) => {
-            let c = &mut p.clustering;
-            ui.add(
-                egui::Slider::new(&mut c.min_distance_m, 0.0..=20.0)
-                    .logarithmic(true)
-                    .text("min distance (m)"),
-            );
-            ui.add(
-                egui::Slider::new(&mut c.distance_scale, 0.0..=1.0).text("distance scale (1/m)"),
-            );
-            ui.add(egui::Slider::new(&mut c.max_clusters, 1..=256).text("max clusters"));
-            ui.horizontal(|ui| {
-                ui.radio_value(&mut p.disk, LcDisk::Extent, "disk: extent");
-                ui.radio_value(
-                    &mut p.disk,
-                    LcDisk::MinDistance,
-                    "disk: min distance (paper)",
-                );
-            });
-            ui.add(
-                egui::Slider::new(&mut p.pcss.blocker_samples, 1..=64).text("PCSS blocker samples"),
-            );
-            ui.add(
-                egui::Slider::new(&mut p.pcss.filter_samples, 1..=128).text("PCSS filter samples"),
-            );
-        }
+        (true, DirectLight::LightCluster(p)) => lc_controls(ui, p),
     }
+}
+
+/// LightCluster's clustering, disk and PCSS sampling (direct lights or VPLs).
+fn lc_controls(ui: &mut egui::Ui, p: &mut LightClusterGpuParams) {
+    let c = &mut p.clustering;
+    ui.add(
+        egui::Slider::new(&mut c.min_distance_m, 0.0..=20.0)
+            .logarithmic(true)
+            .text("min distance (m)"),
+    );
+    ui.add(egui::Slider::new(&mut c.distance_scale, 0.0..=1.0).text("distance scale (1/m)"));
+    ui.add(egui::Slider::new(&mut c.max_clusters, 1..=256).text("max clusters"));
+    ui.horizontal(|ui| {
+        ui.radio_value(&mut p.disk, LcDisk::Extent, "disk: extent");
+        ui.radio_value(
+            &mut p.disk,
+            LcDisk::MinDistance,
+            "disk: min distance (paper)",
+        );
+    });
+    let samples = &mut p.pcss;
+    ui.add(egui::Slider::new(&mut samples.blocker_samples, 1..=64).text("PCSS blocker samples"));
+    ui.add(egui::Slider::new(&mut samples.filter_samples, 1..=128).text("PCSS filter samples"));
 }
 
 /// The interleaving block's slider.

@@ -345,8 +345,8 @@ gpu_struct! {
         pub vertex_count: u32,
         /// A cluster's disk: 0 its minimum distance (the paper), 1 its lights' extent.
         pub disk_extent: u32,
-        /// Padding.
-        pub _pad0: u32,
+        /// 1: the emitters are VPLs, lighting their normal's hemisphere.
+        pub hemisphere: u32,
         /// Padding.
         pub _pad1: u32,
         /// Padding.

@@ -41,6 +41,10 @@ pub enum GpuMode {
     /// As `ValHard`, with convolution soft shadow maps per VAL (Dong et al.): the paper's
     /// method.
     ValCssm(ValModeParams, CssmParams),
+    /// Every VPL lights every pixel with the soft shadow of its cluster: VPLs clustered as
+    /// LightCluster clusters lights (minimum distance, nearest centre), a cube map per
+    /// cluster, PCSS visibility per cluster and pixel (beyond the LightCluster paper).
+    VplClusters(LightClusterGpuParams),
 }
 
 /// Every method's settings at once — what a command line or a viewer panel holds; each method
@@ -55,6 +59,8 @@ pub struct MethodSettings {
     pub vals: ValModeParams,
     /// The CSSM of `val-cssm`.
     pub cssm: CssmParams,
+    /// The VPL clustering of `vpl-clusters`.
+    pub vpl_clusters: LightClusterGpuParams,
 }
 
 impl Default for MethodSettings {
@@ -64,6 +70,7 @@ impl Default for MethodSettings {
             gates: GatesParams::default(),
             vals: ValModeParams::new(),
             cssm: CssmParams::default(),
+            vpl_clusters: LightClusterGpuParams::default(),
         }
     }
 }
@@ -82,7 +89,7 @@ pub struct MethodInfo {
 }
 
 /// Every GPU method, in the order lists show them.
-pub const METHODS: [MethodInfo; 7] = [
+pub const METHODS: [MethodInfo; 8] = [
     MethodInfo {
         name: "none",
         summary: "every VPL lights every point (no indirect shadows)",
@@ -120,6 +127,12 @@ pub const METHODS: [MethodInfo; 7] = [
         make: |s| GpuMode::ValCssm(s.vals, s.cssm),
     },
     MethodInfo {
+        name: "vpl-clusters",
+        summary: "VPLs clustered as LightCluster clusters lights, a PCSS soft shadow per cluster",
+        needs_level: false,
+        make: |s| GpuMode::VplClusters(s.vpl_clusters),
+    },
+    MethodInfo {
         name: "direct-only",
         summary: "direct light alone",
         needs_level: false,
@@ -143,6 +156,7 @@ impl GpuMode {
             GpuMode::GatesPerPixel(_) => "gates-per-pixel",
             GpuMode::ValHard(_) => "val-hard",
             GpuMode::ValCssm(..) => "val-cssm",
+            GpuMode::VplClusters(_) => "vpl-clusters",
         }
     }
 
@@ -171,6 +185,16 @@ impl GpuMode {
                 v.map_size,
                 il(&v.interleave)
             ),
+            GpuMode::VplClusters(p) => {
+                let c = &p.clustering;
+                format!(
+                    "{} m × (1 + {}·d), ≤ {} clusters, {}² faces",
+                    c.min_distance_m,
+                    c.distance_scale,
+                    c.max_clusters,
+                    p.face_size()
+                )
+            }
             GpuMode::ValCssm(v, c) => format!(
                 "{} VALs, {}² maps, {} terms, {}",
                 v.vals.count,
@@ -191,6 +215,7 @@ impl GpuMode {
             GpuMode::GatesPerPixel(g) => super::passes::clustered_gates::check_gates(g),
             GpuMode::ValHard(v) => v.check(),
             GpuMode::ValCssm(v, c) => v.check().and(c.check()),
+            GpuMode::VplClusters(p) => p.check(),
         }
     }
 

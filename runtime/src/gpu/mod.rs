@@ -74,7 +74,7 @@ pub use methods::{
 pub use passes::clustered_gates::{MAX_CLUSTERS, MAX_GATES};
 pub use passes::light_cluster::{MAX_LC_CLUSTERS, MAX_LC_LIGHTS};
 pub use passes::rsm_vpls::RsmParams;
-pub use timing::{DirectClusters, LightListStats, PassTime, PassTimes, ValIterations};
+pub use timing::{LcCounts, LightListStats, PassTime, PassTimes, ValIterations};
 
 /// Where a frame's VPLs come from.
 #[derive(Debug, Clone, Copy)]
@@ -195,6 +195,8 @@ struct Recorded {
     val_state: Option<wgpu::Buffer>,
     /// LightCluster's args (its counts), with `--direct lightcluster`.
     lc_args: Option<wgpu::Buffer>,
+    /// The same of the VPLs' clusters (mode vpl-clusters).
+    vpl_lc_args: Option<wgpu::Buffer>,
 }
 
 /// The frame as its passes (after the VPLs): shadow maps, G-buffer, the mode's passes,
@@ -219,18 +221,22 @@ fn record_passes(
         ),
         None => None,
     };
+    let vpl_lc = match &f.params.mode {
+        GpuMode::VplClusters(vp) => Some(p.light_cluster.record_vpls(f, vp, &g, pool, rec)?),
+        _ => None,
+    };
     let lists = match &f.params.mode {
         GpuMode::Gates(gp) => Some(p.clustered.record(f, gp, pool, rec, &g.views[0])?),
         _ => None,
     };
     let shading = match f.params.mode {
         GpuMode::Gates(gp) if gp.interleave.block > 1 => "shading: direct lighting",
-        GpuMode::None | GpuMode::Gates(_) | GpuMode::GatesPerPixel(_) => {
+        GpuMode::None | GpuMode::Gates(_) | GpuMode::GatesPerPixel(_) | GpuMode::VplClusters(_) => {
             "shading: direct + indirect lighting"
         }
         _ => "shading: direct lighting",
     };
-    let inputs = (&shadows, &g, lists.as_ref(), lc.as_ref());
+    let inputs = (&shadows, &g, lists.as_ref(), lc.as_ref(), vpl_lc.as_ref());
     let hdr = p.shade.record(f, pool, rec, inputs, shading);
     let mut val_state = None;
     match &f.params.mode {
@@ -262,6 +268,7 @@ fn record_passes(
         lists,
         val_state,
         lc_args: lc.map(|o| o.clusters.args),
+        vpl_lc_args: vpl_lc.map(|o| o.clusters.args),
     })
 }
 
@@ -422,6 +429,7 @@ impl GpuRenderer {
             GpuMode::None => ShadeIndirect::All,
             GpuMode::GatesPerPixel(_) => ShadeIndirect::GatesPerPixel,
             GpuMode::Gates(_) => ShadeIndirect::GatesClustered,
+            GpuMode::VplClusters(_) => ShadeIndirect::VplClusters,
             _ => ShadeIndirect::DirectOnly,
         };
         let globals = Globals {
@@ -577,6 +585,8 @@ impl GpuRenderer {
         let state_read =
             (out.val_state.as_ref()).map(|s| read_back("val convergence readback", s, 16));
         let lc_read = (out.lc_args.as_ref()).map(|a| read_back("lc args readback", a, 64));
+        let vpl_lc_read =
+            (out.vpl_lc_args.as_ref()).map(|a| read_back("vpl lc args readback", a, 64));
         let mut times = rec.finish(pool)?;
         let t1 = Instant::now();
         if let (Some(l), Some(r)) = (&out.lists, &counter_read) {
@@ -592,14 +602,20 @@ impl GpuRenderer {
                 converged: c[1] != 0,
             });
         }
-        if let Some(r) = &lc_read {
+        let counts = |r: &wgpu::Buffer, lights: u32| -> Result<LcCounts, RenderError> {
             let c: Vec<u32> = bytemuck::cast_slice(&map_read(ctx, r)?).to_vec();
             let at = passes::light_cluster::ARGS_COUNTS as usize;
-            times.direct_clusters = Some(DirectClusters {
+            Ok(LcCounts {
                 clusters: c[at],
                 culled: c[at + 1],
-                lights: self.scene.lights.len() as u32,
-            });
+                lights,
+            })
+        };
+        if let Some(r) = &lc_read {
+            times.direct_clusters = Some(counts(r, self.scene.lights.len() as u32)?);
+        }
+        if let Some(r) = &vpl_lc_read {
+            times.vpl_clusters = Some(counts(r, count)?);
         }
         let px = texels(&map_read(ctx, &read)?, w, h, false);
         let mut img = HdrImage::new(w, h);
@@ -697,7 +713,7 @@ impl GpuRenderer {
         let mut rec = Recorder::new(ctx, &mut self.pool);
         let c = self.pipelines.light_cluster.record_clustering(
             ctx,
-            &frame,
+            (&frame, passes::light_cluster::LcKind::Direct),
             &lights_buf,
             &mut self.pool,
             &mut rec,

@@ -64,6 +64,8 @@ pub enum ShadeIndirect {
     GatesPerPixel = 2,
     /// The clustered light lists (`SHADE_GATES_CLUSTERED`).
     GatesClustered = 3,
+    /// Every VPL with its LightCluster cluster's visibility (`SHADE_VPL_CLUSTERS`).
+    VplClusters = 4,
 }
 
 /// Workgroup size of the 1D compute passes (VPLs, VALs, RSM samples).
@@ -105,6 +107,7 @@ pub fn constants() -> String {
         "SHADE_GATES_CLUSTERED",
         ShadeIndirect::GatesClustered as u32,
     );
+    s += &u("SHADE_VPL_CLUSTERS", ShadeIndirect::VplClusters as u32);
     s += &u("DIRECT_PER_LIGHT", 0);
     s += &u("DIRECT_LIGHTCLUSTER", 1);
     s += &u(

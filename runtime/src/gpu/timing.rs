@@ -57,17 +57,19 @@ pub struct PassTimes {
     /// The VAL modes: how the clustering converged.
     pub vals: Option<ValIterations>,
     /// `--direct lightcluster`: the lights' clusters.
-    pub direct_clusters: Option<DirectClusters>,
+    pub direct_clusters: Option<LcCounts>,
+    /// Mode vpl-clusters: the VPLs' clusters.
+    pub vpl_clusters: Option<LcCounts>,
 }
 
-/// How LightCluster clustered a frame's lights.
+/// How LightCluster clustered a frame's lights (or VPLs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct DirectClusters {
+pub struct LcCounts {
     /// Clusters (cube shadow maps) made.
     pub clusters: u32,
-    /// Lights culled by range and frustum (not shaded).
+    /// Lights culled by range and frustum (not shaded); VPLs of no flux.
     pub culled: u32,
-    /// Lights in the scene.
+    /// Lights in the scene (VPLs in the frame).
     pub lights: u32,
 }
 
@@ -254,6 +256,7 @@ impl<'c> Recorder<'c> {
             lists: None,
             vals: None,
             direct_clusters: None,
+            vpl_clusters: None,
         })
     }
 }

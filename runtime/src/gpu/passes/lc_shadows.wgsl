@@ -1,4 +1,4 @@
-//! include: lc.wgsl
+//! include: lights.wgsl lc.wgsl
 // LightCluster's shadows: each cluster's cube shadow map as 6 tiles of one depth atlas (a
 // depth-only draw per tile), then each cluster's PCSS visibility at every pixel (see light_cluster.wgsl
 // for the whole method). Read-only: the clustering passes wrote what is bound here.
@@ -17,6 +17,9 @@
 @group(0) @binding(7) var visibility: texture_storage_2d_array<rgba8unorm, write>;
 // Each cluster's extent (m, as f32 bits).
 @group(0) @binding(8) var<storage, read> extent: array<u32>;
+// The lights (VPLs: their normals) and each cluster's centre light.
+@group(0) @binding(9) var<storage, read> lights: array<Light>;
+@group(0) @binding(10) var<storage, read> centres: array<u32>;
 
 // Tile `tile` (cluster tile / 6, face tile % 6) of the atlas, drawn into its own viewport:
 // reversed depth without a far plane, near / (distance along the face's axis).
@@ -89,6 +92,11 @@ fn pcss(k: u32, p: vec3<f32>, n: vec3<f32>, px: vec2<u32>) -> f32 {
     let w0 = dq / dr;
     let bias = 2.0 / size * frame.bias;
     let radius = select(c.w, bitcast<f32>(extent[k]), frame.disk_extent == 1u);
+    // VPLs light their front: directions behind the centre's surface carry no light.
+    var axis = vec3<f32>(0.0);
+    if frame.hemisphere == 1u {
+        axis = lights[centres[k]].direction.xyz;
+    }
     if radius <= 0.0 {
         return select(0.0, 1.0, stored_distance(k, w0) >= dr * (1.0 - bias));
     }
@@ -105,6 +113,9 @@ fn pcss(k: u32, p: vec3<f32>, n: vec3<f32>, px: vec2<u32>) -> f32 {
     for (var i = 0u; i < frame.blocker_samples; i++) {
         let o = vogel(i, frame.blocker_samples, turn, true) * search;
         let w = normalize(w0 + t1 * o.x + t2 * o.y);
+        if dot(w, axis) < 0.0 {
+            continue;
+        }
         let z = stored_distance(k, w);
         let zr = plane_distance(c.xyz, w, q, n, dr);
         if z < zr * (1.0 - bias) && in_cone(o, z, radius, dr) {
@@ -118,13 +129,18 @@ fn pcss(k: u32, p: vec3<f32>, n: vec3<f32>, px: vec2<u32>) -> f32 {
     let zb = max(sum / found, 1e-4);
     let width = min(radius * max(dr - zb, 0.0) / (dr * zb), 1.0);
     var lit = 0.0;
+    var taken = 0.0;
     for (var i = 0u; i < frame.filter_samples; i++) {
         let o = vogel(i, frame.filter_samples, turn, false) * width;
         let w = normalize(w0 + t1 * o.x + t2 * o.y);
+        if dot(w, axis) < 0.0 {
+            continue;
+        }
         let zr = plane_distance(c.xyz, w, q, n, dr);
         lit += select(0.0, 1.0, stored_distance(k, w) >= zr * (1.0 - bias));
+        taken += 1.0;
     }
-    return lit / f32(frame.filter_samples);
+    return select(1.0, lit / taken, taken > 0.0);
 }
 
 @compute @workgroup_size(8, 8)

@@ -10,7 +10,7 @@ use glam::Vec3;
 
 use crate::RenderError;
 use crate::camera::View;
-use crate::cpu::lightcluster::{LightClusterParams, light_range_scale};
+use crate::cpu::lightcluster::light_range_scale;
 use crate::gpu::context::{Pool, bind_group, compute_pipelines};
 use crate::gpu::geometry::{VERTEX_STRIDE, positions};
 use crate::gpu::layout::LcFrame;
@@ -19,121 +19,19 @@ use crate::gpu::shaders::{self, ShaderSources, WG_LINEAR};
 use crate::gpu::timing::Recorder;
 use crate::gpu::{Frame, SceneGpu};
 
+pub use super::lc_params::{DirectLight, LcDisk, LightClusterGpuParams, PcssParams};
+
 /// Most clusters a frame can have (the centre pass keeps them in workgroup memory).
 pub const MAX_LC_CLUSTERS: u32 = 256;
-/// Most lights LightCluster takes (its one-workgroup ranking walks every pair).
-pub const MAX_LC_LIGHTS: u32 = 2048;
-
-/// PCSS sampling of each cluster's visibility.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct PcssParams {
-    /// Blocker-search samples. [Limit: 1..=64]
-    pub blocker_samples: u32,
-    /// Filter (PCF) samples. [Limit: 1..=128]
-    pub filter_samples: u32,
-}
-
-impl Default for PcssParams {
-    fn default() -> Self {
-        PcssParams {
-            blocker_samples: 16,
-            filter_samples: 32,
-        }
-    }
-}
-
-/// The disk each cluster's soft shadow is cast from.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum LcDisk {
-    /// Radius: the cluster's minimum distance (the paper). A cluster of one light is a disk
-    /// too, and a disk wider than the room around its lights reaches through ceilings.
-    MinDistance,
-    /// Radius: the cluster's farthest light from its centre (0 for a light alone: its hard
-    /// shadow).
-    #[default]
-    Extent,
-}
-
-/// LightCluster's settings on the GPU.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct LightClusterGpuParams {
-    /// The clustering (its `max_clusters` at most [`MAX_LC_CLUSTERS`]).
-    pub clustering: LightClusterParams,
-    /// Each cluster's disk.
-    pub disk: LcDisk,
-    /// Side of each cluster's cube face. [Units: texels] [Limit: 16..=2048; 0 for the
-    /// default, 256]
-    pub map_size: u32,
-    /// PCSS sampling.
-    pub pcss: PcssParams,
-}
-
-impl LightClusterGpuParams {
-    /// The face side in use (0 means 256).
-    pub fn face_size(&self) -> u32 {
-        if self.map_size == 0 {
-            256
-        } else {
-            self.map_size
-        }
-    }
-
-    /// Checks every limit.
-    pub fn check(&self) -> Result<(), RenderError> {
-        self.clustering.check()?;
-        let bad = |what: String| Err(RenderError::Param(format!("LightCluster: {what}")));
-        if self.clustering.max_clusters > MAX_LC_CLUSTERS {
-            return bad(format!(
-                "at most {MAX_LC_CLUSTERS} clusters (max clusters {})",
-                self.clustering.max_clusters
-            ));
-        }
-        if !(16..=2048).contains(&self.face_size()) {
-            return bad(format!(
-                "cube face size {} must be 16..=2048 texels",
-                self.face_size()
-            ));
-        }
-        if !(1..=64).contains(&self.pcss.blocker_samples) {
-            return bad("PCSS blocker samples must be 1..=64".into());
-        }
-        if !(1..=128).contains(&self.pcss.filter_samples) {
-            return bad("PCSS filter samples must be 1..=128".into());
-        }
-        Ok(())
-    }
-
-    /// (tiles per row, rows) of the shadow atlas.
-    pub fn atlas_tiles(&self) -> (u32, u32) {
-        let tiles = 6 * self.clustering.max_clusters;
-        let per_row = (tiles as f64).sqrt().ceil() as u32;
-        (per_row, tiles.div_ceil(per_row))
-    }
-}
-
-/// The direct lights' visibility.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub enum DirectLight {
-    /// Each light's own shadow maps, 3 × 3 PCF (the reference of LightCluster's paper).
-    #[default]
-    PerLight,
-    /// LightCluster: a soft shadow per cluster of lights.
-    LightCluster(LightClusterGpuParams),
-}
-
-impl DirectLight {
-    /// The name on the command line and in reports.
-    pub fn name(&self) -> &'static str {
-        match self {
-            DirectLight::PerLight => "per-light",
-            DirectLight::LightCluster(_) => "lightcluster",
-        }
-    }
-}
+/// Most lights (or VPLs) LightCluster takes: its ranking walks every pair, a light's thread
+/// every light (a software rasterizer ends a shader's loops after 65,535 steps).
+pub const MAX_LC_LIGHTS: u32 = 16_384;
 
 /// The pipelines.
 pub struct LightCluster {
     cull: wgpu::ComputePipeline,
+    rank: wgpu::ComputePipeline,
+    vpl_lights: wgpu::ComputePipeline,
     centres: wgpu::ComputePipeline,
     assign: wgpu::ComputePipeline,
     atlas: wgpu::RenderPipeline,
@@ -205,11 +103,56 @@ pub fn lc_frame(
         height: view.size[1],
         vertex_count: scene.geometry.vertex_count,
         disk_extent: u32::from(p.disk == LcDisk::Extent),
-        _pad0: 0,
+        hemisphere: 0,
         _pad1: 0,
         _pad2: 0,
     }
 }
+
+/// What LightCluster clusters: the scene's lights (`--direct lightcluster`) or the frame's
+/// VPLs (mode vpl-clusters). Each keeps its own resources, so both can run in one frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LcKind {
+    /// The lights.
+    Direct = 0,
+    /// The VPLs.
+    Vpls = 1,
+}
+
+/// The pool labels of each kind's resources: frame, light cluster, clusters, centres, reach,
+/// extent, args, key, order, atlas, visibility, tiles, VPL lights.
+const LABELS: [[&str; 13]; 2] = [
+    [
+        "lc frame",
+        "lc light cluster",
+        "lc clusters",
+        "lc centres",
+        "lc reach",
+        "lc extent",
+        "lc args",
+        "lc light key",
+        "lc order",
+        "lc atlas",
+        "lc visibility",
+        "lc tiles",
+        "lc lights",
+    ],
+    [
+        "vpl lc frame",
+        "vpl lc light cluster",
+        "vpl lc clusters",
+        "vpl lc centres",
+        "vpl lc reach",
+        "vpl lc extent",
+        "vpl lc args",
+        "vpl lc light key",
+        "vpl lc order",
+        "vpl lc atlas",
+        "vpl lc visibility",
+        "vpl lc tiles",
+        "vpl lc lights",
+    ],
+];
 
 /// The atlas pipeline: positions and a per-instance tile index in, reversed depth out (test
 /// "greater", cleared to 0), no fragment stage.
@@ -251,13 +194,18 @@ impl LightCluster {
     /// Builds the pipelines.
     pub fn new(d: &wgpu::Device, s: &ShaderSources) -> Result<LightCluster, RenderError> {
         let module = shaders::module(d, s, "light_cluster.wgsl")?;
-        let [cull, centres, assign] =
-            compute_pipelines(d, &module, ["cull", "centres_pass", "assign"]);
+        let [cull, rank, centres, assign, vpl_lights] = compute_pipelines(
+            d,
+            &module,
+            ["cull", "rank", "centres_pass", "assign", "vpl_lights"],
+        );
         let shadows = shaders::module(d, s, "lc_shadows.wgsl")?;
         let atlas = depth_only_pipeline(d, &shadows);
         let [pcss] = compute_pipelines(d, &shadows, ["pcss_pass"]);
         Ok(LightCluster {
             cull,
+            rank,
+            vpl_lights,
             centres,
             assign,
             atlas,
@@ -270,18 +218,22 @@ impl LightCluster {
     pub fn record_clustering(
         &self,
         ctx: &crate::gpu::GpuContext,
-        frame: &LcFrame,
+        (frame, kind): (&LcFrame, LcKind),
         lights: &wgpu::Buffer,
         pool: &mut Pool,
         rec: &mut Recorder,
     ) -> Result<LcClusters, RenderError> {
         let n = frame.light_count;
         if n > MAX_LC_LIGHTS {
+            let (what, instead) = match kind {
+                LcKind::Direct => ("lights; the scene has", "--direct per-light"),
+                LcKind::Vpls => ("VPLs; the frame has", "fewer VPLs"),
+            };
             return Err(RenderError::Param(format!(
-                "LightCluster takes at most {MAX_LC_LIGHTS} lights; the scene has {n} (use \
-                 --direct per-light)"
+                "LightCluster takes at most {MAX_LC_LIGHTS} {what} {n} (use {instead})"
             )));
         }
+        let l = &LABELS[kind as usize];
         let d = &ctx.device;
         let rw = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
         let words = |k: u32| 4 * u64::from(k.max(1));
@@ -289,24 +241,24 @@ impl LightCluster {
         let out = LcClusters {
             frame: pool.upload(
                 ctx,
-                "lc frame",
+                l[0],
                 bytemuck::bytes_of(frame),
                 wgpu::BufferUsages::UNIFORM,
             ),
-            light_cluster: pool.buffer(d, "lc light cluster", words(n), rw),
-            clusters: pool.buffer(d, "lc clusters", 4 * words(m), rw),
-            centres: pool.buffer(d, "lc centres", words(m), rw),
-            reach: pool.buffer(d, "lc reach", words(m), rw),
-            extent: pool.buffer(d, "lc extent", words(m), rw),
+            light_cluster: pool.buffer(d, l[1], words(n), rw),
+            clusters: pool.buffer(d, l[2], 4 * words(m), rw),
+            centres: pool.buffer(d, l[3], words(m), rw),
+            reach: pool.buffer(d, l[4], words(m), rw),
+            extent: pool.buffer(d, l[5], words(m), rw),
             args: pool.buffer(
                 d,
-                "lc args",
+                l[6],
                 ARGS_DRAWS + 16 * 6 * u64::from(m),
                 rw | wgpu::BufferUsages::INDIRECT,
             ),
         };
-        let key = pool.buffer(d, "lc light key", words(n), rw);
-        let order = pool.buffer(d, "lc order", words(n), rw);
+        let key = pool.buffer(d, l[7], words(n), rw);
+        let order = pool.buffer(d, l[8], words(n), rw);
         let all: [(u32, &wgpu::Buffer); 10] = [
             (0, &out.frame),
             (1, lights),
@@ -334,6 +286,11 @@ impl LightCluster {
                 n.div_ceil(WG_LINEAR),
             ),
             (
+                &self.rank,
+                group(&self.rank, &[0, 2, 4]),
+                n.div_ceil(WG_LINEAR),
+            ),
+            (
                 &self.centres,
                 group(&self.centres, &[0, 1, 2, 3, 4, 5, 6, 7, 8, 9]),
                 1,
@@ -345,11 +302,7 @@ impl LightCluster {
             ),
         ];
         for (i, (pipeline, bg, groups)) in steps.iter().enumerate() {
-            let span = rec.begin(if i == 0 {
-                "light culling"
-            } else {
-                "light clustering"
-            });
+            let span = rec.begin(span_names(kind)[usize::from(i > 0)]);
             {
                 let mut pass = rec.enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("lightcluster clustering"),
@@ -369,7 +322,7 @@ impl LightCluster {
     fn record_atlas(
         &self,
         f: &Frame,
-        p: &LightClusterGpuParams,
+        (p, kind): (&LightClusterGpuParams, LcKind),
         clusters: &LcClusters,
         atlas: &wgpu::TextureView,
         pool: &mut Pool,
@@ -378,16 +331,17 @@ impl LightCluster {
         let d = &f.ctx.device;
         let tiles = 6 * p.clustering.max_clusters;
         let index: Vec<u32> = (0..tiles).collect();
+        let l = &LABELS[kind as usize];
         let index_buf = pool.upload(
             f.ctx,
-            "lc tiles",
+            l[11],
             bytemuck::cast_slice(&index),
             wgpu::BufferUsages::VERTEX,
         );
         let bg = bind_group(
             d,
             &self.atlas.get_bind_group_layout(0),
-            "lc atlas",
+            l[9],
             vec![
                 (0, clusters.frame.as_entire_binding()),
                 (1, clusters.clusters.as_entire_binding()),
@@ -395,7 +349,7 @@ impl LightCluster {
         );
         let (per_row, _) = p.atlas_tiles();
         let side = p.face_size();
-        let span = rec.begin("cluster shadow maps");
+        let span = rec.begin(span_names(kind)[2]);
         let mut pass = rec.enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("lightcluster atlas"),
             color_attachments: &[],
@@ -426,8 +380,8 @@ impl LightCluster {
         rec.end();
     }
 
-    /// Records the whole method for frame `f`: clustering, the cluster shadow atlas and the
-    /// PCSS visibility of every cluster at every pixel of `g`.
+    /// Records the whole method for frame `f`'s lights: clustering, the cluster shadow atlas
+    /// and the PCSS visibility of every cluster at every pixel of `g`.
     pub fn record(
         &self,
         f: &Frame,
@@ -437,10 +391,75 @@ impl LightCluster {
         pool: &mut Pool,
         rec: &mut Recorder,
     ) -> Result<LcOutput, RenderError> {
-        p.check()?;
-        let d = &f.ctx.device;
         let shadows = &f.params.shadows;
         let frame = lc_frame(f.scene, f.view, p, (shadows.normal_offset, shadows.bias));
+        self.record_with(f, (p, &frame, LcKind::Direct), lights, g, pool, rec)
+    }
+
+    /// The same for frame `f`'s VPLs (mode vpl-clusters): each a point light of intensity
+    /// Φ/π lighting its normal's hemisphere, none culled by range (a VPL out of view lights
+    /// what is in view).
+    pub fn record_vpls(
+        &self,
+        f: &Frame,
+        p: &LightClusterGpuParams,
+        g: &GBufferOutput,
+        pool: &mut Pool,
+        rec: &mut Recorder,
+    ) -> Result<LcOutput, RenderError> {
+        let shadows = &f.params.shadows;
+        let mut frame = lc_frame(f.scene, f.view, p, (shadows.normal_offset, shadows.bias));
+        frame.light_count = f.vpl_count;
+        frame.range_scale = 1e30;
+        frame.hemisphere = 1;
+        let l = &LABELS[LcKind::Vpls as usize];
+        let d = &f.ctx.device;
+        let uniform = pool.upload(
+            f.ctx,
+            l[0],
+            bytemuck::bytes_of(&frame),
+            wgpu::BufferUsages::UNIFORM,
+        );
+        let lights = pool.buffer(
+            d,
+            l[12],
+            64 * u64::from(f.vpl_count.max(1)),
+            wgpu::BufferUsages::STORAGE,
+        );
+        let bg = bind_group(
+            d,
+            &self.vpl_lights.get_bind_group_layout(0),
+            l[12],
+            vec![
+                (0, uniform.as_entire_binding()),
+                (10, f.vpls.as_entire_binding()),
+                (11, lights.as_entire_binding()),
+            ],
+        );
+        {
+            let mut pass = rec.enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("VPLs as lights"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.vpl_lights);
+            pass.set_bind_group(0, &bg, &[]);
+            pass.dispatch_workgroups(f.vpl_count.div_ceil(WG_LINEAR).max(1), 1, 1);
+        }
+        self.record_with(f, (p, &frame, LcKind::Vpls), &lights, g, pool, rec)
+    }
+
+    /// [`LightCluster::record`] with `frame` for the emitters in `lights`.
+    fn record_with(
+        &self,
+        f: &Frame,
+        (p, frame, kind): (&LightClusterGpuParams, &LcFrame, LcKind),
+        lights: &wgpu::Buffer,
+        g: &GBufferOutput,
+        pool: &mut Pool,
+        rec: &mut Recorder,
+    ) -> Result<LcOutput, RenderError> {
+        p.check()?;
+        let d = &f.ctx.device;
         let (per_row, rows) = p.atlas_tiles();
         let side = p.face_size();
         let max_dim = d.limits().max_texture_dimension_2d;
@@ -453,10 +472,11 @@ impl LightCluster {
                 p.clustering.max_clusters
             )));
         }
-        let clusters = self.record_clustering(f.ctx, &frame, lights, pool, rec)?;
+        let clusters = self.record_clustering(f.ctx, (frame, kind), lights, pool, rec)?;
+        let l = &LABELS[kind as usize];
         let atlas = pool.texture(
             d,
-            "lc atlas",
+            l[9],
             [per_row * side, rows * side, 1],
             1,
             wgpu::TextureFormat::Depth32Float,
@@ -467,14 +487,14 @@ impl LightCluster {
         let layers = p.clustering.max_clusters.div_ceil(4);
         let visibility = pool.texture(
             d,
-            "lc visibility",
+            l[10],
             [w, h, layers],
             1,
             wgpu::TextureFormat::Rgba8Unorm,
             wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING,
         );
-        self.record_atlas(f, p, &clusters, &atlas_view, pool, rec);
-        let span = rec.begin("PCSS visibility");
+        self.record_atlas(f, (p, kind), &clusters, &atlas_view, pool, rec);
+        let span = rec.begin(span_names(kind)[3]);
         let vis_view = visibility.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
             ..Default::default()
@@ -482,7 +502,7 @@ impl LightCluster {
         let bg = bind_group(
             d,
             &self.pcss.get_bind_group_layout(0),
-            "lc pcss",
+            l[10],
             vec![
                 (0, clusters.frame.as_entire_binding()),
                 (1, clusters.clusters.as_entire_binding()),
@@ -493,6 +513,8 @@ impl LightCluster {
                 (6, wgpu::BindingResource::TextureView(&g.views[1])),
                 (7, wgpu::BindingResource::TextureView(&vis_view)),
                 (8, clusters.extent.as_entire_binding()),
+                (9, lights.as_entire_binding()),
+                (10, clusters.centres.as_entire_binding()),
             ],
         );
         {
@@ -509,5 +531,23 @@ impl LightCluster {
             clusters,
             visibility,
         })
+    }
+}
+
+/// The pass names of each kind: culling, clustering, shadow maps, visibility (the paper's).
+fn span_names(kind: LcKind) -> [&'static str; 4] {
+    match kind {
+        LcKind::Direct => [
+            "light culling",
+            "light clustering",
+            "cluster shadow maps",
+            "PCSS visibility",
+        ],
+        LcKind::Vpls => [
+            "VPL culling",
+            "VPL clustering",
+            "VPL cluster shadow maps",
+            "VPL PCSS visibility",
+        ],
     }
 }

@@ -1,11 +1,11 @@
-//! include: lights.wgsl lc.wgsl
+//! include: lights.wgsl lc.wgsl vpl.wgsl
 // LightCluster (../shared/papers/lightcluster-pcss.txt) on the GPU, as its CPU twin
 // runtime::cpu::lightcluster clusters:
 //
 // 1. `cull` (a thread per light): the light's range (range_scale · sqrt(I)) against the view
 //    frustum; a light kept gets its eye distance as its key, a culled one -1;
-// 2. `centres` (one workgroup): the kept lights ranked by (eye distance, index), then the
-//    minimum-distance pass in that order — a light becomes a centre unless a centre lies
+// 2. `rank` (a thread per light): the kept lights ordered by (eye distance, index);
+//    `centres_pass` (one workgroup): the minimum-distance pass in that order — a light becomes a centre unless a centre lies
 //    within min_distance · (1 + distance_scale · d); it writes the clusters, the indirect draw
 //    of their cube faces and the indirect dispatch of the PCSS pass;
 // 3. `assign` (a thread per light): every other kept light joins its nearest centre, and
@@ -37,6 +37,28 @@
 @group(0) @binding(8) var<storage, read_write> args: array<u32>;
 // Each cluster's extent: its farthest light from its centre (m, as f32 bits).
 @group(0) @binding(9) var<storage, read_write> extent: array<atomic<u32>>;
+// VPLs clustered as lights (mode vpl-clusters): the VPLs, and the lights `vpl_lights` makes
+// of them (bound as `lights` to the clustering passes).
+@group(0) @binding(10) var<storage, read> vpls: array<Vpl>;
+@group(0) @binding(11) var<storage, read_write> vpl_as_light: array<Light>;
+
+// VPL i as a point light of intensity Φ/π (its peak, along its normal), lifted off its
+// surface by 10 near distances so that its cube map does not start inside it; its normal is
+// the light's `direction`.
+@compute @workgroup_size(WG_LINEAR)
+fn vpl_lights(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    if i >= frame.light_count {
+        return;
+    }
+    let v = vpls[i];
+    var l: Light;
+    l.position = vec4<f32>(v.position + v.normal * 10.0 * frame.near_m, LIGHT_POINT);
+    l.intensity = vec4<f32>(v.flux / PI, 0.0);
+    l.direction = vec4<f32>(v.normal, 0.0);
+    l.layers = vec4<u32>(0u);
+    vpl_as_light[i] = l;
+}
 
 fn light_range(l: Light) -> f32 {
     let i = max(max(l.intensity.x, l.intensity.y), l.intensity.z);
@@ -83,6 +105,21 @@ fn before(j: u32, i: u32) -> bool {
     return kj >= 0.0 && (kj < ki || (kj == ki && j < i));
 }
 
+// A kept light's place in the first pass's order (a thread per light, every pair: n² work
+// spread over the GPU, n steps a thread).
+@compute @workgroup_size(WG_LINEAR)
+fn rank(@builtin(global_invocation_id) id: vec3<u32>) {
+    let i = id.x;
+    if i >= frame.light_count || light_key[i] < 0.0 {
+        return;
+    }
+    var r = 0u;
+    for (var j = 0u; j < frame.light_count; j++) {
+        r += select(0u, 1u, before(j, i));
+    }
+    order[r] = i;
+}
+
 @compute @workgroup_size(WG_WIDE)
 fn centres_pass(@builtin(local_invocation_index) t: u32) {
     let n = frame.light_count;
@@ -93,17 +130,10 @@ fn centres_pass(@builtin(local_invocation_index) t: u32) {
     }
     workgroupBarrier();
     for (var i = t; i < n; i += WG_WIDE) {
-        if light_key[i] < 0.0 {
-            continue;
+        if light_key[i] >= 0.0 {
+            atomicAdd(&live, 1u);
         }
-        var rank = 0u;
-        for (var j = 0u; j < n; j++) {
-            rank += select(0u, 1u, before(j, i));
-        }
-        order[rank] = i;
-        atomicAdd(&live, 1u);
     }
-    storageBarrier();
     workgroupBarrier();
     if t == 0u {
         live_count = atomicLoad(&live);

@@ -5,6 +5,7 @@ pub mod clustered_gates;
 pub mod cssm;
 pub mod gbuffer;
 pub mod interleave_blur;
+pub mod lc_params;
 pub mod light_cluster;
 pub mod per_vpl_maps;
 pub mod rsm_vpls;

@@ -74,6 +74,7 @@ pub type Inputs<'a> = (
     &'a GBufferOutput,
     Option<&'a ListBuffers>,
     Option<&'a LcOutput>,
+    Option<&'a LcOutput>,
 );
 
 /// The bindings of shade.wgsl's `fs_gates_indirect` (an automatic layout holds only what an
@@ -135,7 +136,7 @@ impl Shade {
         &self,
         f: &Frame,
         rec: &mut Recorder,
-        (shadows, g, lists, lc): Inputs,
+        (shadows, g, lists, lc, vpl_lc): Inputs,
         (pipeline, used): (&wgpu::RenderPipeline, Option<&[u32]>),
         (out, name): (&wgpu::Texture, &'static str),
     ) {
@@ -150,8 +151,9 @@ impl Shade {
                 dimension: Some(wgpu::TextureViewDimension::D2Array),
                 ..Default::default()
             });
-        let vis = lc.map_or(no_vis, |o| array_view(&o.visibility));
-        let buffers: [(u32, &wgpu::Buffer); 14] = [
+        let vis = lc.map_or_else(|| no_vis.clone(), |o| array_view(&o.visibility));
+        let vpl_vis = vpl_lc.map_or(no_vis, |o| array_view(&o.visibility));
+        let buffers: [(u32, &wgpu::Buffer); 15] = [
             (0, &f.globals),
             (1, &shadows.lights),
             (2, &f.vpls),
@@ -166,6 +168,7 @@ impl Shade {
             (15, level.map_or(none, |l| &l.portal_words)),
             (16, lists.map_or(none, |b| &b.vpl_cluster)),
             (18, lc.map_or(none, |o| &o.clusters.light_cluster)),
+            (20, vpl_lc.map_or(none, |o| &o.clusters.light_cluster)),
         ];
         let textures = [
             (4, &maps),
@@ -173,6 +176,7 @@ impl Shade {
             (6, &g.views[1]),
             (7, &g.views[2]),
             (17, &vis),
+            (19, &vpl_vis),
         ];
         let resources = buffers
             .iter()

@@ -48,6 +48,25 @@ struct GeometryCluster {
 // and each light's cluster (NONE: culled, not shaded).
 @group(0) @binding(17) var lc_visibility: texture_2d_array<f32>;
 @group(0) @binding(18) var<storage, read> lc_light_cluster: array<u32>;
+// SHADE_VPL_CLUSTERS: the VPLs' clusters' visibility and each VPL's cluster (NONE: no flux).
+@group(0) @binding(19) var vpl_lc_visibility: texture_2d_array<f32>;
+@group(0) @binding(20) var<storage, read> vpl_lc_cluster: array<u32>;
+
+// SHADE_VPL_CLUSTERS: every VPL, shadowed by its cluster's PCSS visibility at px.
+fn gather_vpl_clusters(p: vec3<f32>, n: vec3<f32>, px: vec2<i32>) -> vec3<f32> {
+    var sum = vec3<f32>(0.0);
+    for (var j = 0u; j < globals.vpl_count; j++) {
+        let c = vpl_lc_cluster[j];
+        if c == NONE {
+            continue;
+        }
+        let l = vpl_light(vpls[j], p, n, globals.g_max);
+        if any(l > vec3<f32>(0.0)) {
+            sum += l * textureLoad(vpl_lc_visibility, px, i32(c / 4u), 0)[c % 4u];
+        }
+    }
+    return sum;
+}
 
 // Light i's visibility at pixel px (p, normal n): its shadow maps, or its cluster's PCSS.
 fn direct_visibility(i: u32, l: Light, p: vec3<f32>, n: vec3<f32>, px: vec2<i32>) -> f32 {
@@ -169,6 +188,8 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
         radiance += albedo / PI * gather_all(p, n);
     } else if mode == SHADE_GATES_PER_PIXEL {
         radiance += albedo / PI * gather_per_pixel(p, n, decode_cluster(pos.w));
+    } else if mode == SHADE_VPL_CLUSTERS {
+        radiance += albedo / PI * gather_vpl_clusters(p, n, px);
     } else if mode == SHADE_GATES_CLUSTERED && globals.interleave_block <= 1u {
         radiance += albedo / PI * clustered_gather(px, p, n, decode_cluster(pos.w));
     }

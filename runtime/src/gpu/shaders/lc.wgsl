@@ -26,7 +26,9 @@ struct LcFrame {
     vertex_count: u32,
     // A cluster's disk: 0 its minimum distance (the paper), 1 its lights' extent.
     disk_extent: u32,
-    pad0: u32,
+    // 1: the emitters are VPLs, lighting their normal's hemisphere (their normal is the
+    // light's `direction`).
+    hemisphere: u32,
     pad1: u32,
     pad2: u32,
 };
