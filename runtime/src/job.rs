@@ -461,21 +461,29 @@ pub fn pass_table(t: &PassTimes) -> String {
             ),
         };
     }
-    if let Some(c) = t.direct_clusters {
-        s += &format!(
-            "LightCluster: {} lights in {} clusters (cube shadow maps), {} culled by range\n",
-            c.lights - c.culled,
-            c.clusters,
-            c.culled
-        );
-    }
-    if let Some(c) = t.vpl_clusters {
-        s += &format!(
-            "VPL clusters: {} VPLs in {} clusters (cube shadow maps), {} of no flux left out\n",
-            c.lights - c.culled,
-            c.clusters,
-            c.culled
-        );
+    let clustered = [
+        (
+            "LightCluster",
+            "lights",
+            "culled by range",
+            t.direct_clusters,
+        ),
+        (
+            "VPL clusters",
+            "VPLs",
+            "of no flux left out",
+            t.vpl_clusters,
+        ),
+    ];
+    for (what, items, dropped, counts) in clustered {
+        if let Some(c) = counts {
+            s += &format!(
+                "{what}: {} {items} in {} clusters (cube shadow maps), {} {dropped}\n",
+                c.lights - c.culled,
+                c.clusters,
+                c.culled
+            );
+        }
     }
     if t.passes.iter().all(|p| p.gpu_s.is_none()) {
         s += "(the adapter has no timestamp queries: each pass was submitted and waited for \

@@ -288,6 +288,9 @@ struct Kept {
     gpu_timed: bool,
     shadow_rays: u64,
     frames: u32,
+    /// Mode vpl-clusters: the VPLs' clusters of the first frame.
+    #[serde(default)]
+    vpl_clusters: Option<u32>,
 }
 
 /// Where renders go and what was reused.
@@ -406,9 +409,14 @@ fn kept_of(frames: &[JobFrame], key: String, adapter: String) -> Result<Kept, Re
         }
         FrameStats::Cpu(s) => (Vec::new(), s.seconds * 1e3, false, s.shadow_rays),
     };
+    let vpl_clusters = match &first.stats {
+        FrameStats::Gpu(t) => t.vpl_clusters.map(|c| c.clusters),
+        FrameStats::Cpu(_) => None,
+    };
     Ok(Kept {
         key,
         adapter,
+        vpl_clusters,
         vpl_count: first.vpl_count,
         passes,
         total_ms,
@@ -621,6 +629,40 @@ fn camera_rows(
     Ok(())
 }
 
+/// The method's settings in words, with its clusters: the VPLs' as the render counted them,
+/// the lights' from LightCluster's CPU twin (the GPU's equal, tested).
+fn settings_of(
+    store: &Store,
+    camera: &Camera,
+    m: &CompareMode,
+    vpl_clusters: Option<u32>,
+) -> Result<String, RenderError> {
+    let mut s = m.describe();
+    if let Some(n) = vpl_clusters {
+        s += &format!(" → {n} clusters");
+    }
+    if let DirectLight::LightCluster(p) = &m.direct {
+        let scene = store.scene;
+        let view = crate::camera::View::new(camera, store.spec.base.size)?;
+        let diagonal = scene
+            .bounds()
+            .map_or(1.0, |(lo, hi)| (hi - lo).length())
+            .max(1e-6);
+        let c = crate::cpu::lightcluster::cluster_lights(
+            &scene.lights,
+            &view,
+            diagonal,
+            &p.clustering,
+        )?;
+        s += &format!(
+            " → {} clusters of {} lights",
+            c.centres.len(),
+            scene.lights.len() as u32 - c.culled
+        );
+    }
+    Ok(s)
+}
+
 /// A method's row: its errors against the reference, its PNG and its panel.
 #[allow(clippy::too_many_arguments)]
 fn measure(
@@ -661,7 +703,7 @@ fn measure(
     Ok(Row {
         camera: camera.name.clone(),
         mode: m.label.clone(),
-        settings: m.describe(),
+        settings: settings_of(store, camera, m, kept.vpl_clusters)?,
         vpls,
         vpl_count: kept.vpl_count,
         passes: kept.passes,

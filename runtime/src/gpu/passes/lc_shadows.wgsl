@@ -84,6 +84,11 @@ fn pcss(k: u32, p: vec3<f32>, n: vec3<f32>, px: vec2<u32>) -> f32 {
     if dist <= 1e-6 || dist > bitcast<f32>(reach[k]) {
         return 1.0;
     }
+    // Every light of the cluster lies within its extent of the centre: below p's plane by
+    // more than that, none lights p (any visibility will do).
+    if dot(n, c.xyz - p) < -bitcast<f32>(extent[k]) {
+        return 1.0;
+    }
     let size = f32(frame.map_size);
     // A cube texel's footprint at distance d is at most 2·d / size.
     let q = p + n * (2.0 * dist / size) * frame.normal_offset;
