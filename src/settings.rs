@@ -125,11 +125,11 @@ pub struct MethodArgs {
     pub direct: DirectArg,
     /// LightCluster: minimum distance between cluster centres at the eye, metres (0: every
     /// light in view is its own cluster, hard shadows); also each cluster's disk radius.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, allow_hyphen_values = true)]
     pub lc_min_distance: f32,
     /// LightCluster: growth of the minimum distance with a light's distance d from the eye,
     /// per metre (min distance · (1 + S·d): clusters are smaller near the camera).
-    #[arg(long, default_value_t = 0.1)]
+    #[arg(long, default_value_t = 0.1, allow_hyphen_values = true)]
     pub lc_distance_scale: f32,
     /// LightCluster: most clusters (cube shadow maps) a frame, 1..=256; lights past them join
     /// the nearest cluster.

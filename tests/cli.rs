@@ -783,3 +783,61 @@ fn a_reader_that_goes_away_ends_visgate_quietly() {
     assert!(!err.contains("panicked"), "{err}");
     assert_eq!(status.code(), Some(141), "{err}");
 }
+
+#[test]
+fn render_lightcluster_prints_its_passes_and_clusters_and_refuses_bad_settings() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("lc.exr");
+    let out = out.to_str().expect("utf-8");
+    let base = [
+        "render",
+        "builtin:lamp-hall",
+        "--size",
+        "48x32",
+        "--direct",
+        "lightcluster",
+        "--out",
+        out,
+    ];
+    let mut a = base.to_vec();
+    a.extend(["--mode", "direct-only"]);
+    let o = visgate(&a);
+    assert!(o.status.success(), "{}", stderr(&o));
+    for p in [
+        "light culling",
+        "light clustering",
+        "cluster shadow maps",
+        "PCSS visibility",
+        "LightCluster: 51 lights in",
+    ] {
+        assert!(stdout(&o).contains(p), "{p}: {}", stdout(&o));
+    }
+    assert!(!stdout(&o).contains("  shadow maps"), "{}", stdout(&o));
+    let mut v = base.to_vec();
+    v.extend(["--mode", "vpl-clusters", "--vpls", "64"]);
+    let o = visgate(&v);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains("VPL PCSS visibility"), "{}", stdout(&o));
+    assert!(stdout(&o).contains("VPL clusters: "), "{}", stdout(&o));
+    for (flag, value, says) in [
+        ("--lc-max-clusters", "300", "at most 256 clusters"),
+        (
+            "--lc-min-distance",
+            "-1",
+            "minimum distance must be finite and >= 0",
+        ),
+        ("--lc-cutoff", "0", "range cutoff must be in (0, 1]"),
+        ("--lc-map-size", "8", "cube face size 8 must be 16..=2048"),
+        (
+            "--pcss-blocker-samples",
+            "0",
+            "blocker samples must be 1..=64",
+        ),
+    ] {
+        let mut b = a.clone();
+        b.extend([flag, value]);
+        let o = visgate(&b);
+        assert!(!o.status.success(), "{flag} {value} was taken");
+        assert!(stderr(&o).contains(says), "{flag}: {}", stderr(&o));
+    }
+}

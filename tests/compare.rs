@@ -413,3 +413,51 @@ fn val_counts_compare_each_val_mode_at_each_count() {
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("--val-counts 0"));
 }
+
+#[test]
+fn lightcluster_sweeps_beside_each_modes_own_shadow_maps() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("lc");
+    let args = [
+        "compare",
+        "builtin:lamp-hall",
+        "--modes",
+        "direct-only",
+        "--vpls",
+        "1",
+        "--lc-min-distances",
+        "0,2",
+        "--metric",
+        "mse",
+        "--size",
+        "48x32",
+        "--spp",
+        "1",
+        "--cameras",
+        "main",
+        "--out",
+        out.to_str().expect("utf-8"),
+    ];
+    let o = visgate(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let json: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).expect("json"))
+            .expect("parses");
+    let rows = json["rows"].as_array().expect("rows");
+    let labels: Vec<&str> = rows.iter().filter_map(|r| r["mode"].as_str()).collect();
+    assert_eq!(
+        labels,
+        ["direct-only", "direct-only-lc0", "direct-only-lc2"],
+        "{json}"
+    );
+    for r in &rows[1..] {
+        let settings = r["settings"].as_str().expect("settings");
+        assert!(settings.contains("clusters of 51 lights"), "{settings}");
+        // Direct light alone is measured against the reference's direct light: per light and
+        // every lamp its own cluster keep it.
+        let energy = r["energy_ratio"].as_f64().expect("energy");
+        assert!(energy > 0.5 && energy < 1.1, "{settings}: {energy}");
+    }
+    let own = rows[0]["energy_ratio"].as_f64().expect("energy");
+    assert!((own - 1.0).abs() < 0.02, "per light: {own}");
+}

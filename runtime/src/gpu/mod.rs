@@ -10,8 +10,10 @@
 //!
 //! 1. VPLs: uploaded, or made from the lights' RSMs on the GPU ([`passes::rsm_vpls`]), where
 //!    they stay;
-//! 2. the lights' shadow maps ([`passes::shadow_maps`]);
-//! 3. the G-buffer ([`passes::gbuffer`]);
+//! 2. the lights' shadow maps ([`passes::shadow_maps`]), unless LightCluster shadows them;
+//! 3. the G-buffer ([`passes::gbuffer`]); with `--direct lightcluster`, LightCluster's light
+//!    culling, clustering, cluster shadow maps and PCSS visibility ([`passes::light_cluster`]),
+//!    and in mode `vpl-clusters` the same over the VPLs;
 //! 4. mode `gates`: unique clusters and light assignment ([`passes::clustered_gates`]);
 //! 5. shading: direct light, and the indirect light of modes `none` and the gate modes
 //!    ([`passes::shade`]);
