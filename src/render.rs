@@ -47,7 +47,8 @@ Modes:
   vpl-clusters GPU: the VPLs clustered as LightCluster clusters lights (--lc-min-distance,
                --lc-distance-scale, --lc-max-clusters; beyond its paper): a cube shadow map
                per cluster (--lc-map-size), every VPL shadowed by its cluster's PCSS soft
-               shadow (--pcss-*), every VPL at every pixel (at most 16,384 VPLs)
+               shadow (--pcss-*), interleaved and blurred as the VAL modes (--interleave;
+               1: every VPL at every pixel; at most 16,384 VPLs)
   direct-only  GPU: direct light alone
 Direct light (GPU, every mode): --direct per-light shadows each light with its own cube or spot
 maps (exact hard shadows); --direct lightcluster clusters the lights in view each frame

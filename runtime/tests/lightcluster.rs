@@ -9,8 +9,8 @@ use visgate_runtime::cpu::lightcluster::{LightClusterParams, cluster_lights};
 use visgate_runtime::cpu::reference::{ReferenceParams, render_reference};
 use visgate_runtime::cpu::tracer::Tracer;
 use visgate_runtime::gpu::{
-    DirectLight, GpuContext, GpuMode, GpuParams, GpuRenderer, LcDisk, LightClusterGpuParams,
-    MAX_LC_LIGHTS,
+    DirectLight, GpuContext, GpuMode, GpuParams, GpuRenderer, InterleaveParams, LcDisk,
+    LightClusterGpuParams, MAX_LC_LIGHTS,
 };
 use visgate_runtime::hdr::HdrImage;
 use visgate_scenes::Builtin;
@@ -365,13 +365,21 @@ fn vpl_clusters_shadow_indirect_light_close_to_the_reference() {
     let vpls = path_vpls(&tracer, &scene.lights, &paths).expect("vpls");
     let view = View::new(scene.cameras.first().expect("camera"), [96, 72]).expect("view");
     let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
-    let mode = GpuMode::VplClusters(LightClusterGpuParams::default());
-    let (img, times) = gpu
-        .render(&ctx, &view, &vpls, &GpuParams::with_mode(mode))
-        .expect("frame");
-    let c = times.vpl_clusters.expect("the VPLs' clusters");
-    assert_eq!(c.lights, vpls.len() as u32);
-    assert!(c.clusters >= 1 && c.clusters <= 64, "{c:?}");
+    let mut frames = Vec::new();
+    for block in [1, 8] {
+        let il = InterleaveParams {
+            block,
+            ..InterleaveParams::default()
+        };
+        let mode = GpuMode::VplClusters(LightClusterGpuParams::default(), il);
+        let (img, times) = gpu
+            .render(&ctx, &view, &vpls, &GpuParams::with_mode(mode))
+            .expect("frame");
+        let c = times.vpl_clusters.expect("the VPLs' clusters");
+        assert_eq!(c.lights, vpls.len() as u32);
+        assert!(c.clusters >= 1 && c.clusters <= 64, "{c:?}");
+        frames.push((block, c.clusters, img));
+    }
     let (direct, _) = gpu
         .render(&ctx, &view, &[], &GpuParams::with_mode(GpuMode::DirectOnly))
         .expect("direct");
@@ -383,18 +391,21 @@ fn vpl_clusters_shadow_indirect_light_close_to_the_reference() {
     let (reference, _) =
         render_reference(&tracer, &scene.lights, &vpls, &view, &params, &|_, _| {})
             .expect("reference");
-    let i = indirect_errors(&img, &reference, &direct).expect("sizes");
-    let e = errors(&img, &reference).expect("sizes");
-    eprintln!(
-        "vpl-clusters, four rooms, {} VPLs in {} clusters: rel. MSE {:.3e}, indirect energy \
-         {:.3}, black where lit {:.1} %",
-        vpls.len(),
-        c.clusters,
-        e.rel_mse,
-        i.energy_ratio,
-        i.black_where_lit * 100.0
-    );
-    assert!((0.9..=1.1).contains(&i.energy_ratio), "{}", i.energy_ratio);
-    assert!(i.black_where_lit < 0.01, "{}", i.black_where_lit);
-    assert!(e.rel_mse < 5e-3, "{}", e.rel_mse);
+    for (block, clusters, img) in &frames {
+        let i = indirect_errors(img, &reference, &direct).expect("sizes");
+        let e = errors(img, &reference).expect("sizes");
+        eprintln!(
+            "vpl-clusters {block}×{block}, four rooms, {} VPLs in {clusters} clusters: rel. MSE \
+             {:.3e}, indirect energy {:.3}, black where lit {:.1} %",
+            vpls.len(),
+            e.rel_mse,
+            i.energy_ratio,
+            i.black_where_lit * 100.0
+        );
+        assert!((0.9..=1.1).contains(&i.energy_ratio), "{}", i.energy_ratio);
+        assert!(i.black_where_lit < 0.01, "{}", i.black_where_lit);
+        // Interleaved, 256 VPLs leave 4 a pixel: the blur's error on top.
+        let bound = if *block == 1 { 5e-3 } else { 3e-2 };
+        assert!(e.rel_mse < bound, "{block}: {}", e.rel_mse);
+    }
 }

@@ -37,7 +37,10 @@ pub fn method_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
             ui.add(interleave_block(&mut v.interleave.block));
             ui.add(egui::Slider::new(&mut v.map_size, 32..=512).text("VAL map size"));
         }
-        "vpl-clusters" => lc_controls(ui, &mut s.vpl_clusters),
+        "vpl-clusters" => {
+            lc_controls(ui, &mut s.vpl_clusters);
+            ui.add(interleave_block(&mut s.vals.interleave.block));
+        }
         "per-vpl-shadow-maps" => {
             ui.add(egui::Slider::new(&mut s.per_vpl.map_size, 16..=512).text("map size"));
             ui.add(egui::Slider::new(&mut s.per_vpl.batch, 1..=256).text("VPLs per batch"));

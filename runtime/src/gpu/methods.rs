@@ -43,8 +43,9 @@ pub enum GpuMode {
     ValCssm(ValModeParams, CssmParams),
     /// Every VPL lights every pixel with the soft shadow of its cluster: VPLs clustered as
     /// LightCluster clusters lights (minimum distance, nearest centre), a cube map per
-    /// cluster, PCSS visibility per cluster and pixel (beyond the LightCluster paper).
-    VplClusters(LightClusterGpuParams),
+    /// cluster, PCSS visibility per cluster and pixel (beyond the LightCluster paper); with
+    /// interleaved sampling and the geometry-aware blur as the VAL modes.
+    VplClusters(LightClusterGpuParams, InterleaveParams),
 }
 
 /// Every method's settings at once — what a command line or a viewer panel holds; each method
@@ -130,7 +131,7 @@ pub const METHODS: [MethodInfo; 8] = [
         name: "vpl-clusters",
         summary: "VPLs clustered as LightCluster clusters lights, a PCSS soft shadow per cluster",
         needs_level: false,
-        make: |s| GpuMode::VplClusters(s.vpl_clusters),
+        make: |s| GpuMode::VplClusters(s.vpl_clusters, s.vals.interleave),
     },
     MethodInfo {
         name: "direct-only",
@@ -156,7 +157,7 @@ impl GpuMode {
             GpuMode::GatesPerPixel(_) => "gates-per-pixel",
             GpuMode::ValHard(_) => "val-hard",
             GpuMode::ValCssm(..) => "val-cssm",
-            GpuMode::VplClusters(_) => "vpl-clusters",
+            GpuMode::VplClusters(..) => "vpl-clusters",
         }
     }
 
@@ -185,14 +186,15 @@ impl GpuMode {
                 v.map_size,
                 il(&v.interleave)
             ),
-            GpuMode::VplClusters(p) => {
+            GpuMode::VplClusters(p, i) => {
                 let c = &p.clustering;
                 format!(
-                    "{} m × (1 + {}·d), ≤ {} clusters, {}² faces",
+                    "{} m × (1 + {}·d), ≤ {} clusters, {}² faces, {}",
                     c.min_distance_m,
                     c.distance_scale,
                     c.max_clusters,
-                    p.face_size()
+                    p.face_size(),
+                    il(i)
                 )
             }
             GpuMode::ValCssm(v, c) => format!(
@@ -215,7 +217,7 @@ impl GpuMode {
             GpuMode::GatesPerPixel(g) => super::passes::clustered_gates::check_gates(g),
             GpuMode::ValHard(v) => v.check(),
             GpuMode::ValCssm(v, c) => v.check().and(c.check()),
-            GpuMode::VplClusters(p) => p.check(),
+            GpuMode::VplClusters(p, i) => p.check().and(i.check()),
         }
     }
 

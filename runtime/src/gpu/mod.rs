@@ -224,7 +224,7 @@ fn record_passes(
         None => None,
     };
     let vpl_lc = match &f.params.mode {
-        GpuMode::VplClusters(vp) => Some(p.light_cluster.record_vpls(f, vp, &g, pool, rec)?),
+        GpuMode::VplClusters(vp, _) => Some(p.light_cluster.record_vpls(f, vp, &g, pool, rec)?),
         _ => None,
     };
     let lists = match &f.params.mode {
@@ -233,9 +233,11 @@ fn record_passes(
     };
     let shading = match f.params.mode {
         GpuMode::Gates(gp) if gp.interleave.block > 1 => "shading: direct lighting",
-        GpuMode::None | GpuMode::Gates(_) | GpuMode::GatesPerPixel(_) | GpuMode::VplClusters(_) => {
-            "shading: direct + indirect lighting"
-        }
+        GpuMode::VplClusters(_, i) if i.block > 1 => "shading: direct lighting",
+        GpuMode::None
+        | GpuMode::Gates(_)
+        | GpuMode::GatesPerPixel(_)
+        | GpuMode::VplClusters(..) => "shading: direct + indirect lighting",
         _ => "shading: direct lighting",
     };
     let inputs = (&shadows, &g, lists.as_ref(), lc.as_ref(), vpl_lc.as_ref());
@@ -243,8 +245,13 @@ fn record_passes(
     let mut val_state = None;
     match &f.params.mode {
         GpuMode::Gates(gp) if gp.interleave.block > 1 => {
-            let indirect = p.shade.record_gates_indirect(f, pool, rec, inputs);
+            let indirect = p.shade.record_indirect(f, pool, rec, inputs, false);
             let uniform = InterleaveBlur::uniform(f, &gp.interleave, pool);
+            p.blur.record(f, pool, rec, (&g, &uniform, &indirect, &hdr));
+        }
+        GpuMode::VplClusters(_, il) if il.block > 1 => {
+            let indirect = p.shade.record_indirect(f, pool, rec, inputs, true);
+            let uniform = InterleaveBlur::uniform(f, il, pool);
             p.blur.record(f, pool, rec, (&g, &uniform, &indirect, &hdr));
         }
         GpuMode::PerVplShadowMaps(pv) => p.maps.record(f, pv, pool, rec, (&g, &hdr)),
@@ -431,7 +438,7 @@ impl GpuRenderer {
             GpuMode::None => ShadeIndirect::All,
             GpuMode::GatesPerPixel(_) => ShadeIndirect::GatesPerPixel,
             GpuMode::Gates(_) => ShadeIndirect::GatesClustered,
-            GpuMode::VplClusters(_) => ShadeIndirect::VplClusters,
+            GpuMode::VplClusters(..) => ShadeIndirect::VplClusters,
             _ => ShadeIndirect::DirectOnly,
         };
         let globals = Globals {
@@ -442,6 +449,7 @@ impl GpuRenderer {
             shadow_bias: params.shadows.bias,
             interleave_block: match params.mode {
                 GpuMode::Gates(gp) => gp.interleave.block,
+                GpuMode::VplClusters(_, il) => il.block,
                 _ => 1,
             },
             vpl_count,

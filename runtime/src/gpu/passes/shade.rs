@@ -19,6 +19,7 @@ pub const HDR: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 pub struct Shade {
     pipeline: wgpu::RenderPipeline,
     gates_indirect: wgpu::RenderPipeline,
+    vpl_clusters_indirect: wgpu::RenderPipeline,
 }
 
 /// A fullscreen triangle into `target` (cleared to black) with `pipeline` and `bind_group`.
@@ -80,6 +81,8 @@ pub type Inputs<'a> = (
 /// The bindings of shade.wgsl's `fs_gates_indirect` (an automatic layout holds only what an
 /// entry point uses).
 const GATES_INDIRECT_BINDINGS: [u32; 11] = [0, 2, 5, 6, 8, 10, 12, 13, 14, 15, 16];
+/// The bindings of shade.wgsl's `fs_vpl_clusters_indirect`.
+const VPL_CLUSTERS_INDIRECT_BINDINGS: [u32; 6] = [0, 2, 5, 6, 19, 20];
 
 impl Shade {
     /// Builds the pipelines.
@@ -95,9 +98,19 @@ impl Shade {
             &[HDR],
             None,
         );
+        let vpl_clusters_indirect = render_pipeline(
+            d,
+            "VPL clusters indirect (interleaved)",
+            &module,
+            ("vs", "fs_vpl_clusters_indirect"),
+            &[],
+            &[HDR],
+            None,
+        );
         Ok(Shade {
             pipeline,
             gates_indirect,
+            vpl_clusters_indirect,
         })
     }
 
@@ -115,17 +128,25 @@ impl Shade {
         out
     }
 
-    /// Records interleaved clustered gates' indirect irradiance (each pixel its subset's, × B)
-    /// into a target of its own, for the blur to compose.
-    pub fn record_gates_indirect(
+    /// Records an interleaved mode's indirect irradiance (each pixel its subset's, × B) into a
+    /// target of its own, for the blur to compose: clustered gates', or with `vpl_clusters`
+    /// the VPL clusters'.
+    pub fn record_indirect(
         &self,
         f: &Frame,
         pool: &mut Pool,
         rec: &mut Recorder,
         inputs: Inputs,
+        vpl_clusters: bool,
     ) -> wgpu::Texture {
         let out = frame_target(f, pool, "indirect irradiance");
-        let pipeline = (&self.gates_indirect, Some(&GATES_INDIRECT_BINDINGS[..]));
+        let pipeline = match vpl_clusters {
+            false => (&self.gates_indirect, Some(&GATES_INDIRECT_BINDINGS[..])),
+            true => (
+                &self.vpl_clusters_indirect,
+                Some(&VPL_CLUSTERS_INDIRECT_BINDINGS[..]),
+            ),
+        };
         self.draw(f, rec, inputs, pipeline, (&out, "indirect lighting"));
         out
     }

@@ -52,10 +52,11 @@ struct GeometryCluster {
 @group(0) @binding(19) var vpl_lc_visibility: texture_2d_array<f32>;
 @group(0) @binding(20) var<storage, read> vpl_lc_cluster: array<u32>;
 
-// SHADE_VPL_CLUSTERS: every VPL, shadowed by its cluster's PCSS visibility at px.
-fn gather_vpl_clusters(p: vec3<f32>, n: vec3<f32>, px: vec2<i32>) -> vec3<f32> {
+// SHADE_VPL_CLUSTERS: the VPLs first, first + step, … (every VPL, or an interleaving subset),
+// each shadowed by its cluster's PCSS visibility at px; the sum × step.
+fn gather_vpl_clusters(p: vec3<f32>, n: vec3<f32>, px: vec2<i32>, first: u32, step: u32) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
-    for (var j = 0u; j < globals.vpl_count; j++) {
+    for (var j = first; j < globals.vpl_count; j += step) {
         let c = vpl_lc_cluster[j];
         if c == NONE {
             continue;
@@ -65,7 +66,7 @@ fn gather_vpl_clusters(p: vec3<f32>, n: vec3<f32>, px: vec2<i32>) -> vec3<f32> {
             sum += l * textureLoad(vpl_lc_visibility, px, i32(c / 4u), 0)[c % 4u];
         }
     }
-    return sum;
+    return sum * f32(step);
 }
 
 // Light i's visibility at pixel px (p, normal n): its shadow maps, or its cluster's PCSS.
@@ -188,8 +189,8 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
         radiance += albedo / PI * gather_all(p, n);
     } else if mode == SHADE_GATES_PER_PIXEL {
         radiance += albedo / PI * gather_per_pixel(p, n, decode_cluster(pos.w));
-    } else if mode == SHADE_VPL_CLUSTERS {
-        radiance += albedo / PI * gather_vpl_clusters(p, n, px);
+    } else if mode == SHADE_VPL_CLUSTERS && globals.interleave_block <= 1u {
+        radiance += albedo / PI * gather_vpl_clusters(p, n, px, 0u, 1u);
     } else if mode == SHADE_GATES_CLUSTERED && globals.interleave_block <= 1u {
         radiance += albedo / PI * clustered_gather(px, p, n, decode_cluster(pos.w));
     }
@@ -292,6 +293,20 @@ fn fs_gates_indirect(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f3
     }
     let n = normalize(textureLoad(g_normal, px, 0).xyz);
     return vec4<f32>(clustered_gather(px, pos.xyz, n, decode_cluster(pos.w)), 1.0);
+}
+
+// Interleaved VPL clusters: as fs_gates_indirect, each pixel its subset of the VPLs.
+@fragment
+fn fs_vpl_clusters_indirect(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
+    let b = max(globals.interleave_block, 1u);
+    let px = interleaved(vec2<i32>(frag.xy), b, textureDimensions(g_position));
+    let pos = textureLoad(g_position, px, 0);
+    if pos.w == 0.0 {
+        return vec4<f32>(0.0);
+    }
+    let n = normalize(textureLoad(g_normal, px, 0).xyz);
+    let j = interleave_subset(px, b);
+    return vec4<f32>(gather_vpl_clusters(pos.xyz, n, px, j, b * b), 1.0);
 }
 
 // SHADE_ALL: every VPL, no visibility.
