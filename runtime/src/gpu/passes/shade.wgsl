@@ -285,28 +285,40 @@ fn subset_start(first: u32, end: u32, subsets: u32, j: u32) -> u32 {
 // pixel that s holds, so that a GPU's neighbouring lanes walk the same VPLs.
 @fragment
 fn fs_gates_indirect(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
-    let b = max(globals.interleave_block, 1u);
-    let px = interleaved(vec2<i32>(frag.xy), b, textureDimensions(g_position));
-    let pos = textureLoad(g_position, px, 0);
-    if pos.w == 0.0 {
+    let s = interleaved_surface(frag);
+    if s.position.w == 0.0 {
         return vec4<f32>(0.0);
     }
-    let n = normalize(textureLoad(g_normal, px, 0).xyz);
-    return vec4<f32>(clustered_gather(px, pos.xyz, n, decode_cluster(pos.w)), 1.0);
+    let here = decode_cluster(s.position.w);
+    return vec4<f32>(clustered_gather(s.px, s.position.xyz, s.normal, here), 1.0);
+}
+
+// The pixel a deinterleaved fragment shades, and its G-buffer surface (w 0: none).
+struct Surface {
+    px: vec2<i32>,
+    position: vec4<f32>,
+    normal: vec3<f32>,
+};
+
+fn interleaved_surface(frag: vec4<f32>) -> Surface {
+    let b = max(globals.interleave_block, 1u);
+    var s: Surface;
+    s.px = interleaved(vec2<i32>(frag.xy), b, textureDimensions(g_position));
+    s.position = textureLoad(g_position, s.px, 0);
+    s.normal = normalize(textureLoad(g_normal, s.px, 0).xyz);
+    return s;
 }
 
 // Interleaved VPL clusters: as fs_gates_indirect, each pixel its subset of the VPLs.
 @fragment
 fn fs_vpl_clusters_indirect(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
-    let b = max(globals.interleave_block, 1u);
-    let px = interleaved(vec2<i32>(frag.xy), b, textureDimensions(g_position));
-    let pos = textureLoad(g_position, px, 0);
-    if pos.w == 0.0 {
+    let s = interleaved_surface(frag);
+    if s.position.w == 0.0 {
         return vec4<f32>(0.0);
     }
-    let n = normalize(textureLoad(g_normal, px, 0).xyz);
-    let j = interleave_subset(px, b);
-    return vec4<f32>(gather_vpl_clusters(pos.xyz, n, px, j, b * b), 1.0);
+    let b = max(globals.interleave_block, 1u);
+    let j = interleave_subset(s.px, b);
+    return vec4<f32>(gather_vpl_clusters(s.position.xyz, s.normal, s.px, j, b * b), 1.0);
 }
 
 // SHADE_ALL: every VPL, no visibility.
