@@ -409,3 +409,52 @@ fn vpl_clusters_shadow_indirect_light_close_to_the_reference() {
         assert!(e.rel_mse < bound, "{block}: {}", e.rel_mse);
     }
 }
+
+#[test]
+fn lightcluster_shadows_spots_too_and_combines_with_every_indirect_mode() {
+    use visgate_runtime::gpu::{METHODS, MethodSettings};
+    use visgate_runtime::vpl::{PathParams, path_vpls};
+    let ctx = context();
+    // The pillared hall: a point light and a spot. Every light its own cluster (radius 0):
+    // the same light as the per-light maps (spots keep their cone in shading).
+    let scene = Builtin::PillaredHall.scene().expect("scene");
+    let view = View::new(scene.cameras.first().expect("camera"), [96, 64]).expect("view");
+    let own = render(&ctx, &scene, &view, DirectLight::PerLight);
+    let hard = render(
+        &ctx,
+        &scene,
+        &view,
+        DirectLight::LightCluster(lc(0.0, 0.0, 64)),
+    );
+    let ratio = hard.mean().x / own.mean().x;
+    eprintln!("pillared hall, point + spot, radius 0: LightCluster / per light {ratio:.4}");
+    assert!((ratio - 1.0).abs() < 0.02, "spot + point: {ratio}");
+    // Every registered method without a level, its indirect light beside LightCluster's
+    // direct light.
+    let tracer = visgate_runtime::cpu::tracer::Tracer::new(&scene);
+    let paths = PathParams {
+        paths: 64,
+        bounces: 1,
+        seed: 1,
+    };
+    let vpls = path_vpls(&tracer, &scene.lights, &paths).expect("vpls");
+    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    for m in METHODS.iter().filter(|m| !m.needs_level) {
+        let params = GpuParams {
+            direct: DirectLight::LightCluster(LightClusterGpuParams::default()),
+            ..GpuParams::with_mode((m.make)(&MethodSettings::default()))
+        };
+        let (img, times) = gpu
+            .render(&ctx, &view, &vpls, &params)
+            .unwrap_or_else(|e| panic!("{}: {e}", m.name));
+        assert!(img.pixels.iter().all(|p| p.is_finite()), "{}", m.name);
+        assert!(img.mean().x > 0.0, "{}", m.name);
+        let c = times.direct_clusters.expect("LightCluster's counts");
+        assert_eq!(c.lights, 2, "{}", m.name);
+        assert!(
+            times.passes.iter().all(|p| p.name != "shadow maps"),
+            "{}: the per-light maps were drawn",
+            m.name
+        );
+    }
+}
