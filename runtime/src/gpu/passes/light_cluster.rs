@@ -297,7 +297,7 @@ impl LightCluster {
             ),
             (
                 &self.assign,
-                group(&self.assign, &[0, 1, 2, 3, 5, 7, 8, 9]),
+                group(&self.assign, &[0, 1, 2, 3, 5, 6, 7, 8, 9]),
                 n.div_ceil(WG_LINEAR),
             ),
         ];

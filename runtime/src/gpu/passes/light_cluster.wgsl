@@ -97,6 +97,13 @@ var<workgroup> live_count: u32;
 var<workgroup> blocked: atomic<u32>;
 var<workgroup> count: u32;
 var<workgroup> centre_at: array<vec4<f32>, MAX_LC_CLUSTERS>;
+var<workgroup> centre_dir: array<vec3<f32>, MAX_LC_CLUSTERS>;
+
+// Whether emitters of axes a and b may share a cluster: lights always; VPLs (hemisphere) only
+// when their normals are within 60° (a cluster does not mix a floor's VPLs with a wall's).
+fn alike(a: vec3<f32>, b: vec3<f32>) -> bool {
+    return frame.hemisphere == 0u || dot(a, b) > 0.5;
+}
 
 // Whether kept light j comes before kept light i in the first pass's order.
 fn before(j: u32, i: u32) -> bool {
@@ -147,8 +154,9 @@ fn centres_pass(@builtin(local_invocation_index) t: u32) {
         let i = order[r];
         let p = lights[i].position.xyz;
         let radius = frame.min_distance_m * (1.0 + frame.distance_scale * light_key[i]);
+        let axis = lights[i].direction.xyz;
         for (var k = t; k < c; k += WG_WIDE) {
-            if distance(centre_at[k].xyz, p) < radius {
+            if alike(centre_dir[k], axis) && distance(centre_at[k].xyz, p) < radius {
                 atomicStore(&blocked, 1u);
             }
         }
@@ -156,6 +164,7 @@ fn centres_pass(@builtin(local_invocation_index) t: u32) {
         if t == 0u {
             if atomicLoad(&blocked) == 0u {
                 centre_at[c] = vec4<f32>(p, radius);
+                centre_dir[c] = axis;
                 centres[c] = i;
                 light_cluster[i] = c;
                 count = c + 1u;
@@ -191,15 +200,27 @@ fn assign(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let p = lights[i].position.xyz;
+    let axis = lights[i].direction.xyz;
+    // The nearest centre alike (see `alike`); the nearest of all where none is.
     var best = 0u;
     var best_d2 = 3.4e38;
+    var any_best = 0u;
+    var any_d2 = 3.4e38;
     for (var k = 0u; k < args[3]; k++) {
         let d = clusters[k].xyz - p;
         let d2 = dot(d, d);
-        if d2 < best_d2 {
+        if d2 < any_d2 {
+            any_d2 = d2;
+            any_best = k;
+        }
+        if d2 < best_d2 && alike(lights[centres[k]].direction.xyz, axis) {
             best_d2 = d2;
             best = k;
         }
+    }
+    if best_d2 == 3.4e38 {
+        best = any_best;
+        best_d2 = any_d2;
     }
     light_cluster[i] = best;
     let d = sqrt(best_d2);
