@@ -158,28 +158,23 @@ fn lightcluster_modes(
     }
     let mut out = Vec::new();
     for m in modes {
-        for &d in min_distances {
-            let mut args = settings.clone();
-            args.direct = crate::settings::DirectArg::Lightcluster;
-            args.lc_min_distance = d;
-            let direct = args.direct();
-            if let DirectLight::LightCluster(p) = &direct {
-                p.check()
-                    .map_err(|e| anyhow::anyhow!("--lc-min-distances {d}: {e}"))?;
-            }
-            out.push(CompareMode {
+        let variants = min_distances.iter().map(|&d| {
+            let mut p = settings.light_cluster();
+            p.clustering.min_distance_m = d;
+            p.check()
+                .map_err(|e| anyhow::anyhow!("--lc-min-distances {d}: {e}"))?;
+            Ok(CompareMode {
                 label: format!("{}-lc{d}", m.label),
                 mode: m.mode,
-                direct,
-            });
-        }
-        out.insert(
-            out.len() - min_distances.len(),
-            CompareMode {
-                direct: DirectLight::PerLight,
-                ..m
-            },
-        );
+                direct: DirectLight::LightCluster(p),
+            })
+        });
+        let variants: Vec<CompareMode> = variants.collect::<Result<_>>()?;
+        out.push(CompareMode {
+            direct: DirectLight::PerLight,
+            ..m
+        });
+        out.extend(variants);
     }
     Ok(out)
 }

@@ -371,6 +371,16 @@ impl Scene {
         bounds_of(self.meshes.iter())
     }
 
+    /// The diagonal of [`Scene::bounds`] (1 for a scene of no vertices), at least 1e-6: the
+    /// length the renderer's near and far planes and LightCluster's light ranges follow.
+    /// [Units: m]
+    pub fn diagonal_m(&self) -> f32 {
+        self.bounds()
+            .map(|(lo, hi)| (hi - lo).length())
+            .unwrap_or(1.0)
+            .max(1e-6)
+    }
+
     /// Axis-aligned bounds of the static meshes' vertices, metres.
     pub fn static_bounds(&self) -> Option<(Vec3, Vec3)> {
         bounds_of(self.meshes.iter().filter(|m| m.is_static))

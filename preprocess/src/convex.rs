@@ -34,12 +34,12 @@ pub struct SplitInput<'a> {
 }
 
 /// The clusters split so that each one's segmented nodes see each other: every segmented
-/// node's cluster, each cluster's seed, and how many clusters were added.
+/// node's cluster and each cluster's seed (the clusters cut off come after `seeds`' own).
 pub fn split_unseen(
     input: &SplitInput,
     node_cluster: &[u32],
     seeds: &[u32],
-) -> (Vec<u32>, Vec<u32>, usize) {
+) -> (Vec<u32>, Vec<u32>) {
     let seg = input.seg;
     let n = seg.nodes.len();
     let voxel = |s: u32| {
@@ -107,8 +107,7 @@ pub fn split_unseen(
             }
         }
     }
-    let added = out_seeds.len() - seeds.len();
-    (out, out_seeds, added)
+    (out, out_seeds)
 }
 
 #[cfg(test)]
@@ -180,7 +179,9 @@ mod tests {
             node_voxel,
             radius: &radius,
         };
-        split_unseen(&input, &[0; 8], &[0])
+        let (cluster, seeds) = split_unseen(&input, &[0; 8], &[0]);
+        let added = seeds.len() - 1;
+        (cluster, seeds, added)
     }
 
     #[test]

@@ -285,7 +285,8 @@ pub fn clusters_and_gates(
             node_voxel: &sk.graph.voxels,
             radius: &sk.radius,
         };
-        let (node_cluster, seeds, added) = split_unseen(&input, &grown, &grown_seeds);
+        let (node_cluster, seeds) = split_unseen(&input, &grown, &grown_seeds);
+        let added = seeds.len() - grown_seeds.len();
         let counts = json!({
             "clusters": seeds.len(),
             "grown": grown_seeds.len(),

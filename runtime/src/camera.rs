@@ -57,7 +57,7 @@ impl View {
     }
 
     /// Half-extents of the image plane at distance 1.
-    fn tan_half(&self) -> Vec2 {
+    pub fn tan_half(&self) -> Vec2 {
         let tx = (0.5 * self.fov_x_rad).tan();
         Vec2::new(tx, tx * self.size[1] as f32 / self.size[0] as f32)
     }

@@ -74,11 +74,7 @@ fn scattered(n: usize, r: f32) -> Vec<Light> {
 /// The GPU's clusters against the CPU twin's for every camera of `scene` and every setting.
 fn check_twin(ctx: &GpuContext, scene: &Scene, cameras: &[Camera], settings: &[(f32, f32, u32)]) {
     let mut gpu = GpuRenderer::new(ctx, scene).expect("upload");
-    // As the renderer's: the first scene's bounding diagonal.
-    let diagonal = scene
-        .bounds()
-        .map_or(1.0, |(lo, hi)| (hi - lo).length())
-        .max(1e-6);
+    let diagonal = scene.diagonal_m();
     for cam in cameras {
         let view = View::new(cam, [320, 180]).expect("view");
         for &(d, s, m) in settings {

@@ -84,19 +84,18 @@ impl CompareMode {
         let DirectLight::LightCluster(p) = &self.direct else {
             return mode;
         };
-        let c = &p.clustering;
-        let lc = format!(
-            "LightCluster {} m × (1 + {}·d), ≤ {} clusters, {}² faces",
-            c.min_distance_m,
-            c.distance_scale,
-            c.max_clusters,
-            p.face_size()
-        );
+        let lc = format!("LightCluster {}", p.describe());
         if mode.is_empty() {
             lc
         } else {
             format!("{mode}; {lc}")
         }
+    }
+
+    /// Whether its image's direct light is not `base`'s: its direct shadows differ, and it has
+    /// indirect light to measure apart.
+    fn own_direct(&self, base: &RenderJob) -> bool {
+        self.direct != base.params.direct && self.mode != GpuMode::DirectOnly
     }
 
     /// `job` rendering this method.
@@ -483,14 +482,14 @@ pub fn run(
     progress: &(dyn Fn(Step) + Sync),
 ) -> Result<CompareReport, RenderError> {
     spec.check(level.is_some())?;
-    // Direct light on the CPU and GPU, then per VPL count the reference, each method, and the
-    // own direct light of each method shadowed otherwise than the run.
+    // Direct light on the CPU and GPU and that of each method shadowed otherwise than the run,
+    // then per VPL count the reference and each method.
     let own_direct = spec
         .modes
         .iter()
-        .filter(|m| m.direct != spec.base.params.direct && m.mode != GpuMode::DirectOnly)
+        .filter(|m| m.own_direct(&spec.base))
         .count() as u32;
-    let per_camera = 2 + spec.vpls.len() as u32 * (1 + spec.modes.len() as u32 + own_direct);
+    let per_camera = 2 + own_direct + spec.vpls.len() as u32 * (1 + spec.modes.len() as u32);
     let mut store = Store {
         dir,
         spec,
@@ -532,10 +531,11 @@ pub fn run(
     Ok(report)
 }
 
-/// The direct light of one camera, on the CPU (the reference's) and on the GPU (the methods').
-struct Direct {
-    cpu: HdrImage,
-    gpu: HdrImage,
+/// The direct light of one camera, on the CPU (the reference's) and on the GPU (the
+/// method's).
+struct Direct<'a> {
+    cpu: &'a HdrImage,
+    gpu: &'a HdrImage,
 }
 
 /// Renders one camera's references and methods into `report`.
@@ -553,22 +553,34 @@ fn camera_rows(
         ..spec.base.clone()
     };
     let one = |v: Vec<HdrImage>| v.into_iter().next().unwrap_or_else(|| HdrImage::new(1, 1));
-    let direct = Direct {
-        cpu: one(store
-            .render(
-                camera,
-                "direct-cpu",
-                &job(Renderer::CpuTwin(GpuMode::DirectOnly), 0),
-            )?
-            .0),
-        gpu: one(store
-            .render(
-                camera,
-                "direct-gpu",
-                &job(Renderer::Gpu(GpuMode::DirectOnly), 0),
-            )?
-            .0),
-    };
+    let direct_cpu = one(store
+        .render(
+            camera,
+            "direct-cpu",
+            &job(Renderer::CpuTwin(GpuMode::DirectOnly), 0),
+        )?
+        .0);
+    let direct_gpu = one(store
+        .render(
+            camera,
+            "direct-gpu",
+            &job(Renderer::Gpu(GpuMode::DirectOnly), 0),
+        )?
+        .0);
+    // A method with other direct shadows than the run's: its own direct light, to take out of
+    // its image (once a camera, whatever the VPL count).
+    let mut own_direct = Vec::new();
+    for m in &spec.modes {
+        own_direct.push(match m.own_direct(&spec.base) {
+            true => {
+                let mut dj = job(Renderer::Gpu(GpuMode::DirectOnly), 0);
+                dj.params.direct = m.direct;
+                let label = format!("direct-gpu-{}", file_name(&m.label));
+                Some(one(store.render(camera, &label, &dj)?.0))
+            }
+            false => None,
+        });
+    }
     for &vpls in &spec.vpls {
         let (images, kept, rel) = store.render(
             camera,
@@ -587,21 +599,12 @@ fn camera_rows(
             ground_truth_rel_mse: gt.map(|e| e.rel_mse),
             image: path_string(&rel.with_extension("png")),
         });
-        for m in &spec.modes {
+        for (m, own) in spec.modes.iter().zip(&own_direct) {
             let name = format!("{}-{vpls}", file_name(&m.label));
             let mode_job = m.job(&job(Renderer::Gpu(m.mode), vpls));
-            // A method with other direct shadows than the run's: its own direct light, to
-            // take out of its image.
-            let mut own = None;
-            if m.direct != spec.base.params.direct && m.mode != GpuMode::DirectOnly {
-                let mut dj = job(Renderer::Gpu(GpuMode::DirectOnly), 0);
-                dj.params.direct = m.direct;
-                let label = format!("direct-gpu-{}", file_name(&m.label));
-                own = Some(one(store.render(camera, &label, &dj)?.0));
-            }
             let direct = Direct {
-                cpu: direct.cpu.clone(),
-                gpu: own.unwrap_or_else(|| direct.gpu.clone()),
+                cpu: &direct_cpu,
+                gpu: own.as_ref().unwrap_or(&direct_gpu),
             };
             match store.render(camera, &name, &mode_job) {
                 Ok((images, kept, rel)) => {
@@ -644,14 +647,10 @@ fn settings_of(
     if let DirectLight::LightCluster(p) = &m.direct {
         let scene = store.scene;
         let view = crate::camera::View::new(camera, store.spec.base.size)?;
-        let diagonal = scene
-            .bounds()
-            .map_or(1.0, |(lo, hi)| (hi - lo).length())
-            .max(1e-6);
         let c = crate::cpu::lightcluster::cluster_lights(
             &scene.lights,
             &view,
-            diagonal,
+            scene.diagonal_m(),
             &p.clustering,
         )?;
         s += &format!(
@@ -679,15 +678,15 @@ fn measure(
     // Direct light alone is measured against the reference's direct light alone (shadow
     // rays): every error, the energy and black-where-lit are then the direct light's.
     let direct_only = m.mode == GpuMode::DirectOnly;
-    let reference = if direct_only { &direct.cpu } else { reference };
+    let reference = if direct_only { direct.cpu } else { reference };
     let e = errors(image, reference)?;
     let (f, flip_map) = flip(image, reference, exposure)?;
     let (i, indirect_mse) = if direct_only {
         let black = HdrImage::new(image.width, image.height);
         (indirect_errors(image, reference, &black)?, e.mse)
     } else {
-        let rebased = rebase_direct(image, &direct.gpu, &direct.cpu)?;
-        let i = indirect_errors(&rebased, reference, &direct.cpu)?;
+        let rebased = rebase_direct(image, direct.gpu, direct.cpu)?;
+        let i = indirect_errors(&rebased, reference, direct.cpu)?;
         (i, errors(&rebased, reference)?.mse)
     };
     let png = rel.with_extension("png");

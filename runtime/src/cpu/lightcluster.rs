@@ -1,5 +1,6 @@
 //! LightCluster's clustering of many direct lights (the paper in
-//! `../shared/papers/lightcluster-pcss.txt`), the CPU twin its GPU passes will follow.
+//! `../shared/papers/lightcluster-pcss.txt`): the CPU twin of the GPU's passes
+//! (`gpu/passes/light_cluster.wgsl`), tested equal.
 //!
 //! 1. **Culling by range.** visgate's lights fall off as 1/d² and have no range; here a
 //!    light reaches as far as its irradiance stays above `cutoff` times the irradiance the
@@ -122,7 +123,7 @@ pub fn sphere_in_view(view: &View, p: Vec3, r: f32) -> bool {
     let d = p - view.eye;
     let (x, y, z) = (d.dot(view.right), d.dot(view.up), d.dot(view.forward));
     let half_x = 0.5 * view.fov_x_rad;
-    let half_y = (half_x.tan() * view.size[1] as f32 / view.size[0] as f32).atan();
+    let half_y = view.tan_half().y.atan();
     let outside = |lateral: f32, half: f32| lateral * half.cos() - z * half.sin() > r;
     !(z < -r
         || outside(x, half_x)
@@ -131,7 +132,8 @@ pub fn sphere_in_view(view: &View, p: Vec3, r: f32) -> bool {
         || outside(-y, half_y))
 }
 
-/// Clusters `lights` for `view` in a level of diagonal `diagonal_m` (see the module notes).
+/// Clusters `lights` for `view` in a level of diagonal `diagonal_m` (the renderer's is
+/// `Scene::diagonal_m`; see the module notes).
 pub fn cluster_lights(
     lights: &[Light],
     view: &View,

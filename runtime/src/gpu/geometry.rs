@@ -163,11 +163,7 @@ impl Geometry {
             }
         }
         let vertex_count = (data.len() / VERTEX_FLOATS) as u32;
-        let size = scene
-            .bounds()
-            .map(|(lo, hi)| (hi - lo).length())
-            .unwrap_or(1.0)
-            .max(1e-6);
+        let size = scene.diagonal_m();
         let tris: Vec<[Vec3; 3]> = data
             .chunks_exact(3 * VERTEX_FLOATS)
             .map(|c| {

@@ -186,17 +186,7 @@ impl GpuMode {
                 v.map_size,
                 il(&v.interleave)
             ),
-            GpuMode::VplClusters(p, i) => {
-                let c = &p.clustering;
-                format!(
-                    "{} m × (1 + {}·d), ≤ {} clusters, {}² faces, {}",
-                    c.min_distance_m,
-                    c.distance_scale,
-                    c.max_clusters,
-                    p.face_size(),
-                    il(i)
-                )
-            }
+            GpuMode::VplClusters(p, i) => format!("{}, {}", p.describe(), il(i)),
             GpuMode::ValCssm(v, c) => format!(
                 "{} VALs, {}² maps, {} terms, {}",
                 v.vals.count,

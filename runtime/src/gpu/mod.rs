@@ -456,10 +456,7 @@ impl GpuRenderer {
             light_count: scene.lights.len() as u32,
             shade_mode: shade_mode as u32,
             shadow_size: params.shadows.size,
-            direct_mode: match params.direct {
-                DirectLight::PerLight => 0,
-                DirectLight::LightCluster(_) => 1,
-            },
+            direct_mode: params.direct.shader_id(),
             _pad0: 0,
             _pad1: 0,
             _pad2: 0,
@@ -612,14 +609,9 @@ impl GpuRenderer {
                 converged: c[1] != 0,
             });
         }
-        let counts = |r: &wgpu::Buffer, lights: u32| -> Result<LcCounts, RenderError> {
-            let c: Vec<u32> = bytemuck::cast_slice(&map_read(ctx, r)?).to_vec();
-            let at = passes::light_cluster::ARGS_COUNTS as usize;
-            Ok(LcCounts {
-                clusters: c[at],
-                culled: c[at + 1],
-                lights,
-            })
+        let counts = |r: &wgpu::Buffer, emitters: u32| -> Result<LcCounts, RenderError> {
+            let args: Vec<u32> = bytemuck::cast_slice(&map_read(ctx, r)?).to_vec();
+            Ok(passes::light_cluster::counts_of(&args, emitters))
         };
         if let Some(r) = &lc_read {
             times.direct_clusters = Some(counts(r, self.scene.lights.len() as u32)?);
@@ -720,10 +712,12 @@ impl GpuRenderer {
             wgpu::BufferUsages::STORAGE,
         );
         let frame = passes::light_cluster::lc_frame(&self.scene, view, params, (0.0, 0.0));
+        let kind = passes::light_cluster::LcKind::Direct;
+        let frame_buf = passes::light_cluster::upload_frame(ctx, &mut self.pool, &frame, kind);
         let mut rec = Recorder::new(ctx, &mut self.pool);
         let c = self.pipelines.light_cluster.record_clustering(
             ctx,
-            (&frame, passes::light_cluster::LcKind::Direct),
+            (&frame, &frame_buf, kind),
             &lights_buf,
             &mut self.pool,
             &mut rec,
@@ -732,18 +726,17 @@ impl GpuRenderer {
         let words = |b: &wgpu::Buffer| -> Result<Vec<u32>, RenderError> {
             Ok(bytemuck::cast_slice(&read_buffer(ctx, b)?).to_vec())
         };
-        let args = words(&c.args)?;
-        let at = passes::light_cluster::ARGS_COUNTS as usize;
-        let (count, culled) = (args[at] as usize, args[at + 1]);
+        let n = self.scene.lights.len();
+        let counts = passes::light_cluster::counts_of(&words(&c.args)?, n as u32);
+        let count = counts.clusters as usize;
         let clusters: Vec<f32> = bytemuck::cast_slice(&read_buffer(ctx, &c.clusters)?).to_vec();
         let extent: Vec<f32> = bytemuck::cast_slice(&read_buffer(ctx, &c.extent)?).to_vec();
-        let n = self.scene.lights.len();
         Ok(LightClusters {
             centres: words(&c.centres)?[..count].to_vec(),
             radius_m: (0..count).map(|k| clusters[4 * k + 3]).collect(),
             extent_m: extent[..count].to_vec(),
             light_cluster: words(&c.light_cluster)?[..n].to_vec(),
-            culled,
+            culled: counts.culled,
         })
     }
 

@@ -68,6 +68,11 @@ pub enum ShadeIndirect {
     VplClusters = 4,
 }
 
+/// `Globals::direct_mode`: each light's own shadow maps.
+pub const DIRECT_PER_LIGHT: u32 = 0;
+/// `Globals::direct_mode`: each light's LightCluster cluster's visibility.
+pub const DIRECT_LIGHTCLUSTER: u32 = 1;
+
 /// Workgroup size of the 1D compute passes (VPLs, VALs, RSM samples).
 pub const WG_LINEAR: u32 = 64;
 /// Side of the clustered passes' square workgroups; also the largest tile side. [Units: px]
@@ -108,8 +113,8 @@ pub fn constants() -> String {
         ShadeIndirect::GatesClustered as u32,
     );
     s += &u("SHADE_VPL_CLUSTERS", ShadeIndirect::VplClusters as u32);
-    s += &u("DIRECT_PER_LIGHT", 0);
-    s += &u("DIRECT_LIGHTCLUSTER", 1);
+    s += &u("DIRECT_PER_LIGHT", DIRECT_PER_LIGHT);
+    s += &u("DIRECT_LIGHTCLUSTER", DIRECT_LIGHTCLUSTER);
     s += &u(
         "MAX_LC_CLUSTERS",
         super::passes::light_cluster::MAX_LC_CLUSTERS,

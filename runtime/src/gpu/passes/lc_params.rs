@@ -37,27 +37,37 @@ pub enum LcDisk {
 }
 
 /// LightCluster's settings on the GPU.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LightClusterGpuParams {
     /// The clustering (its `max_clusters` at most [`MAX_LC_CLUSTERS`]).
     pub clustering: LightClusterParams,
     /// Each cluster's disk.
     pub disk: LcDisk,
-    /// Side of each cluster's cube face. [Units: texels] [Limit: 16..=2048; 0 for the
-    /// default, 256]
+    /// Side of each cluster's cube face. [Units: texels] [Limit: 16..=2048]
     pub map_size: u32,
     /// PCSS sampling.
     pub pcss: PcssParams,
 }
 
-impl LightClusterGpuParams {
-    /// The face side in use (0 means 256).
-    pub fn face_size(&self) -> u32 {
-        if self.map_size == 0 {
-            256
-        } else {
-            self.map_size
+impl Default for LightClusterGpuParams {
+    fn default() -> Self {
+        LightClusterGpuParams {
+            clustering: LightClusterParams::default(),
+            disk: LcDisk::default(),
+            map_size: 256,
+            pcss: PcssParams::default(),
         }
+    }
+}
+
+impl LightClusterGpuParams {
+    /// The settings in a few words, for reports.
+    pub fn describe(&self) -> String {
+        let c = &self.clustering;
+        format!(
+            "{} m × (1 + {}·d), ≤ {} clusters, {}² faces",
+            c.min_distance_m, c.distance_scale, c.max_clusters, self.map_size
+        )
     }
 
     /// Checks every limit.
@@ -70,10 +80,10 @@ impl LightClusterGpuParams {
                 self.clustering.max_clusters
             ));
         }
-        if !(16..=2048).contains(&self.face_size()) {
+        if !(16..=2048).contains(&self.map_size) {
             return bad(format!(
                 "cube face size {} must be 16..=2048 texels",
-                self.face_size()
+                self.map_size
             ));
         }
         if !(1..=64).contains(&self.pcss.blocker_samples) {
@@ -104,11 +114,11 @@ pub enum DirectLight {
 }
 
 impl DirectLight {
-    /// The name on the command line and in reports.
-    pub fn name(&self) -> &'static str {
+    /// The shading pass's `Globals::direct_mode`: one of the `DIRECT_*` constants.
+    pub fn shader_id(&self) -> u32 {
         match self {
-            DirectLight::PerLight => "per-light",
-            DirectLight::LightCluster(_) => "lightcluster",
+            DirectLight::PerLight => crate::gpu::shaders::DIRECT_PER_LIGHT,
+            DirectLight::LightCluster(_) => crate::gpu::shaders::DIRECT_LIGHTCLUSTER,
         }
     }
 }

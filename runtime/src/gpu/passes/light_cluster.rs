@@ -1,8 +1,8 @@
 //! LightCluster for the direct light (`--direct lightcluster`; the paper in
 //! `../shared/papers/lightcluster-pcss.txt`): the lights culled by range and clustered on the
 //! GPU each frame exactly as [`crate::cpu::lightcluster`] does (light_cluster.wgsl), a cube
-//! shadow map per cluster as six tiles of one depth atlas drawn in one instanced indirect draw,
-//! and each cluster's PCSS visibility written once into a screen-sized layer (lc_shadows.wgsl),
+//! shadow map per cluster as six tiles of one depth atlas (a depth-only draw per tile, indirect:
+//! a tile whose cluster was not made draws nothing), and each cluster's PCSS visibility written once into a screen-sized layer (lc_shadows.wgsl),
 //! which the shading pass reads for every light of the cluster. The per-light shadow maps are
 //! not drawn.
 
@@ -11,7 +11,7 @@ use glam::Vec3;
 use crate::RenderError;
 use crate::camera::View;
 use crate::cpu::lightcluster::light_range_scale;
-use crate::gpu::context::{Pool, bind_group, compute_pipelines};
+use crate::gpu::context::{Pool, array_view, bind_group, compute_pipelines};
 use crate::gpu::geometry::{VERTEX_STRIDE, positions};
 use crate::gpu::layout::LcFrame;
 use crate::gpu::passes::gbuffer::GBufferOutput;
@@ -52,7 +52,8 @@ pub struct LcClusters {
     pub reach: wgpu::Buffer,
     /// Each cluster's extent (f32 bits).
     pub extent: wgpu::Buffer,
-    /// Draw args, dispatch args, clusters, culled lights (u32 each).
+    /// The PCSS pass's dispatch args, clusters and culled lights (at [`ARGS_COUNTS`]), then
+    /// from byte 32 each atlas tile's draw args (u32 each).
     pub args: wgpu::Buffer,
 }
 
@@ -77,7 +78,7 @@ pub fn lc_frame(
     (normal_offset, bias): (f32, f32),
 ) -> LcFrame {
     let half_x = 0.5 * view.fov_x_rad;
-    let half_y = (half_x.tan() * view.size[1] as f32 / view.size[0] as f32).atan();
+    let half_y = view.tan_half().y.atan();
     let (per_row, _) = p.atlas_tiles();
     let v4 = |v: Vec3| v.extend(0.0).to_array();
     LcFrame {
@@ -88,7 +89,7 @@ pub fn lc_frame(
         half_fov: [half_x.cos(), half_x.sin(), half_y.cos(), half_y.sin()],
         light_count: scene.lights.len() as u32,
         max_clusters: p.clustering.max_clusters,
-        map_size: p.face_size(),
+        map_size: p.map_size,
         tiles_per_row: per_row,
         min_distance_m: p.clustering.min_distance_m,
         distance_scale: p.clustering.distance_scale,
@@ -119,40 +120,30 @@ pub enum LcKind {
     Vpls = 1,
 }
 
-/// The pool labels of each kind's resources: frame, light cluster, clusters, centres, reach,
-/// extent, args, key, order, atlas, visibility, tiles, VPL lights.
-const LABELS: [[&str; 13]; 2] = [
-    [
-        "lc frame",
-        "lc light cluster",
-        "lc clusters",
-        "lc centres",
-        "lc reach",
-        "lc extent",
-        "lc args",
-        "lc light key",
-        "lc order",
-        "lc atlas",
-        "lc visibility",
-        "lc tiles",
-        "lc lights",
-    ],
-    [
-        "vpl lc frame",
-        "vpl lc light cluster",
-        "vpl lc clusters",
-        "vpl lc centres",
-        "vpl lc reach",
-        "vpl lc extent",
-        "vpl lc args",
-        "vpl lc light key",
-        "vpl lc order",
-        "vpl lc atlas",
-        "vpl lc visibility",
-        "vpl lc tiles",
-        "vpl lc lights",
-    ],
-];
+/// The pool labels of one kind's resources, `prefix` before each: frame, light cluster,
+/// clusters, centres, reach, extent, args, key, order, atlas, visibility, tiles, VPL lights.
+macro_rules! lc_labels {
+    ($prefix:literal) => {
+        [
+            concat!($prefix, "lc frame"),
+            concat!($prefix, "lc light cluster"),
+            concat!($prefix, "lc clusters"),
+            concat!($prefix, "lc centres"),
+            concat!($prefix, "lc reach"),
+            concat!($prefix, "lc extent"),
+            concat!($prefix, "lc args"),
+            concat!($prefix, "lc light key"),
+            concat!($prefix, "lc order"),
+            concat!($prefix, "lc atlas"),
+            concat!($prefix, "lc visibility"),
+            concat!($prefix, "lc tiles"),
+            concat!($prefix, "lc lights"),
+        ]
+    };
+}
+
+/// Each kind's labels (by [`LcKind`]).
+const LABELS: [[&str; 13]; 2] = [lc_labels!(""), lc_labels!("vpl ")];
 
 /// The atlas pipeline: positions and a per-instance tile index in, reversed depth out (test
 /// "greater", cleared to 0), no fragment stage.
@@ -213,12 +204,12 @@ impl LightCluster {
         })
     }
 
-    /// Records the culling and the clustering of `scene`'s lights (uploaded in `lights`) for
-    /// `frame`.
+    /// Records the culling and the clustering of the emitters in `lights` for `frame`
+    /// (uploaded in `frame_buf`, [`upload_frame`]).
     pub fn record_clustering(
         &self,
         ctx: &crate::gpu::GpuContext,
-        (frame, kind): (&LcFrame, LcKind),
+        (frame, frame_buf, kind): (&LcFrame, &wgpu::Buffer, LcKind),
         lights: &wgpu::Buffer,
         pool: &mut Pool,
         rec: &mut Recorder,
@@ -239,12 +230,7 @@ impl LightCluster {
         let words = |k: u32| 4 * u64::from(k.max(1));
         let m = frame.max_clusters;
         let out = LcClusters {
-            frame: pool.upload(
-                ctx,
-                l[0],
-                bytemuck::bytes_of(frame),
-                wgpu::BufferUsages::UNIFORM,
-            ),
+            frame: frame_buf.clone(),
             light_cluster: pool.buffer(d, l[1], words(n), rw),
             clusters: pool.buffer(d, l[2], 4 * words(m), rw),
             centres: pool.buffer(d, l[3], words(m), rw),
@@ -348,7 +334,7 @@ impl LightCluster {
             ],
         );
         let (per_row, _) = p.atlas_tiles();
-        let side = p.face_size();
+        let side = p.map_size;
         let span = rec.begin(span_names(kind)[2]);
         let mut pass = rec.enc.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("lightcluster atlas"),
@@ -393,7 +379,9 @@ impl LightCluster {
     ) -> Result<LcOutput, RenderError> {
         let shadows = &f.params.shadows;
         let frame = lc_frame(f.scene, f.view, p, (shadows.normal_offset, shadows.bias));
-        self.record_with(f, (p, &frame, LcKind::Direct), lights, g, pool, rec)
+        let frame_buf = upload_frame(f.ctx, pool, &frame, LcKind::Direct);
+        let input = (p, &frame, &frame_buf, LcKind::Direct);
+        self.record_with(f, input, lights, g, pool, rec)
     }
 
     /// The same for frame `f`'s VPLs (mode vpl-clusters): each a point light of intensity
@@ -414,12 +402,7 @@ impl LightCluster {
         frame.hemisphere = 1;
         let l = &LABELS[LcKind::Vpls as usize];
         let d = &f.ctx.device;
-        let uniform = pool.upload(
-            f.ctx,
-            l[0],
-            bytemuck::bytes_of(&frame),
-            wgpu::BufferUsages::UNIFORM,
-        );
+        let uniform = upload_frame(f.ctx, pool, &frame, LcKind::Vpls);
         let lights = pool.buffer(
             d,
             l[12],
@@ -445,14 +428,16 @@ impl LightCluster {
             pass.set_bind_group(0, &bg, &[]);
             pass.dispatch_workgroups(f.vpl_count.div_ceil(WG_LINEAR).max(1), 1, 1);
         }
-        self.record_with(f, (p, &frame, LcKind::Vpls), &lights, g, pool, rec)
+        let input = (p, &frame, &uniform, LcKind::Vpls);
+        self.record_with(f, input, &lights, g, pool, rec)
     }
 
-    /// [`LightCluster::record`] with `frame` for the emitters in `lights`.
+    /// [`LightCluster::record`] with `frame` (uploaded in `frame_buf`) for the emitters in
+    /// `lights`.
     fn record_with(
         &self,
         f: &Frame,
-        (p, frame, kind): (&LightClusterGpuParams, &LcFrame, LcKind),
+        (p, frame, frame_buf, kind): (&LightClusterGpuParams, &LcFrame, &wgpu::Buffer, LcKind),
         lights: &wgpu::Buffer,
         g: &GBufferOutput,
         pool: &mut Pool,
@@ -461,7 +446,7 @@ impl LightCluster {
         p.check()?;
         let d = &f.ctx.device;
         let (per_row, rows) = p.atlas_tiles();
-        let side = p.face_size();
+        let side = p.map_size;
         let max_dim = d.limits().max_texture_dimension_2d;
         if per_row * side > max_dim || rows * side > max_dim {
             return Err(RenderError::Param(format!(
@@ -472,7 +457,8 @@ impl LightCluster {
                 p.clustering.max_clusters
             )));
         }
-        let clusters = self.record_clustering(f.ctx, (frame, kind), lights, pool, rec)?;
+        let input = (frame, frame_buf, kind);
+        let clusters = self.record_clustering(f.ctx, input, lights, pool, rec)?;
         let l = &LABELS[kind as usize];
         let atlas = pool.texture(
             d,
@@ -495,10 +481,7 @@ impl LightCluster {
         );
         self.record_atlas(f, (p, kind), &clusters, &atlas_view, pool, rec);
         let span = rec.begin(span_names(kind)[3]);
-        let vis_view = visibility.create_view(&wgpu::TextureViewDescriptor {
-            dimension: Some(wgpu::TextureViewDimension::D2Array),
-            ..Default::default()
-        });
+        let vis_view = array_view(&visibility);
         let bg = bind_group(
             d,
             &self.pcss.get_bind_group_layout(0),
@@ -531,6 +514,33 @@ impl LightCluster {
             clusters,
             visibility,
         })
+    }
+}
+
+/// `frame` uploaded as `kind`'s uniform (one upload a frame: every pass of the kind binds it).
+pub fn upload_frame(
+    ctx: &crate::gpu::GpuContext,
+    pool: &mut Pool,
+    frame: &LcFrame,
+    kind: LcKind,
+) -> wgpu::Buffer {
+    let label = LABELS[kind as usize][0];
+    pool.upload(
+        ctx,
+        label,
+        bytemuck::bytes_of(frame),
+        wgpu::BufferUsages::UNIFORM,
+    )
+}
+
+/// LightCluster's counts from its args (read back): clusters made, emitters culled, of
+/// `emitters`.
+pub fn counts_of(args: &[u32], emitters: u32) -> crate::gpu::LcCounts {
+    let at = ARGS_COUNTS as usize;
+    crate::gpu::LcCounts {
+        clusters: args[at],
+        culled: args[at + 1],
+        lights: emitters,
     }
 }
 

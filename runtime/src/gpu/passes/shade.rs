@@ -165,13 +165,7 @@ impl Shade {
         let level = f.scene.level.as_ref();
         let none = &f.scene.no_level;
         let maps = array_view(&shadows.maps);
-        let no_vis = f
-            .scene
-            .no_visibility
-            .create_view(&wgpu::TextureViewDescriptor {
-                dimension: Some(wgpu::TextureViewDimension::D2Array),
-                ..Default::default()
-            });
+        let no_vis = array_view(&f.scene.no_visibility);
         let vis = lc.map_or_else(|| no_vis.clone(), |o| array_view(&o.visibility));
         let vpl_vis = vpl_lc.map_or(no_vis, |o| array_view(&o.visibility));
         let buffers: [(u32, &wgpu::Buffer); 15] = [
