@@ -7,8 +7,9 @@ use visgate_runtime::cpu::gates::{GateParams, GateShape};
 use visgate_runtime::cpu::lightcluster::LightClusterParams;
 use visgate_runtime::cpu::val::ValParams;
 use visgate_runtime::gpu::{
-    CssmParams, DirectLight, GatesParams, GpuMode, GpuParams, InterleaveParams, LcDisk,
-    LightClusterGpuParams, MethodSettings, PcssParams, PerVplParams, ShadowParams, ValModeParams,
+    CssmParams, DirectLight, GatesParams, GpuMode, GpuParams, InterleaveParams, IsmParams, LcDisk,
+    LightClusterGpuParams, MethodSettings, PcssParams, PerVplParams, ShadowParams, ValIsmParams,
+    ValModeParams, VplIsmParams,
 };
 use visgate_runtime::job::{RenderJob, VplSource as JobVpls};
 use visgate_runtime::vpl::GeometryClamp;
@@ -147,10 +148,12 @@ pub struct MethodArgs {
     /// 6 × --lc-max-clusters faces).
     #[arg(long, default_value_t = 256)]
     pub lc_map_size: u32,
-    /// LightCluster: PCSS blocker-search samples per cluster and pixel, 1..=64.
+    /// LightCluster and val-ism: PCSS blocker-search samples per cluster (VAL) and pixel,
+    /// 1..=64.
     #[arg(long, default_value_t = 16)]
     pub pcss_blocker_samples: u32,
-    /// LightCluster: PCSS filter (PCF) samples per cluster and pixel in a penumbra, 1..=128.
+    /// LightCluster and val-ism: PCSS filter (PCF) samples per cluster (VAL) and pixel in a
+    /// penumbra, 1..=128.
     #[arg(long, default_value_t = 32)]
     pub pcss_filter_samples: u32,
     /// What a gate is (--mode gates): the baked portals, walked, or the paper's disks.
@@ -218,6 +221,50 @@ pub struct MethodArgs {
     /// Per-VPL maps rendered and gathered per batch (bounds their memory).
     #[arg(long, default_value_t = 128)]
     pub vpl_batch: u32,
+    /// Imperfect shadow maps (--mode per-vpl-ism, val-ism): side of each emitter's paraboloid
+    /// map, a power of two in 16..=512 texels. Unset: 128 (the paper's 4096² atlas of 128²
+    /// maps), halved until the maps fit the adapter's largest storage binding (4,096 VPLs:
+    /// 64²).
+    #[arg(long)]
+    pub ism_map_size: Option<u32>,
+    /// ISMs: points splatted into each map, 64..=65536 — the sampling density: a point stands
+    /// for the scene's area over this many.
+    #[arg(long, default_value_t = 8192)]
+    pub ism_points: u32,
+    /// ISMs: pull-push levels that fill the holes between points (the paper: 2; 0: none).
+    #[arg(long, default_value_t = 2)]
+    pub ism_pull_push: u32,
+    /// ISMs: splats covering a point of a surface on average, 0.25..=64 (a point's splat is
+    /// √coverage times the radius of its share of the scene's area; at 1, e⁻¹ of a blocker is
+    /// left open and what lies behind shows through).
+    #[arg(long, default_value_t = 4.0)]
+    pub ism_coverage: f32,
+    /// ISMs: largest splat radius of a point near its emitter, texels, 0..=8.
+    #[arg(long, default_value_t = 3.0)]
+    pub ism_max_splat: f32,
+    /// ISMs: depth bias of lookups, texels (point depths are noisy: larger than a rasterised
+    /// map's).
+    #[arg(long, default_value_t = 3.0)]
+    pub ism_bias: f32,
+    /// ISMs: normal offset of lookups, texels.
+    #[arg(long, default_value_t = 1.5)]
+    pub ism_normal_offset: f32,
+    /// ISM modes: interleaving block side (the split G-buffer's n × m tiles: emitter i lights
+    /// tile i mod side²). Unset: 1 for per-vpl-ism (every VPL at every pixel, as
+    /// per-vpl-shadow-maps), 4 for val-ism.
+    #[arg(long)]
+    pub ism_interleave: Option<u32>,
+    /// val-ism: virtual area lights, 1..=4096 (the paper's Table 1: 64).
+    #[arg(long, default_value_t = 64)]
+    pub ism_vals: u32,
+    /// val-ism: weights w_p, w_n, w_f of the clustering metric μ = w_p·d_p + w_n·d_n + w_f·d_f
+    /// (position over the VPLs' diagonal, normal angle over π, relative flux difference).
+    #[arg(long, value_delimiter = ',', num_args = 3, default_values_t = [0.6, 0.3, 0.1])]
+    pub ism_val_weights: Vec<f32>,
+    /// val-ism: a VPL joins only the VALs whose point splat reaches it, a radius as a fraction
+    /// of the VPLs' diagonal (the nearest VAL where none does).
+    #[arg(long, default_value_t = 0.25)]
+    pub ism_val_splat: f32,
 }
 
 impl MethodArgs {
@@ -260,6 +307,51 @@ impl MethodArgs {
         }
     }
 
+    /// The ISMs from the --ism-* flags.
+    fn ism(&self) -> IsmParams {
+        IsmParams {
+            map_size: self.ism_map_size,
+            points_per_map: self.ism_points,
+            pull_push: self.ism_pull_push,
+            coverage: self.ism_coverage,
+            max_splat: self.ism_max_splat,
+            bias: self.ism_bias,
+            normal_offset: self.ism_normal_offset,
+            ..IsmParams::default()
+        }
+    }
+
+    /// An ISM mode's interleaving: --ism-interleave or `default`, the blur's flags.
+    fn ism_interleave(&self, default: u32) -> InterleaveParams {
+        InterleaveParams {
+            block: self.ism_interleave.unwrap_or(default),
+            ..self.interleave_params()
+        }
+    }
+
+    /// Mode val-ism from the flags.
+    fn val_ism(&self) -> ValIsmParams {
+        let w = |k: usize| self.ism_val_weights.get(k).copied().unwrap_or(f32::NAN);
+        let base = ValIsmParams::default();
+        ValIsmParams {
+            vals: ValParams {
+                count: self.ism_vals,
+                iterations: self.val_iterations,
+                w_x: w(0),
+                w_alpha: w(1),
+                w_f: w(2),
+                splat: Some(self.ism_val_splat),
+                ..base.vals
+            },
+            ism: self.ism(),
+            pcss: PcssParams {
+                blocker_samples: self.pcss_blocker_samples,
+                filter_samples: self.pcss_filter_samples,
+            },
+            interleave: self.ism_interleave(base.interleave.block),
+        }
+    }
+
     /// Every method's settings from the flags.
     pub fn settings(&self) -> MethodSettings {
         MethodSettings {
@@ -296,6 +388,11 @@ impl MethodArgs {
                 interleave: self.interleave_params(),
             },
             vpl_clusters: self.light_cluster(),
+            vpl_ism: VplIsmParams {
+                ism: self.ism(),
+                interleave: self.ism_interleave(VplIsmParams::default().interleave.block),
+            },
+            val_ism: self.val_ism(),
             cssm: CssmParams {
                 terms: self.cssm_terms,
                 normal_offset: self.cssm_normal_offset,

@@ -204,12 +204,14 @@ impl RenderJob {
                     "--mode gates-per-pixel runs on the GPU; the CPU twin is --mode gates --cpu"
                         .into(),
                 )),
-                GpuMode::ValHard(_) | GpuMode::ValCssm(..) | GpuMode::VplClusters(..) => {
-                    Err(RenderError::Param(format!(
-                        "--mode {} runs on the GPU; its reference is --mode reference",
-                        m.name()
-                    )))
-                }
+                GpuMode::ValHard(_)
+                | GpuMode::ValCssm(..)
+                | GpuMode::VplClusters(..)
+                | GpuMode::PerVplIsm(_)
+                | GpuMode::ValIsm(_) => Err(RenderError::Param(format!(
+                    "--mode {} runs on the GPU; its reference is --mode reference",
+                    m.name()
+                ))),
             },
         }
     }

@@ -1,10 +1,11 @@
 //! The CPU side of every method: the ray tracer, the exact reference renderer, and the CPU
 //! twin of each GPU stage that has one (gate visibility, clustered light lists, VAL clustering,
-//! the CSSM's Fourier expansion). Tests hold each twin equal to its GPU pass on small inputs.
+//! the CSSM's Fourier expansion, the point-to-disk form factor). Tests hold each twin equal to its GPU pass on small inputs.
 
 pub mod clustered;
 pub mod cssm;
 pub mod gates;
+pub mod ism;
 pub mod lightcluster;
 pub mod portal_walk;
 pub mod reference;

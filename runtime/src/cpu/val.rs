@@ -15,7 +15,15 @@
 //!   empty VAL keeps its centre; until the assignment repeats itself (convergence, as the
 //!   paper iterates), at most `iterations` times; then the final mapping C.
 //! - **Area**: the 2D bounding rectangle of the VAL's VPLs projected on the plane normal to
-//!   its normal (the frame of [`crate::vpl::basis`]).
+//!   its normal (the frame of [`crate::vpl::basis`]); and the area of the disk with the same
+//!   second moment, 2π·mean(s² + t²) (the point-to-disk form factor's A_c of `val-ism`).
+//!
+//! Weinzierl-Heigl's clustering (`val-ism`, [`ValParams::ism`]) changes three things: the
+//! seeds are a Halton sequence warped by importance — the radical inverse in base 2 of k
+//! through the cumulative flux of the VPLs (r + g + b), so that VALs gather where the light is;
+//! the metric adds a flux term `w_f·|Φ_i − Φ_c| / (|Φ_i| + |Φ_c|)` (Φ_c the mean flux of the
+//! VAL's VPLs); and a VPL joins only the centres whose point splat reaches it (within `splat`
+//! × D), the nearest of all where none does (no light is dropped).
 
 use glam::Vec3;
 
@@ -36,6 +44,23 @@ pub struct ValParams {
     /// Start from last frame's centres instead of the restart (§5.2 rejects this: VALs get
     /// lost as lights move; kept to measure it). On the GPU the renderer keeps the centres.
     pub warm_start: bool,
+    /// Where the centres start.
+    pub seeding: ValSeeding,
+    /// Weight of the flux term (Weinzierl-Heigl's μ). [Limit: ≥ 0]
+    pub w_f: f32,
+    /// A VPL joins only the centres within this distance (the point splats), as a fraction of
+    /// D; `None`: every centre. [Limit: > 0]
+    pub splat: Option<f32>,
+}
+
+/// Where the VAL centres start.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ValSeeding {
+    /// VAL k at VPL ⌊k·N/M⌋ (Dong et al. §5.2).
+    Restart,
+    /// VAL k at the VPL where the cumulative flux crosses the radical inverse of k in base 2
+    /// (Weinzierl-Heigl §4: Halton seeds with importance warping).
+    HaltonFlux,
 }
 
 impl Default for ValParams {
@@ -46,11 +71,29 @@ impl Default for ValParams {
             w_x: 0.7,
             w_alpha: 0.3,
             warm_start: false,
+            seeding: ValSeeding::Restart,
+            w_f: 0.0,
+            splat: None,
         }
     }
 }
 
 impl ValParams {
+    /// Weinzierl-Heigl's clustering (mode `val-ism`): 64 VALs, Halton seeds warped by flux,
+    /// μ = 0.6·d_p + 0.3·d_n + 0.1·d_f, splats of a quarter of D, iterated frame to frame.
+    pub fn ism() -> ValParams {
+        ValParams {
+            count: 64,
+            iterations: 8,
+            w_x: 0.6,
+            w_alpha: 0.3,
+            warm_start: true,
+            seeding: ValSeeding::HaltonFlux,
+            w_f: 0.1,
+            splat: Some(0.25),
+        }
+    }
+
     /// Checks the limits.
     pub fn check(&self) -> Result<(), RenderError> {
         let w_ok = |w: f32| w.is_finite() && w >= 0.0;
@@ -58,17 +101,31 @@ impl ValParams {
             || self.iterations > 256
             || !w_ok(self.w_x)
             || !w_ok(self.w_alpha)
-            || self.w_x + self.w_alpha <= 0.0
+            || !w_ok(self.w_f)
+            || self.w_x + self.w_alpha + self.w_f <= 0.0
         {
             return Err(RenderError::Param(format!(
-                "VALs {} must be 1..=4096, iterations {} 0..=256, weights w_x {} and w_alpha {} \
-                 ≥ 0 and not both 0",
-                self.count, self.iterations, self.w_x, self.w_alpha
+                "VALs {} must be 1..=4096, iterations {} 0..=256, weights w_x {}, w_alpha {} and \
+                 w_f {} ≥ 0 and not all 0",
+                self.count, self.iterations, self.w_x, self.w_alpha, self.w_f
+            )));
+        }
+        if let Some(r) = self.splat.filter(|r| !(r.is_finite() && *r > 0.0)) {
+            return Err(RenderError::Param(format!(
+                "VAL splat {r} must be > 0 (a fraction of the VPLs' diagonal)"
             )));
         }
         Ok(())
     }
+
+    /// The splat radius over D the GPU reads (0: every centre).
+    pub fn splat_or_zero(&self) -> f32 {
+        self.splat.unwrap_or(0.0)
+    }
 }
+
+/// A VAL centre while clustering: position, unit normal, mean flux of its VPLs.
+pub type Centre = (Vec3, Vec3, Vec3);
 
 /// One virtual area light, shared with WGSL (`Val` in vals.wgsl). 64 bytes.
 #[repr(C)]
@@ -78,7 +135,8 @@ pub struct Val {
     pub position: [f32; 4],
     /// xyz unit normal, w area (m²).
     pub normal: [f32; 4],
-    /// rgb summed flux of its VPLs (W), w unused.
+    /// rgb summed flux of its VPLs (W), w the area of the disk of the same second moment
+    /// (m²).
     pub flux: [f32; 4],
     /// Bounding rectangle in the plane normal to `normal`, about `position`, along
     /// [`crate::vpl::basis`]: s min, s max, t min, t max (m).
@@ -99,6 +157,20 @@ impl Val {
     /// VPLs it holds.
     pub fn vpl_count(&self) -> u32 {
         self.position[3] as u32
+    }
+
+    /// The area of the disk with its VPLs' second moment about the centre, in its plane.
+    /// [Units: m²]
+    pub fn disk_area(&self) -> f32 {
+        self.flux[3]
+    }
+
+    /// Mean flux of its VPLs (0 for none).
+    pub fn mean_flux(&self) -> Vec3 {
+        match self.vpl_count() {
+            0 => Vec3::ZERO,
+            c => Vec3::from_slice(&self.flux[..3]) / c as f32,
+        }
     }
 }
 
@@ -148,17 +220,72 @@ pub fn scale_of(vpls: &[Vpl]) -> f32 {
     (hi - lo).length().max(1e-30)
 }
 
-/// The clustering distance between a VPL (`p`, `n`) and a centre (`c`, `m`), with `inv_d` =
-/// 1 / D.
-pub fn distance(p: Vec3, n: Vec3, c: Vec3, m: Vec3, inv_d: f32, params: &ValParams) -> f32 {
+/// The clustering distance between a VPL and a centre, with `inv_d` = 1 / D.
+pub fn distance(v: &Vpl, (c, m, f): Centre, inv_d: f32, params: &ValParams) -> f32 {
+    let (p, n) = (Vec3::from(v.position), Vec3::from(v.normal));
     let dx = (p - c).length() * inv_d;
     let da = n.dot(m).clamp(-1.0, 1.0).acos() / std::f32::consts::PI;
-    params.w_x * dx + params.w_alpha * da
+    let mut d = params.w_x * dx + params.w_alpha * da;
+    if params.w_f > 0.0 {
+        let fv = Vec3::from(v.flux);
+        let sum = fv.length() + f.length();
+        if sum > 0.0 {
+            d += params.w_f * ((fv - f).length() / sum);
+        }
+    }
+    d
 }
 
-/// The initial centres: VAL k starts at VPL ⌊k·N/M⌋ (§5.2), or the next live VPL after it.
-pub fn initial_centres(vpls: &[Vpl], count: u32) -> Vec<(Vec3, Vec3)> {
-    let n = vpls.len();
+/// A VPL's importance for the seeds: r + g + b of its flux.
+fn importance(v: &Vpl) -> f32 {
+    v.flux[0] + v.flux[1] + v.flux[2]
+}
+
+/// The inclusive prefix sums of the VPLs' importance in the GPU's order (vals.wgsl `cdf`):
+/// [`LANES`] contiguous chunks of ⌈N / LANES⌉, each summed in order, the chunks' totals
+/// added in order before them.
+pub fn importance_cdf(vpls: &[Vpl]) -> Vec<f32> {
+    let chunk = vpls.len().div_ceil(LANES).max(1);
+    let mut out = vec![0.0f32; vpls.len()];
+    let mut totals = [0.0f32; LANES];
+    for (t, total) in totals.iter_mut().enumerate() {
+        for v in vpls.iter().skip(t * chunk).take(chunk) {
+            *total += importance(v);
+        }
+    }
+    let mut base = 0.0f32;
+    for (t, total) in totals.iter().enumerate() {
+        let mut run = base;
+        for (i, v) in vpls.iter().enumerate().skip(t * chunk).take(chunk) {
+            run += importance(v);
+            out[i] = run;
+        }
+        base += total;
+    }
+    out
+}
+
+/// The centre of a VPL.
+fn centre_at(v: &Vpl) -> Centre {
+    (v.position.into(), v.normal.into(), v.flux.into())
+}
+
+/// The initial centres: VAL k starts at VPL ⌊k·N/M⌋ (§5.2), or the next live VPL after it;
+/// with [`ValSeeding::HaltonFlux`] at the first VPL whose cumulative importance exceeds
+/// h₂(k) × the total.
+pub fn initial_centres(vpls: &[Vpl], params: &ValParams) -> Vec<Centre> {
+    let (n, count) = (vpls.len(), params.count);
+    if params.seeding == ValSeeding::HaltonFlux {
+        let cdf = importance_cdf(vpls);
+        let total = cdf.last().copied().unwrap_or(0.0);
+        return (0..count as u64)
+            .map(|k| {
+                let target = crate::vpl::radical_inverse(k, 2) * total;
+                let i = cdf.partition_point(|&c| c <= target).min(n - 1);
+                centre_at(&vpls[i])
+            })
+            .collect();
+    }
     (0..count as u64)
         .map(|k| {
             let j = (k * n as u64 / count as u64) as usize;
@@ -166,23 +293,32 @@ pub fn initial_centres(vpls: &[Vpl], count: u32) -> Vec<(Vec3, Vec3)> {
                 .map(|s| &vpls[(j + s) % n])
                 .find(|v| is_live(v))
                 .unwrap_or(&vpls[j]);
-            (Vec3::from(v.position), Vec3::from(v.normal))
+            centre_at(v)
         })
         .collect()
 }
 
-/// Index of the nearest centre (the lower index on ties); [`NO_VAL`] for a VPL of zero flux.
-pub fn nearest(v: &Vpl, centres: &[(Vec3, Vec3)], inv_d: f32, params: &ValParams) -> u32 {
+/// Index of the nearest centre (the lower index on ties) among those whose splat reaches the
+/// VPL (all of them when none does, or without splats); [`NO_VAL`] for a VPL of zero flux.
+pub fn nearest(v: &Vpl, centres: &[Centre], inv_d: f32, params: &ValParams) -> u32 {
     if !is_live(v) {
         return NO_VAL;
     }
-    let (p, n) = (Vec3::from(v.position), Vec3::from(v.normal));
+    let p = Vec3::from(v.position);
+    let reach = params.splat_or_zero();
     let mut best = (f32::INFINITY, 0u32);
-    for (k, &(c, m)) in centres.iter().enumerate() {
-        let d = distance(p, n, c, m, inv_d, params);
+    let mut splat_best = (f32::INFINITY, NO_VAL);
+    for (k, &c) in centres.iter().enumerate() {
+        let d = distance(v, c, inv_d, params);
         if d < best.0 {
             best = (d, k as u32);
         }
+        if reach > 0.0 && (p - c.0).length() * inv_d <= reach && d < splat_best.0 {
+            splat_best = (d, k as u32);
+        }
+    }
+    if splat_best.1 != NO_VAL {
+        return splat_best.1;
     }
     best.1
 }
@@ -192,7 +328,7 @@ pub fn nearest(v: &Vpl, centres: &[(Vec3, Vec3)], inv_d: f32, params: &ValParams
 pub fn cluster(
     vpls: &[Vpl],
     params: &ValParams,
-    start: Option<&[(Vec3, Vec3)]>,
+    start: Option<&[Centre]>,
 ) -> Result<Clustering, RenderError> {
     params.check()?;
     let m = params.count as usize;
@@ -215,7 +351,7 @@ pub fn cluster(
                 s.len()
             )));
         }
-        None => initial_centres(vpls, params.count),
+        None => initial_centres(vpls, params),
     };
     // Iterate until the assignment repeats itself (then every later iteration would repeat
     // the last: the GPU stops there too), at most `params.iterations` updates.
@@ -233,6 +369,7 @@ pub fn cluster(
         iterations += 1;
         let positions = lane_sums(vpls, &mapping, m, |v| v.position);
         let normals = lane_sums(vpls, &mapping, m, |v| v.normal);
+        let fluxes = lane_sums(vpls, &mapping, m, |v| v.flux);
         let counts = counts_of(&mapping, m);
         for (k, c) in centres.iter_mut().enumerate() {
             if counts[k] > 0 {
@@ -241,6 +378,7 @@ pub fn cluster(
                 *c = (
                     positions[k] / counts[k] as f32,
                     if l > 0.0 { normals[k] / l } else { c.1 },
+                    fluxes[k] / counts[k] as f32,
                 );
             }
         }
@@ -298,10 +436,10 @@ fn counts_of(mapping: &[u32], m: usize) -> Vec<u32> {
 
 /// The VALs of a mapping: centre and normal from `centres`, count, flux and bounding rectangle
 /// from their VPLs.
-fn vals_of(vpls: &[Vpl], mapping: &[u32], centres: &[(Vec3, Vec3)]) -> Vec<Val> {
+fn vals_of(vpls: &[Vpl], mapping: &[u32], centres: &[Centre]) -> Vec<Val> {
     let mut vals: Vec<Val> = centres
         .iter()
-        .map(|&(c, n)| Val {
+        .map(|&(c, n, _)| Val {
             position: c.extend(0.0).to_array(),
             normal: n.extend(0.0).to_array(),
             flux: [0.0; 4],
@@ -327,9 +465,15 @@ fn vals_of(vpls: &[Vpl], mapping: &[u32], centres: &[(Vec3, Vec3)]) -> Vec<Val> 
         ];
     }
     let fluxes = lane_sums(vpls, mapping, vals.len(), |v| v.flux);
-    for (val, flux) in vals.iter_mut().zip(fluxes) {
-        val.flux = flux.extend(0.0).to_array();
-        if val.position[3] == 0.0 {
+    let moments = second_moments(vpls, mapping, &vals);
+    for ((val, flux), moment) in vals.iter_mut().zip(fluxes).zip(moments) {
+        let count = val.position[3];
+        let area = match count {
+            0.0 => 0.0,
+            c => 2.0 * std::f32::consts::PI * (moment / c),
+        };
+        val.flux = flux.extend(area).to_array();
+        if count == 0.0 {
             val.rect = [0.0; 4];
         }
         val.normal[3] = (val.rect[1] - val.rect[0]) * (val.rect[3] - val.rect[2]);
@@ -337,10 +481,38 @@ fn vals_of(vpls: &[Vpl], mapping: &[u32], centres: &[(Vec3, Vec3)]) -> Vec<Val> 
     vals
 }
 
+/// Each VAL's sum of s² + t² over its VPLs (their offsets from its centre in its plane), in
+/// the GPU's lane order.
+fn second_moments(vpls: &[Vpl], mapping: &[u32], vals: &[Val]) -> Vec<f32> {
+    let mut lanes = vec![[0.0f32; LANES]; vals.len()];
+    for (i, (v, &k)) in vpls.iter().zip(mapping).enumerate() {
+        if k != NO_VAL {
+            let val = &vals[k as usize];
+            let (t, b) = basis(val.unit_normal());
+            let q = Vec3::from(v.position) - val.centre();
+            let (s, u) = (q.dot(t), q.dot(b));
+            lanes[k as usize][i % LANES] += s * s + u * u;
+        }
+    }
+    lanes
+        .iter_mut()
+        .map(|l| {
+            let mut o = LANES / 2;
+            while o > 0 {
+                for t in 0..o {
+                    l[t] += l[t + o];
+                }
+                o /= 2;
+            }
+            l[0]
+        })
+        .collect()
+}
+
 /// The centres of a clustering (to start the next frame from, or to compare).
-pub fn centres_of(c: &Clustering) -> Vec<(Vec3, Vec3)> {
+pub fn centres_of(c: &Clustering) -> Vec<Centre> {
     c.vals
         .iter()
-        .map(|v| (v.centre(), v.unit_normal()))
+        .map(|v| (v.centre(), v.unit_normal(), v.mean_flux()))
         .collect()
 }

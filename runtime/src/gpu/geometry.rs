@@ -130,6 +130,32 @@ pub struct Geometry {
     pub vpl_vertex_count: u32,
     /// The scene's diagonal. [Units: m]
     pub size: f32,
+    /// The triangles as storage for the imperfect shadow maps' points: 3 corners (xyz, w 0)
+    /// each.
+    pub triangles: wgpu::Buffer,
+    /// Their cumulative area over the total (the last 1).
+    pub area_cdf: wgpu::Buffer,
+    /// Triangles in them (at least 1: a degenerate one for an empty scene).
+    pub triangle_count: u32,
+    /// The scene's surface area. [Units: m²]
+    pub area_m2: f32,
+}
+
+/// The triangles as vec4 corners and their cumulative area over the total, and the total.
+fn area_table(tris: &[[Vec3; 3]]) -> (Vec<[f32; 4]>, Vec<f32>, f32) {
+    let mut corners = Vec::with_capacity(tris.len() * 3);
+    let mut cdf = Vec::with_capacity(tris.len());
+    let mut total = 0.0f64;
+    for t in tris {
+        corners.extend(t.iter().map(|p| p.extend(0.0).to_array()));
+        total += 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length() as f64;
+        cdf.push(total);
+    }
+    if tris.is_empty() {
+        return (vec![[0.0; 4]; 3], vec![1.0], 0.0);
+    }
+    let cdf = cdf.iter().map(|&c| (c / total) as f32).collect();
+    (corners, cdf, total as f32)
 }
 
 impl Geometry {
@@ -181,19 +207,29 @@ impl Geometry {
         if data.is_empty() {
             data.resize(VERTEX_FLOATS, 0.0);
         }
-        let buffer = |label: &str, v: &[f32]| {
+        let (corners, cdf, area_m2) = area_table(&tris);
+        let init = |label: &str, contents: &[u8], usage| {
             d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some(label),
-                contents: bytemuck::cast_slice(v),
-                usage: wgpu::BufferUsages::VERTEX,
+                contents,
+                usage,
             })
         };
+        let (vertex, storage) = (wgpu::BufferUsages::VERTEX, wgpu::BufferUsages::STORAGE);
         Geometry {
-            vertices: buffer("scene vertices", &data),
+            vertices: init("scene vertices", bytemuck::cast_slice(&data), vertex),
             vertex_count,
-            vpl_vertices: buffer("vpl map vertices (subdivided)", &vpl_data),
+            vpl_vertices: init(
+                "vpl map vertices (subdivided)",
+                bytemuck::cast_slice(&vpl_data),
+                vertex,
+            ),
             vpl_vertex_count,
             size,
+            triangles: init("ism triangles", bytemuck::cast_slice(&corners), storage),
+            area_cdf: init("ism triangle areas", bytemuck::cast_slice(&cdf), storage),
+            triangle_count: cdf.len() as u32,
+            area_m2,
         }
     }
 }

@@ -363,14 +363,17 @@ gpu_struct! {
         pub val_count: u32,
         /// Interleaving subsets (block side²).
         pub subsets: u32,
-        /// Padding.
-        pub _pad0: u32,
+        /// 0 restart, 1 Halton seeds warped by flux.
+        pub seeding: u32,
         /// Weight of the position term.
         pub w_x: f32,
         /// Weight of the normal-angle term.
         pub w_alpha: f32,
-        /// Padding (1 / D is a storage word: the GPU computes it for RSM VPLs).
-        pub _pad1: [f32; 2],
+        /// Weight of the flux term.
+        pub w_f: f32,
+        /// Splat radius over D (0: every centre; 1 / D is a storage word: the GPU computes it
+        /// for RSM VPLs).
+        pub splat: f32,
     }
 }
 
@@ -439,6 +442,58 @@ gpu_struct! {
     }
 }
 
+gpu_struct! {
+    /// Constants of the imperfect shadow maps and their gathers (ism.wgsl).
+    pub struct IsmFrame {
+        /// Maps, one per emitter.
+        pub emitters: u32,
+        /// Map side. [Units: texels]
+        pub map_size: u32,
+        /// Points in all.
+        pub points: u32,
+        /// Scene triangles.
+        pub triangles: u32,
+        /// 0 VPLs, 1 VALs.
+        pub kind: u32,
+        /// Seed of the points.
+        pub seed: u32,
+        /// Interleaving block side.
+        pub block: u32,
+        /// Interleaving subsets.
+        pub subsets: u32,
+        /// Radius a point stands for. [Units: m]
+        pub point_radius: f32,
+        /// Largest splat radius. [Units: texels]
+        pub max_splat: f32,
+        /// VAL centre offset. [Units: m]
+        pub centre_offset: f32,
+        /// Geometry-term clamp of VPLs. [Units: 1/m²]
+        pub g_max: f32,
+        /// Lookup depth bias. [Units: texels]
+        pub bias: f32,
+        /// Lookup normal offset. [Units: texels]
+        pub normal_offset: f32,
+        /// PCSS blocker samples (0: hard lookups).
+        pub blocker_samples: u32,
+        /// PCSS filter samples.
+        pub filter_samples: u32,
+    }
+}
+
+gpu_struct! {
+    /// One pull or push dispatch of the ISMs' pyramid (ism_maps.wgsl).
+    pub struct IsmLevel {
+        /// The level written.
+        pub level: u32,
+        /// Its side. [Units: texels]
+        pub side: u32,
+        /// Where it starts in the pyramid. [Units: words]
+        pub offset: u32,
+        /// Where the level it reads starts. [Units: words]
+        pub other: u32,
+    }
+}
+
 /// Every shared struct's layout, for the naga test.
 pub fn all() -> Vec<StructLayout> {
     vec![
@@ -458,6 +513,8 @@ pub fn all() -> Vec<StructLayout> {
         ValGather::layout(),
         CssmFrame::layout(),
         LcFrame::layout(),
+        IsmFrame::layout(),
+        IsmLevel::layout(),
     ]
 }
 

@@ -7,10 +7,12 @@
 
 use crate::RenderError;
 use crate::cpu::gates::GateParams;
+use crate::cpu::val::ValParams;
 
 pub use super::passes::clustered_gates::GatesParams;
 pub use super::passes::cssm::CssmParams;
 pub use super::passes::interleave_blur::InterleaveParams;
+pub use super::passes::ism_params::{IsmParams, ValIsmParams, VplIsmParams};
 pub use super::passes::light_cluster::{DirectLight, LcDisk, LightClusterGpuParams, PcssParams};
 pub use super::passes::per_vpl_maps::PerVplParams;
 pub use super::passes::val_gather::ValModeParams;
@@ -46,6 +48,15 @@ pub enum GpuMode {
     /// cluster, PCSS visibility per cluster and pixel (beyond the LightCluster paper); with
     /// interleaved sampling and the geometry-aware blur as the VAL modes.
     VplClusters(LightClusterGpuParams, InterleaveParams),
+    /// Every VPL through its own imperfect shadow map (Ritschel et al. 2008): the scene as
+    /// points splatted into one atlas of paraboloid maps, holes filled by pull-push, one hard
+    /// lookup — the cheap twin of `PerVplShadowMaps`.
+    PerVplIsm(VplIsmParams),
+    /// Virtual area lights with imperfect shadow maps and PCSS (Weinzierl-Heigl): VPLs
+    /// clustered as the paper clusters its RSM, each VAL a disk lighting through the
+    /// point-to-disk form factor, its visibility PCSS on its ISM sized by its area, over an
+    /// interleaved split G-buffer and the blur.
+    ValIsm(ValIsmParams),
 }
 
 /// Every method's settings at once — what a command line or a viewer panel holds; each method
@@ -62,6 +73,10 @@ pub struct MethodSettings {
     pub cssm: CssmParams,
     /// The VPL clustering of `vpl-clusters`.
     pub vpl_clusters: LightClusterGpuParams,
+    /// `per-vpl-ism`.
+    pub vpl_ism: VplIsmParams,
+    /// `val-ism`.
+    pub val_ism: ValIsmParams,
 }
 
 impl Default for MethodSettings {
@@ -72,6 +87,8 @@ impl Default for MethodSettings {
             vals: ValModeParams::new(),
             cssm: CssmParams::default(),
             vpl_clusters: LightClusterGpuParams::default(),
+            vpl_ism: VplIsmParams::default(),
+            val_ism: ValIsmParams::default(),
         }
     }
 }
@@ -90,7 +107,7 @@ pub struct MethodInfo {
 }
 
 /// Every GPU method, in the order lists show them.
-pub const METHODS: [MethodInfo; 8] = [
+pub const METHODS: [MethodInfo; 10] = [
     MethodInfo {
         name: "none",
         summary: "every VPL lights every point (no indirect shadows)",
@@ -102,6 +119,12 @@ pub const METHODS: [MethodInfo; 8] = [
         summary: "a paraboloid shadow map per VPL, in batches (brute force)",
         needs_level: false,
         make: |s| GpuMode::PerVplShadowMaps(s.per_vpl),
+    },
+    MethodInfo {
+        name: "per-vpl-ism",
+        summary: "an imperfect (point-splatted) shadow map per VPL, holes filled by pull-push",
+        needs_level: false,
+        make: |s| GpuMode::PerVplIsm(s.vpl_ism),
     },
     MethodInfo {
         name: "gates",
@@ -126,6 +149,13 @@ pub const METHODS: [MethodInfo; 8] = [
         summary: "virtual area lights with convolution soft shadow maps (Dong et al.)",
         needs_level: false,
         make: |s| GpuMode::ValCssm(s.vals, s.cssm),
+    },
+    MethodInfo {
+        name: "val-ism",
+        summary: "virtual area lights as disks with imperfect shadow maps and PCSS \
+                  (Weinzierl-Heigl)",
+        needs_level: false,
+        make: |s| GpuMode::ValIsm(s.val_ism),
     },
     MethodInfo {
         name: "vpl-clusters",
@@ -158,6 +188,8 @@ impl GpuMode {
             GpuMode::ValHard(_) => "val-hard",
             GpuMode::ValCssm(..) => "val-cssm",
             GpuMode::VplClusters(..) => "vpl-clusters",
+            GpuMode::PerVplIsm(_) => "per-vpl-ism",
+            GpuMode::ValIsm(_) => "val-ism",
         }
     }
 
@@ -187,6 +219,15 @@ impl GpuMode {
                 il(&v.interleave)
             ),
             GpuMode::VplClusters(p, i) => format!("{}, {}", p.describe(), il(i)),
+            GpuMode::PerVplIsm(p) => format!("{}, {}", p.ism.describe(), il(&p.interleave)),
+            GpuMode::ValIsm(p) => format!(
+                "{} VALs, {}, PCSS {}/{}, {}",
+                p.vals.count,
+                p.ism.describe(),
+                p.pcss.blocker_samples,
+                p.pcss.filter_samples,
+                il(&p.interleave)
+            ),
             GpuMode::ValCssm(v, c) => format!(
                 "{} VALs, {}² maps, {} terms, {}",
                 v.vals.count,
@@ -208,6 +249,8 @@ impl GpuMode {
             GpuMode::ValHard(v) => v.check(),
             GpuMode::ValCssm(v, c) => v.check().and(c.check()),
             GpuMode::VplClusters(p, i) => p.check().and(i.check()),
+            GpuMode::PerVplIsm(p) => p.check(),
+            GpuMode::ValIsm(p) => p.check(),
         }
     }
 
@@ -220,6 +263,15 @@ impl GpuMode {
             }
             GpuMode::GatesPerPixel(g) if g.shape == crate::cpu::gates::GateShape::Portal => vpls,
             _ => 0,
+        }
+    }
+
+    /// The VAL clustering of the VAL modes.
+    pub fn vals(&self) -> Option<ValParams> {
+        match self {
+            GpuMode::ValHard(v) | GpuMode::ValCssm(v, _) => Some(v.vals),
+            GpuMode::ValIsm(v) => Some(v.vals),
+            _ => None,
         }
     }
 

@@ -55,6 +55,7 @@ use passes::clustered_gates::{ClusteredGates, LevelBuffers, ListBuffers};
 use passes::cssm::Cssm;
 use passes::gbuffer::GBuffer;
 use passes::interleave_blur::InterleaveBlur;
+use passes::ism::Isms;
 use passes::light_cluster::LightCluster;
 use passes::per_vpl_maps::ParaboloidMaps;
 use passes::rsm_vpls::RsmVpls;
@@ -69,9 +70,9 @@ use timing::Recorder;
 pub use context::GpuContext;
 pub use geometry::{MAX_TEXTURE_SIZE, VPL_SHADOW_MAX_EDGE};
 pub use methods::{
-    CssmParams, DirectLight, GatesParams, GpuMode, GpuParams, InterleaveParams, LcDisk,
+    CssmParams, DirectLight, GatesParams, GpuMode, GpuParams, InterleaveParams, IsmParams, LcDisk,
     LightClusterGpuParams, METHODS, MethodInfo, MethodSettings, PcssParams, PerVplParams,
-    ShadowParams, ValModeParams, method,
+    ShadowParams, ValIsmParams, ValModeParams, VplIsmParams, method,
 };
 pub use passes::clustered_gates::{MAX_CLUSTERS, MAX_GATES};
 pub use passes::light_cluster::{MAX_LC_CLUSTERS, MAX_LC_LIGHTS};
@@ -158,6 +159,7 @@ pub struct Pipelines {
     val_gather: ValGathers,
     blur: InterleaveBlur,
     light_cluster: LightCluster,
+    isms: Isms,
 }
 
 impl Pipelines {
@@ -174,6 +176,7 @@ impl Pipelines {
             val_gather: ValGathers::new(d, s)?,
             blur: InterleaveBlur::new(d, s)?,
             light_cluster: LightCluster::new(d, s)?,
+            isms: Isms::new(d, s)?,
         })
     }
 }
@@ -246,15 +249,21 @@ fn record_passes(
     match &f.params.mode {
         GpuMode::Gates(gp) if gp.interleave.block > 1 => {
             let indirect = p.shade.record_indirect(f, pool, rec, inputs, false);
-            let uniform = InterleaveBlur::uniform(f, &gp.interleave, pool);
+            let uniform = InterleaveBlur::uniform(f, &gp.interleave, pool, true);
             p.blur.record(f, pool, rec, (&g, &uniform, &indirect, &hdr));
         }
         GpuMode::VplClusters(_, il) if il.block > 1 => {
             let indirect = p.shade.record_indirect(f, pool, rec, inputs, true);
-            let uniform = InterleaveBlur::uniform(f, il, pool);
+            let uniform = InterleaveBlur::uniform(f, il, pool, true);
             p.blur.record(f, pool, rec, (&g, &uniform, &indirect, &hdr));
         }
         GpuMode::PerVplShadowMaps(pv) => p.maps.record(f, pv, pool, rec, (&g, &hdr)),
+        GpuMode::PerVplIsm(pi) => p.isms.record_vpls(f, pi, &p.blur, pool, rec, (&g, &hdr))?,
+        GpuMode::ValIsm(vi) => {
+            val_state = p
+                .isms
+                .record_vals(f, vi, &p.vals, &p.blur, warm, pool, rec, (&g, &hdr))?;
+        }
         GpuMode::ValHard(v) | GpuMode::ValCssm(v, _) => {
             let cssm = match &f.params.mode {
                 GpuMode::ValCssm(_, c) => Some(c),
@@ -549,17 +558,9 @@ impl GpuRenderer {
                 params.mode.name()
             )));
         }
-        let val_count = match params.mode {
-            GpuMode::ValHard(v) | GpuMode::ValCssm(v, _) => Some(v.vals.count),
-            _ => None,
-        };
-        let warm = val_count.is_some_and(|m| {
-            let p = match params.mode {
-                GpuMode::ValHard(v) | GpuMode::ValCssm(v, _) => v.vals,
-                _ => ValParams::default(),
-            };
-            p.warm_start && self.val_warm == Some(m)
-        });
+        let vals = params.mode.vals();
+        let val_count = vals.map(|v| v.count);
+        let warm = vals.is_some_and(|p| p.warm_start && self.val_warm == Some(p.count));
         let mut rec = Recorder::new(ctx, &mut self.pool);
         let (vpl_buf, count) = self.frame_vpls(ctx, &vpls, &mut rec)?;
         methods::warn_software_loop_limit(&ctx.adapter_info.name, &params.mode, count);
@@ -600,12 +601,11 @@ impl GpuRenderer {
             let c: Vec<u32> = bytemuck::cast_slice(&map_read(ctx, r)?).to_vec();
             times.lists = Some(l.stats(&c)?);
         }
-        if let (Some(r), GpuMode::ValHard(v) | GpuMode::ValCssm(v, _)) = (&state_read, params.mode)
-        {
+        if let (Some(r), Some(v)) = (&state_read, vals) {
             let c: Vec<u32> = bytemuck::cast_slice(&map_read(ctx, r)?).to_vec();
             times.vals = Some(ValIterations {
                 iterations: c[2],
-                max: v.vals.iterations,
+                max: v.iterations,
                 converged: c[1] != 0,
             });
         }
@@ -692,6 +692,44 @@ impl GpuRenderer {
             iterations: state[2],
             converged: vpls.is_empty() || state[1] != 0,
         })
+    }
+
+    /// Builds the imperfect shadow maps of `vpls` with `params` (as mode per-vpl-ism does) and
+    /// reads them back: (distances, map side), map k's texel (x, y) at k·s² + y·s + x, in
+    /// metres, `f32::INFINITY` where nothing was seen. For tests and inspection.
+    pub fn ism_maps(
+        &mut self,
+        ctx: &GpuContext,
+        vpls: &[Vpl],
+        params: &IsmParams,
+    ) -> Result<(Vec<f32>, u32), RenderError> {
+        let gpu_params = GpuParams::with_mode(GpuMode::PerVplIsm(VplIsmParams {
+            ism: *params,
+            ..VplIsmParams::default()
+        }));
+        gpu_params.check()?;
+        let camera = visgate_formats::Camera {
+            name: "ism".into(),
+            eye: Vec3::Z,
+            target: Vec3::ZERO,
+            up: Vec3::Y,
+            fov_x_rad: 1.0,
+        };
+        let view = View::new(&camera, [1, 1])?;
+        let mut rec = Recorder::new(ctx, &mut self.pool);
+        let v = self.frame_vpls(ctx, &VplInput::Given(vpls), &mut rec)?;
+        let (frame, p, pool) = self.frame(ctx, &view, &gpu_params, (v.0, v.1, Some(vpls)));
+        let emitters = passes::ism::Emitters::Vpls;
+        let maps = p.isms.record_maps(
+            &frame,
+            params,
+            emitters,
+            (1, Default::default()),
+            pool,
+            &mut rec,
+        )?;
+        rec.finish(pool)?;
+        Ok((passes::ism::read_maps(ctx, &maps)?, maps.map_size))
     }
 
     /// Runs LightCluster's culling and clustering of the scene's lights for `view` on the GPU

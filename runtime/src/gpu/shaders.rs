@@ -17,7 +17,7 @@
 use crate::RenderError;
 
 /// The include files (`gpu/shaders/`).
-const INCLUDES: [(&str, &str); 9] = [
+const INCLUDES: [(&str, &str); 11] = [
     ("globals.wgsl", include_str!("shaders/globals.wgsl")),
     ("lights.wgsl", include_str!("shaders/lights.wgsl")),
     ("vpl.wgsl", include_str!("shaders/vpl.wgsl")),
@@ -27,10 +27,12 @@ const INCLUDES: [(&str, &str); 9] = [
     ("val.wgsl", include_str!("shaders/val.wgsl")),
     ("fullscreen.wgsl", include_str!("shaders/fullscreen.wgsl")),
     ("lc.wgsl", include_str!("shaders/lc.wgsl")),
+    ("pcss.wgsl", include_str!("shaders/pcss.wgsl")),
+    ("ism.wgsl", include_str!("shaders/ism.wgsl")),
 ];
 
 /// The pass shaders (`gpu/passes/`), before composition.
-pub const SOURCES: [(&str, &str); 13] = [
+pub const SOURCES: [(&str, &str); 15] = [
     ("gbuffer.wgsl", include_str!("passes/gbuffer.wgsl")),
     ("shadow.wgsl", include_str!("passes/shadow.wgsl")),
     ("shade.wgsl", include_str!("passes/shade.wgsl")),
@@ -50,6 +52,8 @@ pub const SOURCES: [(&str, &str); 13] = [
         include_str!("passes/light_cluster.wgsl"),
     ),
     ("lc_shadows.wgsl", include_str!("passes/lc_shadows.wgsl")),
+    ("ism_maps.wgsl", include_str!("passes/ism_maps.wgsl")),
+    ("ism_gather.wgsl", include_str!("passes/ism_gather.wgsl")),
 ];
 
 /// What the shading pass adds to the direct light (`Globals::shade_mode`).

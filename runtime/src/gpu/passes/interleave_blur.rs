@@ -80,8 +80,14 @@ impl InterleaveBlur {
     }
 
     /// The blur's constants (a `ValGather` with only the interleaving's fields) for a mode
-    /// without a VAL gather of its own, whose indirect target is deinterleaved (the gates').
-    pub fn uniform(f: &Frame, p: &InterleaveParams, pool: &mut Pool) -> wgpu::Buffer {
+    /// without a VAL gather of its own: its indirect target deinterleaved (the gates') or in
+    /// pixel order (the ISM modes').
+    pub fn uniform(
+        f: &Frame,
+        p: &InterleaveParams,
+        pool: &mut Pool,
+        deinterleaved: bool,
+    ) -> wgpu::Buffer {
         let constants = ValGather {
             vpl_count: f.vpl_count,
             g_max: f.params.g_max,
@@ -89,7 +95,7 @@ impl InterleaveBlur {
             subsets: p.subsets(),
             blur_distance: p.blur_distance_m(f),
             blur_normal: p.blur_normal,
-            deinterleaved: 1,
+            deinterleaved: u32::from(deinterleaved),
             ..bytemuck::Zeroable::zeroed()
         };
         pool.upload(

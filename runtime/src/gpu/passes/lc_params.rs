@@ -24,6 +24,19 @@ impl Default for PcssParams {
     }
 }
 
+impl PcssParams {
+    /// Checks the limits.
+    pub fn check(&self) -> Result<(), RenderError> {
+        if !(1..=64).contains(&self.blocker_samples) || !(1..=128).contains(&self.filter_samples) {
+            return Err(RenderError::Param(format!(
+                "PCSS blocker samples {} must be 1..=64 and filter samples {} 1..=128",
+                self.blocker_samples, self.filter_samples
+            )));
+        }
+        Ok(())
+    }
+}
+
 /// The disk each cluster's soft shadow is cast from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum LcDisk {
@@ -86,13 +99,7 @@ impl LightClusterGpuParams {
                 self.map_size
             ));
         }
-        if !(1..=64).contains(&self.pcss.blocker_samples) {
-            return bad("PCSS blocker samples must be 1..=64".into());
-        }
-        if !(1..=128).contains(&self.pcss.filter_samples) {
-            return bad("PCSS filter samples must be 1..=128".into());
-        }
-        Ok(())
+        self.pcss.check()
     }
 
     /// (tiles per row, rows) of the shadow atlas.

@@ -5,6 +5,8 @@ pub mod clustered_gates;
 pub mod cssm;
 pub mod gbuffer;
 pub mod interleave_blur;
+pub mod ism;
+pub mod ism_params;
 pub mod lc_params;
 pub mod light_cluster;
 pub mod per_vpl_maps;

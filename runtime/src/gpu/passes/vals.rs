@@ -4,7 +4,7 @@
 //! VPLs sorted by (VAL, interleaving subset). [`crate::cpu::val`] is the CPU twin.
 
 use crate::RenderError;
-use crate::cpu::val::{ValParams, scale_of};
+use crate::cpu::val::{ValParams, ValSeeding, scale_of};
 use crate::gpu::GpuContext;
 use crate::gpu::context::{Pool, bind_group, compute_pipelines};
 use crate::gpu::layout::{Val, ValFrame, Vpl};
@@ -15,6 +15,7 @@ use crate::gpu::timing::Recorder;
 /// The clustering pipelines.
 pub struct ValClustering {
     scale: wgpu::ComputePipeline,
+    cumulate: wgpu::ComputePipeline,
     init: wgpu::ComputePipeline,
     assign: wgpu::ComputePipeline,
     converge: wgpu::ComputePipeline,
@@ -54,6 +55,7 @@ impl ValClustering {
         let module = shaders::module(d, s, "vals.wgsl")?;
         let [
             scale,
+            cumulate,
             init,
             assign,
             converge,
@@ -67,6 +69,7 @@ impl ValClustering {
             &module,
             [
                 "scale",
+                "cumulate",
                 "init",
                 "assign",
                 "converge",
@@ -79,6 +82,7 @@ impl ValClustering {
         );
         Ok(ValClustering {
             scale,
+            cumulate,
             init,
             assign,
             converge,
@@ -117,16 +121,19 @@ impl ValClustering {
             vpl_count: n,
             val_count: m,
             subsets,
+            seeding: u32::from(params.seeding == ValSeeding::HaltonFlux),
             w_x: params.w_x,
             w_alpha: params.w_alpha,
-            ..bytemuck::Zeroable::zeroed()
+            w_f: params.w_f,
+            splat: params.splat_or_zero(),
         };
         let uniform = wgpu::BufferUsages::UNIFORM;
         let frame_buf = pool.upload(ctx, "val frame", bytemuck::bytes_of(&frame), uniform);
         let rw = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
         let inv: [f32; 1] = [input.cpu.map_or(1.0, |v| 1.0 / scale_of(v))];
         let inv_scale = pool.upload(ctx, "val inv scale", bytemuck::cast_slice(&inv), rw);
-        let centres = pool.buffer(d, "val centres", m as u64 * 32, rw);
+        let centres = pool.buffer(d, "val centres", m as u64 * 48, rw);
+        let cdf = pool.buffer(d, "vpl importance cdf", n.max(1) as u64 * 4, rw);
         let mapping = pool.buffer(d, "vpl → val", n as u64 * 4, rw);
         let vals = pool.buffer(d, "vals", m as u64 * size_of::<Val>() as u64, rw);
         let buckets = m as u64 * subsets as u64;
@@ -148,7 +155,8 @@ impl ValClustering {
         };
         let base = [(0, &frame_buf), (1, input.buffer), (2, &centres)];
         let scale_bg = bind(&self.scale, &[base[0], base[1], (6, &inv_scale)]);
-        let init_bg = bind(&self.init, &base);
+        let cumulate_bg = bind(&self.cumulate, &[base[0], base[1], (8, &cdf)]);
+        let init_bg = bind(&self.init, &[base[0], base[1], base[2], (8, &cdf)]);
         let assign_bg = bind(
             &self.assign,
             &[
@@ -189,6 +197,9 @@ impl ValClustering {
                     run(&self.scale, &scale_bg, 1);
                 }
                 if !warm {
+                    if params.seeding == ValSeeding::HaltonFlux {
+                        run(&self.cumulate, &cumulate_bg, 1);
+                    }
                     run(&self.init, &init_bg, gm);
                 }
                 // The iterations stop on the GPU once the assignment repeats itself (the

@@ -2,7 +2,10 @@
 // Virtual area lights on the GPU (Dong et al. §5–6): k-means of the VPLs into M VALs by
 // d = w_x·Δx/D + w_α·Δα/π, restarted each frame from VAL k = VPL ⌊k·N/M⌋.
 // runtime::cpu::val is the CPU twin (same order of every sum, so the same VALs).
-//   init    centres from the restart VPLs
+//   cdf     (Weinzierl-Heigl's seeds) the VPLs' cumulative importance r + g + b, in one
+//           workgroup: 64 contiguous chunks, as runtime::cpu::val::importance_cdf
+//   init    centres from the restart VPLs, or from the Halton points warped by the cumulative
+//           importance
 //   assign  each live VPL's nearest centre (ties to the lower index) → the mapping C; a VPL of
 //           zero flux (an RSM sample that found nothing) maps to NONE and joins no VAL
 //   converge stops the iterations once the assignment repeats itself (the paper iterates to
@@ -17,15 +20,18 @@ struct ValFrame {
     val_count: u32,
     // Interleaving subsets B (1: none).
     subsets: u32,
-    pad0: u32,
+    // 0 restart (Dong et al.), 1 Halton seeds warped by flux (Weinzierl-Heigl).
+    seeding: u32,
     w_x: f32,
     w_alpha: f32,
-    pad1: vec2<f32>,
+    // Weight of the flux term; splat radius over D (0: every centre).
+    w_f: f32,
+    splat: f32,
 };
 
 @group(0) @binding(0) var<uniform> frame: ValFrame;
 @group(0) @binding(1) var<storage, read> vpls: array<Vpl>;
-// Per VAL: centre (xyz), normal (xyz) at 2k, 2k + 1.
+// Per VAL: centre (xyz), normal (xyz), mean flux of its VPLs (rgb) at 3k, 3k + 1, 3k + 2.
 @group(0) @binding(2) var<storage, read_write> centres: array<vec4<f32>>;
 @group(0) @binding(3) var<storage, read_write> mapping: array<u32>;
 @group(0) @binding(4) var<storage, read_write> vals: array<Val>;
@@ -35,6 +41,8 @@ struct ValFrame {
 // Convergence: 0 VPLs whose VAL changed in this iteration's assignment, 1 done (the mapping
 // stopped changing: every later iteration would repeat the last), 2 updates run.
 @group(0) @binding(7) var<storage, read_write> state: array<atomic<u32>, 4>;
+// The VPLs' inclusive cumulative importance (seeding 1).
+@group(0) @binding(8) var<storage, read_write> cdf: array<f32>;
 
 var<workgroup> wg_lo: array<vec3<f32>, WG_LINEAR>;
 var<workgroup> wg_hi: array<vec3<f32>, WG_LINEAR>;
@@ -75,12 +83,63 @@ fn scale(@builtin(local_invocation_index) li: u32) {
     }
 }
 
+var<workgroup> wg_total: array<f32, WG_LINEAR>;
+
+fn importance(v: Vpl) -> f32 {
+    return v.flux.x + v.flux.y + v.flux.z;
+}
+
+@compute @workgroup_size(WG_LINEAR)
+fn cumulate(@builtin(local_invocation_index) li: u32) {
+    let n = frame.vpl_count;
+    let chunk = max((n + WG_LINEAR - 1u) / WG_LINEAR, 1u);
+    let first = li * chunk;
+    let last = min(first + chunk, n);
+    var total = 0.0;
+    for (var i = first; i < last; i++) {
+        total += importance(vpls[i]);
+    }
+    wg_total[li] = total;
+    workgroupBarrier();
+    var base = 0.0;
+    for (var t = 0u; t < li; t++) {
+        base += wg_total[t];
+    }
+    var run = base;
+    for (var i = first; i < last; i++) {
+        run += importance(vpls[i]);
+        cdf[i] = run;
+    }
+}
+
+fn set_centre(k: u32, v: Vpl) {
+    centres[3u * k] = vec4<f32>(v.position, 0.0);
+    centres[3u * k + 1u] = vec4<f32>(v.normal, 0.0);
+    centres[3u * k + 2u] = vec4<f32>(v.flux, 0.0);
+}
+
 @compute @workgroup_size(WG_LINEAR)
 fn init(@builtin(global_invocation_id) id: vec3<u32>) {
     let k = id.x;
     let n = frame.vpl_count;
     let m = frame.val_count;
     if k >= m || n == 0u {
+        return;
+    }
+    if frame.seeding == 1u {
+        // The first VPL whose cumulative importance exceeds h2(k) × the total.
+        let target_ = f32(reverseBits(k)) * 2.3283064e-10 * cdf[n - 1u];
+        var lo = 0u;
+        var hi = n;
+        while lo < hi {
+            let mid = (lo + hi) / 2u;
+            if cdf[mid] <= target_ {
+                lo = mid + 1u;
+            } else {
+                hi = mid;
+            }
+        }
+        set_centre(k, vpls[min(lo, n - 1u)]);
         return;
     }
     // ⌊k·N/M⌋ without overflowing 32 bits; a dead VPL there gives way to the next live one.
@@ -92,14 +151,26 @@ fn init(@builtin(global_invocation_id) id: vec3<u32>) {
             break;
         }
     }
-    centres[2u * k] = vec4<f32>(vpls[j].position, 0.0);
-    centres[2u * k + 1u] = vec4<f32>(vpls[j].normal, 0.0);
+    set_centre(k, vpls[j]);
 }
 
 fn distance(v: Vpl, k: u32) -> f32 {
-    let dx = length(v.position - centres[2u * k].xyz) * inv_scale[0];
-    let da = acos(clamp(dot(v.normal, centres[2u * k + 1u].xyz), -1.0, 1.0)) / PI;
-    return frame.w_x * dx + frame.w_alpha * da;
+    let dx = length(v.position - centres[3u * k].xyz) * inv_scale[0];
+    let da = acos(clamp(dot(v.normal, centres[3u * k + 1u].xyz), -1.0, 1.0)) / PI;
+    var d = frame.w_x * dx + frame.w_alpha * da;
+    if frame.w_f > 0.0 {
+        let f = centres[3u * k + 2u].xyz;
+        let sum = length(v.flux) + length(f);
+        if sum > 0.0 {
+            d += frame.w_f * (length(v.flux - f) / sum);
+        }
+    }
+    return d;
+}
+
+// Whether centre k's splat reaches VPL v.
+fn in_splat(v: Vpl, k: u32) -> bool {
+    return length(v.position - centres[3u * k].xyz) * inv_scale[0] <= frame.splat;
 }
 
 @compute @workgroup_size(WG_LINEAR)
@@ -113,14 +184,23 @@ fn assign(@builtin(global_invocation_id) id: vec3<u32>) {
         mapping[i] = NONE;
         return;
     }
-    var best = distance(v, 0u);
+    var best = 3.4e38;
     var at = 0u;
-    for (var k = 1u; k < frame.val_count; k++) {
+    var splat_best = 3.4e38;
+    var splat_at = NONE;
+    for (var k = 0u; k < frame.val_count; k++) {
         let d = distance(v, k);
         if d < best {
             best = d;
             at = k;
         }
+        if frame.splat > 0.0 && in_splat(v, k) && d < splat_best {
+            splat_best = d;
+            splat_at = k;
+        }
+    }
+    if splat_at != NONE {
+        at = splat_at;
     }
     if mapping[i] != at {
         atomicAdd(&state[0], 1u);
@@ -150,6 +230,7 @@ fn converge() {
 var<workgroup> wg_done: u32;
 var<workgroup> wg_a: array<vec3<f32>, WG_LINEAR>;
 var<workgroup> wg_b: array<vec3<f32>, WG_LINEAR>;
+var<workgroup> wg_c: array<vec3<f32>, WG_LINEAR>;
 var<workgroup> wg_count: array<u32, WG_LINEAR>;
 var<workgroup> wg_rect: array<vec4<f32>, WG_LINEAR>;
 
@@ -160,6 +241,7 @@ fn fold(li: u32) {
         if li < o {
             wg_a[li] += wg_a[li + o];
             wg_b[li] += wg_b[li + o];
+            wg_c[li] += wg_c[li + o];
             wg_count[li] += wg_count[li + o];
             let r = wg_rect[li];
             let q = wg_rect[li + o];
@@ -181,25 +263,30 @@ fn update(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index)
     }
     var p = vec3<f32>(0.0);
     var nrm = vec3<f32>(0.0);
+    var flux = vec3<f32>(0.0);
     var count = 0u;
     for (var i = li; i < frame.vpl_count; i += WG_LINEAR) {
         if mapping[i] == k {
             p += vpls[i].position;
             nrm += vpls[i].normal;
+            flux += vpls[i].flux;
             count++;
         }
     }
     wg_a[li] = p;
     wg_b[li] = nrm;
+    wg_c[li] = flux;
     wg_count[li] = count;
     wg_rect[li] = vec4<f32>(0.0);
     fold(li);
     if li == 0u && wg_count[0] > 0u {
-        centres[2u * k] = vec4<f32>(wg_a[0] / f32(wg_count[0]), 0.0);
+        let c = f32(wg_count[0]);
+        centres[3u * k] = vec4<f32>(wg_a[0] / c, 0.0);
         let l = length(wg_b[0]);
         if l > 0.0 {
-            centres[2u * k + 1u] = vec4<f32>(wg_b[0] / l, 0.0);
+            centres[3u * k + 1u] = vec4<f32>(wg_b[0] / l, 0.0);
         }
+        centres[3u * k + 2u] = vec4<f32>(wg_c[0] / c, 0.0);
     }
 }
 
@@ -209,11 +296,12 @@ fn finish(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index)
     if k >= frame.val_count {
         return;
     }
-    let c = centres[2u * k].xyz;
-    let nrm = centres[2u * k + 1u].xyz;
+    let c = centres[3u * k].xyz;
+    let nrm = centres[3u * k + 1u].xyz;
     let tb = basis(nrm);
     var count = 0u;
     var flux = vec3<f32>(0.0);
+    var moment = 0.0;
     var rect = vec4<f32>(1e38, -1e38, 1e38, -1e38);
     for (var i = li; i < frame.vpl_count; i += WG_LINEAR) {
         if mapping[i] == k {
@@ -222,11 +310,13 @@ fn finish(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index)
             let t = dot(q, tb[1]);
             rect = vec4<f32>(min(rect.x, s), max(rect.y, s), min(rect.z, t), max(rect.w, t));
             flux += vpls[i].flux;
+            moment += s * s + t * t;
             count++;
         }
     }
     wg_a[li] = flux;
-    wg_b[li] = vec3<f32>(0.0);
+    wg_b[li] = vec3<f32>(moment, 0.0, 0.0);
+    wg_c[li] = vec3<f32>(0.0);
     wg_count[li] = count;
     wg_rect[li] = rect;
     fold(li);
@@ -241,7 +331,12 @@ fn finish(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index)
     var v: Val;
     v.position = vec4<f32>(c, f32(count));
     v.normal = vec4<f32>(nrm, (rect.y - rect.x) * (rect.w - rect.z));
-    v.flux = vec4<f32>(wg_a[0], 0.0);
+    // The disk of the same second moment: A = 2π·mean(s² + t²).
+    var area = 0.0;
+    if count > 0u {
+        area = 2.0 * PI * (wg_b[0].x / f32(count));
+    }
+    v.flux = vec4<f32>(wg_a[0], area);
     v.rect = rect;
     vals[k] = v;
 }

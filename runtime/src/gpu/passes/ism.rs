@@ -1,0 +1,394 @@
+//! Imperfect shadow maps (ism_maps.wgsl) and the two modes that light through them
+//! (ism_gather.wgsl): `per-vpl-ism` (Ritschel et al. 2008: a map per VPL) and `val-ism`
+//! (Weinzierl-Heigl: a map per virtual area light, the point-to-disk form factor, PCSS).
+//!
+//! The maps are compute passes, not point draws: wgpu draws points one pixel wide, and a splat
+//! of a radius set per point is a loop of `atomicMax` over its texels (the nearest distance
+//! wins, as a depth test would). The maps are one storage buffer, map k at k·s² words; the
+//! pull-push pyramid a second one. The points are not kept: point i is drawn from the scene's
+//! triangles by a hash of i each frame (a few ALU a point), so moved meshes move their points
+//! and no point pool grows with the emitters.
+
+use super::gbuffer::GBufferOutput;
+use super::interleave_blur::InterleaveBlur;
+pub use super::ism_params::{ISM_MAP_SIZE, IsmParams, ValIsmParams, VplIsmParams};
+use super::shade::{HDR, frame_target, fullscreen};
+use super::vals::{ValClustering, ValInput};
+use crate::RenderError;
+use crate::gpu::context::{Pool, bind_group, compute_pipelines, render_pipeline, slice};
+use crate::gpu::layout::{IsmFrame, IsmLevel, UNIFORM_STRIDE, strided};
+use crate::gpu::shaders::{self, ShaderSources, WG_LINEAR};
+use crate::gpu::timing::Recorder;
+use crate::gpu::{Frame, GpuContext};
+
+/// The ISM pipelines.
+pub struct Isms {
+    emit: wgpu::ComputePipeline,
+    sample: wgpu::ComputePipeline,
+    splat: wgpu::ComputePipeline,
+    pull: wgpu::ComputePipeline,
+    push: wgpu::ComputePipeline,
+    gather_vpl: wgpu::RenderPipeline,
+    gather_val: wgpu::RenderPipeline,
+}
+
+/// The maps of a frame.
+pub struct IsmOutput {
+    /// The constants ([`IsmFrame`]).
+    pub frame: wgpu::Buffer,
+    /// Each emitter's centre and axis.
+    pub emitters: wgpu::Buffer,
+    /// The maps (map k at k·s² words, a texel !bits of the distance, 0 nothing).
+    pub atlas: wgpu::Buffer,
+    /// Their side. [Units: texels]
+    pub map_size: u32,
+}
+
+/// What the maps are made for.
+pub enum Emitters<'a> {
+    /// The frame's VPLs.
+    Vpls,
+    /// These VALs.
+    Vals(&'a wgpu::Buffer, u32),
+}
+
+/// Points a frame may keep (16 bytes each): beyond, they are drawn again in the splat pass.
+const MAX_KEPT_POINTS: u64 = 1 << 23;
+
+/// Workgroups for `n` threads as (x, y) within the adapter's 65,535 per dimension.
+fn groups(n: u64) -> (u32, u32) {
+    let g = n.div_ceil(WG_LINEAR as u64);
+    (g.min(65_535) as u32, g.div_ceil(65_535) as u32)
+}
+
+impl Isms {
+    /// Builds the pipelines.
+    pub fn new(d: &wgpu::Device, s: &ShaderSources) -> Result<Isms, RenderError> {
+        let maps = shaders::module(d, s, "ism_maps.wgsl")?;
+        let [emit, sample, splat, pull, push] =
+            compute_pipelines(d, &maps, ["emit", "sample", "splat", "pull", "push"]);
+        let gather = shaders::module(d, s, "ism_gather.wgsl")?;
+        let pipeline =
+            |label, fs| render_pipeline(d, label, &gather, ("vs", fs), &[], &[HDR], None);
+        Ok(Isms {
+            emit,
+            sample,
+            splat,
+            pull,
+            push,
+            gather_vpl: pipeline("per-vpl ism gather", "fs_vpl"),
+            gather_val: pipeline("val ism gather", "fs_val"),
+        })
+    }
+
+    /// Records the maps of `emitters` with `p`; `gather`: the gather's interleaving block and
+    /// PCSS samples, kept in the same constants.
+    pub fn record_maps(
+        &self,
+        f: &Frame,
+        p: &IsmParams,
+        emitters: Emitters,
+        gather: (u32, super::lc_params::PcssParams),
+        pool: &mut Pool,
+        rec: &mut Recorder,
+    ) -> Result<IsmOutput, RenderError> {
+        p.check()?;
+        let ctx = f.ctx;
+        let d = &ctx.device;
+        let (kind, count, vals) = match emitters {
+            Emitters::Vpls => (0, f.vpl_count, None),
+            Emitters::Vals(b, m) => (1, m, Some(b)),
+        };
+        let limit = d.limits().max_storage_buffer_binding_size;
+        let s = p.side_for(count, limit)?;
+        let geo = &f.scene.geometry;
+        let points = count as u64 * p.points_per_map as u64;
+        if points > u32::MAX as u64 {
+            return Err(RenderError::Param(format!(
+                "{count} maps × {} points is more than 2³² points: use fewer points per map",
+                p.points_per_map
+            )));
+        }
+        let (block, pcss) = gather;
+        let constants = IsmFrame {
+            emitters: count,
+            map_size: s,
+            points: points as u32,
+            triangles: geo.triangle_count,
+            kind,
+            seed: p.seed,
+            block,
+            subsets: block * block,
+            // A point stands for the scene's area over the points of a map, as a disk, its
+            // splat √coverage times wider.
+            point_radius: (p.coverage * geo.area_m2
+                / (p.points_per_map as f32 * std::f32::consts::PI))
+                .sqrt(),
+            max_splat: p.max_splat,
+            centre_offset: f.scene.near_m,
+            g_max: f.params.g_max,
+            bias: p.bias,
+            normal_offset: p.normal_offset,
+            blocker_samples: pcss.blocker_samples,
+            filter_samples: pcss.filter_samples,
+        };
+        let frame = pool.upload(
+            ctx,
+            "ism frame",
+            bytemuck::bytes_of(&constants),
+            wgpu::BufferUsages::UNIFORM,
+        );
+        let rw = wgpu::BufferUsages::STORAGE;
+        let emit_buf = pool.buffer(d, "ism emitters", count.max(1) as u64 * 32, rw);
+        let atlas = pool.buffer(
+            d,
+            "ism atlas",
+            count.max(1) as u64 * (s as u64 * s as u64) * 4,
+            rw | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
+        );
+        let levels = p.pull_push.min(s.trailing_zeros());
+        let mut offsets = vec![0u64; levels as usize + 2];
+        for l in 1..=levels as usize {
+            offsets[l + 1] = offsets[l] + count as u64 * ((s >> l) as u64).pow(2);
+        }
+        let pyramid = pool.buffer(d, "ism pyramid", offsets[levels as usize + 1] * 4, rw);
+        let keep = points <= MAX_KEPT_POINTS;
+        let kept = pool.buffer(d, "ism points", if keep { points * 16 } else { 16 }, rw);
+        let no_vals;
+        let vals = match vals {
+            Some(v) => v,
+            None => {
+                no_vals = pool.buffer(d, "ism no vals", 64, rw);
+                &no_vals
+            }
+        };
+        let all: [(u32, &wgpu::Buffer); 9] = [
+            (0, &frame),
+            (1, &f.vpls),
+            (2, vals),
+            (3, &emit_buf),
+            (4, &geo.triangles),
+            (5, &geo.area_cdf),
+            (6, &kept),
+            (7, &atlas),
+            (8, &pyramid),
+        ];
+        let bind = |pl: &wgpu::ComputePipeline, which: &[u32]| {
+            let r = which
+                .iter()
+                .map(|&b| (b, all[b as usize].1.as_entire_binding()))
+                .collect();
+            bind_group(d, &pl.get_bind_group_layout(0), "ism", r)
+        };
+        let emit_bg = bind(&self.emit, &[0, 1, 2, 3]);
+        let sample_bg = bind(&self.sample, &[0, 4, 5, 6]);
+        let splat_bg = bind(&self.splat, &[0, 3, 4, 5, 6, 7]);
+        let pull_bg = bind(&self.pull, &[0, 7, 8]);
+        let push_bg = bind(&self.push, &[0, 7, 8]);
+        // One pull per level up, one push per level down.
+        let mut steps: Vec<IsmLevel> = (1..=levels)
+            .map(|l| IsmLevel {
+                level: l,
+                side: s >> l,
+                offset: offsets[l as usize] as u32,
+                other: offsets[l as usize - 1] as u32,
+            })
+            .collect();
+        steps.extend((0..levels).rev().map(|l| IsmLevel {
+            level: l,
+            side: s >> l,
+            offset: offsets[l as usize] as u32,
+            other: offsets[l as usize + 1] as u32,
+        }));
+        let level_buf = pool.upload(
+            ctx,
+            "ism levels",
+            &strided(&steps),
+            wgpu::BufferUsages::UNIFORM,
+        );
+        let size = size_of::<IsmLevel>() as u64;
+        let level_bgs: Vec<wgpu::BindGroup> = (0..steps.len())
+            .map(|k| {
+                let pl = if k < levels as usize {
+                    &self.pull
+                } else {
+                    &self.push
+                };
+                let off = (k * UNIFORM_STRIDE) as u64;
+                bind_group(
+                    d,
+                    &pl.get_bind_group_layout(1),
+                    "ism level",
+                    vec![(0, slice(&level_buf, off, size))],
+                )
+            })
+            .collect();
+        rec.enc.clear_buffer(&atlas, 0, None);
+        let dispatch = |pass: &mut wgpu::ComputePass, pl, bg, n: u64| {
+            let (x, y) = groups(n);
+            pass.set_pipeline(pl);
+            pass.set_bind_group(0, bg, &[]);
+            pass.dispatch_workgroups(x, y, 1);
+        };
+        let span = rec.begin("ISM points");
+        {
+            let mut pass = rec.enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("ism points"),
+                timestamp_writes: span.compute(),
+            });
+            if count > 0 {
+                dispatch(&mut pass, &self.emit, &emit_bg, count as u64);
+                if keep {
+                    dispatch(&mut pass, &self.sample, &sample_bg, points);
+                }
+            }
+        }
+        rec.end();
+        let span = rec.begin("ISM atlas");
+        {
+            let mut pass = rec.enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("ism atlas"),
+                timestamp_writes: span.compute(),
+            });
+            if count > 0 {
+                dispatch(&mut pass, &self.splat, &splat_bg, points);
+            }
+        }
+        rec.end();
+        let span = rec.begin("pull-push");
+        {
+            let mut pass = rec.enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("ism pull-push"),
+                timestamp_writes: span.compute(),
+            });
+            for (k, step) in steps.iter().enumerate().filter(|_| count > 0) {
+                let (pl, bg) = match k < levels as usize {
+                    true => (&self.pull, &pull_bg),
+                    false => (&self.push, &push_bg),
+                };
+                pass.set_bind_group(1, &level_bgs[k], &[]);
+                dispatch(&mut pass, pl, bg, count as u64 * (step.side as u64).pow(2));
+            }
+        }
+        rec.end();
+        Ok(IsmOutput {
+            frame,
+            emitters: emit_buf,
+            atlas,
+            map_size: s,
+        })
+    }
+
+    /// Records the gather through `maps` into an indirect target and the blur composing it
+    /// onto `out`: `vals` for val-ism, none for per-vpl-ism.
+    #[allow(clippy::too_many_arguments)]
+    fn record_gather(
+        &self,
+        f: &Frame,
+        maps: &IsmOutput,
+        vals: Option<&wgpu::Buffer>,
+        interleave: &super::interleave_blur::InterleaveParams,
+        blur: &InterleaveBlur,
+        pool: &mut Pool,
+        rec: &mut Recorder,
+        (g, out): (&GBufferOutput, &wgpu::Texture),
+    ) {
+        let d = &f.ctx.device;
+        let indirect = frame_target(f, pool, "indirect irradiance");
+        let tex = wgpu::BindingResource::TextureView;
+        let (pipeline, emitters) = match vals {
+            Some(v) => (&self.gather_val, (2, v)),
+            None => (&self.gather_vpl, (1, &f.vpls)),
+        };
+        let bg = bind_group(
+            d,
+            &pipeline.get_bind_group_layout(0),
+            "ism gather",
+            vec![
+                (0, maps.frame.as_entire_binding()),
+                (emitters.0, emitters.1.as_entire_binding()),
+                (3, maps.emitters.as_entire_binding()),
+                (4, maps.atlas.as_entire_binding()),
+                (5, tex(&g.views[0])),
+                (6, tex(&g.views[1])),
+            ],
+        );
+        let span = rec.begin("indirect lighting");
+        fullscreen(
+            &mut rec.enc,
+            "ism gather",
+            &indirect.create_view(&Default::default()),
+            pipeline,
+            &bg,
+            span.render(true, true),
+        );
+        rec.end();
+        let uniform = InterleaveBlur::uniform(f, interleave, pool, false);
+        blur.record(f, pool, rec, (g, &uniform, &indirect, out));
+    }
+
+    /// Mode per-vpl-ism onto `out`.
+    pub fn record_vpls(
+        &self,
+        f: &Frame,
+        p: &VplIsmParams,
+        blur: &InterleaveBlur,
+        pool: &mut Pool,
+        rec: &mut Recorder,
+        io: (&GBufferOutput, &wgpu::Texture),
+    ) -> Result<(), RenderError> {
+        p.check()?;
+        if f.vpl_count == 0 {
+            return Ok(());
+        }
+        let gather = (p.interleave.block, Default::default());
+        let maps = self.record_maps(f, &p.ism, Emitters::Vpls, gather, pool, rec)?;
+        self.record_gather(f, &maps, None, &p.interleave, blur, pool, rec, io);
+        Ok(())
+    }
+
+    /// Mode val-ism onto `out`: the clustering, the VALs' maps, the gather. Returns the
+    /// clustering's convergence words (none without VPLs).
+    #[allow(clippy::too_many_arguments)]
+    pub fn record_vals(
+        &self,
+        f: &Frame,
+        p: &ValIsmParams,
+        clustering: &ValClustering,
+        blur: &InterleaveBlur,
+        warm: bool,
+        pool: &mut Pool,
+        rec: &mut Recorder,
+        io: (&GBufferOutput, &wgpu::Texture),
+    ) -> Result<Option<wgpu::Buffer>, RenderError> {
+        p.check()?;
+        if f.vpl_count == 0 {
+            return Ok(None);
+        }
+        let input = ValInput {
+            buffer: &f.vpls,
+            count: f.vpl_count,
+            cpu: f.vpls_cpu,
+        };
+        let b = clustering.record(f.ctx, &input, &p.vals, 1, warm, pool, rec)?;
+        let m = p.vals.count;
+        let gather = (p.interleave.block, p.pcss);
+        let maps = self.record_maps(f, &p.ism, Emitters::Vals(&b.vals, m), gather, pool, rec)?;
+        self.record_gather(f, &maps, Some(&b.vals), &p.interleave, blur, pool, rec, io);
+        Ok(Some(b.state))
+    }
+}
+
+/// Reads every map back as distances (m; `f32::INFINITY` where nothing was seen): map k's
+/// texel (x, y) at k·s² + y·s + x. For tests and inspection.
+pub fn read_maps(ctx: &GpuContext, maps: &IsmOutput) -> Result<Vec<f32>, RenderError> {
+    let words: Vec<u32> =
+        bytemuck::cast_slice(&crate::gpu::context::read_buffer(ctx, &maps.atlas)?).to_vec();
+    Ok(words
+        .iter()
+        .map(|&w| match w {
+            0 => f32::INFINITY,
+            w => f32::from_bits(!w),
+        })
+        .collect())
+}
