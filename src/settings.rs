@@ -261,6 +261,9 @@ pub struct MethodArgs {
     /// (position over the VPLs' diagonal, normal angle over π, relative flux difference).
     #[arg(long, value_delimiter = ',', num_args = 3, default_values_t = [0.6, 0.3, 0.1])]
     pub ism_val_weights: Vec<f32>,
+    /// val-ism: one hard lookup per VAL instead of PCSS (the paper's "simple-sampled" VALs).
+    #[arg(long)]
+    pub ism_hard_lookups: bool,
     /// val-ism: a VPL joins only the VALs whose point splat reaches it, a radius as a fraction
     /// of the VPLs' diagonal (the nearest VAL where none does).
     #[arg(long, default_value_t = 0.25)]
@@ -348,6 +351,7 @@ impl MethodArgs {
                 blocker_samples: self.pcss_blocker_samples,
                 filter_samples: self.pcss_filter_samples,
             },
+            hard_lookups: self.ism_hard_lookups,
             interleave: self.ism_interleave(base.interleave.block),
         }
     }

@@ -831,11 +831,64 @@ fn render_lightcluster_prints_its_passes_and_clusters_and_refuses_bad_settings()
         (
             "--pcss-blocker-samples",
             "0",
-            "blocker samples must be 1..=64",
+            "blocker samples 0 must be 1..=64",
         ),
     ] {
         let mut b = a.clone();
         b.extend([flag, value]);
+        let o = visgate(&b);
+        assert!(!o.status.success(), "{flag} {value} was taken");
+        assert!(stderr(&o).contains(says), "{flag}: {}", stderr(&o));
+    }
+}
+
+#[test]
+fn render_ism_modes_print_the_papers_passes_and_refuse_bad_settings() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("ism.exr");
+    let out = out.to_str().expect("utf-8");
+    let base = [
+        "render",
+        "builtin:cornell-box",
+        "--size",
+        "48x32",
+        "--vpls",
+        "64",
+        "--ism-points",
+        "512",
+        "--out",
+        out,
+    ];
+    for (mode, passes) in [
+        (
+            "per-vpl-ism",
+            &["ISM points", "ISM atlas", "pull-push", "indirect lighting"][..],
+        ),
+        (
+            "val-ism",
+            &["VAL clustering", "ISM atlas", "pull-push", "blur + compose"][..],
+        ),
+    ] {
+        let mut a = base.to_vec();
+        a.extend(["--mode", mode]);
+        let o = visgate(&a);
+        assert!(o.status.success(), "{mode}: {}", stderr(&o));
+        for p in passes {
+            assert!(stdout(&o).contains(p), "{mode} {p}: {}", stdout(&o));
+        }
+    }
+    for (flag, value, says) in [
+        (
+            "--ism-map-size",
+            "100",
+            "ISM map size 100 must be a power of two",
+        ),
+        ("--ism-max-splat", "9", "max splat 9 0..=8 texels"),
+        ("--ism-coverage", "0", "coverage 0 0.25..=64"),
+        ("--ism-val-splat", "0", "VAL splat 0 must be > 0"),
+    ] {
+        let mut b = base.to_vec();
+        b.extend(["--mode", "val-ism", flag, value]);
         let o = visgate(&b);
         assert!(!o.status.success(), "{flag} {value} was taken");
         assert!(stderr(&o).contains(says), "{flag}: {}", stderr(&o));

@@ -221,11 +221,13 @@ impl GpuMode {
             GpuMode::VplClusters(p, i) => format!("{}, {}", p.describe(), il(i)),
             GpuMode::PerVplIsm(p) => format!("{}, {}", p.ism.describe(), il(&p.interleave)),
             GpuMode::ValIsm(p) => format!(
-                "{} VALs, {}, PCSS {}/{}, {}",
+                "{} VALs, {}, {}, {}",
                 p.vals.count,
                 p.ism.describe(),
-                p.pcss.blocker_samples,
-                p.pcss.filter_samples,
+                match p.hard_lookups {
+                    true => "hard lookups".to_string(),
+                    false => format!("PCSS {}/{}", p.pcss.blocker_samples, p.pcss.filter_samples),
+                },
                 il(&p.interleave)
             ),
             GpuMode::ValCssm(v, c) => format!(

@@ -82,13 +82,13 @@ impl Isms {
     }
 
     /// Records the maps of `emitters` with `p`; `gather`: the gather's interleaving block and
-    /// PCSS samples, kept in the same constants.
+    /// PCSS samples (none: hard lookups), kept in the same constants.
     pub fn record_maps(
         &self,
         f: &Frame,
         p: &IsmParams,
         emitters: Emitters,
-        gather: (u32, super::lc_params::PcssParams),
+        gather: (u32, Option<super::lc_params::PcssParams>),
         pool: &mut Pool,
         rec: &mut Recorder,
     ) -> Result<IsmOutput, RenderError> {
@@ -129,8 +129,8 @@ impl Isms {
             g_max: f.params.g_max,
             bias: p.bias,
             normal_offset: p.normal_offset,
-            blocker_samples: pcss.blocker_samples,
-            filter_samples: pcss.filter_samples,
+            blocker_samples: pcss.map_or(0, |p| p.blocker_samples),
+            filter_samples: pcss.map_or(0, |p| p.filter_samples),
         };
         let frame = pool.upload(
             ctx,
@@ -341,7 +341,7 @@ impl Isms {
         if f.vpl_count == 0 {
             return Ok(());
         }
-        let gather = (p.interleave.block, Default::default());
+        let gather = (p.interleave.block, None);
         let maps = self.record_maps(f, &p.ism, Emitters::Vpls, gather, pool, rec)?;
         self.record_gather(f, &maps, None, &p.interleave, blur, pool, rec, io);
         Ok(())
@@ -372,7 +372,11 @@ impl Isms {
         };
         let b = clustering.record(f.ctx, &input, &p.vals, 1, warm, pool, rec)?;
         let m = p.vals.count;
-        let gather = (p.interleave.block, p.pcss);
+        let samples = match p.hard_lookups {
+            true => None,
+            false => Some(p.pcss),
+        };
+        let gather = (p.interleave.block, samples);
         let maps = self.record_maps(f, &p.ism, Emitters::Vals(&b.vals, m), gather, pool, rec)?;
         self.record_gather(f, &maps, Some(&b.vals), &p.interleave, blur, pool, rec, io);
         Ok(Some(b.state))

@@ -160,6 +160,8 @@ pub struct ValIsmParams {
     pub ism: IsmParams,
     /// PCSS sampling of each VAL's map.
     pub pcss: PcssParams,
+    /// One hard lookup per VAL instead of PCSS (the paper's "simple-sampled" VALs of Table 1).
+    pub hard_lookups: bool,
     /// The split G-buffer: VAL v lights tile v mod b² (default 4 × 4), then the blur.
     pub interleave: InterleaveParams,
 }
@@ -170,6 +172,7 @@ impl Default for ValIsmParams {
             vals: ValParams::ism(),
             ism: IsmParams::default(),
             pcss: PcssParams::default(),
+            hard_lookups: false,
             interleave: InterleaveParams {
                 block: 4,
                 ..InterleaveParams::default()
