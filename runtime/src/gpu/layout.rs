@@ -477,6 +477,14 @@ gpu_struct! {
         pub blocker_samples: u32,
         /// PCSS filter samples.
         pub filter_samples: u32,
+        /// Parts a VAL's disk is lit as (1 or 5).
+        pub disk_parts: u32,
+        /// Padding.
+        pub _pad0: u32,
+        /// Padding.
+        pub _pad1: u32,
+        /// Padding.
+        pub _pad2: u32,
     }
 }
 

@@ -12,7 +12,7 @@ use crate::cpu::val::ValParams;
 pub use super::passes::clustered_gates::GatesParams;
 pub use super::passes::cssm::CssmParams;
 pub use super::passes::interleave_blur::InterleaveParams;
-pub use super::passes::ism_params::{IsmParams, ValIsmParams, VplIsmParams};
+pub use super::passes::ism_params::{DiskLight, IsmParams, ValIsmParams, VplIsmParams};
 pub use super::passes::light_cluster::{DirectLight, LcDisk, LightClusterGpuParams, PcssParams};
 pub use super::passes::per_vpl_maps::PerVplParams;
 pub use super::passes::val_gather::ValModeParams;
@@ -221,8 +221,12 @@ impl GpuMode {
             GpuMode::VplClusters(p, i) => format!("{}, {}", p.describe(), il(i)),
             GpuMode::PerVplIsm(p) => format!("{}, {}", p.ism.describe(), il(&p.interleave)),
             GpuMode::ValIsm(p) => format!(
-                "{} VALs, {}, {}, {}",
+                "{} VALs{}, {}, {}, {}",
                 p.vals.count,
+                match p.disk {
+                    DiskLight::Centre => " (form factor at the centre)",
+                    DiskLight::Parts => "",
+                },
                 p.ism.describe(),
                 match p.hard_lookups {
                     true => "hard lookups".to_string(),

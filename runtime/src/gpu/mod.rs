@@ -70,9 +70,9 @@ use timing::Recorder;
 pub use context::GpuContext;
 pub use geometry::{MAX_TEXTURE_SIZE, VPL_SHADOW_MAX_EDGE};
 pub use methods::{
-    CssmParams, DirectLight, GatesParams, GpuMode, GpuParams, InterleaveParams, IsmParams, LcDisk,
-    LightClusterGpuParams, METHODS, MethodInfo, MethodSettings, PcssParams, PerVplParams,
-    ShadowParams, ValIsmParams, ValModeParams, VplIsmParams, method,
+    CssmParams, DirectLight, DiskLight, GatesParams, GpuMode, GpuParams, InterleaveParams,
+    IsmParams, LcDisk, LightClusterGpuParams, METHODS, MethodInfo, MethodSettings, PcssParams,
+    PerVplParams, ShadowParams, ValIsmParams, ValModeParams, VplIsmParams, method,
 };
 pub use passes::clustered_gates::{MAX_CLUSTERS, MAX_GATES};
 pub use passes::light_cluster::{MAX_LC_CLUSTERS, MAX_LC_LIGHTS};
@@ -724,7 +724,7 @@ impl GpuRenderer {
             &frame,
             params,
             emitters,
-            (1, Default::default()),
+            (1, None, 1),
             pool,
             &mut rec,
         )?;

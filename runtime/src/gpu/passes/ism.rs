@@ -11,7 +11,7 @@
 
 use super::gbuffer::GBufferOutput;
 use super::interleave_blur::InterleaveBlur;
-pub use super::ism_params::{ISM_MAP_SIZE, IsmParams, ValIsmParams, VplIsmParams};
+pub use super::ism_params::{DiskLight, ISM_MAP_SIZE, IsmParams, ValIsmParams, VplIsmParams};
 use super::shade::{HDR, frame_target, fullscreen};
 use super::vals::{ValClustering, ValInput};
 use crate::RenderError;
@@ -82,13 +82,14 @@ impl Isms {
     }
 
     /// Records the maps of `emitters` with `p`; `gather`: the gather's interleaving block and
-    /// PCSS samples (none: hard lookups), kept in the same constants.
+    /// PCSS samples (none: hard lookups) and the parts of a VAL's disk, kept in the same
+    /// constants.
     pub fn record_maps(
         &self,
         f: &Frame,
         p: &IsmParams,
         emitters: Emitters,
-        gather: (u32, Option<super::lc_params::PcssParams>),
+        gather: (u32, Option<super::lc_params::PcssParams>, u32),
         pool: &mut Pool,
         rec: &mut Recorder,
     ) -> Result<IsmOutput, RenderError> {
@@ -109,7 +110,7 @@ impl Isms {
                 p.points_per_map
             )));
         }
-        let (block, pcss) = gather;
+        let (block, pcss, disk_parts) = gather;
         let constants = IsmFrame {
             emitters: count,
             map_size: s,
@@ -131,6 +132,8 @@ impl Isms {
             normal_offset: p.normal_offset,
             blocker_samples: pcss.map_or(0, |p| p.blocker_samples),
             filter_samples: pcss.map_or(0, |p| p.filter_samples),
+            disk_parts,
+            ..bytemuck::Zeroable::zeroed()
         };
         let frame = pool.upload(
             ctx,
@@ -341,7 +344,7 @@ impl Isms {
         if f.vpl_count == 0 {
             return Ok(());
         }
-        let gather = (p.interleave.block, None);
+        let gather = (p.interleave.block, None, 1);
         let maps = self.record_maps(f, &p.ism, Emitters::Vpls, gather, pool, rec)?;
         self.record_gather(f, &maps, None, &p.interleave, blur, pool, rec, io);
         Ok(())
@@ -376,7 +379,7 @@ impl Isms {
             true => None,
             false => Some(p.pcss),
         };
-        let gather = (p.interleave.block, samples);
+        let gather = (p.interleave.block, samples, p.disk.parts());
         let maps = self.record_maps(f, &p.ism, Emitters::Vals(&b.vals, m), gather, pool, rec)?;
         self.record_gather(f, &maps, Some(&b.vals), &p.interleave, blur, pool, rec, io);
         Ok(Some(b.state))

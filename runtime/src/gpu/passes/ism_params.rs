@@ -150,6 +150,28 @@ impl VplIsmParams {
     }
 }
 
+/// How a VAL's disk lights a point (`val-ism`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum DiskLight {
+    /// The paper's point-to-disk form factor at the disk's centre: exact on its axis, 28 %
+    /// under at two radii 60° off it, 38 % at 80°.
+    Centre,
+    /// The disk as 5 parts (its centre and 4 at ¾ of its radius), a fifth of its area and flux
+    /// each, each by the form factor: within 4 % from two radii at every angle.
+    #[default]
+    Parts,
+}
+
+impl DiskLight {
+    /// `IsmFrame::disk_parts`.
+    pub fn parts(&self) -> u32 {
+        match self {
+            DiskLight::Centre => 1,
+            DiskLight::Parts => 5,
+        }
+    }
+}
+
 /// Mode `val-ism` (Weinzierl-Heigl): VALs clustered as the paper clusters them, an ISM each,
 /// the point-to-disk form factor, PCSS by the VAL's area.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -162,6 +184,8 @@ pub struct ValIsmParams {
     pub pcss: PcssParams,
     /// One hard lookup per VAL instead of PCSS (the paper's "simple-sampled" VALs of Table 1).
     pub hard_lookups: bool,
+    /// How a VAL's disk lights a point.
+    pub disk: DiskLight,
     /// The split G-buffer: VAL v lights tile v mod b² (default 4 × 4), then the blur.
     pub interleave: InterleaveParams,
 }
@@ -173,6 +197,7 @@ impl Default for ValIsmParams {
             ism: IsmParams::default(),
             pcss: PcssParams::default(),
             hard_lookups: false,
+            disk: DiskLight::default(),
             interleave: InterleaveParams {
                 block: 4,
                 ..InterleaveParams::default()

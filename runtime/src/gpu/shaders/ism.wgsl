@@ -28,6 +28,11 @@ struct IsmFrame {
     normal_offset: f32,
     blocker_samples: u32,
     filter_samples: u32,
+    // val-ism: 1 the paper's form factor at the disk's centre, 5 the disk as 5 parts.
+    disk_parts: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 };
 
 // Texel (x, y) of map k's word.
