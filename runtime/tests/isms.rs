@@ -77,12 +77,12 @@ fn an_ism_of_a_plane_head_on_has_no_holes_and_the_plane_distances() {
     );
     assert!(seen > 1000, "{seen}");
     assert_eq!(holes, 0, "holes at the default density");
-    // A rasterised map holds 1 / cos θ at each texel's centre; a point holds its own depth,
-    // splatted over up to max_splat texels: the nearest of the splats over a texel is off by
-    // their radius times the slope (tan 60° at the rim of this test), which the lookups' bias
-    // (3 texels, slope-scaled) absorbs.
-    assert!(mean < 0.08, "mean depth error {mean}");
-    assert!(worst < 0.15, "worst depth error {worst}");
+    // A rasterised map holds 1 / cos θ at each texel's centre; a surfel holds its plane's
+    // distance along each texel's ray (measured: mean 1.0 %, worst 8.3 %; splats of one depth
+    // each gave mean 5.7 %, worst 10.8 %: the nearest of the splats over a texel, off by their
+    // radius times the slope).
+    assert!(mean < 0.02, "mean depth error {mean}");
+    assert!(worst < 0.1, "worst depth error {worst}");
     // Few points, no splats, no pull-push: holes — and two pull-push levels fill them.
     let sparse = IsmParams {
         points_per_map: 1024,
@@ -188,7 +188,7 @@ fn under_a_wide_blocker_the_floor_is_dark_and_in_the_open_lit() {
             "{}: under {under} (of {unshadowed}), open {open} (of {lit})",
             mode.name()
         );
-        assert!(under < 0.1 * unshadowed, "{}: under {under}", mode.name());
+        assert!(under < 0.05 * unshadowed, "{}: under {under}", mode.name());
         // VALs are disks (the form factor differs from the VPLs' sum near them) and soft.
         assert!(open > 0.7 * lit, "{}: open {open} vs {lit}", mode.name());
     }
@@ -344,7 +344,10 @@ fn per_vpl_isms_stay_near_per_vpl_shadow_maps_and_val_ism_near_the_vpls_light() 
             mode.name()
         );
         // VALs trade accuracy for speed: better than no visibility, by less.
-        let bound = if mode.name() == "val-ism" { 0.75 } else { 0.5 };
+        let (bound, energy) = match mode.name() {
+            "val-ism" => (0.5, 0.9..1.05),
+            _ => (0.2, 0.95..1.05),
+        };
         assert!(
             e.mse < bound * e_none.mse,
             "{}: {} vs none {}",

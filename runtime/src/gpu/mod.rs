@@ -720,14 +720,9 @@ impl GpuRenderer {
         let v = self.frame_vpls(ctx, &VplInput::Given(vpls), &mut rec)?;
         let (frame, p, pool) = self.frame(ctx, &view, &gpu_params, (v.0, v.1, Some(vpls)));
         let emitters = passes::ism::Emitters::Vpls;
-        let maps = p.isms.record_maps(
-            &frame,
-            params,
-            emitters,
-            (1, None, 1),
-            pool,
-            &mut rec,
-        )?;
+        let maps = p
+            .isms
+            .record_maps(&frame, params, emitters, (1, None, 1), pool, &mut rec)?;
         rec.finish(pool)?;
         Ok((passes::ism::read_maps(ctx, &maps)?, maps.map_size))
     }

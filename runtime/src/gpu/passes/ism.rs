@@ -52,8 +52,9 @@ pub enum Emitters<'a> {
     Vals(&'a wgpu::Buffer, u32),
 }
 
-/// Points a frame may keep (16 bytes each): beyond, they are drawn again in the splat pass.
-const MAX_KEPT_POINTS: u64 = 1 << 23;
+/// Points a frame may keep (32 bytes each: position, normal; and within the adapter's
+/// largest storage binding): beyond, they are drawn again in the splat pass.
+const MAX_KEPT_POINTS: u64 = 1 << 22;
 
 /// Workgroups for `n` threads as (x, y) within the adapter's 65,535 per dimension.
 fn groups(n: u64) -> (u32, u32) {
@@ -111,6 +112,8 @@ impl Isms {
             )));
         }
         let (block, pcss, disk_parts) = gather;
+        let surfel =
+            (p.coverage * geo.area_m2 / (p.points_per_map as f32 * std::f32::consts::PI)).sqrt();
         let constants = IsmFrame {
             emitters: count,
             map_size: s,
@@ -122,9 +125,7 @@ impl Isms {
             subsets: block * block,
             // A point stands for the scene's area over the points of a map, as a disk, its
             // splat √coverage times wider.
-            point_radius: (p.coverage * geo.area_m2
-                / (p.points_per_map as f32 * std::f32::consts::PI))
-                .sqrt(),
+            point_radius: surfel,
             max_splat: p.max_splat,
             centre_offset: f.scene.near_m,
             g_max: f.params.g_max,
@@ -155,8 +156,8 @@ impl Isms {
             offsets[l + 1] = offsets[l] + count as u64 * ((s >> l) as u64).pow(2);
         }
         let pyramid = pool.buffer(d, "ism pyramid", offsets[levels as usize + 1] * 4, rw);
-        let keep = points <= MAX_KEPT_POINTS;
-        let kept = pool.buffer(d, "ism points", if keep { points * 16 } else { 16 }, rw);
+        let keep = points <= MAX_KEPT_POINTS.min(limit / 32);
+        let kept = pool.buffer(d, "ism points", if keep { points * 32 } else { 32 }, rw);
         let no_vals;
         let vals = match vals {
             Some(v) => v,

@@ -3,7 +3,7 @@
 //   emitters  each map's centre and axis: a VPL, or a VAL's centre moved off its surface
 //   sample    the scene as random points: point i picks a triangle by area (a hash through the
 //             triangles' cumulative area) and a uniform barycentric point in it, from the
-//             triangles of this frame (moved meshes move their points); kept up to 2²³ points,
+//             triangles of this frame (moved meshes move their points); kept up to 2²² points,
 //             beyond that drawn again by the splat
 //   splat     point i goes to map i mod N (the paper's round robin) as a disk of the radius it
 //             stands for, its size by its distance to the emitter, the nearest kept by
@@ -62,8 +62,8 @@ fn unit(h: u32) -> f32 {
     return f32(h >> 8u) * (1.0 / 16777216.0);
 }
 
-// Point i of the scene.
-fn scene_point(i: u32) -> vec3<f32> {
+// Point i of the scene and its triangle's unit normal (a surfel).
+fn scene_point(i: u32) -> array<vec3<f32>, 2> {
     let h0 = pcg(i ^ pcg(frame.seed));
     let h1 = pcg(h0);
     let h2 = pcg(h1);
@@ -83,7 +83,8 @@ fn scene_point(i: u32) -> vec3<f32> {
     let c = triangles[3u * lo + 2u].xyz;
     let r1 = sqrt(unit(h1));
     let r2 = unit(h2);
-    return a * (1.0 - r1) + b * (r1 * (1.0 - r2)) + c * (r1 * r2);
+    let p = a * (1.0 - r1) + b * (r1 * (1.0 - r2)) + c * (r1 * r2);
+    return array(p, normalize(cross(b - a, c - a)));
 }
 
 @compute @workgroup_size(WG_LINEAR)
@@ -92,7 +93,9 @@ fn sample(@builtin(global_invocation_id) id: vec3<u32>) {
     if i >= frame.points {
         return;
     }
-    points[i] = vec4<f32>(scene_point(i), 0.0);
+    let s = scene_point(i);
+    points[2u * i] = vec4<f32>(s[0], 0.0);
+    points[2u * i + 1u] = vec4<f32>(s[1], 0.0);
 }
 
 @compute @workgroup_size(WG_LINEAR)
@@ -106,10 +109,12 @@ fn splat(@builtin(global_invocation_id) id: vec3<u32>) {
     let n = emitters[2u * k + 1u].xyz;
     let tb = basis(n);
     // Kept by `sample`, or (too many to keep) drawn again here.
-    var pt = points[min(i, arrayLength(&points) - 1u)].xyz;
-    if arrayLength(&points) < frame.points {
-        pt = scene_point(i);
+    let kept = min(i, arrayLength(&points) / 2u - 1u);
+    var surfel = array(points[2u * kept].xyz, points[2u * kept + 1u].xyz);
+    if arrayLength(&points) < 2u * frame.points {
+        surfel = scene_point(i);
     }
+    let pt = surfel[0];
     let v = pt - c;
     let local = vec3<f32>(dot(v, tb[0]), dot(v, tb[1]), dot(v, n));
     let d = length(local);
@@ -120,16 +125,34 @@ fn splat(@builtin(global_invocation_id) id: vec3<u32>) {
     let sf = f32(s);
     let at = ism_coords(local, sf);
     let r = min(frame.point_radius / d * ism_texels_per_rad(local.z / d, sf), frame.max_splat);
-    let word = ism_encode(d);
+    let own = vec2<i32>(floor(at));
     let lo = vec2<i32>(floor(at - vec2<f32>(r)));
     let hi = vec2<i32>(floor(at + vec2<f32>(r)));
+    // The surfel: a disk of the point's radius in its triangle's plane. A texel takes the
+    // distance where its ray meets that plane (a surface seen at a grazing angle keeps its
+    // slope across the splat, instead of the point's one depth), if within the disk; the
+    // point's own texel takes the point's distance in any case.
+    let sn = surfel[1];
+    let plane = dot(sn, v);
     for (var y = max(lo.y, 0); y <= min(hi.y, i32(s) - 1); y++) {
         for (var x = max(lo.x, 0); x <= min(hi.x, i32(s) - 1); x++) {
             let o = vec2<f32>(f32(x), f32(y)) + 0.5 - at;
-            // Every texel the disk touches (a texel's half diagonal): at r = 0 the point's own.
-            if dot(o, o) <= (r + 0.7072) * (r + 0.7072) {
-                atomicMax(&atlas[ism_index(k, vec2<u32>(u32(x), u32(y)), s)], word);
+            if dot(o, o) > (r + 0.7072) * (r + 0.7072) {
+                continue;
             }
+            var dist = d;
+            if x != own.x || y != own.y {
+                let w = ism_texel_direction(vec2<f32>(f32(x), f32(y)) + 0.5, sf, tb, n);
+                let den = dot(sn, w);
+                if abs(den) < 1e-4 {
+                    continue;
+                }
+                dist = plane / den;
+                if dist <= 0.0 || length(w * dist - v) > frame.point_radius {
+                    continue;
+                }
+            }
+            atomicMax(&atlas[ism_index(k, vec2<u32>(u32(x), u32(y)), s)], ism_encode(dist));
         }
     }
 }

@@ -17,7 +17,8 @@ struct IsmFrame {
     // Interleaving block side b and subsets b².
     block: u32,
     subsets: u32,
-    // Radius a point stands for (m), the largest splat radius (texels), VAL centre offset (m),
+    // Radius of a point's surfel (m: its share of the scene's area as a disk, times
+    // √coverage), the largest splat radius (texels), VAL centre offset (m),
     // geometry-term clamp of VPLs (1/m²).
     point_radius: f32,
     max_splat: f32,
@@ -52,6 +53,16 @@ fn ism_coords(local: vec3<f32>, s: f32) -> vec2<f32> {
 // d(tan(θ/2))/dθ = 1 / (1 + cos θ), in uv over [−1, 1] of s texels.
 fn ism_texels_per_rad(cos_t: f32, s: f32) -> f32 {
     return 0.5 * s / (1.0 + cos_t);
+}
+
+// The world direction of texel centre `t` (continuous texel coordinates) of a map of side s
+// with frame (tb, n): the inverse of ism_coords.
+fn ism_texel_direction(t: vec2<f32>, s: f32, tb: mat2x3<f32>, n: vec3<f32>) -> vec3<f32> {
+    let u = t.x / s * 2.0 - 1.0;
+    let v = 1.0 - t.y / s * 2.0;
+    let r2 = min(u * u + v * v, 1.0);
+    let z = (1.0 - r2) / (1.0 + r2);
+    return normalize(tb[0] * (u * (1.0 + z)) + tb[1] * (v * (1.0 + z)) + n * z);
 }
 
 fn ism_encode(d: f32) -> u32 {
