@@ -355,10 +355,6 @@ fn per_vpl_isms_stay_near_per_vpl_shadow_maps_and_val_ism_near_the_vpls_light() 
             e.mse,
             e_none.mse
         );
-        assert!(
-            (0.8..1.1).contains(&ratio),
-            "{}: energy {ratio}",
-            mode.name()
-        );
+        assert!(energy.contains(&ratio), "{}: energy {ratio}", mode.name());
     }
 }
