@@ -5,7 +5,9 @@ use std::collections::VecDeque;
 use eframe::egui;
 use visgate_formats::Scene;
 use visgate_runtime::cpu::gates::GateShape;
-use visgate_runtime::gpu::{DirectLight, LcDisk, LightClusterGpuParams, MethodSettings, PassTimes};
+use visgate_runtime::gpu::{
+    DirectLight, DiskLight, IsmParams, LcDisk, LightClusterGpuParams, MethodSettings, PassTimes,
+};
 use visgate_runtime::hdr::HdrImage;
 
 use super::camera::FlyCamera;
@@ -40,6 +42,31 @@ pub fn method_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
         "vpl-clusters" => {
             lc_controls(ui, &mut s.vpl_clusters);
             ui.add(interleave_block(&mut s.vals.interleave.block));
+        }
+        "per-vpl-ism" => {
+            ism_controls(ui, &mut s.vpl_ism.ism);
+            ui.add(interleave_block(&mut s.vpl_ism.interleave.block));
+        }
+        "val-ism" => {
+            let v = &mut s.val_ism;
+            ui.add(egui::Slider::new(&mut v.vals.count, 1..=1024).text("VALs"));
+            ui.add(egui::Slider::new(&mut v.vals.iterations, 0..=64).text("k-means iterations"));
+            ui.horizontal(|ui| {
+                ui.radio_value(&mut v.disk, DiskLight::Parts, "disk: 5 parts");
+                ui.radio_value(&mut v.disk, DiskLight::Centre, "disk: centre (paper)");
+            });
+            ui.checkbox(&mut v.hard_lookups, "hard lookups (no PCSS)");
+            if !v.hard_lookups {
+                let p = &mut v.pcss;
+                ui.add(
+                    egui::Slider::new(&mut p.blocker_samples, 1..=64).text("PCSS blocker samples"),
+                );
+                ui.add(
+                    egui::Slider::new(&mut p.filter_samples, 1..=128).text("PCSS filter samples"),
+                );
+            }
+            ism_controls(ui, &mut v.ism);
+            ui.add(interleave_block(&mut v.interleave.block));
         }
         "per-vpl-shadow-maps" => {
             ui.add(egui::Slider::new(&mut s.per_vpl.map_size, 16..=512).text("map size"));
@@ -89,6 +116,28 @@ fn lc_controls(ui: &mut egui::Ui, p: &mut LightClusterGpuParams) {
     let samples = &mut p.pcss;
     ui.add(egui::Slider::new(&mut samples.blocker_samples, 1..=64).text("PCSS blocker samples"));
     ui.add(egui::Slider::new(&mut samples.filter_samples, 1..=128).text("PCSS filter samples"));
+}
+
+/// The imperfect shadow maps: map side (auto or a power of two), points, pull-push, bias.
+fn ism_controls(ui: &mut egui::Ui, p: &mut IsmParams) {
+    let mut log2 = p.map_size.map_or(0, |s| s.trailing_zeros());
+    ui.add(
+        egui::Slider::new(&mut log2, 0..=9)
+            .custom_formatter(|v, _| match v as u32 {
+                0..=3 => "auto".into(),
+                k => format!("{}²", 1u32 << k),
+            })
+            .text("ISM map size"),
+    );
+    p.map_size = (log2 >= 4).then(|| 1 << log2);
+    ui.add(
+        egui::Slider::new(&mut p.points_per_map, 64..=65_536)
+            .logarithmic(true)
+            .text("ISM points per map"),
+    );
+    ui.add(egui::Slider::new(&mut p.pull_push, 0..=6).text("pull-push levels"));
+    ui.add(egui::Slider::new(&mut p.coverage, 0.25..=16.0).text("splat coverage"));
+    ui.add(egui::Slider::new(&mut p.bias, 0.0..=16.0).text("ISM bias (texels)"));
 }
 
 /// The interleaving block's slider.
