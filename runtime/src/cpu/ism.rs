@@ -8,8 +8,20 @@ use std::f32::consts::PI;
 /// Irradiance at `p` (unit normal `n`) of a Lambertian disk of total flux `flux`, area `area`,
 /// centre `c`, unit normal `m`: Φ/π · cos θx·cos θc / (‖x − c‖² + A/π) — the form factor
 /// cos θx·cos θc / (π‖x − c‖² + A) times the disk's radiant exitance Φ / A times A. Zero behind
-/// either surface; `area` 0 gives the point light's Φ/π · cos θx·cos θc / d².
+/// either surface; `area` 0 gives the point light's Φ/π · cos θx·cos θc / d². The GPU clamps
+/// the geometric factor at g_max as every VPL's term is ([`disk_irradiance_clamped`]).
 pub fn disk_irradiance(flux: Vec3, area: f32, c: Vec3, m: Vec3, p: Vec3, n: Vec3) -> Vec3 {
+    disk_irradiance_clamped(flux, area, (c, m), (p, n), f32::INFINITY)
+}
+
+/// [`disk_irradiance`] with the geometric factor clamped at `g_max` (1/m²), as the gather does.
+pub fn disk_irradiance_clamped(
+    flux: Vec3,
+    area: f32,
+    (c, m): (Vec3, Vec3),
+    (p, n): (Vec3, Vec3),
+    g_max: f32,
+) -> Vec3 {
     let d = c - p;
     let d2 = d.length_squared();
     if d2 <= 0.0 {
@@ -20,7 +32,7 @@ pub fn disk_irradiance(flux: Vec3, area: f32, c: Vec3, m: Vec3, p: Vec3, n: Vec3
     if cos_x <= 0.0 || cos_c <= 0.0 {
         return Vec3::ZERO;
     }
-    flux / PI * (cos_x * cos_c / (d2 + area / PI))
+    flux / PI * (cos_x * cos_c / (d2 + area / PI)).min(g_max)
 }
 
 /// The same disk as 5 parts of a fifth of its area and flux — its centre and 4 on the ring at
@@ -173,6 +185,16 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn the_clamp_bounds_a_small_disk_near_its_receiver() {
+        let (c, m) = (Vec3::ZERO, Vec3::NEG_Y);
+        let (p, n) = (Vec3::new(0.0, -0.01, 0.0), Vec3::Y);
+        let free = disk_irradiance(Vec3::ONE, 1e-6, c, m, p, n).x;
+        let clamped = disk_irradiance_clamped(Vec3::ONE, 1e-6, (c, m), (p, n), 10.0).x;
+        assert!(free > 1000.0 / PI, "{free}");
+        assert_eq!(clamped, 10.0 / PI);
     }
 
     #[test]

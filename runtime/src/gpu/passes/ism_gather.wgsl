@@ -113,8 +113,9 @@ fn ism_pcss(k: u32, p: vec3<f32>, n: vec3<f32>, radius: f32, px: vec2<u32>) -> f
 }
 
 // The irradiance at p (normal n) of a Lambertian disk of flux Φ, area A, centre c, normal m:
-// Φ/π · cos θx·cos θc / (‖x − c‖² + A/π) (Wallace et al.'s point-to-disk form factor; A → 0
-// gives the point light's term). runtime::cpu::ism::disk_irradiance is its twin.
+// Φ/π · min(cos θx·cos θc / (‖x − c‖² + A/π), g_max) (Wallace et al.'s point-to-disk form
+// factor, clamped as every VPL's term is; A → 0 gives the point light's term).
+// runtime::cpu::ism::disk_irradiance is its twin.
 fn disk_light(flux: vec3<f32>, area: f32, c: vec3<f32>, m: vec3<f32>, p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     let d = c - p;
     let d2 = dot(d, d);
@@ -127,7 +128,7 @@ fn disk_light(flux: vec3<f32>, area: f32, c: vec3<f32>, m: vec3<f32>, p: vec3<f3
     if cos_x <= 0.0 || cos_c <= 0.0 {
         return vec3<f32>(0.0);
     }
-    return flux / PI * (cos_x * cos_c / (d2 + area / PI));
+    return flux / PI * min(cos_x * cos_c / (d2 + area / PI), frame.g_max);
 }
 
 // The same disk as 5 parts of a fifth of its area and flux each — its centre and 4 on the
