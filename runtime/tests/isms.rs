@@ -132,55 +132,15 @@ fn render(
 #[test]
 fn under_a_wide_blocker_the_floor_is_dark_and_in_the_open_lit() {
     let ctx = context();
-    let blocker = [
-        Vec3::new(-1.5, 1.0, -5.0),
-        Vec3::new(1.5, 1.0, -5.0),
-        Vec3::new(1.5, 1.0, 5.0),
-        Vec3::new(-1.5, 1.0, 5.0),
-    ];
-    let scene = common::quads(&[common::floor(5.0), blocker], 0.5, vec![]);
-    let vpls: Vec<Vpl> = (0..256)
-        .map(|i| {
-            let p = Vec3::new(
-                -1.0 + (i % 8) as f32 * 2.0 / 7.0,
-                2.5,
-                -4.0 + (i / 8) as f32 * 8.0 / 31.0,
-            );
-            Vpl::new(p, Vec3::NEG_Y, Vec3::splat(0.05))
-        })
-        .collect();
-    let cam = visgate_formats::Camera {
-        name: "low".into(),
-        eye: Vec3::new(0.0, 0.5, -4.5),
-        target: Vec3::new(0.0, 0.0, 0.0),
-        up: Vec3::Y,
-        fov_x_rad: 70f32.to_radians(),
-    };
+    let (scene, vpls, cam) = common::blocker_scene();
     let none = render(&ctx, &scene, &cam, &vpls, GpuMode::None);
-    let view = visgate_runtime::camera::View::new(&cam, [64, 48]).expect("view");
-    let tracer = Tracer::new(&scene);
+    let mean = |v: &[f32]| v.iter().sum::<f32>() / v.len().max(1) as f32;
     for mode in [per_vpl_ism(), val_ism(16, 1), val_ism(64, 4)] {
         let img = render(&ctx, &scene, &cam, &vpls, mode);
-        let (mut under, mut open, mut unshadowed, mut lit) = (vec![], vec![], vec![], vec![]);
-        for y in 0..48 {
-            for x in 0..64 {
-                let dir = view.ray_dir(glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
-                let Some(hit) = tracer.trace(view.eye, dir) else {
-                    continue;
-                };
-                if hit.position.y.abs() > 1e-3 {
-                    continue;
-                }
-                if hit.position.x.abs() < 0.8 {
-                    under.push(img.at(x, y).x);
-                    unshadowed.push(none.at(x, y).x);
-                } else if hit.position.x.abs() > 3.0 {
-                    open.push(img.at(x, y).x);
-                    lit.push(none.at(x, y).x);
-                }
-            }
-        }
-        let mean = |v: &[f32]| v.iter().sum::<f32>() / v.len().max(1) as f32;
+        let [[under, open], [unshadowed, lit]] =
+            common::under_and_open(&scene, &cam, &[&img, &none])
+                .try_into()
+                .expect("two images");
         assert!(under.len() > 20 && open.len() > 20);
         let (under, open, unshadowed, lit) =
             (mean(&under), mean(&open), mean(&unshadowed), mean(&lit));

@@ -410,19 +410,20 @@ pub fn lane_sums(vpls: &[Vpl], mapping: &[u32], m: usize, f: fn(&Vpl) -> [f32; 3
             lanes[k as usize][i % LANES] += Vec3::from(f(v));
         }
     }
-    lanes
-        .iter_mut()
-        .map(|l| {
-            let mut o = LANES / 2;
-            while o > 0 {
-                for t in 0..o {
-                    l[t] += l[t + o];
-                }
-                o /= 2;
-            }
-            l[0]
-        })
-        .collect()
+    lanes.iter_mut().map(fold).collect()
+}
+
+/// Lane 0 after the GPU's tree fold of `lanes` (t += t + o for o = 32, 16, …, 1).
+fn fold<T: Copy + std::ops::AddAssign>(lanes: &mut [T; LANES]) -> T {
+    let mut o = LANES / 2;
+    while o > 0 {
+        for t in 0..o {
+            let add = lanes[t + o];
+            lanes[t] += add;
+        }
+        o /= 2;
+    }
+    lanes[0]
 }
 
 /// VPLs per VAL (`m` VALs; [`NO_VAL`] counts nowhere).
@@ -494,19 +495,7 @@ fn second_moments(vpls: &[Vpl], mapping: &[u32], vals: &[Val]) -> Vec<f32> {
             lanes[k as usize][i % LANES] += s * s + u * u;
         }
     }
-    lanes
-        .iter_mut()
-        .map(|l| {
-            let mut o = LANES / 2;
-            while o > 0 {
-                for t in 0..o {
-                    l[t] += l[t + o];
-                }
-                o /= 2;
-            }
-            l[0]
-        })
-        .collect()
+    lanes.iter_mut().map(fold).collect()
 }
 
 /// The centres of a clustering (to start the next frame from, or to compare).

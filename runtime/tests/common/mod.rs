@@ -1,5 +1,5 @@
-//! Scenes the runtime tests build: quads of one albedo, a floor, a closed box, and the
-//! built-in four rooms scaled with its light.
+//! Scenes the runtime tests build: quads of one albedo, a floor, a closed box, the built-in
+//! four rooms scaled with its light, and a floor under a wide blocker with VPLs above it.
 
 #![allow(dead_code)] // each test file uses its own subset
 
@@ -129,4 +129,68 @@ pub fn scaled_four_rooms(scale: f32) -> (Scene, Camera) {
     }
     let cam = s.cameras.first().cloned().expect("a camera");
     (s, cam)
+}
+
+/// A 10 m floor, a 3 × 10 m blocker 1 m above its middle strip, 256 VPLs 2.5 m up facing
+/// down over the blocker, and a low camera looking along the strip.
+pub fn blocker_scene() -> (Scene, Vec<visgate_runtime::vpl::Vpl>, Camera) {
+    let blocker = [
+        Vec3::new(-1.5, 1.0, -5.0),
+        Vec3::new(1.5, 1.0, -5.0),
+        Vec3::new(1.5, 1.0, 5.0),
+        Vec3::new(-1.5, 1.0, 5.0),
+    ];
+    let scene = quads(&[floor(5.0), blocker], 0.5, vec![]);
+    let vpls = (0..256)
+        .map(|i| {
+            let p = Vec3::new(
+                -1.0 + (i % 8) as f32 * 2.0 / 7.0,
+                2.5,
+                -4.0 + (i / 8) as f32 * 8.0 / 31.0,
+            );
+            visgate_runtime::vpl::Vpl::new(p, Vec3::NEG_Y, Vec3::splat(0.05))
+        })
+        .collect();
+    let cam = Camera {
+        name: "low".into(),
+        eye: Vec3::new(0.0, 0.5, -4.5),
+        target: Vec3::new(0.0, 0.0, 0.0),
+        up: Vec3::Y,
+        fov_x_rad: 70f32.to_radians(),
+    };
+    (scene, vpls, cam)
+}
+
+/// Over the floor pixels of [`blocker_scene`] (found by ray casting from `cam` at the images'
+/// size), the red channel of each image under the blocker's middle (|x| < 0.8) and in the open
+/// (|x| > 3): `[under, open]` per image.
+pub fn under_and_open(
+    scene: &Scene,
+    cam: &Camera,
+    images: &[&visgate_runtime::hdr::HdrImage],
+) -> Vec<[Vec<f32>; 2]> {
+    let (w, h) = (images[0].width, images[0].height);
+    let view = visgate_runtime::camera::View::new(cam, [w, h]).expect("view");
+    let tracer = visgate_runtime::cpu::tracer::Tracer::new(scene);
+    let mut out = vec![[Vec::new(), Vec::new()]; images.len()];
+    for y in 0..h {
+        for x in 0..w {
+            let dir = view.ray_dir(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+            let Some(hit) = tracer.trace(view.eye, dir) else {
+                continue;
+            };
+            if hit.position.y.abs() > 1e-3 {
+                continue;
+            }
+            let side = match hit.position.x.abs() {
+                a if a < 0.8 => 0,
+                a if a > 3.0 => 1,
+                _ => continue,
+            };
+            for (o, img) in out.iter_mut().zip(images) {
+                o[side].push(img.at(x, y).x);
+            }
+        }
+    }
+    out
 }

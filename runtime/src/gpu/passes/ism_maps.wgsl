@@ -167,16 +167,26 @@ fn level_value(l: u32, offset: u32, k: u32, t: vec2<u32>) -> f32 {
     return pyramid[offset + ism_index(k, t, side)];
 }
 
-@compute @workgroup_size(WG_LINEAR)
-fn pull(@builtin(global_invocation_id) id: vec3<u32>) {
+// Texel `i` of this dispatch's level: (map, texel), or map ≥ emitters past the last.
+struct LevelTexel {
+    k: u32,
+    t: vec2<u32>,
+};
+
+fn level_texel(i: u32) -> LevelTexel {
     let side = lvl.side;
     let per_map = side * side;
+    return LevelTexel(i / per_map, vec2<u32>(i % per_map % side, i % per_map / side));
+}
+
+@compute @workgroup_size(WG_LINEAR)
+fn pull(@builtin(global_invocation_id) id: vec3<u32>) {
     let i = id.x + id.y * 65535u * WG_LINEAR;
-    if i >= per_map * frame.emitters {
+    let k = level_texel(i).k;
+    let t = level_texel(i).t;
+    if k >= frame.emitters {
         return;
     }
-    let k = i / per_map;
-    let t = vec2<u32>(i % per_map % side, i % per_map / side);
     var sum = 0.0;
     var found = 0.0;
     for (var j = 0u; j < 4u; j++) {
@@ -192,13 +202,12 @@ fn pull(@builtin(global_invocation_id) id: vec3<u32>) {
 @compute @workgroup_size(WG_LINEAR)
 fn push(@builtin(global_invocation_id) id: vec3<u32>) {
     let side = lvl.side;
-    let per_map = side * side;
     let i = id.x + id.y * 65535u * WG_LINEAR;
-    if i >= per_map * frame.emitters {
+    let k = level_texel(i).k;
+    let t = level_texel(i).t;
+    if k >= frame.emitters {
         return;
     }
-    let k = i / per_map;
-    let t = vec2<u32>(i % per_map % side, i % per_map / side);
     let parent = pyramid[lvl.other + ism_index(k, t / 2u, side / 2u)];
     if parent <= 0.0 {
         return;
