@@ -62,6 +62,92 @@ fn groups(n: u64) -> (u32, u32) {
     (g.min(65_535) as u32, g.div_ceil(65_535) as u32)
 }
 
+/// A compute pass in its own timed span `name`.
+fn timed_pass(rec: &mut Recorder, name: &'static str, f: impl FnOnce(&mut wgpu::ComputePass)) {
+    let span = rec.begin(name);
+    {
+        let mut pass = rec.enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(name),
+            timestamp_writes: span.compute(),
+        });
+        f(&mut pass);
+    }
+    rec.end();
+}
+
+/// One dispatch of `n` threads.
+fn dispatch(
+    pass: &mut wgpu::ComputePass,
+    pl: &wgpu::ComputePipeline,
+    bg: &wgpu::BindGroup,
+    n: u64,
+) {
+    let (x, y) = groups(n);
+    pass.set_pipeline(pl);
+    pass.set_bind_group(0, bg, &[]);
+    pass.dispatch_workgroups(x, y, 1);
+}
+
+/// The maps' constants: `kind` (0 VPLs, 1 VALs), `count` maps of side `s`, `points` in all;
+/// `gather`: the gather's interleaving block, PCSS samples (none: hard) and disk parts.
+fn frame_constants(
+    f: &Frame,
+    p: &IsmParams,
+    (kind, count, s): (u32, u32, u32),
+    points: u32,
+    (block, pcss, disk_parts): (u32, Option<super::lc_params::PcssParams>, u32),
+) -> IsmFrame {
+    let geo = &f.scene.geometry;
+    IsmFrame {
+        emitters: count,
+        map_size: s,
+        points,
+        triangles: geo.triangle_count,
+        kind,
+        seed: p.seed,
+        block,
+        subsets: block * block,
+        // A point stands for the scene's area over the points of a map, as a disk; its splat
+        // √coverage times wider.
+        point_radius: (p.coverage * geo.area_m2 / (p.points_per_map as f32 * std::f32::consts::PI))
+            .sqrt(),
+        max_splat: p.max_splat,
+        centre_offset: f.scene.near_m,
+        g_max: f.params.g_max,
+        bias: p.bias,
+        normal_offset: p.normal_offset,
+        blocker_samples: pcss.map_or(0, |p| p.blocker_samples),
+        filter_samples: pcss.map_or(0, |p| p.filter_samples),
+        disk_parts,
+        ..bytemuck::Zeroable::zeroed()
+    }
+}
+
+/// The pull-push of `count` maps of side `s` over `levels` levels: one pull a level up, one
+/// push a level down, and the pyramid's size in words (levels 1… of every map).
+fn pull_push_steps(s: u32, levels: u32, count: u32) -> (Vec<IsmLevel>, u64) {
+    let mut offsets = vec![0u64; levels as usize + 2];
+    for l in 1..=levels as usize {
+        offsets[l + 1] = offsets[l] + count as u64 * ((s >> l) as u64).pow(2);
+    }
+    let at = |l: u32| offsets[l as usize] as u32;
+    let mut steps: Vec<IsmLevel> = (1..=levels)
+        .map(|l| IsmLevel {
+            level: l,
+            side: s >> l,
+            offset: at(l),
+            other: at(l - 1),
+        })
+        .collect();
+    steps.extend((0..levels).rev().map(|l| IsmLevel {
+        level: l,
+        side: s >> l,
+        offset: at(l),
+        other: at(l + 1),
+    }));
+    (steps, offsets[levels as usize + 1])
+}
+
 impl Isms {
     /// Builds the pipelines.
     pub fn new(d: &wgpu::Device, s: &ShaderSources) -> Result<Isms, RenderError> {
@@ -111,31 +197,7 @@ impl Isms {
                 p.points_per_map
             )));
         }
-        let (block, pcss, disk_parts) = gather;
-        let surfel =
-            (p.coverage * geo.area_m2 / (p.points_per_map as f32 * std::f32::consts::PI)).sqrt();
-        let constants = IsmFrame {
-            emitters: count,
-            map_size: s,
-            points: points as u32,
-            triangles: geo.triangle_count,
-            kind,
-            seed: p.seed,
-            block,
-            subsets: block * block,
-            // A point stands for the scene's area over the points of a map, as a disk, its
-            // splat √coverage times wider.
-            point_radius: surfel,
-            max_splat: p.max_splat,
-            centre_offset: f.scene.near_m,
-            g_max: f.params.g_max,
-            bias: p.bias,
-            normal_offset: p.normal_offset,
-            blocker_samples: pcss.map_or(0, |p| p.blocker_samples),
-            filter_samples: pcss.map_or(0, |p| p.filter_samples),
-            disk_parts,
-            ..bytemuck::Zeroable::zeroed()
-        };
+        let constants = frame_constants(f, p, (kind, count, s), points as u32, gather);
         let frame = pool.upload(
             ctx,
             "ism frame",
@@ -151,11 +213,8 @@ impl Isms {
             rw | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
         );
         let levels = p.pull_push.min(s.trailing_zeros());
-        let mut offsets = vec![0u64; levels as usize + 2];
-        for l in 1..=levels as usize {
-            offsets[l + 1] = offsets[l] + count as u64 * ((s >> l) as u64).pow(2);
-        }
-        let pyramid = pool.buffer(d, "ism pyramid", offsets[levels as usize + 1] * 4, rw);
+        let (steps, words) = pull_push_steps(s, levels, count);
+        let pyramid = pool.buffer(d, "ism pyramid", words * 4, rw);
         let keep = points <= MAX_KEPT_POINTS.min(limit / 32);
         let kept = pool.buffer(d, "ism points", if keep { points * 32 } else { 32 }, rw);
         let no_vals;
@@ -189,21 +248,6 @@ impl Isms {
         let splat_bg = bind(&self.splat, &[0, 3, 4, 5, 6, 7]);
         let pull_bg = bind(&self.pull, &[0, 7, 8]);
         let push_bg = bind(&self.push, &[0, 7, 8]);
-        // One pull per level up, one push per level down.
-        let mut steps: Vec<IsmLevel> = (1..=levels)
-            .map(|l| IsmLevel {
-                level: l,
-                side: s >> l,
-                offset: offsets[l as usize] as u32,
-                other: offsets[l as usize - 1] as u32,
-            })
-            .collect();
-        steps.extend((0..levels).rev().map(|l| IsmLevel {
-            level: l,
-            side: s >> l,
-            offset: offsets[l as usize] as u32,
-            other: offsets[l as usize + 1] as u32,
-        }));
         let level_buf = pool.upload(
             ctx,
             "ism levels",
@@ -228,53 +272,29 @@ impl Isms {
             })
             .collect();
         rec.enc.clear_buffer(&atlas, 0, None);
-        let dispatch = |pass: &mut wgpu::ComputePass, pl, bg, n: u64| {
-            let (x, y) = groups(n);
-            pass.set_pipeline(pl);
-            pass.set_bind_group(0, bg, &[]);
-            pass.dispatch_workgroups(x, y, 1);
-        };
-        let span = rec.begin("ISM points");
-        {
-            let mut pass = rec.enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("ism points"),
-                timestamp_writes: span.compute(),
-            });
+        timed_pass(rec, "ISM points", |pass| {
             if count > 0 {
-                dispatch(&mut pass, &self.emit, &emit_bg, count as u64);
+                dispatch(pass, &self.emit, &emit_bg, count as u64);
                 if keep {
-                    dispatch(&mut pass, &self.sample, &sample_bg, points);
+                    dispatch(pass, &self.sample, &sample_bg, points);
                 }
             }
-        }
-        rec.end();
-        let span = rec.begin("ISM atlas");
-        {
-            let mut pass = rec.enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("ism atlas"),
-                timestamp_writes: span.compute(),
-            });
+        });
+        timed_pass(rec, "ISM atlas", |pass| {
             if count > 0 {
-                dispatch(&mut pass, &self.splat, &splat_bg, points);
+                dispatch(pass, &self.splat, &splat_bg, points);
             }
-        }
-        rec.end();
-        let span = rec.begin("pull-push");
-        {
-            let mut pass = rec.enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("ism pull-push"),
-                timestamp_writes: span.compute(),
-            });
+        });
+        timed_pass(rec, "pull-push", |pass| {
             for (k, step) in steps.iter().enumerate().filter(|_| count > 0) {
                 let (pl, bg) = match k < levels as usize {
                     true => (&self.pull, &pull_bg),
                     false => (&self.push, &push_bg),
                 };
                 pass.set_bind_group(1, &level_bgs[k], &[]);
-                dispatch(&mut pass, pl, bg, count as u64 * (step.side as u64).pow(2));
+                dispatch(pass, pl, bg, count as u64 * (step.side as u64).pow(2));
             }
-        }
-        rec.end();
+        });
         Ok(IsmOutput {
             frame,
             emitters: emit_buf,
