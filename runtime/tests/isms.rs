@@ -5,12 +5,11 @@
 mod common;
 
 use glam::Vec3;
-use visgate_runtime::cpu::tracer::Tracer;
 use visgate_runtime::cpu::val::{ValParams, ValSeeding, cluster};
 use visgate_runtime::gpu::{
     GpuContext, GpuMode, GpuParams, GpuRenderer, IsmParams, ValIsmParams, VplIsmParams,
 };
-use visgate_runtime::vpl::{PathParams, Vpl, path_vpls};
+use visgate_runtime::vpl::Vpl;
 use visgate_scenes::Builtin;
 
 fn context() -> GpuContext {
@@ -154,27 +153,11 @@ fn under_a_wide_blocker_the_floor_is_dark_and_in_the_open_lit() {
     }
 }
 
-fn vpls_of(b: Builtin, paths: u32) -> (visgate_formats::Scene, Vec<Vpl>) {
-    let scene = b.scene().expect("scene");
-    let tracer = Tracer::new(&scene);
-    let vpls = path_vpls(
-        &tracer,
-        &scene.lights,
-        &PathParams {
-            paths,
-            bounces: 1,
-            seed: 3,
-        },
-    )
-    .expect("vpls");
-    (scene, vpls)
-}
-
 #[test]
 fn the_papers_clustering_on_the_gpu_equals_its_cpu_twin() {
     let ctx = context();
     for b in [Builtin::CornellBox, Builtin::FourRooms] {
-        let (scene, vpls) = vpls_of(b, 1024);
+        let (scene, vpls) = common::vpls_of(b, 1024);
         let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
         for (m, splat) in [
             (1, Some(0.25)),
@@ -231,7 +214,7 @@ fn the_papers_clustering_on_the_gpu_equals_its_cpu_twin() {
 #[test]
 fn ism_modes_render_0_vpls_m_above_n_one_val_and_coplanar_vpls_without_nan() {
     let ctx = context();
-    let (scene, vpls) = vpls_of(Builtin::FourRooms, 256);
+    let (scene, vpls) = common::vpls_of(Builtin::FourRooms, 256);
     let cam = scene.cameras[0].clone();
     let floor: Vec<Vpl> = (0..64)
         .map(|i| {
@@ -281,7 +264,7 @@ fn per_vpl_isms_stay_near_per_vpl_shadow_maps_and_val_ism_near_the_vpls_light() 
     use visgate_runtime::gpu::PerVplParams;
     use visgate_runtime::metrics::errors;
     let ctx = context();
-    let (scene, vpls) = vpls_of(Builtin::CornellBox, 512);
+    let (scene, vpls) = common::vpls_of(Builtin::CornellBox, 512);
     let cam = scene.cameras[0].clone();
     let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
     let view = visgate_runtime::camera::View::new(&cam, [96, 96]).expect("view");

@@ -21,22 +21,6 @@ fn context() -> GpuContext {
         .unwrap_or_else(|e| panic!("GPU tests need an adapter (CI installs lavapipe): {e}"))
 }
 
-fn vpls_of(b: Builtin, paths: u32) -> (visgate_formats::Scene, Vec<Vpl>) {
-    let scene = b.scene().expect("scene");
-    let tracer = Tracer::new(&scene);
-    let vpls = path_vpls(
-        &tracer,
-        &scene.lights,
-        &PathParams {
-            paths,
-            bounces: 1,
-            seed: 3,
-        },
-    )
-    .expect("vpls");
-    (scene, vpls)
-}
-
 fn assert_sane(c: &Clustering, n: usize, m: u32) {
     assert_eq!(c.vals.len(), m as usize);
     assert_eq!(c.mapping.len(), n);
@@ -60,7 +44,7 @@ fn assert_sane(c: &Clustering, n: usize, m: u32) {
 fn gpu_k_means_equals_the_cpu_twin() {
     let ctx = context();
     for b in [Builtin::CornellBox, Builtin::FourRooms] {
-        let (scene, vpls) = vpls_of(b, 1024);
+        let (scene, vpls) = common::vpls_of(b, 1024);
         let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
         for (m, iterations) in [(1, 8), (4, 8), (30, 8), (64, 8), (30, 64), (4, 2)] {
             let params = ValParams {
@@ -121,7 +105,7 @@ fn gpu_k_means_equals_the_cpu_twin() {
 #[test]
 fn vals_stay_sane_at_the_extremes() {
     let ctx = context();
-    let (scene, vpls) = vpls_of(Builtin::FourRooms, 256);
+    let (scene, vpls) = common::vpls_of(Builtin::FourRooms, 256);
     let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
     let p = |count| ValParams {
         count,
@@ -195,7 +179,7 @@ fn vals_stay_sane_at_the_extremes() {
 #[test]
 fn a_static_light_gives_the_same_vals_every_frame_at_any_scale() {
     let ctx = context();
-    let (scene, vpls) = vpls_of(Builtin::FourRooms, 1024);
+    let (scene, vpls) = common::vpls_of(Builtin::FourRooms, 1024);
     let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
     let params = ValParams::default();
     let a = gpu.cluster_vals(&ctx, &vpls, &params).expect("frame 1");
@@ -335,7 +319,7 @@ fn vals_are_closer_to_the_reference_than_no_visibility() {
     use visgate_runtime::metrics::errors;
     let ctx = context();
     for b in [Builtin::CornellBox, Builtin::FourRooms] {
-        let (scene, vpls) = vpls_of(b, 1024);
+        let (scene, vpls) = common::vpls_of(b, 1024);
         let cam = scene.cameras[0].clone();
         let tracer = Tracer::new(&scene);
         let view = visgate_runtime::camera::View::new(&cam, [64, 48]).expect("view");
@@ -436,7 +420,7 @@ fn the_fourier_shadow_test_approaches_the_step_and_rings_within_its_bound() {
 #[test]
 fn val_modes_render_0_vpls_m_above_n_one_val_and_coplanar_vpls_without_nan() {
     let ctx = context();
-    let (scene, vpls) = vpls_of(Builtin::FourRooms, 256);
+    let (scene, vpls) = common::vpls_of(Builtin::FourRooms, 256);
     let cam = scene.cameras[0].clone();
     let floor: Vec<Vpl> = (0..64)
         .map(|i| {
@@ -472,7 +456,7 @@ fn val_modes_render_0_vpls_m_above_n_one_val_and_coplanar_vpls_without_nan() {
 fn interleaved_sampling_with_the_blur_stays_close_to_every_vpl_at_every_pixel() {
     use visgate_runtime::metrics::errors;
     let ctx = context();
-    let (scene, vpls) = vpls_of(Builtin::CornellBox, 1024);
+    let (scene, vpls) = common::vpls_of(Builtin::CornellBox, 1024);
     let cam = scene.cameras[0].clone();
     let full = gpu_image_with(&ctx, &scene, &cam, &vpls, cssm(), 30, 1, [128, 128]);
     for block in [2, 4, 8] {
@@ -599,7 +583,7 @@ fn cssm_receivers_at_a_val_of_no_area_stay_finite_and_the_open_stays_lit() {
 
 #[test]
 fn k_means_stops_where_the_assignment_repeats_and_more_iterations_change_nothing() {
-    let (_, vpls) = vpls_of(Builtin::CornellBox, 1024);
+    let (_, vpls) = common::vpls_of(Builtin::CornellBox, 1024);
     let at = |iterations| {
         cluster(
             &vpls,

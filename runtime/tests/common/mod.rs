@@ -194,3 +194,21 @@ pub fn under_and_open(
     }
     out
 }
+
+/// Built-in scene `b` and its one-bounce light-path VPLs from `paths` paths (seed 3).
+pub fn vpls_of(b: Builtin, paths: u32) -> (Scene, Vec<visgate_runtime::vpl::Vpl>) {
+    use visgate_runtime::vpl::{PathParams, path_vpls};
+    let scene = b.scene().expect("scene");
+    let tracer = visgate_runtime::cpu::tracer::Tracer::new(&scene);
+    let vpls = path_vpls(
+        &tracer,
+        &scene.lights,
+        &PathParams {
+            paths,
+            bounces: 1,
+            seed: 3,
+        },
+    )
+    .expect("vpls");
+    (scene, vpls)
+}
