@@ -510,7 +510,17 @@ fn set_scene_moves_geometry_and_lights_as_a_fresh_upload_does() {
     )
     .expect("vpls");
     let per_vpl = GpuMode::PerVplShadowMaps(Default::default());
-    for mode in [GpuMode::None, cssm(), per_vpl] {
+    // The ISMs' points are drawn from the triangles of the frame: moved meshes move them.
+    let per_vpl_ism = GpuMode::PerVplIsm(Default::default());
+    let mut val_ism = visgate_runtime::gpu::ValIsmParams::default();
+    val_ism.vals.warm_start = false;
+    for mode in [
+        GpuMode::None,
+        cssm(),
+        per_vpl,
+        per_vpl_ism,
+        GpuMode::ValIsm(val_ism),
+    ] {
         let params = GpuParams::with_mode(mode);
         let mut fresh = GpuRenderer::new(&ctx, &b).expect("upload b");
         let (want, _) = fresh.render(&ctx, &view, &vpls, &params).expect("fresh");
