@@ -1,7 +1,8 @@
 //! The viewer's debug layers, drawn over the image: the visibility cluster of every pixel
 //! (found by a CPU ray per pixel and the level's voxel→cluster grid, as the renderer finds
 //! it), the gates as disks, the skeleton coloured by max-ball radius, the VPLs coloured by
-//! flux; and what lies under the pointer (cluster, position, normal, VPLs that reach it).
+//! flux, the VALs of the VAL modes as disks of their area; and what lies under the pointer
+//! (cluster, position, normal, VPLs that reach it).
 
 use eframe::egui;
 use glam::Vec3;
@@ -28,6 +29,47 @@ pub struct Layers {
     pub geometry: bool,
     /// Each pixel's light-list length, as a heat map.
     pub lists: bool,
+    /// The VALs of a VAL mode as disks of their area.
+    pub vals: bool,
+}
+
+/// A VAL as the layer draws it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ValDisk {
+    /// Centre. [Units: m]
+    pub centre: Vec3,
+    /// Unit normal.
+    pub normal: Vec3,
+    /// Radius of the disk of its area. [Units: m]
+    pub radius: f32,
+    /// Its flux over the brightest VAL's (√, per channel).
+    pub colour: egui::Color32,
+}
+
+/// The VALs that hold VPLs as disks: the area of `val-ism`'s form factor (the disk of their
+/// VPLs' second moment), coloured by flux.
+pub fn val_disks(vals: &[visgate_runtime::cpu::val::Val]) -> Vec<ValDisk> {
+    let live: Vec<_> = vals.iter().filter(|v| v.vpl_count() > 0).collect();
+    let flux = |v: &visgate_runtime::cpu::val::Val| Vec3::from_slice(&v.flux[..3]);
+    let max = live
+        .iter()
+        .map(|v| flux(v).max_element())
+        .fold(1e-30, f32::max);
+    live.iter()
+        .map(|v| {
+            let f = flux(v) / max;
+            ValDisk {
+                centre: v.centre(),
+                normal: v.unit_normal(),
+                radius: (v.disk_area() / std::f32::consts::PI).sqrt(),
+                colour: egui::Color32::from_rgb(
+                    (255.0 * f.x.sqrt()) as u8,
+                    (255.0 * f.y.sqrt()) as u8,
+                    (255.0 * f.z.sqrt()) as u8,
+                ),
+            }
+        })
+        .collect()
 }
 
 impl Layers {
@@ -175,14 +217,14 @@ pub fn portal_lines(level: &GateLevel) -> Vec<Line> {
     out
 }
 
-/// Draws the line layers (gates with the level's `portals` outlines, skeleton, VPLs) over
-/// `rect`.
+/// Draws the line layers (gates with the level's `portals` outlines, skeleton, VPLs, VALs)
+/// over `rect`.
 pub fn draw_lines(
     painter: &egui::Painter,
     rect: egui::Rect,
     view: &View,
     on: Layers,
-    (level, vpls, portals): (Option<&GateLevel>, &[Vpl], &[Line]),
+    (level, vpls, portals, vals): (Option<&GateLevel>, &[Vpl], &[Line], &[ValDisk]),
 ) {
     let seg = |a: Vec3, b: Vec3, colour: egui::Color32, width: f32| {
         if let (Some(p), Some(q)) = (project(view, rect, a), project(view, rect, b)) {
@@ -199,23 +241,34 @@ pub fn draw_lines(
             seg(na.position_m.into(), nb.position_m.into(), colour, 2.0);
         }
     }
+    // A disk's outline and a tick along its normal.
+    let disk = |c: Vec3, n: Vec3, r: f32, colour: egui::Color32, width: f32| {
+        let u = n.any_orthonormal_vector();
+        let v = n.cross(u);
+        let ring = |k: u32| {
+            let a = k as f32 / 32.0 * std::f32::consts::TAU;
+            c + (u * a.cos() + v * a.sin()) * r
+        };
+        for k in 0..32 {
+            seg(ring(k), ring(k + 1), colour, width);
+        }
+        seg(c, c + n * r * 0.3, colour, 1.0);
+    };
     if let (true, Some(l)) = (on.gates, level) {
         for i in 0..l.gate_count() as u32 {
             let (c, n, r) = l.gate(i);
-            let u = n.any_orthonormal_vector();
-            let v = n.cross(u);
-            let colour = id_colour(i);
-            let ring = |k: u32| {
-                let a = k as f32 / 32.0 * std::f32::consts::TAU;
-                c + (u * a.cos() + v * a.sin()) * r
-            };
-            for k in 0..32 {
-                seg(ring(k), ring(k + 1), colour, 2.0);
-            }
-            seg(c, c + n * r * 0.3, colour, 1.0);
+            disk(c, n, r, id_colour(i), 2.0);
         }
         for &(a, b, colour) in portals {
             seg(a, b, colour, 1.0);
+        }
+    }
+    if on.vals {
+        for d in vals {
+            disk(d.centre, d.normal, d.radius, d.colour, 2.0);
+            if let Some(p) = project(view, rect, d.centre) {
+                painter.circle_filled(p, 2.5, d.colour);
+            }
         }
     }
     if on.vpls {

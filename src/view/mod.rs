@@ -62,7 +62,8 @@ pub struct ViewArgs {
     pub window_shot: Option<PathBuf>,
     /// Debug layers on at the start, comma separated: clusters (visibility), geometry
     /// (geometry clusters), lists (light-list length) — one of these shows at a time —, gates,
-    /// skeleton, vpls, indirect (the frame less its direct light).
+    /// skeleton, vpls, vals (the VALs of a VAL mode as disks of their area), indirect (the
+    /// frame less its direct light).
     #[arg(long, value_delimiter = ',')]
     pub layers: Vec<String>,
     /// Render the exact CPU reference of the first view and show it beside the method (the
@@ -253,6 +254,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
             indirect,
             geometry: geometry && lv,
             lists: lists && lv,
+            vals: s.vals_layer,
         };
     }
     for l in &args.layers {
@@ -264,8 +266,10 @@ pub fn run(args: ViewArgs) -> Result<()> {
             "indirect" => layers.indirect = true,
             "geometry" => layers.geometry = true,
             "lists" => layers.lists = true,
+            "vals" => layers.vals = true,
             _ => bail!(
-                "--layers {l}: give clusters, geometry, lists, gates, skeleton, vpls or indirect"
+                "--layers {l}: give clusters, geometry, lists, gates, skeleton, vpls, vals or \
+                 indirect"
             ),
         }
     }

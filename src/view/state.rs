@@ -25,6 +25,9 @@ pub struct SavedView {
     /// Gates as disks rather than portals (absent in older files: portals).
     #[serde(default)]
     pub disks: bool,
+    /// The VAL layer (absent in older files: off).
+    #[serde(default)]
+    pub vals_layer: bool,
 }
 
 /// The state file: one entry per scene name.
@@ -89,6 +92,7 @@ mod tests {
             layers: [true, false, true, false, true, false, true],
             settings: [2.0, 1.5, 30.0, 8.0, 4.0, 128.0, 256.0, 32.0],
             disks: mode == "gates",
+            vals_layer: mode == "val-ism",
         };
         save_to(&p, "a", state("gates"));
         save_to(&p, "b", state("val-cssm"));

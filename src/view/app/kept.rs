@@ -38,6 +38,7 @@ impl ViewerApp {
                 p.batch as f32,
             ],
             disks: g.shape == visgate_runtime::cpu::gates::GateShape::Disk,
+            vals_layer: l.vals,
         }
     }
 

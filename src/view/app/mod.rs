@@ -128,6 +128,8 @@ pub struct ViewerApp {
     last_saved: Option<(SavedView, std::time::Instant)>,
     /// `--shader-dir`: the watched folder of shaders.
     shaders: Option<ShaderWatch>,
+    /// The VAL layer's disks and what they were clustered for.
+    val_disks: Option<(String, Vec<layers::ValDisk>)>,
     /// The camera path being recorded, and what the last recording did.
     recorder: Option<Recorder>,
     record_note: Option<String>,
@@ -173,6 +175,7 @@ impl ViewerApp {
             shaders,
             recorder: None,
             record_note: None,
+            val_disks: None,
             ctx,
             gpu,
             vpls: None,
@@ -280,6 +283,9 @@ impl ViewerApp {
                 self.last = Some((img, times));
                 self.error = None;
                 self.frames += 1;
+                if self.layers.vals {
+                    self.update_val_layer(&mode);
+                }
             }
             Err(e) => self.error = Some(e.to_string()),
         }
@@ -393,6 +399,10 @@ impl ViewerApp {
             );
         });
         ui.checkbox(&mut self.layers.vpls, "VPLs (colour: flux)");
+        ui.checkbox(
+            &mut self.layers.vals,
+            "VALs (VAL modes: disks of their area)",
+        );
         ui.checkbox(&mut self.layers.indirect, "indirect light alone");
         ui.separator();
         let image = self.last.as_ref().map(|(img, _)| img);
@@ -523,7 +533,8 @@ impl ViewerApp {
         }
         let vpls = self.vpls.as_ref().map_or(&[][..], |v| &v.1[..]);
         let painter = ui.painter().with_clip_rect(rect);
-        let lines = (level, vpls, &self.portal_lines[..]);
+        let vals = self.val_disks.as_ref().map_or(&[][..], |v| &v.1[..]);
+        let lines = (level, vpls, &self.portal_lines[..], vals);
         layers::draw_lines(&painter, rect, &view, self.layers, lines);
         if let Some(pos) = response.hover_pos().filter(|p| rect.contains(*p)) {
             let p = glam::Vec2::new(

@@ -156,3 +156,43 @@ fn the_viewer_renders_lightcluster_direct_shadows() {
     assert!((1..=2).contains(&c.clusters), "{c:?}");
     assert!(times.passes.iter().any(|p| p.name == "PCSS visibility"));
 }
+
+#[test]
+fn the_viewer_draws_val_isms_vals_as_disks() {
+    let mut app = viewer(
+        Layers {
+            vals: true,
+            ..Layers::default()
+        },
+        false,
+    );
+    app.start.mode = "val-ism";
+    app.settings.val_ism.vals.count = 8;
+    let mut harness = Harness::builder()
+        .with_size([900.0, 560.0])
+        .wgpu()
+        .build_ui_state(|ui, app: &mut ViewerApp| app.draw(ui), app);
+    for _ in 0..600 {
+        harness.step();
+        if harness.state().frames > 0 {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    harness.run_steps(2);
+    let app = harness.state();
+    assert_eq!(app.error, None);
+    let (_, disks) = app.val_disks.as_ref().expect("the VAL layer's disks");
+    // The 32 light paths' VPLs in at most 8 VALs, each a disk of positive size.
+    assert!((1..=8).contains(&disks.len()), "{}", disks.len());
+    assert!(
+        disks
+            .iter()
+            .all(|d| d.radius >= 0.0 && d.radius.is_finite())
+    );
+    assert!(disks.iter().any(|d| d.radius > 0.0));
+    harness.snapshot_options(
+        "viewer_val_ism_vals",
+        &SnapshotOptions::new().threshold(2.0),
+    );
+}

@@ -1,9 +1,12 @@
 //! The viewer's tools for the people who work on the methods: shader hot reload
-//! (`--shader-dir`) and recording a camera path for the benchmark.
+//! (`--shader-dir`), recording a camera path for the benchmark, and the VAL layer's
+//! clustering.
 
 use eframe::egui;
+use visgate_runtime::gpu::GpuMode;
 
 use super::ViewerApp;
+use crate::view::layers;
 use crate::view::path::Recorder;
 
 impl ViewerApp {
@@ -55,6 +58,34 @@ impl ViewerApp {
         }
         if let Some(note) = &self.record_note {
             ui.label(note);
+        }
+    }
+
+    /// The VAL layer: the VALs of `mode` (a VAL mode; none otherwise) clustered from this
+    /// frame's VPLs on the GPU, again only when the VPLs or the clustering changed.
+    pub(super) fn update_val_layer(&mut self, mode: &GpuMode) {
+        let Some(params) = mode.vals() else {
+            self.val_disks = None;
+            return;
+        };
+        let key = format!(
+            "{params:?} {} {} {}",
+            self.vpl_count, self.start.rsm, self.time
+        );
+        if self.val_disks.as_ref().is_some_and(|(k, _)| *k == key) {
+            return;
+        }
+        let vpls = match (self.start.rsm, &self.vpls) {
+            (true, _) => {
+                let r = self.rsm_params();
+                self.gpu.rsm_vpls(&self.ctx, r.count, r.rsm_size, r.seed)
+            }
+            (false, Some((_, v))) => Ok(v.clone()),
+            (false, None) => Ok(Vec::new()),
+        };
+        match vpls.and_then(|v| self.gpu.cluster_vals(&self.ctx, &v, &params)) {
+            Ok(c) => self.val_disks = Some((key, layers::val_disks(&c.vals))),
+            Err(e) => self.error = Some(format!("VAL layer: {e}")),
         }
     }
 }
