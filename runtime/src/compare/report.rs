@@ -107,7 +107,8 @@ fn header(ground_truth: bool) -> Vec<String> {
 
 /// What the figures mean, for both formats.
 const LEGEND: &str = "Every method renders the very VPLs of the CPU reference (a shadow ray \
-per VPL and pixel sample), so each error is the method's visibility alone. Times: GPU \
+per VPL and pixel sample), so each error is the method's visibility alone (val-ism lights \
+with virtual area lights made of them: its error is also the VALs' light). Times: GPU \
 timestamps per pass after a warm-up frame (CPU wall time per pass where the adapter has none); \
 the total is the frame. Indirect energy: the method's mean indirect light over the reference's \
 (its own direct light taken out). Indirect MSE: the MSE of the image with its own direct light \
