@@ -19,7 +19,8 @@
 //!    ([`passes::shade`]);
 //! 6. mode `per-vpl-shadow-maps`: maps and gather per batch ([`passes::per_vpl_maps`]); the VAL
 //!    modes: clustering, maps, CSSM basis, gather, blur ([`passes::vals`], [`passes::cssm`],
-//!    [`passes::val_gather`], [`passes::interleave_blur`]);
+//!    [`passes::val_gather`], [`passes::interleave_blur`]); the ISM modes: (val-ism) the
+//!    clustering, ISM points, atlas, pull-push, gather, blur ([`passes::ism`]);
 //! 7. readback.
 //!
 //! The methods and their parameters are in [`methods`] (the registry [`METHODS`]); every

@@ -2,7 +2,7 @@
 // Virtual area lights on the GPU (Dong et al. §5–6): k-means of the VPLs into M VALs by
 // d = w_x·Δx/D + w_α·Δα/π, restarted each frame from VAL k = VPL ⌊k·N/M⌋.
 // runtime::cpu::val is the CPU twin (same order of every sum, so the same VALs).
-//   cdf     (Weinzierl-Heigl's seeds) the VPLs' cumulative importance r + g + b, in one
+//   cumulate (Weinzierl-Heigl's seeds) the VPLs' cumulative importance r + g + b, in one
 //           workgroup: 64 contiguous chunks, as runtime::cpu::val::importance_cdf
 //   init    centres from the restart VPLs, or from the Halton points warped by the cumulative
 //           importance
