@@ -232,8 +232,8 @@ pub struct MethodArgs {
     pub vpl_batch: u32,
     /// Imperfect shadow maps (--mode per-vpl-ism, val-ism): side of each emitter's paraboloid
     /// map, a power of two in 16..=512 texels. Unset: 128 (the paper's 4096² atlas of 128²
-    /// maps), halved until the maps fit the adapter's largest storage binding (4,096 VPLs:
-    /// 64²).
+    /// maps), halved until the maps fit the adapter's largest storage buffer (4,096 VPLs in
+    /// 128 MiB: 64²).
     #[arg(long)]
     pub ism_map_size: Option<u32>,
     /// ISMs: points splatted into each map, 64..=65536 — the sampling density: a point stands

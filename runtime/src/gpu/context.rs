@@ -44,6 +44,8 @@ impl GpuContext {
             // LightCluster's shadow atlas (6 faces a cluster in one texture).
             max_texture_dimension_2d: adapter.limits().max_texture_dimension_2d,
             max_storage_buffer_binding_size: adapter.limits().max_storage_buffer_binding_size,
+            // The imperfect shadow maps' atlas (a map per VPL in one buffer).
+            max_buffer_size: adapter.limits().max_buffer_size,
             max_storage_buffers_per_shader_stage: adapter
                 .limits()
                 .max_storage_buffers_per_shader_stage

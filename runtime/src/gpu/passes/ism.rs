@@ -187,7 +187,7 @@ impl Isms {
             Emitters::Vpls => (0, f.vpl_count, None),
             Emitters::Vals(b, m) => (1, m, Some(b)),
         };
-        let limit = d.limits().max_storage_buffer_binding_size;
+        let limit = (d.limits().max_storage_buffer_binding_size).min(d.limits().max_buffer_size);
         let s = p.side_for(count, limit)?;
         let geo = &f.scene.geometry;
         let points = count as u64 * p.points_per_map as u64;

@@ -10,7 +10,7 @@ use crate::cpu::val::ValParams;
 pub struct IsmParams {
     /// Side of each emitter's paraboloid map, a power of two; `None`: 128 (the paper's
     /// 4096² atlas of 128² maps), smaller where that many maps would not fit the adapter's
-    /// largest storage binding. [Units: texels] [Limit: 16..=512]
+    /// largest storage buffer. [Units: texels] [Limit: 16..=512]
     pub map_size: Option<u32>,
     /// Points splatted into each map (the sampling density: the scene's area over this is what
     /// a point stands for). [Limit: 64..=65,536]
@@ -83,7 +83,7 @@ impl IsmParams {
         Ok(())
     }
 
-    /// The map side for `maps` maps when the largest storage binding is `limit` bytes: the
+    /// The map side for `maps` maps when the largest storage buffer is `limit` bytes: the
     /// given one, or the largest power of two up to [`ISM_MAP_SIZE`] that fits (at least 16).
     pub fn side_for(&self, maps: u32, limit: u64) -> Result<u32, RenderError> {
         let fits = |s: u32| maps.max(1) as u64 * (s as u64 * s as u64) * 4 <= limit;
@@ -100,7 +100,7 @@ impl IsmParams {
         if !fits(side) {
             return Err(RenderError::Param(format!(
                 "{maps} imperfect shadow maps of {side}² need {} MiB, more than the adapter's \
-                 storage binding limit of {} MiB: use smaller maps (--ism-map-size) or fewer \
+                 largest storage buffer of {} MiB: use smaller maps (--ism-map-size) or fewer \
                  emitters",
                 (maps as u64 * side as u64 * side as u64 * 4) >> 20,
                 limit >> 20
