@@ -454,12 +454,14 @@ pub fn pass_table(t: &PassTimes) -> String {
     if let Some(v) = t.vals {
         s += &match v.converged {
             true => format!(
-                "VAL clustering: converged after {} of at most {} iterations\n",
-                v.iterations, v.max
+                "VAL clustering: {} of {} VALs hold VPLs, converged after {} of at most {} \
+                 iterations\n",
+                v.live, v.count, v.iterations, v.max
             ),
             false => format!(
-                "VAL clustering: not converged in {} iterations (raise --val-iterations)\n",
-                v.max
+                "VAL clustering: {} of {} VALs hold VPLs, not converged in {} iterations (raise \
+                 --val-iterations)\n",
+                v.live, v.count, v.max
             ),
         };
     }

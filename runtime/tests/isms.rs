@@ -301,3 +301,51 @@ fn per_vpl_isms_stay_near_per_vpl_shadow_maps_and_val_ism_near_the_vpls_light() 
         assert!(energy.contains(&ratio), "{}: energy {ratio}", mode.name());
     }
 }
+
+#[test]
+fn the_papers_warm_start_seeds_again_the_vals_that_held_nothing() {
+    use visgate_runtime::cpu::val::centres_of;
+    let (scene, vpls) = common::vpls_of(Builtin::CornellBox, 1024);
+    let params = ValParams {
+        count: 16,
+        ..ValParams::ism()
+    };
+    let cold = cluster(&vpls, &params, None).expect("cold");
+    // Last frame's centres, one of them empty (flux 0) and far away.
+    let mut start = centres_of(&cold);
+    start[3] = (Vec3::splat(1e3), Vec3::Y, Vec3::ZERO);
+    let warm = cluster(&vpls, &params, Some(&start)).expect("warm");
+    assert!(warm.vals[3].vpl_count() > 0, "{:?}", warm.vals[3]);
+    // Dong et al.'s warm start (the rejected alternative) keeps the empty VAL empty.
+    let dong = ValParams {
+        seeding: ValSeeding::Restart,
+        ..params
+    };
+    let kept = cluster(&vpls, &dong, Some(&start)).expect("dong");
+    assert_eq!(kept.vals[3].vpl_count(), 0);
+    // On the GPU: VPLs on one side of the box, then on the other. The VALs warm-started from
+    // the first side that the second side's VPLs do not reach (their splats) hold nothing
+    // after the second frame; the third frame seeds them again.
+    let ctx = context();
+    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    let view = visgate_runtime::camera::View::new(&scene.cameras[0], [32, 32]).expect("view");
+    let side = |left: bool| -> Vec<Vpl> {
+        vpls.iter()
+            .filter(|v| (v.position[0] < 0.0) == left)
+            .copied()
+            .collect()
+    };
+    let mode = val_ism(32, 4);
+    let mut live = Vec::new();
+    for v in [side(true), side(false), side(false)] {
+        let (_, times) = gpu
+            .render(&ctx, &view, &v, &GpuParams::with_mode(mode))
+            .expect("frame");
+        let c = times.vals.expect("VAL counts");
+        assert_eq!(c.count, 32);
+        live.push(c.live);
+    }
+    eprintln!("live VALs: {live:?}");
+    assert!(live[0] >= 30, "{live:?}");
+    assert!(live[1] < live[0] && live[2] > live[1], "{live:?}");
+}

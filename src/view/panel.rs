@@ -232,7 +232,9 @@ pub fn pass_times(ui: &mut egui::Ui, img: &HdrImage, t: &PassTimes, history: &Ve
     }
     if let Some(v) = &t.vals {
         ui.label(format!(
-            "VAL clustering: {} of at most {} iterations{}",
+            "VAL clustering: {} of {} VALs live, {} of at most {} iterations{}",
+            v.live,
+            v.count,
             v.iterations,
             v.max,
             if v.converged { ", converged" } else { "" }

@@ -23,7 +23,9 @@
 //! through the cumulative flux of the VPLs (r + g + b), so that VALs gather where the light is;
 //! the metric adds a flux term `w_f·|Φ_i − Φ_c| / (|Φ_i| + |Φ_c|)` (Φ_c the mean flux of the
 //! VAL's VPLs); and a VPL joins only the centres whose point splat reaches it (within `splat`
-//! × D), the nearest of all where none does (no light is dropped).
+//! × D), the nearest of all where none does (no light is dropped). Iterated frame to frame
+//! (warm start), a VAL that held no VPL last frame starts again from its seed (the paper's
+//! initialisation "whenever there are no RSM-pixels assigned to a cluster").
 
 use glam::Vec3;
 
@@ -344,6 +346,14 @@ pub fn cluster(
     }
     let inv_d = 1.0 / scale_m;
     let mut centres = match start {
+        // The paper's warm start seeds again the VALs that held no VPL (flux 0) last frame.
+        Some(s) if s.len() == m && params.seeding == ValSeeding::HaltonFlux => {
+            let seeds = initial_centres(vpls, params);
+            s.iter()
+                .zip(seeds)
+                .map(|(&c, seed)| if c.2 == Vec3::ZERO { seed } else { c })
+                .collect()
+        }
         Some(s) if s.len() == m => s.to_vec(),
         Some(s) => {
             return Err(RenderError::Param(format!(

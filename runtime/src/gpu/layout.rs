@@ -374,6 +374,14 @@ gpu_struct! {
         /// Splat radius over D (0: every centre; 1 / D is a storage word: the GPU computes it
         /// for RSM VPLs).
         pub splat: f32,
+        /// 1: a warm start that seeds again the VALs that held no VPL last frame.
+        pub reseed: u32,
+        /// Padding.
+        pub _pad0: u32,
+        /// Padding.
+        pub _pad1: u32,
+        /// Padding.
+        pub _pad2: u32,
     }
 }
 

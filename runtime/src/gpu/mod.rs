@@ -608,6 +608,8 @@ impl GpuRenderer {
                 iterations: c[2],
                 max: v.iterations,
                 converged: c[1] != 0,
+                live: c[3],
+                count: v.count,
             });
         }
         let counts = |r: &wgpu::Buffer, emitters: u32| -> Result<LcCounts, RenderError> {

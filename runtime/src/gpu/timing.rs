@@ -82,6 +82,10 @@ pub struct ValIterations {
     pub max: u32,
     /// Whether the assignment stopped changing within them.
     pub converged: bool,
+    /// VALs that hold VPLs (of `ValParams::count`).
+    pub live: u32,
+    /// VALs in all.
+    pub count: u32,
 }
 
 impl PassTimes {

@@ -126,6 +126,8 @@ impl ValClustering {
             w_alpha: params.w_alpha,
             w_f: params.w_f,
             splat: params.splat_or_zero(),
+            reseed: u32::from(warm && params.seeding == ValSeeding::HaltonFlux),
+            ..bytemuck::Zeroable::zeroed()
         };
         let uniform = wgpu::BufferUsages::UNIFORM;
         let frame_buf = pool.upload(ctx, "val frame", bytemuck::bytes_of(&frame), uniform);
@@ -156,7 +158,10 @@ impl ValClustering {
         let base = [(0, &frame_buf), (1, input.buffer), (2, &centres)];
         let scale_bg = bind(&self.scale, &[base[0], base[1], (6, &inv_scale)]);
         let cumulate_bg = bind(&self.cumulate, &[base[0], base[1], (8, &cdf)]);
-        let init_bg = bind(&self.init, &[base[0], base[1], base[2], (8, &cdf)]);
+        let init_bg = bind(
+            &self.init,
+            &[base[0], base[1], base[2], (4, &vals), (8, &cdf)],
+        );
         let assign_bg = bind(
             &self.assign,
             &[
@@ -175,7 +180,14 @@ impl ValClustering {
         );
         let finish_bg = bind(
             &self.finish,
-            &[base[0], base[1], base[2], (3, &mapping), (4, &vals)],
+            &[
+                base[0],
+                base[1],
+                base[2],
+                (3, &mapping),
+                (4, &vals),
+                (7, &state),
+            ],
         );
         let counts_bg = bind(&self.bucket_counts, &[base[0], (3, &mapping), (5, &order)]);
         let offsets_bg = bind(&self.offsets, &[base[0], (5, &order)]);
@@ -196,7 +208,10 @@ impl ValClustering {
                 if input.cpu.is_none() {
                     run(&self.scale, &scale_bg, 1);
                 }
-                if !warm {
+                // Cold: every centre from its seed; warm with the paper's seeds: the VALs
+                // that held no VPL last frame.
+                let reseed = warm && params.seeding == ValSeeding::HaltonFlux;
+                if !warm || reseed {
                     if params.seeding == ValSeeding::HaltonFlux {
                         run(&self.cumulate, &cumulate_bg, 1);
                     }

@@ -27,6 +27,12 @@ struct ValFrame {
     // Weight of the flux term; splat radius over D (0: every centre).
     w_f: f32,
     splat: f32,
+    // 1: a warm start that seeds again the VALs that held no VPL last frame (the paper's
+    // initialisation "whenever there are no RSM-pixels assigned to a cluster").
+    reseed: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 };
 
 @group(0) @binding(0) var<uniform> frame: ValFrame;
@@ -39,7 +45,8 @@ struct ValFrame {
 // by `scale` (RSM VPLs stay on the GPU).
 @group(0) @binding(6) var<storage, read_write> inv_scale: array<f32, 1>;
 // Convergence: 0 VPLs whose VAL changed in this iteration's assignment, 1 done (the mapping
-// stopped changing: every later iteration would repeat the last), 2 updates run.
+// stopped changing: every later iteration would repeat the last), 2 updates run, 3 VALs that
+// hold VPLs.
 @group(0) @binding(7) var<storage, read_write> state: array<atomic<u32>, 4>;
 // The VPLs' inclusive cumulative importance (seeding 1).
 @group(0) @binding(8) var<storage, read_write> cdf: array<f32>;
@@ -124,6 +131,10 @@ fn init(@builtin(global_invocation_id) id: vec3<u32>) {
     let n = frame.vpl_count;
     let m = frame.val_count;
     if k >= m || n == 0u {
+        return;
+    }
+    // A warm start keeps every VAL that held VPLs last frame (`vals` holds last frame's).
+    if frame.reseed == 1u && vals[k].position.w > 0.0 {
         return;
     }
     if frame.seeding == 1u {
@@ -327,6 +338,9 @@ fn finish(@builtin(workgroup_id) wg: vec3<u32>, @builtin(local_invocation_index)
     rect = wg_rect[0];
     if count == 0u {
         rect = vec4<f32>(0.0);
+    }
+    if count > 0u {
+        atomicAdd(&state[3], 1u);
     }
     var v: Val;
     v.position = vec4<f32>(c, f32(count));
