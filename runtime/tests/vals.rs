@@ -422,15 +422,7 @@ fn val_modes_render_0_vpls_m_above_n_one_val_and_coplanar_vpls_without_nan() {
     let ctx = context();
     let (scene, vpls) = common::vpls_of(Builtin::FourRooms, 256);
     let cam = scene.cameras[0].clone();
-    let floor: Vec<Vpl> = (0..64)
-        .map(|i| {
-            Vpl::new(
-                Vec3::new(1.0 + (i % 8) as f32 * 0.3, 0.0, 1.0 + (i / 8) as f32 * 0.3),
-                Vec3::Y,
-                Vec3::splat(0.1),
-            )
-        })
-        .collect();
+    let floor = common::coplanar_vpls();
     let direct = gpu_image(&ctx, &scene, &cam, &[], GpuMode::DirectOnly, 1);
     for mode in [hard(), cssm()] {
         // N = 0: direct light alone.

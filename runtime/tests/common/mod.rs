@@ -212,3 +212,17 @@ pub fn vpls_of(b: Builtin, paths: u32) -> (Scene, Vec<visgate_runtime::vpl::Vpl>
     .expect("vpls");
     (scene, vpls)
 }
+
+/// 64 VPLs in one plane (a floor patch 2.1 m square, facing up): VALs of zero area in one
+/// plane.
+pub fn coplanar_vpls() -> Vec<visgate_runtime::vpl::Vpl> {
+    (0..64)
+        .map(|i| {
+            visgate_runtime::vpl::Vpl::new(
+                Vec3::new(1.0 + (i % 8) as f32 * 0.3, 0.0, 1.0 + (i / 8) as f32 * 0.3),
+                Vec3::Y,
+                Vec3::splat(0.1),
+            )
+        })
+        .collect()
+}

@@ -77,6 +77,22 @@ fn snapshot(name: &str, layers: Layers, compare: bool) {
     harness.snapshot_options(name, &SnapshotOptions::new().threshold(2.0));
 }
 
+/// The window of `app` stepped until its first frame is drawn.
+fn first_frame(app: ViewerApp) -> Harness<'static, ViewerApp> {
+    let mut harness = Harness::builder()
+        .with_size([900.0, 560.0])
+        .wgpu()
+        .build_ui_state(|ui, app: &mut ViewerApp| app.draw(ui), app);
+    for _ in 0..600 {
+        harness.step();
+        if harness.state().frames > 0 {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    harness
+}
+
 // One test per snapshot: kittest keeps one harness's results per test.
 
 #[test]
@@ -136,17 +152,7 @@ fn the_viewer_renders_lightcluster_direct_shadows() {
     use visgate_runtime::gpu::{DirectLight, LightClusterGpuParams};
     let mut app = viewer(Layers::default(), false);
     app.direct = DirectLight::LightCluster(LightClusterGpuParams::default());
-    let mut harness = Harness::builder()
-        .with_size([900.0, 560.0])
-        .wgpu()
-        .build_ui_state(|ui, app: &mut ViewerApp| app.draw(ui), app);
-    for _ in 0..600 {
-        harness.step();
-        if harness.state().frames > 0 {
-            break;
-        }
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    }
+    let harness = first_frame(app);
     let app = harness.state();
     assert_eq!(app.error, None);
     let (_, times) = app.last.as_ref().expect("a frame");
@@ -168,17 +174,7 @@ fn the_viewer_draws_val_isms_vals_as_disks() {
     );
     app.start.mode = "val-ism";
     app.settings.val_ism.vals.count = 8;
-    let mut harness = Harness::builder()
-        .with_size([900.0, 560.0])
-        .wgpu()
-        .build_ui_state(|ui, app: &mut ViewerApp| app.draw(ui), app);
-    for _ in 0..600 {
-        harness.step();
-        if harness.state().frames > 0 {
-            break;
-        }
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    }
+    let mut harness = first_frame(app);
     harness.run_steps(2);
     let app = harness.state();
     assert_eq!(app.error, None);
