@@ -25,6 +25,10 @@ Modes:
   per-vpl-shadow-maps
                GPU: one paraboloid shadow map per VPL, rendered and gathered in batches of
                --vpl-batch (the brute-force baseline that gates and virtual area lights beat)
+  per-vpl-ism  GPU: an imperfect shadow map per VPL (Ritschel et al.): the scene as
+               --ism-points random points a map, splatted as surfels into one atlas of
+               --ism-map-size² paraboloid maps, holes filled by --ism-pull-push levels; one
+               hard lookup per VPL (the cheap twin of per-vpl-shadow-maps)
   gates        GPU: a VPL lights a point of another visibility cluster only through the
                baked --level's portals (--gate-shape portal, the default: the segment walks
                from cluster to cluster through the openings, at most --max-walk of them) or
@@ -44,6 +48,12 @@ Modes:
   val-cssm     GPU: as val-hard with convolution soft shadow maps per VAL (Dong et al.):
                --cssm-terms Fourier terms of the depth, mip-mapped, filtered over the
                penumbra each VAL's size and the average blocker depth give
+  val-ism      GPU: virtual area lights with imperfect shadow maps and PCSS
+               (Weinzierl-Heigl): the VPLs clustered into --ism-vals VALs (Halton seeds warped
+               by flux, position/normal/flux metric, point splats, iterated frame to frame),
+               each VAL a disk lighting through the point-to-disk form factor
+               (--ism-val-disk), its visibility PCSS on its ISM (--pcss-*, or
+               --ism-hard-lookups) over a --ism-interleave split G-buffer and the blur
   vpl-clusters GPU: the VPLs clustered as LightCluster clusters lights (--lc-min-distance,
                --lc-distance-scale, --lc-max-clusters; beyond its paper): a cube shadow map
                per cluster (--lc-map-size), every VPL shadowed by its cluster's PCSS soft

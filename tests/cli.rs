@@ -844,6 +844,11 @@ fn render_lightcluster_prints_its_passes_and_clusters_and_refuses_bad_settings()
 
 #[test]
 fn render_ism_modes_print_the_papers_passes_and_refuse_bad_settings() {
+    // `render --help` describes every mode of the registry, these two included.
+    let help = visgate(&["render", "--help"]);
+    for mode in ["  per-vpl-ism  GPU:", "  val-ism      GPU:"] {
+        assert!(stdout(&help).contains(mode), "{mode}: {}", stdout(&help));
+    }
     let dir = tempfile::tempdir().expect("tempdir");
     let out = dir.path().join("ism.exr");
     let out = out.to_str().expect("utf-8");
