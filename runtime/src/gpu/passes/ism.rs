@@ -4,10 +4,12 @@
 //!
 //! The maps are compute passes, not point draws: wgpu draws points one pixel wide, and a splat
 //! of a radius set per point is a loop of `atomicMax` over its texels (the nearest distance
-//! wins, as a depth test would). The maps are one storage buffer, map k at k·s² words; the
-//! pull-push pyramid a second one. The points are not kept: point i is drawn from the scene's
-//! triangles by a hash of i each frame (a few ALU a point), so moved meshes move their points
-//! and no point pool grows with the emitters.
+//! wins, as a depth test would), each texel taking the distance where its ray meets the
+//! point's surfel (a disk in its triangle's plane). The maps are one storage buffer, map k at
+//! k·s² words; the pull-push pyramid a second one. The points are drawn each frame: point i
+//! from the scene's triangles by a hash of i (a few ALU a point), so moved meshes move their
+//! points; a frame keeps them (position, normal) up to 2²² points and beyond that the splat
+//! draws them again, so no point pool grows with the emitters.
 
 use super::gbuffer::GBufferOutput;
 use super::interleave_blur::InterleaveBlur;

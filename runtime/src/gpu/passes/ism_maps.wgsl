@@ -1,13 +1,14 @@
 //! include: vpl.wgsl val.wgsl ism.wgsl
 // Imperfect shadow maps (Ritschel et al. 2008; Weinzierl-Heigl §5), as compute passes:
-//   emitters  each map's centre and axis: a VPL, or a VAL's centre moved off its surface
+//   emit      each map's centre and axis: a VPL, or a VAL's centre moved off its surface
 //   sample    the scene as random points: point i picks a triangle by area (a hash through the
 //             triangles' cumulative area) and a uniform barycentric point in it, from the
 //             triangles of this frame (moved meshes move their points); kept up to 2²² points,
 //             beyond that drawn again by the splat
-//   splat     point i goes to map i mod N (the paper's round robin) as a disk of the radius it
-//             stands for, its size by its distance to the emitter, the nearest kept by
-//             atomicMax of the encoded distance
+//   splat     point i goes to map i mod N (the paper's round robin) as a surfel — a disk of
+//             the radius it stands for in its triangle's plane —, its size in texels by its
+//             distance to the emitter, each texel the distance where its ray meets the surfel,
+//             the nearest kept by atomicMax of the encoded distance
 //   pull      level l + 1 of a map: the mean of the filled texels of its 2 × 2 below
 //   push      a hole of level l: its parent's value (the pull-push of the paper's Figure 4)
 
@@ -20,6 +21,7 @@
 @group(0) @binding(4) var<storage, read> triangles: array<vec4<f32>>;
 // The triangles' cumulative area, the last 1.
 @group(0) @binding(5) var<storage, read> area_cdf: array<f32>;
+// Per kept point: position (xyz), its triangle's normal (xyz) at 2i, 2i + 1.
 @group(0) @binding(6) var<storage, read_write> points: array<vec4<f32>>;
 @group(0) @binding(7) var<storage, read_write> atlas: array<atomic<u32>>;
 // Levels 1… of every map, as f32 (0: a hole).
