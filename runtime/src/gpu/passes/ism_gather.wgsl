@@ -76,23 +76,17 @@ fn ism_pcss(k: u32, p: vec3<f32>, n: vec3<f32>, radius: f32, px: vec2<u32>) -> f
     }
     let texel = texel_angle(k, p, dist);
     let q = p + n * (dist * texel * frame.normal_offset);
-    let dq = q - c;
-    let dr = length(dq);
-    let w0 = dq / dr;
+    let cone = pcss_cone(q - c, px);
+    let dr = cone.dr;
     let bias = slope_bias(texel, c, p, n);
-    let t1 = normalize(cross(w0, select(vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(1.0, 0.0, 0.0), abs(w0.y) > 0.9)));
-    let t2 = cross(w0, t1);
-    let turn = 6.2831853 * pixel_noise(px);
-    let nearest = min(max(radius, 0.25 * dr), 0.5 * dr);
-    let search = min(radius * (dr - nearest) / (dr * nearest), 1.0);
+    let search = pcss_search(radius, dr);
     var sum = 0.0;
     var found = 0.0;
     for (var i = 0u; i < frame.blocker_samples; i++) {
-        let o = vogel(i, frame.blocker_samples, turn, true) * search;
-        let w = normalize(w0 + t1 * o.x + t2 * o.y);
-        let z = ism_distance(k, w);
-        let zr = plane_distance(c, w, q, n, dr);
-        if z < zr * (1.0 - bias) && in_cone(o, z, radius, dr) {
+        let s = pcss_sample(cone, i, frame.blocker_samples, true, search);
+        let z = ism_distance(k, s.w);
+        let zr = plane_distance(c, s.w, q, n, dr);
+        if z < zr * (1.0 - bias) && in_cone(s.o, z, radius, dr) {
             sum += z;
             found += 1.0;
         }
@@ -100,14 +94,12 @@ fn ism_pcss(k: u32, p: vec3<f32>, n: vec3<f32>, radius: f32, px: vec2<u32>) -> f
     if found == 0.0 {
         return 1.0;
     }
-    let zb = max(sum / found, 1e-4);
-    let width = min(radius * max(dr - zb, 0.0) / (dr * zb), 1.0);
+    let width = pcss_penumbra(radius, dr, max(sum / found, 1e-4));
     var lit = 0.0;
     for (var i = 0u; i < frame.filter_samples; i++) {
-        let o = vogel(i, frame.filter_samples, turn, false) * width;
-        let w = normalize(w0 + t1 * o.x + t2 * o.y);
-        let zr = plane_distance(c, w, q, n, dr);
-        lit += select(0.0, 1.0, ism_distance(k, w) >= zr * (1.0 - bias));
+        let s = pcss_sample(cone, i, frame.filter_samples, false, width);
+        let zr = plane_distance(c, s.w, q, n, dr);
+        lit += select(0.0, 1.0, ism_distance(k, s.w) >= zr * (1.0 - bias));
     }
     return lit / f32(max(frame.filter_samples, 1u));
 }

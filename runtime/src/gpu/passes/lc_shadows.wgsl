@@ -59,9 +59,8 @@ fn pcss(k: u32, p: vec3<f32>, n: vec3<f32>, px: vec2<u32>) -> f32 {
     let size = f32(frame.map_size);
     // A cube texel's footprint at distance d is at most 2·d / size.
     let q = p + n * (2.0 * dist / size) * frame.normal_offset;
-    let dq = q - c.xyz;
-    let dr = length(dq);
-    let w0 = dq / dr;
+    let cone = pcss_cone(q - c.xyz, px);
+    let dr = cone.dr;
     let bias = 2.0 / size * frame.bias;
     let radius = select(c.w, bitcast<f32>(extent[k]), frame.disk_extent == 1u);
     // VPLs light their front: directions behind the centre's surface carry no light.
@@ -70,27 +69,19 @@ fn pcss(k: u32, p: vec3<f32>, n: vec3<f32>, px: vec2<u32>) -> f32 {
         axis = lights[centres[k]].direction.xyz;
     }
     if radius <= 0.0 {
-        return select(0.0, 1.0, stored_distance(k, w0) >= dr * (1.0 - bias));
+        return select(0.0, 1.0, stored_distance(k, cone.w0) >= dr * (1.0 - bias));
     }
-    let t1 = normalize(cross(w0, select(vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(1.0, 0.0, 0.0), abs(w0.y) > 0.9)));
-    let t2 = cross(w0, t1);
-    let turn = 6.2831853 * pixel_noise(px);
-    // Blockers are looked for no nearer the centre than the radius (nearer is inside the
-    // light) nor than a quarter of the way: the search cone widens as 1 / that distance, and
-    // a sparse search of a wide cone misses the narrow cone a far blocker casts.
-    let nearest = min(max(radius, 0.25 * dr), 0.5 * dr);
-    let search = min(radius * (dr - nearest) / (dr * nearest), 1.0);
+    let search = pcss_search(radius, dr);
     var sum = 0.0;
     var found = 0.0;
     for (var i = 0u; i < frame.blocker_samples; i++) {
-        let o = vogel(i, frame.blocker_samples, turn, true) * search;
-        let w = normalize(w0 + t1 * o.x + t2 * o.y);
-        if dot(w, axis) < 0.0 {
+        let s = pcss_sample(cone, i, frame.blocker_samples, true, search);
+        if dot(s.w, axis) < 0.0 {
             continue;
         }
-        let z = stored_distance(k, w);
-        let zr = plane_distance(c.xyz, w, q, n, dr);
-        if z < zr * (1.0 - bias) && in_cone(o, z, radius, dr) {
+        let z = stored_distance(k, s.w);
+        let zr = plane_distance(c.xyz, s.w, q, n, dr);
+        if z < zr * (1.0 - bias) && in_cone(s.o, z, radius, dr) {
             sum += z;
             found += 1.0;
         }
@@ -98,18 +89,16 @@ fn pcss(k: u32, p: vec3<f32>, n: vec3<f32>, px: vec2<u32>) -> f32 {
     if found == 0.0 {
         return 1.0;
     }
-    let zb = max(sum / found, 1e-4);
-    let width = min(radius * max(dr - zb, 0.0) / (dr * zb), 1.0);
+    let width = pcss_penumbra(radius, dr, max(sum / found, 1e-4));
     var lit = 0.0;
     var taken = 0.0;
     for (var i = 0u; i < frame.filter_samples; i++) {
-        let o = vogel(i, frame.filter_samples, turn, false) * width;
-        let w = normalize(w0 + t1 * o.x + t2 * o.y);
-        if dot(w, axis) < 0.0 {
+        let s = pcss_sample(cone, i, frame.filter_samples, false, width);
+        if dot(s.w, axis) < 0.0 {
             continue;
         }
-        let zr = plane_distance(c.xyz, w, q, n, dr);
-        lit += select(0.0, 1.0, stored_distance(k, w) >= zr * (1.0 - bias));
+        let zr = plane_distance(c.xyz, s.w, q, n, dr);
+        lit += select(0.0, 1.0, stored_distance(k, s.w) >= zr * (1.0 - bias));
         taken += 1.0;
     }
     return select(1.0, lit / taken, taken > 0.0);

@@ -34,3 +34,54 @@ fn pixel_noise(px: vec2<u32>) -> f32 {
 fn in_cone(o: vec2<f32>, z: f32, radius: f32, dr: f32) -> bool {
     return z < dr && length(o) * dr * z <= radius * (dr - z);
 }
+
+// A receiver's view of a disk light: the unit direction w0 from the disk's centre to the
+// (offset) receiver at distance dr, a tangent frame (t1, t2) about it, and the pixel's turn of
+// the sample disks.
+struct PcssCone {
+    w0: vec3<f32>,
+    dr: f32,
+    t1: vec3<f32>,
+    turn: f32,
+    t2: vec3<f32>,
+};
+
+// The cone of a receiver at offset `dq` from the disk's centre, for pixel `px`.
+fn pcss_cone(dq: vec3<f32>, px: vec2<u32>) -> PcssCone {
+    var c: PcssCone;
+    c.dr = length(dq);
+    c.w0 = dq / c.dr;
+    c.t1 = normalize(cross(c.w0, select(vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(1.0, 0.0, 0.0), abs(c.w0.y) > 0.9)));
+    c.t2 = cross(c.w0, c.t1);
+    c.turn = 6.2831853 * pixel_noise(px);
+    return c;
+}
+
+// The blocker search's half-width (tangent units) for a disk of `radius`: blockers are looked
+// for no nearer the centre than the radius (nearer is inside the light) nor than a quarter of
+// the way — the search cone widens as 1 / that distance, and a sparse search of a wide cone
+// misses the narrow cone a far blocker casts.
+fn pcss_search(radius: f32, dr: f32) -> f32 {
+    let nearest = min(max(radius, 0.25 * dr), 0.5 * dr);
+    return min(radius * (dr - nearest) / (dr * nearest), 1.0);
+}
+
+// The penumbra's half-width (tangent units) from the blockers' mean distance zb: (z_r − z_b)
+// / z_b times the disk, over the receiver's distance.
+fn pcss_penumbra(radius: f32, dr: f32, zb: f32) -> f32 {
+    return min(radius * max(dr - zb, 0.0) / (dr * zb), 1.0);
+}
+
+// Sample i of n of the cone: its tangent offset `o` (a Vogel disk of half-width `width`; the
+// centre ray first for the blocker search) and unit direction.
+struct PcssSample {
+    o: vec2<f32>,
+    w: vec3<f32>,
+};
+
+fn pcss_sample(c: PcssCone, i: u32, n: u32, search: bool, width: f32) -> PcssSample {
+    var s: PcssSample;
+    s.o = vogel(i, n, c.turn, search) * width;
+    s.w = normalize(c.w0 + c.t1 * s.o.x + c.t2 * s.o.y);
+    return s;
+}
