@@ -83,6 +83,8 @@ impl ViewerApp {
             (false, Some((_, v))) => Ok(v.clone()),
             (false, None) => Ok(Vec::new()),
         };
+        // The renderer's clustering buffers hold this clustering afterwards: the next frame's
+        // warm start begins from it (the same VPLs, clustered cold), not from its own last.
         match vpls.and_then(|v| self.gpu.cluster_vals(&self.ctx, &v, &params)) {
             Ok(c) => self.val_disks = Some((key, layers::val_disks(&c.vals))),
             Err(e) => self.error = Some(format!("VAL layer: {e}")),
