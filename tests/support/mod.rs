@@ -1,6 +1,29 @@
-//! What the command-line tests share: scenes written to a scratch folder.
+//! What the command-line tests share: the binary run as a user runs it, and scenes written to
+//! a scratch folder.
+
+#![allow(dead_code)] // each test file uses its own subset
 
 use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// `visgate ARGS` with errors-only logging.
+pub fn visgate(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_visgate"))
+        .args(args)
+        .env("RUST_LOG", "error")
+        .output()
+        .expect("runs visgate")
+}
+
+/// Its standard output.
+pub fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// Its standard error.
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
 
 /// A floor and a box sliding across it, lit by a light on an orbit: a dynamic scene.
 pub fn dynamic_scene(dir: &Path) -> PathBuf {
