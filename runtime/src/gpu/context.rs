@@ -21,21 +21,41 @@ pub struct GpuContext {
 }
 
 impl GpuContext {
-    /// Opens the first adapter wgpu finds (backends from `WGPU_BACKEND`, else all that are
-    /// built in); an error that says what to install when there is none.
+    /// Opens the first adapter wgpu finds: the backends `WGPU_BACKEND` names, else the primary
+    /// ones (Vulkan, Metal, DX12) and only when none of them has an adapter, OpenGL (when it is
+    /// built in). OpenGL is not opened beside Vulkan: Mesa's EGL, initialised next to lavapipe
+    /// in one process, crashed one run in twenty at exit. An error that says what to install
+    /// when there is no adapter at all.
     pub fn new() -> Result<GpuContext, RenderError> {
-        let instance =
-            wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
-            power_preference: wgpu::PowerPreference::HighPerformance,
-            force_fallback_adapter: false,
-            compatible_surface: None,
-            apply_limit_buckets: false,
-        }))
-        .map_err(|e| {
+        let from_env = wgpu::Backends::from_env();
+        let tries = match from_env {
+            Some(b) => vec![b],
+            None => vec![wgpu::Backends::PRIMARY, wgpu::Backends::SECONDARY],
+        };
+        let mut refusal = None;
+        let mut found = None;
+        for backends in tries {
+            let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
+            desc.backends = backends;
+            let instance = wgpu::Instance::new(desc);
+            match pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+                power_preference: wgpu::PowerPreference::HighPerformance,
+                force_fallback_adapter: false,
+                compatible_surface: None,
+                apply_limit_buckets: false,
+            })) {
+                Ok(a) => {
+                    found = Some(a);
+                    break;
+                }
+                Err(e) => refusal = Some(e.to_string()),
+            }
+        }
+        let adapter = found.ok_or_else(|| {
             RenderError::NoAdapter(format!(
-                "{e}. Install a Vulkan driver (on Debian/Ubuntu without a GPU: apt-get install \
-                 mesa-vulkan-drivers for the software driver, lavapipe), or Metal/DX12 on macOS/Windows"
+                "{}. Install a Vulkan driver (on Debian/Ubuntu without a GPU: apt-get install \
+                 mesa-vulkan-drivers for the software driver, lavapipe), or Metal/DX12 on macOS/Windows",
+                refusal.unwrap_or_default()
             ))
         })?;
         let adapter_info = adapter.get_info();
