@@ -116,6 +116,52 @@ fn the_viewers_screenshot_is_visgate_renders_image_of_the_same_view() {
         // The same call with the same VPLs, clamp, shadow maps and pose: equal to rounding.
         assert!(e.rel_mse < 1e-9, "{scene} at {time} s: {e:?}");
     }
+    // The PNG is what the window shows: the frame tone-mapped on the GPU into the texture egui
+    // draws (no readback of the HDR image), equal to `visgate render`'s PNG to one level.
+    let (shown, png) = (dir.path().join("shown.png"), dir.path().join("render.png"));
+    let o = visgate(
+        &[
+            "view",
+            "builtin:cornell-box",
+            "--render-size",
+            "64x48",
+            "--vpls",
+            "64",
+            "--screenshot",
+            shown.to_str().expect("utf-8"),
+        ],
+        Some(&x.1),
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    let o = visgate(
+        &[
+            "render",
+            "builtin:cornell-box",
+            "--mode",
+            "none",
+            "--size",
+            "64x48",
+            "--vpls",
+            "64",
+            "--out",
+            png.to_str().expect("utf-8"),
+        ],
+        None,
+    );
+    assert!(o.status.success(), "{}", text(&o));
+    let load = |p: &Path| image::open(p).expect("png").to_rgb8();
+    let (a, b) = (load(&shown), load(&png));
+    assert_eq!(a.dimensions(), b.dimensions());
+    let diffs: Vec<u8> = (a.pixels().zip(b.pixels()))
+        .map(|(p, q)| (0..3).map(|k| p[k].abs_diff(q[k])).max().unwrap_or(0))
+        .collect();
+    let worst = diffs.iter().copied().max().unwrap_or(0);
+    let differ = diffs.iter().filter(|d| **d > 0).count();
+    assert!(
+        worst <= 1 && differ * 100 <= diffs.len(),
+        "{worst}, {differ} pixels"
+    );
+    assert!(a.pixels().any(|p| p[0] > 20), "a blank window image");
     // Another time poses the box and the light elsewhere: another image.
     let other = dir.path().join("other.exr");
     let o = visgate(

@@ -58,6 +58,11 @@ impl Compare {
         self.done.is_some()
     }
 
+    /// Whether a reference is being rendered or shown (the frames must come back to the CPU).
+    pub fn is_active(&self) -> bool {
+        self.running.is_some() || self.done.is_some()
+    }
+
     /// Starts the reference of `view` with `vpls` on a thread.
     pub fn start(&mut self, scene: &Scene, view: &View, vpls: &[Vpl], g_max: f32) {
         self.cancel();

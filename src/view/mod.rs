@@ -18,7 +18,7 @@ use anyhow::{Context, Result, bail};
 use clap::{Args, Parser};
 use visgate_formats::ImportOptions;
 use visgate_runtime::cpu::gates::GateLevel;
-use visgate_runtime::gpu::{MethodInfo, method};
+use visgate_runtime::gpu::{GpuContext, MethodInfo, method};
 
 use state::SavedView;
 use visgate_runtime::job::RenderJob;
@@ -305,18 +305,43 @@ pub fn run(args: ViewArgs) -> Result<()> {
     if !args.time.is_finite() {
         bail!("--time {}: give a finite time in seconds", args.time);
     }
-    let viewer = app::ViewerApp::new(start)?;
     let options = eframe::NativeOptions {
         viewport: eframe::egui::ViewportBuilder::default()
             .with_inner_size([1280.0, 760.0])
             .with_title("visgate"),
         renderer: eframe::Renderer::Wgpu,
+        wgpu_options: wgpu_options(),
         ..Default::default()
     };
     eframe::run_native(
         "visgate",
         options,
-        Box::new(move |_cc| Ok(Box::new(viewer))),
+        Box::new(move |cc| {
+            let window = (cc.wgpu_render_state.clone())
+                .ok_or("the window has no wgpu device (eframe's wgpu renderer is required)")?;
+            Ok(Box::new(app::ViewerApp::new(start, window)?))
+        }),
     )
     .map_err(|e| anyhow::anyhow!("the window failed: {e}"))
+}
+
+/// The window's wgpu set-up: the backends `WGPU_BACKEND` names, else Vulkan, Metal and DX12;
+/// the device asked for as `visgate render` asks (`GpuContext::device_descriptor`: the
+/// methods' limits, timestamp queries), so that the viewer renders on the window's device and
+/// shows the frame from its texture.
+pub fn wgpu_setup() -> eframe::egui_wgpu::WgpuSetup {
+    use eframe::egui_wgpu::{WgpuSetup, WgpuSetupCreateNew, wgpu};
+    let mut setup = WgpuSetupCreateNew::without_display_handle();
+    setup.instance_descriptor.backends =
+        wgpu::Backends::from_env().unwrap_or(wgpu::Backends::PRIMARY);
+    setup.device_descriptor = std::sync::Arc::new(GpuContext::device_descriptor);
+    WgpuSetup::CreateNew(setup)
+}
+
+/// eframe's wgpu configuration with [`wgpu_setup`].
+fn wgpu_options() -> eframe::egui_wgpu::WgpuConfiguration {
+    eframe::egui_wgpu::WgpuConfiguration {
+        wgpu_setup: wgpu_setup(),
+        ..Default::default()
+    }
 }

@@ -8,7 +8,6 @@ use visgate_runtime::cpu::gates::GateShape;
 use visgate_runtime::gpu::{
     DirectLight, DiskLight, IsmParams, LcDisk, LightClusterGpuParams, MethodSettings, PassTimes,
 };
-use visgate_runtime::hdr::HdrImage;
 
 use super::camera::FlyCamera;
 
@@ -175,8 +174,8 @@ pub fn camera_controls(ui: &mut egui::Ui, camera: &mut FlyCamera, scene: &Scene)
 }
 
 /// The frame's passes as a stacked bar and a table, and the frame times of the last frames.
-pub fn pass_times(ui: &mut egui::Ui, img: &HdrImage, t: &PassTimes, history: &VecDeque<f32>) {
-    ui.label(format!("{} × {}", img.width, img.height));
+pub fn pass_times(ui: &mut egui::Ui, size: [u32; 2], t: &PassTimes, history: &VecDeque<f32>) {
+    ui.label(format!("{} × {}", size[0], size[1]));
     let passes = t.by_name();
     let total: f64 = passes
         .iter()

@@ -59,36 +59,55 @@ impl GpuContext {
             ))
         })?;
         let adapter_info = adapter.get_info();
+        let (device, queue) =
+            pollster::block_on(adapter.request_device(&GpuContext::device_descriptor(&adapter)))
+                .map_err(|e| {
+                    RenderError::NoAdapter(format!("cannot open {}: {e}", adapter_info.name))
+                })?;
+        Ok(GpuContext::from_device(adapter_info, device, queue))
+    }
+
+    /// What visgate asks of a device on `adapter`: the downlevel limits raised to the
+    /// adapter's where a method needs more (texture layers and size, storage bindings and
+    /// buffer size), timestamp queries where there are. A window that opens its own device
+    /// (eframe) asks with this too, so that the viewer renders on the window's device.
+    pub fn device_descriptor(adapter: &wgpu::Adapter) -> wgpu::DeviceDescriptor<'static> {
+        let have = adapter.limits();
         let limits = wgpu::Limits {
-            max_texture_array_layers: adapter.limits().max_texture_array_layers,
+            max_texture_array_layers: have.max_texture_array_layers,
             // LightCluster's shadow atlas (6 faces a cluster in one texture).
-            max_texture_dimension_2d: adapter.limits().max_texture_dimension_2d,
-            max_storage_buffer_binding_size: adapter.limits().max_storage_buffer_binding_size,
+            max_texture_dimension_2d: have.max_texture_dimension_2d,
+            max_storage_buffer_binding_size: have.max_storage_buffer_binding_size,
             // The imperfect shadow maps' atlas (a map per VPL in one buffer).
-            max_buffer_size: adapter.limits().max_buffer_size,
-            max_storage_buffers_per_shader_stage: adapter
-                .limits()
-                .max_storage_buffers_per_shader_stage
-                .min(16),
+            max_buffer_size: have.max_buffer_size,
+            max_storage_buffers_per_shader_stage: have.max_storage_buffers_per_shader_stage.min(16),
             ..wgpu::Limits::downlevel_defaults()
         };
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+        wgpu::DeviceDescriptor {
             label: Some("visgate device"),
             required_features: adapter.features() & wgpu::Features::TIMESTAMP_QUERY,
             required_limits: limits,
             ..Default::default()
-        }))
-        .map_err(|e| RenderError::NoAdapter(format!("cannot open {}: {e}", adapter_info.name)))?;
+        }
+    }
+
+    /// The context of a device already open (a window's), made with
+    /// [`GpuContext::device_descriptor`].
+    pub fn from_device(
+        adapter_info: wgpu::AdapterInfo,
+        device: wgpu::Device,
+        queue: wgpu::Queue,
+    ) -> GpuContext {
         let timestamp_period = device
             .features()
             .contains(wgpu::Features::TIMESTAMP_QUERY)
             .then(|| queue.get_timestamp_period());
-        Ok(GpuContext {
+        GpuContext {
             device,
             queue,
             adapter_info,
             timestamp_period,
-        })
+        }
     }
 
     /// Waits until the GPU is idle.
@@ -413,11 +432,7 @@ pub fn row_bytes(width: u32, texel: u64) -> u64 {
 
 /// Records a copy of 2D texture `tex` into `read` (rows of [`row_bytes`]).
 pub fn copy_texture(enc: &mut wgpu::CommandEncoder, tex: &wgpu::Texture, read: &wgpu::Buffer) {
-    let texel = if tex.format() == wgpu::TextureFormat::Rgba16Float {
-        8
-    } else {
-        16
-    };
+    let texel = texel_bytes(tex.format());
     enc.copy_texture_to_buffer(
         tex.as_image_copy(),
         wgpu::TexelCopyBufferInfo {
@@ -456,6 +471,15 @@ pub fn texels(bytes: &[u8], w: u32, h: u32, half: bool) -> Vec<[f32; 4]> {
         }
     }
     out
+}
+
+/// The bytes of a texel of the 4-channel formats the frames copy back.
+pub fn texel_bytes(format: wgpu::TextureFormat) -> u64 {
+    match format {
+        wgpu::TextureFormat::Rgba16Float => 8,
+        wgpu::TextureFormat::Rgba8Unorm => 4,
+        _ => 16,
+    }
 }
 
 /// Copies a 2D texture of 4 channels back to the CPU, waiting (tests and inspection).

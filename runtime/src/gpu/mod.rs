@@ -21,7 +21,9 @@
 //!    modes: clustering, maps, CSSM basis, gather, blur ([`passes::vals`], [`passes::cssm`],
 //!    [`passes::val_gather`], [`passes::interleave_blur`]); the ISM modes: (val-ism) the
 //!    clustering, ISM points, atlas, pull-push, gather, blur ([`passes::ism`]);
-//! 7. readback.
+//! 7. readback of the HDR image, unless a window asked for the frame on the GPU only: then
+//!    [`GpuRenderer::display`] tone-maps it into a texture a window shows as it is
+//!    ([`passes::display`]).
 //!
 //! The methods and their parameters are in [`methods`] (the registry [`METHODS`]); what a
 //! renderer reads back besides a frame (for tests and inspection) in `inspect.rs`; every
@@ -52,6 +54,7 @@ use geometry::{Geometry, albedo_array};
 use layout::{Globals, Grid};
 use passes::clustered_gates::{ClusteredGates, LevelBuffers, ListBuffers};
 use passes::cssm::Cssm;
+use passes::display::Display;
 use passes::gbuffer::GBuffer;
 use passes::interleave_blur::InterleaveBlur;
 use passes::ism::Isms;
@@ -74,6 +77,7 @@ pub use methods::{
     PerVplParams, ShadowParams, ValIsmParams, ValModeParams, VplIsmParams, method,
 };
 pub use passes::clustered_gates::{MAX_CLUSTERS, MAX_GATES};
+pub use passes::display::{DISPLAY_FORMAT, read_display};
 pub use passes::light_cluster::{MAX_LC_CLUSTERS, MAX_LC_LIGHTS};
 pub use passes::rsm_vpls::RsmParams;
 pub use timing::{LcCounts, LightListStats, PassTime, PassTimes, ValIterations};
@@ -159,6 +163,7 @@ pub struct Pipelines {
     blur: InterleaveBlur,
     light_cluster: LightCluster,
     isms: Isms,
+    display: Display,
 }
 
 impl Pipelines {
@@ -176,6 +181,7 @@ impl Pipelines {
             blur: InterleaveBlur::new(d, s)?,
             light_cluster: LightCluster::new(d, s)?,
             isms: Isms::new(d, s)?,
+            display: Display::new(d, s)?,
         })
     }
 }
@@ -189,6 +195,8 @@ pub struct GpuRenderer {
     val_warm: Option<u32>,
     /// The light-list pool's capacity when it grows on its own (mode gates).
     light_entries: u32,
+    /// The last frame's HDR target (in the pool: the next frame of its size overwrites it).
+    last_hdr: Option<wgpu::Texture>,
 }
 
 /// What [`record_passes`] leaves: the image, and the light lists of mode gates.
@@ -341,6 +349,7 @@ impl GpuRenderer {
             pool: Pool::default(),
             val_warm: None,
             light_entries: passes::clustered_gates::AUTO_LIGHT_ENTRIES,
+            last_hdr: None,
         })
     }
 
@@ -507,10 +516,29 @@ impl GpuRenderer {
         vpls: VplInput,
         params: &GpuParams,
     ) -> Result<(HdrImage, PassTimes), RenderError> {
+        let (img, times) = self.render_kept(ctx, view, vpls, params, true)?;
+        let img = img.ok_or_else(|| RenderError::Gpu("the frame was not read back".into()))?;
+        Ok((img, times))
+    }
+
+    /// [`GpuRenderer::render_frame`] with the frame kept on the GPU for
+    /// [`GpuRenderer::display`]; the HDR image is read back only if `read_hdr` (a window that
+    /// shows the frame from its texture needs no readback).
+    pub fn render_kept(
+        &mut self,
+        ctx: &GpuContext,
+        view: &View,
+        vpls: VplInput,
+        params: &GpuParams,
+        read_hdr: bool,
+    ) -> Result<(Option<HdrImage>, PassTimes), RenderError> {
+        let run = |r: &mut Self, p: &GpuParams| {
+            context::scoped(ctx, || r.frame_unscoped(ctx, view, vpls, p, read_hdr))
+        };
         // Only disks keep lists; a pool of a set size fails when full.
         let g = match params.mode {
             GpuMode::Gates(g) if g.light_entries.is_none() && g.gates.shape == GateShape::Disk => g,
-            _ => return context::scoped(ctx, || self.frame_unscoped(ctx, view, vpls, params)),
+            _ => return run(self, params),
         };
         // A pool that grows: the frame again with the capacity it needed (a quarter more,
         // for the next frames' changes), up to the adapter's limit.
@@ -521,7 +549,7 @@ impl GpuRenderer {
                 light_entries: Some(self.light_entries),
                 ..g
             });
-            match context::scoped(ctx, || self.frame_unscoped(ctx, view, vpls, &p)) {
+            match run(self, &p) {
                 Err(RenderError::LightListsFull { needed, .. }) if needed <= max => {
                     self.light_entries = (needed + needed / 4).min(max) as u32;
                 }
@@ -541,14 +569,32 @@ impl GpuRenderer {
         ))
     }
 
-    /// [`GpuRenderer::render_frame`] without the error scope.
+    /// The last frame's linear HDR image, tone-mapped at `exposure_stops` and sRGB-encoded
+    /// into a texture of [`DISPLAY_FORMAT`] (the same bytes as `HdrImage::to_srgb8`), without
+    /// reading anything back; submitted, not waited for. The texture is made again only when
+    /// the frame's size changes. An error before the first frame.
+    pub fn display(
+        &mut self,
+        ctx: &GpuContext,
+        exposure_stops: f32,
+    ) -> Result<wgpu::Texture, RenderError> {
+        let hdr = (self.last_hdr.clone())
+            .ok_or_else(|| RenderError::Param("no frame rendered to display yet".into()))?;
+        let display = &self.pipelines.display;
+        context::scoped(ctx, || {
+            display.run(ctx, &mut self.pool, &hdr, exposure_stops)
+        })
+    }
+
+    /// [`GpuRenderer::render_kept`] without the error scope.
     fn frame_unscoped(
         &mut self,
         ctx: &GpuContext,
         view: &View,
         vpls: VplInput,
         params: &GpuParams,
-    ) -> Result<(HdrImage, PassTimes), RenderError> {
+        read_hdr: bool,
+    ) -> Result<(Option<HdrImage>, PassTimes), RenderError> {
         let t0 = Instant::now();
         params.check()?;
         if params.mode.gates().is_some() && self.scene.level.is_none() {
@@ -570,13 +616,16 @@ impl GpuRenderer {
         let [w, h] = view.size;
         let (frame, pipelines, pool) = self.frame(ctx, view, params, (vpl_buf, count, cpu));
         let out = record_passes(pipelines, &frame, pool, &mut rec, warm)?;
-        let read = pool.buffer(
-            &ctx.device,
-            "hdr readback",
-            row_bytes(w, 16) * h as u64,
-            wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-        );
-        context::copy_texture(&mut rec.enc, &out.hdr, &read);
+        let read = read_hdr.then(|| {
+            let read = pool.buffer(
+                &ctx.device,
+                "hdr readback",
+                row_bytes(w, 16) * h as u64,
+                wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            );
+            context::copy_texture(&mut rec.enc, &out.hdr, &read);
+            read
+        });
         let mut read_back = |label, src: &wgpu::Buffer, bytes| {
             let r = pool.buffer(
                 &ctx.device,
@@ -620,11 +669,18 @@ impl GpuRenderer {
         if let Some(r) = &vpl_lc_read {
             times.vpl_clusters = Some(counts(r, count)?);
         }
-        let px = texels(&map_read(ctx, &read)?, w, h, false);
-        let mut img = HdrImage::new(w, h);
-        for (o, p) in img.pixels.iter_mut().zip(&px) {
-            *o = Vec3::new(p[0], p[1], p[2]);
-        }
+        let img = match &read {
+            Some(read) => {
+                let px = texels(&map_read(ctx, read)?, w, h, false);
+                let mut img = HdrImage::new(w, h);
+                for (o, p) in img.pixels.iter_mut().zip(&px) {
+                    *o = Vec3::new(p[0], p[1], p[2]);
+                }
+                Some(img)
+            }
+            None => None,
+        };
+        self.last_hdr = Some(out.hdr.clone());
         if val_count.is_some() && count > 0 {
             self.val_warm = val_count;
         }

@@ -32,7 +32,7 @@ const INCLUDES: [(&str, &str); 11] = [
 ];
 
 /// The pass shaders (`gpu/passes/`), before composition.
-pub const SOURCES: [(&str, &str); 15] = [
+pub const SOURCES: [(&str, &str); 16] = [
     ("gbuffer.wgsl", include_str!("passes/gbuffer.wgsl")),
     ("shadow.wgsl", include_str!("passes/shadow.wgsl")),
     ("shade.wgsl", include_str!("passes/shade.wgsl")),
@@ -54,6 +54,7 @@ pub const SOURCES: [(&str, &str); 15] = [
     ("lc_shadows.wgsl", include_str!("passes/lc_shadows.wgsl")),
     ("ism_maps.wgsl", include_str!("passes/ism_maps.wgsl")),
     ("ism_gather.wgsl", include_str!("passes/ism_gather.wgsl")),
+    ("display.wgsl", include_str!("passes/display.wgsl")),
 ];
 
 /// What the shading pass adds to the direct light (`Globals::shade_mode`).

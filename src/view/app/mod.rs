@@ -1,11 +1,14 @@
-//! The viewer's window: the runtime's one frame call (`GpuRenderer::render_frame`, as
-//! `visgate render` makes it) drawn in the central panel, the method and its settings in a side
-//! panel applied on the next frame, a fly camera, live pass times.
+//! The viewer's window: the runtime's one frame call (`GpuRenderer::render_kept`, as
+//! `visgate render` makes it) on the window's own device, the frame tone-mapped on the GPU and
+//! drawn from its texture in the central panel (egui's `register_native_texture`; read back
+//! only for the reference, the indirect layer and screenshots), the method and its settings in
+//! a side panel applied on the next frame, a fly camera, live pass times.
 
 use std::collections::VecDeque;
 use std::path::PathBuf;
 
 use eframe::egui;
+use eframe::egui_wgpu::{self, wgpu};
 use glam::Vec3;
 use visgate_formats::Scene;
 use visgate_runtime::camera::View;
@@ -82,6 +85,10 @@ pub struct ViewerApp {
     vpl_count: u32,
     ctx: GpuContext,
     gpu: GpuRenderer,
+    /// The window's device and egui's renderer (the frame's texture is registered there).
+    window: egui_wgpu::RenderState,
+    /// The frame's texture as egui knows it.
+    native: Option<egui::TextureId>,
     tracer: Tracer,
     /// Light-path VPLs and the path count they were made for.
     vpls: Option<(u32, Vec<Vpl>)>,
@@ -92,10 +99,13 @@ pub struct ViewerApp {
     /// Render at this fraction of the panel while the camera moves.
     moving_scale: f32,
     exposure: f32,
+    /// The indirect layer's image, uploaded from the CPU.
     texture: Option<egui::TextureHandle>,
-    /// Frames rendered, exposure and whether the indirect layer showed when it was uploaded.
+    /// Frames rendered, exposure and whether the indirect layer showed when it was drawn.
     texture_key: Option<(u32, f32, bool)>,
-    last: Option<(HdrImage, PassTimes)>,
+    /// The last frame's pass times, and its HDR image where it was read back (see
+    /// [`ViewerApp::needs_hdr`]).
+    last: Option<(Option<HdrImage>, PassTimes)>,
     error: Option<String>,
     /// Recent frame times. [Units: ms]
     history: VecDeque<f32>,
@@ -136,10 +146,15 @@ pub struct ViewerApp {
 }
 
 impl ViewerApp {
-    /// The viewer of `start`, on its own device.
-    pub fn new(start: Start) -> anyhow::Result<ViewerApp> {
-        let ctx = GpuContext::new()?;
-        let software = ctx.adapter_info.device_type == eframe::wgpu::DeviceType::Cpu;
+    /// The viewer of `start`, rendering on `window`'s device (made with
+    /// `GpuContext::device_descriptor`: see `super::wgpu_options`).
+    pub fn new(start: Start, window: egui_wgpu::RenderState) -> anyhow::Result<ViewerApp> {
+        let ctx = GpuContext::from_device(
+            window.adapter.get_info(),
+            window.device.clone(),
+            window.queue.clone(),
+        );
+        let software = ctx.adapter_info.device_type == wgpu::DeviceType::Cpu;
         let vpl_count = start.vpls.unwrap_or(if software { 64 } else { 1024 });
         if software {
             println!(
@@ -178,6 +193,8 @@ impl ViewerApp {
             val_disks: None,
             ctx,
             gpu,
+            window,
+            native: None,
             vpls: None,
             camera,
             settings: MethodSettings::default(),
@@ -248,8 +265,9 @@ impl ViewerApp {
             (false, false, Some((_, v))) => VplInput::Given(v),
             (false, false, None) => VplInput::Given(&[]),
         };
+        let read_hdr = self.needs_hdr();
         let key = format!(
-            "{params:?} {:?} {size:?} {} {} {} {}",
+            "{params:?} {:?} {size:?} {} {} {} {} {read_hdr}",
             self.camera.camera(),
             self.layers.indirect,
             self.time,
@@ -269,16 +287,16 @@ impl ViewerApp {
                 return;
             }
         };
-        match self.gpu.render_frame(&self.ctx, &view, input, &params) {
+        match (self.gpu).render_kept(&self.ctx, &view, input, &params, read_hdr) {
             Ok((img, times)) => {
                 self.last_view = Some(view);
                 self.history.push_back((times.frame_s * 1e3) as f32);
                 if self.history.len() > 120 {
                     self.history.pop_front();
                 }
-                self.indirect = match self.layers.indirect && !direct_only {
-                    true => self.indirect_of(&view, &img),
-                    false => None,
+                self.indirect = match (&img, self.layers.indirect && !direct_only) {
+                    (Some(img), true) => self.indirect_of(&view, img),
+                    _ => None,
                 };
                 self.last = Some((img, times));
                 self.error = None;
@@ -405,7 +423,7 @@ impl ViewerApp {
         );
         ui.checkbox(&mut self.layers.indirect, "indirect light alone");
         ui.separator();
-        let image = self.last.as_ref().map(|(img, _)| img);
+        let image = self.last.as_ref().and_then(|(img, _)| img.as_ref());
         if self.compare.panel(ui, image) {
             self.start_reference();
         }
@@ -435,37 +453,73 @@ impl ViewerApp {
                 format!("kept the last frame: {e}"),
             );
         }
-        if let Some((img, times)) = &self.last {
-            super::panel::pass_times(ui, img, times, &self.history);
+        if let (Some((_, times)), Some(view)) = (&self.last, &self.last_view) {
+            super::panel::pass_times(ui, view.size, times, &self.history);
+        }
+    }
+
+    /// Whether the next frame must come back to the CPU: for the reference's figures and
+    /// split view, the indirect layer (a frame less its direct light) and a screenshot; a frame
+    /// only looked at stays on the GPU.
+    fn needs_hdr(&self) -> bool {
+        self.start.screenshot.is_some()
+            || self.start.compare
+            || self.compare.is_active()
+            || self.layers.indirect
+    }
+
+    /// The texture of what the panel shows (drawn again when the frame, the exposure or the
+    /// image shown changed, not on every repaint: a pointer move repaints too): the frame
+    /// tone-mapped on the GPU, or the indirect layer's image from the CPU.
+    fn shown_texture(&mut self, ui: &egui::Ui) -> Option<egui::TextureId> {
+        let key = (self.frames, self.exposure, self.indirect.is_some());
+        if self.last.is_some() && self.texture_key != Some(key) {
+            self.texture_key = Some(key);
+            match &self.indirect {
+                Some(img) => {
+                    let rgb = img.to_srgb8(self.exposure);
+                    let size = [img.width as usize, img.height as usize];
+                    let colour = egui::ColorImage::from_rgb(size, rgb.as_raw());
+                    match &mut self.texture {
+                        Some(t) => t.set(colour, egui::TextureOptions::LINEAR),
+                        None => {
+                            let o = egui::TextureOptions::LINEAR;
+                            self.texture = Some(ui.ctx().load_texture("indirect", colour, o));
+                        }
+                    }
+                }
+                None => match self.gpu.display(&self.ctx, self.exposure) {
+                    Ok(tex) => self.register(&tex),
+                    Err(e) => self.error = Some(e.to_string()),
+                },
+            }
+        }
+        match &self.indirect {
+            Some(_) => self.texture.as_ref().map(|t| t.id()),
+            None => self.native,
+        }
+    }
+
+    /// Hands the frame's display texture to egui's renderer (a new texture when the size
+    /// changed; the same id throughout).
+    fn register(&mut self, tex: &wgpu::Texture) {
+        let view = tex.create_view(&Default::default());
+        let device = &self.window.device;
+        let filter = wgpu::FilterMode::Linear;
+        let mut r = self.window.renderer.write();
+        match self.native {
+            Some(id) => r.update_egui_texture_from_wgpu_texture(device, &view, filter, id),
+            None => self.native = Some(r.register_native_texture(device, &view, filter)),
         }
     }
 
     /// Shows the last frame, fitted into the panel.
     fn show_image(&mut self, ui: &mut egui::Ui) -> egui::Response {
         let avail = ui.available_size();
-        let shown = self.indirect.as_ref().or(self.last.as_ref().map(|l| &l.0));
-        // Converted and uploaded only when the frame, the exposure or the image shown changed
-        // (not on every repaint: a pointer move repaints too).
-        let key = (self.frames, self.exposure, self.indirect.is_some());
-        if let Some(img) = shown.filter(|_| self.texture_key != Some(key)) {
-            self.texture_key = Some(key);
-            let rgb = img.to_srgb8(self.exposure);
-            let colour =
-                egui::ColorImage::from_rgb([img.width as usize, img.height as usize], rgb.as_raw());
-            match &mut self.texture {
-                Some(t) => t.set(colour, egui::TextureOptions::LINEAR),
-                None => {
-                    self.texture = Some(ui.ctx().load_texture(
-                        "frame",
-                        colour,
-                        egui::TextureOptions::LINEAR,
-                    ))
-                }
-            }
-        }
+        let shown = self.shown_texture(ui);
         let (rect, response) = ui.allocate_exact_size(avail, egui::Sense::click_and_drag());
-        if let (Some(t), Some((img, _))) = (&self.texture, &self.last) {
-            let aspect = img.width as f32 / img.height.max(1) as f32;
+        if let (Some(t), Some(view)) = (shown, self.last_view) {
+            let aspect = view.size[0] as f32 / view.size[1].max(1) as f32;
             let mut size = rect.size();
             if size.x / size.y.max(1.0) > aspect {
                 size.x = size.y * aspect;
@@ -475,8 +529,8 @@ impl ViewerApp {
             let fitted = egui::Rect::from_center_size(rect.center(), size);
             self.image_rect = Some(fitted);
             let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
-            ui.painter().image(t.id(), fitted, uv, egui::Color32::WHITE);
-            if let Some((img, _)) = &self.last {
+            ui.painter().image(t, fitted, uv, egui::Color32::WHITE);
+            if let Some((Some(img), _)) = &self.last {
                 self.compare.draw(ui, fitted, img, self.exposure, &response);
             }
             self.draw_layers(ui, fitted, &response);
@@ -673,6 +727,10 @@ impl ViewerApp {
             }
             let before = self.frames;
             self.render(size);
+            if self.frames > before {
+                // Shown on the next pass (the image was laid out before this frame was made).
+                ui.ctx().request_repaint();
+            }
             self.bench_step(ui.ctx(), before);
             self.compare.poll(self.last_view.as_ref());
             if self.start.compare && !self.compare_started && self.last_view.is_some() {

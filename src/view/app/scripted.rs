@@ -2,6 +2,8 @@
 
 use eframe::egui;
 
+use visgate_runtime::hdr::HdrImage;
+
 use super::ViewerApp;
 
 impl ViewerApp {
@@ -31,24 +33,45 @@ impl ViewerApp {
         ctx.request_repaint();
     }
 
+    /// Writes the frame to `path`: EXR the linear image, PNG what the window shows (the
+    /// display texture read back; the indirect layer's image when that layer is on).
+    fn write_screenshot(&mut self, path: &std::path::Path, img: &HdrImage) -> Result<(), String> {
+        let png = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("png"));
+        if !png || self.indirect.is_some() {
+            let img = self.indirect.as_ref().filter(|_| png).unwrap_or(img);
+            return img.write(path, self.exposure).map_err(|e| e.to_string());
+        }
+        let e = |e: visgate_runtime::RenderError| e.to_string();
+        let tex = self.gpu.display(&self.ctx, self.exposure).map_err(e)?;
+        let shown = visgate_runtime::gpu::read_display(&self.ctx, &tex).map_err(e)?;
+        shown
+            .save(path)
+            .map_err(|err| format!("{}: {err}", path.display()))
+    }
+
     /// Writes the screenshot and closes the window once its frames are rendered.
     pub(super) fn screenshot_done(&mut self, ctx: &egui::Context) {
-        let Some((path, frames)) = &self.start.screenshot else {
+        let Some((path, frames)) = self.start.screenshot.clone() else {
             return;
         };
-        if self.frames < *frames || (self.start.compare && !self.compare.is_done()) {
+        if self.frames < frames || (self.start.compare && !self.compare.is_done()) {
             return;
         }
         let outcome = match &self.last {
-            Some((img, _)) => img.write(path, self.exposure).map_err(|e| e.to_string()),
-            None => Err(self
+            Some((Some(img), _)) => {
+                let img = img.clone();
+                self.write_screenshot(&path, &img)
+            }
+            _ => Err(self
                 .error
                 .clone()
                 .unwrap_or_else(|| "no frame rendered".into())),
         };
         match outcome {
             Ok(()) => {
-                if let Some((img, times)) = &self.last {
+                if let Some((Some(img), times)) = &self.last {
                     println!("last frame, {} x {}:", img.width, img.height);
                     print!("{}", visgate_runtime::job::pass_table(times));
                 }

@@ -50,19 +50,40 @@ fn viewer(layers: Layers, compare: bool) -> ViewerApp {
         shader_dir: None,
         scene,
     };
-    ViewerApp::new(start).expect("viewer")
+    ViewerApp::new(start, window()).expect("viewer")
+}
+
+/// A fresh window device as the viewer's window asks for it (`view::wgpu_setup`), preferring
+/// a software adapter as kittest does (the goldens come from lavapipe).
+fn window() -> eframe::egui_wgpu::RenderState {
+    let setup = match egui_kittest::wgpu::default_wgpu_setup() {
+        eframe::egui_wgpu::WgpuSetup::CreateNew(mut kittest) => {
+            let eframe::egui_wgpu::WgpuSetup::CreateNew(ours) = crate::view::wgpu_setup() else {
+                unreachable!("wgpu_setup creates a device");
+            };
+            kittest.instance_descriptor.backends = ours.instance_descriptor.backends;
+            kittest.device_descriptor = ours.device_descriptor;
+            eframe::egui_wgpu::WgpuSetup::CreateNew(kittest)
+        }
+        existing => existing,
+    };
+    let options = eframe::egui_wgpu::RendererOptions::PREDICTABLE;
+    egui_kittest::wgpu::create_render_state(setup, options)
+}
+
+/// The harness that draws `app`'s window with the app's own device.
+fn harness(app: ViewerApp) -> Harness<'static, ViewerApp> {
+    let renderer = egui_kittest::wgpu::WgpuTestRenderer::from_render_state(app.window.clone());
+    Harness::builder()
+        .with_size([900.0, 560.0])
+        .renderer(renderer)
+        .build_ui_state(|ui, app: &mut ViewerApp| app.draw(ui), app)
 }
 
 /// Renders the window until the frame (and the reference, if asked) is drawn, then checks it
 /// against golden `name`.
 fn snapshot(name: &str, layers: Layers, compare: bool) {
-    let mut harness = Harness::builder()
-        .with_size([900.0, 560.0])
-        .wgpu()
-        .build_ui_state(
-            |ui, app: &mut ViewerApp| app.draw(ui),
-            viewer(layers, compare),
-        );
+    let mut harness = harness(viewer(layers, compare));
     for _ in 0..600 {
         harness.step();
         let app = harness.state();
@@ -79,10 +100,7 @@ fn snapshot(name: &str, layers: Layers, compare: bool) {
 
 /// The window of `app` stepped until its first frame is drawn.
 fn first_frame(app: ViewerApp) -> Harness<'static, ViewerApp> {
-    let mut harness = Harness::builder()
-        .with_size([900.0, 560.0])
-        .wgpu()
-        .build_ui_state(|ui, app: &mut ViewerApp| app.draw(ui), app);
+    let mut harness = harness(app);
     for _ in 0..600 {
         harness.step();
         if harness.state().frames > 0 {

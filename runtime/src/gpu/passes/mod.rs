@@ -3,6 +3,7 @@
 
 pub mod clustered_gates;
 pub mod cssm;
+pub mod display;
 pub mod gbuffer;
 pub mod interleave_blur;
 pub mod ism;
