@@ -37,7 +37,16 @@ Examples:
   visgate compare builtin:ajar-door --vpls 256,1024 --size 320x240 --out cmp
   visgate compare scenes/shared/crytek-sponza.toml --bake-resolution 128 --modes none,gates,val-hard --out sponza
   visgate compare builtin:four-rooms --budget-ms 50 --max-error 0.05 --metric flip --out fr
-  visgate compare builtin:cornell-box --modes val-cssm,val-hard --val-counts 2,8,30,64 --vpls 1024 --out m";
+  visgate compare builtin:cornell-box --modes val-cssm,val-hard --val-counts 2,8,30,64 --vpls 1024 --out m
+  visgate compare builtin:four-rooms --modes direct-only,none,gates --gate-shape disk --gate-hops 1 \
+      --variant \"gates-2hops=gates --gate-hops 2\" --variant \"portals=gates --gate-shape portal\" --out g
+  visgate compare scenes/shared/cornell-box-moving-light.toml --modes val-cssm --stability-frames 60 \
+      --variant \"val-cssm-warm=val-cssm --val-warm-start\" --vpls 1024 --out coherence
+
+Variants (--variant LABEL=MODE FLAGS…): a mode again with other settings, as a row (and a
+curve) of its own — the run's flags with the variant's after them. The stability table of an
+animated scene counts the live VALs of the VAL modes over the frames (restart against warm
+start).";
 
 /// `--metric`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -83,6 +92,12 @@ pub struct CompareArgs {
     /// indirect-only error takes each image's direct light out.
     #[arg(long, value_delimiter = ',')]
     pub lc_min_distances: Vec<f32>,
+    /// A mode with other settings, as a row of its own: `LABEL=MODE FLAGS…` (quoted), the
+    /// run's own settings with FLAGS on top — `--variant "gates-2hops=gates --gate-shape disk
+    /// --gate-hops 2"`, `--variant "val-cssm-warm=val-cssm --val-warm-start"`. Repeat it for
+    /// several; a flag the run gave too is replaced by the variant's.
+    #[arg(long = "variant", value_name = "LABEL=MODE FLAGS")]
+    pub variants: Vec<String>,
     /// Cameras by name, comma-separated, or all.
     #[arg(long, value_delimiter = ',', default_value = "all")]
     pub cameras: Vec<String>,
@@ -144,6 +159,33 @@ fn modes(names: &[String], settings: &MethodArgs, val_counts: &[u32]) -> Result<
         }
     }
     Ok(out)
+}
+
+/// The rows of `--variant LABEL=MODE FLAGS…`: `command_line` (this run's) parsed again with
+/// FLAGS after it, later flags replacing earlier ones, and MODE made with those settings.
+fn variant_modes(variants: &[String], command_line: &[String]) -> Result<Vec<CompareMode>> {
+    let shape = "write LABEL=MODE [FLAGS…], e.g. --variant \"gates-2hops=gates --gate-hops 2\"";
+    variants
+        .iter()
+        .map(|v| {
+            let (label, spec) = v
+                .split_once('=')
+                .filter(|(l, _)| !l.trim().is_empty())
+                .ok_or_else(|| anyhow::anyhow!("--variant {v:?}: {shape}"))?;
+            let mut words = spec.split_whitespace().map(String::from);
+            let name = words
+                .next()
+                .ok_or_else(|| anyhow::anyhow!("--variant {v:?}: no mode; {shape}"))?;
+            let argv = command_line.iter().cloned().chain(words);
+            let args = crate::compare_args_from(argv)
+                .map_err(|e| anyhow::anyhow!("--variant {label}: {e}"))?;
+            let mut m = named_modes(&[name], &args.method)
+                .map_err(|e| anyhow::anyhow!("--variant {label}: {e}"))?
+                .remove(0);
+            m.label = label.trim().to_string();
+            Ok(m)
+        })
+        .collect()
 }
 
 /// Each of `modes` with its lights' own shadow maps, then with LightCluster at each of
@@ -278,6 +320,16 @@ pub fn run_compare(args: CompareArgs) -> Result<()> {
     }
     let mut modes = modes(&args.modes, &args.method, &args.val_counts)?;
     modes = lightcluster_modes(modes, &args.method, &args.lc_min_distances)?;
+    let command_line: Vec<String> = std::env::args().collect();
+    modes.extend(variant_modes(&args.variants, &command_line)?);
+    if let Some(twice) =
+        (modes.iter().enumerate()).find(|(i, m)| modes[..*i].iter().any(|o| o.label == m.label))
+    {
+        bail!(
+            "two rows are labelled {}: give each --variant a label of its own",
+            twice.1.label
+        );
+    }
     let level = level(&args, &scene, &mut modes)?;
     let ground_truth = args
         .ground_truth

@@ -99,6 +99,21 @@ enum ScenesAction {
     },
 }
 
+/// `visgate compare`'s arguments from `argv` (a whole command line), a flag given again
+/// replacing the earlier one: `compare --variant` reads its run's settings this way, with the
+/// variant's flags after them.
+fn compare_args_from(argv: impl IntoIterator<Item = String>) -> Result<compare::CompareArgs> {
+    use clap::{CommandFactory, FromArgMatches};
+    let matches = Cli::command()
+        .args_override_self(true)
+        .try_get_matches_from(argv)
+        .map_err(|e| anyhow::anyhow!("{}", e.render().to_string().trim()))?;
+    match Cli::from_arg_matches(&matches)?.command {
+        Command::Compare(args) => Ok(args),
+        _ => anyhow::bail!("not a compare command line"),
+    }
+}
+
 fn main() -> ExitCode {
     tracing_subscriber::fmt()
         .with_env_filter(

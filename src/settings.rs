@@ -203,6 +203,11 @@ pub struct MethodArgs {
     /// Weight of the normal-angle term of the VAL clustering distance (the paper: 0.3).
     #[arg(long, default_value_t = 0.3, allow_hyphen_values = true)]
     pub val_w_alpha: f32,
+    /// val-hard / val-cssm: start each frame's clustering from the last frame's centres
+    /// instead of the paper's restart from evenly spaced VPLs (steadier, but VALs emptied as
+    /// the light moves stay empty; `visgate compare` counts the live ones over a sequence).
+    #[arg(long)]
+    pub val_warm_start: bool,
     /// Paraboloid shadow map size per VAL, texels.
     #[arg(long, default_value_t = 256)]
     pub val_map_size: u32,
@@ -268,8 +273,8 @@ pub struct MethodArgs {
     pub ism_vals: u32,
     /// val-ism: weights w_p, w_n, w_f of the clustering metric μ = w_p·d_p + w_n·d_n + w_f·d_f
     /// (position over the VPLs' diagonal, normal angle over π, relative flux difference).
-    #[arg(long, value_delimiter = ',', num_args = 3, default_values_t = [0.6, 0.3, 0.1])]
-    pub ism_val_weights: Vec<f32>,
+    #[arg(long, value_name = "P,N,F", value_parser = three_weights, default_value = "0.6,0.3,0.1")]
+    pub ism_val_weights: [f32; 3],
     /// val-ism: how a VAL's disk lights a point — `parts`: as 5 parts (its centre and 4 at ¾
     /// of its radius), each by the form factor, within 4 % of the disk's integral from two
     /// radii at every angle; `centre`: the paper's form factor at its centre, exact on its
@@ -349,7 +354,7 @@ impl MethodArgs {
 
     /// Mode val-ism from the flags.
     fn val_ism(&self) -> ValIsmParams {
-        let w = |k: usize| self.ism_val_weights.get(k).copied().unwrap_or(f32::NAN);
+        let w = |k: usize| self.ism_val_weights[k];
         let base = ValIsmParams::default();
         ValIsmParams {
             vals: ValParams {
@@ -405,6 +410,7 @@ impl MethodArgs {
                     iterations: self.val_iterations,
                     w_x: self.val_w_x,
                     w_alpha: self.val_w_alpha,
+                    warm_start: self.val_warm_start,
                     ..ValParams::default()
                 },
                 map_size: self.val_map_size,
@@ -423,4 +429,19 @@ impl MethodArgs {
             },
         }
     }
+}
+
+/// `--ism-val-weights P,N,F`: three numbers, comma-separated.
+fn three_weights(text: &str) -> Result<[f32; 3], String> {
+    let values: Vec<f32> = text
+        .split(',')
+        .map(|v| v.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| format!("{text:?}: {e}; give three numbers P,N,F such as 0.6,0.3,0.1"))?;
+    <[f32; 3]>::try_from(values).map_err(|v| {
+        format!(
+            "{text:?} gives {} weights; give three, P,N,F (position, normal, flux), such as 0.6,0.3,0.1",
+            v.len()
+        )
+    })
 }

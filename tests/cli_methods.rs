@@ -96,7 +96,8 @@ fn render_ism_modes_print_the_papers_passes_and_refuse_bad_settings() {
         ),
     ] {
         let mut a = base.to_vec();
-        a.extend(["--mode", mode]);
+        // The clustering's weights as one comma list (the paper's, written out).
+        a.extend(["--mode", mode, "--ism-val-weights", "0.6,0.3,0.1"]);
         let o = visgate(&a);
         assert!(o.status.success(), "{mode}: {}", stderr(&o));
         for p in passes {
@@ -112,6 +113,8 @@ fn render_ism_modes_print_the_papers_passes_and_refuse_bad_settings() {
         ("--ism-max-splat", "9", "max splat 9 0..=8 texels"),
         ("--ism-coverage", "0", "coverage 0 0.25..=64"),
         ("--ism-val-splat", "0", "VAL splat 0 must be > 0"),
+        ("--ism-val-weights", "1,0", "gives 2 weights; give three"),
+        ("--ism-val-weights", "1,x,0", "give three numbers P,N,F"),
     ] {
         let mut b = base.to_vec();
         b.extend(["--mode", "val-ism", flag, value]);

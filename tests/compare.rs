@@ -193,6 +193,8 @@ fn an_animated_scene_gets_a_stability_table_and_bad_requests_are_refused() {
     args.extend([
         "--modes",
         "none,val-hard",
+        "--variant",
+        "val-hard-warm=val-hard --val-warm-start",
         "--stability-frames",
         "3",
         "--out",
@@ -204,7 +206,23 @@ fn an_animated_scene_gets_a_stability_table_and_bad_requests_are_refused() {
     )
     .expect("parses");
     let st = json["stability"].as_array().expect("stability");
-    assert_eq!(st.len(), 2, "{st:?}");
+    assert_eq!(st.len(), 3, "{st:?}");
+    // The VAL rows count their live VALs over the sequence (of the 30 asked for).
+    for r in st {
+        let live = &r["live_vals"];
+        match r["mode"].as_str() {
+            Some("none") => assert!(live.is_null(), "{r}"),
+            _ => {
+                let (mean, min) = (live["mean"].as_f64(), live["min"].as_u64());
+                assert_eq!(live["count"], 30, "{r}");
+                assert!(
+                    min.is_some_and(|m| m >= 1) && mean.is_some_and(|m| m <= 30.0),
+                    "{r}"
+                );
+                assert!(mean >= min.map(|m| m as f64), "{r}");
+            }
+        }
+    }
     for r in st {
         let (c, rc) = (r["change"].as_f64(), r["reference_change"].as_f64());
         assert!(
@@ -214,7 +232,16 @@ fn an_animated_scene_gets_a_stability_table_and_bad_requests_are_refused() {
         assert_eq!(r["frames"], 3);
     }
     let md = std::fs::read_to_string(Path::new(&out).join("report.md")).expect("md");
-    assert!(md.contains("## Temporal stability"));
+    assert!(md.contains("## Temporal stability") && md.contains("live VALs"));
+    // The warm start is the variant's setting only.
+    let rows = json["rows"].as_array().expect("rows");
+    assert_eq!(rows.len(), 3, "{rows:?}");
+    let settings = |mode: &str| {
+        let r = rows.iter().find(|r| r["mode"] == mode).expect("row");
+        r["settings"].as_str().expect("settings").to_string()
+    };
+    assert!(settings("val-hard-warm").contains("warm start"));
+    assert!(!settings("val-hard").contains("warm start"));
     // Bad requests say what to give.
     for (extra, says) in [
         (vec!["--modes", "nope"], "gates-disk"),
@@ -460,4 +487,78 @@ fn lightcluster_sweeps_beside_each_modes_own_shadow_maps() {
     }
     let own = rows[0]["energy_ratio"].as_f64().expect("energy");
     assert!((own - 1.0).abs() < 0.02, "per light: {own}");
+}
+
+#[test]
+fn variants_are_rows_of_a_mode_with_the_runs_settings_and_their_own_flags() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("variants");
+    let out_s = out.to_str().expect("utf-8");
+    let base = [
+        "compare",
+        "builtin:two-rooms",
+        "--bake-resolution",
+        "32",
+        "--vpls",
+        "64",
+        "--size",
+        "40x30",
+        "--spp",
+        "1",
+        "--gate-shape",
+        "disk",
+        "--gate-hops",
+        "1",
+        "--out",
+        out_s,
+    ];
+    let mut a = base.to_vec();
+    a.extend([
+        "--modes",
+        "gates",
+        "--variant",
+        "gates-2hops=gates --gate-hops 2",
+        "--variant",
+        "gates-wide=gates --gate-hops 2 --gate-oversize 2",
+    ]);
+    visgate(&a);
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).expect("json"))
+            .expect("parses");
+    let rows = report["rows"].as_array().expect("rows");
+    let settings = |mode: &str| {
+        let r = rows.iter().find(|r| r["mode"] == mode);
+        let r = r.unwrap_or_else(|| panic!("no row {mode}: {rows:?}"));
+        r["settings"].as_str().expect("settings").to_string()
+    };
+    // The run's own --gate-hops 1 for the mode, the variants' flags replacing it in theirs,
+    // and the run's --gate-shape disk kept in both.
+    let (one, two, wide) = (
+        settings("gates"),
+        settings("gates-2hops"),
+        settings("gates-wide"),
+    );
+    assert!(one.contains("disks ×1, 1 hop(s)"), "{one}");
+    assert!(two.contains("disks ×1, 2 hop(s)"), "{two}");
+    assert!(wide.contains("disks ×2, 2 hop(s)"), "{wide}");
+    // Badly written variants are refused, saying how to write one.
+    for (variant, says) in [
+        ("gates --gate-hops 2", "LABEL=MODE"),
+        ("x=", "no mode"),
+        ("x=nope", "gates-disk"),
+        ("x=gates --gate-hops banana", "--variant x"),
+        ("gates=gates --gate-hops 2", "two rows are labelled gates"),
+    ] {
+        let mut b = base.to_vec();
+        b.extend(["--modes", "gates", "--variant", variant]);
+        let o = Command::new(env!("CARGO_BIN_EXE_visgate"))
+            .args(&b)
+            .output()
+            .expect("runs");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            !o.status.success() && err.contains(says),
+            "{variant}: {err}"
+        );
+    }
 }

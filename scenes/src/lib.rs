@@ -618,12 +618,11 @@ pub fn load(arg: &str, options: &visgate_formats::ImportOptions) -> Result<Scene
     }
     let path = Path::new(arg);
     if !path.exists() {
-        return Err(SceneError::Io {
+        // Said once: an Io error's source would be printed twice in a chain.
+        return Err(SceneError::Invalid {
             file: path.to_path_buf(),
-            source: std::io::Error::new(
-                std::io::ErrorKind::NotFound,
-                "no such file (a scene is a .toml, .obj, .gltf or .glb file, or builtin:NAME)",
-            ),
+            what: "no such file (a scene is a .toml, .obj, .gltf or .glb file, or builtin:NAME)"
+                .into(),
         });
     }
     Scene::load(path, options)

@@ -27,7 +27,7 @@ use crate::hdr::HdrImage;
 use crate::job::{FrameStats, JobFrame, RenderJob, Renderer};
 use crate::metrics::{errors, flip, indirect_errors, rebase_direct};
 
-pub use stability::StabilityRow;
+pub use stability::{LiveVals, StabilityRow};
 
 /// The error the plot, `--budget-ms` and `--max-error` go by.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -290,6 +290,11 @@ struct Kept {
     /// Mode vpl-clusters: the VPLs' clusters of the first frame.
     #[serde(default)]
     vpl_clusters: Option<u32>,
+    /// The VAL modes: the VALs holding VPLs in each frame, and the VALs asked for.
+    #[serde(default)]
+    live_vals: Vec<u32>,
+    #[serde(default)]
+    val_count: Option<u32>,
 }
 
 /// Where renders go and what was reused.
@@ -412,10 +417,19 @@ fn kept_of(frames: &[JobFrame], key: String, adapter: String) -> Result<Kept, Re
         FrameStats::Gpu(t) => t.vpl_clusters.map(|c| c.clusters),
         FrameStats::Cpu(_) => None,
     };
+    let vals = |f: &JobFrame| match &f.stats {
+        FrameStats::Gpu(t) => t.vals,
+        FrameStats::Cpu(_) => None,
+    };
     Ok(Kept {
         key,
         adapter,
         vpl_clusters,
+        live_vals: frames
+            .iter()
+            .filter_map(|f| vals(f).map(|v| v.live))
+            .collect(),
+        val_count: vals(first).map(|v| v.count),
         vpl_count: first.vpl_count,
         passes,
         total_ms,

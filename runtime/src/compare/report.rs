@@ -162,9 +162,10 @@ fn summary(r: &CompareReport) -> Vec<String> {
 /// What the stability table means.
 const STABILITY: &str = "Mean absolute frame-to-frame change of the indirect light; ratio 1: \
 as steady as the reference; excess: the change that is the method's alone, over the \
-reference's mean indirect light.";
+reference's mean indirect light; live VALs (the VAL modes): VALs holding VPLs, mean / fewest / \
+last frame of the M asked for.";
 
-const STABILITY_HEADER: [&str; 8] = [
+const STABILITY_HEADER: [&str; 9] = [
     "camera",
     "mode",
     "VPLs",
@@ -173,6 +174,7 @@ const STABILITY_HEADER: [&str; 8] = [
     "reference's",
     "ratio",
     "excess",
+    "live VALs",
 ];
 
 /// The cells of a stability row, in [`STABILITY_HEADER`]'s order.
@@ -186,6 +188,9 @@ fn stability_cells(s: &super::StabilityRow) -> Vec<String> {
         sci(s.reference_change),
         format!("{:.2}", s.ratio),
         format!("{:.3}", s.excess),
+        s.live_vals.map_or("–".into(), |v| {
+            format!("{:.1} / {} / {} of {}", v.mean, v.min, v.last, v.count)
+        }),
     ]
 }
 
@@ -230,7 +235,7 @@ fn markdown(r: &CompareReport) -> String {
             md,
             "| {} |\n|{}",
             STABILITY_HEADER.join(" | "),
-            "---|".repeat(8)
+            "---|".repeat(STABILITY_HEADER.len())
         );
         for s in &r.stability {
             let _ = writeln!(md, "| {} |", stability_cells(s).join(" | "));

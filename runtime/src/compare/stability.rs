@@ -31,6 +31,33 @@ pub struct StabilityRow {
     /// Mean absolute difference of the method's change and the reference's, over the
     /// reference's mean indirect light: the change that is the method's alone.
     pub excess: f64,
+    /// The VAL modes: VALs holding VPLs, mean and fewest over the frames, of the VALs asked
+    /// for (a warm-started clustering loses VALs as the light moves).
+    pub live_vals: Option<LiveVals>,
+}
+
+/// Live VALs over a sequence.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct LiveVals {
+    /// Mean over the frames.
+    pub mean: f64,
+    /// Fewest in a frame.
+    pub min: u32,
+    /// In the last frame.
+    pub last: u32,
+    /// VALs asked for (M).
+    pub count: u32,
+}
+
+/// The live-VAL figures of a render's frames, where it is a VAL mode.
+fn live_vals(live: &[u32], count: Option<u32>) -> Option<LiveVals> {
+    let (count, last) = (count?, *live.last()?);
+    Some(LiveVals {
+        mean: live.iter().map(|&v| v as f64).sum::<f64>() / live.len() as f64,
+        min: live.iter().copied().min().unwrap_or(0),
+        last,
+        count,
+    })
 }
 
 /// Whether `spec` asks for sequences of `scene`.
@@ -90,21 +117,18 @@ pub(super) fn measure(store: &mut Store) -> Result<Vec<StabilityRow>, RenderErro
     };
     let mut rows = Vec::new();
     for camera in &spec.cameras {
-        let mut seq = |name: &str, j: RenderJob| {
-            store
-                .render(camera, &format!("sequence-{name}"), &j)
-                .map(|r| r.0)
-        };
-        let cpu_direct = seq("direct-cpu", job(Renderer::CpuTwin(GpuMode::DirectOnly), 0))?;
-        let gpu_direct = seq("direct-gpu", job(Renderer::Gpu(GpuMode::DirectOnly), 0))?;
-        let reference = seq(&format!("reference-{vpls}"), job(Renderer::Reference, vpls))?;
+        let mut seq =
+            |name: &str, j: RenderJob| store.render(camera, &format!("sequence-{name}"), &j);
+        let cpu_direct = seq("direct-cpu", job(Renderer::CpuTwin(GpuMode::DirectOnly), 0))?.0;
+        let gpu_direct = seq("direct-gpu", job(Renderer::Gpu(GpuMode::DirectOnly), 0))?.0;
+        let reference = seq(&format!("reference-{vpls}"), job(Renderer::Reference, vpls))?.0;
         let ref_ind = indirect(&reference, &cpu_direct);
         let ref_delta = deltas(&ref_ind);
         let reference_change = mean_abs(&ref_delta);
         let ref_mean = mean_abs(&ref_ind);
         for m in &spec.modes {
             let name = format!("{}-{vpls}", super::file_name(&m.label));
-            let Ok(images) = seq(&name, job(Renderer::Gpu(m.mode), vpls)) else {
+            let Ok((images, kept, _)) = seq(&name, job(Renderer::Gpu(m.mode), vpls)) else {
                 continue;
             };
             let d = deltas(&indirect(&images, &gpu_direct));
@@ -123,6 +147,7 @@ pub(super) fn measure(store: &mut Store) -> Result<Vec<StabilityRow>, RenderErro
                 reference_change,
                 ratio: change / reference_change.max(f64::MIN_POSITIVE),
                 excess: mean_abs(&diff) / ref_mean.max(f64::MIN_POSITIVE),
+                live_vals: live_vals(&kept.live_vals, kept.val_count),
             });
         }
     }

@@ -205,6 +205,18 @@ impl GpuMode {
             GateShape::Portal => format!("portals, walk ≤ {}", g.max_walk),
             GateShape::Disk => format!("disks ×{}, {} hop(s)", g.oversize, g.max_hops),
         };
+        // The VAL clustering's settings where they are not the paper's (Dong et al.'s).
+        let vals = |v: &crate::cpu::val::ValParams| {
+            let paper = crate::cpu::val::ValParams::default();
+            let mut s = format!("{} VALs", v.count);
+            if (v.w_x, v.w_alpha) != (paper.w_x, paper.w_alpha) {
+                s += &format!(" (w_x {}, w_α {})", v.w_x, v.w_alpha);
+            }
+            if v.warm_start {
+                s += ", warm start";
+            }
+            s
+        };
         match self {
             GpuMode::None | GpuMode::DirectOnly => String::new(),
             GpuMode::PerVplShadowMaps(p) => {
@@ -213,8 +225,8 @@ impl GpuMode {
             GpuMode::Gates(p) => format!("{}, {}", gates(&p.gates), il(&p.interleave)),
             GpuMode::GatesPerPixel(g) => gates(g),
             GpuMode::ValHard(v) => format!(
-                "{} VALs, {}² maps, {}",
-                v.vals.count,
+                "{}, {}² maps, {}",
+                vals(&v.vals),
                 v.map_size,
                 il(&v.interleave)
             ),
@@ -235,8 +247,8 @@ impl GpuMode {
                 il(&p.interleave)
             ),
             GpuMode::ValCssm(v, c) => format!(
-                "{} VALs, {}² maps, {} terms, {}",
-                v.vals.count,
+                "{}, {}² maps, {} terms, {}",
+                vals(&v.vals),
                 v.map_size,
                 c.terms,
                 il(&v.interleave)
