@@ -34,7 +34,13 @@ pub fn method_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
         "val-hard" | "val-cssm" => {
             let v = &mut s.vals;
             ui.add(egui::Slider::new(&mut v.vals.count, 1..=256).text("VALs"));
-            ui.add(egui::Slider::new(&mut v.vals.iterations, 0..=64).text("k-means iterations"));
+            ui.add(egui::Slider::new(&mut v.vals.iterations, 0..=64).text("k-means iterations"))
+                .on_hover_text("the clustering's k-means iterations a frame");
+            ui.checkbox(&mut v.vals.warm_start, "warm start (last frame's centres)")
+                .on_hover_text(
+                    "off: the paper's restart from evenly spaced VPLs every frame; on: steadier, \
+                     but VALs emptied as the light moves stay empty (the live count is below)",
+                );
             ui.add(interleave_block(&mut v.interleave.block));
             ui.add(egui::Slider::new(&mut v.map_size, 32..=512).text("VAL map size"));
         }

@@ -482,13 +482,12 @@ pub fn texel_bytes(format: wgpu::TextureFormat) -> u64 {
     }
 }
 
-/// Copies a 2D texture of 4 channels back to the CPU, waiting (tests and inspection).
-pub fn read_texture(ctx: &GpuContext, tex: &wgpu::Texture) -> Result<Vec<[f32; 4]>, RenderError> {
-    let half = tex.format() == wgpu::TextureFormat::Rgba16Float;
-    let (w, h) = (tex.width(), tex.height());
+/// The bytes of a 2D texture of 4 channels copied back to the CPU (rows of [`row_bytes`]),
+/// waiting (tests, inspection, screenshots).
+pub fn read_texture_bytes(ctx: &GpuContext, tex: &wgpu::Texture) -> Result<Vec<u8>, RenderError> {
     let read = ctx.device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("texture readback"),
-        size: row_bytes(w, if half { 8 } else { 16 }) * h as u64,
+        size: row_bytes(tex.width(), texel_bytes(tex.format())) * tex.height() as u64,
         usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
         mapped_at_creation: false,
     });
@@ -499,5 +498,12 @@ pub fn read_texture(ctx: &GpuContext, tex: &wgpu::Texture) -> Result<Vec<[f32; 4
         });
     copy_texture(&mut enc, tex, &read);
     ctx.queue.submit([enc.finish()]);
-    Ok(texels(&map_read(ctx, &read)?, w, h, half))
+    map_read(ctx, &read)
+}
+
+/// Copies a 2D texture of 4 channels (Rgba32Float or Rgba16Float) back to the CPU, waiting.
+pub fn read_texture(ctx: &GpuContext, tex: &wgpu::Texture) -> Result<Vec<[f32; 4]>, RenderError> {
+    let half = tex.format() == wgpu::TextureFormat::Rgba16Float;
+    let bytes = read_texture_bytes(ctx, tex)?;
+    Ok(texels(&bytes, tex.width(), tex.height(), half))
 }

@@ -5,7 +5,7 @@
 
 use crate::RenderError;
 use crate::gpu::GpuContext;
-use crate::gpu::context::{Pool, bind_group, compute_pipelines, copy_texture, map_read, row_bytes};
+use crate::gpu::context::{Pool, bind_group, compute_pipelines, read_texture_bytes, row_bytes};
 use crate::gpu::shaders::{self, ShaderSources};
 
 /// The display texture's format (egui's native textures: sRGB-encoded values in Rgba8Unorm).
@@ -91,24 +91,14 @@ impl Display {
 /// The display texture's pixels read back (waiting for the GPU), as 8-bit sRGB: what a window
 /// shows, for screenshots and tests.
 pub fn read_display(ctx: &GpuContext, tex: &wgpu::Texture) -> Result<image::RgbImage, RenderError> {
-    let (w, h) = (tex.width(), tex.height());
-    let read = ctx.device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("display readback"),
-        size: row_bytes(w, 4) * h as u64,
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-        mapped_at_creation: false,
-    });
-    let mut enc = ctx
-        .device
-        .create_command_encoder(&wgpu::CommandEncoderDescriptor {
-            label: Some("display readback"),
-        });
-    copy_texture(&mut enc, tex, &read);
-    ctx.queue.submit([enc.finish()]);
-    let bytes = map_read(ctx, &read)?;
-    let row = row_bytes(w, 4) as usize;
-    Ok(image::RgbImage::from_fn(w, h, |x, y| {
-        let p = &bytes[y as usize * row + x as usize * 4..][..3];
-        image::Rgb([p[0], p[1], p[2]])
-    }))
+    let bytes = read_texture_bytes(ctx, tex)?;
+    let row = row_bytes(tex.width(), 4) as usize;
+    Ok(image::RgbImage::from_fn(
+        tex.width(),
+        tex.height(),
+        |x, y| {
+            let p = &bytes[y as usize * row + x as usize * 4..][..3];
+            image::Rgb([p[0], p[1], p[2]])
+        },
+    ))
 }
