@@ -40,7 +40,7 @@ Examples:
   visgate compare builtin:cornell-box --modes val-cssm,val-hard --val-counts 2,8,30,64 --vpls 1024 --out m
   visgate compare builtin:four-rooms --modes direct-only,none,gates --gate-shape disk --gate-hops 1 \
       --variant \"gates-2hops=gates --gate-hops 2\" --variant \"portals=gates --gate-shape portal\" --out g
-  visgate compare scenes/shared/cornell-box-moving-light.toml --modes val-cssm --stability-frames 60 \
+  visgate compare scenes/shared/cornell-box-turning-spot.toml --modes val-cssm --stability-frames 60 \
       --variant \"val-cssm-warm=val-cssm --val-warm-start\" --vpls 1024 --out coherence
 
 Variants (--variant LABEL=MODE FLAGS…): a mode again with other settings, as a row (and a
@@ -358,8 +358,8 @@ pub fn run_compare(args: CompareArgs) -> Result<()> {
         ground_truth,
         stability_frames: args.stability_frames,
         exposure: args.exposure,
-        command: std::iter::once("visgate".to_string())
-            .chain(std::env::args().skip(1))
+        command: std::iter::once("visgate")
+            .chain(command_line.iter().skip(1).map(String::as_str))
             .collect::<Vec<_>>()
             .join(" "),
     };

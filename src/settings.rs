@@ -354,15 +354,15 @@ impl MethodArgs {
 
     /// Mode val-ism from the flags.
     fn val_ism(&self) -> ValIsmParams {
-        let w = |k: usize| self.ism_val_weights[k];
+        let [w_x, w_alpha, w_f] = self.ism_val_weights;
         let base = ValIsmParams::default();
         ValIsmParams {
             vals: ValParams {
                 count: self.ism_vals,
                 iterations: self.val_iterations,
-                w_x: w(0),
-                w_alpha: w(1),
-                w_f: w(2),
+                w_x,
+                w_alpha,
+                w_f,
                 splat: Some(self.ism_val_splat),
                 ..base.vals
             },

@@ -329,19 +329,17 @@ pub fn run(args: ViewArgs) -> Result<()> {
 /// the device asked for as `visgate render` asks (`GpuContext::device_descriptor`: the
 /// methods' limits, timestamp queries), so that the viewer renders on the window's device and
 /// shows the frame from its texture.
-pub fn wgpu_setup() -> eframe::egui_wgpu::WgpuSetup {
-    use eframe::egui_wgpu::{WgpuSetup, WgpuSetupCreateNew, wgpu};
-    let mut setup = WgpuSetupCreateNew::without_display_handle();
-    setup.instance_descriptor.backends =
-        wgpu::Backends::from_env().unwrap_or(wgpu::Backends::PRIMARY);
+pub fn wgpu_setup() -> eframe::egui_wgpu::WgpuSetupCreateNew {
+    let mut setup = eframe::egui_wgpu::WgpuSetupCreateNew::without_display_handle();
+    setup.instance_descriptor.backends = GpuContext::primary_backends();
     setup.device_descriptor = std::sync::Arc::new(GpuContext::device_descriptor);
-    WgpuSetup::CreateNew(setup)
+    setup
 }
 
 /// eframe's wgpu configuration with [`wgpu_setup`].
 fn wgpu_options() -> eframe::egui_wgpu::WgpuConfiguration {
     eframe::egui_wgpu::WgpuConfiguration {
-        wgpu_setup: wgpu_setup(),
+        wgpu_setup: eframe::egui_wgpu::WgpuSetup::CreateNew(wgpu_setup()),
         ..Default::default()
     }
 }

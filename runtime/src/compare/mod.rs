@@ -567,20 +567,10 @@ fn camera_rows(
         ..spec.base.clone()
     };
     let one = |v: Vec<HdrImage>| v.into_iter().next().unwrap_or_else(|| HdrImage::new(1, 1));
-    let direct_cpu = one(store
-        .render(
-            camera,
-            "direct-cpu",
-            &job(Renderer::CpuTwin(GpuMode::DirectOnly), 0),
-        )?
-        .0);
-    let direct_gpu = one(store
-        .render(
-            camera,
-            "direct-gpu",
-            &job(Renderer::Gpu(GpuMode::DirectOnly), 0),
-        )?
-        .0);
+    let mut direct =
+        |name: &str, renderer| (store.render(camera, name, &job(renderer, 0))).map(|r| one(r.0));
+    let direct_cpu = direct("direct-cpu", Renderer::CpuTwin(GpuMode::DirectOnly))?;
+    let direct_gpu = direct("direct-gpu", Renderer::Gpu(GpuMode::DirectOnly))?;
     // A method with other direct shadows than the run's: its own direct light, to take out of
     // its image (once a camera, whatever the VPL count).
     let mut own_direct = Vec::new();

@@ -21,19 +21,22 @@ pub struct GpuContext {
 }
 
 impl GpuContext {
-    /// Opens the first adapter wgpu finds: the backends `WGPU_BACKEND` names, else the primary
-    /// ones (Vulkan, Metal, DX12) and only when none of them has an adapter, OpenGL (when it is
-    /// built in). OpenGL is not opened beside Vulkan: Mesa's EGL, initialised next to lavapipe
-    /// in one process, crashed one run in twenty at exit. An error that says what to install
-    /// when there is no adapter at all.
+    /// The backends a window or a renderer opens first: those `WGPU_BACKEND` names, else the
+    /// primary ones (Vulkan, Metal, DX12) — not OpenGL, whose EGL, initialised next to lavapipe
+    /// in one process, crashed one run in twenty at exit.
+    pub fn primary_backends() -> wgpu::Backends {
+        wgpu::Backends::from_env().unwrap_or(wgpu::Backends::PRIMARY)
+    }
+
+    /// Opens the first adapter of [`GpuContext::primary_backends`], and only when they have
+    /// none (and `WGPU_BACKEND` is unset), OpenGL's where it is built in. An error that says
+    /// what to install when there is no adapter at all.
     pub fn new() -> Result<GpuContext, RenderError> {
-        let from_env = wgpu::Backends::from_env();
-        let tries = match from_env {
-            Some(b) => vec![b],
-            None => vec![wgpu::Backends::PRIMARY, wgpu::Backends::SECONDARY],
-        };
-        let mut refusal = None;
-        let mut found = None;
+        let mut tries = vec![GpuContext::primary_backends()];
+        if wgpu::Backends::from_env().is_none() {
+            tries.push(wgpu::Backends::SECONDARY);
+        }
+        let mut refusal = String::new();
         for backends in tries {
             let mut desc = wgpu::InstanceDescriptor::new_without_display_handle_from_env();
             desc.backends = backends;
@@ -44,27 +47,23 @@ impl GpuContext {
                 compatible_surface: None,
                 apply_limit_buckets: false,
             })) {
-                Ok(a) => {
-                    found = Some(a);
-                    break;
-                }
-                Err(e) => refusal = Some(e.to_string()),
+                Ok(adapter) => return GpuContext::open(&adapter),
+                Err(e) => refusal = e.to_string(),
             }
         }
-        let adapter = found.ok_or_else(|| {
-            RenderError::NoAdapter(format!(
-                "{}. Install a Vulkan driver (on Debian/Ubuntu without a GPU: apt-get install \
-                 mesa-vulkan-drivers for the software driver, lavapipe), or Metal/DX12 on macOS/Windows",
-                refusal.unwrap_or_default()
-            ))
-        })?;
-        let adapter_info = adapter.get_info();
+        Err(RenderError::NoAdapter(format!(
+            "{refusal}. Install a Vulkan driver (on Debian/Ubuntu without a GPU: apt-get install \
+             mesa-vulkan-drivers for the software driver, lavapipe), or Metal/DX12 on macOS/Windows"
+        )))
+    }
+
+    /// A device on `adapter`, asked for with [`GpuContext::device_descriptor`].
+    fn open(adapter: &wgpu::Adapter) -> Result<GpuContext, RenderError> {
+        let info = adapter.get_info();
         let (device, queue) =
-            pollster::block_on(adapter.request_device(&GpuContext::device_descriptor(&adapter)))
-                .map_err(|e| {
-                    RenderError::NoAdapter(format!("cannot open {}: {e}", adapter_info.name))
-                })?;
-        Ok(GpuContext::from_device(adapter_info, device, queue))
+            pollster::block_on(adapter.request_device(&GpuContext::device_descriptor(adapter)))
+                .map_err(|e| RenderError::NoAdapter(format!("cannot open {}: {e}", info.name)))?;
+        Ok(GpuContext::from_device(info, device, queue))
     }
 
     /// What visgate asks of a device on `adapter`: the downlevel limits raised to the

@@ -2,8 +2,6 @@
 
 use eframe::egui;
 
-use visgate_runtime::hdr::HdrImage;
-
 use super::ViewerApp;
 
 impl ViewerApp {
@@ -35,20 +33,22 @@ impl ViewerApp {
 
     /// Writes the frame to `path`: EXR the linear image, PNG what the window shows (the
     /// display texture read back; the indirect layer's image when that layer is on).
-    fn write_screenshot(&mut self, path: &std::path::Path, img: &HdrImage) -> Result<(), String> {
+    fn write_screenshot(&mut self, path: &std::path::Path) -> Result<(), String> {
         let png = path
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("png"));
-        if !png || self.indirect.is_some() {
-            let img = self.indirect.as_ref().filter(|_| png).unwrap_or(img);
-            return img.write(path, self.exposure).map_err(|e| e.to_string());
+        if png && self.indirect.is_none() {
+            let e = |e: visgate_runtime::RenderError| e.to_string();
+            let tex = self.gpu.display(&self.ctx, self.exposure).map_err(e)?;
+            let shown = visgate_runtime::gpu::read_display(&self.ctx, &tex).map_err(e)?;
+            return (shown.save(path)).map_err(|err| format!("{}: {err}", path.display()));
         }
-        let e = |e: visgate_runtime::RenderError| e.to_string();
-        let tex = self.gpu.display(&self.ctx, self.exposure).map_err(e)?;
-        let shown = visgate_runtime::gpu::read_display(&self.ctx, &tex).map_err(e)?;
-        shown
-            .save(path)
-            .map_err(|err| format!("{}: {err}", path.display()))
+        let img = match (&self.indirect, &self.last) {
+            (Some(indirect), _) if png => indirect,
+            (_, Some((Some(img), _))) => img,
+            _ => return Err("the frame was not read back".into()),
+        };
+        img.write(path, self.exposure).map_err(|e| e.to_string())
     }
 
     /// Writes the screenshot and closes the window once its frames are rendered.
@@ -60,11 +60,8 @@ impl ViewerApp {
             return;
         }
         let outcome = match &self.last {
-            Some((Some(img), _)) => {
-                let img = img.clone();
-                self.write_screenshot(&path, &img)
-            }
-            _ => Err(self
+            Some(_) => self.write_screenshot(&path),
+            None => Err(self
                 .error
                 .clone()
                 .unwrap_or_else(|| "no frame rendered".into())),

@@ -56,14 +56,13 @@ fn viewer(layers: Layers, compare: bool) -> ViewerApp {
 /// A fresh window device as the viewer's window asks for it (`view::wgpu_setup`), preferring
 /// a software adapter as kittest does (the goldens come from lavapipe).
 fn window() -> eframe::egui_wgpu::RenderState {
+    use eframe::egui_wgpu::WgpuSetup;
     let setup = match egui_kittest::wgpu::default_wgpu_setup() {
-        eframe::egui_wgpu::WgpuSetup::CreateNew(mut kittest) => {
-            let eframe::egui_wgpu::WgpuSetup::CreateNew(ours) = crate::view::wgpu_setup() else {
-                unreachable!("wgpu_setup creates a device");
-            };
+        WgpuSetup::CreateNew(mut kittest) => {
+            let ours = crate::view::wgpu_setup();
             kittest.instance_descriptor.backends = ours.instance_descriptor.backends;
             kittest.device_descriptor = ours.device_descriptor;
-            eframe::egui_wgpu::WgpuSetup::CreateNew(kittest)
+            WgpuSetup::CreateNew(kittest)
         }
         existing => existing,
     };
