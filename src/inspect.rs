@@ -5,7 +5,7 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use serde::Serialize;
 use visgate_formats::scene::FileKind;
-use visgate_formats::vgate::{BakeParams, BakedLevel, GridMeta};
+use visgate_formats::vgate::{BakeParams, BakedLevel, GridMeta, SectionKind};
 use visgate_formats::{ImportOptions, Light, Scene};
 
 /// The summary of a scene, as printed and as JSON.
@@ -57,8 +57,10 @@ struct BakedSummary {
     gates: usize,
     portals: usize,
     portal_mask_cells: u64,
-    voxel_node_bytes_per_voxel: u32,
     voxel_cluster_bytes_per_voxel: u32,
+    /// How the file stores the voxel→cluster grid ("dense" or "runs") and its bytes there.
+    voxel_cluster_stored_as: &'static str,
+    voxel_cluster_stored_bytes: u64,
     read_seconds: f64,
 }
 
@@ -184,7 +186,15 @@ fn inspect_baked(path: &Path, json: bool) -> Result<()> {
         .with_context(|| format!("{}: cannot load the baked level", path.display()))?;
     let read_seconds = start.elapsed().as_secs_f64();
     let t = &level.topology;
-    let bytes_per = |v: &visgate_formats::vgate::VoxelValues| v.elem().size() as u32;
+    let (stored_as, stored_bytes) = BakedLevel::read_header(&bytes)?
+        .sections
+        .iter()
+        .find_map(|s| match s.kind {
+            SectionKind::VoxelCluster => Some(("dense", s.len)),
+            SectionKind::VoxelClusterRuns => Some(("runs", s.len)),
+            SectionKind::Topology => None,
+        })
+        .unwrap_or(("absent", 0));
     let s = BakedSummary {
         kind: "baked level",
         file: path.display().to_string(),
@@ -207,8 +217,9 @@ fn inspect_baked(path: &Path, json: bool) -> Result<()> {
             .iter()
             .map(|p| u64::from(p.size[0]) * u64::from(p.size[1]))
             .sum(),
-        voxel_node_bytes_per_voxel: bytes_per(&level.voxel_node),
-        voxel_cluster_bytes_per_voxel: bytes_per(&level.voxel_cluster),
+        voxel_cluster_bytes_per_voxel: level.voxel_cluster.elem().size() as u32,
+        voxel_cluster_stored_as: stored_as,
+        voxel_cluster_stored_bytes: stored_bytes,
         read_seconds,
     };
     if json {
@@ -246,8 +257,8 @@ fn inspect_baked(path: &Path, json: bool) -> Result<()> {
         s.portals, s.portal_mask_cells
     );
     println!(
-        "grids       voxel→node {} B/voxel, voxel→cluster {} B/voxel",
-        s.voxel_node_bytes_per_voxel, s.voxel_cluster_bytes_per_voxel
+        "grid        voxel→cluster {} B/voxel in memory, stored {} in {} bytes",
+        s.voxel_cluster_bytes_per_voxel, s.voxel_cluster_stored_as, s.voxel_cluster_stored_bytes
     );
     println!("read time   {:.3} s", s.read_seconds);
     Ok(())

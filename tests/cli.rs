@@ -127,7 +127,6 @@ fn inspect_a_baked_file_and_refuse_a_broken_one() {
             gates: vec![],
             portals: vec![],
         },
-        voxel_node: VoxelValues::pack(&[0; 8]),
         voxel_cluster: VoxelValues::pack(&[0; 8]),
     };
     let path = dir.path().join("l.vgate");

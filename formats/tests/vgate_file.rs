@@ -50,13 +50,11 @@ fn two_room_level(nx: u32) -> BakedLevel {
         ],
     };
     let voxels = grid.voxel_count().expect("fits") as usize;
-    let mut voxel_node = vec![NONE; voxels];
     let mut voxel_cluster = vec![NONE; voxels];
     for z in 1..4 {
         for y in 1..5 {
             for x in 1..nx - 1 {
                 let i = grid.index([x, y, z]);
-                voxel_node[i] = x - 1;
                 voxel_cluster[i] = u32::from(x - 1 > mid);
             }
         }
@@ -104,7 +102,6 @@ fn two_room_level(nx: u32) -> BakedLevel {
                 faces: 12,
             }],
         },
-        voxel_node: VoxelValues::pack(&voxel_node),
         voxel_cluster: VoxelValues::pack(&voxel_cluster),
     }
 }
@@ -140,6 +137,57 @@ fn grids_are_stored_in_the_smallest_type_that_holds_them() {
             .map(|i| packed.get(i).expect("in range"))
             .collect();
         assert_eq!(back, values);
+    }
+}
+
+/// The kind and byte length of the voxel→cluster section of an encoded level.
+fn cluster_section(bytes: &[u8]) -> (SectionKind, u64) {
+    let header = BakedLevel::read_header(bytes).expect("header");
+    let s = header.sections[1];
+    (s.kind, s.len)
+}
+
+#[test]
+fn the_cluster_grid_is_stored_as_runs_where_that_is_smaller_and_reads_back_dense() {
+    // Two rooms: a few long runs.
+    let level = two_room_level(40);
+    let bytes = level.to_bytes().expect("encodes");
+    let (kind, len) = cluster_section(&bytes);
+    let voxels = level.voxel_cluster.len() as u64;
+    assert_eq!(kind, SectionKind::VoxelClusterRuns);
+    assert!(len < voxels / 4, "{len} bytes of runs for {voxels} voxels");
+    assert_eq!(BakedLevel::from_bytes(&bytes).expect("decodes"), level);
+    // Every voxel its own value (a checkerboard of two clusters): dense is smaller.
+    let mut noisy = level.clone();
+    let values: Vec<u32> = (0..voxels as u32).map(|i| i % 2).collect();
+    noisy.voxel_cluster = VoxelValues::pack(&values);
+    let bytes = noisy.to_bytes().expect("encodes");
+    assert_eq!(cluster_section(&bytes), (SectionKind::VoxelCluster, voxels));
+    assert_eq!(BakedLevel::from_bytes(&bytes).expect("decodes"), noisy);
+}
+
+#[test]
+fn runs_that_do_not_add_up_to_the_grid_are_refused_even_with_a_right_checksum() {
+    let bytes = two_room_level(40).to_bytes().expect("encodes");
+    let header = BakedLevel::read_header(&bytes).expect("header");
+    let s = header.sections[1];
+    let runs = s.offset as usize;
+    for (what, patch) in [("longer", 1u32), ("empty", 0)] {
+        let mut b = bytes.clone();
+        let first = u32::from_le_bytes(b[runs..runs + 4].try_into().expect("4 bytes"));
+        let n = if patch == 0 { 0 } else { first + patch };
+        b[runs..runs + 4].copy_from_slice(&n.to_le_bytes());
+        // Mend the section's checksum in the header, and the header's own.
+        let mut h = header.clone();
+        h.sections[1].crc32 = crc32fast::hash(&b[runs..runs + s.len as usize]);
+        let hb = postcard::to_allocvec(&h).expect("header bytes");
+        let hlen = u32::from_le_bytes(b[12..16].try_into().expect("4 bytes")) as usize;
+        assert_eq!(hb.len(), hlen, "{what}: the header keeps its length");
+        b[16..16 + hlen].copy_from_slice(&hb);
+        let crc = crc32fast::hash(&b[..16 + hlen]);
+        b[16 + hlen..20 + hlen].copy_from_slice(&crc.to_le_bytes());
+        let e = BakedLevel::from_bytes(&b).expect_err(what).to_string();
+        assert!(e.contains("runs"), "{what}: {e}");
     }
 }
 
@@ -238,8 +286,8 @@ fn indices_out_of_range_and_lengths_that_disagree_are_errors() {
         ("voxel_cluster value", |l| {
             l.voxel_cluster = VoxelValues::pack(&vec![3; 300])
         }),
-        ("voxel_node length", |l| {
-            l.voxel_node = VoxelValues::pack(&[0; 17])
+        ("voxel_cluster length", |l| {
+            l.voxel_cluster = VoxelValues::pack(&[0; 17])
         }),
         ("node voxel", |l| {
             l.topology.skeleton.nodes[0].voxel = [99, 0, 0]
@@ -302,7 +350,6 @@ fn arb_level() -> impl Strategy<Value = BakedLevel> {
                         .collect::<Vec<_>>()
                 }),
                 proptest::collection::vec((node.clone(), 0u8..3, cluster.clone()), 1..12),
-                proptest::collection::vec(prop_oneof![Just(NONE), node.clone()], voxels),
                 proptest::collection::vec(prop_oneof![Just(NONE), cluster.clone()], voxels),
                 proptest::collection::vec(
                     (cluster.clone(), cluster.clone(), 0f32..3.0, -1f32..1.0),
@@ -312,7 +359,7 @@ fn arb_level() -> impl Strategy<Value = BakedLevel> {
             )
         })
         .prop_map(
-            |(nodes, edges, seg, vnode, vcluster, gates, (nx, ny, nz, seed, n_clusters))| {
+            |(nodes, edges, seg, vcluster, gates, (nx, ny, nz, seed, n_clusters))| {
                 let grid = GridMeta {
                     origin_m: [1.5, -2.0, 0.25],
                     voxel_size_m: 0.05,
@@ -395,7 +442,6 @@ fn arb_level() -> impl Strategy<Value = BakedLevel> {
                         gates,
                         portals: vec![],
                     },
-                    voxel_node: VoxelValues::pack(&vnode),
                     voxel_cluster: VoxelValues::pack(&vcluster),
                 }
             },

@@ -6,12 +6,14 @@
 
 use std::time::Instant;
 
+use serde::Serialize;
 use serde_json::{Value, json};
 use visgate_formats::Scene;
 use visgate_formats::scene::Light;
 use visgate_formats::vgate::{BakeInfo, BakeParams, BakedLevel};
 
 use crate::BakeError;
+use crate::counters::VoxelizeCounts;
 use crate::empty::Seed;
 use crate::stages;
 use crate::voxelize::{SolidGrid, grid_for, voxelize};
@@ -97,20 +99,22 @@ impl<'a> BakeContext<'a> {
 
     /// Runs stage `name` timed (`total`: the units of work its [`BakeContext::advance`] counts
     /// towards, 0 for unknown): `f` gives its result and its counts for the report.
-    pub fn stage<T>(
+    pub fn stage<T, C: Serialize>(
         &mut self,
         name: &'static str,
         total: u64,
-        f: impl FnOnce(&mut Self) -> Result<(T, Value), BakeError>,
+        f: impl FnOnce(&mut Self) -> Result<(T, C), BakeError>,
     ) -> Result<T, BakeError> {
         (self.progress)(Progress::Start { stage: name, total });
+        reset_peak_memory();
         let t = Instant::now();
         let (out, counts) = f(self)?;
         (self.progress)(Progress::Finish);
         self.stages.push(StageReport {
             name,
             seconds: t.elapsed().as_secs_f64(),
-            counts,
+            peak_memory_bytes: peak_memory_bytes(),
+            counts: serde_json::to_value(counts).unwrap_or(Value::Null),
         });
         Ok(out)
     }
@@ -126,7 +130,15 @@ impl<'a> BakeContext<'a> {
     }
 }
 
-/// Peak resident set size of this process (Linux `VmHWM`), bytes.
+/// Starts the peak resident set size over from the current one (Linux: `5` written to
+/// `/proc/self/clear_refs`), so that [`peak_memory_bytes`] gives a stage's own peak; does
+/// nothing where the OS does not offer it.
+fn reset_peak_memory() {
+    let _ = std::fs::write("/proc/self/clear_refs", "5");
+}
+
+/// Peak resident set size of this process (Linux `VmHWM`) since it started or since the last
+/// reset, bytes.
 pub fn peak_memory_bytes() -> Option<u64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
     let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
@@ -196,8 +208,11 @@ pub fn bake(
     let (solid, solid_voxels) = cx.stage("voxelize", 0, |_| {
         let solid = voxelize(meta, &input.triangles);
         let n = solid.solid_count();
-        let counts = json!({ "dims": meta.dims, "voxel_size_m": meta.voxel_size_m,
-            "solid_voxels": n });
+        let counts = VoxelizeCounts {
+            dims: meta.dims,
+            voxel_size_m: meta.voxel_size_m,
+            solid_voxels: n,
+        };
         Ok(((solid, n), counts))
     })?;
     let mut params = params.clone();
@@ -214,14 +229,15 @@ pub fn bake(
     let thinned = cx.stage("thin", es.empty_voxels, |cx| {
         Ok(stages::skeletonize(&es, &field, persistence, cx))
     })?;
-    let sk = cx.stage("skeleton graph", 0, |_| {
-        Ok(stages::skeleton(&meta, &es, &thinned, &field))
-    })?;
     let radius_vx = field.whole_radii();
+    let skeleton_radius_vx = field.radii_vx(&thinned.skeleton);
     drop(field);
+    let mut sk = cx.stage("skeleton graph", 0, |_| {
+        Ok(stages::skeleton(&meta, &es, &thinned, &skeleton_radius_vx))
+    })?;
     let sg = cx.stage("segment", 0, |_| Ok(stages::segmentation(&sk, &params)))?;
     let (step, cluster_account) =
-        stages::clusters_and_gates(&meta, &es, &sk, &sg, &params, &mut cx)?;
+        stages::clusters_and_gates(&meta, &es, &radius_vx, &sk, &sg, &params, &mut cx)?;
     let info = BakeInfo {
         params: params.clone(),
         geometry_hash: input.hash,
@@ -233,7 +249,10 @@ pub fn bake(
             &meta, &es, &radius_vx, &sk, &sg, &step, info,
         ))
     })?;
+    // The per-voxel grids are done with as soon as their last stage is: at 512³ each is
+    // 70–140 MB, and the stages after them would otherwise hold them to the end.
     drop(radius_vx);
+    drop(std::mem::take(&mut sk.voxel_node));
     let found = cx.stage("portals", 0, |_| {
         Ok(stages::portals(
             &meta,
@@ -242,6 +261,7 @@ pub fn bake(
             params.portal_cell_voxels,
         ))
     })?;
+    drop(voxel_cluster);
     let uncovered = found.uncovered;
     level.topology.portals = found.portals;
     let [empty_topology, skeleton_topology] = cx.stage("topology check", 0, |_| {
@@ -261,14 +281,16 @@ pub fn bake(
         cycles: sk.cycles,
         components: sk.components,
     };
+    let stages = cx.into_stages();
+    let peak_memory_bytes = stages.iter().filter_map(|s| s.peak_memory_bytes).max();
     let report = BakeReport {
         scene: scene.name.clone(),
         params,
         grid: meta,
         threads: rayon::current_num_threads(),
-        stages: cx.into_stages(),
+        stages,
         total_seconds: total.elapsed().as_secs_f64(),
-        peak_memory_bytes: peak_memory_bytes(),
+        peak_memory_bytes,
         summary,
         empty_topology,
         skeleton_topology,

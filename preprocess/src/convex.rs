@@ -16,7 +16,7 @@ use std::collections::VecDeque;
 
 use visgate_formats::vgate::{GridMeta, SegmentedSkeleton};
 
-use crate::sightline::sees;
+use crate::sightline::Sight;
 
 /// What the split reads: the grid and its empty voxels, the segmented skeleton, the voxel of
 /// each skeleton node and the max-ball radius of each.
@@ -25,6 +25,9 @@ pub struct SplitInput<'a> {
     pub meta: &'a GridMeta,
     /// Kept empty voxels.
     pub empty: &'a [bool],
+    /// Each voxel's clearance in whole voxels (the max-ball radii), if known: sight lines are
+    /// then proved clear a stretch at a time where the space is wide (same answers).
+    pub clearance_vx: Option<&'a [u16]>,
     /// The segmented skeleton.
     pub seg: &'a SegmentedSkeleton,
     /// Each skeleton node's voxel (an index into the grid).
@@ -47,10 +50,15 @@ pub fn split_unseen(
         input.meta.coords(input.node_voxel[node])
     };
     let rad = |s: u32| input.radius[seg.nodes[s as usize].skeleton_node as usize];
+    let sight = Sight {
+        meta: input.meta,
+        empty: input.empty,
+        clearance_vx: input.clearance_vx,
+    };
     // Both ways: a line through voxel corners takes other voxels backwards.
     let see = |a: u32, b: u32| {
         let (va, vb) = (voxel(a), voxel(b));
-        a == b || (sees(input.meta, input.empty, va, vb) && sees(input.meta, input.empty, vb, va))
+        a == b || (sight.sees(va, vb) && sight.sees(vb, va))
     };
     let mut adj = vec![Vec::new(); n];
     for e in &seg.edges {
@@ -175,6 +183,7 @@ mod tests {
         let input = SplitInput {
             meta,
             empty,
+            clearance_vx: None,
             seg,
             node_voxel,
             radius: &radius,
@@ -198,7 +207,12 @@ mod tests {
                 if cluster[a as usize] == cluster[b as usize] {
                     let (va, vb) = (node_voxel[a as usize], node_voxel[b as usize]);
                     assert!(
-                        sees(&meta, &empty, meta.coords(va), meta.coords(vb)),
+                        Sight {
+                            meta: &meta,
+                            empty: &empty,
+                            clearance_vx: None
+                        }
+                        .sees(meta.coords(va), meta.coords(vb)),
                         "{a} {b}"
                     );
                 }

@@ -18,6 +18,9 @@ use crate::clusters::GateDisk;
 
 /// Voxels one gate's flood may visit.
 const MAX_FLOOD: usize = 1 << 20;
+/// How far from the gate's centre the voxels that tell a slot's direction are sought, in
+/// reaches of its cut's disk (three radii and a voxel). [Units: ratio]
+const SLOT_SEARCH_REACHES: f32 = 4.0;
 
 /// The largest eigenvector of a symmetric 3×3 matrix (columns), by power iteration, and its
 /// eigenvalue.
@@ -40,8 +43,15 @@ fn dominant(m: glam::Mat3) -> (Vec3, f32) {
 fn cut_normal(meta: &GridMeta, (empty, radius_vx): Space, g: &GateDisk, narrow: f32) -> Vec3 {
     let vs = meta.voxel_size_m;
     let band = 2.0 * g.radius + vs;
+    // Only the narrow voxels near the gate say which way a slot runs; unbounded, the flood
+    // followed the narrow strip along every wall of the level within the band.
+    let near = SLOT_SEARCH_REACHES * (3.0 * g.radius + vs);
     let pts: Vec<Vec3> = flood(meta, g.centre, |i, p| {
-        empty[i] && f32::from(radius_vx[i]) <= narrow && (p - g.centre).dot(g.normal).abs() <= band
+        let d = p - g.centre;
+        empty[i]
+            && f32::from(radius_vx[i]) <= narrow
+            && d.dot(g.normal).abs() <= band
+            && d.length_squared() <= near * near
     })
     .into_iter()
     .map(|i| centre(meta, i))
@@ -85,20 +95,14 @@ fn flood(meta: &GridMeta, from: Vec3, keep: impl Fn(usize, Vec3) -> bool) -> Vec
         return out;
     }
     let index = |v: [i64; 3]| (v[0] + dims[0] * (v[1] + dims[1] * v[2])) as usize;
-    // One bit a voxel (zeroed pages cost nothing until touched): a set of grid coordinates
-    // hashed 26 times a voxel made the floods the bake's slowest step.
-    let mut seen = vec![0u64; (dims.iter().product::<i64>() as usize).div_ceil(64)];
-    let mut insert = |i: usize| {
-        let (w, bit) = (i / 64, 1u64 << (i % 64));
-        let new = seen[w] & bit == 0;
-        seen[w] |= bit;
-        new
-    };
-    insert(index(start));
+    let mut seen = Visited::new(dims);
+    let mut insert = |v: [i64; 3]| seen.insert(v);
+    insert(start);
     let mut queue = VecDeque::from([start]);
     while let Some(v) = queue.pop_front() {
         let i = index(v);
-        if !keep(i, centre(meta, i)) || out.len() >= MAX_FLOOD {
+        let p = Vec3::from(meta.voxel_to_world(v.map(|c| c as u32)));
+        if !keep(i, p) || out.len() >= MAX_FLOOD {
             continue;
         }
         out.push(i);
@@ -106,7 +110,7 @@ fn flood(meta: &GridMeta, from: Vec3, keep: impl Fn(usize, Vec3) -> bool) -> Vec
             for dy in -1..=1 {
                 for dx in -1..=1 {
                     let w = [v[0] + dx, v[1] + dy, v[2] + dz];
-                    if (0..3).all(|a| w[a] >= 0 && w[a] < dims[a]) && insert(index(w)) {
+                    if (0..3).all(|a| w[a] >= 0 && w[a] < dims[a]) && insert(w) {
                         queue.push_back(w);
                     }
                 }
@@ -114,6 +118,46 @@ fn flood(meta: &GridMeta, from: Vec3, keep: impl Fn(usize, Vec3) -> bool) -> Vec
         }
     }
     out
+}
+
+/// The voxels a flood has seen: one bit a voxel, in 8³ bricks allocated as the flood reaches
+/// them. A flood follows a plane or a slot through a whole level and touches a few voxels of
+/// many bricks; a bit per grid voxel (4.4 MB at 512³, for each of thousands of floods) cost a
+/// page fault every few voxels, and a hash set of coordinates 26 hashes a voxel.
+struct Visited {
+    /// Bricks per axis.
+    bricks: [i64; 3],
+    /// Each brick's slot in `bits`, or `u32::MAX` while untouched.
+    slot: Vec<u32>,
+    /// 512 bits a touched brick.
+    bits: Vec<[u64; 8]>,
+}
+
+impl Visited {
+    fn new(dims: [i64; 3]) -> Visited {
+        let bricks = dims.map(|d| (d + 7) / 8);
+        Visited {
+            bricks,
+            slot: vec![u32::MAX; bricks.iter().product::<i64>() as usize],
+            bits: Vec::new(),
+        }
+    }
+
+    /// Marks voxel `v` (inside the grid) seen; whether it was new.
+    fn insert(&mut self, v: [i64; 3]) -> bool {
+        let b =
+            ((v[0] >> 3) + self.bricks[0] * ((v[1] >> 3) + self.bricks[1] * (v[2] >> 3))) as usize;
+        if self.slot[b] == u32::MAX {
+            self.slot[b] = self.bits.len() as u32;
+            self.bits.push([0; 8]);
+        }
+        let bit = (v[0] & 7) + 8 * ((v[1] & 7) + 8 * (v[2] & 7));
+        let word = &mut self.bits[self.slot[b] as usize][(bit >> 6) as usize];
+        let mask = 1u64 << (bit & 63);
+        let new = *word & mask == 0;
+        *word |= mask;
+        new
+    }
 }
 
 /// The voxels of gate `g`'s cut (linear indices; the caller clears them from the empty

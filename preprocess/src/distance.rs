@@ -17,6 +17,8 @@ use visgate_formats::vgate::MaxBall;
 
 /// "Infinitely far": larger than any squared distance in a grid of up to 2^20 voxels a side.
 const INF: i64 = 1 << 42;
+/// Lines transformed between two write-backs of the y and z passes (bounds the copy).
+const LINES_PER_BATCH: usize = 1 << 13;
 
 /// Squared Euclidean distance (voxel units) to the nearest solid voxel's centre, per voxel.
 pub fn squared_distance(dims: [u32; 3], solid: &[bool]) -> Vec<u64> {
@@ -56,16 +58,19 @@ pub fn transform(dims: [u32; 3], solid: &[bool], rule: MaxBall) -> Vec<u64> {
         ),
         (nz, nx * ny, (0..nx * ny).collect::<Vec<_>>()),
     ] {
-        let results: Vec<Vec<i64>> = lines
-            .par_iter()
-            .map(|&start| {
-                let line: Vec<i64> = (0..len).map(|k| d[start + k * stride]).collect();
-                envelope(&line)
-            })
-            .collect();
-        for (&start, r) in lines.iter().zip(&results) {
-            for (k, v) in r.iter().enumerate() {
-                d[start + k * stride] = *v;
+        // A batch of lines at a time: all of them at once held a second copy of the grid.
+        for batch in lines.chunks(LINES_PER_BATCH) {
+            let results: Vec<Vec<i64>> = batch
+                .par_iter()
+                .map(|&start| {
+                    let line: Vec<i64> = (0..len).map(|k| d[start + k * stride]).collect();
+                    envelope(&line)
+                })
+                .collect();
+            for (&start, r) in batch.iter().zip(&results) {
+                for (k, v) in r.iter().enumerate() {
+                    d[start + k * stride] = *v;
+                }
             }
         }
     }

@@ -9,10 +9,10 @@
 
 use glam::Vec3;
 use rayon::prelude::*;
-use serde_json::{Value, json};
 use visgate_formats::vgate::{Cluster, GridMeta};
 
 use crate::clusters::{GateDisk, skeleton_clusters};
+use crate::counters::FlattenCounts;
 use crate::graph::SkeletonGraph;
 use crate::neighbourhood::{Conn, label_components};
 use crate::segment::Segmented;
@@ -49,8 +49,9 @@ pub struct Flattened {
     pub voxel_cluster: Vec<u32>,
     /// The clusters with their boxes.
     pub clusters: Vec<Cluster>,
-    /// Nodes moved across gates, voxels moved to their piece and by sight, pieces.
-    pub counts: Value,
+    /// Nodes moved across gates, voxels moved to their piece and by sight, pieces (the grid's
+    /// bytes are the caller's to fill in).
+    pub counts: FlattenCounts,
 }
 
 /// The flatten stage (see the module notes).
@@ -78,24 +79,25 @@ pub fn flatten(input: &FlattenInput) -> Flattened {
         let node = input.seg.skeleton.nodes[s].skeleton_node as usize;
         Some((input.node_cluster[s], meta.coords(input.graph.voxels[node])))
     };
-    let voxels_by_sight = crate::sightline::clusters_by_sight(
+    let sight = crate::sightline::Sight {
         meta,
-        input.empty,
-        &mut voxel_cluster,
-        &seed_at,
-        &anchor,
-    );
+        empty: input.empty,
+        clearance_vx: Some(input.radius_vx),
+    };
+    let voxels_by_sight =
+        crate::sightline::clusters_by_sight(&sight, &mut voxel_cluster, &seed_at, &anchor);
     let clusters = cluster_boxes(input, &voxel_cluster);
     Flattened {
         voxel_cluster,
         clusters,
-        counts: json!({
-            "nodes_moved_across_gates": nodes_moved,
-            "voxels_moved_to_their_piece": pieces.voxels_moved,
-            "voxels_moved_by_sight": voxels_by_sight,
-            "pieces": pieces.pieces,
-            "pieces_of_several_clusters": pieces.of_several,
-        }),
+        counts: FlattenCounts {
+            nodes_moved_across_gates: nodes_moved,
+            voxels_moved_to_their_piece: pieces.voxels_moved,
+            voxels_moved_by_sight: voxels_by_sight,
+            pieces: pieces.pieces,
+            pieces_of_several_clusters: pieces.of_several,
+            voxel_cluster_bytes: 0,
+        },
     }
 }
 

@@ -18,6 +18,7 @@
 pub mod bake;
 pub mod clusters;
 pub mod convex;
+pub mod counters;
 pub mod cut;
 pub mod debug;
 pub mod distance;

@@ -253,11 +253,8 @@ pub fn betti(dims: [u32; 3], set: &[bool]) -> Betti {
         })
         .sum();
     let (components, background) = rayon::join(
-        || label_components(dims, set, Conn::C26).1 as u64,
-        || {
-            let complement: Vec<bool> = set.par_iter().map(|&s| !s).collect();
-            label_components(dims, &complement, Conn::C6).1 as u64
-        },
+        || count_components(dims, |i| set[i], Conn::C26) as u64,
+        || count_components(dims, |i| !set[i], Conn::C6) as u64,
     );
     let cavities = background.saturating_sub(1);
     let cycles = (components as i64 + cavities as i64 - chi).max(0) as u64;
@@ -287,19 +284,53 @@ pub enum Conn {
 /// the rows before it that touch it (2 rows for 6-adjacency, 4 for 26-adjacency, where runs
 /// that meet at a corner or edge overlap once widened by one voxel).
 pub fn label_components(dims: [u32; 3], set: &[bool], conn: Conn) -> (Vec<u32>, u32) {
+    let nx = dims[0] as usize;
+    let (runs, run_label, count) = labelled_runs(dims, |i| set[i], conn);
+    let mut label = vec![u32::MAX; set.len()];
+    label.par_chunks_mut(nx).enumerate().for_each(|(r, row)| {
+        let mine = runs.row_start[r]..runs.row_start[r + 1];
+        for (&(a, b), &l) in runs.runs[mine.clone()].iter().zip(&run_label[mine]) {
+            row[a as usize..=b as usize].fill(l);
+        }
+    });
+    (label, count)
+}
+
+/// The number of components of the voxels where `member` holds (as [`label_components`]
+/// counts them), without a label per voxel: the topology check counts four sets of a 512³
+/// grid, and their labels would take 4 bytes a voxel each.
+pub fn count_components(dims: [u32; 3], member: impl Fn(usize) -> bool + Sync, conn: Conn) -> u32 {
+    labelled_runs(dims, member, conn).2
+}
+
+/// The runs along x of a set, row by row.
+struct Runs {
+    /// Each run's first and last x, rows in voxel order.
+    runs: Vec<(u32, u32)>,
+    /// Where each row's runs start in `runs` (one more entry than rows).
+    row_start: Vec<usize>,
+}
+
+/// The runs of the voxels where `member` holds, each run's component label (numbered by the
+/// component's first voxel) and the number of components.
+fn labelled_runs(
+    dims: [u32; 3],
+    member: impl Fn(usize) -> bool + Sync,
+    conn: Conn,
+) -> (Runs, Vec<u32>, u32) {
     let [nx, ny, nz] = dims.map(|d| d as usize);
     let rows = ny * nz;
     // Runs of each row, in voxel order: (first x, last x).
     let per_row: Vec<Vec<(u32, u32)>> = (0..rows)
         .into_par_iter()
         .map(|r| {
-            let row = &set[r * nx..(r + 1) * nx];
+            let row = |x: usize| member(r * nx + x);
             let mut runs = Vec::new();
             let mut x = 0;
             while x < nx {
-                if row[x] {
+                if row(x) {
                     let start = x;
-                    while x < nx && row[x] {
+                    while x < nx && row(x) {
                         x += 1;
                     }
                     runs.push((start as u32, x as u32 - 1));
@@ -377,14 +408,7 @@ pub fn label_components(dims: [u32; 3], set: &[bool], conn: Conn) -> (Vec<u32>, 
             run_label[root]
         };
     }
-    let mut label = vec![u32::MAX; set.len()];
-    label.par_chunks_mut(nx).enumerate().for_each(|(r, row)| {
-        for i in row_start[r]..row_start[r + 1] {
-            let (a, b) = runs[i];
-            row[a as usize..=b as usize].fill(run_label[i]);
-        }
-    });
-    (label, count)
+    (Runs { runs, row_start }, run_label, count)
 }
 
 #[cfg(test)]

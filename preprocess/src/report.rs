@@ -14,6 +14,9 @@ pub struct StageReport {
     pub name: &'static str,
     /// Wall time. [Units: s]
     pub seconds: f64,
+    /// The process's peak resident memory while the stage ran (Linux: the high-water mark is
+    /// reset as the stage starts), where the OS tells. [Units: bytes]
+    pub peak_memory_bytes: Option<u64>,
     /// What it produced.
     pub counts: Value,
 }
@@ -77,6 +80,11 @@ pub struct BakeReport {
     pub gate_placements: Vec<Value>,
 }
 
+/// `bytes` in MiB, for the timing tree.
+fn mib(bytes: u64) -> String {
+    format!("{:.0} MiB", bytes as f64 / (1 << 20) as f64)
+}
+
 impl BakeReport {
     /// The timing tree and summary, as printed at the end of a bake.
     pub fn text(&self) -> String {
@@ -88,7 +96,7 @@ impl BakeReport {
             self.total_seconds,
             self.threads,
             self.peak_memory_bytes
-                .map(|b| format!("{:.0} MiB", b as f64 / (1 << 20) as f64))
+                .map(mib)
                 .unwrap_or_else(|| "unknown".into())
         );
         for (i, st) in self.stages.iter().enumerate() {
@@ -98,10 +106,11 @@ impl BakeReport {
                 "├─"
             };
             s += &format!(
-                "{branch} {:<18} {:>8.3} s {:>5.1} %\n",
+                "{branch} {:<18} {:>8.3} s {:>5.1} %  {:>9}\n",
                 st.name,
                 st.seconds,
-                100.0 * st.seconds / self.total_seconds.max(1e-9)
+                100.0 * st.seconds / self.total_seconds.max(1e-9),
+                st.peak_memory_bytes.map(mib).unwrap_or_default()
             );
         }
         let m = &self.summary;

@@ -5,7 +5,6 @@
 
 use glam::Vec3;
 use rayon::prelude::*;
-use serde_json::{Value, json};
 use visgate_formats::Scene;
 use visgate_formats::vgate::{
     BakeInfo, BakeParams, BakedLevel, Gate, GridMeta, MaxBall, SegNodeKind, Skeleton, SkeletonNode,
@@ -15,6 +14,10 @@ use visgate_formats::vgate::{
 use crate::bake::{BakeContext, scene_seeds};
 use crate::clusters::{ClusterParams, clusters};
 use crate::convex::{SplitInput, split_unseen};
+use crate::counters::{
+    ClusterCounts, DistanceCounts, EmptyCounts, FlattenCounts, GateCounts, LoadCounts,
+    PortalCounts, SegmentCounts, SkeletonCounts, ThinCounts, TopologyCounts,
+};
 use crate::empty::{EmptySpace, EmptySpaceParams, empty_space};
 use crate::gate_step::{GateInput, GateStep, gate_step};
 use crate::graph::{SkeletonGraph, nearest_node, skeleton_graph};
@@ -25,7 +28,7 @@ use crate::thin::{ThinParams, Thinned, extend_ends, thin};
 use crate::{BakeError, distance};
 
 /// A stage's result and its counts for the report.
-pub type Counted<T> = (T, Value);
+pub type Counted<T, C> = (T, C);
 
 /// The static geometry.
 pub struct Loaded {
@@ -38,13 +41,15 @@ pub struct Loaded {
 }
 
 /// Stage 1: the scene's static triangles; a scene without any is refused.
-pub fn load(scene: &Scene) -> Result<Counted<Loaded>, BakeError> {
+pub fn load(scene: &Scene) -> Result<Counted<Loaded, LoadCounts>, BakeError> {
     let triangles: Vec<[Vec3; 3]> = scene.static_triangles().collect();
     let bounds = scene.static_bounds().ok_or(BakeError::NoGeometry)?;
     if triangles.is_empty() {
         return Err(BakeError::NoGeometry);
     }
-    let counts = json!({ "triangles": triangles.len() });
+    let counts = LoadCounts {
+        triangles: triangles.len(),
+    };
     let hash = scene.static_geometry_hash();
     Ok((
         Loaded {
@@ -63,7 +68,7 @@ pub fn empty(
     solid: &[bool],
     triangles: &[[Vec3; 3]],
     params: &BakeParams,
-) -> Result<Counted<EmptySpace>, BakeError> {
+) -> Result<Counted<EmptySpace, EmptyCounts>, BakeError> {
     let es = empty_space(
         meta,
         solid,
@@ -75,13 +80,13 @@ pub fn empty(
             allow_leaks: params.allow_leaks,
         },
     )?;
-    let counts = json!({
-        "empty_voxels": es.empty_voxels,
-        "components": es.components.len(),
-        "kept": es.components.iter().filter(|c| c.kept).count(),
-        "leaks": es.leaks.len(),
-        "hung_objects": es.threads.len(),
-    });
+    let counts = EmptyCounts {
+        empty_voxels: es.empty_voxels,
+        components: es.components.len(),
+        kept: es.components.iter().filter(|c| c.kept).count(),
+        leaks: es.leaks.len(),
+        hung_objects: es.threads.len(),
+    };
     Ok((es, counts))
 }
 
@@ -101,7 +106,13 @@ impl DistanceField {
         distance::radius_vx(self.dist2[i], self.max_ball)
     }
 
-    /// Each voxel's largest ball in whole voxels (2 bytes a voxel), for the gates' cuts.
+    /// The max-ball radii of `voxels`. [Units: voxels]
+    pub fn radii_vx(&self, voxels: &[u32]) -> Vec<f64> {
+        voxels.iter().map(|&v| self.radius_vx(v as usize)).collect()
+    }
+
+    /// Each voxel's largest ball in whole voxels (2 bytes a voxel), for the gates' cuts and
+    /// as the sight lines' clearance.
     pub fn whole_radii(&self) -> Vec<u16> {
         self.dist2
             .par_iter()
@@ -111,7 +122,11 @@ impl DistanceField {
 }
 
 /// Stage 4: the exact squared distance transform of the kept empty space.
-pub fn distance(meta: &GridMeta, es: &EmptySpace, max_ball: MaxBall) -> Counted<DistanceField> {
+pub fn distance(
+    meta: &GridMeta,
+    es: &EmptySpace,
+    max_ball: MaxBall,
+) -> Counted<DistanceField, DistanceCounts> {
     let not_empty: Vec<bool> = es.empty.iter().map(|&e| !e).collect();
     let dist2 = distance::transform(meta.dims, &not_empty, max_ball);
     drop(not_empty);
@@ -123,7 +138,9 @@ pub fn distance(meta: &GridMeta, es: &EmptySpace, max_ball: MaxBall) -> Counted<
         .map(|(_, d)| *d)
         .max()
         .unwrap_or(0);
-    let counts = json!({ "largest_radius_vx": distance::radius_vx(max_r, max_ball) });
+    let counts = DistanceCounts {
+        largest_radius_vx: distance::radius_vx(max_r, max_ball),
+    };
     let field = DistanceField {
         dims: meta.dims,
         dist2,
@@ -138,7 +155,7 @@ pub fn skeletonize(
     field: &DistanceField,
     persistence: u32,
     cx: &BakeContext,
-) -> Counted<Thinned> {
+) -> Counted<Thinned, ThinCounts> {
     let mut thinned = thin(
         field.dims,
         &es.empty,
@@ -147,14 +164,14 @@ pub fn skeletonize(
         &|done, _| cx.advance(done),
     );
     let extended = extend_ends(field.dims, &es.empty, &field.dist2, &mut thinned.skeleton);
-    let counts = json!({
-        "ends_extended_by": extended,
-        "skeleton_voxels": thinned.skeleton.len(),
-        "steps": thinned.steps,
-        "constrained": thinned.constrained,
-        "voxels_examined": thinned.border_visits,
-        "persistence": persistence,
-    });
+    let counts = ThinCounts {
+        ends_extended_by: extended,
+        skeleton_voxels: thinned.skeleton.len(),
+        steps: thinned.steps,
+        constrained: thinned.constrained,
+        voxels_examined: thinned.border_visits,
+        persistence,
+    };
     (thinned, counts)
 }
 
@@ -175,13 +192,15 @@ pub struct SkeletonStage {
     pub components: u64,
 }
 
-/// Stage 6: the skeleton graph and the nearest-node grid (independent: side by side).
+/// Stage 6: the skeleton graph and the nearest-node grid (independent: side by side);
+/// `skeleton_radius_vx` is the max-ball radius of each skeleton voxel (the distance field is
+/// gone by then: the nearest-node search needs its memory).
 pub fn skeleton(
     meta: &GridMeta,
     es: &EmptySpace,
     thinned: &Thinned,
-    field: &DistanceField,
-) -> Counted<SkeletonStage> {
+    skeleton_radius_vx: &[f64],
+) -> Counted<SkeletonStage, SkeletonCounts> {
     let (graph, voxel_node): (SkeletonGraph, Vec<u32>) = rayon::join(
         || skeleton_graph(meta.dims, &thinned.skeleton),
         || nearest_node(meta.dims, &es.empty, &thinned.skeleton),
@@ -192,20 +211,18 @@ pub fn skeleton(
         .iter()
         .map(|&v| Vec3::from(meta.voxel_to_world(meta.coords(v))))
         .collect();
-    let radius = graph
-        .voxels
-        .iter()
-        .map(|&v| field.radius_vx(v as usize) as f32 * vs)
-        .collect();
+    // The graph's nodes are the skeleton voxels, in the same order.
+    debug_assert_eq!(graph.voxels, thinned.skeleton);
+    let radius = skeleton_radius_vx.iter().map(|&r| r as f32 * vs).collect();
     let cycles = graph.cycles();
     let components = petgraph::algo::connected_components(&graph.graph) as u64;
-    let counts = json!({
-        "nodes": graph.voxels.len(),
-        "edges": graph.graph.edge_count(),
-        "shortcuts_dropped": graph.shortcuts_dropped,
-        "cycles": cycles,
-        "components": components,
-    });
+    let counts = SkeletonCounts {
+        nodes: graph.voxels.len(),
+        edges: graph.graph.edge_count(),
+        shortcuts_dropped: graph.shortcuts_dropped,
+        cycles,
+        components,
+    };
     let stage = SkeletonStage {
         graph,
         voxel_node,
@@ -229,7 +246,10 @@ pub struct SegmentStage {
 }
 
 /// Stage 7: segmentation (IV.B.1).
-pub fn segmentation(sk: &SkeletonStage, params: &BakeParams) -> Counted<SegmentStage> {
+pub fn segmentation(
+    sk: &SkeletonStage,
+    params: &BakeParams,
+) -> Counted<SegmentStage, SegmentCounts> {
     let adjacency = sk.graph.adjacency();
     let seg_params = SegmentParams {
         curvature_to: params.curvature_to,
@@ -245,10 +265,14 @@ pub fn segmentation(sk: &SkeletonStage, params: &BakeParams) -> Counted<SegmentS
         count_kind(SegNodeKind::Coverage),
         count_kind(SegNodeKind::Narrowing),
     ];
-    let counts = json!({
-        "nodes": n[0], "topology": n[1], "curvature": n[2],
-        "coverage": n[3], "narrowing": n[4], "edges": seg.skeleton.edges.len(),
-    });
+    let counts = SegmentCounts {
+        nodes: n[0],
+        topology: n[1],
+        curvature: n[2],
+        coverage: n[3],
+        narrowing: n[4],
+        edges: seg.skeleton.edges.len(),
+    };
     let stage = SegmentStage {
         seg,
         adjacency,
@@ -263,6 +287,7 @@ pub fn segmentation(sk: &SkeletonStage, params: &BakeParams) -> Counted<SegmentS
 pub fn clusters_and_gates(
     meta: &GridMeta,
     es: &EmptySpace,
+    radius_vx: &[u16],
     sk: &SkeletonStage,
     sg: &SegmentStage,
     params: &BakeParams,
@@ -281,18 +306,19 @@ pub fn clusters_and_gates(
         let input = SplitInput {
             meta,
             empty: &es.empty,
+            clearance_vx: Some(radius_vx),
             seg: &sg.seg.skeleton,
             node_voxel: &sk.graph.voxels,
             radius: &sk.radius,
         };
         let (node_cluster, seeds) = split_unseen(&input, &grown, &grown_seeds);
         let added = seeds.len() - grown_seeds.len();
-        let counts = json!({
-            "clusters": seeds.len(),
-            "grown": grown_seeds.len(),
-            "split_off_unseen": added,
-            "alpha": params.alpha,
-        });
+        let counts = ClusterCounts {
+            clusters: seeds.len(),
+            grown: grown_seeds.len(),
+            split_off_unseen: added,
+            alpha: params.alpha,
+        };
         Ok((
             (node_cluster, seeds, grown_seeds.len() as u64, added as u64),
             counts,
@@ -306,11 +332,11 @@ pub fn clusters_and_gates(
             radius: &sk.radius,
         };
         let step = gate_step(&input, node_cluster, seeds_of, params.alpha);
-        let counts = json!({
-            "gates": step.chosen(params.gate_placement).len(),
-            "slivers_merged": step.slivers_merged,
-            "clusters": step.seeds_of.len(),
-        });
+        let counts = GateCounts {
+            gates: step.chosen(params.gate_placement).len(),
+            slivers_merged: step.slivers_merged,
+            clusters: step.seeds_of.len(),
+        };
         let account = [grown, split_off, step.slivers_merged];
         Ok(((step, account), counts))
     })
@@ -326,7 +352,7 @@ pub fn flatten(
     sg: &SegmentStage,
     step: &GateStep,
     info: BakeInfo,
-) -> Counted<(BakedLevel, Vec<u32>)> {
+) -> Counted<(BakedLevel, Vec<u32>), FlattenCounts> {
     let chosen = step.chosen(info.params.gate_placement);
     let flat = crate::flatten::flatten(&crate::flatten::FlattenInput {
         meta,
@@ -374,13 +400,12 @@ pub fn flatten(
             gates,
             portals: Vec::new(),
         },
-        voxel_node: VoxelValues::pack(&sk.voxel_node),
         voxel_cluster: VoxelValues::pack(&flat.voxel_cluster),
     };
-    let n_voxels = es.empty.len() as u64;
-    let mut counts = flat.counts;
-    counts["voxel_node_bytes"] = json!(level.voxel_node.elem().size() * n_voxels);
-    counts["voxel_cluster_bytes"] = json!(level.voxel_cluster.elem().size() * n_voxels);
+    let counts = FlattenCounts {
+        voxel_cluster_bytes: level.voxel_cluster.elem().size() * es.empty.len() as u64,
+        ..flat.counts
+    };
     ((level, flat.voxel_cluster), counts)
 }
 
@@ -390,32 +415,36 @@ pub fn portals(
     es: &EmptySpace,
     voxel_cluster: &[u32],
     cell_voxels: f32,
-) -> Counted<Portals> {
+) -> Counted<Portals, PortalCounts> {
     let found = crate::portals::portals(meta, &es.empty, voxel_cluster, cell_voxels);
     let cells: u64 = found
         .portals
         .iter()
         .map(|p| u64::from(p.size[0]) * u64::from(p.size[1]))
         .sum();
-    let counts = json!({
-        "portals": found.portals.len(),
-        "interface_faces": found.interface_faces,
-        "faces_no_portal_covers": found.uncovered,
-        "faces_off_every_plane": found.off_plane,
-        "mask_cells": cells,
-    });
+    let counts = PortalCounts {
+        portals: found.portals.len(),
+        interface_faces: found.interface_faces,
+        faces_no_portal_covers: found.uncovered,
+        faces_off_every_plane: found.off_plane,
+        mask_cells: cells,
+    };
     (found, counts)
 }
 
 /// Stage 12: the topology of the empty space and of the skeleton, counted independently of the
 /// graph (components, cycles, cavities).
-pub fn topology_check(meta: &GridMeta, es: &EmptySpace, thinned: &Thinned) -> Counted<[Betti; 2]> {
+pub fn topology_check(
+    meta: &GridMeta,
+    es: &EmptySpace,
+    thinned: &Thinned,
+) -> Counted<[Betti; 2], TopologyCounts> {
     let mut skel = vec![false; es.empty.len()];
     thinned
         .skeleton
         .iter()
         .for_each(|&i| skel[i as usize] = true);
     let (empty, skeleton) = rayon::join(|| betti(meta.dims, &es.empty), || betti(meta.dims, &skel));
-    let counts = json!({ "empty": empty, "skeleton": skeleton });
+    let counts = TopologyCounts { empty, skeleton };
     ([empty, skeleton], counts)
 }

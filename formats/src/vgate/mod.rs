@@ -11,12 +11,15 @@
 //! ...                 sections, contiguous, in table order, up to the end of the file:
 //!                       topology      postcard(Topology): skeleton, segmented skeleton,
 //!                                     node→cluster, clusters, gates, portals
-//!                       voxel_node    little-endian blob, one element per voxel (x fastest)
-//!                       voxel_cluster little-endian blob, one element per voxel
+//!                       voxel_cluster little-endian blob, one element per voxel (x fastest),
+//!                                     or, where smaller, its runs: (u32 LE length, element)
 //! ```
 //!
-//! The grids are stored in the smallest unsigned type (u8, u16, u32) that holds their largest
-//! value, with the type's maximum meaning "none". Reading checks everything — magic, version,
+//! The grid is stored in the smallest unsigned type (u8, u16, u32) that holds its largest
+//! value, with the type's maximum meaning "none"; as runs of equal values when that is
+//! smaller (it is on every real level: 144 → 4 MB for Crytek Sponza at 512), decoded to the
+//! dense grid on load. Format 3 also stored each voxel's nearest skeleton node, which no
+//! reader used. Reading checks everything — magic, version,
 //! every length against the file and each other, every checksum, every index against the
 //! array it indexes, every float — and returns a typed [`VgateError`]; it never panics.
 
@@ -40,7 +43,7 @@ pub use values::{Elem, VoxelValues};
 /// The first eight bytes of every `.vgate` file.
 pub const MAGIC: [u8; 8] = *b"VGATE\r\n\x1a";
 /// The format version this build writes and reads.
-pub const FORMAT_VERSION: u32 = 3;
+pub const FORMAT_VERSION: u32 = 4;
 /// "No node / no cluster" in a grid decoded to u32.
 pub const NONE: u32 = u32::MAX;
 
@@ -65,12 +68,14 @@ impl GridMeta {
     }
 
     /// Linear index of voxel (x, y, z).
+    #[inline]
     pub fn index(&self, v: [u32; 3]) -> usize {
         let [nx, ny, _] = self.dims.map(|d| d as usize);
         v[0] as usize + nx * (v[1] as usize + ny * v[2] as usize)
     }
 
     /// The voxel holding world point `p` (metres), if it lies in the grid.
+    #[inline]
     pub fn world_to_voxel(&self, p: [f32; 3]) -> Option<[u32; 3]> {
         let v: [f32; 3] = std::array::from_fn(|a| (p[a] - self.origin_m[a]) / self.voxel_size_m);
         (0..3)
@@ -79,12 +84,14 @@ impl GridMeta {
     }
 
     /// Voxel coordinates of grid index `i` (the inverse of [`GridMeta::index`]).
+    #[inline]
     pub fn coords(&self, i: u32) -> [u32; 3] {
         let (nx, ny) = (self.dims[0], self.dims[1]);
         [i % nx, (i / nx) % ny, i / (nx * ny)]
     }
 
     /// Centre of voxel `v` in world space, metres.
+    #[inline]
     pub fn voxel_to_world(&self, v: [u32; 3]) -> [f32; 3] {
         std::array::from_fn(|a| self.origin_m[a] + (v[a] as f32 + 0.5) * self.voxel_size_m)
     }
@@ -199,17 +206,12 @@ pub struct Topology {
 pub enum SectionKind {
     /// postcard(Topology).
     Topology,
-    /// Nearest skeleton node of every empty voxel.
-    VoxelNode,
-    /// Visibility cluster of every voxel a visible surface or a VPL can fall in.
+    /// Visibility cluster of every voxel a visible surface or a VPL can fall in, one value
+    /// per voxel.
     VoxelCluster,
+    /// The same grid as runs of equal values in voxel order: (u32 LE length, value).
+    VoxelClusterRuns,
 }
-
-const SECTION_ORDER: [SectionKind; 3] = [
-    SectionKind::Topology,
-    SectionKind::VoxelNode,
-    SectionKind::VoxelCluster,
-];
 
 /// An entry of the section table.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -242,8 +244,6 @@ pub struct BakedLevel {
     pub info: BakeInfo,
     /// Skeleton, segmentation, clusters, gates.
     pub topology: Topology,
-    /// Nearest skeleton node (through empty space) of every empty voxel; [`NONE`] elsewhere.
-    pub voxel_node: VoxelValues,
     /// Visibility cluster of every voxel; [`NONE`] where no surface or VPL can be.
     pub voxel_cluster: VoxelValues,
 }
@@ -261,18 +261,15 @@ impl BakedLevel {
     #[doc(hidden)]
     pub fn encode_unchecked(&self) -> Vec<u8> {
         let topo = postcard::to_allocvec(&self.topology).unwrap_or_default();
+        let runs = self.voxel_cluster.to_runs_le_bytes();
+        let clusters = if (runs.len() as u64) < self.voxel_cluster.dense_len() {
+            (SectionKind::VoxelClusterRuns, runs)
+        } else {
+            (SectionKind::VoxelCluster, self.voxel_cluster.to_le_bytes())
+        };
         let blobs = [
             (SectionKind::Topology, Elem::Structure, topo),
-            (
-                SectionKind::VoxelNode,
-                self.voxel_node.elem(),
-                self.voxel_node.to_le_bytes(),
-            ),
-            (
-                SectionKind::VoxelCluster,
-                self.voxel_cluster.elem(),
-                self.voxel_cluster.to_le_bytes(),
-            ),
+            (clusters.0, self.voxel_cluster.elem(), clusters.1),
         ];
         let mut header = Header {
             info: self.info.clone(),
@@ -413,14 +410,20 @@ impl BakedLevel {
         let header = Self::read_header(bytes)?;
         let avail = bytes.len() as u64;
         let kinds: Vec<SectionKind> = header.sections.iter().map(|s| s.kind).collect();
-        if kinds != SECTION_ORDER {
+        if !matches!(
+            kinds[..],
+            [
+                SectionKind::Topology,
+                SectionKind::VoxelCluster | SectionKind::VoxelClusterRuns
+            ]
+        ) {
             return Err(VgateError::Length(format!(
-                "section table lists {kinds:?}, expected {SECTION_ORDER:?}"
+                "section table lists {kinds:?}, expected the topology and the voxel clusters"
             )));
         }
         let hlen = u32::from_le_bytes([bytes[12], bytes[13], bytes[14], bytes[15]]) as u64;
         let mut at = PREFIX as u64 + hlen + 4;
-        let mut slices = Vec::with_capacity(3);
+        let mut slices = Vec::with_capacity(2);
         for s in &header.sections {
             if s.offset != at {
                 return Err(VgateError::Length(format!(
@@ -447,7 +450,7 @@ impl BakedLevel {
                     expected: s.crc32,
                 });
             }
-            if s.len % s.elem.size() != 0 {
+            if s.kind != SectionKind::VoxelClusterRuns && s.len % s.elem.size() != 0 {
                 return Err(VgateError::Length(format!(
                     "section {:?} is {} bytes, not a whole number of {:?} elements",
                     s.kind, s.len, s.elem
@@ -481,20 +484,28 @@ impl BakedLevel {
             }
             t
         };
-        let grid_of = |(s, data): (&SectionEntry, &[u8])| {
+        let voxel_cluster = {
+            let (s, data) = slices[1];
             if s.elem == Elem::Structure {
                 return Err(VgateError::Length(format!(
                     "section {:?} must be a blob of integers",
                     s.kind
                 )));
             }
-            Ok(VoxelValues::from_le_bytes(s.elem, data))
+            if s.kind == SectionKind::VoxelClusterRuns {
+                let voxels = header.info.grid.voxel_count().ok_or_else(|| {
+                    VgateError::BadValue(format!("grid dims {:?} overflow", header.info.grid.dims))
+                })?;
+                VoxelValues::from_runs_le_bytes(s.elem, data, voxels)
+                    .map_err(|e| VgateError::Length(format!("voxel cluster runs: {e}")))?
+            } else {
+                VoxelValues::from_le_bytes(s.elem, data)
+            }
         };
         let level = BakedLevel {
             info: header.info,
             topology,
-            voxel_node: grid_of(slices[1])?,
-            voxel_cluster: grid_of(slices[2])?,
+            voxel_cluster,
         };
         level.validate()?;
         Ok(level)
@@ -514,16 +525,11 @@ impl BakedLevel {
         let voxels = g
             .voxel_count()
             .ok_or_else(|| VgateError::BadValue(format!("grid dims {:?} overflow", g.dims)))?;
-        for (name, grid) in [
-            ("voxel_node", &self.voxel_node),
-            ("voxel_cluster", &self.voxel_cluster),
-        ] {
-            if grid.len() as u64 != voxels {
-                return Err(VgateError::Length(format!(
-                    "{name} grid has {} values but the grid has {voxels} voxels",
-                    grid.len()
-                )));
-            }
+        if self.voxel_cluster.len() as u64 != voxels {
+            return Err(VgateError::Length(format!(
+                "voxel_cluster grid has {} values but the grid has {voxels} voxels",
+                self.voxel_cluster.len()
+            )));
         }
         let t = &self.topology;
         let n_nodes = t.skeleton.nodes.len();
@@ -613,13 +619,6 @@ impl BakedLevel {
         for (i, p) in t.portals.iter().enumerate() {
             p.check(n_clusters)
                 .or_else(|e| bad(format!("portal {i}: {e}")))?;
-        }
-        if let Some(m) = self.voxel_node.max_value()
-            && m as usize >= n_nodes
-        {
-            {
-                return oob(format!("voxel_node value {m} ({n_nodes} skeleton nodes)"));
-            }
         }
         if let Some(m) = self.voxel_cluster.max_value()
             && m as usize >= n_clusters

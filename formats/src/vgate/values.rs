@@ -109,6 +109,84 @@ impl VoxelValues {
         }
     }
 
+    /// Bytes of [`VoxelValues::to_le_bytes`], without encoding them.
+    pub(super) fn dense_len(&self) -> u64 {
+        self.len() as u64 * self.elem().size()
+    }
+
+    /// The values as runs of equal values in index order, each a u32 LE length and a value LE
+    /// of the element type: a level's clusters are large, so a 512³ grid is a few hundred
+    /// thousand runs instead of 35 million values.
+    pub(super) fn to_runs_le_bytes(&self) -> Vec<u8> {
+        fn runs<T: Copy + PartialEq>(v: &[T], put: impl Fn(&mut Vec<u8>, T)) -> Vec<u8> {
+            let mut out = Vec::new();
+            let mut i = 0;
+            while i < v.len() {
+                let start = i;
+                // A run's length is a u32: a longer one is cut in two.
+                while i < v.len() && v[i] == v[start] && i - start < u32::MAX as usize {
+                    i += 1;
+                }
+                out.extend_from_slice(&((i - start) as u32).to_le_bytes());
+                put(&mut out, v[start]);
+            }
+            out
+        }
+        match self {
+            VoxelValues::U8(v) => runs(v, |o, x| o.push(x)),
+            VoxelValues::U16(v) => runs(v, |o, x| o.extend_from_slice(&x.to_le_bytes())),
+            VoxelValues::U32(v) => runs(v, |o, x| o.extend_from_slice(&x.to_le_bytes())),
+        }
+    }
+
+    /// Decodes [`VoxelValues::to_runs_le_bytes`]: `Err` says what is wrong when the runs are
+    /// not whole, one is empty, or they do not add up to `voxels`.
+    pub(super) fn from_runs_le_bytes(
+        elem: Elem,
+        bytes: &[u8],
+        voxels: u64,
+    ) -> Result<Self, String> {
+        let es = elem.size() as usize;
+        if elem == Elem::Structure || !bytes.len().is_multiple_of(4 + es) {
+            return Err(format!(
+                "{} bytes are not whole runs of a u32 length and a {elem:?} value",
+                bytes.len()
+            ));
+        }
+        let total: u64 = bytes
+            .chunks_exact(4 + es)
+            .map(|r| u64::from(u32::from_le_bytes([r[0], r[1], r[2], r[3]])))
+            .sum();
+        if total != voxels {
+            return Err(format!("runs cover {total} voxels, the grid has {voxels}"));
+        }
+        fn decode<T: Copy>(
+            bytes: &[u8],
+            es: usize,
+            total: u64,
+            value: impl Fn(&[u8]) -> T,
+        ) -> Result<Vec<T>, String> {
+            let mut out = Vec::with_capacity(total as usize);
+            for r in bytes.chunks_exact(4 + es) {
+                let n = u32::from_le_bytes([r[0], r[1], r[2], r[3]]) as usize;
+                if n == 0 {
+                    return Err(format!("an empty run at value {} of the grid", out.len()));
+                }
+                out.resize(out.len() + n, value(&r[4..]));
+            }
+            Ok(out)
+        }
+        Ok(match elem {
+            Elem::U8 | Elem::Structure => VoxelValues::U8(decode(bytes, es, total, |b| b[0])?),
+            Elem::U16 => VoxelValues::U16(decode(bytes, es, total, |b| {
+                u16::from_le_bytes([b[0], b[1]])
+            })?),
+            Elem::U32 => VoxelValues::U32(decode(bytes, es, total, |b| {
+                u32::from_le_bytes([b[0], b[1], b[2], b[3]])
+            })?),
+        })
+    }
+
     pub(super) fn from_le_bytes(elem: Elem, bytes: &[u8]) -> Self {
         match elem {
             Elem::U8 | Elem::Structure => VoxelValues::U8(bytes.to_vec()),
