@@ -15,6 +15,8 @@ use visgate_formats::vgate::{BakeInfo, BakeParams, BakedLevel};
 use crate::BakeError;
 use crate::counters::VoxelizeCounts;
 use crate::empty::Seed;
+use crate::memory::StagePeak;
+pub use crate::memory::peak_memory_bytes;
 use crate::stages;
 use crate::voxelize::{SolidGrid, grid_for, voxelize};
 
@@ -106,14 +108,14 @@ impl<'a> BakeContext<'a> {
         f: impl FnOnce(&mut Self) -> Result<(T, C), BakeError>,
     ) -> Result<T, BakeError> {
         (self.progress)(Progress::Start { stage: name, total });
-        reset_peak_memory();
+        let peak = StagePeak::start();
         let t = Instant::now();
         let (out, counts) = f(self)?;
         (self.progress)(Progress::Finish);
         self.stages.push(StageReport {
             name,
             seconds: t.elapsed().as_secs_f64(),
-            peak_memory_bytes: peak_memory_bytes(),
+            peak_memory_bytes: peak.finish(),
             counts: serde_json::to_value(counts).unwrap_or(Value::Null),
         });
         Ok(out)
@@ -128,22 +130,6 @@ impl<'a> BakeContext<'a> {
     pub fn into_stages(self) -> Vec<StageReport> {
         self.stages
     }
-}
-
-/// Starts the peak resident set size over from the current one (Linux: `5` written to
-/// `/proc/self/clear_refs`), so that [`peak_memory_bytes`] gives a stage's own peak; does
-/// nothing where the OS does not offer it.
-fn reset_peak_memory() {
-    let _ = std::fs::write("/proc/self/clear_refs", "5");
-}
-
-/// Peak resident set size of this process (Linux `VmHWM`) since it started or since the last
-/// reset, bytes.
-pub fn peak_memory_bytes() -> Option<u64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
-    let kb: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kb * 1024)
 }
 
 fn check_params(p: &BakeParams) -> Result<(), BakeError> {
@@ -282,7 +268,6 @@ pub fn bake(
         components: sk.components,
     };
     let stages = cx.into_stages();
-    let peak_memory_bytes = stages.iter().filter_map(|s| s.peak_memory_bytes).max();
     let report = BakeReport {
         scene: scene.name.clone(),
         params,
@@ -290,7 +275,7 @@ pub fn bake(
         threads: rayon::current_num_threads(),
         stages,
         total_seconds: total.elapsed().as_secs_f64(),
-        peak_memory_bytes,
+        peak_memory_bytes: peak_memory_bytes(),
         summary,
         empty_topology,
         skeleton_topology,

@@ -27,6 +27,7 @@ pub mod flatten;
 pub mod gate_step;
 pub mod graph;
 pub mod leak;
+pub mod memory;
 pub mod neighbourhood;
 pub mod portals;
 pub mod report;

@@ -14,8 +14,8 @@ pub struct StageReport {
     pub name: &'static str,
     /// Wall time. [Units: s]
     pub seconds: f64,
-    /// The process's peak resident memory while the stage ran (Linux: the high-water mark is
-    /// reset as the stage starts), where the OS tells. [Units: bytes]
+    /// The process's largest resident memory seen while the stage ran (sampled every few
+    /// milliseconds: see [`crate::memory`]), where the OS tells. [Units: bytes]
     pub peak_memory_bytes: Option<u64>,
     /// What it produced.
     pub counts: Value,
