@@ -169,9 +169,7 @@ pub fn run(args: BakeArgs) -> Result<()> {
             load_textures: false,
         },
     )?;
-    for w in &scene.report.warnings {
-        tracing::warn!("{w}");
-    }
+    // The importer has logged the scene's warnings (degenerate triangles dropped, …) once.
     let mut pool = rayon::ThreadPoolBuilder::new();
     if let Some(t) = args.threads {
         pool = pool.num_threads(t);

@@ -286,6 +286,33 @@ fn leaky_room(dir: &std::path::Path) -> std::path::PathBuf {
 }
 
 #[test]
+fn bake_says_each_import_warning_once() {
+    // The leaky room's mesh with a zero-area triangle added: the importer drops it and says
+    // so; the bake used to say it a second time.
+    let dir = tempfile::tempdir().expect("tempdir");
+    leaky_room(dir.path());
+    let mesh = dir.path().join("room.obj");
+    let mut obj = std::fs::read_to_string(&mesh).expect("obj");
+    obj += "v 1 1 1\nv 2 2 2\nv 3 3 3\nf -3 -2 -1\n";
+    std::fs::write(&mesh, obj).expect("obj");
+    let out = dir.path().join("l.vgate");
+    // Warnings shown, as a user sees them (the other tests run with RUST_LOG=error).
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_visgate"))
+        .args(["bake", mesh.to_str().expect("utf-8"), "--resolution", "16"])
+        .args(["-o", out.to_str().expect("utf-8")])
+        .env("RUST_LOG", "warn")
+        .output()
+        .expect("runs visgate");
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(
+        stderr(&o).matches("degenerate").count(),
+        1,
+        "{}",
+        stderr(&o)
+    );
+}
+
+#[test]
 fn a_leak_is_printed_where_it_is_and_written_as_a_path() {
     let dir = tempfile::tempdir().expect("tempdir");
     let scene = leaky_room(dir.path());
