@@ -14,7 +14,7 @@ use visgate_formats::vgate::{Cluster, GridMeta};
 use crate::clusters::{GateDisk, skeleton_clusters};
 use crate::counters::FlattenCounts;
 use crate::graph::SkeletonGraph;
-use crate::neighbourhood::{Conn, label_components};
+use crate::neighbourhood::{Conn, grid_components};
 use crate::segment::Segmented;
 
 /// What the flatten reads: the grid, the empty space and its largest balls, the nearest-node
@@ -218,7 +218,8 @@ struct Pieces {
 /// (a gate in open space that does not close its opening) keep the per-voxel rule.
 fn join_pieces(input: &FlattenInput, skel_cluster: &[u32], voxel_cluster: &mut [u32]) -> Pieces {
     let (meta, empty) = (input.meta, input.empty);
-    let mut cut = empty.to_vec();
+    // The cut voxels, a bit each.
+    let mut cut = vec![0u64; empty.len().div_ceil(64)];
     // Gates are independent: flooded in parallel, a few dozen at a time (a cut can hold a
     // whole plane of a 512³ grid).
     for gates in input.gates.chunks(64) {
@@ -227,18 +228,19 @@ fn join_pieces(input: &FlattenInput, skel_cluster: &[u32], voxel_cluster: &mut [
             .map(|g| crate::cut::gate_cut(meta, (empty, input.radius_vx), g))
             .collect();
         for i in cuts.into_iter().flatten() {
-            cut[i] = false;
+            cut[i / 64] |= 1 << (i % 64);
         }
     }
-    let (piece, pieces) = label_components(meta.dims, &cut, Conn::C6);
+    // The pieces as labelled runs: a label per voxel would be 4 bytes a voxel.
+    let uncut = |i: usize| empty[i] && cut[i / 64] & (1 << (i % 64)) == 0;
+    let piece = grid_components(meta.dims, uncut, Conn::C6);
     drop(cut);
     // Cluster of each piece's nodes: u32::MAX none yet, u32::MAX - 1 several.
-    let mut piece_cluster = vec![u32::MAX; pieces as usize];
+    let mut piece_cluster = vec![u32::MAX; piece.count as usize];
     for (n, &v) in input.graph.voxels.iter().enumerate() {
-        let p = piece[v as usize];
-        if p == u32::MAX {
+        let Some(p) = piece.label(v as usize) else {
             continue;
-        }
+        };
         let pc = &mut piece_cluster[p as usize];
         *pc = match *pc {
             u32::MAX => skel_cluster[n],
@@ -247,20 +249,27 @@ fn join_pieces(input: &FlattenInput, skel_cluster: &[u32], voxel_cluster: &mut [
         };
     }
     let voxels_moved = voxel_cluster
-        .par_iter_mut()
-        .zip(piece.par_iter())
-        .filter(|(c, p)| **p != u32::MAX && **c != u32::MAX)
-        .map(|(c, &p)| {
-            let pc = piece_cluster[p as usize];
-            let changed = pc < u32::MAX - 1 && *c != pc;
-            if changed {
-                *c = pc;
+        .par_chunks_mut(meta.dims[0] as usize)
+        .enumerate()
+        .map(|(r, row)| {
+            let mut moved = 0u64;
+            for (a, b, p) in piece.row(r) {
+                let pc = piece_cluster[p as usize];
+                if pc >= u32::MAX - 1 {
+                    continue;
+                }
+                for c in &mut row[a as usize..=b as usize] {
+                    if *c != u32::MAX && *c != pc {
+                        *c = pc;
+                        moved += 1;
+                    }
+                }
             }
-            changed as u64
+            moved
         })
         .sum::<u64>();
     Pieces {
-        pieces,
+        pieces: piece.count,
         of_several: piece_cluster.iter().filter(|&&c| c == u32::MAX - 1).count(),
         voxels_moved,
     }

@@ -284,40 +284,69 @@ pub enum Conn {
 /// the rows before it that touch it (2 rows for 6-adjacency, 4 for 26-adjacency, where runs
 /// that meet at a corner or edge overlap once widened by one voxel).
 pub fn label_components(dims: [u32; 3], set: &[bool], conn: Conn) -> (Vec<u32>, u32) {
-    let nx = dims[0] as usize;
-    let (runs, run_label, count) = labelled_runs(dims, |i| set[i], conn);
+    let c = grid_components(dims, |i| set[i], conn);
     let mut label = vec![u32::MAX; set.len()];
-    label.par_chunks_mut(nx).enumerate().for_each(|(r, row)| {
-        let mine = runs.row_start[r]..runs.row_start[r + 1];
-        for (&(a, b), &l) in runs.runs[mine.clone()].iter().zip(&run_label[mine]) {
-            row[a as usize..=b as usize].fill(l);
-        }
-    });
-    (label, count)
+    label
+        .par_chunks_mut(dims[0] as usize)
+        .enumerate()
+        .for_each(|(r, row)| {
+            for (a, b, l) in c.row(r) {
+                row[a as usize..=b as usize].fill(l);
+            }
+        });
+    (label, c.count)
 }
 
 /// The number of components of the voxels where `member` holds (as [`label_components`]
 /// counts them), without a label per voxel: the topology check counts four sets of a 512³
 /// grid, and their labels would take 4 bytes a voxel each.
 pub fn count_components(dims: [u32; 3], member: impl Fn(usize) -> bool + Sync, conn: Conn) -> u32 {
-    labelled_runs(dims, member, conn).2
+    grid_components(dims, member, conn).count
 }
 
-/// The runs along x of a set, row by row.
-struct Runs {
+/// The components of a set as labelled runs along x, row by row: what [`label_components`]
+/// writes out per voxel, in a few bytes a run ([`grid_components`]).
+pub struct Components {
+    /// Voxels a row.
+    nx: usize,
     /// Each run's first and last x, rows in voxel order.
     runs: Vec<(u32, u32)>,
     /// Where each row's runs start in `runs` (one more entry than rows).
     row_start: Vec<usize>,
+    /// Each run's component.
+    run_label: Vec<u32>,
+    /// Number of components.
+    pub count: u32,
 }
 
-/// The runs of the voxels where `member` holds, each run's component label (numbered by the
-/// component's first voxel) and the number of components.
-fn labelled_runs(
+impl Components {
+    /// Row `r`'s runs: first x, last x, component.
+    pub fn row(&self, r: usize) -> impl Iterator<Item = (u32, u32, u32)> + '_ {
+        let mine = self.row_start[r]..self.row_start[r + 1];
+        self.runs[mine.clone()]
+            .iter()
+            .zip(&self.run_label[mine])
+            .map(|(&(a, b), &l)| (a, b, l))
+    }
+
+    /// The component of voxel `i`, if it is in the set.
+    pub fn label(&self, i: usize) -> Option<u32> {
+        let (r, x) = (i / self.nx, (i % self.nx) as u32);
+        let runs = &self.runs[self.row_start[r]..self.row_start[r + 1]];
+        let k = runs.partition_point(|&(_, b)| b < x);
+        runs.get(k)
+            .filter(|&&(a, _)| a <= x)
+            .map(|_| self.run_label[self.row_start[r] + k])
+    }
+}
+
+/// The components of the voxels where `member` holds, labels numbered by each component's
+/// first voxel.
+pub fn grid_components(
     dims: [u32; 3],
     member: impl Fn(usize) -> bool + Sync,
     conn: Conn,
-) -> (Runs, Vec<u32>, u32) {
+) -> Components {
     let [nx, ny, nz] = dims.map(|d| d as usize);
     let rows = ny * nz;
     // Runs of each row, in voxel order: (first x, last x).
@@ -408,7 +437,13 @@ fn labelled_runs(
             run_label[root]
         };
     }
-    (Runs { runs, row_start }, run_label, count)
+    Components {
+        nx,
+        runs,
+        row_start,
+        run_label,
+        count,
+    }
 }
 
 #[cfg(test)]
