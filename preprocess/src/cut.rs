@@ -40,22 +40,31 @@ fn dominant(m: glam::Mat3) -> (Vec3, f32) {
 /// The cut plane's normal: the gate's, or, in a slot (the narrow voxels near the plane spread
 /// at least twice as far along one axis as along any other, that axis across the gate's
 /// normal), the gate's normal with its component along the slot removed.
-fn cut_normal(meta: &GridMeta, (empty, radius_vx): Space, g: &GateDisk, narrow: f32) -> Vec3 {
+fn cut_normal(
+    scratch: &mut Flood,
+    meta: &GridMeta,
+    (empty, radius_vx): Space,
+    g: &GateDisk,
+    narrow: f32,
+) -> Vec3 {
     let vs = meta.voxel_size_m;
     let band = 2.0 * g.radius + vs;
     // Only the narrow voxels near the gate say which way a slot runs; unbounded, the flood
     // followed the narrow strip along every wall of the level within the band.
     let near = SLOT_SEARCH_REACHES * (3.0 * g.radius + vs);
-    let pts: Vec<Vec3> = flood(meta, g.centre, |i, p| {
-        let d = p - g.centre;
-        empty[i]
-            && f32::from(radius_vx[i]) <= narrow
-            && d.dot(g.normal).abs() <= band
-            && d.length_squared() <= near * near
-    })
-    .into_iter()
-    .map(|i| centre(meta, i))
-    .collect();
+    let pts: Vec<Vec3> = scratch
+        .run(meta, g.centre, |i, p| {
+            // The arithmetic first: most voxels tried lie off the band, and their grid reads wait
+            // on memory.
+            let d = p - g.centre;
+            d.dot(g.normal).abs() <= band
+                && d.length_squared() <= near * near
+                && empty[i]
+                && f32::from(radius_vx[i]) <= narrow
+        })
+        .into_iter()
+        .map(|i| centre(meta, i))
+        .collect();
     if pts.len() < 8 {
         return g.normal;
     }
@@ -81,82 +90,97 @@ fn centre(meta: &GridMeta, i: usize) -> Vec3 {
     Vec3::from(meta.voxel_to_world(meta.coords(i as u32)))
 }
 
-/// The voxels reached from `from`'s voxel (26-connected) through voxels that `keep` (linear
-/// index, centre) accepts, as linear indices in breadth-first order; at most [`MAX_FLOOD`].
-fn flood(meta: &GridMeta, from: Vec3, keep: impl Fn(usize, Vec3) -> bool) -> Vec<usize> {
-    let dims = meta.dims.map(i64::from);
-    let o = Vec3::from(meta.origin_m);
-    let start = ((from - o) / meta.voxel_size_m)
-        .floor()
-        .as_i64vec3()
-        .to_array();
-    let mut out = Vec::new();
-    if (0..3).any(|a| start[a] < 0 || start[a] >= dims[a]) {
-        return out;
-    }
-    let index = |v: [i64; 3]| (v[0] + dims[0] * (v[1] + dims[1] * v[2])) as usize;
-    let mut seen = Visited::new(dims);
-    let mut insert = |v: [i64; 3]| seen.insert(v);
-    insert(start);
-    let mut queue = VecDeque::from([start]);
-    while let Some(v) = queue.pop_front() {
-        let i = index(v);
-        let p = Vec3::from(meta.voxel_to_world(v.map(|c| c as u32)));
-        if !keep(i, p) || out.len() >= MAX_FLOOD {
-            continue;
+/// A flood's scratch, kept from one flood to the next by the thread that runs them: a bit a
+/// voxel of the grid, of which only the words a flood set are cleared after it. A fresh
+/// bitset a flood (4.4 MB at 512³, thousands of floods) cost a page fault every few voxels; a
+/// hash set of coordinates, 26 hashes a voxel; bricks allocated on demand, a table lookup a
+/// neighbour.
+pub struct Flood {
+    /// Grid dimensions.
+    dims: [i64; 3],
+    /// One bit a voxel: seen by the current flood.
+    seen: Vec<u64>,
+    /// The words of `seen` the current flood set.
+    touched: Vec<usize>,
+    /// The breadth-first queue.
+    queue: VecDeque<[i64; 3]>,
+}
+
+impl Flood {
+    /// Scratch for floods of `meta`'s grid.
+    pub fn new(meta: &GridMeta) -> Flood {
+        let dims = meta.dims.map(i64::from);
+        Flood {
+            dims,
+            seen: vec![0; (dims.iter().product::<i64>() as usize).div_ceil(64)],
+            touched: Vec::new(),
+            queue: VecDeque::new(),
         }
-        out.push(i);
-        for dz in -1..=1 {
-            for dy in -1..=1 {
-                for dx in -1..=1 {
-                    let w = [v[0] + dx, v[1] + dy, v[2] + dz];
-                    if (0..3).all(|a| w[a] >= 0 && w[a] < dims[a]) && insert(w) {
-                        queue.push_back(w);
+    }
+
+    /// Marks voxel `i` seen; whether it was new.
+    fn insert(&mut self, i: usize) -> bool {
+        let (w, bit) = (i / 64, 1u64 << (i % 64));
+        let word = self.seen[w];
+        if word & bit != 0 {
+            return false;
+        }
+        if word == 0 {
+            self.touched.push(w);
+        }
+        self.seen[w] = word | bit;
+        true
+    }
+
+    /// The voxels reached from `from`'s voxel (26-connected) through voxels that `keep`
+    /// (linear index, centre) accepts, as linear indices in breadth-first order; at most
+    /// [`MAX_FLOOD`].
+    fn run(
+        &mut self,
+        meta: &GridMeta,
+        from: Vec3,
+        keep: impl Fn(usize, Vec3) -> bool,
+    ) -> Vec<usize> {
+        let dims = self.dims;
+        let o = Vec3::from(meta.origin_m);
+        let start = ((from - o) / meta.voxel_size_m)
+            .floor()
+            .as_i64vec3()
+            .to_array();
+        let mut out = Vec::new();
+        if (0..3).any(|a| start[a] < 0 || start[a] >= dims[a]) {
+            return out;
+        }
+        let index = |v: [i64; 3]| (v[0] + dims[0] * (v[1] + dims[1] * v[2])) as usize;
+        self.insert(index(start));
+        self.queue.push_back(start);
+        while let Some(v) = self.queue.pop_front() {
+            let i = index(v);
+            let p = Vec3::from(meta.voxel_to_world(v.map(|c| c as u32)));
+            if !keep(i, p) || out.len() >= MAX_FLOOD {
+                continue;
+            }
+            out.push(i);
+            // Away from the grid's faces every neighbour is inside it.
+            let interior = (0..3).all(|a| v[a] > 0 && v[a] + 1 < dims[a]);
+            for dz in -1..=1 {
+                for dy in -1..=1 {
+                    for dx in -1..=1 {
+                        let w = [v[0] + dx, v[1] + dy, v[2] + dz];
+                        if (interior || (0..3).all(|a| w[a] >= 0 && w[a] < dims[a]))
+                            && self.insert(index(w))
+                        {
+                            self.queue.push_back(w);
+                        }
                     }
                 }
             }
         }
-    }
-    out
-}
-
-/// The voxels a flood has seen: one bit a voxel, in 8³ bricks allocated as the flood reaches
-/// them. A flood follows a plane or a slot through a whole level and touches a few voxels of
-/// many bricks; a bit per grid voxel (4.4 MB at 512³, for each of thousands of floods) cost a
-/// page fault every few voxels, and a hash set of coordinates 26 hashes a voxel.
-struct Visited {
-    /// Bricks per axis.
-    bricks: [i64; 3],
-    /// Each brick's slot in `bits`, or `u32::MAX` while untouched.
-    slot: Vec<u32>,
-    /// 512 bits a touched brick.
-    bits: Vec<[u64; 8]>,
-}
-
-impl Visited {
-    fn new(dims: [i64; 3]) -> Visited {
-        let bricks = dims.map(|d| (d + 7) / 8);
-        Visited {
-            bricks,
-            slot: vec![u32::MAX; bricks.iter().product::<i64>() as usize],
-            bits: Vec::new(),
+        for &w in &self.touched {
+            self.seen[w] = 0;
         }
-    }
-
-    /// Marks voxel `v` (inside the grid) seen; whether it was new.
-    fn insert(&mut self, v: [i64; 3]) -> bool {
-        let b =
-            ((v[0] >> 3) + self.bricks[0] * ((v[1] >> 3) + self.bricks[1] * (v[2] >> 3))) as usize;
-        if self.slot[b] == u32::MAX {
-            self.slot[b] = self.bits.len() as u32;
-            self.bits.push([0; 8]);
-        }
-        let bit = (v[0] & 7) + 8 * ((v[1] & 7) + 8 * (v[2] & 7));
-        let word = &mut self.bits[self.slot[b] as usize][(bit >> 6) as usize];
-        let mask = 1u64 << (bit & 63);
-        let new = *word & mask == 0;
-        *word |= mask;
-        new
+        self.touched.clear();
+        out
     }
 }
 
@@ -164,23 +188,33 @@ impl Visited {
 /// space): the plane's voxels reached from the gate's centre through the disk (solid or not)
 /// or through empty voxels as narrow as the opening; `radius_vx` is each voxel's largest-ball
 /// radius in whole voxels (saturated).
-pub fn gate_cut(meta: &GridMeta, (empty, radius_vx): Space, g: &GateDisk) -> Vec<usize> {
+pub fn gate_cut(meta: &GridMeta, space: Space, g: &GateDisk) -> Vec<usize> {
+    gate_cut_with(&mut Flood::new(meta), meta, space, g)
+}
+
+/// [`gate_cut`] with a flood's scratch of the caller's (one a thread, for many gates).
+pub fn gate_cut_with(
+    scratch: &mut Flood,
+    meta: &GridMeta,
+    (empty, radius_vx): Space,
+    g: &GateDisk,
+) -> Vec<usize> {
     let vs = meta.voxel_size_m;
     // Thresholds a hair over their values, so that a distance equal to one in exact arithmetic
     // counts the same at every scale of the level (voxel units round differently).
     let reach = (3.0 * g.radius + vs) * (1.0 + 1e-4);
     let narrow = (1.5 * g.radius / vs + 1.0 + 1e-3).floor();
-    let normal = cut_normal(meta, (empty, radius_vx), g, narrow);
+    let normal = cut_normal(scratch, meta, (empty, radius_vx), g, narrow);
     // A voxel lies on the plane when the plane passes through its cube.
     let half = 0.5 * vs * normal.abs().element_sum();
     let on_cut = |i: usize, p: Vec3| {
         let d = p - g.centre;
         let along = d.dot(normal);
-        let in_disk = (d - along * normal).length() <= reach;
-        let slot = empty[i] && f32::from(radius_vx[i]) <= narrow;
-        along.abs() <= half && (in_disk || slot)
+        along.abs() <= half
+            && ((d - along * normal).length() <= reach
+                || (empty[i] && f32::from(radius_vx[i]) <= narrow))
     };
-    flood(meta, g.centre, on_cut)
+    scratch.run(meta, g.centre, on_cut)
 }
 #[cfg(test)]
 mod tests {

@@ -225,7 +225,10 @@ fn join_pieces(input: &FlattenInput, skel_cluster: &[u32], voxel_cluster: &mut [
     for gates in input.gates.chunks(64) {
         let cuts: Vec<Vec<usize>> = gates
             .par_iter()
-            .map(|g| crate::cut::gate_cut(meta, (empty, input.radius_vx), g))
+            .map_init(
+                || crate::cut::Flood::new(meta),
+                |scratch, g| crate::cut::gate_cut_with(scratch, meta, (empty, input.radius_vx), g),
+            )
             .collect();
         for i in cuts.into_iter().flatten() {
             cut[i / 64] |= 1 << (i % 64);
