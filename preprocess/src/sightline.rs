@@ -54,9 +54,18 @@ impl Sight<'_> {
     pub fn sees(&self, from: [u32; 3], to: [u32; 3]) -> bool {
         let (from, to) = (from.map(i64::from), to.map(i64::from));
         let d: [i64; 3] = std::array::from_fn(|k| to[k] - from[k]);
-        let p: i64 = d.iter().filter(|&&x| x != 0).map(|x| x.abs()).product();
-        // Boundary-crossing period per axis, in units of 1 / (2P); 0 for an axis not crossed.
-        let q: [i64; 3] = d.map(|x| if x == 0 { 0 } else { p / x.abs() });
+        // |d_k|, with 1 for an axis not crossed, so that products skip it.
+        let m = d.map(|x| x.abs().max(1));
+        let p: i64 = m[0] * m[1] * m[2];
+        // Boundary-crossing period per axis, in units of 1 / (2P): P / |d_k|, the product of
+        // the other two; 0 for an axis not crossed.
+        let q: [i64; 3] = std::array::from_fn(|k| {
+            if d[k] == 0 {
+                0
+            } else {
+                m[(k + 1) % 3] * m[(k + 2) % 3]
+            }
+        });
         let step = d.map(i64::signum);
         let dims = self.meta.dims.map(i64::from);
         let (two_p, mut n, mut cell) = (2 * p, [0i64; 3], from);
