@@ -163,6 +163,7 @@ pub fn run(args: BakeArgs) -> Result<()> {
     };
     let options = BakeOptions {
         memory_limit_bytes: (args.memory_limit_gib * (1u64 << 30) as f64) as u64,
+        keep_solid_grid: args.debug_dir.is_some(),
     };
     let scene = crate::load_scene(
         &args.scene,

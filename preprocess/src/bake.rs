@@ -43,12 +43,16 @@ pub enum Progress {
 pub struct BakeOptions {
     /// Refuse grids that would need more memory than this. [Units: bytes]
     pub memory_limit_bytes: u64,
+    /// Keep the voxelized solid grid to the end, for the debug exports ([`BakeGrids::solid`]);
+    /// otherwise it is dropped once the empty space is found (1 byte a voxel: 35 MB at 512³).
+    pub keep_solid_grid: bool,
 }
 
 impl Default for BakeOptions {
     fn default() -> Self {
         BakeOptions {
             memory_limit_bytes: 16 << 30,
+            keep_solid_grid: true,
         }
     }
 }
@@ -62,8 +66,8 @@ pub fn auto_persistence(dims: [u32; 3]) -> u32 {
 /// Intermediate grids, for debug exports.
 #[derive(Debug, Clone)]
 pub struct BakeGrids {
-    /// Solid voxels as voxelized.
-    pub solid: SolidGrid,
+    /// Solid voxels as voxelized, when [`BakeOptions::keep_solid_grid`] asked for them.
+    pub solid: Option<SolidGrid>,
     /// Kept empty voxels.
     pub empty: Vec<bool>,
     /// Skeleton voxels, ascending grid index.
@@ -209,6 +213,7 @@ pub fn bake(
     let es = cx.stage("empty space", 0, |_| {
         stages::empty(scene, &meta, &solid.solid, &input.triangles, &params)
     })?;
+    let solid = options.keep_solid_grid.then_some(solid);
     let field = cx.stage("distance", 0, |_| {
         Ok(stages::distance(&meta, &es, params.max_ball))
     })?;

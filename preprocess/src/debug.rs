@@ -33,12 +33,18 @@ pub fn write_all(dir: &Path, level: &BakedLevel, grids: &BakeGrids) -> io::Resul
         written.push(path.display().to_string());
         Ok(())
     };
+    let solid = grids.solid.as_ref().ok_or_else(|| {
+        io::Error::new(
+            io::ErrorKind::InvalidInput,
+            "the bake did not keep its solid grid: bake with BakeOptions::keep_solid_grid",
+        )
+    })?;
     let mut skel = vec![false; grids.empty.len()];
     grids.skeleton.iter().for_each(|&i| skel[i as usize] = true);
-    out("solid.npy", &|w| write_npy(w, dims, &grids.solid.solid))?;
+    out("solid.npy", &|w| write_npy(w, dims, &solid.solid))?;
     out("skeleton.npy", &|w| write_npy(w, dims, &skel))?;
     out("solid_surface.ply", &|w| {
-        solid_surface(w, level, &grids.solid.solid, &grids.empty)
+        solid_surface(w, level, &solid.solid, &grids.empty)
     })?;
     let t = &level.topology;
     out("skeleton.ply", &|w| {

@@ -567,6 +567,7 @@ fn no_empty_space_no_triangles_and_too_much_memory_are_clear_errors() {
     let s = Builtin::EmptyBox.scene().expect("scene");
     let opts = BakeOptions {
         memory_limit_bytes: 1 << 30,
+        ..BakeOptions::default()
     };
     let e = bake(&s, &params(2048), &opts, &|_| {}).expect_err("too large");
     match &e {
