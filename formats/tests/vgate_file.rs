@@ -166,29 +166,67 @@ fn the_cluster_grid_is_stored_as_runs_where_that_is_smaller_and_reads_back_dense
     assert_eq!(BakedLevel::from_bytes(&bytes).expect("decodes"), noisy);
 }
 
+/// A file of `header` (its grid and its voxel→cluster section's kind and element type) and
+/// the two sections, with every offset, length and checksum right: what a writer that got the
+/// contents wrong would write.
+fn file_of(mut header: Header, topology: &[u8], clusters: &[u8]) -> Vec<u8> {
+    let blobs = [topology, clusters];
+    for (s, b) in header.sections.iter_mut().zip(blobs) {
+        s.len = b.len() as u64;
+        s.crc32 = crc32fast::hash(b);
+    }
+    let mut hb: Vec<u8> = Vec::new();
+    for _ in 0..8 {
+        let mut at = (16 + hb.len() + 4) as u64;
+        for s in &mut header.sections {
+            s.offset = at;
+            at += s.len;
+        }
+        let next = postcard::to_allocvec(&header).expect("header bytes");
+        if next == hb {
+            break;
+        }
+        hb = next;
+    }
+    let mut out = MAGIC.to_vec();
+    out.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
+    out.extend_from_slice(&(hb.len() as u32).to_le_bytes());
+    out.extend_from_slice(&hb);
+    let crc = crc32fast::hash(&out);
+    out.extend_from_slice(&crc.to_le_bytes());
+    blobs.iter().for_each(|b| out.extend_from_slice(b));
+    out
+}
+
 #[test]
 fn runs_that_do_not_add_up_to_the_grid_are_refused_even_with_a_right_checksum() {
     let bytes = two_room_level(40).to_bytes().expect("encodes");
     let header = BakedLevel::read_header(&bytes).expect("header");
-    let s = header.sections[1];
-    let runs = s.offset as usize;
-    for (what, patch) in [("longer", 1u32), ("empty", 0)] {
-        let mut b = bytes.clone();
-        let first = u32::from_le_bytes(b[runs..runs + 4].try_into().expect("4 bytes"));
-        let n = if patch == 0 { 0 } else { first + patch };
-        b[runs..runs + 4].copy_from_slice(&n.to_le_bytes());
-        // Mend the section's checksum in the header, and the header's own.
-        let mut h = header.clone();
-        h.sections[1].crc32 = crc32fast::hash(&b[runs..runs + s.len as usize]);
-        let hb = postcard::to_allocvec(&h).expect("header bytes");
-        let hlen = u32::from_le_bytes(b[12..16].try_into().expect("4 bytes")) as usize;
-        assert_eq!(hb.len(), hlen, "{what}: the header keeps its length");
-        b[16..16 + hlen].copy_from_slice(&hb);
-        let crc = crc32fast::hash(&b[..16 + hlen]);
-        b[16 + hlen..20 + hlen].copy_from_slice(&crc.to_le_bytes());
-        let e = BakedLevel::from_bytes(&b).expect_err(what).to_string();
+    let [t, c] = [0, 1].map(|k| {
+        let s = header.sections[k];
+        &bytes[s.offset as usize..(s.offset + s.len) as usize]
+    });
+    let first = u32::from_le_bytes(c[..4].try_into().expect("4 bytes"));
+    for (what, n) in [("longer", first + 1), ("empty", 0)] {
+        let mut runs = c.to_vec();
+        runs[..4].copy_from_slice(&n.to_le_bytes());
+        let e = BakedLevel::from_bytes(&file_of(header.clone(), t, &runs))
+            .expect_err(what)
+            .to_string();
         assert!(e.contains("runs"), "{what}: {e}");
     }
+    // A few runs that declare a grid of 2^33 voxels (the header's grid made to match) are
+    // refused, not allocated.
+    let mut huge = header.clone();
+    huge.info.grid.dims = [1 << 11, 1 << 11, 1 << 11];
+    let runs: Vec<u8> = (0..2)
+        .flat_map(|_| [u32::MAX.to_le_bytes().to_vec(), vec![0]].concat())
+        .chain([2u32.to_le_bytes().to_vec(), vec![0]].concat())
+        .collect();
+    let e = BakedLevel::from_bytes(&file_of(huge, t, &runs))
+        .expect_err("huge")
+        .to_string();
+    assert!(e.contains("u32"), "{e}");
 }
 
 #[test]

@@ -160,13 +160,20 @@ impl VoxelValues {
         if total != voxels {
             return Err(format!("runs cover {total} voxels, the grid has {voxels}"));
         }
+        if total > u64::from(u32::MAX) {
+            return Err(format!("{total} voxels: grids are indexed by u32"));
+        }
         fn decode<T: Copy>(
             bytes: &[u8],
             es: usize,
             total: u64,
             value: impl Fn(&[u8]) -> T,
         ) -> Result<Vec<T>, String> {
-            let mut out = Vec::with_capacity(total as usize);
+            // A few runs can declare a huge grid: refuse one that does not fit rather than abort.
+            let mut out = Vec::new();
+            out.try_reserve_exact(total as usize).map_err(|_| {
+                format!("the runs describe {total} voxels, more than this machine can hold")
+            })?;
             for r in bytes.chunks_exact(4 + es) {
                 let n = u32::from_le_bytes([r[0], r[1], r[2], r[3]]) as usize;
                 if n == 0 {
