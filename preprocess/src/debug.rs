@@ -21,6 +21,12 @@ use crate::bake::BakeGrids;
 
 /// Writes every debug file into `dir` (created if missing); returns the paths written.
 pub fn write_all(dir: &Path, level: &BakedLevel, grids: &BakeGrids) -> io::Result<Vec<String>> {
+    let solid = grids.solid.as_ref().ok_or_else(|| {
+        io::Error::new(
+            io::ErrorKind::InvalidInput,
+            "the bake did not keep its solid grid: bake with BakeOptions::keep_solid_grid",
+        )
+    })?;
     std::fs::create_dir_all(dir)?;
     let meta = &level.info.grid;
     let dims = meta.dims;
@@ -33,12 +39,6 @@ pub fn write_all(dir: &Path, level: &BakedLevel, grids: &BakeGrids) -> io::Resul
         written.push(path.display().to_string());
         Ok(())
     };
-    let solid = grids.solid.as_ref().ok_or_else(|| {
-        io::Error::new(
-            io::ErrorKind::InvalidInput,
-            "the bake did not keep its solid grid: bake with BakeOptions::keep_solid_grid",
-        )
-    })?;
     let mut skel = vec![false; grids.empty.len()];
     grids.skeleton.iter().for_each(|&i| skel[i as usize] = true);
     out("solid.npy", &|w| write_npy(w, dims, &solid.solid))?;

@@ -74,3 +74,16 @@ pub enum BakeError {
         limit: u64,
     },
 }
+
+/// xorshift32 from `seed` (not 0): the same pseudo-random sequence every run, for tests that
+/// sweep random levels.
+#[cfg(test)]
+pub(crate) fn xorshift32(seed: u32) -> impl FnMut() -> u32 {
+    let mut state = seed;
+    move || {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        state
+    }
+}

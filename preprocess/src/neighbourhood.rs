@@ -522,13 +522,7 @@ mod tests {
     fn labelled_runs_give_every_voxel_the_label_of_the_per_voxel_labelling() {
         // Random sets of several densities, both adjacencies: the runs' labels, looked up
         // voxel by voxel, are the per-voxel labels, and the counts agree.
-        let mut state = 0x2545_f491u32;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 17;
-            state ^= state << 5;
-            state
-        };
+        let mut next = crate::xorshift32(0x2545_f491);
         let dims = [23, 9, 7];
         let n = 23 * 9 * 7;
         for density in [10, 35, 50, 65, 90] {

@@ -76,6 +76,7 @@ impl Sight<'_> {
                 (2 * n + 1) * q[k]
             }
         };
+        let line = Line::between(from, d);
         // A proof is tried again only past the narrow place where the last one stopped.
         let mut retry_from = 0i64;
         loop {
@@ -110,10 +111,6 @@ impl Sight<'_> {
             if entered < retry_from || clear[i] < MIN_PROOF_CLEARANCE {
                 continue;
             }
-            let line = Line {
-                a: Vec3::from(from.map(|c| c as f32 + 0.5)),
-                d: Vec3::from(d.map(|c| c as f32)),
-            };
             let t0 = entered as f64 / two_p as f64;
             match prove_clear(clear, dims, &line, t0 as f32, clear[i]) {
                 Ok(()) => return true,
@@ -142,6 +139,16 @@ impl Sight<'_> {
 struct Line {
     a: Vec3,
     d: Vec3,
+}
+
+impl Line {
+    /// From the centre of voxel `from` along `d` (to the centre of voxel `from + d`).
+    fn between(from: [i64; 3], d: [i64; 3]) -> Line {
+        Line {
+            a: Vec3::from(from.map(|c| c as f32 + 0.5)),
+            d: Vec3::from(d.map(|c| c as f32)),
+        }
+    }
 }
 
 /// Proves that every voxel the segment crosses for `t` from `t0` to 1 is empty, by steps of
@@ -188,7 +195,8 @@ pub fn clusters_by_sight(
                 return false;
             }
             let at = meta.coords(i as u32);
-            // The voxel's own node first: it is nearer than the seed, so its line is shorter.
+            // The voxel's own node first: it is usually nearer than the seed, so its line is
+            // shorter.
             let sees_own = anchor(i).is_some_and(|(ac, v)| ac == c && sight.sees(at, v));
             !(sees_own || seeds.get(c as usize).is_some_and(|&s| sight.sees(at, s)))
         })
@@ -300,14 +308,8 @@ mod tests {
 
     #[test]
     fn sight_lines_with_clearance_answer_as_the_plain_dda_on_random_levels() {
-        // xorshift32: the same levels and pairs every run.
-        let mut state = 0x9e37_79b9u32;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 17;
-            state ^= state << 5;
-            state
-        };
+        // The same levels and pairs every run.
+        let mut next = crate::xorshift32(0x9e37_79b9);
         let (mut pairs, mut seen, mut proved) = (0u64, 0u64, 0u64);
         for (level, blocks) in [0usize, 4, 12, 30, 60, 120].into_iter().enumerate() {
             let dims = [40 + 7 * level as u32, 31, 36 - 2 * level as u32];
@@ -344,11 +346,8 @@ mod tests {
                     assert_eq!(fast.sees(from, to), answer, "{from:?} -> {to:?}, {rule:?}");
                     pairs += 1;
                     seen += u64::from(answer);
-                    let a = Vec3::from(from.map(|c| c as f32 + 0.5));
-                    let line = Line {
-                        a,
-                        d: Vec3::from(to.map(|c| c as f32 + 0.5)) - a,
-                    };
+                    let (f, t) = (from.map(i64::from), to.map(i64::from));
+                    let line = Line::between(f, std::array::from_fn(|k| t[k] - f[k]));
                     let r0 = clear[meta.index(from)];
                     let long = line.d.length() > 8.0;
                     proved += u64::from(

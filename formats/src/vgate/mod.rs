@@ -17,7 +17,8 @@
 //!
 //! The grid is stored in the smallest unsigned type (u8, u16, u32) that holds its largest
 //! value, with the type's maximum meaning "none"; as runs of equal values when that is
-//! smaller (it is on every real level: 144 → 4 MB for Crytek Sponza at 512), decoded to the
+//! smaller (it is on every real level: Crytek Sponza at 512 keeps 35 M voxels in 8 MB of
+//! runs, where format 3's whole file was 145 MB), decoded to the
 //! dense grid on load. Format 3 also stored each voxel's nearest skeleton node, which no
 //! reader used. Reading checks everything — magic, version,
 //! every length against the file and each other, every checksum, every index against the
