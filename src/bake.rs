@@ -51,6 +51,18 @@ pub struct BakeArgs {
     /// shapes more closely, coarser makes smaller files.
     #[arg(long, default_value_t = 1.0)]
     pub portal_cell: f32,
+    /// Narrowest gap that shapes the partition, metres (max-ball radius, 0–10; 0 = every gap,
+    /// the paper's): skeleton loops through narrower cracks are opened and thinner branches
+    /// pruned, so cluster counts stay put as the resolution grows; light still passes there.
+    /// Default: 0.15 m, or 1/256 of the level's longest extent if smaller.
+    #[arg(long)]
+    pub min_gap: Option<f32>,
+    /// Voxel edge of the grid the skeleton, clusters and gates are made on, metres (0–10; 0 =
+    /// the level's grid): a finer --resolution then refines only the voxels' clusters and the
+    /// portals, so the partition is the same at 256, 512 or 1024 and the bake much faster.
+    /// Default: 0.125 m, or 1/256 of the level's longest extent if smaller.
+    #[arg(long)]
+    pub partition_voxel: Option<f32>,
     /// Empty components with no camera or light and fewer voxels than this are dropped.
     #[arg(long, default_value_t = 64)]
     pub min_component_voxels: u64,
@@ -140,6 +152,8 @@ pub fn run(args: BakeArgs) -> Result<()> {
         alpha: args.alpha,
         persistence: args.persistence,
         min_component_voxels: args.min_component_voxels,
+        min_gap_m: args.min_gap,
+        partition_voxel_m: args.partition_voxel,
         gate_placement: match args.gates {
             Gates::Narrowest => GatePlacement::Narrowest,
             Gates::Midpoint => GatePlacement::Midpoint,

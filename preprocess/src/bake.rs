@@ -9,15 +9,18 @@ use std::time::Instant;
 use serde::Serialize;
 use serde_json::{Value, json};
 use visgate_formats::Scene;
+use visgate_formats::scene::GeometryHash;
 use visgate_formats::scene::Light;
-use visgate_formats::vgate::{BakeInfo, BakeParams, BakedLevel};
+use visgate_formats::vgate::{BakeInfo, BakeParams, BakedLevel, GridMeta, Resolution, VoxelValues};
 
 use crate::BakeError;
 use crate::counters::VoxelizeCounts;
+use crate::empty::EmptySpace;
 use crate::empty::Seed;
 use crate::memory::StagePeak;
 pub use crate::memory::peak_memory_bytes;
 use crate::stages;
+use crate::thin::Thinned;
 use crate::voxelize::{SolidGrid, grid_for, voxelize};
 
 pub use crate::report::{BakeReport, StageReport, Summary};
@@ -149,6 +152,20 @@ fn check_params(p: &BakeParams) -> Result<(), BakeError> {
             p.portal_cell_voxels
         )));
     }
+    if let Some(g) = p.min_gap_m
+        && !(g.is_finite() && (0.0..=10.0).contains(&g))
+    {
+        return Err(BakeError::Param(format!(
+            "minimum gap {g} m must be in 0..=10 (a max-ball radius in metres; 0 keeps every gap)"
+        )));
+    }
+    if let Some(v) = p.partition_voxel_m
+        && !(v.is_finite() && (0.0..=10.0).contains(&v))
+    {
+        return Err(BakeError::Param(format!(
+            "partition voxel {v} m must be in 0..=10 (0 partitions the level's own grid)"
+        )));
+    }
     if let Some(persistence) = p.persistence
         && persistence > 10_000
     {
@@ -205,45 +222,47 @@ pub fn bake(
         };
         Ok(((solid, n), counts))
     })?;
-    let mut params = params.clone();
-    let persistence = params
-        .persistence
-        .unwrap_or_else(|| auto_persistence(meta.dims));
-    params.persistence = Some(persistence);
+    let mut params = level_scaled(params, input.bounds);
     let es = cx.stage("empty space", 0, |_| {
         stages::empty(scene, &meta, &solid.solid, &input.triangles, &params)
     })?;
     let solid = options.keep_solid_grid.then_some(solid);
-    let field = cx.stage("distance", 0, |_| {
-        Ok(stages::distance(&meta, &es, params.max_ball))
-    })?;
-    let thinned = cx.stage("thin", es.empty_voxels, |cx| {
-        Ok(stages::skeletonize(&es, &field, persistence, cx))
-    })?;
-    let radius_vx = field.whole_radii();
-    let skeleton_radius_vx = field.radii_vx(&thinned.skeleton);
-    drop(field);
-    let mut sk = cx.stage("skeleton graph", 0, |_| {
-        Ok(stages::skeleton(&meta, &es, &thinned, &skeleton_radius_vx))
-    })?;
-    let sg = cx.stage("segment", 0, |_| Ok(stages::segmentation(&sk, &params)))?;
-    let (step, cluster_account) =
-        stages::clusters_and_gates(&meta, &es, &radius_vx, &sk, &sg, &params, &mut cx)?;
-    let info = BakeInfo {
-        params: params.clone(),
-        geometry_hash: input.hash,
-        grid: meta,
-        tool_version: env!("CARGO_PKG_VERSION").to_string(),
+    let coarse = partition_grid(input.bounds, &meta, &params, options)?;
+    let part = match &coarse {
+        None => partition(&mut cx, &meta, &es, input.hash, &mut params)?,
+        Some(pm) => {
+            let pes = cx.stage("partition grid: voxelize, empty space", 0, |_| {
+                let s = voxelize(*pm, &input.triangles);
+                let (pes, counts) = stages::empty(scene, pm, &s.solid, &input.triangles, &params)?;
+                Ok((pes, counts))
+            })?;
+            let mut part = partition(&mut cx, pm, &pes, input.hash, &mut params)?;
+            let voxel_cluster = cx.stage("refine", 0, |_| {
+                let c = crate::refine::Coarse {
+                    meta: pm,
+                    empty: &pes.empty,
+                    voxel_cluster: &part.voxel_cluster,
+                };
+                Ok(crate::refine::refine(&meta, &es.empty, &c))
+            })?;
+            crate::refine::carry_level(&meta, &es.empty, &voxel_cluster, &mut part.level);
+            part.level.voxel_cluster = VoxelValues::pack(&voxel_cluster);
+            part.level.info.params = params.clone();
+            part.voxel_cluster = voxel_cluster;
+            part.empty = Some(pes);
+            part
+        }
     };
-    let (mut level, voxel_cluster) = cx.stage("flatten", 0, |_| {
-        Ok(stages::flatten(
-            &meta, &es, &radius_vx, &sk, &sg, &step, info,
-        ))
-    })?;
-    // The per-voxel grids are done with as soon as their last stage is: at 512³ each is
-    // 70–140 MB, and the stages after them would otherwise hold them to the end.
-    drop(radius_vx);
-    drop(std::mem::take(&mut sk.voxel_node));
+    let Partition {
+        mut level,
+        voxel_cluster,
+        thinned,
+        skeleton_counts,
+        segmented_counts,
+        cluster_account,
+        placements,
+        empty: partition_empty,
+    } = part;
     let found = cx.stage("portals", 0, |_| {
         Ok(stages::portals(
             &meta,
@@ -255,22 +274,26 @@ pub fn bake(
     drop(voxel_cluster);
     let uncovered = found.uncovered;
     level.topology.portals = found.portals;
+    let (top_meta, top_es) = match (&coarse, &partition_empty) {
+        (Some(pm), Some(pes)) => (pm, pes),
+        _ => (&meta, &es),
+    };
     let [empty_topology, skeleton_topology] = cx.stage("topology check", 0, |_| {
-        Ok(stages::topology_check(&meta, &es, &thinned))
+        Ok(stages::topology_check(top_meta, top_es, &thinned))
     })?;
     let summary = Summary {
         voxels: es.empty.len() as u64,
         solid_voxels,
         empty_voxels: es.empty_voxels,
-        skeleton_nodes: sk.graph.voxels.len() as u64,
-        segmented_nodes: sg.counts,
+        skeleton_nodes: skeleton_counts[0],
+        segmented_nodes: segmented_counts,
         clusters: level.topology.clusters.len() as u64,
         clusters_grown_split_merged: cluster_account,
         gates: level.topology.gates.len() as u64,
         portals: level.topology.portals.len() as u64,
         uncovered_interface_faces: uncovered,
-        cycles: sk.cycles,
-        components: sk.components,
+        cycles: skeleton_counts[1],
+        components: skeleton_counts[2],
     };
     let stages = cx.into_stages();
     let report = BakeReport {
@@ -291,7 +314,17 @@ pub fn bake(
             "hung_objects": es.threads,
             "seeds_outside_grid": es.seeds_outside,
         }),
-        gate_placements: step.placements_json(),
+        gate_placements: placements,
+    };
+    let skeleton = match coarse {
+        None => thinned.skeleton,
+        Some(_) => {
+            let t = &level.topology.skeleton.nodes;
+            let mut v: Vec<u32> = t.iter().map(|n| meta.index(n.voxel) as u32).collect();
+            v.sort_unstable();
+            v.dedup();
+            v
+        }
     };
     Ok(Baked {
         level,
@@ -299,8 +332,124 @@ pub fn bake(
         openings: es.openings,
         grids: BakeGrids {
             solid,
+            skeleton,
             empty: es.empty,
-            skeleton: thinned.skeleton,
         },
+    })
+}
+
+/// What the partition's stages made: the level on the grid they ran on, each voxel's cluster
+/// and the counts the summary reads.
+struct Partition {
+    level: BakedLevel,
+    voxel_cluster: Vec<u32>,
+    thinned: Thinned,
+    /// Skeleton nodes, cycles, components.
+    skeleton_counts: [u64; 3],
+    segmented_counts: [u64; 5],
+    cluster_account: [u64; 3],
+    placements: Vec<Value>,
+    /// The partition grid's empty space, when it is not the level's grid.
+    empty: Option<EmptySpace>,
+}
+
+/// The default minimum gap ([`BakeParams::min_gap_m`]), unless the level is small.
+/// [Units: m]
+pub const MIN_GAP_M: f32 = 0.15;
+/// The default partition voxel ([`BakeParams::partition_voxel_m`]), unless the level is small.
+/// [Units: m]
+pub const PARTITION_VOXEL_M: f32 = 0.125;
+/// The default sizes that shape the partition are at most 1/this of the level's longest
+/// extent: a small level (a few rooms) keeps the detail of its doors and furniture, and a
+/// level whose units were declared wrong (a model in millimetres read as metres) is
+/// partitioned as at its true scale.
+pub const PARTITION_MIN_VOXELS: u32 = 256;
+
+/// `params` with the minimum gap and the partition voxel it leaves to the bake filled in (see
+/// [`PARTITION_MIN_VOXELS`]): the values used, which the file records.
+fn level_scaled(params: &BakeParams, bounds: (glam::Vec3, glam::Vec3)) -> BakeParams {
+    let scale = (bounds.1 - bounds.0).max_element() / PARTITION_MIN_VOXELS as f32;
+    BakeParams {
+        min_gap_m: Some(params.min_gap_m.unwrap_or(MIN_GAP_M.min(scale))),
+        partition_voxel_m: Some(
+            params
+                .partition_voxel_m
+                .unwrap_or(PARTITION_VOXEL_M.min(scale)),
+        ),
+        ..params.clone()
+    }
+}
+
+/// The partition grid: the level's bounds at [`BakeParams::partition_voxel_m`], when that is
+/// coarser than the level's voxels (by more than 1 %); `None` partitions the level's grid.
+fn partition_grid(
+    bounds: (glam::Vec3, glam::Vec3),
+    meta: &GridMeta,
+    params: &BakeParams,
+    options: &BakeOptions,
+) -> Result<Option<GridMeta>, BakeError> {
+    let size = params.partition_voxel_m.unwrap_or(0.0);
+    if size <= 1.01 * meta.voxel_size_m {
+        return Ok(None);
+    }
+    let pm = grid_for(
+        bounds,
+        Resolution::VoxelSizeM(size),
+        options.memory_limit_bytes,
+    )?;
+    Ok(Some(pm))
+}
+
+/// Stages 4–10 on grid `meta` with its empty space: distance, thinning, skeleton graph,
+/// segmentation, clusters, gates and the voxels' clusters. Sets the persistence in `params`
+/// when it was left to the bake.
+fn partition(
+    cx: &mut BakeContext,
+    meta: &GridMeta,
+    es: &EmptySpace,
+    hash: GeometryHash,
+    params: &mut BakeParams,
+) -> Result<Partition, BakeError> {
+    let persistence = params
+        .persistence
+        .unwrap_or_else(|| auto_persistence(meta.dims));
+    params.persistence = Some(persistence);
+    let field = cx.stage("distance", 0, |_| {
+        Ok(stages::distance(meta, es, params.max_ball))
+    })?;
+    let thinned = cx.stage("thin", es.empty_voxels, |cx| {
+        Ok(stages::skeletonize(es, &field, persistence, cx))
+    })?;
+    let radius_vx = field.whole_radii();
+    let skeleton_radius_vx = field.radii_vx(&thinned.skeleton);
+    drop(field);
+    let mut sk = cx.stage("skeleton graph", 0, |_| {
+        Ok(stages::skeleton(meta, es, &thinned, &skeleton_radius_vx))
+    })?;
+    let sg = cx.stage("segment", 0, |_| Ok(stages::segmentation(&sk, params)))?;
+    let (step, cluster_account) =
+        stages::clusters_and_gates(meta, es, &radius_vx, &sk, &sg, params, cx)?;
+    let info = BakeInfo {
+        params: params.clone(),
+        geometry_hash: hash,
+        grid: *meta,
+        tool_version: env!("CARGO_PKG_VERSION").to_string(),
+    };
+    let (level, voxel_cluster) = cx.stage("flatten", 0, |_| {
+        Ok(stages::flatten(meta, es, &radius_vx, &sk, &sg, &step, info))
+    })?;
+    // The per-voxel grids are done with as soon as their last stage is: at 512³ each is
+    // 70–140 MB, and the stages after them would otherwise hold them to the end.
+    drop(radius_vx);
+    drop(std::mem::take(&mut sk.voxel_node));
+    Ok(Partition {
+        level,
+        voxel_cluster,
+        thinned,
+        skeleton_counts: [sk.graph.voxels.len() as u64, sk.cycles, sk.components],
+        segmented_counts: sg.counts,
+        cluster_account,
+        placements: step.placements_json(),
+        empty: None,
     })
 }

@@ -95,6 +95,12 @@ pub struct SegmentCounts {
     pub narrowing: u64,
     /// Segmented edges.
     pub edges: usize,
+    /// Skeleton cycles opened at a gap narrower than the minimum gap ([`crate::simplify`]).
+    pub thin_cycles_opened: u64,
+    /// Skeleton nodes pruned with them (thin branches and what was left of opened cycles).
+    pub nodes_pruned: u64,
+    /// The minimum gap. [Units: m]
+    pub min_gap_m: f32,
 }
 
 /// Stage 8, clusters.

@@ -283,10 +283,45 @@ fn join_pieces(input: &FlattenInput, skel_cluster: &[u32], voxel_cluster: &mut [
 fn cluster_boxes(input: &FlattenInput, voxel_cluster: &[u32]) -> Vec<Cluster> {
     let (meta, vs) = (input.meta, input.meta.voxel_size_m);
     let nc = input.seeds_of.len();
+    let (vlo, vhi) = voxel_bounds(meta, input.empty, voxel_cluster, nc);
+    input
+        .seeds_of
+        .iter()
+        .enumerate()
+        .map(|(c, &seed)| {
+            let p = input.position[seed_node(input, seed)];
+            // No empty voxel of its own (infinite box): the seed's voxel.
+            let (lo, hi) = if vlo[c][0] == u32::MAX {
+                ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3])
+            } else {
+                let (a, b) = (meta.voxel_to_world(vlo[c]), meta.voxel_to_world(vhi[c]));
+                (a.map(|x| x - 0.5 * vs), b.map(|x| x + 0.5 * vs))
+            };
+            let fix = |v: [f32; 3], d: f32| -> [f32; 3] {
+                std::array::from_fn(|a| if v[a].is_finite() { v[a] } else { p[a] + d })
+            };
+            Cluster {
+                seed,
+                bounds_min_m: fix(lo, -0.5 * vs),
+                bounds_max_m: fix(hi, 0.5 * vs),
+            }
+        })
+        .collect()
+}
+
+/// The voxel bounds (min, max corner) of each of `clusters` clusters' empty voxels; a cluster
+/// without any keeps `u32::MAX` as its minimum.
+pub fn voxel_bounds(
+    meta: &GridMeta,
+    empty: &[bool],
+    voxel_cluster: &[u32],
+    clusters: usize,
+) -> (Vec<[u32; 3]>, Vec<[u32; 3]>) {
+    let nc = clusters;
     let slab = (meta.dims[0] * meta.dims[1]) as usize;
-    let (vlo, vhi) = voxel_cluster
+    voxel_cluster
         .par_chunks(slab)
-        .zip(input.empty.par_chunks(slab))
+        .zip(empty.par_chunks(slab))
         .enumerate()
         .fold(
             || (vec![[u32::MAX; 3]; nc], vec![[0u32; 3]; nc]),
@@ -315,28 +350,5 @@ fn cluster_boxes(input: &FlattenInput, voxel_cluster: &[u32]) -> Vec<Cluster> {
                 }
                 (lo, hi)
             },
-        );
-    input
-        .seeds_of
-        .iter()
-        .enumerate()
-        .map(|(c, &seed)| {
-            let p = input.position[seed_node(input, seed)];
-            // No empty voxel of its own (infinite box): the seed's voxel.
-            let (lo, hi) = if vlo[c][0] == u32::MAX {
-                ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3])
-            } else {
-                let (a, b) = (meta.voxel_to_world(vlo[c]), meta.voxel_to_world(vhi[c]));
-                (a.map(|x| x - 0.5 * vs), b.map(|x| x + 0.5 * vs))
-            };
-            let fix = |v: [f32; 3], d: f32| -> [f32; 3] {
-                std::array::from_fn(|a| if v[a].is_finite() { v[a] } else { p[a] + d })
-            };
-            Cluster {
-                seed,
-                bounds_min_m: fix(lo, -0.5 * vs),
-                bounds_max_m: fix(hi, 0.5 * vs),
-            }
-        })
-        .collect()
+        )
 }

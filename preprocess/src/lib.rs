@@ -4,14 +4,14 @@
 //! space (border solid, enclosed voids and small unlit components dropped, leaks reported) →
 //! exact Euclidean distance transform → topology-preserving curvilinear thinning (asymmetric
 //! critical kernels with 1D isthmuses and persistence) → skeleton graph and nearest-node grid
-//! → segmentation (topology, curvature and coverage nodes) → visibility clusters (greedy, α)
+//! → the skeleton without gaps narrower than a size in metres → segmentation (topology, curvature and coverage nodes) → visibility clusters (greedy, α)
 //! → visibility gates → the runtime layout of `visgate_formats::vgate`.
 //!
 //! Each stage is a function from plain data to new plain data with its own params struct.
 //! This crate never imports `visgate-runtime`; what the two share is a type in
 //! `visgate-formats`.
 //!
-//! Stages: [`voxelize`], [`empty`], [`distance`], [`thin`], [`graph`], [`segment`],
+//! Stages: [`voxelize`], [`empty`], [`distance`], [`thin`], [`graph`], [`simplify`], [`segment`],
 //! [`clusters`] (clusters and gates); [`bake::bake`] runs them all, timed and counted, and
 //! [`debug`] writes what each produced in formats Blender and MeshLab open.
 
@@ -30,9 +30,11 @@ pub mod leak;
 pub mod memory;
 pub mod neighbourhood;
 pub mod portals;
+pub mod refine;
 pub mod report;
 pub mod segment;
 pub mod sightline;
+pub mod simplify;
 pub mod stages;
 pub mod thin;
 pub mod voxelize;

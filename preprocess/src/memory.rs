@@ -77,6 +77,8 @@ mod tests {
         let stage = StagePeak::start();
         // Touched, so that it is resident (a zeroed allocation would map pages lazily).
         let held: Vec<u8> = (0..64usize << 20).map(|i| i as u8).collect();
+        // Kept alive past the sample, or an optimised build drops the allocation.
+        std::hint::black_box(&held);
         let peak = stage.finish().expect("Linux tells the resident set");
         assert!(peak >= 64 << 20, "{peak} bytes");
         assert!(peak_memory_bytes().is_some_and(|p| p >= peak), "{peak}");

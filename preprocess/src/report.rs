@@ -153,6 +153,20 @@ impl BakeReport {
             self.params.max_ball,
             self.params.curvature_to
         );
+        let pv = self.params.partition_voxel_m.unwrap_or(0.0);
+        s += &format!(
+            "partition: {}; gaps under {:.3} m left out of it\n",
+            if pv > 1.01 * self.grid.voxel_size_m {
+                format!(
+                    "made on a {pv:.3} m grid (its topology below), each {:.4} m voxel given the \
+                     cluster of its space",
+                    self.grid.voxel_size_m
+                )
+            } else {
+                "made on the level's grid".to_string()
+            },
+            self.params.min_gap_m.unwrap_or(0.0)
+        );
         let (e, k) = (&self.empty_topology, &self.skeleton_topology);
         s += &format!(
             "topology: empty space {} components / {} cycles / {} cavities, skeleton {} / {} / {}{}\n",

@@ -57,22 +57,27 @@ pub struct Segmented {
 }
 
 /// Segments a skeleton graph given by sorted adjacency lists, node positions and max-ball
-/// radii (same units as the positions).
+/// radii (same units as the positions). With `attach` (from [`crate::simplify`]), a node
+/// attached to another is no part of the graph: it takes the segmented node of the node it is
+/// attached to.
 pub fn segment(
     adjacency: &[Vec<u32>],
+    attach: Option<&[u32]>,
     position: &[Vec3],
     radius: &[f32],
     params: &SegmentParams,
 ) -> Segmented {
     let n = adjacency.len();
+    let removed = |i: usize| attach.is_some_and(|a| a[i] as usize != i);
     let mut kind: Vec<Option<SegNodeKind>> = adjacency
         .iter()
-        .map(|a| (a.len() != 2).then_some(SegNodeKind::Topology))
+        .enumerate()
+        .map(|(i, a)| (a.len() != 2 && !removed(i)).then_some(SegNodeKind::Topology))
         .collect();
     // Bare loops: give each an extremity.
     let mut seen = vec![false; n];
     for start in 0..n {
-        if seen[start] {
+        if seen[start] || removed(start) {
             continue;
         }
         let mut comp = vec![start as u32];
@@ -239,6 +244,13 @@ pub fn segment(
             path: line,
         });
     }
+    if let Some(attach) = attach {
+        for (i, &a) in attach.iter().enumerate() {
+            if a as usize != i {
+                node_segment[i] = node_segment[a as usize];
+            }
+        }
+    }
     Segmented {
         skeleton: SegmentedSkeleton { nodes, edges },
         node_segment,
@@ -288,7 +300,7 @@ mod tests {
     fn a_straight_line_of_wide_balls_keeps_its_ends_only() {
         let adj = chain(10);
         let pos: Vec<Vec3> = (0..10).map(|i| Vec3::new(i as f32, 0.0, 0.0)).collect();
-        let s = segment(&adj, &pos, &[10.0; 10], &SegmentParams::default());
+        let s = segment(&adj, None, &pos, &[10.0; 10], &SegmentParams::default());
         assert_eq!(s.skeleton.nodes.len(), 2);
         assert_eq!(s.skeleton.edges.len(), 1);
         assert_eq!(s.skeleton.edges[0].path.len(), 10);
@@ -308,7 +320,7 @@ mod tests {
                 curvature_to,
                 ..SegmentParams::default()
             };
-            let s = segment(&adj, &pos, &radius, &p);
+            let s = segment(&adj, None, &pos, &radius, &p);
             s.skeleton
                 .nodes
                 .iter()
@@ -334,7 +346,7 @@ mod tests {
                 }
             })
             .collect();
-        let s = segment(&adj, &pos, &[1.0; 11], &SegmentParams::default());
+        let s = segment(&adj, None, &pos, &[1.0; 11], &SegmentParams::default());
         let corner = s.skeleton.nodes.iter().find(|n| n.skeleton_node == 5);
         assert_eq!(corner.map(|n| n.kind), Some(SegNodeKind::Curvature));
         assert!(

@@ -24,6 +24,7 @@ use crate::graph::{SkeletonGraph, nearest_node, skeleton_graph};
 use crate::neighbourhood::{Betti, betti};
 use crate::portals::Portals;
 use crate::segment::{SegmentParams, Segmented, segment};
+use crate::simplify::simplify;
 use crate::thin::{ThinParams, Thinned, extend_ends, thin};
 use crate::{BakeError, distance};
 
@@ -239,23 +240,32 @@ pub fn skeleton(
 pub struct SegmentStage {
     /// The segmentation.
     pub seg: Segmented,
-    /// The skeleton graph's sorted adjacency lists.
+    /// The skeleton graph's sorted adjacency lists, without the pruned nodes and opened edges.
     pub adjacency: Vec<Vec<u32>>,
     /// Nodes: all, topology, curvature, coverage, narrowing.
     pub counts: [u64; 5],
 }
 
-/// Stage 7: segmentation (IV.B.1).
+/// Stage 7: segmentation (IV.B.1) of the skeleton graph without its thin gaps
+/// ([`crate::simplify`]).
 pub fn segmentation(
     sk: &SkeletonStage,
     params: &BakeParams,
 ) -> Counted<SegmentStage, SegmentCounts> {
-    let adjacency = sk.graph.adjacency();
+    let min_gap_m = params.min_gap_m.unwrap_or(0.0);
+    let simple = simplify(&sk.graph.adjacency(), &sk.radius, min_gap_m);
     let seg_params = SegmentParams {
         curvature_to: params.curvature_to,
         ..SegmentParams::default()
     };
-    let seg = segment(&adjacency, &sk.position, &sk.radius, &seg_params);
+    let seg = segment(
+        &simple.adjacency,
+        Some(&simple.attach),
+        &sk.position,
+        &sk.radius,
+        &seg_params,
+    );
+    let adjacency = simple.adjacency;
     let count_kind =
         |k: SegNodeKind| seg.skeleton.nodes.iter().filter(|n| n.kind == k).count() as u64;
     let n = [
@@ -272,6 +282,9 @@ pub fn segmentation(
         coverage: n[3],
         narrowing: n[4],
         edges: seg.skeleton.edges.len(),
+        thin_cycles_opened: simple.cycles_opened,
+        nodes_pruned: simple.nodes_removed,
+        min_gap_m,
     };
     let stage = SegmentStage {
         seg,

@@ -44,7 +44,7 @@ pub use values::{Elem, VoxelValues};
 /// The first eight bytes of every `.vgate` file.
 pub const MAGIC: [u8; 8] = *b"VGATE\r\n\x1a";
 /// The format version this build writes and reads.
-pub const FORMAT_VERSION: u32 = 4;
+pub const FORMAT_VERSION: u32 = 5;
 /// "No node / no cluster" in a grid decoded to u32.
 pub const NONE: u32 = u32::MAX;
 

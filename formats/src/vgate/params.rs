@@ -79,6 +79,18 @@ pub struct BakeParams {
     pub allow_leaks: bool,
     /// Edge of a portal's coverage-mask cell. [Limit: [0.25, 8]] [Units: voxels]
     pub portal_cell_voxels: f32,
+    /// Skeleton cycles through gaps narrower than this are opened and skeleton branches
+    /// narrower than it pruned before the segmentation, so that the partition does not depend
+    /// on which cracks the resolution opens; 0 keeps the whole skeleton (the paper's). `None`
+    /// asks the bake for 0.15 m or 1/256 of the level's longest extent, whichever is smaller;
+    /// a baked file stores the value used. [Limit: [0, 10]] [Units: m, max-ball radius]
+    pub min_gap_m: Option<f32>,
+    /// The skeleton, clusters and gates are made on a grid of this voxel size when the
+    /// level's voxels are finer, and each fine voxel then takes the cluster of its space: the
+    /// partition stays that of this scale at any finer resolution. 0 partitions the level's
+    /// own grid. `None` asks the bake for 0.125 m or 1/256 of the level's longest extent,
+    /// whichever is smaller; a baked file stores the value used. [Limit: [0, 10]] [Units: m]
+    pub partition_voxel_m: Option<f32>,
 }
 
 impl Default for BakeParams {
@@ -94,6 +106,8 @@ impl Default for BakeParams {
             curvature_to: CurvatureTo::Line,
             allow_leaks: false,
             portal_cell_voxels: 1.0,
+            min_gap_m: None,
+            partition_voxel_m: None,
         }
     }
 }

@@ -1,0 +1,262 @@
+//! The partition carried from the partition grid to the level's grid.
+//!
+//! When the level's voxels are finer than the partition's size (`--partition-voxel`), the
+//! skeleton, the clusters and the gates are made on a coarser grid of the same bounds, and
+//! this stage gives every voxel of the fine grid its cluster:
+//!
+//! 1. a fine empty voxel whose centre lies in an empty coarse voxel takes that voxel's
+//!    cluster (a coarse empty voxel holds no geometry, so no wall separates the two);
+//! 2. the fine empty voxels left — in coarse voxels that the conservative voxelization made
+//!    solid: beside walls, in gaps and openings only the fine grid resolves — are flooded
+//!    breadth-first through the fine empty space (26-neighbours, in voxel order), so a voxel
+//!    beside a thin wall takes the cluster of its own side;
+//! 3. the solid voxels within [`SOLID_SHELL_VOXELS`] steps of the empty space take a cluster the
+//!    same way, as the nearest-node grid gives them on a single grid (a surface point is looked
+//!    up half a voxel towards its normal or in its solid voxel).
+//!
+//! Fine empty voxels no flood reaches (space the coarse grid closed off entirely) keep no
+//! cluster and are counted.
+
+use rayon::prelude::*;
+use serde::Serialize;
+use visgate_formats::vgate::{BakedLevel, GridMeta};
+
+use crate::graph::SOLID_SHELL_VOXELS;
+
+/// The partition grid's result to carry.
+pub struct Coarse<'a> {
+    /// Its grid.
+    pub meta: &'a GridMeta,
+    /// Its kept empty voxels.
+    pub empty: &'a [bool],
+    /// Each of its voxels' cluster (`u32::MAX`: none).
+    pub voxel_cluster: &'a [u32],
+}
+
+/// What [`refine`] did.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct RefineCounts {
+    /// Fine empty voxels that took their coarse voxel's cluster.
+    pub from_coarse: u64,
+    /// Fine empty voxels flooded from their neighbours.
+    pub flooded: u64,
+    /// Fine empty voxels no flood reached: they keep no cluster.
+    pub unreached: u64,
+    /// Solid voxels of the shell given a cluster.
+    pub shell: u64,
+    /// Voxel edge of the partition grid. [Units: m]
+    pub partition_voxel_m: f32,
+}
+
+/// Each fine voxel's cluster (see the module notes).
+pub fn refine(meta: &GridMeta, empty: &[bool], coarse: &Coarse) -> (Vec<u32>, RefineCounts) {
+    let [nx, ny, _] = meta.dims.map(|d| d as usize);
+    let slab = nx * ny;
+    let mut cluster: Vec<u32> = vec![u32::MAX; empty.len()];
+    cluster
+        .par_chunks_mut(slab)
+        .zip(empty.par_chunks(slab))
+        .enumerate()
+        .for_each(|(z, (cs, es))| {
+            for (i, (c, &e)) in cs.iter_mut().zip(es).enumerate() {
+                if !e {
+                    continue;
+                }
+                let v = [(i % nx) as u32, (i / nx) as u32, z as u32];
+                let Some(cv) = coarse.meta.world_to_voxel(meta.voxel_to_world(v)) else {
+                    continue;
+                };
+                let ci = coarse.meta.index(cv);
+                if coarse.empty[ci] {
+                    *c = coarse.voxel_cluster[ci];
+                }
+            }
+        });
+    let from_coarse = cluster.par_iter().filter(|&&c| c != u32::MAX).count() as u64;
+    let flooded = flood(meta, &mut cluster, &|j| empty[j], usize::MAX);
+    let unreached = empty
+        .par_iter()
+        .zip(&cluster)
+        .filter(|&(&e, &c)| e && c == u32::MAX)
+        .count() as u64;
+    let shell = flood(
+        meta,
+        &mut cluster,
+        &|j| !empty[j],
+        SOLID_SHELL_VOXELS as usize,
+    );
+    let counts = RefineCounts {
+        from_coarse,
+        flooded,
+        unreached,
+        shell,
+        partition_voxel_m: coarse.meta.voxel_size_m,
+    };
+    (cluster, counts)
+}
+
+/// Sets each cluster's bounds to those of its voxels on the fine grid (a cluster without any
+/// keeps the bounds it had), and every skeleton node's voxel to the fine voxel holding it.
+pub fn carry_level(meta: &GridMeta, empty: &[bool], voxel_cluster: &[u32], level: &mut BakedLevel) {
+    let t = &mut level.topology;
+    let (lo, hi) = crate::flatten::voxel_bounds(meta, empty, voxel_cluster, t.clusters.len());
+    let h = 0.5 * meta.voxel_size_m;
+    for (c, cl) in t.clusters.iter_mut().enumerate() {
+        if lo[c][0] != u32::MAX {
+            cl.bounds_min_m = meta.voxel_to_world(lo[c]).map(|x| x - h);
+            cl.bounds_max_m = meta.voxel_to_world(hi[c]).map(|x| x + h);
+        }
+    }
+    for n in &mut t.skeleton.nodes {
+        let v: [f32; 3] = std::array::from_fn(|a| {
+            ((n.position_m[a] - meta.origin_m[a]) / meta.voxel_size_m)
+                .clamp(0.0, (meta.dims[a] - 1) as f32)
+        });
+        n.voxel = v.map(|c| c as u32);
+    }
+    level.info.grid = *meta;
+}
+
+/// Breadth-first flood of the clusters into the voxels without one that `open` accepts, at
+/// most `rounds` steps from the voxels that have one; returns the voxels given a cluster. Each
+/// round, every such voxel beside a voxel with a cluster takes the first one in neighbour
+/// order (from the round before: the result does not depend on the threads). The grid's
+/// outer layer is never entered.
+fn flood(
+    meta: &GridMeta,
+    cluster: &mut [u32],
+    open: &(dyn Fn(usize) -> bool + Sync),
+    rounds: usize,
+) -> u64 {
+    let [nx, ny, nz] = meta.dims.map(|d| d as usize);
+    let off: Vec<isize> = (0..27)
+        .filter(|&k| k != 13)
+        .map(|k: isize| {
+            (k % 3 - 1) + ((k / 3) % 3 - 1) * nx as isize + (k / 9 - 1) * (nx * ny) as isize
+        })
+        .collect();
+    let inner = |j: usize| {
+        let (x, y, z) = (j % nx, (j / nx) % ny, j / (nx * ny));
+        x > 0 && y > 0 && z > 0 && x + 1 < nx && y + 1 < ny && z + 1 < nz
+    };
+    let shared: &[u32] = cluster;
+    let mut left: Vec<u32> = (0..shared.len())
+        .into_par_iter()
+        .filter(|&j| shared[j] == u32::MAX && open(j) && inner(j))
+        .map(|j| j as u32)
+        .collect();
+    let mut given = 0u64;
+    for _ in 0..rounds {
+        let shared: &[u32] = cluster;
+        let got: Vec<(u32, u32)> = left
+            .par_iter()
+            .filter_map(|&j| {
+                off.iter()
+                    .map(|&o| shared[(j as isize + o) as usize])
+                    .find(|&c| c != u32::MAX)
+                    .map(|c| (j, c))
+            })
+            .collect();
+        if got.is_empty() {
+            break;
+        }
+        for &(j, c) in &got {
+            cluster[j as usize] = c;
+        }
+        given += got.len() as u64;
+        let shared: &[u32] = cluster;
+        left = left
+            .into_par_iter()
+            .filter(|&j| shared[j as usize] == u32::MAX)
+            .collect();
+    }
+    given
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn meta(dims: [u32; 3], voxel: f32) -> GridMeta {
+        GridMeta {
+            origin_m: [0.0; 3],
+            voxel_size_m: voxel,
+            dims,
+        }
+    }
+
+    #[test]
+    fn a_thin_wall_keeps_each_side_its_cluster_and_the_shell_follows() {
+        // Coarse 6³ voxels of 2 m: empty inside, the x = 3 layer solid (the wall, which the
+        // fine grid resolves thinner), clusters 0 left and 1 right.
+        let cm = meta([6; 3], 2.0);
+        let mut ce = vec![false; 216];
+        let mut cc = vec![u32::MAX; 216];
+        for z in 1..5 {
+            for y in 1..5 {
+                for x in 1..5 {
+                    let i = cm.index([x, y, z]);
+                    if x != 3 {
+                        ce[i] = true;
+                        cc[i] = u32::from(x > 3);
+                    }
+                }
+            }
+        }
+        // Fine 12³ voxels of 1 m: the wall is the x = 7 layer only.
+        let fm = meta([12; 3], 1.0);
+        let mut fe = vec![false; 1728];
+        for z in 2..10 {
+            for y in 2..10 {
+                for x in 2..10 {
+                    fe[fm.index([x, y, z])] = x != 7;
+                }
+            }
+        }
+        let coarse = Coarse {
+            meta: &cm,
+            empty: &ce,
+            voxel_cluster: &cc,
+        };
+        let (c, n) = refine(&fm, &fe, &coarse);
+        assert_eq!(n.unreached, 0);
+        assert!(n.flooded > 0, "x = 6 lies in the coarse wall");
+        for z in 2..10 {
+            for y in 2..10 {
+                for x in 2..10 {
+                    let got = c[fm.index([x, y, z])];
+                    match x {
+                        7 => assert!(got <= 1, "the wall is shell"),
+                        _ => assert_eq!(got, u32::from(x > 7), "{x} {y} {z}"),
+                    }
+                }
+            }
+        }
+        // The shell reaches two voxels into the solid around the room, no further.
+        assert_ne!(c[fm.index([1, 5, 5])], u32::MAX);
+        assert_eq!(c[fm.index([0, 5, 5])], u32::MAX, "the outer layer");
+        assert!(n.shell > 0);
+    }
+
+    #[test]
+    fn space_the_coarse_grid_closed_keeps_no_cluster_and_is_counted() {
+        let cm = meta([4; 3], 2.0);
+        let ce = vec![false; 64];
+        let cc = vec![u32::MAX; 64];
+        let fm = meta([8; 3], 1.0);
+        let mut fe = vec![false; 512];
+        fe[fm.index([3, 3, 3])] = true;
+        fe[fm.index([4, 3, 3])] = true;
+        let coarse = Coarse {
+            meta: &cm,
+            empty: &ce,
+            voxel_cluster: &cc,
+        };
+        let (c, n) = refine(&fm, &fe, &coarse);
+        assert_eq!(
+            (n.from_coarse, n.flooded, n.unreached, n.shell),
+            (0, 0, 2, 0)
+        );
+        assert!(c.iter().all(|&x| x == u32::MAX));
+    }
+}
