@@ -159,6 +159,13 @@ fn check_params(p: &BakeParams) -> Result<(), BakeError> {
             "minimum gap {g} m must be in 0..=10 (a max-ball radius in metres; 0 keeps every gap)"
         )));
     }
+    if let Some(v) = p.min_cluster_ball_m
+        && !(v.is_finite() && (0.0..=10.0).contains(&v))
+    {
+        return Err(BakeError::Param(format!(
+            "smallest cluster ball {v} m must be in 0..=10 (a radius in metres; 0 merges none)"
+        )));
+    }
     if let Some(v) = p.partition_voxel_m
         && !(v.is_finite() && (0.0..=10.0).contains(&v))
     {
@@ -269,6 +276,7 @@ pub fn bake(
             &es,
             &voxel_cluster,
             params.portal_cell_voxels,
+            coarse.map_or(meta.voxel_size_m, |c| c.voxel_size_m),
         ))
     })?;
     drop(voxel_cluster);
@@ -353,9 +361,10 @@ struct Partition {
     empty: Option<EmptySpace>,
 }
 
-/// The default minimum gap ([`BakeParams::min_gap_m`]), unless the level is small.
+/// The default minimum gap ([`BakeParams::min_gap_m`]: half the width of a gap, 20 cm wide),
+/// unless the level is small.
 /// [Units: m]
-pub const MIN_GAP_M: f32 = 0.15;
+pub const MIN_GAP_M: f32 = 0.1;
 /// The default partition voxel ([`BakeParams::partition_voxel_m`]), unless the level is small.
 /// [Units: m]
 pub const PARTITION_VOXEL_M: f32 = 0.125;
@@ -368,8 +377,10 @@ pub const PARTITION_MIN_VOXELS: u32 = 256;
 /// `params` with the minimum gap and the partition voxel it leaves to the bake filled in (see
 /// [`PARTITION_MIN_VOXELS`]): the values used, which the file records.
 fn level_scaled(params: &BakeParams, bounds: (glam::Vec3, glam::Vec3)) -> BakeParams {
-    let scale = (bounds.1 - bounds.0).max_element() / PARTITION_MIN_VOXELS as f32;
+    let longest = (bounds.1 - bounds.0).max_element();
+    let scale = longest / PARTITION_MIN_VOXELS as f32;
     BakeParams {
+        min_cluster_ball_m: Some(params.min_cluster_ball_m.unwrap_or(0.0)),
         min_gap_m: Some(params.min_gap_m.unwrap_or(MIN_GAP_M.min(scale))),
         partition_voxel_m: Some(
             params
@@ -426,7 +437,9 @@ fn partition(
     let mut sk = cx.stage("skeleton graph", 0, |_| {
         Ok(stages::skeleton(meta, es, &thinned, &skeleton_radius_vx))
     })?;
-    let sg = cx.stage("segment", 0, |_| Ok(stages::segmentation(&sk, params)))?;
+    let sg = cx.stage("segment", 0, |_| {
+        Ok(stages::segmentation(meta, &sk, params))
+    })?;
     let (step, cluster_account) =
         stages::clusters_and_gates(meta, es, &radius_vx, &sk, &sg, params, cx)?;
     let info = BakeInfo {

@@ -388,6 +388,34 @@ pub fn find_sliver(gates: &[GateDisk], cluster_radius: &[f32], alpha: f32) -> Op
     None
 }
 
+/// A cluster too small to stand alone: its largest max ball is below `min_radius`. Returns the
+/// smallest such cluster that has a gate (ties to the lower id) and the neighbour across its
+/// widest gate (ties to the lower id) to merge it into.
+pub fn find_small(
+    gates: &[GateDisk],
+    cluster_radius: &[f32],
+    min_radius: f32,
+) -> Option<(u32, u32)> {
+    let mut best: Option<(u32, u32, f32)> = None;
+    for (x, &r) in cluster_radius.iter().enumerate() {
+        if r >= min_radius || best.is_some_and(|(b, _, _)| cluster_radius[b as usize] <= r) {
+            continue;
+        }
+        let widest = gates
+            .iter()
+            .filter_map(|g| match g.clusters {
+                [a, b] if a as usize == x && b != a => Some((b, g.radius)),
+                [a, b] if b as usize == x && a != b => Some((a, g.radius)),
+                _ => None,
+            })
+            .max_by(|p, q| p.1.total_cmp(&q.1).then(q.0.cmp(&p.0)));
+        if let Some((into, _)) = widest {
+            best = Some((x as u32, into, r));
+        }
+    }
+    best.map(|(x, into, _)| (x, into))
+}
+
 /// Merges cluster `from` into `into`: relabels the segmented nodes, drops `from`'s seed and
 /// renumbers the clusters after it, so ids stay dense and in creation order.
 pub fn merge_cluster(node_cluster: &mut [u32], seeds: &mut Vec<u32>, from: u32, into: u32) {
@@ -494,6 +522,28 @@ mod tests {
         assert_eq!(count(AlphaRule::PoppedNode), 1);
         // Within 20 % of each cluster's widest: 1.0–0.8, 0.75–0.6, 0.55–0.45, 0.4–0.35, 0.3.
         assert_eq!(count(AlphaRule::ClusterMax), 5);
+    }
+
+    #[test]
+    fn a_cluster_too_small_to_stand_alone_merges_across_its_widest_gate() {
+        // Rooms 0 (2 m balls) and 2 (1.5 m) joined through a slab 1 (0.2 m) by gates of 1.0
+        // and 0.5 m, and a thin 3 (0.25 m) off room 2 by a 0.1 m gate.
+        let gates = [
+            gate([0.0; 3], [1.0, 0.0, 0.0], 1.0, [0, 1]),
+            gate([1.0, 0.0, 0.0], [1.0, 0.0, 0.0], 0.5, [1, 2]),
+            gate([2.0, 0.0, 0.0], [0.0, 1.0, 0.0], 0.1, [3, 2]),
+        ];
+        let radius = [2.0, 0.2, 1.5, 0.25];
+        // The smallest goes first, across its widest gate; then the next.
+        assert_eq!(find_small(&gates, &radius, 0.3), Some((1, 0)));
+        assert_eq!(find_small(&gates, &radius, 0.22), Some((1, 0)));
+        assert_eq!(
+            find_small(&gates, &[2.0, 0.4, 1.5, 0.25], 0.3),
+            Some((3, 2))
+        );
+        // None below the size, and a cluster without gates stays.
+        assert_eq!(find_small(&gates, &radius, 0.2), None);
+        assert_eq!(find_small(&gates[..1], &[2.0, 3.0, 1.5, 0.25], 0.3), None);
     }
 
     #[test]

@@ -123,6 +123,8 @@ pub struct GateCounts {
     pub gates: usize,
     /// Clusters merged as slivers.
     pub slivers_merged: u64,
+    /// Clusters merged because they hold no ball of the smallest cluster ball.
+    pub small_merged: u64,
     /// Clusters after merging.
     pub clusters: usize,
 }

@@ -5,7 +5,7 @@ use glam::Vec3;
 use serde_json::{Value, json};
 use visgate_formats::vgate::GatePlacement;
 
-use crate::clusters::{GateDisk, cluster_radius, find_sliver, gates, merge_cluster};
+use crate::clusters::{GateDisk, cluster_radius, find_sliver, find_small, gates, merge_cluster};
 use crate::segment::Segmented;
 
 /// What the gate step reads: the segmented skeleton, the skeleton graph's adjacency and each
@@ -33,6 +33,8 @@ pub struct GateStep {
     pub midpoint: Vec<GateDisk>,
     /// Clusters merged as slivers.
     pub slivers_merged: u64,
+    /// Clusters merged because no ball of `min_radius` fits in them.
+    pub small_merged: u64,
 }
 
 impl GateStep {
@@ -66,12 +68,15 @@ impl GateStep {
 }
 
 /// Merges the slivers of the clusters (`node_cluster`, `seeds_of`, greedy growth's) with
-/// clustering threshold `alpha`, then places the gates by both rules.
+/// clustering threshold `alpha`, then the clusters whose largest ball is below `min_radius`
+/// (same units as the radii; 0 merges none) into their widest neighbours, then places the
+/// gates by both rules.
 pub fn gate_step(
     input: &GateInput,
     mut node_cluster: Vec<u32>,
     mut seeds_of: Vec<u32>,
     alpha: f32,
+    min_radius: f32,
 ) -> GateStep {
     let seg = &input.seg.skeleton;
     let gates_by = |placement: GatePlacement, node_cluster: &[u32]| {
@@ -84,17 +89,22 @@ pub fn gate_step(
             placement,
         )
     };
-    let mut slivers_merged = 0u64;
+    let (mut slivers_merged, mut small_merged) = (0u64, 0u64);
     loop {
-        // Slivers are found with the narrowest-place gates whatever rule is stored, so both
-        // rules see the same clusters.
+        // Slivers (then small clusters) are found with the narrowest-place gates whatever rule
+        // is stored, so both rules see the same clusters.
         let g = gates_by(GatePlacement::Narrowest, &node_cluster);
         let cr = cluster_radius(seg, &node_cluster, input.radius, seeds_of.len());
-        let Some((from, into)) = find_sliver(&g, &cr, alpha) else {
+        let (from, into) = if let Some(m) = find_sliver(&g, &cr, alpha) {
+            slivers_merged += 1;
+            m
+        } else if let Some(m) = find_small(&g, &cr, min_radius) {
+            small_merged += 1;
+            m
+        } else {
             break;
         };
         merge_cluster(&mut node_cluster, &mut seeds_of, from, into);
-        slivers_merged += 1;
     }
     GateStep {
         narrowest: gates_by(GatePlacement::Narrowest, &node_cluster),
@@ -102,5 +112,6 @@ pub fn gate_step(
         node_cluster,
         seeds_of,
         slivers_merged,
+        small_merged,
     }
 }

@@ -24,8 +24,10 @@ struct Face {
     sign: f32,
 }
 
-/// Spread of a planar piece's faces about its plane, voxels.
-const PLANAR_SPREAD_VOXELS: f32 = 1.5;
+/// Spread of a planar piece's faces about its plane, in voxels of the grid the clusters were
+/// made on (the partition grid when the level's grid is finer: the refined interfaces are
+/// staircases of its voxels).
+pub const PLANAR_SPREAD_VOXELS: f32 = 1.5;
 /// Pieces of one pair, at most 2^MAX_DEPTH.
 const MAX_DEPTH: u32 = 6;
 
@@ -77,7 +79,7 @@ fn axis_vec(axis: usize) -> Vec3 {
 }
 
 /// The unit normal of a set of faces and whether they form one planar piece.
-fn plane_of(faces: &[Face], vs: f32) -> (Vec3, Vec3, bool) {
+fn plane_of(faces: &[Face], spread_m: f32) -> (Vec3, Vec3, bool) {
     let sum: Vec3 = faces.iter().map(|f| axis_vec(f.axis) * f.sign).sum();
     let centroid = faces.iter().map(|f| f.centre).sum::<Vec3>() / faces.len() as f32;
     let len = sum.length();
@@ -90,12 +92,12 @@ fn plane_of(faces: &[Face], vs: f32) -> (Vec3, Vec3, bool) {
         let d = (f.centre - centroid).dot(n);
         (lo.min(d), hi.max(d))
     });
-    (centroid, n, hi - lo <= PLANAR_SPREAD_VOXELS * vs)
+    (centroid, n, hi - lo <= spread_m)
 }
 
 /// Splits `faces` into planar pieces.
-fn pieces(mut faces: Vec<Face>, vs: f32, depth: u32, out: &mut Vec<Vec<Face>>) {
-    let (_, _, planar) = plane_of(&faces, vs);
+fn pieces(mut faces: Vec<Face>, spread_m: f32, depth: u32, out: &mut Vec<Vec<Face>>) {
+    let (_, _, planar) = plane_of(&faces, spread_m);
     if planar || depth >= MAX_DEPTH || faces.len() < 8 {
         out.push(faces);
         return;
@@ -113,8 +115,8 @@ fn pieces(mut faces: Vec<Face>, vs: f32, depth: u32, out: &mut Vec<Vec<Face>>) {
     };
     faces.sort_by(|a, b| a.centre[axis].total_cmp(&b.centre[axis]));
     let rest = faces.split_off(faces.len() / 2);
-    pieces(faces, vs, depth + 1, out);
-    pieces(rest, vs, depth + 1, out);
+    pieces(faces, spread_m, depth + 1, out);
+    pieces(rest, spread_m, depth + 1, out);
 }
 
 /// A frame (u, v) perpendicular to `n`.
@@ -141,7 +143,7 @@ fn corners(f: &Face, vs: f32) -> [Vec3; 4] {
 /// One portal from a planar piece: the faces' projections rasterised, each face marking every
 /// cell its projected square's bounds touch.
 fn portal_of(pair: (u32, u32), faces: &[Face], vs: f32, cell_voxels: f32) -> Portal {
-    let (centroid, n, _) = plane_of(faces, vs);
+    let (centroid, n, _) = plane_of(faces, f32::MAX);
     let (u, v) = frame(n);
     let uv = |p: Vec3| ((p - centroid).dot(u), (p - centroid).dot(v));
     let bounds = |f: &Face| {
@@ -225,12 +227,21 @@ pub struct Portals {
 
 /// The portals of a level: `empty` marks its empty voxels, `cluster` holds each voxel's
 /// cluster ([`NONE`] for none); each interface face is checked against its pair's portals.
-pub fn portals(meta: &GridMeta, empty: &[bool], cluster: &[u32], cell_voxels: f32) -> Portals {
+/// A piece is planar when its faces spread at most `spread_m` about its plane (at least
+/// [`PLANAR_SPREAD_VOXELS`] of this grid's voxels is used).
+pub fn portals(
+    meta: &GridMeta,
+    empty: &[bool],
+    cluster: &[u32],
+    cell_voxels: f32,
+    spread_m: f32,
+) -> Portals {
     let vs = meta.voxel_size_m;
+    let spread_m = spread_m.max(PLANAR_SPREAD_VOXELS * vs);
     let mut out = Portals::default();
     for (pair, faces) in interface_faces(meta, empty, cluster) {
         let mut parts = Vec::new();
-        pieces(faces.clone(), vs, 0, &mut parts);
+        pieces(faces.clone(), spread_m, 0, &mut parts);
         let mine: Vec<Portal> = parts
             .iter()
             .map(|p| portal_of(pair, p, vs, cell_voxels))
@@ -246,7 +257,7 @@ pub fn portals(meta: &GridMeta, empty: &[bool], cluster: &[u32], cell_voxels: f3
                 .map(|p| p.distance(c).abs())
                 .fold(f32::MAX, f32::min);
             out.uncovered += u64::from(!covered);
-            out.off_plane += u64::from(nearest > PLANAR_SPREAD_VOXELS * vs);
+            out.off_plane += u64::from(nearest > spread_m);
         }
         out.interface_faces += faces.len() as u64;
         out.portals.extend(mine);
@@ -278,7 +289,7 @@ mod tests {
                 u32::from(x + z >= 20)
             })
             .collect();
-        let out = portals(&meta, &empty, &cluster, 1.0);
+        let out = portals(&meta, &empty, &cluster, 1.0, 0.0);
         let ps = &out.portals;
         assert_eq!(ps.len(), 1, "{ps:?}");
         let nrm = Vec3::from(ps[0].normal);
@@ -313,7 +324,7 @@ mod tests {
                 empty[i as usize] = false;
             }
         }
-        let out = portals(&meta, &empty, &cluster, 1.0);
+        let out = portals(&meta, &empty, &cluster, 1.0, 0.0);
         let ps = &out.portals;
         assert!(ps.len() >= 2, "{}", ps.len());
         let (uncovered, total) = (out.uncovered, out.interface_faces);

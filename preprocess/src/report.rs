@@ -37,7 +37,7 @@ pub struct Summary {
     /// Visibility clusters.
     pub clusters: u64,
     /// Clusters the greedy growth made, split off where their nodes did not see each other,
-    /// and merged as slivers: `clusters = grown + split off − merged`.
+    /// and merged (as slivers or too small): `clusters = grown + split off − merged`.
     pub clusters_grown_split_merged: [u64; 3],
     /// Visibility gates.
     pub gates: u64,
@@ -140,7 +140,7 @@ impl BakeReport {
             "clusters {}  gates {}  portals {}  cycles {}  components {}  (alpha {} against {:?}, \
              persistence {}, gates at {:?}, max ball {:?}, curvature to {:?})\n\
              clusters: {grown} grown, {split} split off where their nodes did not see each other, \
-             {merged} merged as slivers\n",
+             {merged} merged as slivers or as too small to stand alone\n",
             m.clusters,
             m.gates,
             m.portals,

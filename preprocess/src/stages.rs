@@ -249,11 +249,15 @@ pub struct SegmentStage {
 /// Stage 7: segmentation (IV.B.1) of the skeleton graph without its thin gaps
 /// ([`crate::simplify`]).
 pub fn segmentation(
+    meta: &GridMeta,
     sk: &SkeletonStage,
     params: &BakeParams,
 ) -> Counted<SegmentStage, SegmentCounts> {
     let min_gap_m = params.min_gap_m.unwrap_or(0.0);
-    let simple = simplify(&sk.graph.adjacency(), &sk.radius, min_gap_m);
+    // The minimum gap is a contained ball's radius; a solid-centre radius is up to half a
+    // voxel larger, so that the same crack is measured alike at every resolution.
+    let measured = measured_radius(min_gap_m, meta, params.max_ball);
+    let simple = simplify(&sk.graph.adjacency(), &sk.radius, measured);
     let seg_params = SegmentParams {
         curvature_to: params.curvature_to,
         ..SegmentParams::default()
@@ -294,9 +298,18 @@ pub fn segmentation(
     (stage, counts)
 }
 
+/// A contained ball's radius `r` as the max-ball rule measures it: a solid-centre radius is up
+/// to half a voxel larger, so that the same crack is measured alike at every resolution.
+fn measured_radius(r: f32, meta: &GridMeta, max_ball: MaxBall) -> f32 {
+    match max_ball {
+        MaxBall::SolidCentre if r > 0.0 => r + 0.5 * meta.voxel_size_m,
+        _ => r,
+    }
+}
+
 /// Stages 8 and 9: the greedy clusters (IV.B.2) split where their nodes do not see each other,
 /// then the gates (both rules) after merging slivers; with the clusters' account (grown, split
-/// off, merged as slivers).
+/// off, merged as slivers or too small).
 pub fn clusters_and_gates(
     meta: &GridMeta,
     es: &EmptySpace,
@@ -344,13 +357,18 @@ pub fn clusters_and_gates(
             position: &sk.position,
             radius: &sk.radius,
         };
-        let step = gate_step(&input, node_cluster, seeds_of, params.alpha);
+        let min_ball = params.min_cluster_ball_m.unwrap_or(0.0);
+        // Compared with the radii as measured: at a coarse grid a solid-centre radius of one
+        // voxel may hold much less, and correcting by half a voxel merged real rooms.
+        let min_radius = min_ball;
+        let step = gate_step(&input, node_cluster, seeds_of, params.alpha, min_radius);
         let counts = GateCounts {
             gates: step.chosen(params.gate_placement).len(),
             slivers_merged: step.slivers_merged,
+            small_merged: step.small_merged,
             clusters: step.seeds_of.len(),
         };
-        let account = [grown, split_off, step.slivers_merged];
+        let account = [grown, split_off, step.slivers_merged + step.small_merged];
         Ok(((step, account), counts))
     })
 }
@@ -422,14 +440,18 @@ pub fn flatten(
     ((level, flat.voxel_cluster), counts)
 }
 
-/// Stage 11: the portals: the interfaces between clusters, made planar ([`crate::portals`]).
+/// Stage 11: the portals: the interfaces between clusters, made planar ([`crate::portals`]);
+/// `partition_voxel_m` is the voxel of the grid the clusters were made on (its staircases set
+/// how far an interface may spread about its plane).
 pub fn portals(
     meta: &GridMeta,
     es: &EmptySpace,
     voxel_cluster: &[u32],
     cell_voxels: f32,
+    partition_voxel_m: f32,
 ) -> Counted<Portals, PortalCounts> {
-    let found = crate::portals::portals(meta, &es.empty, voxel_cluster, cell_voxels);
+    let spread_m = crate::portals::PLANAR_SPREAD_VOXELS * partition_voxel_m;
+    let found = crate::portals::portals(meta, &es.empty, voxel_cluster, cell_voxels, spread_m);
     let cells: u64 = found
         .portals
         .iter()

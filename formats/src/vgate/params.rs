@@ -79,11 +79,12 @@ pub struct BakeParams {
     pub allow_leaks: bool,
     /// Edge of a portal's coverage-mask cell. [Limit: [0.25, 8]] [Units: voxels]
     pub portal_cell_voxels: f32,
-    /// Skeleton cycles through gaps narrower than this are opened and skeleton branches
-    /// narrower than it pruned before the segmentation, so that the partition does not depend
-    /// on which cracks the resolution opens; 0 keeps the whole skeleton (the paper's). `None`
-    /// asks the bake for 0.15 m or 1/256 of the level's longest extent, whichever is smaller;
-    /// a baked file stores the value used. [Limit: [0, 10]] [Units: m, max-ball radius]
+    /// Skeleton cycles through gaps whose largest contained ball is smaller than this are
+    /// opened and skeleton branches as thin pruned before the segmentation, so that the
+    /// partition does not depend on which cracks the resolution opens; 0 keeps the whole
+    /// skeleton (the paper's). `None` asks the bake for 0.1 m (gaps under 20 cm wide) or
+    /// 1/256 of the level's longest extent, whichever is smaller; a baked file stores the
+    /// value used. [Limit: [0, 10]] [Units: m, contained ball's radius]
     pub min_gap_m: Option<f32>,
     /// The skeleton, clusters and gates are made on a grid of this voxel size when the
     /// level's voxels are finer, and each fine voxel then takes the cluster of its space: the
@@ -91,6 +92,11 @@ pub struct BakeParams {
     /// own grid. `None` asks the bake for 0.125 m or 1/256 of the level's longest extent,
     /// whichever is smaller; a baked file stores the value used. [Limit: [0, 10]] [Units: m]
     pub partition_voxel_m: Option<f32>,
+    /// A cluster whose largest max ball is smaller than this is merged into the neighbour
+    /// across its widest gate: a roof slab, a crack or a niche where nobody stands is no room
+    /// of its own. 0 (and `None`, the default) merges none; a baked file stores the value
+    /// used. [Limit: [0, 10]] [Units: m, max-ball radius]
+    pub min_cluster_ball_m: Option<f32>,
 }
 
 impl Default for BakeParams {
@@ -108,6 +114,7 @@ impl Default for BakeParams {
             portal_cell_voxels: 1.0,
             min_gap_m: None,
             partition_voxel_m: None,
+            min_cluster_ball_m: None,
         }
     }
 }
