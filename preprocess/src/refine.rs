@@ -118,10 +118,11 @@ pub fn carry_level(meta: &GridMeta, empty: &[bool], voxel_cluster: &[u32], level
 }
 
 /// Breadth-first flood of the clusters into the voxels without one that `open` accepts, at
-/// most `rounds` steps from the voxels that have one; returns the voxels given a cluster. Each
-/// round, every such voxel beside a voxel with a cluster takes the first one in neighbour
-/// order (from the round before: the result does not depend on the threads). The grid's
-/// outer layer is never entered.
+/// most `rounds` steps from the voxels that have one; returns the voxels given a cluster. A
+/// voxel reached in a round takes the cluster of its lowest-index neighbour that had one
+/// before the round (the result does not depend on the threads): the first round looks at
+/// every open voxel, the later ones only around the voxels the round before reached. The
+/// grid's outer layer is never entered.
 fn flood(
     meta: &GridMeta,
     cluster: &mut [u32],
@@ -129,6 +130,7 @@ fn flood(
     rounds: usize,
 ) -> u64 {
     let [nx, ny, nz] = meta.dims.map(|d| d as usize);
+    // Ascending, so the first neighbour found is the lowest index.
     let off: Vec<isize> = (0..27)
         .filter(|&k| k != 13)
         .map(|k: isize| {
@@ -139,36 +141,43 @@ fn flood(
         let (x, y, z) = (j % nx, (j / nx) % ny, j / (nx * ny));
         x > 0 && y > 0 && z > 0 && x + 1 < nx && y + 1 < ny && z + 1 < nz
     };
+    if rounds == 0 {
+        return 0;
+    }
     let shared: &[u32] = cluster;
-    let mut left: Vec<u32> = (0..shared.len())
+    let mut reached: Vec<(u32, u32)> = (0..shared.len())
         .into_par_iter()
         .filter(|&j| shared[j] == u32::MAX && open(j) && inner(j))
-        .map(|j| j as u32)
+        .filter_map(|j| {
+            off.iter()
+                .map(|&o| shared[(j as isize + o) as usize])
+                .find(|&c| c != u32::MAX)
+                .map(|c| (j as u32, c))
+        })
         .collect();
     let mut given = 0u64;
-    for _ in 0..rounds {
-        let shared: &[u32] = cluster;
-        let got: Vec<(u32, u32)> = left
-            .par_iter()
-            .filter_map(|&j| {
-                off.iter()
-                    .map(|&o| shared[(j as isize + o) as usize])
-                    .find(|&c| c != u32::MAX)
-                    .map(|c| (j, c))
-            })
-            .collect();
-        if got.is_empty() {
-            break;
-        }
-        for &(j, c) in &got {
+    for round in 1.. {
+        for &(j, c) in &reached {
             cluster[j as usize] = c;
         }
-        given += got.len() as u64;
+        given += reached.len() as u64;
+        if reached.is_empty() || round >= rounds {
+            break;
+        }
         let shared: &[u32] = cluster;
-        left = left
-            .into_par_iter()
-            .filter(|&j| shared[j as usize] == u32::MAX)
+        // (voxel, the neighbour it is reached from, its cluster), lowest neighbour kept.
+        let mut next: Vec<(u32, u32, u32)> = reached
+            .par_iter()
+            .flat_map_iter(|&(j, c)| {
+                off.iter().filter_map(move |&o| {
+                    let k = (j as isize - o) as usize;
+                    (shared[k] == u32::MAX && inner(k) && open(k)).then_some((k as u32, j, c))
+                })
+            })
             .collect();
+        next.par_sort_unstable();
+        next.dedup_by_key(|t| t.0);
+        reached = next.into_iter().map(|(k, _, c)| (k, c)).collect();
     }
     given
 }
