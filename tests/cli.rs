@@ -448,6 +448,25 @@ fn bake_refuses_bad_arguments_clearly() {
     assert!(stderr(&o).contains("GiB"), "{}", stderr(&o));
     let o = visgate(&["bake", "nope.toml", "-o", out]);
     assert!(stderr(&o).contains("no such file"), "{}", stderr(&o));
+    // The sizes that shape the partition name their limits.
+    for (flag, value, says) in [
+        ("--min-gap", "-0.1", "minimum gap -0.1 m must be in 0..=10"),
+        (
+            "--partition-voxel",
+            "NaN",
+            "partition voxel NaN m must be in 0..=10",
+        ),
+        (
+            "--min-cluster-ball",
+            "11",
+            "smallest cluster ball 11 m must be in 0..=10",
+        ),
+    ] {
+        let arg = format!("{flag}={value}");
+        let o = visgate(&["bake", "builtin:two-rooms", "-o", out, &arg]);
+        assert!(!o.status.success());
+        assert!(stderr(&o).contains(says), "{flag}: {}", stderr(&o));
+    }
 }
 
 #[test]

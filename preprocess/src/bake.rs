@@ -156,7 +156,8 @@ fn check_params(p: &BakeParams) -> Result<(), BakeError> {
         && !(g.is_finite() && (0.0..=10.0).contains(&g))
     {
         return Err(BakeError::Param(format!(
-            "minimum gap {g} m must be in 0..=10 (a max-ball radius in metres; 0 keeps every gap)"
+            "minimum gap {g} m must be in 0..=10 (the radius of the largest ball a gap holds, metres; \
+             0 keeps every gap)"
         )));
     }
     if let Some(v) = p.min_cluster_ball_m
