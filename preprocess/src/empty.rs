@@ -22,7 +22,7 @@ use serde::Serialize;
 use visgate_formats::vgate::GridMeta;
 
 use crate::BakeError;
-use crate::neighbourhood::{Conn, label_components};
+use crate::neighbourhood::{Conn, grid_components};
 
 /// Parameters of [`empty_space`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -118,7 +118,9 @@ pub fn empty_space(
     let dims = meta.dims;
     let [nx, ny, nz] = dims.map(|d| d as usize);
     let mut empty: Vec<bool> = solid.iter().map(|&s| !s).collect();
-    let (label, count) = label_components(dims, &empty, Conn::C26);
+    // Labelled runs along x, not a label a voxel: 4 bytes a voxel would set the bake's peak.
+    let comps = grid_components(dims, |i| empty[i], Conn::C26);
+    let count = comps.count;
     if count == 0 {
         return Err(BakeError::NoEmptySpace(format!(
             "every voxel of the {nx} x {ny} x {nz} grid is solid; raise --resolution so the geometry's gaps are wider than a voxel"
@@ -129,20 +131,18 @@ pub fn empty_space(
     let mut lo = vec![[u32::MAX; 3]; n];
     let mut hi = vec![[0u32; 3]; n];
     let mut at_bounds = vec![false; n];
-    for z in 0..nz {
-        for y in 0..ny {
-            for x in 0..nx {
-                let l = label[x + nx * (y + ny * z)];
-                if l == u32::MAX {
-                    continue;
+    for r in 0..ny * nz {
+        let (y, z) = ((r % ny) as u32, (r / ny) as u32);
+        for (a, b, l) in comps.row(r) {
+            let c = l as usize;
+            voxels[c] += u64::from(b - a + 1);
+            for v in [[a, y, z], [b, y, z]] {
+                for ax in 0..3 {
+                    lo[c][ax] = lo[c][ax].min(v[ax]);
+                    hi[c][ax] = hi[c][ax].max(v[ax]);
                 }
-                let c = l as usize;
-                voxels[c] += 1;
-                let v = [x as u32, y as u32, z as u32];
-                for a in 0..3 {
-                    lo[c][a] = lo[c][a].min(v[a]);
-                    hi[c][a] = hi[c][a].max(v[a]);
-                }
+                // A run's ends are its only voxels that can be next to the ring in x; in y
+                // and z all of its voxels are alike.
                 at_bounds[c] |= crate::leak::next_to_ring(v, dims);
             }
         }
@@ -163,7 +163,7 @@ pub fn empty_space(
                         return None;
                     }
                     let i = w[0] as usize + nx * (w[1] as usize + ny * w[2] as usize);
-                    (label[i] != u32::MAX).then_some((label[i], i))
+                    comps.label(i).map(|l| (l, i))
                 })
         });
         match found {
@@ -184,11 +184,11 @@ pub fn empty_space(
         }
         let c = (t[0] + t[1] + t[2]) / 3.0;
         for (side, p) in [(0, c + nrm * step), (1, c - nrm * step)] {
-            if let Some(v) = meta.world_to_voxel(p.to_array()) {
-                let l = label[meta.index(v)];
-                if l != u32::MAX {
-                    faced[l as usize][side] += 1;
-                }
+            if let Some(l) = meta
+                .world_to_voxel(p.to_array())
+                .and_then(|v| comps.label(meta.index(v)))
+            {
+                faced[l as usize][side] += 1;
             }
         }
     }
@@ -243,11 +243,14 @@ pub fn empty_space(
         })
         .collect();
     let kept: Vec<bool> = components.iter().map(|c| c.kept).collect();
-    for (e, &l) in empty.iter_mut().zip(&label) {
-        if l != u32::MAX && !kept[l as usize] {
-            *e = false;
+    for (r, row) in empty.chunks_mut(nx).enumerate() {
+        for (a, b, l) in comps.row(r) {
+            if !kept[l as usize] {
+                row[a as usize..=b as usize].fill(false);
+            }
         }
     }
+    drop(comps);
     // Leaks: kept empty voxels next to the border ring, and the openings they pass.
     let mut leaks = Vec::new();
     let mut openings = Vec::new();
@@ -338,25 +341,29 @@ fn hang_floating_objects(meta: &GridMeta, empty: &mut [bool]) -> Vec<Thread> {
     let strides = [1isize, nx as isize, (nx * ny) as isize];
     let mut threads = Vec::new();
     loop {
-        let solid: Vec<bool> = empty.iter().map(|&e| !e).collect();
-        let (label, count) = label_components(dims, &solid, Conn::C6);
+        let solid = grid_components(dims, |i| !empty[i], Conn::C6);
+        let count = solid.count;
         if count <= 1 {
             return threads;
         }
         // Voxel 0 is on the border ring, which is solid: its label is the grounded one.
-        let ground = label[0];
+        let ground = solid.label(0).unwrap_or(u32::MAX);
         let mut sizes = vec![0u64; count as usize];
-        for &l in &label {
-            if l != u32::MAX {
-                sizes[l as usize] += 1;
+        let rows = empty.len() / nx;
+        for r in 0..rows {
+            for (a, b, l) in solid.row(r) {
+                sizes[l as usize] += u64::from(b - a + 1);
             }
         }
         // Shortest march per floating component: (length, start, dir).
         let mut best: Vec<Option<(usize, usize, usize)>> = vec![None; count as usize];
-        for (i, &l) in label.iter().enumerate() {
-            if l == u32::MAX || l == ground {
-                continue;
-            }
+        let floating = (0..rows).flat_map(|r| {
+            solid
+                .row(r)
+                .filter(|&(_, _, l)| l != ground)
+                .flat_map(move |(a, b, l)| (a..=b).map(move |x| (r * nx + x as usize, l)))
+        });
+        for (i, l) in floating {
             for dir in 0..6 {
                 let step = if dir % 2 == 0 {
                     -strides[dir / 2]
@@ -370,7 +377,7 @@ fn hang_floating_objects(meta: &GridMeta, empty: &mut [bool]) -> Vec<Thread> {
                     len += 1;
                     j += step;
                 }
-                if len == 0 || label[j as usize] == l {
+                if len == 0 || solid.label(j as usize) == Some(l) {
                     continue;
                 }
                 let cand = (len, i, dir);
