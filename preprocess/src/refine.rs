@@ -17,6 +17,8 @@
 //! Fine empty voxels no flood reaches (space the coarse grid closed off entirely) keep no
 //! cluster and are counted.
 
+use std::sync::atomic::{AtomicU64, Ordering};
+
 use rayon::prelude::*;
 use serde::Serialize;
 use visgate_formats::vgate::{BakedLevel, GridMeta};
@@ -121,8 +123,8 @@ pub fn carry_level(meta: &GridMeta, empty: &[bool], voxel_cluster: &[u32], level
 /// most `rounds` steps from the voxels that have one; returns the voxels given a cluster. A
 /// voxel reached in a round takes the cluster of its lowest-index neighbour that had one
 /// before the round (the result does not depend on the threads): the first round looks at
-/// every open voxel, the later ones only around the voxels the round before reached. The
-/// grid's outer layer is never entered.
+/// every open voxel, the later ones only at the neighbours of the voxels the round before
+/// reached. The grid's outer layer is never entered.
 fn flood(
     meta: &GridMeta,
     cluster: &mut [u32],
@@ -144,16 +146,22 @@ fn flood(
     if rounds == 0 {
         return 0;
     }
+    // The cluster a voxel takes: that of its lowest-index neighbour with one.
+    let pull = |shared: &[u32], j: usize| {
+        off.iter()
+            .map(|&o| shared[(j as isize + o) as usize])
+            .find(|&c| c != u32::MAX)
+    };
     let shared: &[u32] = cluster;
     let mut reached: Vec<(u32, u32)> = (0..shared.len())
         .into_par_iter()
         .filter(|&j| shared[j] == u32::MAX && open(j) && inner(j))
-        .filter_map(|j| {
-            off.iter()
-                .map(|&o| shared[(j as isize + o) as usize])
-                .find(|&c| c != u32::MAX)
-                .map(|c| (j as u32, c))
-        })
+        .filter_map(|j| pull(shared, j).map(|c| (j as u32, c)))
+        .collect();
+    // Voxels already put forward in a round: each is looked at once (a voxel beside many of
+    // the round before would otherwise be listed for each).
+    let seen: Vec<AtomicU64> = (0..shared.len().div_ceil(64))
+        .map(|_| AtomicU64::new(0))
         .collect();
     let mut given = 0u64;
     for round in 1.. {
@@ -165,19 +173,26 @@ fn flood(
             break;
         }
         let shared: &[u32] = cluster;
-        // (voxel, the neighbour it is reached from, its cluster), lowest neighbour kept.
-        let mut next: Vec<(u32, u32, u32)> = reached
+        let mut next: Vec<u32> = reached
             .par_iter()
-            .flat_map_iter(|&(j, c)| {
+            .flat_map_iter(|&(j, _)| {
+                let seen = &seen;
                 off.iter().filter_map(move |&o| {
                     let k = (j as isize - o) as usize;
-                    (shared[k] == u32::MAX && inner(k) && open(k)).then_some((k as u32, j, c))
+                    if shared[k] != u32::MAX || !inner(k) || !open(k) {
+                        return None;
+                    }
+                    let bit = 1u64 << (k % 64);
+                    let was = seen[k / 64].fetch_or(bit, Ordering::Relaxed);
+                    (was & bit == 0).then_some(k as u32)
                 })
             })
             .collect();
         next.par_sort_unstable();
-        next.dedup_by_key(|t| t.0);
-        reached = next.into_iter().map(|(k, _, c)| (k, c)).collect();
+        reached = next
+            .par_iter()
+            .filter_map(|&k| pull(shared, k as usize).map(|c| (k, c)))
+            .collect();
     }
     given
 }
