@@ -4,6 +4,7 @@
 //! answer), and the bake's boundary check on every built-in scene.
 
 use glam::{Vec2, Vec3};
+use visgate_formats::vgate::BakeParams;
 use visgate_runtime::camera::View;
 use visgate_runtime::cpu::gates::{GateLevel, GateParams, GateShape, Walk};
 use visgate_scenes::Builtin;
@@ -11,7 +12,7 @@ use visgate_scenes::Builtin;
 #[path = "support/gates.rs"]
 mod gate_support;
 
-use gate_support::{baked, fixture};
+use gate_support::{baked, fixture, fixture_with, params_at};
 
 /// Pairs, disagreements with the shadow ray (false visible, false occluded) for `params`.
 #[derive(Debug, Default, Clone, Copy)]
@@ -31,7 +32,12 @@ impl Agreement {
 /// agreement with the shadow ray over every pixel–VPL pair of the 64×48 view that could
 /// exchange light.
 fn agreement(b: Builtin, res: u32, params: &[GateParams]) -> Vec<Vec<Agreement>> {
-    let (scene, gates, tracer, vpls, _) = fixture(b, res, 0);
+    agreement_with(b, &params_at(res), params)
+}
+
+/// [`agreement`] on a level baked with `bake`.
+fn agreement_with(b: Builtin, bake: &BakeParams, params: &[GateParams]) -> Vec<Vec<Agreement>> {
+    let (scene, gates, tracer, vpls, _) = fixture_with(b, bake, 0);
     let mut all = Vec::new();
     for camera in &scene.cameras {
         let view = View::new(camera, [64, 48]).expect("view");
@@ -107,6 +113,37 @@ fn ajar_door_portal_visibility_agrees_with_shadow_rays() {
         assert!(
             p.rate() > d.rate(),
             "camera {camera}: portals {p:?} disks {d:?}"
+        );
+    }
+}
+
+#[test]
+fn a_level_refined_from_a_coarser_partition_agrees_with_shadow_rays_better_than_its_own_grid() {
+    // The ajar door at 256: by default its partition is its 128 grid's (1/128 of the level),
+    // refined; partitioned on its own 256 grid instead, its many small clusters agree less.
+    let portals = &shapes()[..1];
+    let coarse = agreement(Builtin::AjarDoor, 128, portals);
+    let refined = agreement(Builtin::AjarDoor, 256, portals);
+    let own = BakeParams {
+        partition_voxel_m: Some(0.0),
+        ..params_at(256)
+    };
+    let own = agreement_with(Builtin::AjarDoor, &own, portals);
+    for (camera, ((c, r), o)) in coarse.iter().zip(&refined).zip(&own).enumerate() {
+        let (c, r, o) = (c[0], r[0], o[0]);
+        println!(
+            "ajar-door camera {camera}, {} pairs: 256 refined from its 128 partition agrees \
+             {:.2} %, on its own grid {:.2} %; the 128 bake {:.2} %",
+            r.pairs,
+            100.0 * r.rate(),
+            100.0 * o.rate(),
+            100.0 * c.rate()
+        );
+        assert!(r.pairs > 10_000, "{r:?}");
+        assert!(r.rate() >= o.rate(), "camera {camera}: {r:?} against {o:?}");
+        assert!(
+            r.rate() >= c.rate() - 0.02,
+            "camera {camera}: {r:?} against {c:?}"
         );
     }
 }

@@ -369,24 +369,29 @@ pub const MIN_GAP_M: f32 = 0.1;
 /// The default partition voxel ([`BakeParams::partition_voxel_m`]), unless the level is small.
 /// [Units: m]
 pub const PARTITION_VOXEL_M: f32 = 0.125;
-/// The default sizes that shape the partition are at most 1/this of the level's longest
-/// extent: a small level (a few rooms) keeps the detail of its doors and furniture, and a
-/// level whose units were declared wrong (a model in millimetres read as metres) is
-/// partitioned as at its true scale.
+/// The default minimum gap is at most 1/this of the level's longest extent: a small level (a
+/// few rooms) keeps the detail of its doors and furniture, and a level whose units were
+/// declared wrong (a model in millimetres read as metres) is partitioned as at its true scale.
 pub const PARTITION_MIN_VOXELS: u32 = 256;
+/// The default partition voxel is at most 1/this of the level's longest extent (so a small
+/// level is partitioned on at least this many voxels, and refined from there: `ajar-door` at
+/// 256 agrees with shadow rays on 95.2 / 91.5 / 98.0 % of pairs so, on 89.5 / 78.9 / 98.0 %
+/// partitioned on its own 256 grid).
+pub const PARTITION_VOXELS: u32 = 128;
 
 /// `params` with the minimum gap and the partition voxel it leaves to the bake filled in (see
 /// [`PARTITION_MIN_VOXELS`]): the values used, which the file records.
 fn level_scaled(params: &BakeParams, bounds: (glam::Vec3, glam::Vec3)) -> BakeParams {
     let longest = (bounds.1 - bounds.0).max_element();
     let scale = longest / PARTITION_MIN_VOXELS as f32;
+    let partition = longest / PARTITION_VOXELS as f32;
     BakeParams {
         min_cluster_ball_m: Some(params.min_cluster_ball_m.unwrap_or(0.0)),
         min_gap_m: Some(params.min_gap_m.unwrap_or(MIN_GAP_M.min(scale))),
         partition_voxel_m: Some(
             params
                 .partition_voxel_m
-                .unwrap_or(PARTITION_VOXEL_M.min(scale)),
+                .unwrap_or(PARTITION_VOXEL_M.min(partition)),
         ),
         ..params.clone()
     }

@@ -10,13 +10,17 @@ use visgate_runtime::cpu::tracer::Tracer;
 use visgate_runtime::vpl::{PathParams, Vpl, path_vpls};
 use visgate_scenes::Builtin;
 
-/// `scene` baked at `res` voxels on its longest axis, default parameters otherwise.
-pub fn bake_at(scene: &Scene, res: u32) -> Baked {
-    let params = BakeParams {
+/// Default bake parameters at `res` voxels on the longest axis.
+pub fn params_at(res: u32) -> BakeParams {
+    BakeParams {
         resolution: Resolution::LongestAxisVoxels(res),
         ..BakeParams::default()
-    };
-    bake(scene, &params, &BakeOptions::default(), &|_| {}).expect("bake")
+    }
+}
+
+/// `scene` baked at `res` voxels on its longest axis, default parameters otherwise.
+pub fn bake_at(scene: &Scene, res: u32) -> Baked {
+    bake(scene, &params_at(res), &BakeOptions::default(), &|_| {}).expect("bake")
 }
 
 /// Built-in `b` and its bake at `res`.
@@ -39,7 +43,17 @@ pub fn light_paths(tracer: &Tracer, scene: &Scene) -> Vec<Vpl> {
 /// Built-in `b` baked at `res`: its gate level, tracer, 256 path VPLs and the 64×48 view of
 /// its camera `camera`.
 pub fn fixture(b: Builtin, res: u32, camera: usize) -> (Scene, GateLevel, Tracer, Vec<Vpl>, View) {
-    let (scene, baked) = baked(b, res);
+    fixture_with(b, &params_at(res), camera)
+}
+
+/// [`fixture`] baked with `params`.
+pub fn fixture_with(
+    b: Builtin,
+    params: &BakeParams,
+    camera: usize,
+) -> (Scene, GateLevel, Tracer, Vec<Vpl>, View) {
+    let scene = b.scene().expect("scene");
+    let baked = bake(&scene, params, &BakeOptions::default(), &|_| {}).expect("bake");
     let gates = GateLevel::new(baked.level, &scene).expect("level");
     let tracer = Tracer::new(&scene);
     let vpls = light_paths(&tracer, &scene);

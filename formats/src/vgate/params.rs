@@ -89,7 +89,7 @@ pub struct BakeParams {
     /// The skeleton, clusters and gates are made on a grid of this voxel size when the
     /// level's voxels are finer, and each fine voxel then takes the cluster of its space: the
     /// partition stays that of this scale at any finer resolution. 0 partitions the level's
-    /// own grid. `None` asks the bake for 0.125 m or 1/256 of the level's longest extent,
+    /// own grid. `None` asks the bake for 0.125 m or 1/128 of the level's longest extent,
     /// whichever is smaller; a baked file stores the value used. [Limit: [0, 10]] [Units: m]
     pub partition_voxel_m: Option<f32>,
     /// A cluster whose largest max ball is smaller than this is merged into the neighbour
