@@ -8,8 +8,11 @@
 //!    cluster (a coarse empty voxel holds no geometry, so no wall separates the two);
 //! 2. the fine empty voxels left — in coarse voxels that the conservative voxelization made
 //!    solid: beside walls, in gaps and openings only the fine grid resolves — are flooded
-//!    breadth-first through the fine empty space (26-neighbours, in voxel order), so a voxel
-//!    beside a thin wall takes the cluster of its own side;
+//!    breadth-first through the fine empty space, so a voxel beside a thin wall takes the
+//!    cluster of its own side: across faces first, then across edges and corners for what only
+//!    they join (a flood across edges slips past a door's edge sooner: `ajar-door` at 256
+//!    refined from 128 agreed with shadow rays on 95.24 / 91.45 / 98.28 % of pairs so, 95.43 /
+//!    92.05 / 98.31 % face first);
 //! 3. the solid voxels within [`SOLID_SHELL_VOXELS`] steps of the empty space take a cluster the
 //!    same way, as the nearest-node grid gives them on a single grid (a surface point is looked
 //!    up half a voxel towards its normal or in its solid voxel).
@@ -24,6 +27,7 @@ use serde::Serialize;
 use visgate_formats::vgate::{BakedLevel, GridMeta};
 
 use crate::graph::SOLID_SHELL_VOXELS;
+use crate::neighbourhood::Conn;
 
 /// The partition grid's result to carry.
 pub struct Coarse<'a> {
@@ -75,18 +79,19 @@ pub fn refine(meta: &GridMeta, empty: &[bool], coarse: &Coarse) -> (Vec<u32>, Re
             }
         });
     let from_coarse = cluster.par_iter().filter(|&&c| c != u32::MAX).count() as u64;
-    let flooded = flood(meta, &mut cluster, &|j| empty[j], usize::MAX);
+    // Across faces first: a flood across edges and corners slips past a wall's end (a door's
+    // edge) sooner; then across edges and corners, for what only they join.
+    let flooded = flood(meta, &mut cluster, &|j| empty[j], usize::MAX, Conn::C6)
+        + flood(meta, &mut cluster, &|j| empty[j], usize::MAX, Conn::C26);
     let unreached = empty
         .par_iter()
         .zip(&cluster)
         .filter(|&(&e, &c)| e && c == u32::MAX)
         .count() as u64;
-    let shell = flood(
-        meta,
-        &mut cluster,
-        &|j| !empty[j],
-        SOLID_SHELL_VOXELS as usize,
-    );
+    // The shell likewise: across faces, then what only edges and corners reach.
+    let depth = SOLID_SHELL_VOXELS as usize;
+    let shell = flood(meta, &mut cluster, &|j| !empty[j], depth, Conn::C6)
+        + flood(meta, &mut cluster, &|j| !empty[j], depth, Conn::C26);
     let counts = RefineCounts {
         from_coarse,
         flooded,
@@ -130,11 +135,13 @@ fn flood(
     cluster: &mut [u32],
     open: &(dyn Fn(usize) -> bool + Sync),
     rounds: usize,
+    conn: Conn,
 ) -> u64 {
     let [nx, ny, nz] = meta.dims.map(|d| d as usize);
     // Ascending, so the first neighbour found is the lowest index.
+    let faces = [4, 10, 12, 14, 16, 22];
     let off: Vec<isize> = (0..27)
-        .filter(|&k| k != 13)
+        .filter(|&k| k != 13 && (conn == Conn::C26 || faces.contains(&k)))
         .map(|k: isize| {
             (k % 3 - 1) + ((k / 3) % 3 - 1) * nx as isize + (k / 9 - 1) * (nx * ny) as isize
         })
