@@ -254,8 +254,6 @@ pub fn segmentation(
     params: &BakeParams,
 ) -> Counted<SegmentStage, SegmentCounts> {
     let min_gap_m = params.min_gap_m.unwrap_or(0.0);
-    // The minimum gap is a contained ball's radius; a solid-centre radius is up to half a
-    // voxel larger, so that the same crack is measured alike at every resolution.
     let measured = measured_radius(min_gap_m, meta, params.max_ball);
     let simple = simplify(&sk.graph.adjacency(), &sk.radius, measured);
     let seg_params = SegmentParams {
@@ -357,10 +355,10 @@ pub fn clusters_and_gates(
             position: &sk.position,
             radius: &sk.radius,
         };
-        let min_ball = params.min_cluster_ball_m.unwrap_or(0.0);
-        // Compared with the radii as measured: at a coarse grid a solid-centre radius of one
-        // voxel may hold much less, and correcting by half a voxel merged real rooms.
-        let min_radius = min_ball;
+        // Compared with the radii as measured, unlike the minimum gap: at a coarse grid a
+        // solid-centre radius of one voxel may hold much less, and correcting by half a voxel
+        // merged real rooms.
+        let min_radius = params.min_cluster_ball_m.unwrap_or(0.0);
         let step = gate_step(&input, node_cluster, seeds_of, params.alpha, min_radius);
         let counts = GateCounts {
             gates: step.chosen(params.gate_placement).len(),
