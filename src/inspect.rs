@@ -242,6 +242,16 @@ fn inspect_baked(path: &Path, json: bool) -> Result<()> {
         v3(g.origin_m)
     );
     println!("params      {:?}", s.params);
+    let pv = s.params.partition_voxel_m.unwrap_or(0.0);
+    let on = if pv > 1.01 * g.voxel_size_m {
+        format!("on a {pv} m grid, refined onto this one")
+    } else {
+        "on this grid".to_string()
+    };
+    println!(
+        "partition   skeleton, clusters and gates made {on}; gaps under {} m left out",
+        s.params.min_gap_m.unwrap_or(0.0)
+    );
     println!(
         "skeleton    {} nodes, {} edges, {} independent cycles",
         s.skeleton_nodes, s.skeleton_edges, s.skeleton_cycles

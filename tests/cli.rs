@@ -426,6 +426,39 @@ fn bake_takes_the_papers_readings_and_records_them_in_the_file() {
 }
 
 #[test]
+fn a_refined_bake_says_where_its_partition_was_made() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("x.vgate");
+    let out = out.to_str().expect("utf-8");
+    // Two rooms at 64 voxels of 0.134 m, partitioned on 0.27 m voxels.
+    let o = visgate(&[
+        "bake",
+        "builtin:two-rooms",
+        "-o",
+        out,
+        "--resolution",
+        "64",
+        "--partition-voxel",
+        "0.27",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    for want in ["refine", "partition: made on a 0.270 m grid", "clusters 2"] {
+        assert!(text.contains(want), "missing '{want}' in:\n{text}");
+    }
+    let info = stdout(&visgate(&["inspect", out]));
+    assert!(
+        info.contains("made on a 0.27 m grid, refined onto this one"),
+        "{info}"
+    );
+    // On its own grid it says so.
+    let o = visgate(&["bake", "builtin:two-rooms", "-o", out, "--resolution", "64"]);
+    assert!(stdout(&o).contains("partition: made on the level's grid"));
+    let info = stdout(&visgate(&["inspect", out]));
+    assert!(info.contains("made on this grid"), "{info}");
+}
+
+#[test]
 fn bake_refuses_bad_arguments_clearly() {
     let dir = tempfile::tempdir().expect("tempdir");
     let out = dir.path().join("x.vgate");
