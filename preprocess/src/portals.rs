@@ -13,6 +13,7 @@
 use std::collections::BTreeMap;
 
 use glam::Vec3;
+use rayon::prelude::*;
 use visgate_formats::vgate::{GridMeta, MAX_MASK_CELLS, NONE, Portal};
 
 /// One interface face: the centre, its axis and the sign of the normal from the pair's lower
@@ -39,35 +40,42 @@ fn interface_faces(
 ) -> BTreeMap<(u32, u32), Vec<Face>> {
     let [nx, ny, nz] = meta.dims.map(|d| d as usize);
     let stride = [1, nx, nx * ny];
-    let mut out: BTreeMap<(u32, u32), Vec<Face>> = BTreeMap::new();
-    for z in 0..nz {
-        for y in 0..ny {
-            for x in 0..nx {
-                let i = x + nx * (y + ny * z);
-                let c = cluster[i];
-                if !empty[i] || c == NONE {
-                    continue;
-                }
-                let at = [x, y, z];
-                for axis in 0..3 {
-                    if at[axis] + 1 >= meta.dims[axis] as usize {
+    // Each z slab's faces in voxel order, in parallel; then grouped by pair in slab order, so
+    // every pair's faces stay in voxel order.
+    let slabs: Vec<Vec<((u32, u32), Face)>> = (0..nz)
+        .into_par_iter()
+        .map(|z| {
+            let mut found = Vec::new();
+            for y in 0..ny {
+                for x in 0..nx {
+                    let i = x + nx * (y + ny * z);
+                    let c = cluster[i];
+                    if !empty[i] || c == NONE {
                         continue;
                     }
-                    let j = i + stride[axis];
-                    let d = cluster[j];
-                    if !empty[j] || d == NONE || d == c {
-                        continue;
+                    let at = [x, y, z];
+                    for axis in 0..3 {
+                        if at[axis] + 1 >= meta.dims[axis] as usize {
+                            continue;
+                        }
+                        let j = i + stride[axis];
+                        let d = cluster[j];
+                        if !empty[j] || d == NONE || d == c {
+                            continue;
+                        }
+                        let mut centre = Vec3::from(meta.voxel_to_world(at.map(|k| k as u32)));
+                        centre[axis] += 0.5 * meta.voxel_size_m;
+                        let sign = if c < d { 1.0 } else { -1.0 };
+                        found.push(((c.min(d), c.max(d)), Face { centre, axis, sign }));
                     }
-                    let mut centre = Vec3::from(meta.voxel_to_world(at.map(|k| k as u32)));
-                    centre[axis] += 0.5 * meta.voxel_size_m;
-                    let key = (c.min(d), c.max(d));
-                    let sign = if c < d { 1.0 } else { -1.0 };
-                    out.entry(key)
-                        .or_default()
-                        .push(Face { centre, axis, sign });
                 }
             }
-        }
+            found
+        })
+        .collect();
+    let mut out: BTreeMap<(u32, u32), Vec<Face>> = BTreeMap::new();
+    for (key, face) in slabs.into_iter().flatten() {
+        out.entry(key).or_default().push(face);
     }
     out
 }
@@ -238,29 +246,43 @@ pub fn portals(
 ) -> Portals {
     let vs = meta.voxel_size_m;
     let spread_m = spread_m.max(PLANAR_SPREAD_VOXELS * vs);
-    let mut out = Portals::default();
-    for (pair, faces) in interface_faces(meta, empty, cluster) {
-        let mut parts = Vec::new();
-        pieces(faces.clone(), spread_m, 0, &mut parts);
-        let mine: Vec<Portal> = parts
-            .iter()
-            .map(|p| portal_of(pair, p, vs, cell_voxels))
-            .collect();
-        for f in &faces {
-            let c = f.centre.to_array();
-            let covered = mine.iter().any(|p| {
-                let q = f.centre - Vec3::from(p.normal) * p.distance(c);
-                p.covers(q.to_array())
-            });
-            let nearest = mine
+    let pairs: Vec<((u32, u32), Vec<Face>)> =
+        interface_faces(meta, empty, cluster).into_iter().collect();
+    // Each pair on its own (in parallel), joined in pair order.
+    let each: Vec<Portals> = pairs
+        .into_par_iter()
+        .map(|(pair, faces)| {
+            let mut parts = Vec::new();
+            pieces(faces.clone(), spread_m, 0, &mut parts);
+            let mine: Vec<Portal> = parts
                 .iter()
-                .map(|p| p.distance(c).abs())
-                .fold(f32::MAX, f32::min);
-            out.uncovered += u64::from(!covered);
-            out.off_plane += u64::from(nearest > spread_m);
-        }
-        out.interface_faces += faces.len() as u64;
-        out.portals.extend(mine);
+                .map(|p| portal_of(pair, p, vs, cell_voxels))
+                .collect();
+            let mut out = Portals::default();
+            for f in &faces {
+                let c = f.centre.to_array();
+                let covered = mine.iter().any(|p| {
+                    let q = f.centre - Vec3::from(p.normal) * p.distance(c);
+                    p.covers(q.to_array())
+                });
+                let nearest = mine
+                    .iter()
+                    .map(|p| p.distance(c).abs())
+                    .fold(f32::MAX, f32::min);
+                out.uncovered += u64::from(!covered);
+                out.off_plane += u64::from(nearest > spread_m);
+            }
+            out.interface_faces = faces.len() as u64;
+            out.portals = mine;
+            out
+        })
+        .collect();
+    let mut out = Portals::default();
+    for p in each {
+        out.portals.extend(p.portals);
+        out.interface_faces += p.interface_faces;
+        out.uncovered += p.uncovered;
+        out.off_plane += p.off_plane;
     }
     out
 }
