@@ -235,12 +235,11 @@ pub fn bake(
         stages::empty(scene, &meta, &solid.solid, &input.triangles, &params)
     })?;
     let solid = options.keep_solid_grid.then_some(solid);
-    let coarse = partition_grid(input.bounds, &meta, &params, options)?;
-    let part = match &coarse {
+    let part = match partition_grid(input.bounds, &meta, &params, options)? {
         None => partition(&mut cx, &meta, &es, input.hash, &mut params)?,
         Some(pm) => {
             let fine = (&meta, &es);
-            refined_partition(&mut cx, scene, &input, fine, pm, &mut params)?
+            refined_partition(&mut cx, scene, &input, fine, &pm, &mut params)?
         }
     };
     let Partition {
@@ -251,26 +250,26 @@ pub fn bake(
         segmented_counts,
         cluster_account,
         placements,
-        empty: partition_empty,
+        grid: partition_grid,
     } = part;
+    // The grid the partition was made on, and its empty space.
+    let (part_meta, part_es) = partition_grid
+        .as_ref()
+        .map_or((&meta, &es), |(g, e)| (g, e));
     let found = cx.stage("portals", 0, |_| {
         Ok(stages::portals(
             &meta,
             &es,
             &voxel_cluster,
             params.portal_cell_voxels,
-            coarse.map_or(meta.voxel_size_m, |c| c.voxel_size_m),
+            part_meta.voxel_size_m,
         ))
     })?;
     drop(voxel_cluster);
     let uncovered = found.uncovered;
     level.topology.portals = found.portals;
-    let (top_meta, top_es) = match (&coarse, &partition_empty) {
-        (Some(pm), Some(pes)) => (pm, pes),
-        _ => (&meta, &es),
-    };
     let [empty_topology, skeleton_topology] = cx.stage("topology check", 0, |_| {
-        Ok(stages::topology_check(top_meta, top_es, &thinned))
+        Ok(stages::topology_check(part_meta, part_es, &thinned))
     })?;
     let summary = Summary {
         voxels: es.empty.len() as u64,
@@ -307,7 +306,7 @@ pub fn bake(
         }),
         gate_placements: placements,
     };
-    let skeleton = match coarse {
+    let skeleton = match partition_grid {
         None => thinned.skeleton,
         Some(_) => {
             let t = &level.topology.skeleton.nodes;
@@ -340,8 +339,8 @@ struct Partition {
     segmented_counts: [u64; 5],
     cluster_account: [u64; 3],
     placements: Vec<Value>,
-    /// The partition grid's empty space, when it is not the level's grid.
-    empty: Option<EmptySpace>,
+    /// The partition grid and its empty space, when it is not the level's grid.
+    grid: Option<(GridMeta, EmptySpace)>,
 }
 
 /// The default minimum gap ([`BakeParams::min_gap_m`]: half the width of a gap, 20 cm wide),
@@ -427,7 +426,7 @@ fn refined_partition(
     part.level.voxel_cluster = VoxelValues::pack(&voxel_cluster);
     part.level.info.params = params.clone();
     part.voxel_cluster = voxel_cluster;
-    part.empty = Some(pes);
+    part.grid = Some((*pm, pes));
     Ok(part)
 }
 
@@ -483,6 +482,6 @@ fn partition(
         segmented_counts: sg.counts,
         cluster_account,
         placements: step.placements_json(),
-        empty: None,
+        grid: None,
     })
 }

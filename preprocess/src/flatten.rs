@@ -281,37 +281,49 @@ fn join_pieces(input: &FlattenInput, skel_cluster: &[u32], voxel_cluster: &mut [
 /// Each cluster with the box of its empty voxels (reduced over z slabs); a cluster's box holds
 /// at least its seed's voxel.
 fn cluster_boxes(input: &FlattenInput, voxel_cluster: &[u32]) -> Vec<Cluster> {
-    let (meta, vs) = (input.meta, input.meta.voxel_size_m);
-    let nc = input.seeds_of.len();
-    let (vlo, vhi) = voxel_bounds(meta, input.empty, voxel_cluster, nc);
+    let h = 0.5 * input.meta.voxel_size_m;
+    let boxes = cluster_bounds_m(input.meta, input.empty, voxel_cluster, input.seeds_of.len());
     input
         .seeds_of
         .iter()
-        .enumerate()
-        .map(|(c, &seed)| {
+        .zip(boxes)
+        .map(|(&seed, found)| {
+            // No empty voxel of its own: the seed's voxel.
             let p = input.position[seed_node(input, seed)];
-            // No empty voxel of its own (infinite box): the seed's voxel.
-            let (lo, hi) = if vlo[c][0] == u32::MAX {
-                ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3])
-            } else {
-                let (a, b) = (meta.voxel_to_world(vlo[c]), meta.voxel_to_world(vhi[c]));
-                (a.map(|x| x - 0.5 * vs), b.map(|x| x + 0.5 * vs))
-            };
-            let fix = |v: [f32; 3], d: f32| -> [f32; 3] {
-                std::array::from_fn(|a| if v[a].is_finite() { v[a] } else { p[a] + d })
-            };
+            let (lo, hi) = found.unwrap_or(((p - h).to_array(), (p + h).to_array()));
             Cluster {
                 seed,
-                bounds_min_m: fix(lo, -0.5 * vs),
-                bounds_max_m: fix(hi, 0.5 * vs),
+                bounds_min_m: lo,
+                bounds_max_m: hi,
             }
+        })
+        .collect()
+}
+
+/// The bounds (minimum and maximum corner, metres) of each of `clusters` clusters' empty
+/// voxels; `None` for a cluster without any.
+pub fn cluster_bounds_m(
+    meta: &GridMeta,
+    empty: &[bool],
+    voxel_cluster: &[u32],
+    clusters: usize,
+) -> Vec<Option<([f32; 3], [f32; 3])>> {
+    let h = 0.5 * meta.voxel_size_m;
+    let (lo, hi) = voxel_bounds(meta, empty, voxel_cluster, clusters);
+    lo.iter()
+        .zip(&hi)
+        .map(|(lo, hi)| {
+            (lo[0] != u32::MAX).then(|| {
+                let (a, b) = (meta.voxel_to_world(*lo), meta.voxel_to_world(*hi));
+                (a.map(|x| x - h), b.map(|x| x + h))
+            })
         })
         .collect()
 }
 
 /// The voxel bounds (min, max corner) of each of `clusters` clusters' empty voxels; a cluster
 /// without any keeps `u32::MAX` as its minimum.
-pub fn voxel_bounds(
+fn voxel_bounds(
     meta: &GridMeta,
     empty: &[bool],
     voxel_cluster: &[u32],

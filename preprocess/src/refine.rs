@@ -108,12 +108,10 @@ pub fn refine(meta: &GridMeta, empty: &[bool], coarse: &Coarse) -> (Vec<u32>, Re
 /// keeps the bounds it had), and every skeleton node's voxel to the fine voxel holding it.
 pub fn carry_level(meta: &GridMeta, empty: &[bool], voxel_cluster: &[u32], level: &mut BakedLevel) {
     let t = &mut level.topology;
-    let (lo, hi) = crate::flatten::voxel_bounds(meta, empty, voxel_cluster, t.clusters.len());
-    let h = 0.5 * meta.voxel_size_m;
-    for (c, cl) in t.clusters.iter_mut().enumerate() {
-        if lo[c][0] != u32::MAX {
-            cl.bounds_min_m = meta.voxel_to_world(lo[c]).map(|x| x - h);
-            cl.bounds_max_m = meta.voxel_to_world(hi[c]).map(|x| x + h);
+    let boxes = crate::flatten::cluster_bounds_m(meta, empty, voxel_cluster, t.clusters.len());
+    for (cl, found) in t.clusters.iter_mut().zip(boxes) {
+        if let Some((lo, hi)) = found {
+            (cl.bounds_min_m, cl.bounds_max_m) = (lo, hi);
         }
     }
     for n in &mut t.skeleton.nodes {
