@@ -83,7 +83,8 @@ pub fn flatten(input: &FlattenInput) -> Flattened {
         meta,
         empty: input.empty,
         clearance_vx: Some(input.radius_vx),
-    };
+    }
+    .packed();
     let voxels_by_sight =
         crate::sightline::clusters_by_sight(&sight, &mut voxel_cluster, &seed_at, &anchor);
     let clusters = cluster_boxes(input, &voxel_cluster);
