@@ -13,7 +13,7 @@ use visgate_runtime::cpu::gates::GateLevel;
 use visgate_runtime::gpu::{METHODS, method};
 use visgate_runtime::hdr::{HdrImage, false_colour};
 use visgate_runtime::job::{FrameStats, JobFrame, RenderJob, Renderer, pass_table};
-use visgate_runtime::metrics::{errors, flip, indirect_errors, rebase_direct};
+use visgate_runtime::metrics::{errors, flip, indirect_errors, indirect_map, rebase_direct};
 use visgate_runtime::vpl::GeometryClamp;
 
 pub const RENDER_HELP: &str = "\
@@ -347,6 +347,10 @@ pub struct DiffArgs {
     /// instead of --direct's (GPU shadow maps and CPU rays differ a little at shadow edges).
     #[arg(long, requires = "direct")]
     pub image_direct: Option<PathBuf>,
+    /// Write where the image is black where the reference is lit indirectly, as a PNG: red
+    /// there, grey where the reference's indirect light counts, dark grey where it does not.
+    #[arg(long, requires = "direct")]
+    pub black_map: Option<PathBuf>,
 }
 
 pub fn diff(args: DiffArgs) -> Result<()> {
@@ -375,6 +379,13 @@ pub fn diff(args: DiffArgs) -> Result<()> {
             None => a.clone(),
         };
         let i = indirect_errors(&own, &r, &direct)?;
+        if let Some(out) = &args.black_map {
+            indirect_map(&own, &r, &direct)?
+                .to_image(a.width, a.height)
+                .save(out)
+                .with_context(|| format!("cannot write {}", out.display()))?;
+            println!("wrote {}", out.display());
+        }
         if args.image_direct.is_some() {
             println!(
                 "indirect MSE     {:.6e}  (its direct light replaced by the reference's)",

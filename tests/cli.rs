@@ -589,6 +589,51 @@ fn render_writes_exr_and_png_and_diff_compares_them() {
     // The same image against itself: zero error.
     let o = visgate(&["diff", &p("ref.exr"), &p("ref.exr")]);
     assert!(stdout(&o).contains("MSE        0.0"), "{}", stdout(&o));
+    // Direct light alone has no indirect light: black wherever the reference is lit
+    // indirectly, every such pixel red in the black map, the rest grey.
+    let o = visgate(&[
+        "render",
+        "builtin:cornell-box",
+        "--mode",
+        "direct-only",
+        "--cpu",
+        "--size",
+        "24x16",
+        "--spp",
+        "1",
+        "--out",
+        &p("direct.exr"),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let (image, reference, direct) = (p("direct.exr"), p("ref.exr"), p("direct.exr"));
+    let map = p("black.png");
+    let args = [
+        "diff",
+        &image,
+        &reference,
+        "--direct",
+        &direct,
+        "--black-map",
+        &map,
+    ];
+    let o = visgate(&args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stdout(&o).contains("black where lit  100.0"),
+        "{}",
+        stdout(&o)
+    );
+    let png = image::open(&map).expect("the black map").to_rgb8();
+    assert_eq!(png.dimensions(), (24, 16));
+    let red = png.pixels().filter(|p| p.0 == [255, 0, 0]).count();
+    assert!(red > 24 * 16 / 2, "{red} red pixels");
+    assert!(
+        png.pixels()
+            .all(|p| [[255, 0, 0], [32, 32, 32]].contains(&p.0))
+    );
+    // It needs the direct light to know what is indirect.
+    let o = visgate(&["diff", &image, &reference, "--black-map", &map]);
+    assert!(stderr(&o).contains("--direct"), "{}", stderr(&o));
 }
 
 #[test]

@@ -97,7 +97,20 @@ fn the_report_holds_every_table_plot_and_panel_with_the_figures_of_render_and_di
             "{panel} not in the report"
         );
         let p = image::open(out.join(panel)).expect("panel jpeg").to_rgb8();
-        assert_eq!(p.dimensions(), (3 * 48 + 12, 36 + 44));
+        // Reference | method | FLIP | black where lit, 6 pixels apart.
+        assert_eq!(p.dimensions(), (4 * 48 + 18, 36 + 44));
+        // The black map's tile holds only its three greys and red (JPEG: near them).
+        let tile = image::imageops::crop_imm(&p, 3 * 54, 44, 48, 36).to_image();
+        let known = |c: [u8; 3]| {
+            [[32, 32, 32], [150, 150, 150], [255, 0, 0]]
+                .iter()
+                .any(|k| (0..3).all(|i| c[i].abs_diff(k[i]) < 40))
+        };
+        let off = tile.pixels().filter(|px| !known(px.0)).count();
+        assert!(
+            off < 48 * 36 / 10,
+            "{off} pixels of the black map are no class's colour"
+        );
         let cells = [
             "mode",
             "total_ms",

@@ -76,6 +76,64 @@ pub fn indirect_errors(
     r: &HdrImage,
     direct: &HdrImage,
 ) -> Result<IndirectErrors, RenderError> {
+    Ok(indirect_map(a, r, direct)?.errors())
+}
+
+/// What the reference's indirect light says of a pixel, and the image's there.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Lit {
+    /// The reference's indirect light is under a tenth of its mean (or none): not counted.
+    Not,
+    /// Lit, and the image's indirect light is at least a tenth of the reference's.
+    Lit,
+    /// Lit, and the image's is under a tenth of it: black where it is lit.
+    Black,
+}
+
+/// Per pixel, [`Lit`], with the indirect images' means.
+pub struct IndirectMap {
+    /// Each pixel's class, rows from the top.
+    pub class: Vec<Lit>,
+    /// Mean indirect light (r + g + b) of the image.
+    pub mean_a: f64,
+    /// Mean indirect light (r + g + b) of the reference.
+    pub mean_r: f64,
+}
+
+impl IndirectMap {
+    /// The energy ratio and the black-where-lit share.
+    pub fn errors(&self) -> IndirectErrors {
+        let lit = self.class.iter().filter(|c| **c != Lit::Not).count();
+        let black = self.class.iter().filter(|c| **c == Lit::Black).count();
+        IndirectErrors {
+            energy_ratio: if self.mean_r > 0.0 {
+                self.mean_a / self.mean_r
+            } else {
+                1.0
+            },
+            black_where_lit: black as f64 / lit.max(1) as f64,
+        }
+    }
+
+    /// The classes as a picture: red where black where lit, grey where lit, dark grey where
+    /// the reference's indirect light is not counted.
+    pub fn to_image(&self, width: u32, height: u32) -> image::RgbImage {
+        image::ImageBuffer::from_fn(width, height, |x, y| {
+            image::Rgb(match self.class[(y * width + x) as usize] {
+                Lit::Not => [32, 32, 32],
+                Lit::Lit => [150, 150, 150],
+                Lit::Black => [255, 0, 0],
+            })
+        })
+    }
+}
+
+/// Each pixel of `a` against reference `r`, both less the direct light `direct`.
+pub fn indirect_map(
+    a: &HdrImage,
+    r: &HdrImage,
+    direct: &HdrImage,
+) -> Result<IndirectMap, RenderError> {
     same_size(a, r)?;
     same_size(direct, r)?;
     let sum = |p: Vec3| (p.x + p.y + p.z) as f64;
@@ -89,16 +147,23 @@ pub fn indirect_errors(
     let (ia, ir) = (ind(a), ind(r));
     let n = ir.len().max(1) as f64;
     let (mean_a, mean_r) = (ia.iter().sum::<f64>() / n, ir.iter().sum::<f64>() / n);
-    let lit: Vec<(f64, f64)> = ia
+    let class = ia
         .iter()
         .zip(&ir)
-        .filter(|(_, r)| **r > 0.0 && **r >= 0.1 * mean_r)
-        .map(|(a, r)| (*a, *r))
+        .map(|(&a, &r)| {
+            if !(r > 0.0 && r >= 0.1 * mean_r) {
+                Lit::Not
+            } else if a < 0.1 * r {
+                Lit::Black
+            } else {
+                Lit::Lit
+            }
+        })
         .collect();
-    let black = lit.iter().filter(|(a, r)| *a < 0.1 * r).count();
-    Ok(IndirectErrors {
-        energy_ratio: if mean_r > 0.0 { mean_a / mean_r } else { 1.0 },
-        black_where_lit: black as f64 / lit.len().max(1) as f64,
+    Ok(IndirectMap {
+        class,
+        mean_a,
+        mean_r,
     })
 }
 
@@ -172,5 +237,14 @@ mod tests {
         assert!((e.black_where_lit - 0.5).abs() < 1e-12, "{e:?}");
         let same = indirect_errors(&reference, &reference, &direct).expect("same size");
         assert_eq!((same.energy_ratio, same.black_where_lit), (1.0, 0.0));
+        // Pixel by pixel: the second and third are black, and red in the picture.
+        let map = indirect_map(&method, &reference, &direct).expect("same size");
+        assert_eq!(map.class, [Lit::Lit, Lit::Black, Lit::Black, Lit::Lit]);
+        let red = map
+            .to_image(4, 1)
+            .pixels()
+            .map(|p| p.0 == [255, 0, 0])
+            .collect::<Vec<_>>();
+        assert_eq!(red, [false, true, true, false]);
     }
 }

@@ -25,7 +25,7 @@ use crate::cpu::gates::GateLevel;
 use crate::gpu::{DirectLight, GpuMode};
 use crate::hdr::HdrImage;
 use crate::job::{FrameStats, JobFrame, RenderJob, Renderer};
-use crate::metrics::{errors, flip, indirect_errors, rebase_direct};
+use crate::metrics::{errors, flip, indirect_map, rebase_direct};
 
 pub use stability::{LiveVals, StabilityRow};
 
@@ -685,14 +685,15 @@ fn measure(
     let reference = if direct_only { direct.cpu } else { reference };
     let e = errors(image, reference)?;
     let (f, flip_map) = flip(image, reference, exposure)?;
-    let (i, indirect_mse) = if direct_only {
+    let (map, indirect_mse) = if direct_only {
         let black = HdrImage::new(image.width, image.height);
-        (indirect_errors(image, reference, &black)?, e.mse)
+        (indirect_map(image, reference, &black)?, e.mse)
     } else {
         let rebased = rebase_direct(image, direct.gpu, direct.cpu)?;
-        let i = indirect_errors(&rebased, reference, direct.cpu)?;
-        (i, errors(&rebased, reference)?.mse)
+        let map = indirect_map(&rebased, reference, direct.cpu)?;
+        (map, errors(&rebased, reference)?.mse)
     };
+    let i = map.errors();
     let png = rel.with_extension("png");
     image.write_png(&store.dir.join(&png), exposure)?;
     let panel = Path::new("panels").join(format!(
@@ -701,7 +702,8 @@ fn measure(
         file_name(&m.label)
     ));
     let title = format!("{} · {} · {vpls} VPLs", camera.name, m.label);
-    let picture = plot::panel(reference, image, &flip_map, exposure, &title)?;
+    let black_map = map.to_image(image.width, image.height);
+    let picture = plot::panel(reference, image, (&flip_map, &black_map), exposure, &title)?;
     plot::write_jpeg(&picture, &store.dir.join(&panel))?;
     Ok(Row {
         camera: camera.name.clone(),

@@ -157,12 +157,14 @@ pub fn pareto(
     RgbImage::from_raw(w, h, buf).ok_or_else(|| RenderError::Param("plot buffer size".into()))
 }
 
-/// Reference | method | FLIP map (black 0 … white 1) side by side under `title`, both images
-/// tone mapped at `exposure` stops.
+/// Reference | method | FLIP map (black 0 … white 1) | black where lit (red: the method's
+/// indirect light under a tenth of the reference's where that counts, grey: lit and counted;
+/// [`crate::metrics::IndirectMap::to_image`]) side by side under `title`, both images tone
+/// mapped at `exposure` stops.
 pub fn panel(
     reference: &HdrImage,
     image: &HdrImage,
-    flip_map: &[f32],
+    (flip_map, black_map): (&[f32], &RgbImage),
     exposure: f32,
     title: &str,
 ) -> Result<RgbImage, RenderError> {
@@ -173,8 +175,10 @@ pub fn panel(
         reference.to_srgb8(exposure),
         image.to_srgb8(exposure),
         false_colour(flip_map, w, h, 1.0),
+        black_map.clone(),
     ];
-    let (pw, ph) = (3 * w + 2 * gap, h + top);
+    let n = tiles.len() as u32;
+    let (pw, ph) = (n * w + (n - 1) * gap, h + top);
     let mut out = RgbImage::from_pixel(pw, ph, image::Rgb([255, 255, 255]));
     for (i, t) in tiles.iter().enumerate() {
         image::imageops::replace(&mut out, t, (i as u32 * (w + gap)) as i64, top as i64);
@@ -184,9 +188,14 @@ pub fn panel(
         let root = BitMapBackend::with_buffer(&mut buf, (pw, ph)).into_drawing_area();
         let style = (FONT, 14).into_font().color(&BLACK);
         root.draw_text(title, &style, (2, 2)).map_err(drawing)?;
-        for (i, label) in ["reference", "method", "FLIP error (black 0 … white 1)"]
-            .iter()
-            .enumerate()
+        for (i, label) in [
+            "reference",
+            "method",
+            "FLIP (black 0 … white 1)",
+            "red: black where lit",
+        ]
+        .iter()
+        .enumerate()
         {
             let x = (i as u32 * (w + gap)) as i32 + 2;
             root.draw_text(label, &style, (x, 22)).map_err(drawing)?;
