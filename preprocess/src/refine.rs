@@ -61,20 +61,38 @@ pub fn refine(meta: &GridMeta, empty: &[bool], coarse: &Coarse) -> (Vec<u32>, Re
     let [nx, ny, _] = meta.dims.map(|d| d as usize);
     let slab = nx * ny;
     let mut cluster: Vec<u32> = vec![u32::MAX; empty.len()];
+    // The coarse voxel holding each fine voxel's centre, axis by axis (the mapping is
+    // separable: `world_to_voxel` of `voxel_to_world`, one axis at a time).
+    let along: [Vec<Option<u32>>; 3] = std::array::from_fn(|a| {
+        (0..meta.dims[a])
+            .map(|v| {
+                let mut p = [0u32; 3];
+                p[a] = v;
+                let mut w = coarse
+                    .meta
+                    .origin_m
+                    .map(|o| o + 0.5 * coarse.meta.voxel_size_m);
+                w[a] = meta.voxel_to_world(p)[a];
+                coarse.meta.world_to_voxel(w).map(|c| c[a])
+            })
+            .collect()
+    });
     cluster
         .par_chunks_mut(slab)
         .zip(empty.par_chunks(slab))
         .enumerate()
         .for_each(|(z, (cs, es))| {
+            let Some(cz) = along[2][z] else {
+                return;
+            };
             for (i, (c, &e)) in cs.iter_mut().zip(es).enumerate() {
                 if !e {
                     continue;
                 }
-                let v = [(i % nx) as u32, (i / nx) as u32, z as u32];
-                let Some(cv) = coarse.meta.world_to_voxel(meta.voxel_to_world(v)) else {
+                let (Some(cx), Some(cy)) = (along[0][i % nx], along[1][i / nx]) else {
                     continue;
                 };
-                let ci = coarse.meta.index(cv);
+                let ci = coarse.meta.index([cx, cy, cz]);
                 if coarse.empty[ci] {
                     *c = coarse.voxel_cluster[ci];
                 }
