@@ -840,3 +840,62 @@ fn the_light_list_pool_grows_to_what_a_frame_needs() {
     let l = t.lists.expect("stats");
     assert_eq!((l.entries, l.capacity), (0, 1));
 }
+
+#[test]
+fn gpu_portal_walks_keep_their_light_however_many_vpls_a_pixel_walks() {
+    // llvmpipe ends a shader invocation's loops after 65,535 iterations in all: a pixel that
+    // walked 2,048 VPLs' portals in one pass lost a third of their light on ajar-door's `door`
+    // camera (then it warned). Mode gates walks them in batches there; the GPU keeps the CPU
+    // twin's light.
+    use visgate_runtime::cpu::reference::{IndirectVisibility, ReferenceParams, render_with};
+    use visgate_runtime::gpu::{GpuContext, GpuMode, GpuParams, GpuRenderer};
+    use visgate_runtime::vpl::{PathParams, path_vpls};
+    let ctx = GpuContext::new().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"));
+    let (scene, baked) = gate_support::baked(Builtin::AjarDoor, 128);
+    let gates = GateLevel::new(baked.level, &scene).expect("level");
+    let tracer = Tracer::new(&scene);
+    let paths = PathParams {
+        paths: 2048,
+        bounces: 1,
+        seed: 4,
+    };
+    let vpls = path_vpls(&tracer, &scene.lights, &paths).expect("vpls");
+    let view = visgate_runtime::camera::View::new(&scene.cameras[1], [24, 16]).expect("view");
+    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    gpu.set_level(&ctx, &gates).expect("level");
+    let (cpu, _) = render_with(
+        &tracer,
+        &scene.lights,
+        &vpls,
+        &view,
+        &ReferenceParams {
+            samples_per_pixel: 1,
+            ..ReferenceParams::default()
+        },
+        IndirectVisibility::Gates(&gates, GateParams::default()),
+        &|_, _| {},
+    )
+    .expect("cpu");
+    let (direct, _) = gpu
+        .render(
+            &ctx,
+            &view,
+            &vpls,
+            &GpuParams::with_mode(GpuMode::DirectOnly),
+        )
+        .expect("direct");
+    let indirect = |img: &visgate_runtime::hdr::HdrImage| -> f64 {
+        img.pixels
+            .iter()
+            .zip(&direct.pixels)
+            .map(|(p, d)| f64::from((*p - *d).element_sum()))
+            .sum()
+    };
+    let mode = GpuMode::Gates(every_vpl_at_every_pixel());
+    let (img, _) = gpu
+        .render(&ctx, &view, &vpls, &GpuParams::with_mode(mode))
+        .expect("gpu");
+    let ratio = indirect(&img) / indirect(&cpu);
+    eprintln!("{} VPLs a pixel: GPU / CPU indirect {ratio:.4}", vpls.len());
+    assert!((ratio - 1.0).abs() < 0.01, "{ratio}");
+}

@@ -6,7 +6,7 @@
 //! its line in [`METHODS`], and its branch in [`super::GpuRenderer`]'s frame.
 
 use crate::RenderError;
-use crate::cpu::gates::GateParams;
+use crate::cpu::gates::{GateParams, GateShape};
 use crate::cpu::val::ValParams;
 
 pub use super::passes::clustered_gates::GatesParams;
@@ -383,21 +383,41 @@ impl GpuParams {
 /// 65,535 iterations in all (its `LP_MAX_TGSI_LOOP_ITERATIONS`), without a word: a pixel that
 /// walks many VPLs through the portals stops early and loses their light (ajar-door's `door`
 /// camera, gates per pixel against the CPU twin: 93 % of the light at 512 VPLs, 55 % at
-/// 4,096; an H100 matches it to 0.03 % at every count). Walked VPLs a pixel above which it
-/// warns.
-pub const SOFTWARE_WALK_WARNING: u32 = 256;
+/// 4,096; Crytek Sponza's gallery, 512 bake, 1,024 VPLs a pixel: 27 %; an H100 matches it to
+/// 0.03 % at every count). Mode `gates` there walks a pixel's VPLs this many a draw
+/// ([`walk_batch`]); `gates-per-pixel` (one pass, no batches) warns above it.
+pub const SOFTWARE_WALK_BATCH: u32 = 16;
+
+/// Whether `adapter` is llvmpipe (lavapipe's rasterizer), with its loop limit.
+fn software(adapter: &str) -> bool {
+    adapter.contains("llvmpipe")
+}
+
+/// VPLs of a pixel's subset that mode `gates` with portals walks in one draw on `adapter`: 0
+/// (all in one) but on a software rasterizer, [`SOFTWARE_WALK_BATCH`].
+pub fn walk_batch(adapter: &str, mode: &GpuMode) -> u32 {
+    match mode {
+        GpuMode::Gates(p) if p.gates.shape == GateShape::Portal && software(adapter) => {
+            SOFTWARE_WALK_BATCH
+        }
+        _ => 0,
+    }
+}
 
 /// Warns (once a process) when `adapter` is llvmpipe and `mode` walks more than
-/// [`SOFTWARE_WALK_WARNING`] VPLs a pixel.
+/// [`SOFTWARE_WALK_BATCH`] VPLs a pixel in one draw (`gates-per-pixel`).
 pub fn warn_software_loop_limit(adapter: &str, mode: &GpuMode, vpls: u32) {
     static WARNED: std::sync::Once = std::sync::Once::new();
-    let walks = mode.portal_walks_per_pixel(vpls);
-    if adapter.contains("llvmpipe") && walks > SOFTWARE_WALK_WARNING {
+    let walks = match mode {
+        GpuMode::GatesPerPixel(_) => mode.portal_walks_per_pixel(vpls),
+        _ => 0,
+    };
+    if software(adapter) && walks > SOFTWARE_WALK_BATCH {
         WARNED.call_once(|| {
             tracing::warn!(
                 "{adapter} ends a shader's loops after 65,535 iterations in all: the portal \
-                 walks of {walks} VPLs a pixel may stop early and lose light (interleave, \
-                 --interleave 8, or use a hardware GPU)"
+                 walks of {walks} VPLs a pixel in one pass may stop early and lose light (mode \
+                 gates walks them in batches, or use a hardware GPU)"
             )
         });
     }
@@ -406,6 +426,22 @@ pub fn warn_software_loop_limit(adapter: &str, mode: &GpuMode, vpls: u32) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn portals_walk_in_batches_on_a_software_rasterizer_alone() {
+        let portals = GatesParams::default();
+        let llvmpipe = "llvmpipe (LLVM 19.1.7, 256 bits)";
+        let gates = GpuMode::Gates(portals);
+        assert_eq!(walk_batch(llvmpipe, &gates), SOFTWARE_WALK_BATCH);
+        assert_eq!(walk_batch("NVIDIA H100 80GB HBM3", &gates), 0);
+        let mut disks = portals;
+        disks.gates.shape = GateShape::Disk;
+        assert_eq!(walk_batch(llvmpipe, &GpuMode::Gates(disks)), 0);
+        assert_eq!(
+            walk_batch(llvmpipe, &GpuMode::GatesPerPixel(portals.gates)),
+            0
+        );
+    }
 
     #[test]
     fn portal_walks_a_pixel_follow_the_shape_and_the_interleaving() {

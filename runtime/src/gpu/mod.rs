@@ -242,7 +242,9 @@ fn record_passes(
         _ => None,
     };
     let shading = match f.params.mode {
-        GpuMode::Gates(gp) if gp.interleave.block > 1 => "shading: direct lighting",
+        GpuMode::Gates(gp) if gp.interleave.block > 1 || gp.gates.shape == GateShape::Portal => {
+            "shading: direct lighting"
+        }
         GpuMode::VplClusters(_, i) if i.block > 1 => "shading: direct lighting",
         GpuMode::None
         | GpuMode::Gates(_)
@@ -254,7 +256,7 @@ fn record_passes(
     let hdr = p.shade.record(f, pool, rec, inputs, shading);
     let mut val_state = None;
     match &f.params.mode {
-        GpuMode::Gates(gp) if gp.interleave.block > 1 => {
+        GpuMode::Gates(gp) if gp.interleave.block > 1 || gp.gates.shape == GateShape::Portal => {
             let indirect = p.shade.record_indirect(f, pool, rec, inputs, false);
             let uniform = InterleaveBlur::uniform(f, &gp.interleave, pool, true);
             p.blur.record(f, pool, rec, (&g, &uniform, &indirect, &hdr));
@@ -474,7 +476,7 @@ impl GpuRenderer {
             shade_mode: shade_mode as u32,
             shadow_size: params.shadows.size,
             direct_mode: params.direct.shader_id(),
-            _pad0: 0,
+            walk_batch: methods::walk_batch(&ctx.adapter_info.name, &params.mode),
             _pad1: 0,
             _pad2: 0,
         };

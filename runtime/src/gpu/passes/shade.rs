@@ -31,6 +31,18 @@ pub fn fullscreen(
     bind_group: &wgpu::BindGroup,
     timestamps: Option<wgpu::RenderPassTimestampWrites>,
 ) {
+    fullscreen_batch(enc, label, target, (pipeline, bind_group), timestamps, 0);
+}
+
+/// [`fullscreen`] as instance `batch` (shade.wgsl's `vs_batch` passes it on).
+fn fullscreen_batch(
+    enc: &mut wgpu::CommandEncoder,
+    label: &str,
+    target: &wgpu::TextureView,
+    (pipeline, bind_group): (&wgpu::RenderPipeline, &wgpu::BindGroup),
+    timestamps: Option<wgpu::RenderPassTimestampWrites>,
+    batch: u32,
+) {
     let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some(label),
         color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -49,7 +61,7 @@ pub fn fullscreen(
     });
     pass.set_pipeline(pipeline);
     pass.set_bind_group(0, bind_group, &[]);
-    pass.draw(0..3, 0..1);
+    pass.draw(0..3, batch..batch + 1);
 }
 
 /// A full-frame RGBA32F target `label` of the frame's size (kept in `pool`).
@@ -80,7 +92,11 @@ pub type Inputs<'a> = (
 
 /// The bindings of shade.wgsl's `fs_gates_indirect` (an automatic layout holds only what an
 /// entry point uses).
-const GATES_INDIRECT_BINDINGS: [u32; 11] = [0, 2, 5, 6, 8, 10, 12, 13, 14, 15, 16];
+const GATES_INDIRECT_BINDINGS: [u32; 12] = [0, 2, 5, 6, 8, 10, 12, 13, 14, 15, 16, 21];
+/// The bindings of shade.wgsl's `fs`: all but the batches' sum.
+const SHADE_BINDINGS: [u32; 21] = [
+    0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20,
+];
 /// The bindings of shade.wgsl's `fs_vpl_clusters_indirect`.
 const VPL_CLUSTERS_INDIRECT_BINDINGS: [u32; 6] = [0, 2, 5, 6, 19, 20];
 
@@ -93,7 +109,7 @@ impl Shade {
             d,
             "gates indirect (interleaved)",
             &module,
-            ("vs", "fs_gates_indirect"),
+            ("vs_batch", "fs_gates_indirect"),
             &[],
             &[HDR],
             None,
@@ -124,7 +140,8 @@ impl Shade {
         name: &'static str,
     ) -> wgpu::Texture {
         let out = frame_target(f, pool, "hdr");
-        self.draw(f, rec, inputs, (&self.pipeline, None), (&out, name));
+        let pipeline = (&self.pipeline, Some(&SHADE_BINDINGS[..]));
+        self.draw(f, rec, inputs, pipeline, (std::slice::from_ref(&out), name));
         out
     }
 
@@ -140,15 +157,27 @@ impl Shade {
         vpl_clusters: bool,
     ) -> wgpu::Texture {
         let out = frame_target(f, pool, "indirect irradiance");
-        let pipeline = match vpl_clusters {
-            false => (&self.gates_indirect, Some(&GATES_INDIRECT_BINDINGS[..])),
-            true => (
+        let name = "indirect lighting";
+        if vpl_clusters {
+            let pipeline = (
                 &self.vpl_clusters_indirect,
                 Some(&VPL_CLUSTERS_INDIRECT_BINDINGS[..]),
-            ),
+            );
+            self.draw(f, rec, inputs, pipeline, (std::slice::from_ref(&out), name));
+            return out;
+        }
+        // Portals' batches ping-pong between two targets, each adding onto the other's sum.
+        let batch = crate::gpu::methods::walk_batch(&f.ctx.adapter_info.name, &f.params.mode);
+        let walks = f.params.mode.portal_walks_per_pixel(f.vpl_count);
+        let batches = if batch > 0 {
+            walks.div_ceil(batch).max(1)
+        } else {
+            1
         };
-        self.draw(f, rec, inputs, pipeline, (&out, "indirect lighting"));
-        out
+        let targets = [out, frame_target(f, pool, "indirect irradiance (batches)")];
+        let pipeline = (&self.gates_indirect, Some(&GATES_INDIRECT_BINDINGS[..]));
+        self.draw_batches(f, rec, inputs, pipeline, (&targets, name), batches);
+        targets[(batches as usize - 1) % 2].clone()
     }
 
     /// A fullscreen pass of shade.wgsl with `pipeline` (and the bindings it uses, all if
@@ -157,9 +186,24 @@ impl Shade {
         &self,
         f: &Frame,
         rec: &mut Recorder,
+        inputs: Inputs,
+        pipeline: (&wgpu::RenderPipeline, Option<&[u32]>),
+        (out, name): (&[wgpu::Texture], &'static str),
+    ) {
+        self.draw_batches(f, rec, inputs, pipeline, (out, name), 1);
+    }
+
+    /// `batches` fullscreen passes of shade.wgsl with `pipeline` (and the bindings it uses),
+    /// timed together as `name`: pass `i` is instance `i`, writes `targets[i % 2]` and reads
+    /// the other as the batches' sum so far (binding 21; one target: one pass, no sum).
+    fn draw_batches(
+        &self,
+        f: &Frame,
+        rec: &mut Recorder,
         (shadows, g, lists, lc, vpl_lc): Inputs,
         (pipeline, used): (&wgpu::RenderPipeline, Option<&[u32]>),
-        (out, name): (&wgpu::Texture, &'static str),
+        (targets, name): (&[wgpu::Texture], &'static str),
+        batches: u32,
     ) {
         let d = &f.ctx.device;
         let level = f.scene.level.as_ref();
@@ -185,34 +229,48 @@ impl Shade {
             (18, lc.map_or(none, |o| &o.clusters.light_cluster)),
             (20, vpl_lc.map_or(none, |o| &o.clusters.light_cluster)),
         ];
-        let textures = [
-            (4, &maps),
-            (5, &g.views[0]),
-            (6, &g.views[1]),
-            (7, &g.views[2]),
-            (17, &vis),
-            (19, &vpl_vis),
-        ];
-        let resources = buffers
+        let views: Vec<wgpu::TextureView> = targets
             .iter()
-            .map(|&(k, b)| (k, b.as_entire_binding()))
-            .chain(
-                textures
-                    .iter()
-                    .map(|&(k, v)| (k, wgpu::BindingResource::TextureView(v))),
-            )
-            .filter(|(k, _)| used.is_none_or(|u| u.contains(k)))
+            .map(|t| t.create_view(&Default::default()))
             .collect();
-        let bg = bind_group(d, &pipeline.get_bind_group_layout(0), name, resources);
+        // One bind group a target written: the batches' sum is the other target.
+        let groups: Vec<wgpu::BindGroup> = (0..views.len().min(batches as usize))
+            .map(|i| {
+                let earlier = &views[(i + 1) % views.len()];
+                let textures = [
+                    (4, &maps),
+                    (5, &g.views[0]),
+                    (6, &g.views[1]),
+                    (7, &g.views[2]),
+                    (17, &vis),
+                    (19, &vpl_vis),
+                    (21, earlier),
+                ];
+                let resources = buffers
+                    .iter()
+                    .map(|&(k, b)| (k, b.as_entire_binding()))
+                    .chain(
+                        textures
+                            .iter()
+                            .map(|&(k, v)| (k, wgpu::BindingResource::TextureView(v))),
+                    )
+                    .filter(|(k, _)| used.is_none_or(|u| u.contains(k)))
+                    .collect();
+                bind_group(d, &pipeline.get_bind_group_layout(0), name, resources)
+            })
+            .collect();
         let span = rec.begin(name);
-        fullscreen(
-            &mut rec.enc,
-            name,
-            &out.create_view(&Default::default()),
-            pipeline,
-            &bg,
-            span.render(true, true),
-        );
+        for i in 0..batches as usize {
+            let k = i % views.len();
+            fullscreen_batch(
+                &mut rec.enc,
+                name,
+                &views[k],
+                (pipeline, &groups[k]),
+                span.render(i == 0, i + 1 == batches as usize),
+                i as u32,
+            );
+        }
         rec.end();
     }
 }

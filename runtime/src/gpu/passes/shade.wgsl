@@ -51,6 +51,9 @@ struct GeometryCluster {
 // SHADE_VPL_CLUSTERS: the VPLs' clusters' visibility and each VPL's cluster (NONE: no flux).
 @group(0) @binding(19) var vpl_lc_visibility: texture_2d_array<f32>;
 @group(0) @binding(20) var<storage, read> vpl_lc_cluster: array<u32>;
+// Portals walked in batches (fs_gates_indirect): the sum of the batches before, in the
+// (deinterleaved) layout of the indirect target.
+@group(0) @binding(21) var earlier_batches: texture_2d<f32>;
 
 // SHADE_VPL_CLUSTERS: the VPLs first, first + step, … (every VPL, or an interleaving subset),
 // each shadowed by its cluster's PCSS visibility at px; the sum × step.
@@ -191,8 +194,8 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
         radiance += albedo / PI * gather_per_pixel(p, n, decode_cluster(pos.w));
     } else if mode == SHADE_VPL_CLUSTERS && globals.interleave_block <= 1u {
         radiance += albedo / PI * gather_vpl_clusters(p, n, px, 0u, 1u);
-    } else if mode == SHADE_GATES_CLUSTERED && globals.interleave_block <= 1u {
-        radiance += albedo / PI * clustered_gather(px, p, n, decode_cluster(pos.w));
+    } else if mode == SHADE_GATES_CLUSTERED && globals.interleave_block <= 1u && grid.shape == 0u {
+        radiance += albedo / PI * clustered_gather(px, p, n, decode_cluster(pos.w), 0u);
     }
     return vec4<f32>(radiance, 1.0);
 }
@@ -201,12 +204,12 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
 // entry with gates is tested here, per fragment; a VPL whose light passes by several chains
 // counts once (a list is ordered by (VPL mod B, VPL)). With interleaving (B = b² subsets) the
 // pixel takes only its subset's run of the list, found by binary search, and the sum is × B.
-fn clustered_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32) -> vec3<f32> {
+fn clustered_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, batch: u32) -> vec3<f32> {
     let b = max(globals.interleave_block, 1u);
     let subsets = b * b;
     let j = interleave_subset(px, b);
     if grid.shape == 1u {
-        return portal_gather(p, n, here, j, subsets);
+        return portal_gather(p, n, here, j, subsets, batch);
     }
     let width = textureDimensions(g_position).x;
     let gc = pixel_cluster[u32(px.x) + u32(px.y) * width];
@@ -246,10 +249,17 @@ fn clustered_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32) -> vec
     return sum * f32(subsets);
 }
 
-// Portals: the VPLs of subset j (VPL mod B = j), each walked from its cluster to p, × B.
-fn portal_gather(p: vec3<f32>, n: vec3<f32>, here: u32, j: u32, subsets: u32) -> vec3<f32> {
+// Portals: the VPLs of subset j (VPL mod B = j), each walked from its cluster to p, × B; of
+// them, batch `batch` of globals.walk_batch (0: all in one).
+fn portal_gather(p: vec3<f32>, n: vec3<f32>, here: u32, j: u32, subsets: u32, batch: u32) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
-    for (var k = j; k < globals.vpl_count; k += subsets) {
+    var first = j;
+    var end = globals.vpl_count;
+    if globals.walk_batch > 0u {
+        first = j + batch * globals.walk_batch * subsets;
+        end = min(end, first + globals.walk_batch * subsets);
+    }
+    for (var k = first; k < end; k += subsets) {
         let v = vpls[k];
         let l = vpl_light(v, p, n, globals.g_max);
         if all(l == vec3<f32>(0.0)) {
@@ -283,14 +293,38 @@ fn subset_start(first: u32, end: u32, subsets: u32, j: u32) -> u32 {
 // Interleaved clustered gates: a pixel's subset's irradiance × B alone (no albedo / π), into
 // the indirect target that blur.wgsl composes, deinterleaved: the fragment at s shades the
 // pixel that s holds, so that a GPU's neighbouring lanes walk the same VPLs.
+//
+// Portals on a software rasterizer walk a pixel's VPLs in batches, a draw each (the instance
+// index is the batch), each adding its light to the batches' before: llvmpipe ends a shader
+// invocation's loops after 65,535 iterations in all, which a pixel walking hundreds of VPLs
+// reaches, losing the light of the rest.
+struct BatchOut {
+    @builtin(position) position: vec4<f32>,
+    @location(0) @interpolate(flat) batch: u32,
+};
+
+@vertex
+fn vs_batch(@builtin(vertex_index) i: u32, @builtin(instance_index) batch: u32) -> BatchOut {
+    var out: BatchOut;
+    // fullscreen.wgsl's triangle.
+    let uv = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
+    out.position = vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
+    out.batch = batch;
+    return out;
+}
+
 @fragment
-fn fs_gates_indirect(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
+fn fs_gates_indirect(@builtin(position) frag: vec4<f32>, @location(0) @interpolate(flat) batch: u32) -> @location(0) vec4<f32> {
+    var sum = vec3<f32>(0.0);
+    if batch > 0u {
+        sum = textureLoad(earlier_batches, vec2<i32>(frag.xy), 0).xyz;
+    }
     let s = interleaved_surface(frag);
     if s.position.w == 0.0 {
-        return vec4<f32>(0.0);
+        return vec4<f32>(sum, 1.0);
     }
     let here = decode_cluster(s.position.w);
-    return vec4<f32>(clustered_gather(s.px, s.position.xyz, s.normal, here), 1.0);
+    return vec4<f32>(sum + clustered_gather(s.px, s.position.xyz, s.normal, here, batch), 1.0);
 }
 
 // The pixel a deinterleaved fragment shades, and its G-buffer surface (w 0: none).

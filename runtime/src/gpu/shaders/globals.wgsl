@@ -17,7 +17,8 @@ struct Globals {
     shadow_size: u32,
     // DIRECT_PER_LIGHT or DIRECT_LIGHTCLUSTER.
     direct_mode: u32,
-    pad0: u32,
+    // Portals: VPLs of a pixel's subset walked a draw (0: all in one draw).
+    walk_batch: u32,
     pad1: u32,
     pad2: u32,
 };
