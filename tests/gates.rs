@@ -168,7 +168,6 @@ fn gate_tests_are_stable_at_the_extremes() {
 
 #[test]
 fn gpu_gates_agree_with_the_cpu_twin() {
-    use visgate_runtime::cpu::reference::{IndirectVisibility, ReferenceParams, render_with};
     use visgate_runtime::gpu::{GatesParams, GpuContext, GpuMode, GpuParams, GpuRenderer};
     use visgate_runtime::metrics::errors;
     let ctx = GpuContext::new().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"));
@@ -211,19 +210,7 @@ fn gpu_gates_agree_with_the_cpu_twin() {
             let (img, _) = gpu
                 .render(&ctx, &view, &vpls, &GpuParams::with_mode(mode))
                 .expect("render");
-            let (cpu, _) = render_with(
-                &tracer,
-                &scene.lights,
-                &vpls,
-                &view,
-                &ReferenceParams {
-                    samples_per_pixel: 1,
-                    ..ReferenceParams::default()
-                },
-                IndirectVisibility::Gates(&gates, gp),
-                &|_, _| {},
-            )
-            .expect("cpu");
+            let cpu = cpu_twin(&tracer, &scene.lights, &vpls, &view, (&gates, gp));
             let e = errors(&img, &cpu).expect("same size");
             eprintln!(
                 "{} {} {shape:?} {hops} hop(s): {e:?}",
@@ -498,7 +485,6 @@ fn gpu_vs_twin(
     vpls: &[visgate_runtime::vpl::Vpl],
     view: &visgate_runtime::camera::View,
 ) -> (visgate_runtime::hdr::HdrImage, f64) {
-    use visgate_runtime::cpu::reference::{IndirectVisibility, ReferenceParams, render_with};
     use visgate_runtime::gpu::{GpuMode, GpuParams};
     use visgate_runtime::metrics::errors;
     let (img, _) = gpu
@@ -510,19 +496,13 @@ fn gpu_vs_twin(
         )
         .expect("gpu");
     assert!(img.pixels.iter().all(|p| p.is_finite()), "finite");
-    let (cpu, _) = render_with(
+    let cpu = cpu_twin(
         tracer,
         &scene.lights,
         vpls,
         view,
-        &ReferenceParams {
-            samples_per_pixel: 1,
-            ..ReferenceParams::default()
-        },
-        IndirectVisibility::Gates(gates, GateParams::default()),
-        &|_, _| {},
-    )
-    .expect("cpu");
+        (gates, GateParams::default()),
+    );
     let e = errors(&img, &cpu).expect("same size");
     (img, e.rel_mse)
 }
@@ -847,7 +827,6 @@ fn gpu_portal_walks_keep_their_light_however_many_vpls_a_pixel_walks() {
     // walked 2,048 VPLs' portals in one pass lost a third of their light on ajar-door's `door`
     // camera (then it warned). Mode gates walks them in batches there; the GPU keeps the CPU
     // twin's light.
-    use visgate_runtime::cpu::reference::{IndirectVisibility, ReferenceParams, render_with};
     use visgate_runtime::gpu::{GpuContext, GpuMode, GpuParams, GpuRenderer};
     use visgate_runtime::vpl::{PathParams, path_vpls};
     let ctx = GpuContext::new().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"));
@@ -863,19 +842,13 @@ fn gpu_portal_walks_keep_their_light_however_many_vpls_a_pixel_walks() {
     let view = visgate_runtime::camera::View::new(&scene.cameras[1], [24, 16]).expect("view");
     let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
     gpu.set_level(&ctx, &gates).expect("level");
-    let (cpu, _) = render_with(
+    let cpu = cpu_twin(
         &tracer,
         &scene.lights,
         &vpls,
         &view,
-        &ReferenceParams {
-            samples_per_pixel: 1,
-            ..ReferenceParams::default()
-        },
-        IndirectVisibility::Gates(&gates, GateParams::default()),
-        &|_, _| {},
-    )
-    .expect("cpu");
+        (&gates, GateParams::default()),
+    );
     let (direct, _) = gpu
         .render(
             &ctx,
@@ -898,4 +871,31 @@ fn gpu_portal_walks_keep_their_light_however_many_vpls_a_pixel_walks() {
     let ratio = indirect(&img) / indirect(&cpu);
     eprintln!("{} VPLs a pixel: GPU / CPU indirect {ratio:.4}", vpls.len());
     assert!((ratio - 1.0).abs() < 0.01, "{ratio}");
+}
+
+/// The CPU twin of mode `gates` (one sample at each pixel's centre) with `gates` and `params`.
+fn cpu_twin(
+    tracer: &Tracer,
+    lights: &[visgate_formats::Light],
+    vpls: &[visgate_runtime::vpl::Vpl],
+    view: &visgate_runtime::camera::View,
+    (gates, params): (&GateLevel, GateParams),
+) -> visgate_runtime::hdr::HdrImage {
+    use visgate_runtime::cpu::reference::{IndirectVisibility, ReferenceParams, render_with};
+    let reference = ReferenceParams {
+        samples_per_pixel: 1,
+        ..ReferenceParams::default()
+    };
+    let visibility = IndirectVisibility::Gates(gates, params);
+    render_with(
+        tracer,
+        lights,
+        vpls,
+        view,
+        &reference,
+        visibility,
+        &|_, _| {},
+    )
+    .expect("cpu")
+    .0
 }
