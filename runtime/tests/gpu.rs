@@ -627,3 +627,42 @@ fn direct_on_gpu_and_cpu(
         .expect("reference");
     (img, cpu)
 }
+
+#[test]
+fn gpu_normals_that_lean_far_from_their_faces_light_as_the_cpu_does() {
+    // Real meshes carry vertex normals far off their faces (Crytek Sponza's arches: up to 90°).
+    // The G-buffer once turned the shading normal itself towards the camera, the CPU tracer
+    // turns the face's normal towards the ray and the shading normal to its side. A floor whose
+    // normals lean 80° away from the camera, under a point light: the CPU lights it (the
+    // normal's upward part), the old G-buffer turned the normal down and left it black.
+    use visgate_formats::{Camera, Light};
+    let mut scene = floor_scene(
+        1.0,
+        vec![Light::Point {
+            position: Vec3::new(0.0, 2.0, 0.0),
+            intensity: Vec3::splat(10.0),
+        }],
+    );
+    let lean = 80f32.to_radians();
+    for n in &mut scene.meshes[0].normals {
+        *n = Vec3::new(lean.sin(), lean.cos(), 0.0);
+    }
+    let cam = Camera {
+        name: "oblique".into(),
+        eye: Vec3::new(-3.0, 1.0, 0.0),
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        fov_x_rad: 0.5,
+    };
+    let view = View::new(&cam, [16, 16]).expect("view");
+    let ctx = context();
+    let (gpu, cpu) = direct_on_gpu_and_cpu(&ctx, &scene, &view);
+    let e = errors(&gpu, &cpu).expect("same size");
+    eprintln!("{e:?}");
+    assert!(cpu.mean().x > 0.0);
+    assert!(
+        (e.image_mean / e.reference_mean - 1.0).abs() < 0.02,
+        "{e:?}"
+    );
+    assert!(e.rel_mse < 0.01, "{e:?}");
+}

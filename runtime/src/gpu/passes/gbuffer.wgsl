@@ -1,7 +1,7 @@
 //! include: globals.wgsl grid.wgsl
 // G-buffer pass: world position (w: the visibility cluster it faces, 0 where
-// no surface is, see encode_cluster), shading normal turned towards the camera (surfaces are
-// two-sided), linear albedo (material × texture, the texture an sRGB layer
+// no surface is, see encode_cluster), shading normal on the side of the face that the camera
+// sees (surfaces are two-sided), linear albedo (material × texture, the texture an sRGB layer
 // of one array, sampled nearest with repeat as the CPU reference does). Depth test less.
 
 @group(0) @binding(0) var<uniform> globals: Globals;
@@ -45,9 +45,21 @@ struct GOut {
 
 @fragment
 fn fs(i: VsOut) -> GOut {
+    // Two-sided, as the CPU tracer: the triangle's own normal turned towards the camera, the
+    // shading normal turned to its side. (Turning the shading normal itself to the camera
+    // disagrees where a mesh's normals lean far from its faces — Crytek Sponza's arches, up to
+    // 90° —, and those pixels took their light from the other hemisphere.) The face's normal
+    // comes from the position's screen derivatives, which a 2 × 2 quad takes from one triangle.
+    let to_eye = globals.eye.xyz - i.world;
+    var ng = cross(dpdx(i.world), dpdy(i.world));
+    if dot(ng, ng) <= 0.0 {
+        ng = to_eye;
+    }
+    if dot(ng, to_eye) < 0.0 {
+        ng = -ng;
+    }
     var n = normalize(i.normal);
-    // Two-sided: face the camera.
-    if dot(n, globals.eye.xyz - i.world) < 0.0 {
+    if dot(n, ng) < 0.0 {
         n = -n;
     }
     var o: GOut;
