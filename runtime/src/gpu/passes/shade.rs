@@ -146,8 +146,9 @@ impl Shade {
     }
 
     /// Records an interleaved mode's indirect irradiance (each pixel its subset's, × B) into a
-    /// target of its own, for the blur to compose: clustered gates', or with `vpl_clusters`
-    /// the VPL clusters'.
+    /// target of its own, for the blur to compose: clustered gates' (portals also without
+    /// interleaving, B = 1, and in batches of VPLs on a software rasterizer), or with
+    /// `vpl_clusters` the VPL clusters'.
     pub fn record_indirect(
         &self,
         f: &Frame,
