@@ -25,8 +25,8 @@ Every mode renders at every --vpls count from every camera, beside the CPU refer
 very same VPLs (a shadow ray per VPL and pixel sample; --spp samples). OUT/report.md and
 OUT/report.html hold a table per camera (pass times, MSE, relative MSE, FLIP, indirect energy
 ratio, black-where-lit share, speed-up over per-VPL shadow maps), the Pareto plot (frame time
-against --metric, log-log) and a panel per render (reference | method | FLIP map);
-OUT/report.json holds every figure. Renders are kept in OUT/renders: run the same command
+against --metric, log-log) and a panel per render (reference | method | FLIP map | where the
+method is black and the reference lit, in red); OUT/report.json holds every figure. Renders are kept in OUT/renders: run the same command
 again after a stop and it resumes, redoing only what changed.
 
 A level: --level LEVEL.vgate, or --bake-resolution N to bake one here; with neither, a gate

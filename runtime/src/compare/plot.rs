@@ -1,7 +1,7 @@
 //! The pictures of a comparison: the Pareto plot (frame time against error, log-log, a curve
 //! per method over its VPL counts, the non-dominated points filled, the answers ringed) and
-//! the panels (reference | method | false-colour FLIP map, JPEG), drawn with plotters into
-//! bitmaps, text in egui's own font so nothing is looked up on the system.
+//! the panels (reference | method | false-colour FLIP map | black where lit, JPEG), drawn with
+//! plotters into bitmaps, text in egui's own font so nothing is looked up on the system.
 
 use std::sync::Once;
 
