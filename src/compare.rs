@@ -26,8 +26,9 @@ very same VPLs (a shadow ray per VPL and pixel sample; --spp samples). OUT/repor
 OUT/report.html hold a table per camera (pass times, MSE, relative MSE, FLIP, indirect energy
 ratio, black-where-lit share, speed-up over per-VPL shadow maps), the Pareto plot (frame time
 against --metric, log-log) and a panel per render (reference | method | FLIP map | where the
-method is black and the reference lit, in red); OUT/report.json holds every figure. Renders are kept in OUT/renders: run the same command
-again after a stop and it resumes, redoing only what changed.
+method is black and the reference lit, in red); OUT/report.json holds every figure. Renders
+are kept in OUT/renders: run the same command again after a stop and it resumes, redoing only
+what changed.
 
 A level: --level LEVEL.vgate, or --bake-resolution N to bake one here; with neither, a gate
 mode makes the level be baked here at 128 voxels (and is left out, with a warning, if the
