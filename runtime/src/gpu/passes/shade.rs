@@ -175,7 +175,19 @@ impl Shade {
         } else {
             1
         };
-        let targets = [out, frame_target(f, pool, "indirect irradiance (batches)")];
+        // One pass reads no earlier batches: a texel stands in for the second target.
+        let earlier = match batches {
+            1 => pool.texture(
+                &f.ctx.device,
+                "no earlier batches",
+                [1, 1, 1],
+                1,
+                HDR,
+                wgpu::TextureUsages::TEXTURE_BINDING,
+            ),
+            _ => frame_target(f, pool, "indirect irradiance (batches)"),
+        };
+        let targets = [out, earlier];
         let pipeline = (&self.gates_indirect, Some(&GATES_INDIRECT_BINDINGS[..]));
         self.draw_batches(f, rec, inputs, pipeline, (&targets, name), batches);
         targets[(batches as usize - 1) % 2].clone()
