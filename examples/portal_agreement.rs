@@ -1,0 +1,145 @@
+//! The portal walk against shadow rays on any scene and level, every pixel–VPL pair of a view
+//! that could exchange light (the two surfaces face each other): the pairs an exact ray sees
+//! that the walk finds or blocks, the pairs it occludes that the walk lets through or blocks,
+//! and the blocked ones by how many cluster changes the segment passes (sampled at 101
+//! points). `tests/portals.rs` holds `ajar-door` to this on built-ins; this measures real
+//! levels.
+//!
+//! `cargo run --release --example portal_agreement -- SCENE LEVEL.vgate CAMERA [WxH] [PATHS]`
+//!
+//! Defaults: 160x90, 1,024 one-bounce light paths (seed 1, as `visgate compare`).
+
+use glam::{Vec2, Vec3};
+use visgate_formats::ImportOptions;
+use visgate_formats::vgate::BakedLevel;
+use visgate_runtime::camera::View;
+use visgate_runtime::cpu::gates::{GateLevel, GateParams, Walk};
+use visgate_runtime::cpu::tracer::Tracer;
+use visgate_runtime::vpl::{PathParams, path_vpls};
+
+/// Pair counts of one view.
+#[derive(Debug, Default)]
+struct Counts {
+    visible_found: u64,
+    visible_blocked: u64,
+    occluded_let_through: u64,
+    occluded_blocked: u64,
+    /// Blocked visible pairs by the cluster changes along the segment: 0, 1, 2–3, 4 or more.
+    blocked_by_changes: [u64; 4],
+    over_the_limit: u64,
+}
+
+/// Cluster changes along `a`–`b`, sampled at 101 points (looked up facing along the segment).
+fn changes(gates: &GateLevel, a: Vec3, b: Vec3) -> usize {
+    let dir = (b - a).normalize_or_zero();
+    let mut last = None;
+    let mut n = 0;
+    for k in 0..=100 {
+        let c = gates.cluster_at(a + (b - a) * (k as f32 / 100.0), dir);
+        if last.is_some() && c != last.flatten() {
+            n += 1;
+        }
+        last = Some(c);
+    }
+    n
+}
+
+fn main() -> anyhow::Result<()> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let [scene, level, camera, ..] = args.as_slice() else {
+        anyhow::bail!("usage: portal_agreement SCENE LEVEL.vgate CAMERA [WxH] [PATHS]");
+    };
+    let size = args.get(3).map_or("160x90", String::as_str);
+    let (w, h) = size
+        .split_once('x')
+        .and_then(|(w, h)| Some((w.parse::<u32>().ok()?, h.parse::<u32>().ok()?)))
+        .ok_or_else(|| anyhow::anyhow!("size {size}: WIDTHxHEIGHT"))?;
+    let paths = args.get(4).map_or(Ok(1024), |p| p.parse::<u32>())?;
+    let scene = visgate_scenes::load(scene, &ImportOptions::default())?;
+    let gates = GateLevel::new(BakedLevel::read(std::path::Path::new(level))?, &scene)?;
+    let tracer = Tracer::new(&scene);
+    let params = PathParams {
+        paths,
+        bounces: 1,
+        seed: 1,
+    };
+    let vpls = path_vpls(&tracer, &scene.lights, &params)?;
+    let cam = scene
+        .cameras
+        .iter()
+        .find(|c| &c.name == camera)
+        .ok_or_else(|| anyhow::anyhow!("no camera '{camera}'"))?;
+    let view = View::new(cam, [w, h])?;
+    let walk = GateParams::default();
+    let mut n = Counts::default();
+    for y in 0..h {
+        for x in 0..w {
+            let dir = view.ray_dir(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+            let Some(s) = tracer.trace(view.eye, dir) else {
+                continue;
+            };
+            let Some(here) = gates.cluster_at(s.position, s.normal) else {
+                continue;
+            };
+            let from = s.position + s.geometric_normal * tracer.epsilon_m;
+            for v in &vpls {
+                let (vp, vn) = (Vec3::from(v.position), Vec3::from(v.normal));
+                let to = vp - s.position;
+                if to.dot(s.normal) <= 0.0 || (-to).dot(vn) <= 0.0 {
+                    continue;
+                }
+                let Some(there) = gates.cluster_at(vp, vn) else {
+                    continue;
+                };
+                let exact = !tracer.occluded(from, vp + vn * tracer.epsilon_m);
+                let found = match gates.walk(vp, there, s.position, here, walk.max_walk) {
+                    Walk::Visible(_) => true,
+                    Walk::Blocked => false,
+                    Walk::Limit => {
+                        n.over_the_limit += 1;
+                        false
+                    }
+                };
+                match (exact, found) {
+                    (true, true) => n.visible_found += 1,
+                    (true, false) => {
+                        n.visible_blocked += 1;
+                        let k = match changes(&gates, vp, s.position) {
+                            0 => 0,
+                            1 => 1,
+                            2 | 3 => 2,
+                            _ => 3,
+                        };
+                        n.blocked_by_changes[k] += 1;
+                    }
+                    (false, true) => n.occluded_let_through += 1,
+                    (false, false) => n.occluded_blocked += 1,
+                }
+            }
+        }
+    }
+    let pairs = n.visible_found + n.visible_blocked + n.occluded_let_through + n.occluded_blocked;
+    let pct = |k: u64| 100.0 * k as f64 / pairs.max(1) as f64;
+    println!("{camera}: {pairs} pairs, {} VPLs, {w}x{h}", vpls.len());
+    println!(
+        "agree {:.2} %: visible and found {}, occluded and blocked {}",
+        pct(n.visible_found + n.occluded_blocked),
+        n.visible_found,
+        n.occluded_blocked
+    );
+    println!(
+        "false occluded {} ({:.2} %; {:.1} % of the visible pairs), false visible {} ({:.2} %)",
+        n.visible_blocked,
+        pct(n.visible_blocked),
+        100.0 * n.visible_blocked as f64 / (n.visible_found + n.visible_blocked).max(1) as f64,
+        n.occluded_let_through,
+        pct(n.occluded_let_through)
+    );
+    let [c0, c1, c2, c4] = n.blocked_by_changes;
+    println!(
+        "blocked visible pairs by cluster changes along the segment: 0: {c0}, 1: {c1}, \
+         2-3: {c2}, 4+: {c4}; walks over the limit {}",
+        n.over_the_limit
+    );
+    Ok(())
+}
