@@ -426,6 +426,24 @@ fn bake_takes_the_papers_readings_and_records_them_in_the_file() {
 }
 
 #[test]
+fn a_clean_bake_writes_nothing_on_stderr() {
+    // Warnings and errors go to stderr; a built-in level with nothing to warn of leaves it
+    // empty (a stage's leftover timing print once went there on every bake).
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("x.vgate");
+    let o = visgate(&[
+        "bake",
+        "builtin:two-rooms",
+        "-o",
+        out.to_str().expect("utf-8"),
+        "--resolution",
+        "64",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(stderr(&o), "", "stderr of a clean bake");
+}
+
+#[test]
 fn a_refined_bake_says_where_its_partition_was_made() {
     let dir = tempfile::tempdir().expect("tempdir");
     let out = dir.path().join("x.vgate");

@@ -68,9 +68,9 @@ impl<'a> Sight<'a> {
     }
 
     /// The same sight lines over one byte a voxel: 0 where not empty, else 1 + the clearance
-    /// (saturated at 254, which only shortens a proof's steps). Half the memory of the flags
-    /// and the clearance together and one load a step: the lines of a level are walked several
-    /// times faster where the grid does not fit in the cache.
+    /// (saturated at 254, which only shortens a proof's steps): a third of the memory of the
+    /// flags and the clearance together and one load a step (measured with the stepping by
+    /// stride: Crytek Sponza's 512 flatten 1.40 → 1.25 s).
     pub fn packed(&self) -> PackedSight<'a> {
         let cells = self
             .empty

@@ -104,7 +104,6 @@ pub fn voxelize(meta: GridMeta, triangles: &[[Vec3; 3]]) -> SolidGrid {
     // A hair over half a voxel, so that a triangle lying exactly on a voxel face marks both
     // sides (conservative) whatever the rounding.
     let half = 0.5 * size * (1.0 + 1e-9);
-    let t0 = std::time::Instant::now();
     let grid = TriGrid {
         origin,
         size,
@@ -137,7 +136,6 @@ pub fn voxelize(meta: GridMeta, triangles: &[[Vec3; 3]]) -> SolidGrid {
                 a
             },
         );
-    eprintln!("marks {:?}", t0.elapsed());
     // Unpacked a z slice at a time in parallel, with the border ring.
     let mut solid = vec![false; n];
     solid
@@ -156,7 +154,6 @@ pub fn voxelize(meta: GridMeta, triangles: &[[Vec3; 3]]) -> SolidGrid {
                     || bits[i / 64] >> (i % 64) & 1 == 1;
             }
         });
-    eprintln!("all {:?}", t0.elapsed());
     SolidGrid { meta, solid }
 }
 
