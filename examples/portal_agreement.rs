@@ -9,11 +9,12 @@
 //!
 //! Defaults: 160x90, 1,024 one-bounce light paths (seed 1, as `visgate compare`).
 
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 use visgate_formats::ImportOptions;
 use visgate_formats::vgate::BakedLevel;
 use visgate_runtime::camera::View;
 use visgate_runtime::cpu::gates::{GateLevel, GateParams, Walk};
+use visgate_runtime::cpu::portal_walk::facing_pairs;
 use visgate_runtime::cpu::tracer::Tracer;
 use visgate_runtime::vpl::{PathParams, path_vpls};
 
@@ -72,52 +73,31 @@ fn main() -> anyhow::Result<()> {
     let view = View::new(cam, [w, h])?;
     let walk = GateParams::default();
     let mut n = Counts::default();
-    for y in 0..h {
-        for x in 0..w {
-            let dir = view.ray_dir(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
-            let Some(s) = tracer.trace(view.eye, dir) else {
-                continue;
-            };
-            let Some(here) = gates.cluster_at(s.position, s.normal) else {
-                continue;
-            };
-            let from = s.position + s.geometric_normal * tracer.epsilon_m;
-            for v in &vpls {
-                let (vp, vn) = (Vec3::from(v.position), Vec3::from(v.normal));
-                let to = vp - s.position;
-                if to.dot(s.normal) <= 0.0 || (-to).dot(vn) <= 0.0 {
-                    continue;
-                }
-                let Some(there) = gates.cluster_at(vp, vn) else {
-                    continue;
-                };
-                let exact = !tracer.occluded(from, vp + vn * tracer.epsilon_m);
-                let found = match gates.walk(vp, there, s.position, here, walk.max_walk) {
-                    Walk::Visible(_) => true,
-                    Walk::Blocked => false,
-                    Walk::Limit => {
-                        n.over_the_limit += 1;
-                        false
-                    }
-                };
-                match (exact, found) {
-                    (true, true) => n.visible_found += 1,
-                    (true, false) => {
-                        n.visible_blocked += 1;
-                        let k = match changes(&gates, vp, s.position) {
-                            0 => 0,
-                            1 => 1,
-                            2 | 3 => 2,
-                            _ => 3,
-                        };
-                        n.blocked_by_changes[k] += 1;
-                    }
-                    (false, true) => n.occluded_let_through += 1,
-                    (false, false) => n.occluded_blocked += 1,
-                }
+    facing_pairs(&tracer, &gates, &view, &vpls, |pair| {
+        let found = match gates.walk(pair.vpl, pair.there, pair.point, pair.here, walk.max_walk) {
+            Walk::Visible(_) => true,
+            Walk::Blocked => false,
+            Walk::Limit => {
+                n.over_the_limit += 1;
+                false
             }
+        };
+        match (pair.exact, found) {
+            (true, true) => n.visible_found += 1,
+            (true, false) => {
+                n.visible_blocked += 1;
+                let k = match changes(&gates, pair.vpl, pair.point) {
+                    0 => 0,
+                    1 => 1,
+                    2 | 3 => 2,
+                    _ => 3,
+                };
+                n.blocked_by_changes[k] += 1;
+            }
+            (false, true) => n.occluded_let_through += 1,
+            (false, false) => n.occluded_blocked += 1,
         }
-    }
+    });
     let pairs = n.visible_found + n.visible_blocked + n.occluded_let_through + n.occluded_blocked;
     let pct = |k: u64| 100.0 * k as f64 / pairs.max(1) as f64;
     println!("{camera}: {pairs} pairs, {} VPLs, {w}x{h}", vpls.len());

@@ -7,6 +7,7 @@ use glam::{Vec2, Vec3};
 use visgate_formats::vgate::BakeParams;
 use visgate_runtime::camera::View;
 use visgate_runtime::cpu::gates::{GateLevel, GateParams, GateShape, Walk};
+use visgate_runtime::cpu::portal_walk::facing_pairs;
 use visgate_scenes::Builtin;
 
 #[path = "support/gates.rs"]
@@ -42,35 +43,14 @@ fn agreement_with(b: Builtin, bake: &BakeParams, params: &[GateParams]) -> Vec<V
     for camera in &scene.cameras {
         let view = View::new(camera, [64, 48]).expect("view");
         let mut out = vec![Agreement::default(); params.len()];
-        for y in 0..48 {
-            for x in 0..64 {
-                let dir = view.ray_dir(Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
-                let Some(s) = tracer.trace(view.eye, dir) else {
-                    continue;
-                };
-                let Some(here) = gates.cluster_at(s.position, s.normal) else {
-                    continue;
-                };
-                let from = s.position + s.geometric_normal * tracer.epsilon_m;
-                for v in &vpls {
-                    let (vp, vn) = (Vec3::from(v.position), Vec3::from(v.normal));
-                    let w = vp - s.position;
-                    if w.dot(s.normal) <= 0.0 || (-w).dot(vn) <= 0.0 {
-                        continue;
-                    }
-                    let Some(there) = gates.cluster_at(vp, vn) else {
-                        continue;
-                    };
-                    let exact = !tracer.occluded(from, vp + vn * tracer.epsilon_m);
-                    for (a, p) in out.iter_mut().zip(params) {
-                        let vis = gates.visible(vp, there, s.position, here, p);
-                        a.pairs += 1;
-                        a.false_visible += u64::from(vis && !exact);
-                        a.false_occluded += u64::from(!vis && exact);
-                    }
-                }
+        facing_pairs(&tracer, &gates, &view, &vpls, |pair| {
+            for (a, p) in out.iter_mut().zip(params) {
+                let vis = gates.visible(pair.vpl, pair.there, pair.point, pair.here, p);
+                a.pairs += 1;
+                a.false_visible += u64::from(vis && !pair.exact);
+                a.false_occluded += u64::from(!vis && pair.exact);
             }
-        }
+        });
         all.push(out);
     }
     all

@@ -392,3 +392,61 @@ mod tests {
         ));
     }
 }
+
+/// A pixel–VPL pair of a view whose surfaces face each other, with both ends' visibility
+/// clusters and the exact answer (a shadow ray between them).
+#[derive(Debug, Clone, Copy)]
+pub struct FacingPair {
+    /// The pixel's surface point. [Units: m]
+    pub point: Vec3,
+    /// Its visibility cluster.
+    pub here: u32,
+    /// The VPL's position. [Units: m]
+    pub vpl: Vec3,
+    /// Its visibility cluster.
+    pub there: u32,
+    /// Whether the shadow ray between them is clear.
+    pub exact: bool,
+}
+
+/// Calls `f` with every pixel–VPL pair of `view` (pixel centres) whose surfaces face each other
+/// and both lie in a cluster of `gates`: what the portal walk is held to against shadow rays
+/// (tests/portals.rs, examples/portal_agreement.rs).
+pub fn facing_pairs(
+    tracer: &super::tracer::Tracer,
+    gates: &GateLevel,
+    view: &crate::camera::View,
+    vpls: &[crate::vpl::Vpl],
+    mut f: impl FnMut(&FacingPair),
+) {
+    let [w, h] = view.size;
+    for y in 0..h {
+        for x in 0..w {
+            let dir = view.ray_dir(glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+            let Some(s) = tracer.trace(view.eye, dir) else {
+                continue;
+            };
+            let Some(here) = gates.cluster_at(s.position, s.normal) else {
+                continue;
+            };
+            let from = s.position + s.geometric_normal * tracer.epsilon_m;
+            for v in vpls {
+                let (vp, vn) = (Vec3::from(v.position), Vec3::from(v.normal));
+                let to = vp - s.position;
+                if to.dot(s.normal) <= 0.0 || (-to).dot(vn) <= 0.0 {
+                    continue;
+                }
+                let Some(there) = gates.cluster_at(vp, vn) else {
+                    continue;
+                };
+                f(&FacingPair {
+                    point: s.position,
+                    here,
+                    vpl: vp,
+                    there,
+                    exact: !tracer.occluded(from, vp + vn * tracer.epsilon_m),
+                });
+            }
+        }
+    }
+}
