@@ -9,6 +9,8 @@
 //! every resolution and scale whatever the rounding puts where (and empty space next to the
 //! ring is truly beyond the geometry: a leak).
 
+use std::ops::RangeInclusive;
+
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 use visgate_formats::vgate::{GridMeta, Resolution};
@@ -172,53 +174,61 @@ impl TriGrid {
         (((t - self.origin[a]) / self.size).floor().max(0.0) as usize).min(self.dims[a] - 1)
     }
 
+    /// The centre of voxel `i` on axis `a`.
+    fn centre(&self, a: usize, i: usize) -> f64 {
+        self.origin[a] + (i as f64 + 0.5) * self.size
+    }
+
+    /// The voxels on axis `a` whose centre lies in `lo..=hi` widened by a millionth of a voxel
+    /// (far more than rounding moves it), within `span`.
+    fn centres_in(
+        &self,
+        a: usize,
+        (lo, hi): (f64, f64),
+        span: (usize, usize),
+    ) -> RangeInclusive<usize> {
+        let slack = 1e-6 * self.size + 1e-12 * (lo.abs() + hi.abs());
+        let (lo, hi) = (lo - slack, hi + slack);
+        let low = self.cell(lo - 0.5 * self.size, a);
+        let low = low + usize::from(self.centre(a, low) < lo);
+        low.max(span.0)..=self.cell(hi - 0.5 * self.size, a).min(span.1)
+    }
+
     /// Calls `hit` with every voxel that triangle `v` touches ([`tri_box_overlap`]). The box
     /// around the triangle is walked as columns along the axis its normal is nearest, each row
     /// of columns only where the triangle's part in the row's slab reaches (within the box's
-    /// half-size); in each column only the voxels whose centre lies within the box's reach of the triangle's plane
-    /// (widened by a millionth of a voxel, far more than rounding moves it) are tested — a
-    /// voxel or two a column instead of the box's whole depth; the exact test decides as before.
+    /// half-size); in each column only the voxels whose centre lies within the box's reach of
+    /// the triangle's plane are tested — a voxel or two a column instead of the box's whole
+    /// depth; the exact test decides as before.
     fn mark(&self, v: [DVec3; 3], hit: &mut impl FnMut([usize; 3])) {
-        let (h, size) = (self.half, self.size);
+        let h = self.half;
         let lo = v[0].min(v[1]).min(v[2]) - h;
         let hi = v[0].max(v[1]).max(v[2]) + h;
-        let first: [usize; 3] = std::array::from_fn(|k| self.cell(lo[k], k));
-        let last: [usize; 3] = std::array::from_fn(|k| self.cell(hi[k], k));
+        let span = |k: usize| (self.cell(lo[k], k), self.cell(hi[k], k));
         let n = (v[1] - v[0]).cross(v[2] - v[0]);
         let a = n.abs().max_position();
         let (u, w) = ((a + 1) % 3, (a + 2) % 3);
         let reach = h * (n.x.abs() + n.y.abs() + n.z.abs());
-        let centre = |k: usize, i: usize| self.origin[k] + (i as f64 + 0.5) * size;
-        for iw in first[w]..=last[w] {
-            let Some((u_lo, u_hi)) = slab_extent(v, u, w, centre(w, iw), h) else {
+        let (w0, w1) = span(w);
+        for iw in w0..=w1 {
+            let Some((u_lo, u_hi)) = slab_extent(v, u, w, self.centre(w, iw), h) else {
                 continue;
             };
-            let slack = 1e-6 * size + 1e-12 * (u_lo.abs() + u_hi.abs());
-            let (u_lo, u_hi) = (u_lo - h - slack, u_hi + h + slack);
-            let low = self.cell(u_lo - 0.5 * size, u);
-            let low = low + usize::from(centre(u, low) < u_lo);
-            let high = self.cell(u_hi - 0.5 * size, u);
-            for iu in low.max(first[u])..=high.min(last[u]) {
-                let (a0, a1) = if n[a] == 0.0 {
-                    (first[a], last[a])
+            for iu in self.centres_in(u, (u_lo - h, u_hi + h), span(u)) {
+                let column = if n[a] == 0.0 {
+                    span(a).0..=span(a).1
                 } else {
                     // |n · (c − v0)| ≤ reach, solved for the centre's coordinate on axis a.
-                    let s = n[u] * (centre(u, iu) - v[0][u]) + n[w] * (centre(w, iw) - v[0][w]);
+                    let s = n[u] * (self.centre(u, iu) - v[0][u])
+                        + n[w] * (self.centre(w, iw) - v[0][w]);
                     let (t0, t1) = ((-reach - s) / n[a], (reach - s) / n[a]);
-                    let (t0, t1) = (t0.min(t1) + v[0][a], t0.max(t1) + v[0][a]);
-                    let slack = 1e-6 * size + 1e-12 * (t0.abs() + t1.abs());
-                    let (t0, t1) = (t0 - slack, t1 + slack);
-                    let low = self.cell(t0 - 0.5 * size, a);
-                    let low = low + usize::from(centre(a, low) < t0);
-                    (
-                        low.max(first[a]),
-                        self.cell(t1 - 0.5 * size, a).min(last[a]),
-                    )
+                    let along = (t0.min(t1) + v[0][a], t0.max(t1) + v[0][a]);
+                    self.centres_in(a, along, span(a))
                 };
-                for ia in a0..=a1 {
+                for ia in column {
                     let mut at = [0usize; 3];
                     (at[a], at[u], at[w]) = (ia, iu, iw);
-                    let c = DVec3::new(centre(0, at[0]), centre(1, at[1]), centre(2, at[2]));
+                    let c = DVec3::from_array(std::array::from_fn(|k| self.centre(k, at[k])));
                     if tri_box_overlap(c, h, v) {
                         hit(at);
                     }
