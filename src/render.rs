@@ -13,7 +13,7 @@ use visgate_runtime::cpu::gates::GateLevel;
 use visgate_runtime::gpu::{METHODS, method};
 use visgate_runtime::hdr::{HdrImage, false_colour};
 use visgate_runtime::job::{FrameStats, JobFrame, RenderJob, Renderer, pass_table};
-use visgate_runtime::metrics::{errors, flip, indirect_errors, indirect_map, rebase_direct};
+use visgate_runtime::metrics::{errors, flip, indirect_map, rebase_direct};
 use visgate_runtime::vpl::GeometryClamp;
 
 pub const RENDER_HELP: &str = "\
@@ -378,10 +378,10 @@ pub fn diff(args: DiffArgs) -> Result<()> {
             Some(p) => rebase_direct(&a, &HdrImage::read(p)?, &direct)?,
             None => a.clone(),
         };
-        let i = indirect_errors(&own, &r, &direct)?;
+        let map = indirect_map(&own, &r, &direct)?;
+        let i = map.errors();
         if let Some(out) = &args.black_map {
-            indirect_map(&own, &r, &direct)?
-                .to_image(a.width, a.height)
+            map.to_image(a.width, a.height)
                 .save(out)
                 .with_context(|| format!("cannot write {}", out.display()))?;
             println!("wrote {}", out.display());

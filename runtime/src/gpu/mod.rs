@@ -242,9 +242,7 @@ fn record_passes(
         _ => None,
     };
     let shading = match f.params.mode {
-        GpuMode::Gates(gp) if gp.interleave.block > 1 || gp.gates.shape == GateShape::Portal => {
-            "shading: direct lighting"
-        }
+        GpuMode::Gates(gp) if gp.gathers_apart() => "shading: direct lighting",
         GpuMode::VplClusters(_, i) if i.block > 1 => "shading: direct lighting",
         GpuMode::None
         | GpuMode::Gates(_)
@@ -256,7 +254,7 @@ fn record_passes(
     let hdr = p.shade.record(f, pool, rec, inputs, shading);
     let mut val_state = None;
     match &f.params.mode {
-        GpuMode::Gates(gp) if gp.interleave.block > 1 || gp.gates.shape == GateShape::Portal => {
+        GpuMode::Gates(gp) if gp.gathers_apart() => {
             let indirect = p.shade.record_indirect(f, pool, rec, inputs, false);
             let uniform = InterleaveBlur::uniform(f, &gp.interleave, pool, true);
             p.blur.record(f, pool, rec, (&g, &uniform, &indirect, &hdr));

@@ -68,6 +68,13 @@ pub fn check_gates(g: &GateParams) -> Result<(), RenderError> {
 }
 
 impl GatesParams {
+    /// Whether the indirect light is gathered in a pass of its own and composed by the blur
+    /// (interleaved, or portals, which walk in batches on a software rasterizer), not in the
+    /// shading pass (disks gathering every VPL at every pixel). shade.wgsl's `fs` says the same.
+    pub fn gathers_apart(&self) -> bool {
+        self.interleave.block > 1 || self.gates.shape == GateShape::Portal
+    }
+
     /// Checks the limits (the pool's size against the adapter's at render time).
     pub fn check(&self) -> Result<(), RenderError> {
         check_gates(&self.gates)?;
