@@ -66,6 +66,12 @@ pub struct BakeArgs {
     /// partitioned on its own grid).
     #[arg(long)]
     pub partition_voxel: Option<f32>,
+    /// Voxel edge of the open-voxel grid that `--gate-shape voxels` walks, metres (0–10; 0 =
+    /// the level's grid; a bit a voxel): openings narrow by up to a voxel at each edge, so a
+    /// finer grid lets more of the light through them. Default: the level's voxel, or 1/256 of
+    /// the level's longest extent if smaller (a 128 bake walks a 256 grid).
+    #[arg(long)]
+    pub sight_voxel: Option<f32>,
     /// Smallest room, metres: a cluster whose largest ball (radius, 0–10) is smaller is merged
     /// into the neighbour across its widest gate (a roof slab, a crack, a niche where nobody
     /// stands). Default 0: none merged (the paper's). 0.3 halves Dabrovic Sponza's clusters at
@@ -163,6 +169,7 @@ pub fn run(args: BakeArgs) -> Result<()> {
         min_component_voxels: args.min_component_voxels,
         min_gap_m: args.min_gap,
         partition_voxel_m: args.partition_voxel,
+        sight_voxel_m: args.sight_voxel,
         min_cluster_ball_m: args.min_cluster_ball,
         gate_placement: match args.gates {
             Gates::Narrowest => GatePlacement::Narrowest,

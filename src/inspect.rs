@@ -61,6 +61,8 @@ struct BakedSummary {
     /// How the file stores the voxel→cluster grid ("dense" or "runs") and its bytes there.
     voxel_cluster_stored_as: &'static str,
     voxel_cluster_stored_bytes: u64,
+    /// Voxels the voxelization left open (the voxel walk's grid).
+    open_voxels: u64,
     read_seconds: f64,
 }
 
@@ -192,7 +194,7 @@ fn inspect_baked(path: &Path, json: bool) -> Result<()> {
         .find_map(|s| match s.kind {
             SectionKind::VoxelCluster => Some(("dense", s.len)),
             SectionKind::VoxelClusterRuns => Some(("runs", s.len)),
-            SectionKind::Topology => None,
+            SectionKind::Topology | SectionKind::OpenVoxels => None,
         })
         .unwrap_or(("absent", 0));
     let s = BakedSummary {
@@ -220,6 +222,7 @@ fn inspect_baked(path: &Path, json: bool) -> Result<()> {
         voxel_cluster_bytes_per_voxel: level.voxel_cluster.elem().size() as u32,
         voxel_cluster_stored_as: stored_as,
         voxel_cluster_stored_bytes: stored_bytes,
+        open_voxels: level.open.count_ones(),
         read_seconds,
     };
     if json {
@@ -269,6 +272,12 @@ fn inspect_baked(path: &Path, json: bool) -> Result<()> {
     println!(
         "grid        voxel→cluster {} B/voxel in memory, stored {} in {} bytes",
         s.voxel_cluster_bytes_per_voxel, s.voxel_cluster_stored_as, s.voxel_cluster_stored_bytes
+    );
+    let sg = &level.info.sight_grid;
+    println!(
+        "sight grid  {} x {} x {} voxels of {} m: {} left open by the voxelization (the voxel \
+         walk's grid, a bit each)",
+        sg.dims[0], sg.dims[1], sg.dims[2], sg.voxel_size_m, s.open_voxels
     );
     println!("read time   {:.3} s", s.read_seconds);
     Ok(())

@@ -100,6 +100,7 @@ fn inspect_a_baked_file_and_refuse_a_broken_one() {
             params: BakeParams::default(),
             geometry_hash: visgate_formats::GeometryHash([1; 16]),
             grid,
+            sight_grid: grid,
             tool_version: "test".into(),
         },
         topology: Topology {
@@ -128,6 +129,7 @@ fn inspect_a_baked_file_and_refuse_a_broken_one() {
             portals: vec![],
         },
         voxel_cluster: VoxelValues::pack(&[0; 8]),
+        open: VoxelBits::from_fn(8, |_| true),
     };
     let path = dir.path().join("l.vgate");
     level.write(&path).expect("write");

@@ -65,6 +65,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             params: BakeParams::default(),
             geometry_hash: GeometryHash([0xab; 16]),
             grid,
+            sight_grid: grid,
             tool_version: env!("CARGO_PKG_VERSION").into(),
         },
         topology: Topology {
@@ -94,6 +95,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             portals: vec![],
         },
         voxel_cluster: VoxelValues::pack(&vc),
+        open: VoxelBits::from_fn(vc.len(), |i| vc[i] != NONE),
     };
     let dir = std::env::temp_dir().join(format!("visgate-roundtrip-{}", std::process::id()));
     std::fs::create_dir_all(&dir)?;

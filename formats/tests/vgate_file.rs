@@ -65,6 +65,7 @@ fn two_room_level(nx: u32) -> BakedLevel {
             params: BakeParams::default(),
             geometry_hash: GeometryHash([7; 16]),
             grid,
+            sight_grid: grid,
             tool_version: "test".into(),
         },
         topology: Topology {
@@ -102,6 +103,7 @@ fn two_room_level(nx: u32) -> BakedLevel {
                 faces: 12,
             }],
         },
+        open: VoxelBits::from_fn(voxel_cluster.len(), |i| voxel_cluster[i] != NONE),
         voxel_cluster: VoxelValues::pack(&voxel_cluster),
     }
 }
@@ -169,8 +171,8 @@ fn the_cluster_grid_is_stored_as_runs_where_that_is_smaller_and_reads_back_dense
 /// A file of `header` (its grid and its voxel→cluster section's kind and element type) and
 /// the two sections, with every offset, length and checksum right: what a writer that got the
 /// contents wrong would write.
-fn file_of(mut header: Header, topology: &[u8], clusters: &[u8]) -> Vec<u8> {
-    let blobs = [topology, clusters];
+fn file_of(mut header: Header, [topology, clusters, open]: [&[u8]; 3]) -> Vec<u8> {
+    let blobs = [topology, clusters, open];
     for (s, b) in header.sections.iter_mut().zip(blobs) {
         s.len = b.len() as u64;
         s.crc32 = crc32fast::hash(b);
@@ -202,7 +204,7 @@ fn file_of(mut header: Header, topology: &[u8], clusters: &[u8]) -> Vec<u8> {
 fn runs_that_do_not_add_up_to_the_grid_are_refused_even_with_a_right_checksum() {
     let bytes = two_room_level(40).to_bytes().expect("encodes");
     let header = BakedLevel::read_header(&bytes).expect("header");
-    let [t, c] = [0, 1].map(|k| {
+    let [t, c, o] = [0, 1, 2].map(|k| {
         let s = header.sections[k];
         &bytes[s.offset as usize..(s.offset + s.len) as usize]
     });
@@ -210,7 +212,7 @@ fn runs_that_do_not_add_up_to_the_grid_are_refused_even_with_a_right_checksum() 
     for (what, n) in [("longer", first + 1), ("empty", 0)] {
         let mut runs = c.to_vec();
         runs[..4].copy_from_slice(&n.to_le_bytes());
-        let e = BakedLevel::from_bytes(&file_of(header.clone(), t, &runs))
+        let e = BakedLevel::from_bytes(&file_of(header.clone(), [t, &runs, o]))
             .expect_err(what)
             .to_string();
         assert!(e.contains("runs"), "{what}: {e}");
@@ -223,10 +225,55 @@ fn runs_that_do_not_add_up_to_the_grid_are_refused_even_with_a_right_checksum() 
         .flat_map(|_| [u32::MAX.to_le_bytes().to_vec(), vec![0]].concat())
         .chain([2u32.to_le_bytes().to_vec(), vec![0]].concat())
         .collect();
-    let e = BakedLevel::from_bytes(&file_of(huge, t, &runs))
+    let e = BakedLevel::from_bytes(&file_of(huge, [t, &runs, o]))
         .expect_err("huge")
         .to_string();
     assert!(e.contains("u32"), "{e}");
+}
+
+#[test]
+fn open_voxels_that_do_not_fit_the_sight_grid_are_refused_even_with_a_right_checksum() {
+    let level = two_room_level(40);
+    let bytes = level.to_bytes().expect("encodes");
+    let header = BakedLevel::read_header(&bytes).expect("header");
+    let [t, c, o] = [0, 1, 2].map(|k| {
+        let s = header.sections[k];
+        &bytes[s.offset as usize..(s.offset + s.len) as usize]
+    });
+    // A word short, a word more, and a bit set past the grid's last voxel.
+    let short = &o[..o.len() - 8];
+    let long = [o, &[0u8; 8][..]].concat();
+    let voxels = level.info.sight_grid.voxel_count().expect("voxels");
+    assert_ne!(voxels % 64, 0, "the fixture's grid must end inside a word");
+    let mut stray = o.to_vec();
+    let last = stray.len() - 1;
+    stray[last] |= 0x80;
+    for (what, blob) in [
+        ("short", short),
+        ("long", &long[..]),
+        ("stray bit", &stray[..]),
+    ] {
+        let e = BakedLevel::from_bytes(&file_of(header.clone(), [t, c, blob]))
+            .expect_err(what)
+            .to_string();
+        assert!(e.contains("open voxels"), "{what}: {e}");
+    }
+    // A sight grid of its own: the open bits follow it, not the level's grid.
+    let mut finer = level.clone();
+    let g = finer.info.grid;
+    finer.info.sight_grid = GridMeta {
+        voxel_size_m: g.voxel_size_m / 2.0,
+        dims: g.dims.map(|d| d * 2),
+        ..g
+    };
+    assert!(
+        finer.to_bytes().is_err(),
+        "bits of the level's grid, a finer sight grid"
+    );
+    let n = finer.info.sight_grid.voxel_count().expect("voxels") as usize;
+    finer.open = VoxelBits::from_fn(n, |i| i % 5 != 0);
+    let back = BakedLevel::from_bytes(&finer.to_bytes().expect("encodes")).expect("decodes");
+    assert_eq!(back, finer);
 }
 
 #[test]
@@ -445,6 +492,7 @@ fn arb_level() -> impl Strategy<Value = BakedLevel> {
                             ((seed as u128) << 64 | seed as u128).to_le_bytes(),
                         ),
                         grid,
+                        sight_grid: grid,
                         tool_version: format!("v{seed}"),
                     },
                     topology: Topology {
@@ -480,6 +528,7 @@ fn arb_level() -> impl Strategy<Value = BakedLevel> {
                         gates,
                         portals: vec![],
                     },
+                    open: VoxelBits::from_fn(vcluster.len(), |i| vcluster[i] != NONE),
                     voxel_cluster: VoxelValues::pack(&vcluster),
                 }
             },

@@ -11,10 +11,12 @@ use serde_json::{Value, json};
 use visgate_formats::Scene;
 use visgate_formats::scene::GeometryHash;
 use visgate_formats::scene::Light;
-use visgate_formats::vgate::{BakeInfo, BakeParams, BakedLevel, GridMeta, Resolution, VoxelValues};
+use visgate_formats::vgate::{
+    BakeInfo, BakeParams, BakedLevel, GridMeta, Resolution, VoxelBits, VoxelValues,
+};
 
 use crate::BakeError;
-use crate::counters::VoxelizeCounts;
+use crate::counters::{SightCounts, VoxelizeCounts};
 use crate::empty::EmptySpace;
 use crate::empty::Seed;
 use crate::memory::StagePeak;
@@ -174,6 +176,13 @@ fn check_params(p: &BakeParams) -> Result<(), BakeError> {
             "partition voxel {v} m must be in 0..=10 (0 partitions the level's own grid)"
         )));
     }
+    if let Some(v) = p.sight_voxel_m
+        && !(v.is_finite() && (0.0..=10.0).contains(&v))
+    {
+        return Err(BakeError::Param(format!(
+            "sight voxel {v} m must be in 0..=10 (0 walks the level's own grid)"
+        )));
+    }
     if let Some(persistence) = p.persistence
         && persistence > 10_000
     {
@@ -230,7 +239,10 @@ pub fn bake(
         };
         Ok(((solid, n), counts))
     })?;
-    let mut params = level_scaled(params, input.bounds);
+    let mut params = level_scaled(params, input.bounds, meta.voxel_size_m);
+    let (sight_grid, open) = cx.stage("sight grid", 0, |_| {
+        sight_grid(&input, (&meta, &solid), &params, options)
+    })?;
     let es = cx.stage("empty space", 0, |_| {
         stages::empty(scene, &meta, &solid.solid, &input.triangles, &params)
     })?;
@@ -266,6 +278,8 @@ pub fn bake(
         ))
     })?;
     drop(voxel_cluster);
+    level.info.sight_grid = sight_grid;
+    level.open = open;
     let uncovered = found.uncovered;
     level.topology.portals = found.portals;
     let [empty_topology, skeleton_topology] = cx.stage("topology check", 0, |_| {
@@ -360,13 +374,24 @@ pub const MIN_GAP_PARTS: u32 = 256;
 /// partitioned on its own 256 grid).
 pub const PARTITION_PARTS: u32 = 128;
 
-/// `params` with the minimum gap and the partition voxel it leaves to the bake filled in (see
-/// [`MIN_GAP_PARTS`], [`PARTITION_PARTS`]): the values used, which the file records.
-fn level_scaled(params: &BakeParams, bounds: (glam::Vec3, glam::Vec3)) -> BakeParams {
+/// The default sight voxel ([`BakeParams::sight_voxel_m`]) is at most 1/this of the level's
+/// longest extent: a level baked coarser still walks its openings on this many voxels.
+pub const SIGHT_PARTS: u32 = 256;
+
+/// `params` with the minimum gap, the partition voxel and the sight voxel it leaves to the
+/// bake filled in (see [`MIN_GAP_PARTS`], [`PARTITION_PARTS`], [`SIGHT_PARTS`]) for a level of
+/// `bounds` on voxels of `voxel_m`: the values used, which the file records.
+fn level_scaled(params: &BakeParams, bounds: (glam::Vec3, glam::Vec3), voxel_m: f32) -> BakeParams {
     let longest = (bounds.1 - bounds.0).max_element();
     let scale = longest / MIN_GAP_PARTS as f32;
     let partition = longest / PARTITION_PARTS as f32;
+    let sight = match params.sight_voxel_m {
+        None => voxel_m.min(longest / SIGHT_PARTS as f32),
+        Some(v) if v == 0.0 || v > voxel_m => voxel_m,
+        Some(v) => v,
+    };
     BakeParams {
+        sight_voxel_m: Some(sight),
         min_cluster_ball_m: Some(params.min_cluster_ball_m.unwrap_or(0.0)),
         min_gap_m: Some(params.min_gap_m.unwrap_or(MIN_GAP_M.min(scale))),
         partition_voxel_m: Some(
@@ -376,6 +401,35 @@ fn level_scaled(params: &BakeParams, bounds: (glam::Vec3, glam::Vec3)) -> BakePa
         ),
         ..params.clone()
     }
+}
+
+/// The sight grid ([`BakeParams::sight_voxel_m`], filled in) and its open voxels: the level's
+/// grid and its voxelization, or the level's bounds voxelized again at the finer sight voxel.
+fn sight_grid(
+    input: &stages::Loaded,
+    (meta, solid): (&GridMeta, &SolidGrid),
+    params: &BakeParams,
+    options: &BakeOptions,
+) -> Result<((GridMeta, VoxelBits), SightCounts), BakeError> {
+    let size = params.sight_voxel_m.unwrap_or(meta.voxel_size_m);
+    let open = |s: &SolidGrid| VoxelBits::from_fn(s.solid.len(), |i| !s.solid[i]);
+    let (grid, bits) = if size < 0.99 * meta.voxel_size_m {
+        let sm = grid_for(
+            input.bounds,
+            Resolution::VoxelSizeM(size),
+            options.memory_limit_bytes,
+        )?;
+        (sm, open(&voxelize(sm, &input.triangles)))
+    } else {
+        (*meta, open(solid))
+    };
+    let counts = SightCounts {
+        dims: grid.dims,
+        voxel_size_m: grid.voxel_size_m,
+        open_voxels: bits.count_ones(),
+        bytes: grid.voxel_count().unwrap_or(0).div_ceil(8),
+    };
+    Ok(((grid, bits), counts))
 }
 
 /// The partition grid: the level's bounds at [`BakeParams::partition_voxel_m`], when that is
@@ -465,6 +519,8 @@ fn partition(
         params: params.clone(),
         geometry_hash: hash,
         grid: *meta,
+        // The bake sets the level's sight grid and its open voxels at its end.
+        sight_grid: *meta,
         tool_version: env!("CARGO_PKG_VERSION").to_string(),
     };
     let (level, voxel_cluster) = cx.stage("flatten", 0, |_| {

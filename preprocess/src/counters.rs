@@ -26,6 +26,19 @@ pub struct VoxelizeCounts {
     pub solid_voxels: u64,
 }
 
+/// The sight grid: the open voxels the voxel walk reads.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct SightCounts {
+    /// Grid dimensions, border included. [Units: voxels]
+    pub dims: [u32; 3],
+    /// Voxel edge. [Units: m]
+    pub voxel_size_m: f32,
+    /// Voxels the voxelization left open.
+    pub open_voxels: u64,
+    /// Bytes the open voxels take (a bit each).
+    pub bytes: u64,
+}
+
 /// Stage 3, empty space.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct EmptyCounts {

@@ -8,7 +8,7 @@ use rayon::prelude::*;
 use visgate_formats::Scene;
 use visgate_formats::vgate::{
     BakeInfo, BakeParams, BakedLevel, Gate, GridMeta, MaxBall, SegNodeKind, Skeleton, SkeletonNode,
-    Topology, VoxelValues,
+    Topology, VoxelBits, VoxelValues,
 };
 
 use crate::bake::{BakeContext, scene_seeds};
@@ -430,6 +430,9 @@ pub fn flatten(
             portals: Vec::new(),
         },
         voxel_cluster: VoxelValues::pack(&flat.voxel_cluster),
+        // The level grid's open voxels: the bake sets them (the partition may run on a grid
+        // of its own).
+        open: VoxelBits::default(),
     };
     let counts = FlattenCounts {
         voxel_cluster_bytes: level.voxel_cluster.elem().size() * es.empty.len() as u64,

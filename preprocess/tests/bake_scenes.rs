@@ -7,21 +7,22 @@ use glam::{Vec2, Vec3};
 use visgate_formats::Scene;
 use visgate_formats::desc::{CameraDesc, SceneDesc};
 use visgate_formats::import::{ImportedModel, RawMesh};
-use visgate_formats::vgate::{BakeParams, BakedLevel, GatePlacement, NONE, Resolution};
+use visgate_formats::vgate::{BakeParams, BakedLevel, GatePlacement, GridMeta, NONE, Resolution};
 use visgate_preprocess::BakeError;
 use visgate_preprocess::bake::{BakeOptions, Baked, bake};
 use visgate_preprocess::voxelize::BAKE_BYTES_PER_VOXEL;
 use visgate_scenes::level::{BoxLevel, cbox};
 use visgate_scenes::{Builtin, Opening};
 
-// Recorded again with format 5 (the minimum gap, the partition voxel and the smallest cluster
-// ball stored: 15 bytes more; none of them changes these small levels at 64, whose portal
-// agreement figures in tests/portals.rs did not move: 95.55 / 93.23 / 98.24 %, 85.41 / 93.78 %,
-// 99.28 %). The third bake is the pillared hall at 128 partitioned on its 64 grid.
-const RECORDED_AJAR_DOOR: (&str, u64, usize) = ("ajar-door", 0x126b_91b4_adfb_ee50, 31_898);
-const RECORDED_PILLARED_HALL: (&str, u64, usize) = ("pillared-hall", 0x781a_f76d_e566_eabd, 16_278);
+// Recorded again with format 6: the open voxels of the sight grid (a bit a voxel, at 1/256 of
+// the level by default: 256 voxels on these levels' longest axis) and its grid in the header;
+// nothing else changed (the portal agreement figures in tests/portals.rs did not move). The
+// third bake is the pillared hall at 128 partitioned on its 64 grid.
+const RECORDED_AJAR_DOOR: (&str, u64, usize) = ("ajar-door", 0x3582_717b_baa0_5c46, 442_809);
+const RECORDED_PILLARED_HALL: (&str, u64, usize) =
+    ("pillared-hall", 0x7e8c_69a1_d1f8_559d, 515_485);
 const RECORDED_PILLARED_HALL_REFINED: (&str, u64, usize) =
-    ("pillared-hall", 0x6431_50e9_3792_c3ab, 54_499);
+    ("pillared-hall", 0x7e23_af3c_43d8_ef5b, 553_707);
 
 fn params(res: u32) -> BakeParams {
     BakeParams {
@@ -762,6 +763,61 @@ fn bad_parameters_are_refused() {
         assert!(
             matches!(bake_scene(&s, &params(res)), Err(BakeError::Param(_))),
             "res {res}"
+        );
+    }
+}
+
+#[test]
+fn the_sight_grid_is_the_voxelization_s_open_voxels_never_coarser_than_the_level() {
+    use visgate_preprocess::voxelize::voxelize;
+    let scene = Builtin::AjarDoor.scene().expect("scene");
+    let triangles: Vec<[Vec3; 3]> = scene.static_triangles().collect();
+    // (resolution, sight voxel asked for, the sight grid's voxels on the longest axis): by
+    // default at most 1/256 of the level (8 m: 3.125 cm), a finer level keeps its own grid, 0
+    // and a coarser sight voxel take the level's, a finer one is taken as given.
+    for (res, asked, longest) in [
+        (64, None, 256),
+        (512, None, 512),
+        (64, Some(0.0), 64),
+        (64, Some(1.0), 64),
+        (64, Some(0.0625), 128),
+    ] {
+        let p = BakeParams {
+            sight_voxel_m: asked,
+            ..params(res)
+        };
+        let level = bake_scene(&scene, &p).expect("bake").level;
+        let (g, s) = (level.info.grid, level.info.sight_grid);
+        assert_eq!(
+            s.dims.iter().max().copied(),
+            Some(longest + 2),
+            "{res} {asked:?}"
+        );
+        assert_eq!(level.info.params.sight_voxel_m, Some(s.voxel_size_m));
+        assert!(s.voxel_size_m <= g.voxel_size_m, "{res} {asked:?}");
+        // Over the same bounds: the grids' far corners agree within a voxel.
+        let far = |m: &GridMeta| {
+            Vec3::from(m.origin_m) + m.voxel_size_m * Vec3::from(m.dims.map(|d| d as f32))
+        };
+        assert!(
+            (far(&s) - far(&g)).abs().max_element() <= g.voxel_size_m,
+            "{res} {asked:?}"
+        );
+        let solid = voxelize(s, &triangles).solid;
+        assert_eq!(level.open.len(), solid.len() as u64);
+        assert!(
+            (0..solid.len()).all(|i| level.open.get(i) != solid[i]),
+            "{res} {asked:?}"
+        );
+    }
+    for v in [-0.1, 11.0, f32::NAN] {
+        let p = BakeParams {
+            sight_voxel_m: Some(v),
+            ..params(32)
+        };
+        assert!(
+            matches!(bake_scene(&scene, &p), Err(BakeError::Param(_))),
+            "{v}"
         );
     }
 }

@@ -13,6 +13,8 @@
 //!                                     node→cluster, clusters, gates, portals
 //!                       voxel_cluster little-endian blob, one element per voxel (x fastest),
 //!                                     or, where smaller, its runs: (u32 LE length, element)
+//!                       open_voxels   a bit per voxel of the sight grid (x fastest), 1 = open
+//!                                     (not solid), u64 LE words (format 6)
 //! ```
 //!
 //! The grid is stored in the smallest unsigned type (u8, u16, u32) that holds its largest
@@ -31,10 +33,12 @@ use serde::{Deserialize, Serialize};
 use crate::error::VgateError;
 use crate::scene::GeometryHash;
 
+mod bits;
 mod params;
 mod portal;
 mod values;
 
+pub use bits::VoxelBits;
 pub use params::{
     AlphaRule, BakeInfo, BakeParams, CurvatureTo, GatePlacement, MaxBall, Resolution,
 };
@@ -44,7 +48,7 @@ pub use values::{Elem, VoxelValues};
 /// The first eight bytes of every `.vgate` file.
 pub const MAGIC: [u8; 8] = *b"VGATE\r\n\x1a";
 /// The format version this build writes and reads.
-pub const FORMAT_VERSION: u32 = 5;
+pub const FORMAT_VERSION: u32 = 6;
 /// "No node / no cluster" in a grid decoded to u32.
 pub const NONE: u32 = u32::MAX;
 
@@ -212,6 +216,8 @@ pub enum SectionKind {
     VoxelCluster,
     /// The same grid as runs of equal values in voxel order: (u32 LE length, value).
     VoxelClusterRuns,
+    /// A bit per voxel, set where the voxelization left it open (not solid): u64 LE words.
+    OpenVoxels,
 }
 
 /// An entry of the section table.
@@ -247,6 +253,9 @@ pub struct BakedLevel {
     pub topology: Topology,
     /// Visibility cluster of every voxel; [`NONE`] where no surface or VPL can be.
     pub voxel_cluster: VoxelValues,
+    /// The voxels the voxelization left open (not solid) on [`BakeInfo::sight_grid`], for the
+    /// voxel walk: a segment through open voxels alone meets no wall (format 6).
+    pub open: VoxelBits,
 }
 
 const PREFIX: usize = 16;
@@ -271,6 +280,7 @@ impl BakedLevel {
         let blobs = [
             (SectionKind::Topology, Elem::Structure, topo),
             (clusters.0, self.voxel_cluster.elem(), clusters.1),
+            (SectionKind::OpenVoxels, Elem::U8, self.open.to_le_bytes()),
         ];
         let mut header = Header {
             info: self.info.clone(),
@@ -415,16 +425,18 @@ impl BakedLevel {
             kinds[..],
             [
                 SectionKind::Topology,
-                SectionKind::VoxelCluster | SectionKind::VoxelClusterRuns
+                SectionKind::VoxelCluster | SectionKind::VoxelClusterRuns,
+                SectionKind::OpenVoxels
             ]
         ) {
             return Err(VgateError::Length(format!(
-                "section table lists {kinds:?}, expected the topology and the voxel clusters"
+                "section table lists {kinds:?}, expected the topology, the voxel clusters and \
+                 the open voxels"
             )));
         }
         let hlen = u32::from_le_bytes([bytes[12], bytes[13], bytes[14], bytes[15]]) as u64;
         let mut at = PREFIX as u64 + hlen + 4;
-        let mut slices = Vec::with_capacity(2);
+        let mut slices = Vec::with_capacity(3);
         for s in &header.sections {
             if s.offset != at {
                 return Err(VgateError::Length(format!(
@@ -485,6 +497,13 @@ impl BakedLevel {
             }
             t
         };
+        let voxels = header.info.grid.voxel_count().ok_or_else(|| {
+            VgateError::BadValue(format!("grid dims {:?} overflow", header.info.grid.dims))
+        })?;
+        let sight = &header.info.sight_grid;
+        let sight_voxels = sight.voxel_count().ok_or_else(|| {
+            VgateError::BadValue(format!("sight grid dims {:?} overflow", sight.dims))
+        })?;
         let voxel_cluster = {
             let (s, data) = slices[1];
             if s.elem == Elem::Structure {
@@ -494,19 +513,27 @@ impl BakedLevel {
                 )));
             }
             if s.kind == SectionKind::VoxelClusterRuns {
-                let voxels = header.info.grid.voxel_count().ok_or_else(|| {
-                    VgateError::BadValue(format!("grid dims {:?} overflow", header.info.grid.dims))
-                })?;
                 VoxelValues::from_runs_le_bytes(s.elem, data, voxels)
                     .map_err(|e| VgateError::Length(format!("voxel cluster runs: {e}")))?
             } else {
                 VoxelValues::from_le_bytes(s.elem, data)
             }
         };
+        let open = {
+            let (s, data) = slices[2];
+            if s.elem != Elem::U8 {
+                return Err(VgateError::Length(
+                    "the open voxels' section is not a blob of bytes".into(),
+                ));
+            }
+            VoxelBits::from_le_bytes(data, sight_voxels)
+                .map_err(|e| VgateError::Length(format!("open voxels: {e}")))?
+        };
         let level = BakedLevel {
             info: header.info,
             topology,
             voxel_cluster,
+            open,
         };
         level.validate()?;
         Ok(level)
@@ -517,19 +544,36 @@ impl BakedLevel {
         let oob = |what: String| Err(VgateError::IndexOutOfRange(what));
         let bad = |what: String| Err(VgateError::BadValue(what));
         let g = &self.info.grid;
-        if !(g.voxel_size_m.is_finite() && g.voxel_size_m > 0.0) {
-            return bad(format!("voxel size {} m", g.voxel_size_m));
-        }
-        if g.origin_m.iter().any(|x| !x.is_finite()) || g.dims.contains(&0) {
-            return bad(format!("grid origin {:?} / dims {:?}", g.origin_m, g.dims));
+        for (what, g) in [("", g), ("sight ", &self.info.sight_grid)] {
+            if !(g.voxel_size_m.is_finite() && g.voxel_size_m > 0.0) {
+                return bad(format!("{what}voxel size {} m", g.voxel_size_m));
+            }
+            if g.origin_m.iter().any(|x| !x.is_finite()) || g.dims.contains(&0) {
+                return bad(format!(
+                    "{what}grid origin {:?} / dims {:?}",
+                    g.origin_m, g.dims
+                ));
+            }
         }
         let voxels = g
             .voxel_count()
             .ok_or_else(|| VgateError::BadValue(format!("grid dims {:?} overflow", g.dims)))?;
+        let sight_voxels = self.info.sight_grid.voxel_count().ok_or_else(|| {
+            VgateError::BadValue(format!(
+                "sight grid dims {:?} overflow",
+                self.info.sight_grid.dims
+            ))
+        })?;
         if self.voxel_cluster.len() as u64 != voxels {
             return Err(VgateError::Length(format!(
                 "voxel_cluster grid has {} values but the grid has {voxels} voxels",
                 self.voxel_cluster.len()
+            )));
+        }
+        if self.open.len() != sight_voxels {
+            return Err(VgateError::Length(format!(
+                "the open voxels hold {} bits but the sight grid has {sight_voxels} voxels",
+                self.open.len()
             )));
         }
         let t = &self.topology;

@@ -97,6 +97,13 @@ pub struct BakeParams {
     /// of its own. 0 (and `None`, the default) merges none; a baked file stores the value
     /// used. [Limit: [0, 10]] [Units: m, max-ball radius]
     pub min_cluster_ball_m: Option<f32>,
+    /// Voxel edge of the open-voxel grid the voxel walk reads (a bit a voxel), when finer
+    /// than the level's voxels: openings narrow by up to a voxel at each edge (the
+    /// voxelization is conservative), so a finer grid passes more of the light that passes
+    /// there. 0 takes the level's grid. `None` asks the bake for the level's voxel or 1/256 of
+    /// the level's longest extent, whichever is smaller; a baked file stores the value used.
+    /// [Limit: [0, 10]] [Units: m]
+    pub sight_voxel_m: Option<f32>,
 }
 
 impl Default for BakeParams {
@@ -115,6 +122,7 @@ impl Default for BakeParams {
             min_gap_m: None,
             partition_voxel_m: None,
             min_cluster_ball_m: None,
+            sight_voxel_m: None,
         }
     }
 }
@@ -128,6 +136,9 @@ pub struct BakeInfo {
     pub geometry_hash: GeometryHash,
     /// The voxel grid.
     pub grid: GridMeta,
+    /// The grid of the open voxels ([`super::BakedLevel::open`]): the level's, or a finer
+    /// one over the same bounds ([`BakeParams::sight_voxel_m`]).
+    pub sight_grid: GridMeta,
     /// visgate version that baked it (informative).
     pub tool_version: String,
 }
