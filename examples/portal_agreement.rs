@@ -2,8 +2,8 @@
 //! that could exchange light (the two surfaces face each other): the pairs an exact ray sees
 //! that the walk finds or blocks, the pairs it occludes that the walk lets through or blocks,
 //! and the blocked ones by how many cluster changes the segment passes (sampled at 101
-//! points). `tests/portals.rs` holds `ajar-door` to this on built-ins; this measures real
-//! levels.
+//! points); then the voxel walk's agreement on the same pairs, and both walks' CPU time.
+//! `tests/portals.rs` holds `ajar-door` to this on built-ins; this measures real levels.
 //!
 //! `cargo run --release --example portal_agreement -- SCENE LEVEL.vgate CAMERA [WxH] [PATHS]`
 //!
@@ -28,6 +28,10 @@ struct Counts {
     /// Blocked visible pairs by the cluster changes along the segment: 0, 1, 2–3, 4 or more.
     blocked_by_changes: [u64; 4],
     over_the_limit: u64,
+    /// The voxel walk: visible and found, visible and blocked, occluded and let through.
+    voxels: [u64; 3],
+    /// CPU time of the portal walks and of the voxel walks.
+    seconds: [f64; 2],
 }
 
 /// Cluster changes along `a`–`b`, sampled at 101 points (looked up facing along the segment).
@@ -74,6 +78,7 @@ fn main() -> anyhow::Result<()> {
     let walk = GateParams::default();
     let mut n = Counts::default();
     facing_pairs(&tracer, &gates, &view, &vpls, |pair| {
+        let t = std::time::Instant::now();
         let found = match gates.walk(pair.vpl, pair.there, pair.point, pair.here, walk.max_walk) {
             Walk::Visible(_) => true,
             Walk::Blocked => false,
@@ -82,6 +87,17 @@ fn main() -> anyhow::Result<()> {
                 false
             }
         };
+        n.seconds[0] += t.elapsed().as_secs_f64();
+        let t = std::time::Instant::now();
+        let sight = gates.sight();
+        let through = sight.visible(pair.vpl, pair.vpl_normal, pair.point, pair.point_normal);
+        n.seconds[1] += t.elapsed().as_secs_f64();
+        match (pair.exact, through) {
+            (true, true) => n.voxels[0] += 1,
+            (true, false) => n.voxels[1] += 1,
+            (false, true) => n.voxels[2] += 1,
+            (false, false) => {}
+        }
         match (pair.exact, found) {
             (true, true) => n.visible_found += 1,
             (true, false) => {
@@ -120,6 +136,20 @@ fn main() -> anyhow::Result<()> {
         "blocked visible pairs by cluster changes along the segment: 0: {c0}, 1: {c1}, \
          2-3: {c2}, 4+: {c4}; walks over the limit {}",
         n.over_the_limit
+    );
+    let [found, blocked, let_through] = n.voxels;
+    println!(
+        "voxel walk: agree {:.2} %, false occluded {blocked} ({:.2} %; {:.1} % of the visible \
+         pairs), false visible {let_through} ({:.2} %)",
+        100.0 - pct(blocked + let_through),
+        pct(blocked),
+        100.0 * blocked as f64 / (found + blocked).max(1) as f64,
+        pct(let_through)
+    );
+    println!(
+        "CPU time: portal walks {:.0} ms, voxel walks {:.0} ms",
+        n.seconds[0] * 1e3,
+        n.seconds[1] * 1e3
     );
     Ok(())
 }

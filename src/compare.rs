@@ -17,9 +17,9 @@ use crate::settings::{LightArgs, MethodArgs};
 pub const COMPARE_HELP: &str = "\
 Modes (--modes, comma-separated, or all): every GPU method of `visgate render --mode`
 (none, per-vpl-shadow-maps, gates, gates-per-pixel, val-hard, val-cssm, direct-only) and
-gates-disk (mode gates with the paper's disks, whatever --gate-shape says; gates takes
---gate-shape, portals by default). `all`: every one but
-direct-only; the gate modes only with a level (given, or baked here).
+gates-disk and gates-voxels (mode gates with the paper's disks, or walking the level's open
+voxels, whatever --gate-shape says; gates takes --gate-shape, portals by default). `all`: every
+one but direct-only; the gate modes only with a level (given, or baked here).
 
 Every mode renders at every --vpls count from every camera, beside the CPU reference with the
 very same VPLs (a shadow ray per VPL and pixel sample; --spp samples). OUT/report.md and
@@ -222,17 +222,22 @@ fn lightcluster_modes(
     Ok(out)
 }
 
-/// The modes `names` ask for (`all` expanded; `gates-disk` is gates with disks).
+/// The modes `names` ask for (`all` expanded; `gates-disk` and `gates-voxels` are gates with
+/// disks and with the voxel walk).
 fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMode>> {
     let s = settings.settings();
-    let mut disk = s.gates;
-    disk.gates.shape = GateShape::Disk;
+    let shaped = |shape| {
+        let mut g = s.gates;
+        g.gates.shape = shape;
+        GpuMode::Gates(g)
+    };
     let named = |name: &str| -> Result<CompareMode> {
         let mode = match (name, method(name)) {
-            ("gates-disk", _) => GpuMode::Gates(disk),
+            ("gates-disk", _) => shaped(GateShape::Disk),
+            ("gates-voxels", _) => shaped(GateShape::Voxels),
             (_, Some(m)) => (m.make)(&s),
             (_, None) => bail!(
-                "--modes {name}: give all or some of {}, gates-disk",
+                "--modes {name}: give all or some of {}, gates-disk, gates-voxels",
                 METHODS.map(|m| m.name).join(", ")
             ),
         };
@@ -249,6 +254,7 @@ fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMod
                 out.push(named(m.name)?);
                 if m.name == "gates" {
                     out.push(named("gates-disk")?);
+                    out.push(named("gates-voxels")?);
                 }
             }
         } else {

@@ -33,7 +33,9 @@ Modes:
                baked --level's portals (--gate-shape portal, the default: the segment walks
                from cluster to cluster through the openings, at most --max-walk of them) or
                a chain of at most --gate-hops gate disks (× --gate-oversize; --gate-shape
-               disk, the paper's), by
+               disk, the paper's), or along the level's open voxels (--gate-shape voxels:
+               blocked by the first voxel the bake's voxelization closed, so what stands
+               inside a cluster blocks too; a finer bake or --sight-voxel is closer), by
                clustered shading (the paper's Table I passes: geometry pass, unique clusters
                of --tile-px tiles × --depth-slices slices × visibility cluster, light
                assignment into a pool of --light-entries, indirect lighting); GPU: ≤ 2 hops;

@@ -21,6 +21,9 @@ pub enum GateShapeArg {
     Portal,
     /// The paper's disks, through chains of at most --gate-hops of them.
     Disk,
+    /// The walk through the level's open voxels: the openings at voxel resolution, and what
+    /// stands inside a cluster (a door panel, a table) blocks too; finer bakes are closer.
+    Voxels,
 }
 
 /// `--direct`: how the direct lights are shadowed.
@@ -165,7 +168,8 @@ pub struct MethodArgs {
     /// penumbra, 1..=128.
     #[arg(long, default_value_t = 32)]
     pub pcss_filter_samples: u32,
-    /// What a gate is (--mode gates): the baked portals, walked, or the paper's disks.
+    /// What a gate is (--mode gates): the baked portals, walked, the paper's disks, or the
+    /// level's open voxels, walked.
     #[arg(long, value_enum, default_value_t = GateShapeArg::Portal)]
     pub gate_shape: GateShapeArg,
     /// Portals one walk may pass before it is given up and counted as occluded (--gate-shape
@@ -394,6 +398,7 @@ impl MethodArgs {
                     shape: match self.gate_shape {
                         GateShapeArg::Portal => GateShape::Portal,
                         GateShapeArg::Disk => GateShape::Disk,
+                        GateShapeArg::Voxels => GateShape::Voxels,
                     },
                     max_walk: self.max_walk,
                 },

@@ -2,7 +2,7 @@
 //! against the exact ray-cast visibility.
 
 use glam::Vec3;
-use visgate_runtime::cpu::gates::{GateLevel, GateParams, GateShape};
+use visgate_runtime::cpu::gates::{End, GateLevel, GateParams, GateShape};
 use visgate_runtime::cpu::tracer::Tracer;
 use visgate_scenes::Builtin;
 
@@ -74,7 +74,13 @@ fn two_rooms_a_vpl_in_a_lights_b_only_through_the_doorway_gates() {
                     let cb = gates.cluster_at(p, Vec3::Y).expect("point cluster");
                     assert_ne!(ca, cb, "rooms A and B share a cluster");
                     tested += 1;
-                    let through = gates.visible(vpl, ca, p, cb, &params);
+                    let end = |position, cluster| End {
+                        position,
+                        normal: Vec3::Y,
+                        cluster: Some(cluster),
+                    };
+                    let (from, to) = (end(vpl, ca), end(p, cb));
+                    let through = gates.visible(&from, &to, &params);
                     let seen = !tracer.occluded(vpl, p);
                     exact_lit += seen as u32;
                     if through {
@@ -84,10 +90,10 @@ fn two_rooms_a_vpl_in_a_lights_b_only_through_the_doorway_gates() {
                     }
                     // Portals: the walk's answer is the ray's but for segments that graze the
                     // doorway's frame (crossing within a voxel of its edge, 0.0854 m).
-                    if gates.visible(vpl, ca, p, cb, &portals) {
+                    if gates.visible(&from, &to, &portals) {
                         portal_lit += 1;
                     }
-                    if gates.visible(vpl, ca, p, cb, &portals) != seen {
+                    if gates.visible(&from, &to, &portals) != seen {
                         portal_wrong += 1;
                         assert!(
                             outside_doorway(vpl, p).abs() < 0.0854,
@@ -121,7 +127,12 @@ fn two_rooms_a_vpl_in_a_lights_b_only_through_the_doorway_gates() {
     let ca = closed.cluster_at(vpl, Vec3::Y).expect("cluster");
     let p = Vec3::from(b_room.min_m).lerp(Vec3::from(b_room.max_m), 0.5);
     let cb = closed.cluster_at(p, Vec3::Y).expect("cluster");
-    assert!(!closed.visible(vpl, ca, p, cb, &params));
+    let end = |position, cluster| End {
+        position,
+        normal: Vec3::Y,
+        cluster: Some(cluster),
+    };
+    assert!(!closed.visible(&end(vpl, ca), &end(p, cb), &params));
 }
 
 #[test]
@@ -192,6 +203,8 @@ fn gpu_gates_agree_with_the_cpu_twin() {
             (false, 2, GateShape::Disk),
             (true, 2, GateShape::Portal),
             (false, 2, GateShape::Portal),
+            (true, 2, GateShape::Voxels),
+            (false, 2, GateShape::Voxels),
         ] {
             let gp = GateParams {
                 oversize: 1.5,
@@ -273,6 +286,10 @@ fn clustered_light_lists_give_exactly_the_per_point_gate_test() {
                 shape: GateShape::Portal,
                 ..GateParams::default()
             },
+            GateParams {
+                shape: GateShape::Voxels,
+                ..GateParams::default()
+            },
         ] {
             let c = assign(
                 &pixels,
@@ -291,22 +308,27 @@ fn clustered_light_lists_give_exactly_the_per_point_gate_test() {
                 let Some(p) = p else { continue };
                 let list = &c.lists[c.pixel_cluster[i] as usize];
                 for (j, v) in vpls.iter().enumerate() {
-                    // Portal lists drop the VPLs a point lies behind (they cannot light it).
+                    // Walks' lists drop the VPLs a point lies behind (they cannot light it).
                     let behind =
                         (p.position - Vec3::from(v.position)).dot(Vec3::from(v.normal)) < 0.0;
-                    if gp.shape == GateShape::Portal && behind {
+                    if gp.shape != GateShape::Disk && behind {
                         continue;
                     }
-                    let want = match (vpl_cluster[j], p.cluster) {
-                        (Some(a), Some(bc)) => {
-                            gates.visible(Vec3::from(v.position), a, p.position, bc, &gp)
-                        }
-                        _ => true,
+                    let vpl = End {
+                        position: Vec3::from(v.position),
+                        normal: Vec3::from(v.normal),
+                        cluster: vpl_cluster[j],
                     };
-                    let got = list.iter().filter(|e| e.vpl == j as u32).any(|e| {
-                        let here = p.cluster.unwrap_or(u32::MAX);
-                        entry_reaches(e, v, (p.position, here), &gates, &gp)
-                    });
+                    let point = End {
+                        position: p.position,
+                        normal: p.normal,
+                        cluster: p.cluster,
+                    };
+                    let want = gates.visible(&vpl, &point, &gp);
+                    let got = list
+                        .iter()
+                        .filter(|e| e.vpl == j as u32)
+                        .any(|e| entry_reaches(e, v, &point, &gates, &gp));
                     assert_eq!(got, want, "{} pixel {i} VPL {j} {gp:?}", b.name());
                     lit_pairs += got as u64;
                 }
@@ -625,9 +647,9 @@ fn gpu_gates_give_the_same_image_at_scales_1e_3_to_1e4() {
     use visgate_runtime::gpu::{GatesParams, GpuContext, GpuMode, GpuParams, GpuRenderer};
     use visgate_runtime::metrics::errors;
     let ctx = GpuContext::new().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"));
-    let shapes = [GateShape::Portal, GateShape::Disk];
+    let shapes = [GateShape::Portal, GateShape::Disk, GateShape::Voxels];
     // Each scale baked once; its image with each gate shape.
-    let mut images: [Vec<_>; 2] = Default::default();
+    let mut images: [Vec<_>; 3] = Default::default();
     for s in [1e-3f32, 1.0, 1e4] {
         let (scene, cam) = common::scaled_four_rooms(s);
         let gates = GateLevel::new(gate_support::bake_at(&scene, 96).level, &scene).expect("level");
@@ -822,11 +844,11 @@ fn the_light_list_pool_grows_to_what_a_frame_needs() {
 }
 
 #[test]
-fn gpu_portal_walks_keep_their_light_however_many_vpls_a_pixel_walks() {
+fn gpu_walks_keep_their_light_however_many_vpls_a_pixel_walks() {
     // llvmpipe ends a shader invocation's loops after 65,535 iterations in all: a pixel that
     // walked 2,048 VPLs' portals in one pass lost a third of their light on ajar-door's `door`
-    // camera (then it warned). Mode gates walks them in batches there; the GPU keeps the CPU
-    // twin's light.
+    // camera (then it warned). Mode gates walks them in batches there, portals and voxels; the
+    // GPU keeps the CPU twin's light.
     use visgate_runtime::gpu::{GpuContext, GpuMode, GpuParams, GpuRenderer};
     use visgate_runtime::vpl::{PathParams, path_vpls};
     let ctx = GpuContext::new().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"));
@@ -842,13 +864,6 @@ fn gpu_portal_walks_keep_their_light_however_many_vpls_a_pixel_walks() {
     let view = visgate_runtime::camera::View::new(&scene.cameras[1], [24, 16]).expect("view");
     let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
     gpu.set_level(&ctx, &gates).expect("level");
-    let cpu = cpu_twin(
-        &tracer,
-        &scene.lights,
-        &vpls,
-        &view,
-        (&gates, GateParams::default()),
-    );
     let (direct, _) = gpu
         .render(
             &ctx,
@@ -864,13 +879,25 @@ fn gpu_portal_walks_keep_their_light_however_many_vpls_a_pixel_walks() {
             .map(|(p, d)| f64::from((*p - *d).element_sum()))
             .sum()
     };
-    let mode = GpuMode::Gates(every_vpl_at_every_pixel());
-    let (img, _) = gpu
-        .render(&ctx, &view, &vpls, &GpuParams::with_mode(mode))
-        .expect("gpu");
-    let ratio = indirect(&img) / indirect(&cpu);
-    eprintln!("{} VPLs a pixel: GPU / CPU indirect {ratio:.4}", vpls.len());
-    assert!((ratio - 1.0).abs() < 0.01, "{ratio}");
+    for shape in [GateShape::Portal, GateShape::Voxels] {
+        let gp = GateParams {
+            shape,
+            ..GateParams::default()
+        };
+        let cpu = cpu_twin(&tracer, &scene.lights, &vpls, &view, (&gates, gp));
+        let mut p = every_vpl_at_every_pixel();
+        p.gates = gp;
+        let mode = GpuMode::Gates(p);
+        let (img, _) = gpu
+            .render(&ctx, &view, &vpls, &GpuParams::with_mode(mode))
+            .expect("gpu");
+        let ratio = indirect(&img) / indirect(&cpu);
+        eprintln!(
+            "{shape:?}, {} VPLs a pixel: GPU / CPU indirect {ratio:.4}",
+            vpls.len()
+        );
+        assert!((ratio - 1.0).abs() < 0.01, "{shape:?}: {ratio}");
+    }
 }
 
 /// The CPU twin of mode `gates` (one sample at each pixel's centre) with `gates` and `params`.

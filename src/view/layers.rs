@@ -8,7 +8,7 @@ use eframe::egui;
 use glam::Vec3;
 use rayon::prelude::*;
 use visgate_runtime::camera::View;
-use visgate_runtime::cpu::gates::{GateLevel, GateParams};
+use visgate_runtime::cpu::gates::{End, GateLevel, GateParams};
 use visgate_runtime::cpu::tracer::Tracer;
 use visgate_runtime::vpl::Vpl;
 
@@ -359,18 +359,19 @@ pub fn probe(
         exact
     );
     if let Some(l) = level {
-        let c = l.cluster_at(x, n);
+        let point = End {
+            position: x,
+            normal: s.geometric_normal,
+            cluster: l.cluster_at(x, n),
+        };
         let through = facing
             .iter()
             .filter(|v| {
-                let (vp, vn) = (Vec3::from(v.position), Vec3::from(v.normal));
-                match (c, l.cluster_at(vp, vn)) {
-                    (Some(a), Some(b)) => l.visible(x, a, vp, b, gates),
-                    _ => true,
-                }
+                let vpl = End::at(l, Vec3::from(v.position), Vec3::from(v.normal));
+                l.visible(&vpl, &point, gates)
             })
             .count();
-        out += &match c {
+        out += &match point.cluster {
             Some(k) => format!("; cluster {k}, through the gates {through}"),
             None => format!("; no cluster (unoccluded), through the gates {through}"),
         };

@@ -20,10 +20,12 @@ pub fn method_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
             ui.horizontal(|ui| {
                 ui.radio_value(&mut g.shape, GateShape::Portal, "portals");
                 ui.radio_value(&mut g.shape, GateShape::Disk, "disks (paper)");
+                ui.radio_value(&mut g.shape, GateShape::Voxels, "voxels")
+                    .on_hover_text("the walk through the level's open voxels");
             });
             if g.shape == GateShape::Portal {
                 ui.add(egui::Slider::new(&mut g.max_walk, 1..=256).text("portals per walk"));
-            } else {
+            } else if g.shape == GateShape::Disk {
                 ui.add(egui::Slider::new(&mut g.max_hops, 1..=2).text("gate hops"));
                 ui.add(egui::Slider::new(&mut g.oversize, 0.5..=3.0).text("gate oversize"));
             }

@@ -25,6 +25,9 @@ pub struct SavedView {
     /// Gates as disks rather than portals (absent in older files: portals).
     #[serde(default)]
     pub disks: bool,
+    /// Gates as the voxel walk (absent in older files: not).
+    #[serde(default)]
+    pub voxels: bool,
     /// The VAL layer (absent in older files: off).
     #[serde(default)]
     pub vals_layer: bool,
@@ -92,6 +95,7 @@ mod tests {
             layers: [true, false, true, false, true, false, true],
             settings: [2.0, 1.5, 30.0, 8.0, 4.0, 128.0, 256.0, 32.0],
             disks: mode == "gates",
+            voxels: false,
             vals_layer: mode == "val-ism",
         };
         save_to(&p, "a", state("gates"));

@@ -14,9 +14,9 @@
 //!    exactly (the segment to the pixel's point crosses every disk of the chain). A VPL with
 //!    several passing chains counts once.
 //!
-//! With portals the GPU keeps no lists: each pixel walks every VPL of its interleaving subset.
-//! This twin still lists them (less the clusters wholly behind a VPL's surface, which light
-//! nothing there), so the image is the same and the viewer can draw them.
+//! With portals or voxels the GPU keeps no lists: each pixel walks every VPL of its
+//! interleaving subset. This twin still lists them (less the clusters wholly behind a VPL's
+//! surface, which light nothing there), so the image is the same and the viewer can draw them.
 //!
 //! The assignment is conservative (the cone through a disk lies inside the cone through the
 //! disk's bounding sphere), so the gather gives exactly the per-point gate test
@@ -27,7 +27,7 @@ use std::collections::BTreeMap;
 
 use glam::Vec3;
 
-use crate::cpu::gates::{GateLevel, GateParams, GateShape, Walk, segment_crosses_disk};
+use crate::cpu::gates::{End, GateLevel, GateParams, GateShape, Walk, segment_crosses_disk};
 use crate::vpl::Vpl;
 
 /// Parameters of geometry clusters.
@@ -194,11 +194,22 @@ pub fn assign(
             let mut list = Vec::new();
             for (j, v) in vpls.iter().enumerate() {
                 let a = Vec3::from(v.position);
+                let in_front = (s - a).dot(Vec3::from(v.normal)) >= -r;
                 match (vpl_cluster[j], gc.cluster) {
-                    // Portals: culled only when the cluster lies wholly behind the VPL's
-                    // surface; the walk runs per point.
+                    // Voxels: culled only when the cluster lies wholly behind the VPL's
+                    // surface; the voxel walk runs per point, whatever the clusters.
+                    _ if gates.shape == GateShape::Voxels => {
+                        if in_front {
+                            list.push(LightEntry {
+                                vpl: j as u32,
+                                gates: Vec::new(),
+                                walk_from: None,
+                            });
+                        }
+                    }
+                    // Portals: likewise; the walk runs per point from the VPL's cluster.
                     (Some(ca), Some(cb)) if ca != cb && gates.shape == GateShape::Portal => {
-                        if (s - a).dot(Vec3::from(v.normal)) >= -r {
+                        if in_front {
                             list.push(LightEntry {
                                 vpl: j as u32,
                                 gates: Vec::new(),
@@ -279,16 +290,22 @@ pub fn cone_margin(
     angle - (half + spread)
 }
 
-/// Step 4 for one pixel: whether entry `e`'s light reaches point `p` (of cluster `here`).
+/// Step 4 for one pixel: whether entry `e`'s light reaches `point` (its cluster `None`:
+/// outside every cluster).
 pub fn entry_reaches(
     e: &LightEntry,
     vpl: &Vpl,
-    (p, here): (Vec3, u32),
+    point: &End,
     level: &GateLevel,
     gates: &GateParams,
 ) -> bool {
-    let a = Vec3::from(vpl.position);
-    if let Some(ca) = e.walk_from {
+    let (a, p) = (Vec3::from(vpl.position), point.position);
+    if gates.shape == GateShape::Voxels {
+        return level
+            .sight()
+            .visible(a, Vec3::from(vpl.normal), p, point.normal);
+    }
+    if let (Some(ca), Some(here)) = (e.walk_from, point.cluster) {
         return matches!(level.walk(a, ca, p, here, gates.max_walk), Walk::Visible(_));
     }
     e.gates.iter().all(|&g| {

@@ -6,13 +6,16 @@
 //!
 //! Beyond the paper, each a parameter: disks oversized by a factor (the paper's suggested fix
 //! for darkening), and light through a chain of up to K gates (the paper stops at neighbouring
-//! clusters, K = 1).
+//! clusters, K = 1); portals, the planar pieces of the interfaces between clusters, walked
+//! cluster by cluster ([`super::portal_walk`]); and the walk through the level's open voxels
+//! ([`super::sight`]), the openings at voxel resolution.
 
 use glam::Vec3;
 use visgate_formats::vgate::GridMeta;
 use visgate_formats::{BakedLevel, Scene};
 
 use super::portal_walk::PortalBvh;
+use super::sight::VoxelSight;
 use crate::RenderError;
 
 /// What a gate is at runtime.
@@ -23,6 +26,20 @@ pub enum GateShape {
     /// The baked portals (the true openings), walked cluster by cluster along the segment.
     #[default]
     Portal,
+    /// The walk through the level's open voxels: the segment is blocked by the first voxel
+    /// the voxelization closed ([`super::sight`]).
+    Voxels,
+}
+
+impl GateShape {
+    /// Its value in grid.wgsl's `Grid.shape` (`GATE_DISKS`, `GATE_PORTALS`, `GATE_VOXELS`).
+    pub fn shader_id(self) -> u32 {
+        match self {
+            GateShape::Disk => 0,
+            GateShape::Portal => 1,
+            GateShape::Voxels => 2,
+        }
+    }
 }
 
 /// The end of a portal walk.
@@ -69,6 +86,8 @@ pub struct GateLevel {
     cluster_gates: Vec<Vec<usize>>,
     /// Each cluster's portals in a bounding-volume hierarchy.
     portal_bvh: PortalBvh,
+    /// The open voxels, for the voxel walk.
+    sight: VoxelSight,
     /// Walks through [`GateLevel::visible`] that reached the limit (counted as occluded).
     walks_over_limit: std::sync::atomic::AtomicU64,
 }
@@ -95,11 +114,13 @@ impl GateLevel {
             }
         }
         let portal_bvh = PortalBvh::new(&level.topology.portals, clusters);
+        let sight = VoxelSight::new(&level.info.sight_grid, &level.open);
         Ok(GateLevel {
             grid: level.info.grid,
             level,
             cluster_gates,
             portal_bvh,
+            sight,
             walks_over_limit: std::sync::atomic::AtomicU64::new(0),
         })
     }
@@ -117,6 +138,11 @@ impl GateLevel {
     /// Every cluster's portal hierarchy.
     pub fn portal_bvh(&self) -> &PortalBvh {
         &self.portal_bvh
+    }
+
+    /// The open voxels, for the voxel walk.
+    pub fn sight(&self) -> &VoxelSight {
+        &self.sight
     }
 
     /// Voxel edge of the level's grid. [Units: m]
@@ -226,11 +252,21 @@ impl GateLevel {
             .swap(0, std::sync::atomic::Ordering::Relaxed)
     }
 
-    /// Whether light from `a` (cluster `ca`) reaches `b` (cluster `cb`) through the gates: same
-    /// cluster, or (disks) the segment passes through a chain of at most `max_hops` gate disks
-    /// that leads from `ca` to `cb`, or (portals) the walk reaches `cb` (a walk over the limit
-    /// counts as occluded).
-    pub fn visible(&self, a: Vec3, ca: u32, b: Vec3, cb: u32, params: &GateParams) -> bool {
+    /// Whether light from a VPL reaches a surface point: with voxels, the voxel walk between
+    /// them; otherwise through the gates — same cluster, outside every cluster (the bake knows
+    /// nothing there: unoccluded), or (disks) the segment passes through a chain of at most
+    /// `max_hops` gate disks that leads from the VPL's cluster to the point's, or (portals)
+    /// the walk reaches the point's cluster (a walk over the limit counts as occluded).
+    pub fn visible(&self, vpl: &End, point: &End, params: &GateParams) -> bool {
+        if params.shape == GateShape::Voxels {
+            return self
+                .sight
+                .visible(vpl.position, vpl.normal, point.position, point.normal);
+        }
+        let (Some(ca), Some(cb)) = (vpl.cluster, point.cluster) else {
+            return true;
+        };
+        let (a, b) = (vpl.position, point.position);
         if ca == cb {
             return true;
         }
@@ -285,6 +321,30 @@ impl GateLevel {
     }
 }
 
+/// One end of a segment that light may pass: a VPL or a surface point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct End {
+    /// Position. [Units: m]
+    pub position: Vec3,
+    /// Unit normal of its surface, on the side it lights or is lit from: a VPL's own, a
+    /// surface point's face normal (the voxel walk starts off it; a shading normal can lean
+    /// far off its face).
+    pub normal: Vec3,
+    /// Its visibility cluster ([`GateLevel::cluster_at`]; `None`: outside every cluster).
+    pub cluster: Option<u32>,
+}
+
+impl End {
+    /// The end at `position` with `normal`, its cluster looked up in `level`.
+    pub fn at(level: &GateLevel, position: Vec3, normal: Vec3) -> End {
+        End {
+            position,
+            normal,
+            cluster: level.cluster_at(position, normal),
+        }
+    }
+}
+
 /// Whether segment `a`–`b` crosses the disk of `centre`, unit `normal` and `radius`.
 pub fn segment_crosses_disk(a: Vec3, b: Vec3, centre: Vec3, normal: Vec3, radius: f32) -> bool {
     let d = b - a;
@@ -316,6 +376,8 @@ pub struct GateTables {
     pub cluster_gates: Vec<u32>,
     /// The portals, packed ([`GateLevel::portal_words`]).
     pub portal_words: Vec<u32>,
+    /// The open voxels and their bricks' clearance, packed ([`VoxelSight::words`]).
+    pub sight_words: Vec<u32>,
 }
 
 impl GateLevel {
@@ -371,6 +433,7 @@ impl GateLevel {
             gates,
             cluster_gates: starts,
             portal_words: self.portal_words(),
+            sight_words: self.sight.words(),
         }
     }
 }

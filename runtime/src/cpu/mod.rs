@@ -9,5 +9,6 @@ pub mod ism;
 pub mod lightcluster;
 pub mod portal_walk;
 pub mod reference;
+pub mod sight;
 pub mod tracer;
 pub mod val;

@@ -399,14 +399,38 @@ mod tests {
 pub struct FacingPair {
     /// The pixel's surface point. [Units: m]
     pub point: Vec3,
+    /// Its face's normal (facing the camera).
+    pub point_normal: Vec3,
     /// Its visibility cluster.
     pub here: u32,
     /// The VPL's position. [Units: m]
     pub vpl: Vec3,
+    /// Its normal (on its lit side).
+    pub vpl_normal: Vec3,
     /// Its visibility cluster.
     pub there: u32,
     /// Whether the shadow ray between them is clear.
     pub exact: bool,
+}
+
+impl FacingPair {
+    /// The pair's VPL end.
+    pub fn vpl_end(&self) -> super::gates::End {
+        super::gates::End {
+            position: self.vpl,
+            normal: self.vpl_normal,
+            cluster: Some(self.there),
+        }
+    }
+
+    /// The pair's pixel end.
+    pub fn point_end(&self) -> super::gates::End {
+        super::gates::End {
+            position: self.point,
+            normal: self.point_normal,
+            cluster: Some(self.here),
+        }
+    }
 }
 
 /// Calls `f` with every pixel–VPL pair of `view` (pixel centres) whose surfaces face each other
@@ -441,8 +465,10 @@ pub fn facing_pairs(
                 };
                 f(&FacingPair {
                     point: s.position,
+                    point_normal: s.geometric_normal,
                     here,
                     vpl: vp,
+                    vpl_normal: vn,
                     there,
                     exact: !tracer.occluded(from, vp + vn * tracer.epsilon_m),
                 });

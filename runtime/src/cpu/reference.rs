@@ -14,7 +14,7 @@ use visgate_formats::Light;
 
 use crate::RenderError;
 use crate::camera::View;
-use crate::cpu::gates::{GateLevel, GateParams};
+use crate::cpu::gates::{End, GateLevel, GateParams};
 use crate::cpu::tracer::Tracer;
 use crate::hdr::HdrImage;
 use crate::lights::direct_radiance;
@@ -190,19 +190,20 @@ pub fn render_cancellable(
                                         + Vec3::from(v.normal) * tracer.epsilon_m;
                                     !tracer.occluded(from, to)
                                 }
-                                // A point or VPL outside every cluster (in a dropped void)
-                                // meets no gate: unoccluded, as without visibility.
+                                // Gates, portals or voxels (GateLevel::visible: a point or
+                                // VPL outside every cluster meets no gate, unoccluded).
                                 IndirectVisibility::Gates(level, gp) => {
-                                    match (vpl_cluster[j], here) {
-                                        (Some(a), Some(b)) => level.visible(
-                                            Vec3::from(v.position),
-                                            a,
-                                            surf.position,
-                                            b,
-                                            &gp,
-                                        ),
-                                        _ => true,
-                                    }
+                                    let vpl = End {
+                                        position: Vec3::from(v.position),
+                                        normal: Vec3::from(v.normal),
+                                        cluster: vpl_cluster[j],
+                                    };
+                                    let point = End {
+                                        position: surf.position,
+                                        normal: surf.geometric_normal,
+                                        cluster: here,
+                                    };
+                                    level.visible(&vpl, &point, &gp)
                                 }
                             };
                             if lit {

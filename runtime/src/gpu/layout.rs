@@ -160,7 +160,7 @@ gpu_struct! {
         pub oversize: f32,
         /// Gates a VPL's light may pass (1 or 2 on the GPU).
         pub max_hops: u32,
-        /// 0: gate disks, 1: portals (walked).
+        /// 0: gate disks, 1: portals (walked), 2: the voxel walk ([`crate::cpu::gates::GateShape::shader_id`]).
         pub shape: u32,
         /// Portals a walk may pass before it is given up.
         pub max_walk: u32,

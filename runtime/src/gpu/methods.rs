@@ -204,6 +204,7 @@ impl GpuMode {
         let gates = |g: &GateParams| match g.shape {
             GateShape::Portal => format!("portals, walk ≤ {}", g.max_walk),
             GateShape::Disk => format!("disks ×{}, {} hop(s)", g.oversize, g.max_hops),
+            GateShape::Voxels => "voxel walk".to_string(),
         };
         // The VAL clustering's settings where they are not the paper's (Dong et al.'s).
         let vals = |v: &crate::cpu::val::ValParams| {
@@ -272,14 +273,14 @@ impl GpuMode {
         }
     }
 
-    /// How many VPLs a pixel walks through the portals with `vpls` in the frame (0 for modes
-    /// that walk none): all of them per pixel, a b²-th interleaved.
-    pub fn portal_walks_per_pixel(&self, vpls: u32) -> u32 {
+    /// How many VPLs a pixel walks (through the portals or the voxels) with `vpls` in the
+    /// frame (0 for modes that walk none): all of them per pixel, a b²-th interleaved.
+    pub fn walks_per_pixel(&self, vpls: u32) -> u32 {
         match self {
-            GpuMode::Gates(p) if p.gates.shape == crate::cpu::gates::GateShape::Portal => {
+            GpuMode::Gates(p) if p.gates.shape != GateShape::Disk => {
                 vpls.div_ceil(p.interleave.subsets())
             }
-            GpuMode::GatesPerPixel(g) if g.shape == crate::cpu::gates::GateShape::Portal => vpls,
+            GpuMode::GatesPerPixel(g) if g.shape != GateShape::Disk => vpls,
             _ => 0,
         }
     }
@@ -393,11 +394,11 @@ fn software(adapter: &str) -> bool {
     adapter.contains("llvmpipe")
 }
 
-/// VPLs of a pixel's subset that mode `gates` with portals walks in one draw on `adapter`: 0
-/// (all in one) but on a software rasterizer, [`SOFTWARE_WALK_BATCH`].
+/// VPLs of a pixel's subset that mode `gates` with portals or voxels walks in one draw on
+/// `adapter`: 0 (all in one) but on a software rasterizer, [`SOFTWARE_WALK_BATCH`].
 pub fn walk_batch(adapter: &str, mode: &GpuMode) -> u32 {
     match mode {
-        GpuMode::Gates(p) if p.gates.shape == GateShape::Portal && software(adapter) => {
+        GpuMode::Gates(p) if p.gates.shape != GateShape::Disk && software(adapter) => {
             SOFTWARE_WALK_BATCH
         }
         _ => 0,
@@ -409,7 +410,7 @@ pub fn walk_batch(adapter: &str, mode: &GpuMode) -> u32 {
 pub fn warn_software_loop_limit(adapter: &str, mode: &GpuMode, vpls: u32) {
     static WARNED: std::sync::Once = std::sync::Once::new();
     let walks = match mode {
-        GpuMode::GatesPerPixel(_) => mode.portal_walks_per_pixel(vpls),
+        GpuMode::GatesPerPixel(_) => mode.walks_per_pixel(vpls),
         _ => 0,
     };
     if software(adapter) && walks > SOFTWARE_WALK_BATCH {
@@ -449,20 +450,17 @@ mod tests {
         let portals = GatesParams::default();
         assert_eq!(portals.gates.shape, GateShape::Portal);
         assert_eq!(portals.interleave.subsets(), 64);
-        assert_eq!(GpuMode::Gates(portals).portal_walks_per_pixel(4096), 64);
-        assert_eq!(GpuMode::Gates(portals).portal_walks_per_pixel(4097), 65);
+        assert_eq!(GpuMode::Gates(portals).walks_per_pixel(4096), 64);
+        assert_eq!(GpuMode::Gates(portals).walks_per_pixel(4097), 65);
         assert_eq!(
-            GpuMode::GatesPerPixel(portals.gates).portal_walks_per_pixel(4096),
+            GpuMode::GatesPerPixel(portals.gates).walks_per_pixel(4096),
             4096
         );
         let mut disks = portals;
         disks.gates.shape = GateShape::Disk;
-        assert_eq!(GpuMode::Gates(disks).portal_walks_per_pixel(4096), 0);
-        assert_eq!(
-            GpuMode::GatesPerPixel(disks.gates).portal_walks_per_pixel(4096),
-            0
-        );
-        assert_eq!(GpuMode::None.portal_walks_per_pixel(4096), 0);
+        assert_eq!(GpuMode::Gates(disks).walks_per_pixel(4096), 0);
+        assert_eq!(GpuMode::GatesPerPixel(disks.gates).walks_per_pixel(4096), 0);
+        assert_eq!(GpuMode::None.walks_per_pixel(4096), 0);
     }
 
     #[test]

@@ -237,7 +237,14 @@ fn record_passes(
         GpuMode::VplClusters(vp, _) => Some(p.light_cluster.record_vpls(f, vp, &g, pool, rec)?),
         _ => None,
     };
+    // The voxel walk needs no geometry clusters, lists or VPL clusters: only the level.
     let lists = match &f.params.mode {
+        GpuMode::Gates(gp) if gp.gates.shape == GateShape::Voxels => {
+            f.scene.level.as_ref().ok_or_else(|| {
+                RenderError::Param("mode gates needs a baked level (GpuRenderer::set_level)".into())
+            })?;
+            None
+        }
         GpuMode::Gates(gp) => Some(p.clustered.record(f, gp, pool, rec, &g.views[0])?),
         _ => None,
     };
@@ -487,7 +494,7 @@ impl GpuRenderer {
             value_bytes: level.map_or(4, |l| l.dims[3]),
             oversize: gates.oversize,
             max_hops: gates.max_hops,
-            shape: u32::from(gates.shape == GateShape::Portal),
+            shape: gates.shape.shader_id(),
             max_walk: gates.max_walk,
         };
         let uniform = wgpu::BufferUsages::UNIFORM;

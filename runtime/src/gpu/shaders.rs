@@ -17,13 +17,14 @@
 use crate::RenderError;
 
 /// The include files (`gpu/shaders/`).
-const INCLUDES: [(&str, &str); 11] = [
+const INCLUDES: [(&str, &str); 12] = [
     ("globals.wgsl", include_str!("shaders/globals.wgsl")),
     ("lights.wgsl", include_str!("shaders/lights.wgsl")),
     ("vpl.wgsl", include_str!("shaders/vpl.wgsl")),
     ("grid.wgsl", include_str!("shaders/grid.wgsl")),
     ("gates.wgsl", include_str!("shaders/gates.wgsl")),
     ("portals.wgsl", include_str!("shaders/portals.wgsl")),
+    ("sight.wgsl", include_str!("shaders/sight.wgsl")),
     ("val.wgsl", include_str!("shaders/val.wgsl")),
     ("fullscreen.wgsl", include_str!("shaders/fullscreen.wgsl")),
     ("lc.wgsl", include_str!("shaders/lc.wgsl")),

@@ -38,6 +38,7 @@ impl ViewerApp {
                 p.batch as f32,
             ],
             disks: g.shape == visgate_runtime::cpu::gates::GateShape::Disk,
+            voxels: g.shape == visgate_runtime::cpu::gates::GateShape::Voxels,
             vals_layer: l.vals,
         }
     }
@@ -55,10 +56,10 @@ impl ViewerApp {
             &mut self.settings.per_vpl,
         );
         g.max_hops = hops as u32;
-        g.shape = if s.disks {
-            visgate_runtime::cpu::gates::GateShape::Disk
-        } else {
-            visgate_runtime::cpu::gates::GateShape::Portal
+        g.shape = match (s.disks, s.voxels) {
+            (true, _) => visgate_runtime::cpu::gates::GateShape::Disk,
+            (false, true) => visgate_runtime::cpu::gates::GateShape::Voxels,
+            (false, false) => visgate_runtime::cpu::gates::GateShape::Portal,
         };
         g.oversize = oversize;
         v.vals.count = vals as u32;

@@ -69,10 +69,11 @@ pub fn check_gates(g: &GateParams) -> Result<(), RenderError> {
 
 impl GatesParams {
     /// Whether the indirect light is gathered in a pass of its own and composed by the blur
-    /// (interleaved, or portals, which walk in batches on a software rasterizer), not in the
-    /// shading pass (disks gathering every VPL at every pixel). shade.wgsl's `fs` says the same.
+    /// (interleaved, or walks — portals or voxels —, which run in batches on a software
+    /// rasterizer), not in the shading pass (disks gathering every VPL at every pixel).
+    /// shade.wgsl's `fs` says the same.
     pub fn gathers_apart(&self) -> bool {
-        self.interleave.block > 1 || self.gates.shape == GateShape::Portal
+        self.interleave.block > 1 || self.gates.shape != GateShape::Disk
     }
 
     /// Checks the limits (the pool's size against the adapter's at render time).
@@ -110,6 +111,8 @@ pub struct LevelBuffers {
     pub cluster_gates: wgpu::Buffer,
     /// The portals, packed (`GateLevel::portal_words`).
     pub portal_words: wgpu::Buffer,
+    /// The open voxels, packed (`VoxelSight::words`).
+    pub sight_words: wgpu::Buffer,
 }
 
 impl LevelBuffers {
@@ -128,13 +131,18 @@ impl LevelBuffers {
                 MAX_CLUSTERS
             )));
         }
-        let bytes = (t.voxel_words.len() * 4) as u64;
-        if bytes > d.limits().max_storage_buffer_binding_size {
-            return Err(RenderError::Param(format!(
-                "the voxel→cluster grid needs {bytes} bytes, more than the adapter's storage \
-                 binding limit {}: bake at a lower resolution",
-                d.limits().max_storage_buffer_binding_size
-            )));
+        for (what, words) in [
+            ("voxel→cluster grid", &t.voxel_words),
+            ("open voxels' grid", &t.sight_words),
+        ] {
+            let bytes = (words.len() * 4) as u64;
+            if bytes > d.limits().max_storage_buffer_binding_size {
+                return Err(RenderError::Param(format!(
+                    "the {what} needs {bytes} bytes, more than the adapter's storage binding \
+                     limit {}: bake at a lower resolution",
+                    d.limits().max_storage_buffer_binding_size
+                )));
+            }
         }
         let storage = wgpu::BufferUsages::STORAGE;
         Ok(LevelBuffers {
@@ -154,6 +162,12 @@ impl LevelBuffers {
                 storage,
             ),
             portal_words: init_buffer(d, "portals", bytemuck::cast_slice(&t.portal_words), storage),
+            sight_words: init_buffer(
+                d,
+                "open voxels",
+                bytemuck::cast_slice(&t.sight_words),
+                storage,
+            ),
         })
     }
 }
@@ -252,9 +266,9 @@ impl ClusteredGates {
         let max_binding = limits
             .max_storage_buffer_binding_size
             .min(limits.max_buffer_size);
-        // Portals keep no lists: a pixel walks every VPL of its subset (clusters.wgsl).
+        // Walks keep no lists: a pixel walks every VPL of its subset (clusters.wgsl).
         let capacity = match p.gates.shape {
-            GateShape::Portal => 1,
+            GateShape::Portal | GateShape::Voxels => 1,
             GateShape::Disk => p.light_entries.unwrap_or(AUTO_LIGHT_ENTRIES),
         };
         let sizes = [

@@ -2,7 +2,8 @@
 // G-buffer pass: world position (w: the visibility cluster it faces, 0 where
 // no surface is, see encode_cluster), shading normal on the side of the face that the camera
 // sees (surfaces are two-sided), linear albedo (material × texture, the texture an sRGB layer
-// of one array, sampled nearest with repeat as the CPU reference does). Depth test less.
+// of one array, sampled nearest with repeat as the CPU reference does); the face's normal in
+// normal.w and albedo.w (encode_face_normal). Depth test less.
 
 @group(0) @binding(0) var<uniform> globals: Globals;
 @group(0) @binding(1) var albedo_maps: texture_2d_array<f32>;
@@ -64,12 +65,13 @@ fn fs(i: VsOut) -> GOut {
     }
     var o: GOut;
     o.position = vec4<f32>(i.world, encode_cluster(cluster_at(i.world, n)));
-    o.normal = vec4<f32>(n, 0.0);
+    let face = encode_face_normal(normalize(ng));
+    o.normal = vec4<f32>(n, face.x);
     var albedo = i.albedo;
     if i.uv_layer.z >= 0.0 {
         let layer = i32(i.uv_layer.z + 0.5);
         albedo *= textureSampleLevel(albedo_maps, albedo_sampler, i.uv_layer.xy, layer, 0.0).xyz;
     }
-    o.albedo = vec4<f32>(albedo, 1.0);
+    o.albedo = vec4<f32>(albedo, face.y);
     return o;
 }

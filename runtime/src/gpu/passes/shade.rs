@@ -92,10 +92,10 @@ pub type Inputs<'a> = (
 
 /// The bindings of shade.wgsl's `fs_gates_indirect` (an automatic layout holds only what an
 /// entry point uses).
-const GATES_INDIRECT_BINDINGS: [u32; 12] = [0, 2, 5, 6, 8, 10, 12, 13, 14, 15, 16, 21];
+const GATES_INDIRECT_BINDINGS: [u32; 14] = [0, 2, 5, 6, 7, 8, 10, 12, 13, 14, 15, 16, 21, 22];
 /// The bindings of shade.wgsl's `fs`: all but the batches' sum.
-const SHADE_BINDINGS: [u32; 21] = [
-    0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20,
+const SHADE_BINDINGS: [u32; 22] = [
+    0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20, 22,
 ];
 /// The bindings of shade.wgsl's `fs_vpl_clusters_indirect`.
 const VPL_CLUSTERS_INDIRECT_BINDINGS: [u32; 6] = [0, 2, 5, 6, 19, 20];
@@ -169,7 +169,7 @@ impl Shade {
         }
         // Portals' batches ping-pong between two targets, each adding onto the other's sum.
         let batch = crate::gpu::methods::walk_batch(&f.ctx.adapter_info.name, &f.params.mode);
-        let walks = f.params.mode.portal_walks_per_pixel(f.vpl_count);
+        let walks = f.params.mode.walks_per_pixel(f.vpl_count);
         let batches = if batch > 0 {
             walks.div_ceil(batch).max(1)
         } else {
@@ -225,7 +225,7 @@ impl Shade {
         let no_vis = array_view(&f.scene.no_visibility);
         let vis = lc.map_or_else(|| no_vis.clone(), |o| array_view(&o.visibility));
         let vpl_vis = vpl_lc.map_or(no_vis, |o| array_view(&o.visibility));
-        let buffers: [(u32, &wgpu::Buffer); 15] = [
+        let buffers: [(u32, &wgpu::Buffer); 16] = [
             (0, &f.globals),
             (1, &shadows.lights),
             (2, &f.vpls),
@@ -241,6 +241,7 @@ impl Shade {
             (16, lists.map_or(none, |b| &b.vpl_cluster)),
             (18, lc.map_or(none, |o| &o.clusters.light_cluster)),
             (20, vpl_lc.map_or(none, |o| &o.clusters.light_cluster)),
+            (22, level.map_or(none, |l| &l.sight_words)),
         ];
         let views: Vec<wgpu::TextureView> = targets
             .iter()

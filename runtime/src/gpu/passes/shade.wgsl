@@ -1,4 +1,4 @@
-//! include: globals.wgsl lights.wgsl vpl.wgsl gates.wgsl portals.wgsl fullscreen.wgsl
+//! include: globals.wgsl lights.wgsl vpl.wgsl gates.wgsl portals.wgsl sight.wgsl fullscreen.wgsl
 // Deferred shading: direct light from point and spot lights with shadow-map PCF (3 × 3), and
 // the indirect sum over VPLs without visibility (SHADE_ALL), through the gates of a baked
 // level per pixel (SHADE_GATES_PER_PIXEL) or by clustered light lists (SHADE_GATES_CLUSTERED),
@@ -54,6 +54,8 @@ struct GeometryCluster {
 // Portals walked in batches (fs_gates_indirect): the sum of the batches before, in the
 // (deinterleaved) layout of the indirect target.
 @group(0) @binding(21) var earlier_batches: texture_2d<f32>;
+// The level's open voxels and their bricks' clearance, for the voxel walk (sight.wgsl).
+@group(0) @binding(22) var<storage, read> sight_words: array<u32>;
 
 // SHADE_VPL_CLUSTERS: the VPLs first, first + step, … (every VPL, or an interleaving subset),
 // each shadowed by its cluster's PCSS visibility at px; the sum × step.
@@ -84,11 +86,26 @@ fn direct_visibility(i: u32, l: Light, p: vec3<f32>, n: vec3<f32>, px: vec2<i32>
     return shadow(l, p, n);
 }
 
+// The face's own normal at pixel px (the G-buffer's encode_face_normal).
+fn face_normal(px: vec2<i32>) -> vec3<f32> {
+    let e = vec2<f32>(textureLoad(g_normal, px, 0).w, textureLoad(g_albedo, px, 0).w);
+    return decode_face_normal(e);
+}
+
+// Whether VPL v's light reaches p (pixel px, cluster here) through the gates, the portals or
+// the voxels (GateLevel::visible; the voxel walk starts off p's face).
+fn lit_through(v: Vpl, px: vec2<i32>, p: vec3<f32>, here: u32) -> bool {
+    if grid.shape == GATE_VOXELS {
+        return voxel_sight(v.position, v.normal, p, face_normal(px));
+    }
+    return through_gates(v.position, cluster_at(v.position, v.normal), p, here);
+}
+
 fn through_gates(a: vec3<f32>, ca: u32, b: vec3<f32>, cb: u32) -> bool {
     if ca == cb || ca == NONE || cb == NONE {
         return true;
     }
-    if grid.shape == 1u {
+    if grid.shape == GATE_PORTALS {
         return portal_walk(a, ca, b, cb) == WALK_VISIBLE;
     }
     for (var i = cluster_gates[ca]; i < cluster_gates[ca + 1u]; i++) {
@@ -191,10 +208,10 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     if mode == SHADE_ALL {
         radiance += albedo / PI * gather_all(p, n);
     } else if mode == SHADE_GATES_PER_PIXEL {
-        radiance += albedo / PI * gather_per_pixel(p, n, decode_cluster(pos.w));
+        radiance += albedo / PI * gather_per_pixel(px, p, n, decode_cluster(pos.w));
     } else if mode == SHADE_VPL_CLUSTERS && globals.interleave_block <= 1u {
         radiance += albedo / PI * gather_vpl_clusters(p, n, px, 0u, 1u);
-    } else if mode == SHADE_GATES_CLUSTERED && globals.interleave_block <= 1u && grid.shape == 0u {
+    } else if mode == SHADE_GATES_CLUSTERED && globals.interleave_block <= 1u && grid.shape == GATE_DISKS {
         radiance += albedo / PI * clustered_gather(px, p, n, decode_cluster(pos.w), 0u);
     }
     return vec4<f32>(radiance, 1.0);
@@ -208,8 +225,8 @@ fn clustered_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, batch:
     let b = max(globals.interleave_block, 1u);
     let subsets = b * b;
     let j = interleave_subset(px, b);
-    if grid.shape == 1u {
-        return portal_gather(p, n, here, j, subsets, batch);
+    if grid.shape != GATE_DISKS {
+        return portal_gather(px, p, n, here, j, subsets, batch);
     }
     let width = textureDimensions(g_position).x;
     let gc = pixel_cluster[u32(px.x) + u32(px.y) * width];
@@ -249,12 +266,18 @@ fn clustered_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, batch:
     return sum * f32(subsets);
 }
 
-// Portals: the VPLs of subset j (VPL mod B = j), each walked from its cluster to p, × B; of
-// them, batch `batch` of globals.walk_batch (0: all in one).
-fn portal_gather(p: vec3<f32>, n: vec3<f32>, here: u32, j: u32, subsets: u32, batch: u32) -> vec3<f32> {
+// Portals or voxels: the VPLs of subset j (VPL mod B = j), each walked from its cluster to p
+// (portals) or through the open voxels (voxels), × B; of them, batch `batch` of
+// globals.walk_batch (0: all in one).
+fn portal_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, j: u32, subsets: u32, batch: u32) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
     var first = j;
     var end = globals.vpl_count;
+    // The voxel walk's end at p (off its face), the same for every VPL.
+    var at_p = vec4<f32>(0.0);
+    if grid.shape == GATE_VOXELS {
+        at_p = sight_end(p, face_normal(px));
+    }
     if globals.walk_batch > 0u {
         first = j + batch * globals.walk_batch * subsets;
         end = min(end, first + globals.walk_batch * subsets);
@@ -265,10 +288,17 @@ fn portal_gather(p: vec3<f32>, n: vec3<f32>, here: u32, j: u32, subsets: u32, ba
         if all(l == vec3<f32>(0.0)) {
             continue;
         }
-        let ca = vpl_cluster[k];
-        if ca != NONE && here != NONE && ca != here
-            && portal_walk(v.position, ca, p, here) != WALK_VISIBLE {
-            continue;
+        if grid.shape == GATE_VOXELS {
+            let at_v = sight_end(v.position, v.normal);
+            if at_v.w != 0.0 && at_p.w != 0.0 && !sight_clear(at_v.xyz, at_p.xyz) {
+                continue;
+            }
+        } else {
+            let ca = vpl_cluster[k];
+            if ca != NONE && here != NONE && ca != here
+                && portal_walk(v.position, ca, p, here) != WALK_VISIBLE {
+                continue;
+            }
         }
         sum += l;
     }
@@ -365,12 +395,12 @@ fn gather_all(p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
 }
 
 // SHADE_GATES_PER_PIXEL: every VPL through the gates, brute force.
-fn gather_per_pixel(p: vec3<f32>, n: vec3<f32>, here: u32) -> vec3<f32> {
+fn gather_per_pixel(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
     for (var j = 0u; j < globals.vpl_count; j++) {
         let v = vpls[j];
         let l = vpl_light(v, p, n, globals.g_max);
-        if any(l > vec3<f32>(0.0)) && through_gates(v.position, cluster_at(v.position, v.normal), p, here) {
+        if any(l > vec3<f32>(0.0)) && lit_through(v, px, p, here) {
             sum += l;
         }
     }

@@ -15,11 +15,16 @@ struct Grid {
     oversize: f32,
     // Gates a VPL's light may pass (1 or 2).
     max_hops: u32,
-    // 0: gate disks, 1: portals (walked).
+    // GATE_DISKS, GATE_PORTALS (walked) or GATE_VOXELS (the voxel walk).
     shape: u32,
     // Portals a walk may pass before it is given up.
     max_walk: u32,
 };
+
+// Grid.shape's values (runtime::cpu::gates::GateShape).
+const GATE_DISKS: u32 = 0u;
+const GATE_PORTALS: u32 = 1u;
+const GATE_VOXELS: u32 = 2u;
 
 fn cluster_of(p: vec3<f32>) -> u32 {
     let v = (p - grid.origin) / grid.voxel_size;
@@ -85,4 +90,22 @@ fn encode_cluster(c: u32) -> f32 {
 
 fn decode_cluster(w: f32) -> u32 {
     return u32(w - 1.0) - 1u;
+}
+
+// The G-buffer keeps the face's own normal (turned to the camera) octahedral-encoded in
+// normal.w and albedo.w: the voxel walk starts off the face, whatever the shading normal.
+fn encode_face_normal(n: vec3<f32>) -> vec2<f32> {
+    let p = n.xy / (abs(n.x) + abs(n.y) + abs(n.z));
+    if n.z < 0.0 {
+        return (1.0 - abs(p.yx)) * select(vec2<f32>(-1.0), vec2<f32>(1.0), p >= vec2<f32>(0.0));
+    }
+    return p;
+}
+
+fn decode_face_normal(e: vec2<f32>) -> vec3<f32> {
+    var n = vec3<f32>(e.x, e.y, 1.0 - abs(e.x) - abs(e.y));
+    let t = max(-n.z, 0.0);
+    n.x += select(t, -t, n.x >= 0.0);
+    n.y += select(t, -t, n.y >= 0.0);
+    return normalize(n);
 }

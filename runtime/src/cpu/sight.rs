@@ -1,0 +1,467 @@
+//! The voxel walk: whether the segment between a VPL and a surface point meets a wall, read
+//! from the level's open voxels (the voxels the bake's conservative voxelization left empty;
+//! `sight.wgsl` is the GPU twin).
+//!
+//! A segment that crosses only open voxels meets no triangle (a voxel any triangle touches is
+//! closed), so the walk is the portal walk with the portals at voxel resolution: it passes
+//! from cluster to cluster through the interface faces themselves, not through planes fitted
+//! to them, and it also meets what stands inside a cluster (a door panel, a table). It steps
+//! through the grid like a DDA, but jumps: the grid is cut into bricks of [`BRICK`]³ voxels,
+//! and each brick knows its chessboard distance, in bricks, to the nearest brick that holds a
+//! closed voxel; a brick `c` bricks clear sits in a cube of `2c − 1` bricks that holds none,
+//! so the walk crosses that cube in one step. Near walls it steps voxel by voxel. On the
+//! shared levels at 512 voxels a walk takes about 20 steps where the plain DDA takes 120–160.
+//!
+//! Each end starts off its own surface, whose closed voxels it lies in: at the first of
+//! [`END_OFFSETS_VOXELS`] along its normal that lands in an open voxel (a segment from a plane
+//! that starts √3 voxels off it never enters that plane's voxels again), else at the centre of
+//! the open voxel in front of the surface nearest to one voxel out (a point in a corner). An
+//! end with no open voxel near it is where the bake knows nothing: it is unoccluded, as a
+//! point outside every cluster is.
+
+use glam::{IVec3, Vec3};
+use visgate_formats::vgate::{GridMeta, VoxelBits};
+
+/// Voxels along a brick's side.
+pub const BRICK: i32 = 4;
+
+/// Offsets of a segment's end along its surface normal, tried in order: the first that lands
+/// in an open voxel is the end. [Units: voxels]
+pub const END_OFFSETS_VOXELS: [f32; 3] = [1.25, 2.25, 3.25];
+
+/// A level's open voxels and their bricks' clearance, ready for walks.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VoxelSight {
+    origin_m: Vec3,
+    voxel_m: f32,
+    dims: IVec3,
+    /// The open bits, 32 to a word (bit `i % 32` of word `i / 32`).
+    words: Vec<u32>,
+    /// Bricks per axis.
+    bricks: IVec3,
+    /// Per brick, the chessboard distance in bricks to the nearest brick that holds a closed
+    /// voxel (0: it holds one), at most 255; the grid's outside counts as closed.
+    clear: Vec<u8>,
+}
+
+/// `a` divided by `b`, rounded up.
+fn div_up(a: i32, b: i32) -> i32 {
+    (a + b - 1) / b
+}
+
+impl VoxelSight {
+    /// The walk over `open` (one bit per voxel of `grid`).
+    pub fn new(grid: &GridMeta, open: &VoxelBits) -> VoxelSight {
+        let dims = IVec3::from_array(grid.dims.map(|d| d as i32));
+        let words: Vec<u32> = open
+            .words()
+            .iter()
+            .flat_map(|&w| [w as u32, (w >> 32) as u32])
+            .take((open.len() as usize).div_ceil(32))
+            .collect();
+        let bricks = IVec3::new(
+            div_up(dims.x, BRICK),
+            div_up(dims.y, BRICK),
+            div_up(dims.z, BRICK),
+        );
+        // A brick that reaches past the grid's far side holds closed voxels there.
+        let mut closed: Vec<bool> = (0..bricks.x * bricks.y * bricks.z)
+            .map(|i| {
+                let b = IVec3::new(
+                    i % bricks.x,
+                    (i / bricks.x) % bricks.y,
+                    i / (bricks.x * bricks.y),
+                );
+                ((b + 1) * BRICK).cmpgt(dims).any()
+            })
+            .collect();
+        for i in 0..open.len() as usize {
+            if !open.get(i) {
+                let v = voxel_of(i, dims);
+                let b = v / BRICK;
+                closed[(b.x + bricks.x * (b.y + bricks.y * b.z)) as usize] = true;
+            }
+        }
+        VoxelSight {
+            origin_m: Vec3::from(grid.origin_m),
+            voxel_m: grid.voxel_size_m,
+            dims,
+            words,
+            bricks,
+            clear: chessboard(bricks, &closed),
+        }
+    }
+
+    /// Whether voxel `v` is open (false outside the grid).
+    #[inline]
+    pub fn open(&self, v: IVec3) -> bool {
+        if v.cmplt(IVec3::ZERO).any() || v.cmpge(self.dims).any() {
+            return false;
+        }
+        let i = (v.x + self.dims.x * (v.y + self.dims.y * v.z)) as usize;
+        (self.words[i / 32] >> (i % 32)) & 1 == 1
+    }
+
+    /// A brick's clearance ([`VoxelSight::clear`]'s field), 0 outside the brick grid.
+    fn brick_clear(&self, b: IVec3) -> i32 {
+        if b.cmplt(IVec3::ZERO).any() || b.cmpge(self.bricks).any() {
+            return 0;
+        }
+        i32::from(self.clear[(b.x + self.bricks.x * (b.y + self.bricks.y * b.z)) as usize])
+    }
+
+    /// Where the walk from or to surface point `p` (normal `n`) starts, in voxel coordinates
+    /// (the grid's minimum corner at 0, a voxel 1 wide); `None` with no open voxel near.
+    pub fn end(&self, p: Vec3, n: Vec3) -> Option<Vec3> {
+        let q = (p - self.origin_m) / self.voxel_m;
+        for k in END_OFFSETS_VOXELS {
+            let s = q + n * k;
+            if self.open(s.floor().as_ivec3()) {
+                return Some(s);
+            }
+        }
+        let out = q + n;
+        let base = out.floor().as_ivec3();
+        let mut best: Option<(f32, Vec3)> = None;
+        for dz in -1..=1 {
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    let v = base + IVec3::new(dx, dy, dz);
+                    let centre = v.as_vec3() + 0.5;
+                    let d2 = (centre - out).length_squared();
+                    if self.open(v)
+                        && (centre - q).dot(n) > 0.0
+                        && best.is_none_or(|(bd, _)| d2 < bd)
+                    {
+                        best = Some((d2, centre));
+                    }
+                }
+            }
+        }
+        best.map(|(_, c)| c)
+    }
+
+    /// Whether the segment from `a` to `b` (voxel coordinates, both in open voxels) crosses
+    /// open voxels alone: the brick march described in the module docs.
+    pub fn clear(&self, a: Vec3, b: Vec3) -> bool {
+        let d = b - a;
+        let end = b.floor().as_ivec3();
+        let mut v = a.floor().as_ivec3();
+        // Each step crosses a face along the segment, so a walk takes at most as many steps
+        // as the segment crosses voxel faces: at most the grid's dims summed, plus one.
+        let most = self.dims.x + self.dims.y + self.dims.z + 1;
+        for _ in 0..most {
+            let c = self.brick_clear(v.div_euclid(IVec3::splat(BRICK)));
+            let (lo, hi) = if c > 0 {
+                let b = v.div_euclid(IVec3::splat(BRICK));
+                ((b - (c - 1)) * BRICK, (b + c) * BRICK - 1)
+            } else if self.open(v) {
+                (v, v)
+            } else {
+                return false;
+            };
+            if v == end {
+                return true;
+            }
+            let (mut te, mut axis) = (f32::INFINITY, 0);
+            for k in 0..3 {
+                let face = if d[k] > 0.0 {
+                    (hi[k] + 1) as f32
+                } else if d[k] < 0.0 {
+                    lo[k] as f32
+                } else {
+                    continue;
+                };
+                let t = (face - a[k]) / d[k];
+                if t < te {
+                    (te, axis) = (t, k);
+                }
+            }
+            if te >= 1.0 {
+                return true;
+            }
+            let p = a + d * te;
+            for k in 0..3 {
+                v[k] = if k != axis {
+                    (p[k].floor() as i32).clamp(lo[k], hi[k])
+                } else if d[k] > 0.0 {
+                    hi[k] + 1
+                } else {
+                    lo[k] - 1
+                };
+            }
+        }
+        false
+    }
+
+    /// Whether light passes between surface points `a` (normal `na`) and `b` (normal `nb`):
+    /// the walk between their ends; unoccluded when either has no open voxel near.
+    pub fn visible(&self, a: Vec3, na: Vec3, b: Vec3, nb: Vec3) -> bool {
+        match (self.end(a, na), self.end(b, nb)) {
+            (Some(x), Some(y)) => self.clear(x, y),
+            _ => true,
+        }
+    }
+
+    /// The walk's tables packed into words for sight.wgsl: `[nx, ny, nz, bricks x, y, z, word
+    /// offset of the clearances, 0, origin x, y, z (m, f32 bits), voxel edge (m, f32 bits)]`,
+    /// the open bits (32 a word), then the bricks' clearances, four bytes a word
+    /// (little-endian).
+    pub fn words(&self) -> Vec<u32> {
+        let clear_at = SIGHT_HEADER_WORDS + self.words.len();
+        let mut w = Vec::with_capacity(clear_at + self.clear.len().div_ceil(4));
+        w.extend(self.dims.to_array().map(|x| x as u32));
+        w.extend(self.bricks.to_array().map(|x| x as u32));
+        w.extend([clear_at as u32, 0]);
+        w.extend(self.origin_m.to_array().map(f32::to_bits));
+        w.push(self.voxel_m.to_bits());
+        w.extend(&self.words);
+        w.extend(self.clear.chunks(4).map(|c| {
+            let mut b = [0u8; 4];
+            b[..c.len()].copy_from_slice(c);
+            u32::from_le_bytes(b)
+        }));
+        w
+    }
+}
+
+/// Words before the open bits in [`VoxelSight::words`].
+pub const SIGHT_HEADER_WORDS: usize = 12;
+
+/// Voxel `i` of a grid of `dims` (x fastest).
+fn voxel_of(i: usize, dims: IVec3) -> IVec3 {
+    let (nx, ny) = (dims.x as usize, dims.y as usize);
+    IVec3::new(
+        (i % nx) as i32,
+        ((i / nx) % ny) as i32,
+        (i / (nx * ny)) as i32,
+    )
+}
+
+/// The chessboard (L∞) distance of every cell of a grid of `dims` to the nearest `closed`
+/// cell or the grid's outside, at most 255: two passes of the 26-neighbour chamfer with unit
+/// weights, which is exact for this distance.
+fn chessboard(dims: IVec3, closed: &[bool]) -> Vec<u8> {
+    let mut d: Vec<u8> = closed
+        .iter()
+        .map(|&c| if c { 0 } else { u8::MAX })
+        .collect();
+    let idx = |v: IVec3| (v.x + dims.x * (v.y + dims.y * v.z)) as usize;
+    // The 13 neighbours that come before a cell in x-fastest order.
+    let mut before = Vec::with_capacity(13);
+    for dz in -1..=1 {
+        for dy in -1..=1 {
+            for dx in -1..=1 {
+                if (dz, dy, dx) < (0, 0, 0) {
+                    before.push(IVec3::new(dx, dy, dz));
+                }
+            }
+        }
+    }
+    let n = closed.len();
+    for pass in 0..2 {
+        for k in 0..n {
+            let i = if pass == 0 { k } else { n - 1 - k };
+            if d[i] == 0 {
+                continue;
+            }
+            let v = voxel_of(i, dims);
+            let mut m = d[i];
+            for &o in &before {
+                let u = if pass == 0 { v + o } else { v - o };
+                m = m.min(if u.cmplt(IVec3::ZERO).any() || u.cmpge(dims).any() {
+                    1
+                } else {
+                    d[idx(u)].saturating_add(1)
+                });
+            }
+            d[i] = m;
+        }
+    }
+    d
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn grid(dims: [u32; 3]) -> GridMeta {
+        GridMeta {
+            origin_m: [0.0; 3],
+            voxel_size_m: 1.0,
+            dims,
+        }
+    }
+
+    /// The plain DDA: every voxel the segment touches, in order.
+    fn dda_clear(s: &VoxelSight, a: Vec3, b: Vec3) -> bool {
+        let d = b - a;
+        let mut v = a.floor().as_ivec3();
+        let end = b.floor().as_ivec3();
+        let mut t_max = Vec3::INFINITY;
+        let mut t_delta = Vec3::INFINITY;
+        let mut step = IVec3::ZERO;
+        for k in 0..3 {
+            if d[k] != 0.0 {
+                step[k] = d[k].signum() as i32;
+                let face = if d[k] > 0.0 { v[k] + 1 } else { v[k] } as f32;
+                t_max[k] = (face - a[k]) / d[k];
+                t_delta[k] = 1.0 / d[k].abs();
+            }
+        }
+        loop {
+            if !s.open(v) {
+                return false;
+            }
+            if v == end {
+                return true;
+            }
+            let k = t_max.min_position();
+            if t_max[k] >= 1.0 {
+                return true;
+            }
+            v[k] += step[k];
+            t_max[k] += t_delta[k];
+        }
+    }
+
+    #[test]
+    fn chessboard_distance_is_exact_against_brute_force() {
+        let dims = IVec3::new(9, 7, 5);
+        let closed: Vec<bool> = (0..dims.x * dims.y * dims.z)
+            .map(|i| (i * 37 + 11) % 53 == 0)
+            .collect();
+        let d = chessboard(dims, &closed);
+        for (i, &got) in d.iter().enumerate() {
+            let v = voxel_of(i, dims);
+            let to_outside = (v + 1).min(dims - v).min_element();
+            let to_closed = (0..closed.len())
+                .filter(|&j| closed[j])
+                .map(|j| (voxel_of(j, dims) - v).abs().max_element())
+                .min()
+                .unwrap_or(i32::MAX);
+            assert_eq!(i32::from(got), to_outside.min(to_closed), "cell {v}");
+        }
+    }
+
+    #[test]
+    fn brick_march_agrees_with_the_plain_dda_on_random_levels() {
+        // Random boxes of closed voxels in a 40 × 23 × 31 grid (sizes not multiples of a
+        // brick), segments between random open voxels, some along axes and diagonals.
+        let dims = [40u32, 23, 31];
+        let mut seed = 0x2545_f491u32;
+        let mut rnd = move |n: u32| {
+            seed ^= seed << 13;
+            seed ^= seed >> 17;
+            seed ^= seed << 5;
+            seed % n
+        };
+        for level in 0..12 {
+            let mut open = vec![true; (dims[0] * dims[1] * dims[2]) as usize];
+            for _ in 0..(4 + level * 3) {
+                let lo = [rnd(dims[0]), rnd(dims[1]), rnd(dims[2])];
+                let size = [1 + rnd(6), 1 + rnd(9), 1 + rnd(4)];
+                for z in lo[2]..(lo[2] + size[2]).min(dims[2]) {
+                    for y in lo[1]..(lo[1] + size[1]).min(dims[1]) {
+                        for x in lo[0]..(lo[0] + size[0]).min(dims[0]) {
+                            open[(x + dims[0] * (y + dims[1] * z)) as usize] = false;
+                        }
+                    }
+                }
+            }
+            let bits = VoxelBits::from_fn(open.len(), |i| open[i]);
+            let s = VoxelSight::new(&grid(dims), &bits);
+            let mut pairs = 0;
+            while pairs < 400 {
+                let p = |r: &mut dyn FnMut(u32) -> u32| {
+                    Vec3::new(
+                        r(dims[0] * 64) as f32 / 64.0,
+                        r(dims[1] * 64) as f32 / 64.0,
+                        r(dims[2] * 64) as f32 / 64.0,
+                    )
+                };
+                let a = p(&mut rnd);
+                let mut b = p(&mut rnd);
+                match pairs % 5 {
+                    0 => b.y = a.y,
+                    1 => (b.y, b.z) = (a.y, a.z),
+                    2 => b = a + Vec3::splat(b.x - a.x) * Vec3::new(1.0, 0.5, 0.25),
+                    _ => {}
+                }
+                if !s.open(a.floor().as_ivec3()) || !s.open(b.floor().as_ivec3()) {
+                    continue;
+                }
+                pairs += 1;
+                assert_eq!(
+                    s.clear(a, b),
+                    dda_clear(&s, a, b),
+                    "level {level}: {a} → {b}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn a_wall_blocks_its_own_surface_does_not_and_an_opening_passes() {
+        // A room 20 voxels long, a wall one voxel thick at x = 10 with a hole at y, z in 4..6.
+        let dims = [20u32, 10, 10];
+        let open = VoxelBits::from_fn(2000, |i| {
+            let (x, y, z) = (i % 20, (i / 20) % 10, i / 200);
+            let border = x == 0 || y == 0 || z == 0 || x == 19 || y == 9 || z == 9;
+            let wall = x == 10 && !((4..6).contains(&y) && (4..6).contains(&z));
+            !border && !wall
+        });
+        let s = VoxelSight::new(&grid(dims), &open);
+        // Two floor points (the floor is the closed layer y = 0, its surface at y = 1).
+        let floor = |x: f32, z: f32| Vec3::new(x, 1.0, z);
+        assert!(!s.visible(floor(3.0, 5.0), Vec3::Y, floor(16.0, 5.0), Vec3::Y));
+        // Grazing along the floor, then up the far wall of the same side: clear.
+        assert!(s.visible(floor(2.0, 5.0), Vec3::Y, Vec3::new(9.0, 1.2, 5.0), -Vec3::X));
+        // Through the hole.
+        assert!(s.visible(
+            Vec3::new(1.0, 5.0, 5.0),
+            Vec3::X,
+            Vec3::new(19.0, 5.0, 5.0),
+            -Vec3::X
+        ));
+        // Beside it.
+        assert!(!s.visible(
+            Vec3::new(1.0, 2.5, 5.0),
+            Vec3::X,
+            Vec3::new(19.0, 2.5, 5.0),
+            -Vec3::X
+        ));
+        // An end on the wall's face starts 1.25 voxels out; one with no open voxel near knows
+        // nothing, so its light is unoccluded.
+        assert_eq!(
+            s.end(Vec3::new(10.0, 2.5, 5.0), -Vec3::X),
+            Some(Vec3::new(8.75, 2.5, 5.0))
+        );
+        assert_eq!(s.end(Vec3::new(-5.0, -5.0, -5.0), Vec3::X), None);
+        assert!(s.visible(
+            Vec3::new(-5.0, -5.0, -5.0),
+            Vec3::X,
+            floor(3.0, 5.0),
+            Vec3::Y
+        ));
+    }
+
+    #[test]
+    fn the_packed_words_hold_the_bits_and_the_clearances() {
+        let dims = [9u32, 5, 6];
+        let open = VoxelBits::from_fn(270, |i| i % 11 != 0);
+        let s = VoxelSight::new(&grid(dims), &open);
+        let w = s.words();
+        assert_eq!(&w[..6], &[9, 5, 6, 3, 2, 2]);
+        assert_eq!(&w[8..12], &[0.0f32, 0.0, 0.0, 1.0].map(f32::to_bits));
+        let at = w[6] as usize;
+        assert_eq!(at, SIGHT_HEADER_WORDS + 270usize.div_ceil(32));
+        for i in 0..270 {
+            let k = SIGHT_HEADER_WORDS + i / 32;
+            assert_eq!((w[k] >> (i % 32)) & 1 == 1, open.get(i));
+        }
+        for (k, &c) in s.clear.iter().enumerate() {
+            assert_eq!((w[at + k / 4] >> (8 * (k % 4))) & 0xff, u32::from(c));
+        }
+    }
+}
