@@ -97,10 +97,11 @@ fn ajar_door_portal_visibility_agrees_with_shadow_rays() {
             p.rate() > d.rate(),
             "camera {camera}: portals {p:?} disks {d:?}"
         );
-        // The voxel walk on the level's 256 sight grid (3.1 cm): measured 98.3, 96.6 and
-        // 99.7 %, almost every disagreement a pair the conservative voxels close (the door's
-        // 33 cm gap narrows by up to a voxel at each edge, the 5 cm slit above it by more).
-        let floor = [0.98, 0.96, 0.99][camera];
+        // The voxel walk on the level's 512 sight grid (1.6 cm): measured 98.8, 97.7 and
+        // 99.9 %, almost every disagreement a pair the conservative voxels close (the door's
+        // 33 cm gap narrows by up to a voxel at each edge, the 5 cm slit above it by more;
+        // on a 256 grid 98.3, 96.6 and 99.7 %).
+        let floor = [0.985, 0.975, 0.995][camera];
         assert!(v.rate() >= floor, "camera {camera}: {v:?}");
         assert!(
             v.rate() > p.rate(),
@@ -150,8 +151,8 @@ fn four_rooms_portal_visibility_agrees_with_shadow_rays_on_99_percent_of_pairs()
     print("four-rooms", 0, [&p, &d, &v]);
     assert!(p.pairs > 100_000, "{p:?}");
     assert!(p.rate() >= 0.99 && p.rate() > d.rate(), "{p:?} {d:?}");
-    // The voxels close a doorway's edges a voxel wide: 99.2 % (no false visible pair).
-    assert!(v.rate() >= 0.99, "{v:?}");
+    // The voxels close a doorway's edges a voxel wide: 99.35 % (56 false visible pairs).
+    assert!(v.rate() >= 0.99 && v.rate() > p.rate(), "{v:?} {p:?}");
 }
 
 #[test]
@@ -163,14 +164,14 @@ fn pillared_hall_portal_visibility_agrees_with_shadow_rays_past_the_columns() {
     // (78.0 and 76.9 % before; disks 84.6 and 96.8 %). What is left: from the part of a gap on
     // one side of its gate, a segment can reach the column's flank inside that side's cluster.
     let cameras = agreement(Builtin::PillaredHall, 128, &shapes());
-    // The voxel walk sees the columns themselves: 97.5 and 99.7 %.
+    // The voxel walk sees the columns themselves: 99.1 and 99.8 %.
     let floor = [0.85, 0.93];
     for (camera, found) in cameras.iter().enumerate() {
         let [p, d, v] = found[..] else { unreachable!() };
         print("pillared-hall", camera, [&p, &d, &v]);
         assert!(p.pairs > 10_000, "{p:?}");
         assert!(p.rate() >= floor[camera], "camera {camera}: {p:?}");
-        assert!(v.rate() >= [0.97, 0.99][camera], "camera {camera}: {v:?}");
+        assert!(v.rate() >= [0.99, 0.995][camera], "camera {camera}: {v:?}");
     }
 }
 

@@ -376,7 +376,7 @@ pub const PARTITION_PARTS: u32 = 128;
 
 /// The default sight voxel ([`BakeParams::sight_voxel_m`]) is at most 1/this of the level's
 /// longest extent: a level baked coarser still walks its openings on this many voxels.
-pub const SIGHT_PARTS: u32 = 256;
+pub const SIGHT_PARTS: u32 = 512;
 
 /// `params` with the minimum gap, the partition voxel and the sight voxel it leaves to the
 /// bake filled in (see [`MIN_GAP_PARTS`], [`PARTITION_PARTS`], [`SIGHT_PARTS`]) for a level of

@@ -100,7 +100,7 @@ pub struct BakeParams {
     /// Voxel edge of the open-voxel grid the voxel walk reads (a bit a voxel), when finer
     /// than the level's voxels: openings narrow by up to a voxel at each edge (the
     /// voxelization is conservative), so a finer grid passes more of the light that passes
-    /// there. 0 takes the level's grid. `None` asks the bake for the level's voxel or 1/256 of
+    /// there. 0 takes the level's grid. `None` asks the bake for the level's voxel or 1/512 of
     /// the level's longest extent, whichever is smaller; a baked file stores the value used.
     /// [Limit: [0, 10]] [Units: m]
     pub sight_voxel_m: Option<f32>,
