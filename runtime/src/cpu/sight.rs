@@ -19,7 +19,7 @@
 //! end with no open voxel near it is where the bake knows nothing: it is unoccluded, as a
 //! point outside every cluster is.
 
-use glam::{IVec3, Vec3};
+use glam::{BVec3, IVec3, Vec3};
 use visgate_formats::vgate::{GridMeta, VoxelBits};
 
 /// Voxels along a brick's side.
@@ -145,51 +145,48 @@ impl VoxelSight {
     /// open voxels alone: the brick march described in the module docs.
     pub fn clear(&self, a: Vec3, b: Vec3) -> bool {
         let d = b - a;
+        let (moves, up) = (d.cmpne(Vec3::ZERO), d.cmpgt(Vec3::ZERO));
+        // An axis the segment does not move along is never the one it leaves a cube across.
+        let inv = Vec3::select(moves, d.recip(), Vec3::ZERO);
         let end = b.floor().as_ivec3();
         let mut v = a.floor().as_ivec3();
         // Each step crosses a face along the segment, so a walk takes at most as many steps
         // as the segment crosses voxel faces: at most the grid's dims summed, plus one.
         let most = self.dims.x + self.dims.y + self.dims.z + 1;
         for _ in 0..most {
-            let c = self.brick_clear(v.div_euclid(IVec3::splat(BRICK)));
+            let brick = v.div_euclid(IVec3::splat(BRICK));
+            let c = self.brick_clear(brick);
             let (lo, hi) = if c > 0 {
-                let b = v.div_euclid(IVec3::splat(BRICK));
-                ((b - (c - 1)) * BRICK, (b + c) * BRICK - 1)
+                ((brick - (c - 1)) * BRICK, (brick + c) * BRICK - 1)
             } else if self.open(v) {
                 (v, v)
             } else {
                 return false;
             };
-            if v == end {
+            // The cube is open and convex: from where the segment entered it, a cube that
+            // holds the end holds the rest of the segment (said before any time is computed,
+            // whose rounding could take the walk past an end on the cube's face).
+            if end.cmpge(lo).all() && end.cmple(hi).all() {
                 return true;
             }
-            let (mut te, mut axis) = (f32::INFINITY, 0);
-            for k in 0..3 {
-                let face = if d[k] > 0.0 {
-                    (hi[k] + 1) as f32
-                } else if d[k] < 0.0 {
-                    lo[k] as f32
-                } else {
-                    continue;
-                };
-                let t = (face - a[k]) / d[k];
-                if t < te {
-                    (te, axis) = (t, k);
-                }
-            }
+            // The time the segment leaves the open cube [lo, hi] along each axis.
+            let face = Vec3::select(up, (hi + 1).as_vec3(), lo.as_vec3());
+            let t = Vec3::select(moves, (face - a) * inv, Vec3::INFINITY);
+            let te = t.min_element();
             if te >= 1.0 {
                 return true;
             }
-            let p = a + d * te;
-            for k in 0..3 {
-                v[k] = if k != axis {
-                    (p[k].floor() as i32).clamp(lo[k], hi[k])
-                } else if d[k] > 0.0 {
-                    hi[k] + 1
-                } else {
-                    lo[k] - 1
-                };
-            }
+            // It leaves across the first axis to reach that time (the lowest, on a tie), into
+            // the voxel beyond the face; on the other axes it stays within the cube.
+            let across = if t.x <= t.y && t.x <= t.z {
+                BVec3::new(true, false, false)
+            } else if t.y <= t.z {
+                BVec3::new(false, true, false)
+            } else {
+                BVec3::new(false, false, true)
+            };
+            let inside = (a + d * te).floor().as_ivec3().clamp(lo, hi);
+            v = IVec3::select(across, IVec3::select(up, hi + 1, lo - 1), inside);
         }
         false
     }

@@ -61,8 +61,9 @@ use passes::ism::Isms;
 use passes::light_cluster::LightCluster;
 use passes::per_vpl_maps::ParaboloidMaps;
 use passes::rsm_vpls::RsmVpls;
-use passes::shade::Shade;
+use passes::shade::{Gathers, Shade};
 use passes::shadow_maps::ShadowMaps;
+use passes::sight_ends::SightEnds;
 use passes::val_gather::{ValGathers, ValPasses};
 use passes::vals::ValClustering;
 use shaders::ShadeIndirect;
@@ -164,6 +165,7 @@ pub struct Pipelines {
     light_cluster: LightCluster,
     isms: Isms,
     display: Display,
+    sight_ends: SightEnds,
 }
 
 impl Pipelines {
@@ -182,6 +184,7 @@ impl Pipelines {
             light_cluster: LightCluster::new(d, s)?,
             isms: Isms::new(d, s)?,
             display: Display::new(d, s)?,
+            sight_ends: SightEnds::new(d, s)?,
         })
     }
 }
@@ -237,16 +240,20 @@ fn record_passes(
         GpuMode::VplClusters(vp, _) => Some(p.light_cluster.record_vpls(f, vp, &g, pool, rec)?),
         _ => None,
     };
-    // The voxel walk needs no geometry clusters, lists or VPL clusters: only the level.
-    let lists = match &f.params.mode {
+    // The voxel walk needs no geometry clusters, lists or VPL clusters: the VPLs' ends.
+    let (lists, vpl_ends) = match &f.params.mode {
         GpuMode::Gates(gp) if gp.gates.shape == GateShape::Voxels => {
-            f.scene.level.as_ref().ok_or_else(|| {
+            let level = f.scene.level.as_ref().ok_or_else(|| {
                 RenderError::Param("mode gates needs a baked level (GpuRenderer::set_level)".into())
             })?;
-            None
+            let ends = p.sight_ends.record(f, &level.sight_words, pool, rec)?;
+            (None, Some(ends))
         }
-        GpuMode::Gates(gp) => Some(p.clustered.record(f, gp, pool, rec, &g.views[0])?),
-        _ => None,
+        GpuMode::Gates(gp) => (
+            Some(p.clustered.record(f, gp, pool, rec, &g.views[0])?),
+            None,
+        ),
+        _ => (None, None),
     };
     let shading = match f.params.mode {
         GpuMode::Gates(gp) if gp.gathers_apart() => "shading: direct lighting",
@@ -257,7 +264,11 @@ fn record_passes(
         | GpuMode::VplClusters(..) => "shading: direct + indirect lighting",
         _ => "shading: direct lighting",
     };
-    let inputs = (&shadows, &g, lists.as_ref(), lc.as_ref(), vpl_lc.as_ref());
+    let gathers = Gathers {
+        lists: lists.as_ref(),
+        vpl_ends: vpl_ends.as_ref(),
+    };
+    let inputs = (&shadows, &g, gathers, lc.as_ref(), vpl_lc.as_ref());
     let hdr = p.shade.record(f, pool, rec, inputs, shading);
     let mut val_state = None;
     match &f.params.mode {

@@ -33,10 +33,11 @@ const INCLUDES: [(&str, &str); 12] = [
 ];
 
 /// The pass shaders (`gpu/passes/`), before composition.
-pub const SOURCES: [(&str, &str); 16] = [
+pub const SOURCES: [(&str, &str); 17] = [
     ("gbuffer.wgsl", include_str!("passes/gbuffer.wgsl")),
     ("shadow.wgsl", include_str!("passes/shadow.wgsl")),
     ("shade.wgsl", include_str!("passes/shade.wgsl")),
+    ("sight_ends.wgsl", include_str!("passes/sight_ends.wgsl")),
     ("rsm_vpls.wgsl", include_str!("passes/rsm_vpls.wgsl")),
     ("vpl_shadow.wgsl", include_str!("passes/vpl_shadow.wgsl")),
     (

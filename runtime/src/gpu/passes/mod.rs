@@ -14,5 +14,6 @@ pub mod per_vpl_maps;
 pub mod rsm_vpls;
 pub mod shade;
 pub mod shadow_maps;
+pub mod sight_ends;
 pub mod val_gather;
 pub mod vals;

@@ -80,22 +80,32 @@ pub fn frame_target(f: &Frame, pool: &mut Pool, label: &'static str) -> wgpu::Te
     )
 }
 
-/// What shading reads: the lights (and their maps), the G-buffer, mode gates' light lists,
+/// What shading reads: the lights (and their maps), the G-buffer, mode gates' gather inputs,
 /// LightCluster's visibility.
 pub type Inputs<'a> = (
     &'a ShadowOutput,
     &'a GBufferOutput,
-    Option<&'a ListBuffers>,
+    Gathers<'a>,
     Option<&'a LcOutput>,
     Option<&'a LcOutput>,
 );
 
+/// What mode gates' gather reads beside the level: the light lists (disks; portals' VPL
+/// clusters) or each VPL's end of the voxel walk (voxels).
+#[derive(Clone, Copy, Default)]
+pub struct Gathers<'a> {
+    /// The clustered passes' lists.
+    pub lists: Option<&'a ListBuffers>,
+    /// [`super::sight_ends`]'s output.
+    pub vpl_ends: Option<&'a wgpu::Buffer>,
+}
+
 /// The bindings of shade.wgsl's `fs_gates_indirect` (an automatic layout holds only what an
 /// entry point uses).
-const GATES_INDIRECT_BINDINGS: [u32; 14] = [0, 2, 5, 6, 7, 8, 10, 12, 13, 14, 15, 16, 21, 22];
+const GATES_INDIRECT_BINDINGS: [u32; 15] = [0, 2, 5, 6, 7, 8, 10, 12, 13, 14, 15, 16, 21, 22, 23];
 /// The bindings of shade.wgsl's `fs`: all but the batches' sum.
-const SHADE_BINDINGS: [u32; 22] = [
-    0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20, 22,
+const SHADE_BINDINGS: [u32; 23] = [
+    0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20, 22, 23,
 ];
 /// The bindings of shade.wgsl's `fs_vpl_clusters_indirect`.
 const VPL_CLUSTERS_INDIRECT_BINDINGS: [u32; 6] = [0, 2, 5, 6, 19, 20];
@@ -213,19 +223,20 @@ impl Shade {
         &self,
         f: &Frame,
         rec: &mut Recorder,
-        (shadows, g, lists, lc, vpl_lc): Inputs,
+        (shadows, g, gathers, lc, vpl_lc): Inputs,
         (pipeline, used): (&wgpu::RenderPipeline, Option<&[u32]>),
         (targets, name): (&[wgpu::Texture], &'static str),
         batches: u32,
     ) {
         let d = &f.ctx.device;
         let level = f.scene.level.as_ref();
+        let lists = gathers.lists;
         let none = &f.scene.no_level;
         let maps = array_view(&shadows.maps);
         let no_vis = array_view(&f.scene.no_visibility);
         let vis = lc.map_or_else(|| no_vis.clone(), |o| array_view(&o.visibility));
         let vpl_vis = vpl_lc.map_or(no_vis, |o| array_view(&o.visibility));
-        let buffers: [(u32, &wgpu::Buffer); 16] = [
+        let buffers: [(u32, &wgpu::Buffer); 17] = [
             (0, &f.globals),
             (1, &shadows.lights),
             (2, &f.vpls),
@@ -242,6 +253,7 @@ impl Shade {
             (18, lc.map_or(none, |o| &o.clusters.light_cluster)),
             (20, vpl_lc.map_or(none, |o| &o.clusters.light_cluster)),
             (22, level.map_or(none, |l| &l.sight_words)),
+            (23, gathers.vpl_ends.unwrap_or(none)),
         ];
         let views: Vec<wgpu::TextureView> = targets
             .iter()

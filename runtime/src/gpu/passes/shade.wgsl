@@ -56,6 +56,8 @@ struct GeometryCluster {
 @group(0) @binding(21) var earlier_batches: texture_2d<f32>;
 // The level's open voxels and their bricks' clearance, for the voxel walk (sight.wgsl).
 @group(0) @binding(22) var<storage, read> sight_words: array<u32>;
+// Each VPL's end of the voxel walk (sight_ends.wgsl), for fs_gates_indirect.
+@group(0) @binding(23) var<storage, read> vpl_ends: array<vec4<f32>>;
 
 // SHADE_VPL_CLUSTERS: the VPLs first, first + step, … (every VPL, or an interleaving subset),
 // each shadowed by its cluster's PCSS visibility at px; the sum × step.
@@ -289,7 +291,7 @@ fn portal_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, j: u32, s
             continue;
         }
         if grid.shape == GATE_VOXELS {
-            let at_v = sight_end(v.position, v.normal);
+            let at_v = vpl_ends[k];
             if at_v.w != 0.0 && at_p.w != 0.0 && !sight_clear(at_v.xyz, at_p.xyz) {
                 continue;
             }

@@ -66,60 +66,53 @@ fn sight_end(p: vec3<f32>, n: vec3<f32>) -> vec4<f32> {
 }
 
 // Whether the segment a → b (voxel coordinates, both in open voxels) crosses open voxels alone
-// (VoxelSight::clear).
+// (VoxelSight::clear, step for step).
 fn sight_clear(a: vec3<f32>, b: vec3<f32>) -> bool {
     let d = b - a;
+    let moves = d != vec3<f32>(0.0);
+    let up = d > vec3<f32>(0.0);
+    let inv = select(vec3<f32>(0.0), 1.0 / select(vec3<f32>(1.0), d, moves), moves);
     let end = vec3<i32>(floor(b));
     var v = vec3<i32>(floor(a));
     let dims = sight_dims();
+    let bricks = vec3<i32>(i32(sight_words[3]), i32(sight_words[4]), i32(sight_words[5]));
+    let clear_at = sight_words[6];
     let most = dims.x + dims.y + dims.z + 1;
     for (var step = 0; step < most; step++) {
         if any(v < vec3<i32>(0)) || any(v >= dims) {
             return false;
         }
-        let c = sight_brick(v / SIGHT_BRICK);
+        let brick = v / SIGHT_BRICK;
+        let k = u32(brick.x + bricks.x * (brick.y + bricks.y * brick.z));
+        let c = i32((sight_words[clear_at + k / 4u] >> (8u * (k % 4u))) & 0xffu);
         var lo = v;
         var hi = v;
         if c > 0 {
-            let bb = v / SIGHT_BRICK;
-            lo = (bb - (c - 1)) * SIGHT_BRICK;
-            hi = (bb + c) * SIGHT_BRICK - 1;
-        } else if !sight_open(v) {
-            return false;
+            lo = (brick - (c - 1)) * SIGHT_BRICK;
+            hi = (brick + c) * SIGHT_BRICK - 1;
+        } else {
+            let i = u32(v.x + dims.x * (v.y + dims.y * v.z));
+            if ((sight_words[SIGHT_BITS + i / 32u] >> (i % 32u)) & 1u) == 0u {
+                return false;
+            }
         }
-        if all(v == end) {
+        if all(end >= lo) && all(end <= hi) {
             return true;
         }
-        var te = 3.4e38;
-        var axis = 0;
-        for (var k = 0; k < 3; k++) {
-            var face: f32;
-            if d[k] > 0.0 {
-                face = f32(hi[k] + 1);
-            } else if d[k] < 0.0 {
-                face = f32(lo[k]);
-            } else {
-                continue;
-            }
-            let t = (face - a[k]) / d[k];
-            if t < te {
-                te = t;
-                axis = k;
-            }
-        }
+        let face = select(vec3<f32>(lo), vec3<f32>(hi + 1), up);
+        let t = select(vec3<f32>(3.4e38), (face - a) * inv, moves);
+        let te = min(t.x, min(t.y, t.z));
         if te >= 1.0 {
             return true;
         }
-        let p = a + d * te;
-        for (var k = 0; k < 3; k++) {
-            if k != axis {
-                v[k] = clamp(i32(floor(p[k])), lo[k], hi[k]);
-            } else if d[k] > 0.0 {
-                v[k] = hi[k] + 1;
-            } else {
-                v[k] = lo[k] - 1;
-            }
+        var across = vec3<bool>(false, false, true);
+        if t.x <= t.y && t.x <= t.z {
+            across = vec3<bool>(true, false, false);
+        } else if t.y <= t.z {
+            across = vec3<bool>(false, true, false);
         }
+        let inside = clamp(vec3<i32>(floor(a + d * te)), lo, hi);
+        v = select(inside, select(lo - 1, hi + 1, up), across);
     }
     return false;
 }

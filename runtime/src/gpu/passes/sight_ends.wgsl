@@ -1,0 +1,17 @@
+//! include: vpl.wgsl sight.wgsl
+// Each VPL's end of the voxel walk (sight.wgsl's sight_end), once a frame: mode gates with
+// voxels reads them for every pixel's walks instead of finding each VPL's end again
+// (shade.wgsl's portal_gather; runtime::cpu::sight::VoxelSight::end is the CPU twin).
+
+@group(0) @binding(0) var<storage, read> vpls: array<Vpl>;
+@group(0) @binding(1) var<storage, read> sight_words: array<u32>;
+// xyz: the end in the sight grid's voxel coordinates; w: 1, or 0 where no open voxel is near.
+@group(0) @binding(2) var<storage, read_write> vpl_ends: array<vec4<f32>>;
+
+@compute @workgroup_size(WG_LINEAR)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if id.x < min(arrayLength(&vpls), arrayLength(&vpl_ends)) {
+        let v = vpls[id.x];
+        vpl_ends[id.x] = sight_end(v.position, v.normal);
+    }
+}
