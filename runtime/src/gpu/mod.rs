@@ -14,7 +14,8 @@
 //! 3. the G-buffer ([`passes::gbuffer`]); with `--direct lightcluster`, LightCluster's light
 //!    culling, clustering, cluster shadow maps and PCSS visibility ([`passes::light_cluster`]),
 //!    and in mode `vpl-clusters` the same over the VPLs;
-//! 4. mode `gates`: unique clusters and light assignment ([`passes::clustered_gates`]);
+//! 4. mode `gates`: unique clusters and light assignment ([`passes::clustered_gates`]), or with
+//!    the voxel walk each VPL's walk end ([`passes::sight_ends`]);
 //! 5. shading: direct light, and the indirect light of modes `none` and the gate modes
 //!    ([`passes::shade`]);
 //! 6. mode `per-vpl-shadow-maps`: maps and gather per batch ([`passes::per_vpl_maps`]); the VAL

@@ -23,16 +23,6 @@ fn sight_open(v: vec3<i32>) -> bool {
     return ((sight_words[SIGHT_BITS + i / 32u] >> (i % 32u)) & 1u) == 1u;
 }
 
-// Brick b's clearance, 0 outside the brick grid.
-fn sight_brick(b: vec3<i32>) -> i32 {
-    let bricks = vec3<i32>(i32(sight_words[3]), i32(sight_words[4]), i32(sight_words[5]));
-    if any(b < vec3<i32>(0)) || any(b >= bricks) {
-        return 0;
-    }
-    let k = u32(b.x + bricks.x * (b.y + bricks.y * b.z));
-    return i32((sight_words[sight_words[6] + k / 4u] >> (8u * (k % 4u))) & 0xffu);
-}
-
 // Where the walk from or to surface point p (normal n) starts, in voxel coordinates; w = 0:
 // no open voxel near (VoxelSight::end).
 fn sight_end(p: vec3<f32>, n: vec3<f32>) -> vec4<f32> {
