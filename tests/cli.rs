@@ -514,6 +514,11 @@ fn bake_refuses_bad_arguments_clearly() {
             "11",
             "smallest cluster ball 11 m must be in 0..=10",
         ),
+        (
+            "--sight-voxel",
+            "-1",
+            "sight voxel -1 m must be in 0..=10 (0 walks the level's own grid)",
+        ),
     ] {
         let arg = format!("{flag}={value}");
         let o = visgate(&["bake", "builtin:two-rooms", "-o", out, &arg]);
@@ -742,6 +747,16 @@ fn render_gates_uses_a_baked_level_and_refuses_a_missing_or_stale_one() {
     brute.push("--cpu");
     let o = visgate(&brute);
     assert!(stderr(&o).contains("--mode gates --cpu"), "{}", stderr(&o));
+    // The voxel walk: no clusters or lists, each VPL's end, on the GPU and its CPU twin.
+    let mut voxels = a.clone();
+    voxels.extend(["--gate-shape", "voxels"]);
+    let o = visgate(&voxels);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(stdout(&o).contains("VPL walk ends"), "{}", stdout(&o));
+    assert!(!stdout(&o).contains("unique clusters"), "{}", stdout(&o));
+    voxels.push("--cpu");
+    let o = visgate(&voxels);
+    assert!(o.status.success(), "{}", stderr(&o));
     a.push("--cpu");
     let o = visgate(&a);
     assert!(o.status.success(), "{}", stderr(&o));
