@@ -129,6 +129,8 @@ pub fn constants() -> String {
     s += "const LIGHT_POINT: f32 = 0.0;\nconst LIGHT_SPOT: f32 = 1.0;\n";
     s += &format!("const CSSM_DEPTH_SCALE: f32 = {CSSM_DEPTH_SCALE:?};\n");
     s += &format!("const CSSM_EMPTY_DEPTH: f32 = {CSSM_EMPTY_DEPTH:?};\n");
+    s += &format!("const SIGHT_BRICK: i32 = {};\n", crate::cpu::sight::BRICK);
+    s += &u("SIGHT_BITS", crate::cpu::sight::SIGHT_HEADER_WORDS as u32);
     s += &u(
         "PORTAL_RECORD",
         crate::cpu::portal_walk::PORTAL_RECORD_WORDS,

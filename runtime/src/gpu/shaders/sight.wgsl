@@ -1,13 +1,12 @@
 // The voxel walk (runtime::cpu::sight::VoxelSight is its CPU twin): whether the segment between
 // a VPL and a surface point crosses open voxels alone. It reads the including pass's
 // `sight_words: array<u32>` (VoxelSight::words: [nx, ny, nz, bricks x, y, z, offset of the
-// clearances, 0, origin xyz (m), voxel edge (m)], the open bits 32 a word, then each 4³ brick's
+// clearances, 0, origin xyz (m), voxel edge (m)], the open bits 32 a word, then each brick's
 // chessboard distance in bricks to the nearest brick holding a closed voxel, a byte each). A
 // step crosses the cube of bricks that a brick's clearance proves open, or one open voxel.
 
-const SIGHT_BRICK: i32 = 4;
-// VoxelSight's SIGHT_HEADER_WORDS.
-const SIGHT_BITS: u32 = 12u;
+// SIGHT_BRICK (voxels along a brick's side) and SIGHT_BITS (VoxelSight's header words) are
+// injected from runtime::cpu::sight.
 
 fn sight_dims() -> vec3<i32> {
     return vec3<i32>(i32(sight_words[0]), i32(sight_words[1]), i32(sight_words[2]));
