@@ -131,15 +131,15 @@ impl LevelBuffers {
                 MAX_CLUSTERS
             )));
         }
-        for (what, words) in [
-            ("voxel→cluster grid", &t.voxel_words),
-            ("open voxels' grid", &t.sight_words),
+        for (what, words, fix) in [
+            ("voxel→cluster grid", &t.voxel_words, ""),
+            ("open voxels' grid", &t.sight_words, " or a coarser --sight-voxel"),
         ] {
             let bytes = (words.len() * 4) as u64;
             if bytes > d.limits().max_storage_buffer_binding_size {
                 return Err(RenderError::Param(format!(
                     "the {what} needs {bytes} bytes, more than the adapter's storage binding \
-                     limit {}: bake at a lower resolution",
+                     limit {}: bake at a lower resolution{fix}",
                     d.limits().max_storage_buffer_binding_size
                 )));
             }
