@@ -133,7 +133,11 @@ impl LevelBuffers {
         }
         for (what, words, fix) in [
             ("voxel→cluster grid", &t.voxel_words, ""),
-            ("open voxels' grid", &t.sight_words, " or a coarser --sight-voxel"),
+            (
+                "open voxels' grid",
+                &t.sight_words,
+                " or a coarser --sight-voxel",
+            ),
         ] {
             let bytes = (words.len() * 4) as u64;
             if bytes > d.limits().max_storage_buffer_binding_size {
