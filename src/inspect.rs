@@ -275,8 +275,8 @@ fn inspect_baked(path: &Path, json: bool) -> Result<()> {
     );
     let sg = &level.info.sight_grid;
     println!(
-        "sight grid  {} x {} x {} voxels of {} m: {} left open by the voxelization (the voxel \
-         walk's grid, a bit each)",
+        "sight grid  {} x {} x {} voxels of {} m: {} left open by its thin voxelization \
+         (the voxel walk's grid, a bit each)",
         sg.dims[0], sg.dims[1], sg.dims[2], sg.voxel_size_m, s.open_voxels
     );
     println!("read time   {:.3} s", s.read_seconds);

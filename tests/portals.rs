@@ -97,11 +97,12 @@ fn ajar_door_portal_visibility_agrees_with_shadow_rays() {
             p.rate() > d.rate(),
             "camera {camera}: portals {p:?} disks {d:?}"
         );
-        // The voxel walk on the level's 512 sight grid (1.6 cm): measured 98.8, 97.7 and
-        // 99.9 %, almost every disagreement a pair the conservative voxels close (the door's
-        // 33 cm gap narrows by up to a voxel at each edge, the 5 cm slit above it by more;
-        // on a 256 grid 98.3, 96.6 and 99.7 %).
-        let floor = [0.985, 0.975, 0.995][camera];
+        // The voxel walk on the level's 512 sight grid (1.6 cm), voxelized thin: measured
+        // 99.14, 98.29 and 99.90 %, almost every disagreement a pair the voxels close (the
+        // door's 33 cm gap narrows by under half a voxel at each edge, the 5 cm slit above it
+        // by more). The conservative voxelization gave 98.84, 97.69 and 99.85 %, under these
+        // floors on every camera.
+        let floor = [0.99, 0.98, 0.9987][camera];
         assert!(v.rate() >= floor, "camera {camera}: {v:?}");
         assert!(
             v.rate() > p.rate(),

@@ -241,7 +241,7 @@ pub fn bake(
     })?;
     let mut params = level_scaled(params, input.bounds, meta.voxel_size_m);
     let (sight_grid, open) = cx.stage("sight grid", 0, |_| {
-        sight_grid(&input, (&meta, &solid), &params, options)
+        sight_grid(&input, &meta, &params, options)
     })?;
     let es = cx.stage("empty space", 0, |_| {
         stages::empty(scene, &meta, &solid.solid, &input.triangles, &params)
@@ -403,26 +403,25 @@ fn level_scaled(params: &BakeParams, bounds: (glam::Vec3, glam::Vec3), voxel_m: 
     }
 }
 
-/// The sight grid ([`BakeParams::sight_voxel_m`], filled in) and its open voxels: the level's
-/// grid and its voxelization, or the level's bounds voxelized again at the finer sight voxel.
+/// The sight grid ([`BakeParams::sight_voxel_m`], filled in: the level's grid, or its bounds at
+/// the finer sight voxel) and its open voxels, voxelized thin ([`crate::separating`]).
 fn sight_grid(
     input: &stages::Loaded,
-    (meta, solid): (&GridMeta, &SolidGrid),
+    meta: &GridMeta,
     params: &BakeParams,
     options: &BakeOptions,
 ) -> Result<((GridMeta, VoxelBits), SightCounts), BakeError> {
     let size = params.sight_voxel_m.unwrap_or(meta.voxel_size_m);
-    let open = |s: &SolidGrid| VoxelBits::from_fn(s.solid.len(), |i| !s.solid[i]);
-    let (grid, bits) = if size < 0.99 * meta.voxel_size_m {
-        let sm = grid_for(
+    let grid = if size < 0.99 * meta.voxel_size_m {
+        grid_for(
             input.bounds,
             Resolution::VoxelSizeM(size),
             options.memory_limit_bytes,
-        )?;
-        (sm, open(&voxelize(sm, &input.triangles)))
+        )?
     } else {
-        (*meta, open(solid))
+        *meta
     };
+    let bits = crate::separating::open_voxels(grid, &input.triangles);
     let counts = SightCounts {
         dims: grid.dims,
         voxel_size_m: grid.voxel_size_m,

@@ -33,6 +33,7 @@ pub mod portals;
 pub mod refine;
 pub mod report;
 pub mod segment;
+pub mod separating;
 pub mod sightline;
 pub mod simplify;
 pub mod stages;

@@ -24,6 +24,19 @@ impl VoxelBits {
         }
     }
 
+    /// `len` bits from whole words (bit `i % 64` of word `i / 64`), the bits past the last
+    /// cleared. Panics unless there are `len.div_ceil(64)` words.
+    pub fn from_words(len: usize, mut words: Vec<u64>) -> VoxelBits {
+        assert_eq!(words.len(), len.div_ceil(64), "words for {len} bits");
+        if let (Some(last), tail @ 1..) = (words.last_mut(), len % 64) {
+            *last &= (1u64 << tail) - 1;
+        }
+        VoxelBits {
+            len: len as u64,
+            words,
+        }
+    }
+
     /// Number of bits (voxels).
     pub fn len(&self) -> u64 {
         self.len
@@ -101,5 +114,14 @@ mod tests {
         }
         let b = VoxelBits::from_fn(130, |i| i < 100);
         assert_eq!(b.count_ones(), 100);
+    }
+
+    #[test]
+    fn bits_from_whole_words_clear_what_lies_past_the_last() {
+        for len in [1usize, 63, 64, 65, 130] {
+            let b = VoxelBits::from_words(len, vec![u64::MAX; len.div_ceil(64)]);
+            assert_eq!(b, VoxelBits::from_fn(len, |_| true), "{len}");
+            assert_eq!(b.count_ones(), len as u64);
+        }
     }
 }

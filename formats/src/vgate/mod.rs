@@ -14,7 +14,8 @@
 //!                       voxel_cluster little-endian blob, one element per voxel (x fastest),
 //!                                     or, where smaller, its runs: (u32 LE length, element)
 //!                       open_voxels   a bit per voxel of the sight grid (x fastest), 1 = open
-//!                                     (not solid), u64 LE words (format 6)
+//!                                     (no triangle crosses its centre segments), u64 LE
+//!                                     words (format 6)
 //! ```
 //!
 //! The grid is stored in the smallest unsigned type (u8, u16, u32) that holds its largest
@@ -254,8 +255,10 @@ pub struct BakedLevel {
     pub topology: Topology,
     /// Visibility cluster of every voxel; [`NONE`] where no surface or VPL can be.
     pub voxel_cluster: VoxelValues,
-    /// The voxels the voxelization left open (not solid) on [`BakeInfo::sight_grid`], for the
-    /// voxel walk: a segment through open voxels alone meets no wall (format 6).
+    /// The open voxels of [`BakeInfo::sight_grid`], for the voxel walk: no triangle crosses
+    /// their centre segments (the bake's thin voxelization), so a walk through open voxels
+    /// alone passes through no wall (format 6; files baked before the thin voxelization hold
+    /// the conservative one's, which the walk reads the same way).
     pub open: VoxelBits,
 }
 

@@ -1,9 +1,11 @@
 //! The voxel walk: whether the segment between a VPL and a surface point meets a wall, read
-//! from the level's open voxels (the voxels the bake's conservative voxelization left empty;
-//! `sight.wgsl` is the GPU twin).
+//! from the level's open voxels (the sight grid, voxelized thin by the bake:
+//! `visgate_preprocess::separating`; `sight.wgsl` is the GPU twin).
 //!
-//! A segment that crosses only open voxels meets no triangle (a voxel any triangle touches is
-//! closed), so the walk is the portal walk with the portals at voxel resolution: it passes
+//! A voxel is closed when a triangle crosses one of its three centre segments, so no path of
+//! voxels joined by faces — which is what the walk steps through — passes through a watertight
+//! surface, and a plane closes one voxel a column (it may graze a triangle's edge by less than
+//! a voxel). So the walk is the portal walk with the portals at voxel resolution: it passes
 //! from cluster to cluster through the interface faces themselves, not through planes fitted
 //! to them, and it also meets what stands inside a cluster (a door panel, a table). It steps
 //! through the grid like a DDA, but jumps: the grid is cut into bricks of [`BRICK`]³ voxels,
@@ -13,7 +15,7 @@
 //! shared levels at 512 voxels a walk took about 20 steps with 4³ bricks where the plain DDA
 //! takes 120–160.
 //!
-//! Each end starts off its own surface, whose closed voxels it lies in: at the first of
+//! Each end starts off its own surface, whose closed voxels it may lie in: at the first of
 //! [`END_OFFSETS_VOXELS`] along its normal that lands in an open voxel (a segment from a plane
 //! that starts √3 voxels off it never enters that plane's voxels again), else at the centre of
 //! the open voxel in front of the surface nearest to one voxel out (a point in a corner). An
