@@ -162,11 +162,30 @@ pub fn render_pipeline(
     d: &wgpu::Device,
     label: &str,
     module: &wgpu::ShaderModule,
-    (vertex, fragment): (&str, &str),
+    entries: (&str, &str),
     buffers: &[Option<wgpu::VertexBufferLayout>],
     targets: &[wgpu::TextureFormat],
     depth: Option<wgpu::CompareFunction>,
 ) -> wgpu::RenderPipeline {
+    let fixed = (targets, depth);
+    render_pipeline_with(d, label, module, entries, buffers, fixed, &[])
+}
+
+/// [`render_pipeline`] with the shader's pipeline-overridable `constants` set (WGSL
+/// `override`s, by name): a branch on one is decided when the pipeline is compiled.
+pub fn render_pipeline_with(
+    d: &wgpu::Device,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    (vertex, fragment): (&str, &str),
+    buffers: &[Option<wgpu::VertexBufferLayout>],
+    (targets, depth): (&[wgpu::TextureFormat], Option<wgpu::CompareFunction>),
+    constants: &[(&str, f64)],
+) -> wgpu::RenderPipeline {
+    let compilation_options = wgpu::PipelineCompilationOptions {
+        constants,
+        ..Default::default()
+    };
     let targets: Vec<Option<wgpu::ColorTargetState>> = targets
         .iter()
         .map(|&format| {
@@ -184,7 +203,7 @@ pub fn render_pipeline(
             module,
             entry_point: Some(vertex),
             buffers,
-            compilation_options: Default::default(),
+            compilation_options: compilation_options.clone(),
         },
         primitive: wgpu::PrimitiveState::default(),
         depth_stencil: depth.map(|compare| wgpu::DepthStencilState {
@@ -199,7 +218,7 @@ pub fn render_pipeline(
             module,
             entry_point: Some(fragment),
             targets: &targets,
-            compilation_options: Default::default(),
+            compilation_options: compilation_options.clone(),
         }),
         multiview_mask: None,
         cache: None,

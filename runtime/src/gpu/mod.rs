@@ -274,12 +274,14 @@ fn record_passes(
     let mut val_state = None;
     match &f.params.mode {
         GpuMode::Gates(gp) if gp.gathers_apart() => {
-            let indirect = p.shade.record_indirect(f, pool, rec, inputs, false);
+            let indirect = p
+                .shade
+                .record_indirect(f, pool, rec, inputs, Some(gp.gates.shape));
             let uniform = InterleaveBlur::uniform(f, &gp.interleave, pool, true);
             p.blur.record(f, pool, rec, (&g, &uniform, &indirect, &hdr));
         }
         GpuMode::VplClusters(_, il) if il.block > 1 => {
-            let indirect = p.shade.record_indirect(f, pool, rec, inputs, true);
+            let indirect = p.shade.record_indirect(f, pool, rec, inputs, None);
             let uniform = InterleaveBlur::uniform(f, il, pool, true);
             p.blur.record(f, pool, rec, (&g, &uniform, &indirect, &hdr));
         }

@@ -7,7 +7,8 @@ use super::gbuffer::GBufferOutput;
 use super::light_cluster::LcOutput;
 use super::shadow_maps::ShadowOutput;
 use crate::RenderError;
-use crate::gpu::context::{Pool, array_view, bind_group, render_pipeline};
+use crate::cpu::gates::GateShape;
+use crate::gpu::context::{Pool, array_view, bind_group, render_pipeline, render_pipeline_with};
 use crate::gpu::shaders::ShaderSources;
 use crate::gpu::timing::Recorder;
 use crate::gpu::{Frame, shaders};
@@ -18,7 +19,11 @@ pub const HDR: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 /// The shading pipelines: direct + the mode's indirect, and interleaved gates' indirect alone.
 pub struct Shade {
     pipeline: wgpu::RenderPipeline,
-    gates_indirect: wgpu::RenderPipeline,
+    /// The interleaved gates' indirect pass, a pipeline per gate shape (shade.wgsl's
+    /// `GATE_SHAPE`, by [`crate::cpu::gates::GateShape::shader_id`]), each made when first
+    /// used.
+    gates_indirect: [std::sync::OnceLock<wgpu::RenderPipeline>; 3],
+    module: wgpu::ShaderModule,
     vpl_clusters_indirect: wgpu::RenderPipeline,
 }
 
@@ -115,15 +120,6 @@ impl Shade {
     pub fn new(d: &wgpu::Device, s: &ShaderSources) -> Result<Shade, RenderError> {
         let module = shaders::module(d, s, "shade.wgsl")?;
         let pipeline = render_pipeline(d, "shade", &module, ("vs", "fs"), &[], &[HDR], None);
-        let gates_indirect = render_pipeline(
-            d,
-            "gates indirect (interleaved)",
-            &module,
-            ("vs_batch", "fs_gates_indirect"),
-            &[],
-            &[HDR],
-            None,
-        );
         let vpl_clusters_indirect = render_pipeline(
             d,
             "VPL clusters indirect (interleaved)",
@@ -135,8 +131,24 @@ impl Shade {
         );
         Ok(Shade {
             pipeline,
-            gates_indirect,
+            gates_indirect: Default::default(),
+            module,
             vpl_clusters_indirect,
+        })
+    }
+
+    /// The interleaved gates' indirect pipeline for gate shape `shape` (its shader id).
+    fn gates_indirect(&self, d: &wgpu::Device, shape: u32) -> &wgpu::RenderPipeline {
+        self.gates_indirect[shape as usize].get_or_init(|| {
+            render_pipeline_with(
+                d,
+                "gates indirect (interleaved)",
+                &self.module,
+                ("vs_batch", "fs_gates_indirect"),
+                &[],
+                (&[HDR], None),
+                &[("GATE_SHAPE", f64::from(shape))],
+            )
         })
     }
 
@@ -156,27 +168,27 @@ impl Shade {
     }
 
     /// Records an interleaved mode's indirect irradiance (each pixel its subset's, × B) into a
-    /// target of its own, for the blur to compose: clustered gates' (portals also without
-    /// interleaving, B = 1, and in batches of VPLs on a software rasterizer), or with
-    /// `vpl_clusters` the VPL clusters'.
+    /// target of its own, for the blur to compose: clustered gates' with gate shape `gates`
+    /// (portals also without interleaving, B = 1, and in batches of VPLs on a software
+    /// rasterizer), or with `gates` `None` the VPL clusters'.
     pub fn record_indirect(
         &self,
         f: &Frame,
         pool: &mut Pool,
         rec: &mut Recorder,
         inputs: Inputs,
-        vpl_clusters: bool,
+        gates: Option<GateShape>,
     ) -> wgpu::Texture {
         let out = frame_target(f, pool, "indirect irradiance");
         let name = "indirect lighting";
-        if vpl_clusters {
+        let Some(shape) = gates else {
             let pipeline = (
                 &self.vpl_clusters_indirect,
                 Some(&VPL_CLUSTERS_INDIRECT_BINDINGS[..]),
             );
             self.draw(f, rec, inputs, pipeline, (std::slice::from_ref(&out), name));
             return out;
-        }
+        };
         // Portals' batches ping-pong between two targets, each adding onto the other's sum.
         let batch = crate::gpu::methods::walk_batch(&f.ctx.adapter_info.name, &f.params.mode);
         let walks = f.params.mode.walks_per_pixel(f.vpl_count);
@@ -198,7 +210,8 @@ impl Shade {
             _ => frame_target(f, pool, "indirect irradiance (batches)"),
         };
         let targets = [out, earlier];
-        let pipeline = (&self.gates_indirect, Some(&GATES_INDIRECT_BINDINGS[..]));
+        let pipeline = self.gates_indirect(&f.ctx.device, shape.shader_id());
+        let pipeline = (pipeline, Some(&GATES_INDIRECT_BINDINGS[..]));
         self.draw_batches(f, rec, inputs, pipeline, (&targets, name), batches);
         targets[(batches as usize - 1) % 2].clone()
     }

@@ -94,10 +94,25 @@ fn face_normal(px: vec2<i32>) -> vec3<f32> {
     return decode_face_normal(e);
 }
 
+// The gate shape: fixed when a pipeline is made (the interleaved indirect pass has one per
+// shape, runtime::gpu::passes::shade), or GATE_SHAPE_AT_RUNTIME: the level's. llvmpipe runs
+// both sides of a branch on a value read at run time, under masks: with the shape read from
+// the level every VPL's voxel walk also ran the portal walk's code (LibreQuake e2m3's hall,
+// 512 x 512, 4,096 VPLs: indirect pass 1,363 -> 818 ms; with no walk at all, 632 -> 167 ms).
+override GATE_SHAPE: u32 = 3u;
+const GATE_SHAPE_AT_RUNTIME: u32 = 3u;
+
+fn gate_shape() -> u32 {
+    if GATE_SHAPE != GATE_SHAPE_AT_RUNTIME {
+        return GATE_SHAPE;
+    }
+    return grid.shape;
+}
+
 // Whether VPL v's light reaches p (pixel px, cluster here) through the gates, the portals or
 // the voxels (GateLevel::visible; the voxel walk starts off p's face).
 fn lit_through(v: Vpl, px: vec2<i32>, p: vec3<f32>, here: u32) -> bool {
-    if grid.shape == GATE_VOXELS {
+    if gate_shape() == GATE_VOXELS {
         return voxel_sight(v.position, v.normal, p, face_normal(px));
     }
     return through_gates(v.position, cluster_at(v.position, v.normal), p, here);
@@ -107,7 +122,7 @@ fn through_gates(a: vec3<f32>, ca: u32, b: vec3<f32>, cb: u32) -> bool {
     if ca == cb || ca == NONE || cb == NONE {
         return true;
     }
-    if grid.shape == GATE_PORTALS {
+    if gate_shape() == GATE_PORTALS {
         return portal_walk(a, ca, b, cb) == WALK_VISIBLE;
     }
     for (var i = cluster_gates[ca]; i < cluster_gates[ca + 1u]; i++) {
@@ -213,7 +228,7 @@ fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
         radiance += albedo / PI * gather_per_pixel(px, p, n, decode_cluster(pos.w));
     } else if mode == SHADE_VPL_CLUSTERS && globals.interleave_block <= 1u {
         radiance += albedo / PI * gather_vpl_clusters(p, n, px, 0u, 1u);
-    } else if mode == SHADE_GATES_CLUSTERED && globals.interleave_block <= 1u && grid.shape == GATE_DISKS {
+    } else if mode == SHADE_GATES_CLUSTERED && globals.interleave_block <= 1u && gate_shape() == GATE_DISKS {
         radiance += albedo / PI * clustered_gather(px, p, n, decode_cluster(pos.w), 0u);
     }
     return vec4<f32>(radiance, 1.0);
@@ -227,7 +242,7 @@ fn clustered_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, batch:
     let b = max(globals.interleave_block, 1u);
     let subsets = b * b;
     let j = interleave_subset(px, b);
-    if grid.shape != GATE_DISKS {
+    if gate_shape() != GATE_DISKS {
         return portal_gather(px, p, n, here, j, subsets, batch);
     }
     let width = textureDimensions(g_position).x;
@@ -277,7 +292,7 @@ fn portal_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, j: u32, s
     var end = globals.vpl_count;
     // The voxel walk's end at p (off its face), the same for every VPL.
     var at_p = vec4<f32>(0.0);
-    if grid.shape == GATE_VOXELS {
+    if gate_shape() == GATE_VOXELS {
         at_p = sight_end(p, face_normal(px));
     }
     if globals.walk_batch > 0u {
@@ -290,7 +305,7 @@ fn portal_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, j: u32, s
         if all(l == vec3<f32>(0.0)) {
             continue;
         }
-        if grid.shape == GATE_VOXELS {
+        if gate_shape() == GATE_VOXELS {
             let at_v = vpl_ends[k];
             if at_v.w != 0.0 && at_p.w != 0.0 && !sight_clear(at_v.xyz, at_p.xyz) {
                 continue;
