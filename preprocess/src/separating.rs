@@ -15,6 +15,8 @@
 //! slack, so a line through an edge shared by two triangles hits one of them) meet its plane at
 //! one point, whose voxel is closed (both voxels when the point lies on their common face).
 
+use std::sync::atomic::{AtomicU64, Ordering};
+
 use glam::{DVec2, DVec3, Vec3};
 use rayon::prelude::*;
 use visgate_formats::vgate::{GridMeta, VoxelBits};
@@ -29,29 +31,16 @@ pub fn open_voxels(meta: GridMeta, triangles: &[[Vec3; 3]]) -> VoxelBits {
         size: f64::from(meta.voxel_size_m),
         dims: [nx, ny, nz],
     };
-    let closed = triangles
-        .par_chunks(4096)
-        .fold(
-            || vec![0u64; n.div_ceil(64)],
-            |mut bits, chunk| {
-                for tri in chunk {
-                    grid.mark(tri.map(|p| p.as_dvec3()), &mut |[x, y, z]| {
-                        let i = x + nx * (y + ny * z);
-                        bits[i / 64] |= 1 << (i % 64);
-                    });
-                }
-                bits
-            },
-        )
-        .reduce(
-            || vec![0u64; n.div_ceil(64)],
-            |mut a, b| {
-                a.iter_mut().zip(&b).for_each(|(x, y)| *x |= y);
-                a
-            },
-        );
-    let mut open = closed;
-    open.par_iter_mut().for_each(|w| *w = !*w);
+    // One grid of bits, set from every thread (an OR in any order gives the same bits): a
+    // grid a thread would cost as many copies of the grid as rayon splits the triangles.
+    let closed: Vec<AtomicU64> = (0..n.div_ceil(64)).map(|_| AtomicU64::new(0)).collect();
+    triangles.par_iter().for_each(|tri| {
+        grid.mark(tri.map(|p| p.as_dvec3()), &mut |[x, y, z]| {
+            let i = x + nx * (y + ny * z);
+            closed[i / 64].fetch_or(1 << (i % 64), Ordering::Relaxed);
+        });
+    });
+    let mut open: Vec<u64> = closed.into_par_iter().map(|w| !w.into_inner()).collect();
     // The border ring: two voxels a row, and the rows of the four sides.
     let mut close = |x: usize, y: usize, z: usize| {
         let i = x + nx * (y + ny * z);
