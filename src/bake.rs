@@ -71,7 +71,7 @@ pub struct BakeArgs {
     /// crosses its centre segments): openings narrow by up to half a voxel at each edge, so a
     /// finer grid lets more of the light through them. Default: the level's voxel, or 1/512 of
     /// the level's longest extent if smaller (a 128 or 256 bake walks a 512 grid: on 2 cores
-    /// 0.06–0.26 s more for Crytek Sponza or the Quake level, 4–8 MB of bits).
+    /// 0.03–0.07 s more for Crytek Sponza or the Quake level, 4–8 MB of bits).
     #[arg(long)]
     pub sight_voxel: Option<f32>,
     /// Smallest room, metres: a cluster whose largest ball (radius, 0–10) is smaller is merged
