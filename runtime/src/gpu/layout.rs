@@ -134,8 +134,9 @@ gpu_struct! {
         /// Direct lights' visibility: `DIRECT_PER_LIGHT` (each light's shadow maps) or
         /// `DIRECT_LIGHTCLUSTER` (its cluster's PCSS visibility texture).
         pub direct_mode: u32,
-        /// Portals: VPLs of a pixel's interleaving subset walked a draw (0: all in one draw;
-        /// a software rasterizer's loop limit, [`crate::gpu::methods::SOFTWARE_WALK_BATCH`]).
+        /// Portals and voxels: VPLs of a pixel's interleaving subset walked a draw (0: all in
+        /// one draw; on a software rasterizer, what its loop limit allows,
+        /// [`crate::gpu::methods::walk_batch`]).
         pub walk_batch: u32,
         /// Padding.
         pub _pad1: u32,

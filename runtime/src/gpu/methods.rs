@@ -385,8 +385,9 @@ impl GpuParams {
 /// walks many VPLs through the portals stops early and loses their light (ajar-door's `door`
 /// camera, gates per pixel against the CPU twin: 93 % of the light at 512 VPLs, 55 % at
 /// 4,096; Crytek Sponza's gallery, 512 bake, 1,024 VPLs a pixel: 27 %; an H100 matches it to
-/// 0.03 % at every count). Mode `gates` there walks a pixel's VPLs this many a draw
-/// ([`walk_batch`]); `gates-per-pixel` (one pass, no batches) warns above it.
+/// 0.03 % at every count). Mode `gates` there walks a pixel's VPLs through the portals this
+/// many a draw, through the voxels as many as the loop limit allows ([`walk_batch`]);
+/// `gates-per-pixel` (one pass, no batches) warns above it.
 pub const SOFTWARE_WALK_BATCH: u32 = 16;
 
 /// Whether `adapter` is llvmpipe (lavapipe's rasterizer), with its loop limit.
@@ -394,12 +395,24 @@ fn software(adapter: &str) -> bool {
     adapter.contains("llvmpipe")
 }
 
+/// The loop iterations a software rasterizer allows a shader invocation, less a margin for
+/// the loops around the walks (a walk's end: 3 offsets and a 3³ neighbourhood).
+const SOFTWARE_LOOP_ITERATIONS: u32 = 65_535 - 256;
+
 /// VPLs of a pixel's subset that mode `gates` with portals or voxels walks in one draw on
-/// `adapter`: 0 (all in one) but on a software rasterizer, [`SOFTWARE_WALK_BATCH`].
-pub fn walk_batch(adapter: &str, mode: &GpuMode) -> u32 {
+/// `adapter`: 0 (all in one) but on a software rasterizer, where portals take
+/// [`SOFTWARE_WALK_BATCH`] and voxel walks as many as fit the loop limit when each takes the
+/// most steps one can, `sight_steps` (the sight grid's dims summed, plus one; the level's
+/// [`LevelBuffers::sight_steps`](super::passes::clustered_gates::LevelBuffers)): a draw costs
+/// a pass over the frame, so fewer draws are faster (e2m3's 21 cm grid: 52 walks a draw; its
+/// hall at 512 x 512, 16,384 VPLs: indirect pass 3,466 -> 3,040 ms against 16 a draw).
+pub fn walk_batch(adapter: &str, mode: &GpuMode, sight_steps: Option<u32>) -> u32 {
     match mode {
         GpuMode::Gates(p) if p.gates.shape != GateShape::Disk && software(adapter) => {
-            SOFTWARE_WALK_BATCH
+            match (p.gates.shape, sight_steps) {
+                (GateShape::Voxels, Some(steps)) => (SOFTWARE_LOOP_ITERATIONS / (steps + 1)).max(1),
+                _ => SOFTWARE_WALK_BATCH,
+            }
         }
         _ => 0,
     }
@@ -433,15 +446,32 @@ mod tests {
         let portals = GatesParams::default();
         let llvmpipe = "llvmpipe (LLVM 19.1.7, 256 bits)";
         let gates = GpuMode::Gates(portals);
-        assert_eq!(walk_batch(llvmpipe, &gates), SOFTWARE_WALK_BATCH);
-        assert_eq!(walk_batch("NVIDIA H100 80GB HBM3", &gates), 0);
+        assert_eq!(
+            walk_batch(llvmpipe, &gates, Some(1251)),
+            SOFTWARE_WALK_BATCH
+        );
+        assert_eq!(walk_batch("NVIDIA H100 80GB HBM3", &gates, Some(1251)), 0);
         let mut disks = portals;
         disks.gates.shape = GateShape::Disk;
-        assert_eq!(walk_batch(llvmpipe, &GpuMode::Gates(disks)), 0);
+        assert_eq!(walk_batch(llvmpipe, &GpuMode::Gates(disks), None), 0);
         assert_eq!(
-            walk_batch(llvmpipe, &GpuMode::GatesPerPixel(portals.gates)),
+            walk_batch(llvmpipe, &GpuMode::GatesPerPixel(portals.gates), None),
             0
         );
+        // Voxel walks: as many as fit the loop limit at the sight grid's longest walk, at
+        // least one (tests/gates.rs loses light with a thousand times as many).
+        let mut voxels = portals;
+        voxels.gates.shape = GateShape::Voxels;
+        let voxels = GpuMode::Gates(voxels);
+        assert_eq!(walk_batch(llvmpipe, &voxels, Some(1251)), 52);
+        assert_eq!(walk_batch(llvmpipe, &voxels, Some(99)), 652);
+        assert_eq!(walk_batch(llvmpipe, &voxels, Some(200_000)), 1);
+        assert_eq!(walk_batch(llvmpipe, &voxels, None), SOFTWARE_WALK_BATCH);
+        for steps in [3, 100, 1251, 4000] {
+            let batch = walk_batch(llvmpipe, &voxels, Some(steps));
+            assert!(batch * (steps + 1) + 256 <= 65_535, "{steps}: {batch}");
+        }
+        assert_eq!(walk_batch("NVIDIA H100 80GB HBM3", &voxels, Some(1251)), 0);
     }
 
     #[test]

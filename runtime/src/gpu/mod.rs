@@ -495,7 +495,11 @@ impl GpuRenderer {
             shade_mode: shade_mode as u32,
             shadow_size: params.shadows.size,
             direct_mode: params.direct.shader_id(),
-            walk_batch: methods::walk_batch(&ctx.adapter_info.name, &params.mode),
+            walk_batch: methods::walk_batch(
+                &ctx.adapter_info.name,
+                &params.mode,
+                scene.level.as_ref().map(|l| l.sight_steps),
+            ),
             _pad1: 0,
             _pad2: 0,
         };

@@ -113,6 +113,9 @@ pub struct LevelBuffers {
     pub portal_words: wgpu::Buffer,
     /// The open voxels, packed (`VoxelSight::words`).
     pub sight_words: wgpu::Buffer,
+    /// The most steps a voxel walk can take: the sight grid's dims summed, plus one
+    /// (sight.wgsl's loop bound).
+    pub sight_steps: u32,
 }
 
 impl LevelBuffers {
@@ -172,6 +175,7 @@ impl LevelBuffers {
                 bytemuck::cast_slice(&t.sight_words),
                 storage,
             ),
+            sight_steps: t.sight_words[..3].iter().sum::<u32>() + 1,
         })
     }
 }
