@@ -292,4 +292,36 @@ mod tests {
         let (fewer, all) = closed(&tilted);
         assert_eq!((fewer, all), (20, ring + 10 * 10));
     }
+
+    #[test]
+    fn a_crack_narrower_than_a_voxel_is_open_only_where_a_row_of_centres_falls_in_it() {
+        let bounds = (Vec3::ZERO, Vec3::splat(1.0));
+        let meta = grid_for(bounds, Resolution::LongestAxisVoxels(10), u64::MAX).expect("grid");
+        // A wall at x = 0.52 across the whole level, in two pieces that leave a crack between
+        // heights lo and hi (the voxel centres lie at heights 0.05, 0.15, …).
+        let wall = |lo: f32, hi: f32| {
+            let quad = |y0: f32, y1: f32| {
+                let p = [(y0, 0.0), (y0, 1.0), (y1, 1.0), (y1, 0.0)]
+                    .map(|(y, z)| Vec3::new(0.52, y, z));
+                [[p[0], p[1], p[2]], [p[0], p[2], p[3]]]
+            };
+            [quad(0.0, lo), quad(hi, 1.0)].concat()
+        };
+        // Voxel (x, y, z) of the grid's inside (1..=10 each; centres at (i - 0.5) / 10).
+        let across = |tris: &[[Vec3; 3]]| {
+            let open = open_voxels(meta, tris);
+            let seen = flood(&meta, &open, [3, 5, 5]);
+            seen[8 + 12 * (5 + 12 * 5)]
+        };
+        assert!(
+            across(&wall(0.44, 0.46)),
+            "a row of centres (0.45) in the crack: open"
+        );
+        assert!(!across(&wall(0.49, 0.51)), "no centre in the crack: sealed");
+        assert!(!across(&wall(0.5, 0.5)), "no crack");
+        // The conservative voxels seal it: every voxel beside the crack touches a piece.
+        let solid = voxelize(meta, &wall(0.44, 0.46)).solid;
+        let open = VoxelBits::from_fn(solid.len(), |i| !solid[i]);
+        assert!(!flood(&meta, &open, [3, 5, 5])[8 + 12 * (5 + 12 * 5)]);
+    }
 }
