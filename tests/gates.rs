@@ -314,11 +314,7 @@ fn clustered_light_lists_give_exactly_the_per_point_gate_test() {
                     if gp.shape != GateShape::Disk && behind {
                         continue;
                     }
-                    let vpl = End {
-                        position: Vec3::from(v.position),
-                        normal: Vec3::from(v.normal),
-                        cluster: vpl_cluster[j],
-                    };
+                    let vpl = End::of_vpl(v, vpl_cluster[j]);
                     let point = End {
                         position: p.position,
                         normal: p.normal,

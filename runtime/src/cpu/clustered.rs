@@ -195,26 +195,24 @@ pub fn assign(
             for (j, v) in vpls.iter().enumerate() {
                 let a = Vec3::from(v.position);
                 let in_front = (s - a).dot(Vec3::from(v.normal)) >= -r;
+                // An entry with no gates: the walk (if any) runs per point.
+                let walk = |walk_from| LightEntry {
+                    vpl: j as u32,
+                    gates: Vec::new(),
+                    walk_from,
+                };
                 match (vpl_cluster[j], gc.cluster) {
                     // Voxels: culled only when the cluster lies wholly behind the VPL's
                     // surface; the voxel walk runs per point, whatever the clusters.
                     _ if gates.shape == GateShape::Voxels => {
                         if in_front {
-                            list.push(LightEntry {
-                                vpl: j as u32,
-                                gates: Vec::new(),
-                                walk_from: None,
-                            });
+                            list.push(walk(None));
                         }
                     }
                     // Portals: likewise; the walk runs per point from the VPL's cluster.
                     (Some(ca), Some(cb)) if ca != cb && gates.shape == GateShape::Portal => {
                         if in_front {
-                            list.push(LightEntry {
-                                vpl: j as u32,
-                                gates: Vec::new(),
-                                walk_from: Some(ca),
-                            });
+                            list.push(walk(Some(ca)));
                         }
                     }
                     (Some(ca), Some(cb)) if ca != cb => {
@@ -230,11 +228,7 @@ pub fn assign(
                         }
                     }
                     // Same cluster, or outside every cluster: no gate stands between.
-                    _ => list.push(LightEntry {
-                        vpl: j as u32,
-                        gates: Vec::new(),
-                        walk_from: None,
-                    }),
+                    _ => list.push(walk(None)),
                 }
             }
             list.sort_by_key(|e| (e.vpl % subsets, e.vpl));
@@ -299,12 +293,10 @@ pub fn entry_reaches(
     level: &GateLevel,
     gates: &GateParams,
 ) -> bool {
-    let (a, p) = (Vec3::from(vpl.position), point.position);
     if gates.shape == GateShape::Voxels {
-        return level
-            .sight()
-            .visible(a, Vec3::from(vpl.normal), p, point.normal);
+        return level.visible(&End::of_vpl(vpl, None), point, gates);
     }
+    let (a, p) = (Vec3::from(vpl.position), point.position);
     if let (Some(ca), Some(here)) = (e.walk_from, point.cluster) {
         return matches!(level.walk(a, ca, p, here, gates.max_walk), Walk::Visible(_));
     }

@@ -335,6 +335,15 @@ pub struct End {
 }
 
 impl End {
+    /// VPL `v`'s end, of visibility cluster `cluster`.
+    pub fn of_vpl(v: &crate::vpl::Vpl, cluster: Option<u32>) -> End {
+        End {
+            position: Vec3::from(v.position),
+            normal: Vec3::from(v.normal),
+            cluster,
+        }
+    }
+
     /// The end at `position` with `normal`, its cluster looked up in `level`.
     pub fn at(level: &GateLevel, position: Vec3, normal: Vec3) -> End {
         End {
@@ -378,6 +387,8 @@ pub struct GateTables {
     pub portal_words: Vec<u32>,
     /// The open voxels and their bricks' clearance, packed ([`VoxelSight::words`]).
     pub sight_words: Vec<u32>,
+    /// The most steps a voxel walk takes ([`VoxelSight::most_steps`]).
+    pub sight_steps: u32,
 }
 
 impl GateLevel {
@@ -434,6 +445,7 @@ impl GateLevel {
             cluster_gates: starts,
             portal_words: self.portal_words(),
             sight_words: self.sight.words(),
+            sight_steps: self.sight.most_steps(),
         }
     }
 }

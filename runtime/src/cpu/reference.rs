@@ -193,11 +193,7 @@ pub fn render_cancellable(
                                 // Gates, portals or voxels (GateLevel::visible: a point or
                                 // VPL outside every cluster meets no gate, unoccluded).
                                 IndirectVisibility::Gates(level, gp) => {
-                                    let vpl = End {
-                                        position: Vec3::from(v.position),
-                                        normal: Vec3::from(v.normal),
-                                        cluster: vpl_cluster[j],
-                                    };
+                                    let vpl = End::of_vpl(v, vpl_cluster[j]);
                                     let point = End {
                                         position: surf.position,
                                         normal: surf.geometric_normal,

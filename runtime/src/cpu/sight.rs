@@ -147,6 +147,13 @@ impl VoxelSight {
         best.map(|(_, c)| c)
     }
 
+    /// The most steps a walk takes (sight.wgsl's loop bound too): each step crosses a face
+    /// along the segment, so at most as many as the segment crosses voxel faces — the grid's
+    /// dims summed — plus one.
+    pub fn most_steps(&self) -> u32 {
+        (self.dims.x + self.dims.y + self.dims.z + 1) as u32
+    }
+
     /// Whether the segment from `a` to `b` (voxel coordinates, both in open voxels) crosses
     /// open voxels alone: the brick march described in the module docs.
     pub fn clear(&self, a: Vec3, b: Vec3) -> bool {
@@ -156,10 +163,7 @@ impl VoxelSight {
         let inv = Vec3::select(moves, d.recip(), Vec3::ZERO);
         let end = b.floor().as_ivec3();
         let mut v = a.floor().as_ivec3();
-        // Each step crosses a face along the segment, so a walk takes at most as many steps
-        // as the segment crosses voxel faces: at most the grid's dims summed, plus one.
-        let most = self.dims.x + self.dims.y + self.dims.z + 1;
-        for _ in 0..most {
+        for _ in 0..self.most_steps() {
             let brick = v.div_euclid(IVec3::splat(BRICK));
             let c = self.brick_clear(brick);
             let (lo, hi) = if c > 0 {

@@ -244,9 +244,7 @@ fn record_passes(
     // The voxel walk needs no geometry clusters, lists or VPL clusters: the VPLs' ends.
     let (lists, vpl_ends) = match &f.params.mode {
         GpuMode::Gates(gp) if gp.gates.shape == GateShape::Voxels => {
-            let level = f.scene.level.as_ref().ok_or_else(|| {
-                RenderError::Param("mode gates needs a baked level (GpuRenderer::set_level)".into())
-            })?;
+            let level = passes::clustered_gates::LevelBuffers::of(f)?;
             let ends = p.sight_ends.record(f, &level.sight_words, pool, rec)?;
             (None, Some(ends))
         }

@@ -113,12 +113,18 @@ pub struct LevelBuffers {
     pub portal_words: wgpu::Buffer,
     /// The open voxels, packed (`VoxelSight::words`).
     pub sight_words: wgpu::Buffer,
-    /// The most steps a voxel walk can take: the sight grid's dims summed, plus one
-    /// (sight.wgsl's loop bound).
+    /// The most steps a voxel walk takes (`VoxelSight::most_steps`).
     pub sight_steps: u32,
 }
 
 impl LevelBuffers {
+    /// The frame's level, which mode gates needs.
+    pub fn of<'a>(f: &Frame<'a>) -> Result<&'a LevelBuffers, RenderError> {
+        f.scene.level.as_ref().ok_or_else(|| {
+            RenderError::Param("mode gates needs a baked level (GpuRenderer::set_level)".into())
+        })
+    }
+
     /// Uploads `level`'s tables; the voxel grid keeps the smallest integer type that holds the
     /// level's clusters.
     pub fn upload(ctx: &GpuContext, level: &GateLevel) -> Result<LevelBuffers, RenderError> {
@@ -175,7 +181,7 @@ impl LevelBuffers {
                 bytemuck::cast_slice(&t.sight_words),
                 storage,
             ),
-            sight_steps: t.sight_words[..3].iter().sum::<u32>() + 1,
+            sight_steps: t.sight_steps,
         })
     }
 }
@@ -323,9 +329,7 @@ impl ClusteredGates {
         g_position: &wgpu::TextureView,
     ) -> Result<ListBuffers, RenderError> {
         let d = &f.ctx.device;
-        let level = f.scene.level.as_ref().ok_or_else(|| {
-            RenderError::Param("mode gates needs a baked level (GpuRenderer::set_level)".into())
-        })?;
+        let level = LevelBuffers::of(f)?;
         let cp = p.clusters;
         let [w, h] = f.view.size;
         let tiles = [w.div_ceil(cp.tile_px), h.div_ceil(cp.tile_px)];
