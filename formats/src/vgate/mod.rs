@@ -218,7 +218,8 @@ pub enum SectionKind {
     VoxelCluster,
     /// The same grid as runs of equal values in voxel order: (u32 LE length, value).
     VoxelClusterRuns,
-    /// A bit per voxel, set where the voxelization left it open (not solid): u64 LE words.
+    /// A bit per voxel of the sight grid, set where it is open (no triangle crosses its centre
+    /// segments): u64 LE words.
     OpenVoxels,
 }
 
