@@ -17,9 +17,10 @@ use crate::settings::{LightArgs, MethodArgs};
 pub const COMPARE_HELP: &str = "\
 Modes (--modes, comma-separated, or all): every GPU method of `visgate render --mode`
 (none, per-vpl-shadow-maps, gates, gates-per-pixel, val-hard, val-cssm, direct-only) and
-gates-disk and gates-voxels (mode gates with the paper's disks, or walking the level's open
-voxels, whatever --gate-shape says; gates takes --gate-shape, portals by default). `all`: every
-one but direct-only; the gate modes only with a level (given, or baked here).
+gates-voxels, gates-portal and gates-disk (mode gates walking the level's open voxels, walking
+its portals, or with the paper's disks, whatever --gate-shape says; gates takes --gate-shape,
+voxels by default). `all`: every one but direct-only, gates once a shape; the gate modes only
+with a level (given, or baked here).
 
 Every mode renders at every --vpls count from every camera, beside the CPU reference with the
 very same VPLs (a shadow ray per VPL and pixel sample; --spp samples). OUT/report.md and
@@ -136,7 +137,7 @@ pub struct CompareArgs {
     pub method: MethodArgs,
 }
 
-/// The modes `names` ask for (`all` expanded; `gates-disk` is gates with disks), each VAL mode
+/// The modes `names` ask for ([`named_modes`]), each VAL mode
 /// once per count of `val_counts` (labelled `val-hard-m16`, …) when it is given.
 fn modes(names: &[String], settings: &MethodArgs, val_counts: &[u32]) -> Result<Vec<CompareMode>> {
     let mut out = Vec::new();
@@ -222,8 +223,16 @@ fn lightcluster_modes(
     Ok(out)
 }
 
-/// The modes `names` ask for (`all` expanded; `gates-disk` and `gates-voxels` are gates with
-/// disks and with the voxel walk).
+/// The shaped gate modes of `visgate compare`, each gates with one --gate-shape.
+const SHAPED: [(&str, GateShape); 3] = [
+    ("gates-voxels", GateShape::Voxels),
+    ("gates-portal", GateShape::Portal),
+    ("gates-disk", GateShape::Disk),
+];
+
+/// The modes `names` ask for (`all` expanded: gates with --gate-shape, then each other shape
+/// by its own name; `gates-voxels`, `gates-portal` and `gates-disk` are gates with that
+/// shape).
 fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMode>> {
     let s = settings.settings();
     let shaped = |shape| {
@@ -232,13 +241,14 @@ fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMod
         GpuMode::Gates(g)
     };
     let named = |name: &str| -> Result<CompareMode> {
-        let mode = match (name, method(name)) {
-            ("gates-disk", _) => shaped(GateShape::Disk),
-            ("gates-voxels", _) => shaped(GateShape::Voxels),
+        let shape = SHAPED.iter().find(|(n, _)| *n == name).map(|&(_, g)| g);
+        let mode = match (shape, method(name)) {
+            (Some(g), _) => shaped(g),
             (_, Some(m)) => (m.make)(&s),
-            (_, None) => bail!(
-                "--modes {name}: give all or some of {}, gates-disk, gates-voxels",
-                METHODS.map(|m| m.name).join(", ")
+            (None, None) => bail!(
+                "--modes {name}: give all or some of {}, {}",
+                METHODS.map(|m| m.name).join(", "),
+                SHAPED.map(|(n, _)| n).join(", ")
             ),
         };
         Ok(CompareMode {
@@ -253,8 +263,11 @@ fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMod
             for m in METHODS.iter().filter(|m| m.name != "direct-only") {
                 out.push(named(m.name)?);
                 if m.name == "gates" {
-                    out.push(named("gates-disk")?);
-                    out.push(named("gates-voxels")?);
+                    for (n, g) in SHAPED {
+                        if g != s.gates.gates.shape {
+                            out.push(named(n)?);
+                        }
+                    }
                 }
             }
         } else {

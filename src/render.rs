@@ -29,13 +29,14 @@ Modes:
                --ism-points random points a map, splatted as surfels into one atlas of
                --ism-map-size² paraboloid maps, holes filled by --ism-pull-push levels; one
                hard lookup per VPL (the cheap twin of per-vpl-shadow-maps)
-  gates        GPU: a VPL lights a point of another visibility cluster only through the
-               baked --level's portals (--gate-shape portal, the default: the segment walks
-               from cluster to cluster through the openings, at most --max-walk of them) or
-               a chain of at most --gate-hops gate disks (× --gate-oversize; --gate-shape
-               disk, the paper's), or along the level's open voxels (--gate-shape voxels:
-               blocked by the first voxel the bake's voxelization closed, so what stands
-               inside a cluster blocks too; a finer bake or --sight-voxel is closer), by
+  gates        GPU: a VPL lights a point along the baked --level's open voxels
+               (--gate-shape voxels, the default: blocked by the first voxel the bake's
+               voxelization closed, so what stands inside a cluster blocks too; a finer
+               --sight-voxel is closer), or only through its portals when the point lies in
+               another visibility cluster (--gate-shape portal: the segment walks from
+               cluster to cluster through the openings, at most --max-walk of them), or
+               through a chain of at most --gate-hops gate disks (× --gate-oversize;
+               --gate-shape disk, the paper's), by
                clustered shading (the paper's Table I passes: geometry pass, unique clusters
                of --tile-px tiles × --depth-slices slices × visibility cluster, light
                assignment into a pool of --light-entries, indirect lighting); GPU: ≤ 2 hops;

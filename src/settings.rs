@@ -17,13 +17,14 @@ use visgate_runtime::vpl::GeometryClamp;
 /// `--gate-shape`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum GateShapeArg {
+    /// The walk through the level's open voxels (the default): the openings at voxel
+    /// resolution, and what stands inside a cluster (a door panel, a table) blocks too; a
+    /// finer sight grid (bake --sight-voxel) is closer.
+    Voxels,
     /// The baked portals (the true openings between clusters), walked along each segment.
     Portal,
     /// The paper's disks, through chains of at most --gate-hops of them.
     Disk,
-    /// The walk through the level's open voxels: the openings at voxel resolution, and what
-    /// stands inside a cluster (a door panel, a table) blocks too; finer bakes are closer.
-    Voxels,
 }
 
 /// `--direct`: how the direct lights are shadowed.
@@ -168,9 +169,9 @@ pub struct MethodArgs {
     /// penumbra, 1..=128.
     #[arg(long, default_value_t = 32)]
     pub pcss_filter_samples: u32,
-    /// What a gate is (--mode gates): the baked portals, walked, the paper's disks, or the
-    /// level's open voxels, walked.
-    #[arg(long, value_enum, default_value_t = GateShapeArg::Portal)]
+    /// What a gate is (--mode gates): the level's open voxels, walked (the default: the
+    /// lowest error and mostly the fastest), the baked portals, walked, or the paper's disks.
+    #[arg(long, value_enum, default_value_t = GateShapeArg::Voxels)]
     pub gate_shape: GateShapeArg,
     /// Portals one walk may pass before it is given up and counted as occluded (--gate-shape
     /// portal), 1..=1024.

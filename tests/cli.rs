@@ -717,9 +717,15 @@ fn render_gates_uses_a_baked_level_and_refuses_a_missing_or_stale_one() {
     let out = p("g.exr");
     let level = p("two.vgate");
     a.extend(["--level", &level, "--out", &out]);
+    // The default: the voxel walk (no clusters or lists, each VPL's end).
     let o = visgate(&a);
     assert!(o.status.success(), "{}", stderr(&o));
-    // The passes are named as the paper's Table I, with the lists' fill.
+    assert!(stdout(&o).contains("VPL walk ends"), "{}", stdout(&o));
+    assert!(!stdout(&o).contains("unique clusters"), "{}", stdout(&o));
+    a.extend(["--gate-shape", "portal"]);
+    let o = visgate(&a);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // Portals: the passes are named as the paper's Table I, with the lists' fill.
     for pass in [
         "geometry pass",
         "unique clusters",
@@ -732,7 +738,8 @@ fn render_gates_uses_a_baked_level_and_refuses_a_missing_or_stale_one() {
     // A pool too small (disks keep lists; portals none): the error names the setting and
     // what it needs.
     let mut small = a.clone();
-    small.extend(["--light-entries", "10", "--gate-shape", "disk"]);
+    *small.last_mut().expect("shape") = "disk";
+    small.extend(["--light-entries", "10"]);
     let o = visgate(&small);
     assert!(!o.status.success());
     assert!(
@@ -749,7 +756,7 @@ fn render_gates_uses_a_baked_level_and_refuses_a_missing_or_stale_one() {
     assert!(stderr(&o).contains("--mode gates --cpu"), "{}", stderr(&o));
     // The voxel walk: no clusters or lists, each VPL's end, on the GPU and its CPU twin.
     let mut voxels = a.clone();
-    voxels.extend(["--gate-shape", "voxels"]);
+    *voxels.last_mut().expect("shape") = "voxels";
     let o = visgate(&voxels);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stdout(&o).contains("VPL walk ends"), "{}", stdout(&o));

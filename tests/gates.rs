@@ -50,7 +50,10 @@ fn two_rooms_a_vpl_in_a_lights_b_only_through_the_doorway_gates() {
         shape: GateShape::Disk,
         ..GateParams::default()
     };
-    let portals = GateParams::default();
+    let portals = GateParams {
+        shape: GateShape::Portal,
+        ..GateParams::default()
+    };
     // Where a segment crosses the doorway wall (x 4.0–4.2 m), its least distance from the
     // doorway's frame (z 1.5–2.5, y 0–2.1), metres.
     let outside_doorway = |a: Vec3, b: Vec3| {
@@ -534,7 +537,7 @@ fn gpu_gates_stay_stable_at_the_extremes() {
     let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
     gpu.set_level(&ctx, &gates).expect("level");
     let params = GpuParams::with_mode;
-    let gates_mode = || GpuMode::Gates(GatesParams::default());
+    let gates_mode = || GpuMode::Gates(portal_gates());
     // No VPLs: direct light alone, empty lists.
     let (none, t) = gpu
         .render(&ctx, &view, &[], &params(gates_mode()))
@@ -687,7 +690,7 @@ fn gpu_gates_give_the_same_image_at_scales_1e_3_to_1e4() {
 
 #[test]
 fn the_pass_report_counts_pixels_and_vpls_outside_every_cluster() {
-    use visgate_runtime::gpu::{GatesParams, GpuContext, GpuMode, GpuParams, GpuRenderer};
+    use visgate_runtime::gpu::{GpuContext, GpuMode, GpuParams, GpuRenderer};
     use visgate_runtime::vpl::Vpl;
     let ctx = GpuContext::new().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"));
     let (scene, gates, _tracer, mut vpls, inside) = fixture(Builtin::FourRooms, 128);
@@ -714,12 +717,12 @@ fn the_pass_report_counts_pixels_and_vpls_outside_every_cluster() {
     assert!(want_vpls >= 5);
     let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
     gpu.set_level(&ctx, &gates).expect("level");
-    let params = GpuParams::with_mode(GpuMode::Gates(GatesParams::default()));
+    let params = GpuParams::with_mode(GpuMode::Gates(portal_gates()));
     let (_, t) = gpu.render(&ctx, &view, &vpls, &params).expect("render");
     let lists = t.lists.expect("lists");
     assert_eq!(lists.vpls_outside as usize, want_vpls);
     let (pixels, _) = gpu
-        .light_lists(&ctx, &view, &vpls, &GatesParams::default())
+        .light_lists(&ctx, &view, &vpls, &portal_gates())
         .expect("lists");
     let outside = pixels
         .iter()
@@ -832,7 +835,7 @@ fn the_light_list_pool_grows_to_what_a_frame_needs() {
             &ctx,
             &view,
             &vpls,
-            &GpuParams::with_mode(GpuMode::Gates(GatesParams::default())),
+            &GpuParams::with_mode(GpuMode::Gates(portal_gates())),
         )
         .expect("portals");
     let l = t.lists.expect("stats");
@@ -921,4 +924,11 @@ fn cpu_twin(
     )
     .expect("cpu")
     .0
+}
+
+/// Mode gates' settings with the portal walk.
+fn portal_gates() -> visgate_runtime::gpu::GatesParams {
+    let mut p = visgate_runtime::gpu::GatesParams::default();
+    p.gates.shape = GateShape::Portal;
+    p
 }

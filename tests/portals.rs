@@ -240,7 +240,11 @@ fn a_walk_over_its_limit_is_counted_and_occluded_never_visible() {
     };
     assert!(!gates.visible(&from, &to, &short));
     assert_eq!(gates.take_walks_over_limit(), 1);
-    assert!(gates.visible(&from, &to, &GateParams::default()));
+    let long = GateParams {
+        shape: GateShape::Portal,
+        ..GateParams::default()
+    };
+    assert!(gates.visible(&from, &to, &long));
     assert_eq!(gates.take_walks_over_limit(), 0);
 }
 

@@ -18,10 +18,10 @@ pub fn method_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
         "gates" | "gates-per-pixel" => {
             let g = &mut s.gates.gates;
             ui.horizontal(|ui| {
-                ui.radio_value(&mut g.shape, GateShape::Portal, "portals");
-                ui.radio_value(&mut g.shape, GateShape::Disk, "disks (paper)");
                 ui.radio_value(&mut g.shape, GateShape::Voxels, "voxels")
                     .on_hover_text("the walk through the level's open voxels");
+                ui.radio_value(&mut g.shape, GateShape::Portal, "portals");
+                ui.radio_value(&mut g.shape, GateShape::Disk, "disks (paper)");
             });
             if g.shape == GateShape::Portal {
                 ui.add(egui::Slider::new(&mut g.max_walk, 1..=256).text("portals per walk"));

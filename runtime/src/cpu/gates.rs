@@ -24,10 +24,11 @@ pub enum GateShape {
     /// The paper's disks, through chains of at most `max_hops` of them.
     Disk,
     /// The baked portals (the true openings), walked cluster by cluster along the segment.
-    #[default]
     Portal,
     /// The walk through the level's open voxels: the segment is blocked by the first voxel
-    /// the voxelization closed ([`super::sight`]).
+    /// the voxelization closed ([`super::sight`]). The default: the lowest indirect error of
+    /// the three on every camera measured, and faster than the portals on nearly all.
+    #[default]
     Voxels,
 }
 
@@ -70,7 +71,7 @@ pub struct GateParams {
 impl Default for GateParams {
     fn default() -> Self {
         GateParams {
-            shape: GateShape::Portal,
+            shape: GateShape::Voxels,
             max_walk: 64,
             oversize: 1.0,
             max_hops: 2,

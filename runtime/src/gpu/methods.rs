@@ -441,9 +441,16 @@ pub fn warn_software_loop_limit(adapter: &str, mode: &GpuMode, vpls: u32) {
 mod tests {
     use super::*;
 
+    /// Gates with the portal walk.
+    fn portals() -> GatesParams {
+        let mut p = GatesParams::default();
+        p.gates.shape = GateShape::Portal;
+        p
+    }
+
     #[test]
     fn portals_walk_in_batches_on_a_software_rasterizer_alone() {
-        let portals = GatesParams::default();
+        let portals = portals();
         let llvmpipe = "llvmpipe (LLVM 19.1.7, 256 bits)";
         let gates = GpuMode::Gates(portals);
         assert_eq!(
@@ -477,8 +484,8 @@ mod tests {
     #[test]
     fn portal_walks_a_pixel_follow_the_shape_and_the_interleaving() {
         use crate::cpu::gates::GateShape;
-        let portals = GatesParams::default();
-        assert_eq!(portals.gates.shape, GateShape::Portal);
+        assert_eq!(GatesParams::default().gates.shape, GateShape::Voxels);
+        let portals = portals();
         assert_eq!(portals.interleave.subsets(), 64);
         assert_eq!(GpuMode::Gates(portals).walks_per_pixel(4096), 64);
         assert_eq!(GpuMode::Gates(portals).walks_per_pixel(4097), 65);
