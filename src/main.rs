@@ -191,7 +191,18 @@ pub fn camera_of(scene: &Scene, arg: &str, name: Option<&str>) -> Result<visgate
             )
         }),
         None => scene.cameras.first().cloned().with_context(|| {
-            format!("{arg}: the scene has no camera; add a [[camera]] to its TOML (see README)")
+            let bare = [".obj", ".gltf", ".glb"]
+                .iter()
+                .any(|e| arg.to_ascii_lowercase().ends_with(e));
+            if bare {
+                format!(
+                    "{arg}: a bare mesh carries no camera (nor lights); write a scene TOML \
+                     beside it that names it ([[mesh]] path = \"…\") and adds a [[camera]] and \
+                     a [[light]] (see README, Scenes), or walk it in the viewer's window"
+                )
+            } else {
+                format!("{arg}: the scene has no camera; add a [[camera]] to its TOML (see README)")
+            }
         }),
     }
 }

@@ -84,6 +84,22 @@ fn export_then_inspect_the_files_and_a_bare_mesh() {
     assert_eq!(v["triangles"], 36);
     assert_eq!(v["point_lights"], 0);
     assert_eq!(v["static_triangles"], 36);
+    // Rendering it: no camera, and the message says how to give it one.
+    let png = dir.path().join("bare.png");
+    let o = visgate(&[
+        "render",
+        out.join("CornellBox-Original.obj").to_str().expect("utf8"),
+        "--mode",
+        "none",
+        "-o",
+        png.to_str().expect("utf8"),
+    ]);
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("bare mesh carries no camera") && stderr(&o).contains("[[mesh]]"),
+        "{}",
+        stderr(&o)
+    );
 }
 
 #[test]
