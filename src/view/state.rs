@@ -7,6 +7,7 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use serde::{Deserialize, Serialize};
+use visgate_runtime::cpu::gates::GateShape;
 
 /// The viewer's state for one scene.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -22,15 +23,43 @@ pub struct SavedView {
     pub layers: [bool; 7],
     /// Hops, oversize, VALs, iterations, interleave block, VAL map, per-VPL map, batch.
     pub settings: [f32; 8],
-    /// Gates as disks rather than portals (absent in older files: portals).
-    #[serde(default)]
+    /// The gate shape: `voxels`, `portal` or `disk` (absent in older files: [`Self::shape`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub gate_shape: Option<String>,
+    /// Older files: gates as disks (read, no longer written).
+    #[serde(default, skip_serializing)]
     pub disks: bool,
-    /// Gates as the voxel walk (absent in older files: not).
-    #[serde(default)]
+    /// Older files: gates as the voxel walk (read, no longer written).
+    #[serde(default, skip_serializing)]
     pub voxels: bool,
     /// The VAL layer (absent in older files: off).
     #[serde(default)]
     pub vals_layer: bool,
+}
+
+impl SavedView {
+    /// The gate shape kept: the one named, or in a file from before it was named, disks or the
+    /// voxel walk where that was chosen and else today's default — such a file cannot tell
+    /// the portals chosen from the portals that were the default then.
+    pub fn shape(&self) -> GateShape {
+        match self.gate_shape.as_deref() {
+            Some("portal") => GateShape::Portal,
+            Some("disk") => GateShape::Disk,
+            Some("voxels") => GateShape::Voxels,
+            _ if self.disks => GateShape::Disk,
+            _ => GateShape::default(),
+        }
+    }
+
+    /// `shape`'s name in the file.
+    pub fn shape_name(shape: GateShape) -> String {
+        match shape {
+            GateShape::Voxels => "voxels",
+            GateShape::Portal => "portal",
+            GateShape::Disk => "disk",
+        }
+        .to_string()
+    }
 }
 
 /// The state file: one entry per scene name.
@@ -94,7 +123,8 @@ mod tests {
             camera: [1.0, 2.0, 3.0, 0.5, -0.2, 1.2, 4.0],
             layers: [true, false, true, false, true, false, true],
             settings: [2.0, 1.5, 30.0, 8.0, 4.0, 128.0, 256.0, 32.0],
-            disks: mode == "gates",
+            gate_shape: (mode == "gates").then(|| SavedView::shape_name(GateShape::Disk)),
+            disks: false,
             voxels: false,
             vals_layer: mode == "val-ism",
         };
@@ -103,6 +133,27 @@ mod tests {
         let all = read_all(&p);
         assert_eq!(all.get("a"), Some(&state("gates")));
         assert_eq!(all.get("b"), Some(&state("val-cssm")));
+        assert_eq!(all["a"].shape(), GateShape::Disk);
+        // A file from before the shape was named: disks and voxels as chosen, else today's
+        // default.
+        let old = |disks: bool, voxels: bool| SavedView {
+            gate_shape: None,
+            disks,
+            voxels,
+            ..state("gates")
+        };
+        assert_eq!(old(true, false).shape(), GateShape::Disk);
+        assert_eq!(old(false, true).shape(), GateShape::Voxels);
+        assert_eq!(old(false, false).shape(), GateShape::Voxels);
+        let text = serde_json::to_string(&old(true, false)).expect("json");
+        assert!(!text.contains("disks"), "{text}");
+        for shape in [GateShape::Portal, GateShape::Disk, GateShape::Voxels] {
+            let s = SavedView {
+                gate_shape: Some(SavedView::shape_name(shape)),
+                ..state("gates")
+            };
+            assert_eq!(s.shape(), shape);
+        }
         std::fs::write(&p, "{ not json").expect("write");
         assert!(read_all(&p).is_empty());
     }

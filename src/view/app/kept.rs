@@ -37,8 +37,9 @@ impl ViewerApp {
                 p.map_size as f32,
                 p.batch as f32,
             ],
-            disks: g.shape == visgate_runtime::cpu::gates::GateShape::Disk,
-            voxels: g.shape == visgate_runtime::cpu::gates::GateShape::Voxels,
+            gate_shape: Some(SavedView::shape_name(g.shape)),
+            disks: false,
+            voxels: false,
             vals_layer: l.vals,
         }
     }
@@ -56,11 +57,7 @@ impl ViewerApp {
             &mut self.settings.per_vpl,
         );
         g.max_hops = hops as u32;
-        g.shape = match (s.disks, s.voxels) {
-            (true, _) => visgate_runtime::cpu::gates::GateShape::Disk,
-            (false, true) => visgate_runtime::cpu::gates::GateShape::Voxels,
-            (false, false) => visgate_runtime::cpu::gates::GateShape::Portal,
-        };
+        g.shape = s.shape();
         g.oversize = oversize;
         v.vals.count = vals as u32;
         v.vals.iterations = iterations as u32;
