@@ -2,7 +2,8 @@
 //! that could exchange light (the two surfaces face each other): the pairs an exact ray sees
 //! that the walk finds or blocks, the pairs it occludes that the walk lets through or blocks,
 //! and the blocked ones by how many cluster changes the segment passes (sampled at 101
-//! points); then the voxel walk's agreement on the same pairs, and both walks' CPU time.
+//! points); then the voxel walk's agreement on the same pairs, where along the segment it
+//! blocks the visible ones (voxels from the nearer end), and both walks' CPU time.
 //! `tests/portals.rs` holds `ajar-door` to this on built-ins; this measures real levels.
 //!
 //! `cargo run --release --example portal_agreement -- SCENE LEVEL.vgate CAMERA [WxH] [PATHS]`
@@ -15,6 +16,7 @@ use visgate_formats::vgate::BakedLevel;
 use visgate_runtime::camera::View;
 use visgate_runtime::cpu::gates::{GateLevel, GateParams, Walk};
 use visgate_runtime::cpu::portal_walk::facing_pairs;
+use visgate_runtime::cpu::sight::VoxelSight;
 use visgate_runtime::cpu::tracer::Tracer;
 use visgate_runtime::vpl::{PathParams, path_vpls};
 
@@ -30,6 +32,9 @@ struct Counts {
     over_the_limit: u64,
     /// The voxel walk: visible and found, visible and blocked, occluded and let through.
     voxels: [u64; 3],
+    /// The voxel walk's blocked visible pairs by how far the first closed voxel lies from the
+    /// nearer end, in voxels: under 1, 1–2, 2–4, 4–8, 8 or more.
+    voxels_blocked_from_end: [u64; 5],
     /// CPU time of the portal walks and of the voxel walks.
     seconds: [f64; 2],
 }
@@ -47,6 +52,22 @@ fn changes(gates: &GateLevel, a: Vec3, b: Vec3) -> usize {
         last = Some(c);
     }
     n
+}
+
+/// How far along the walk from `x` to `y` (voxel coordinates) the first closed voxel lies from
+/// the nearer end, in voxels (bisection on where the walk stops being clear).
+fn block_from_end(sight: &VoxelSight, x: Vec3, y: Vec3) -> f32 {
+    let (mut lo, mut hi) = (0.0f32, 1.0f32);
+    for _ in 0..24 {
+        let m = 0.5 * (lo + hi);
+        if sight.clear(x, x + (y - x) * m) {
+            lo = m;
+        } else {
+            hi = m;
+        }
+    }
+    let len = (y - x).length();
+    (lo * len).min((1.0 - lo) * len)
 }
 
 fn main() -> anyhow::Result<()> {
@@ -94,7 +115,18 @@ fn main() -> anyhow::Result<()> {
         n.seconds[1] += t.elapsed().as_secs_f64();
         match (pair.exact, through) {
             (true, true) => n.voxels[0] += 1,
-            (true, false) => n.voxels[1] += 1,
+            (true, false) => {
+                n.voxels[1] += 1;
+                let ends = (
+                    sight.end(pair.vpl, pair.vpl_normal),
+                    sight.end(pair.point, pair.point_normal),
+                );
+                if let (Some(x), Some(y)) = ends {
+                    let d = block_from_end(sight, x, y);
+                    n.voxels_blocked_from_end[[1.0, 2.0, 4.0, 8.0].partition_point(|&b| b <= d)] +=
+                        1;
+                }
+            }
             (false, true) => n.voxels[2] += 1,
             (false, false) => {}
         }
@@ -145,6 +177,11 @@ fn main() -> anyhow::Result<()> {
         pct(blocked),
         100.0 * blocked as f64 / (found + blocked).max(1) as f64,
         pct(let_through)
+    );
+    let [b1, b2, b4, b8, b_far] = n.voxels_blocked_from_end;
+    println!(
+        "voxel walk's blocked visible pairs by the first closed voxel's distance from the nearer \
+         end: < 1 voxel {b1}, 1-2 {b2}, 2-4 {b4}, 4-8 {b8}, 8 or more {b_far}"
     );
     println!(
         "CPU time: portal walks {:.0} ms, voxel walks {:.0} ms",
