@@ -253,26 +253,30 @@ pub fn portals(
         .into_par_iter()
         .map(|(pair, faces)| {
             let mut parts = Vec::new();
-            pieces(faces.clone(), spread_m, 0, &mut parts);
+            let count = faces.len() as u64;
+            pieces(faces, spread_m, 0, &mut parts);
             let mine: Vec<Portal> = parts
                 .iter()
                 .map(|p| portal_of(pair, p, vs, cell_voxels))
                 .collect();
             let mut out = Portals::default();
-            for f in &faces {
-                let c = f.centre.to_array();
-                let covered = mine.iter().any(|p| {
-                    let q = f.centre - Vec3::from(p.normal) * p.distance(c);
-                    p.covers(q.to_array())
-                });
-                let nearest = mine
-                    .iter()
-                    .map(|p| p.distance(c).abs())
-                    .fold(f32::MAX, f32::min);
-                out.uncovered += u64::from(!covered);
-                out.off_plane += u64::from(nearest > spread_m);
+            // Each face against its own piece's portal first, which nearly always covers it
+            // and lies within the spread: the counts of testing every portal, at a fraction of
+            // the tests (Crytek Sponza 512: 64 pieces a pair at most).
+            for (k, part) in parts.iter().enumerate() {
+                let order = || std::iter::once(&mine[k]).chain(mine.iter());
+                for f in part {
+                    let c = f.centre.to_array();
+                    let covered = order().any(|p| {
+                        let q = f.centre - Vec3::from(p.normal) * p.distance(c);
+                        p.covers(q.to_array())
+                    });
+                    let near = order().any(|p| p.distance(c).abs() <= spread_m);
+                    out.uncovered += u64::from(!covered);
+                    out.off_plane += u64::from(!near);
+                }
             }
-            out.interface_faces = faces.len() as u64;
+            out.interface_faces = count;
             out.portals = mine;
             out
         })
