@@ -11,18 +11,16 @@
 //!
 //! `cargo run --release --example closed_voxel_triangles -- SCENE LEVEL.vgate CAMERA [WxH] [PATHS]`
 
+#[path = "common/pairs.rs"]
+mod pairs;
+
 use std::collections::HashMap;
 
 use glam::{IVec3, Vec3};
-use visgate_formats::ImportOptions;
-use visgate_formats::vgate::{BakedLevel, GridMeta};
+use visgate_formats::vgate::GridMeta;
 use visgate_preprocess::voxelize::tri_box_overlap;
-use visgate_runtime::camera::View;
-use visgate_runtime::cpu::gates::GateLevel;
 use visgate_runtime::cpu::portal_walk::facing_pairs;
 use visgate_runtime::cpu::sight::VoxelSight;
-use visgate_runtime::cpu::tracer::Tracer;
-use visgate_runtime::vpl::{PathParams, path_vpls};
 
 /// The triangles touching each closed voxel of the sight grid.
 struct ClosedTriangles {
@@ -128,42 +126,25 @@ impl ClosedTriangles {
 }
 
 fn main() -> anyhow::Result<()> {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let [scene, level, camera, ..] = args.as_slice() else {
-        anyhow::bail!("usage: closed_voxel_triangles SCENE LEVEL.vgate CAMERA [WxH] [PATHS]");
-    };
-    let size = args.get(3).map_or("160x90", String::as_str);
-    let (w, h) = size
-        .split_once('x')
-        .and_then(|(w, h)| Some((w.parse::<u32>().ok()?, h.parse::<u32>().ok()?)))
-        .ok_or_else(|| anyhow::anyhow!("size {size}: WIDTHxHEIGHT"))?;
-    let paths = args.get(4).map_or(Ok(1024), |p| p.parse::<u32>())?;
-    let scene = visgate_scenes::load(scene, &ImportOptions::default())?;
-    let baked = BakedLevel::read(std::path::Path::new(level))?;
-    let grid = baked.info.sight_grid;
-    let gates = GateLevel::new(baked, &scene)?;
+    let pairs::Pairs {
+        gates,
+        tracer,
+        vpls,
+        view,
+        camera,
+        size: [w, h],
+        sight_grid: grid,
+        triangles,
+    } = pairs::from_args("closed_voxel_triangles")?;
     let sight = gates.sight();
     let t0 = std::time::Instant::now();
-    let closed = ClosedTriangles::new(grid, sight, scene.static_triangles().collect());
+    let closed = ClosedTriangles::new(grid, sight, triangles);
     let refs: usize = closed.by_voxel.values().map(Vec::len).sum();
     println!(
         "closed voxels with triangles {}, triangle references {refs}, built in {:.2} s",
         closed.by_voxel.len(),
         t0.elapsed().as_secs_f64()
     );
-    let tracer = Tracer::new(&scene);
-    let params = PathParams {
-        paths,
-        bounces: 1,
-        seed: 1,
-    };
-    let vpls = path_vpls(&tracer, &scene.lights, &params)?;
-    let cam = scene
-        .cameras
-        .iter()
-        .find(|c| &c.name == camera)
-        .ok_or_else(|| anyhow::anyhow!("no camera '{camera}'"))?;
-    let view = View::new(cam, [w, h])?;
     // [exact][walk][hybrid] pair counts; the same with the true segment tested too.
     let mut n = [[[0u64; 2]; 2]; 2];
     let mut n2 = [[[0u64; 2]; 2]; 2];

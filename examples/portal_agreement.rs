@@ -10,15 +10,13 @@
 //!
 //! Defaults: 160x90, 1,024 one-bounce light paths (seed 1, as `visgate compare`).
 
+#[path = "common/pairs.rs"]
+mod pairs;
+
 use glam::Vec3;
-use visgate_formats::ImportOptions;
-use visgate_formats::vgate::BakedLevel;
-use visgate_runtime::camera::View;
 use visgate_runtime::cpu::gates::{GateLevel, GateParams, Walk};
 use visgate_runtime::cpu::portal_walk::facing_pairs;
 use visgate_runtime::cpu::sight::VoxelSight;
-use visgate_runtime::cpu::tracer::Tracer;
-use visgate_runtime::vpl::{PathParams, path_vpls};
 
 /// Pair counts of one view.
 #[derive(Debug, Default)]
@@ -71,31 +69,15 @@ fn block_from_end(sight: &VoxelSight, x: Vec3, y: Vec3) -> f32 {
 }
 
 fn main() -> anyhow::Result<()> {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let [scene, level, camera, ..] = args.as_slice() else {
-        anyhow::bail!("usage: portal_agreement SCENE LEVEL.vgate CAMERA [WxH] [PATHS]");
-    };
-    let size = args.get(3).map_or("160x90", String::as_str);
-    let (w, h) = size
-        .split_once('x')
-        .and_then(|(w, h)| Some((w.parse::<u32>().ok()?, h.parse::<u32>().ok()?)))
-        .ok_or_else(|| anyhow::anyhow!("size {size}: WIDTHxHEIGHT"))?;
-    let paths = args.get(4).map_or(Ok(1024), |p| p.parse::<u32>())?;
-    let scene = visgate_scenes::load(scene, &ImportOptions::default())?;
-    let gates = GateLevel::new(BakedLevel::read(std::path::Path::new(level))?, &scene)?;
-    let tracer = Tracer::new(&scene);
-    let params = PathParams {
-        paths,
-        bounces: 1,
-        seed: 1,
-    };
-    let vpls = path_vpls(&tracer, &scene.lights, &params)?;
-    let cam = scene
-        .cameras
-        .iter()
-        .find(|c| &c.name == camera)
-        .ok_or_else(|| anyhow::anyhow!("no camera '{camera}'"))?;
-    let view = View::new(cam, [w, h])?;
+    let pairs::Pairs {
+        gates,
+        tracer,
+        vpls,
+        view,
+        camera,
+        size: [w, h],
+        ..
+    } = pairs::from_args("portal_agreement")?;
     let walk = GateParams::default();
     let mut n = Counts::default();
     facing_pairs(&tracer, &gates, &view, &vpls, |pair| {
