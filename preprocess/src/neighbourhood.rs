@@ -136,6 +136,15 @@ pub fn is_isthmus_1d(mask: u32) -> bool {
     components(mask & N26, &ADJ26, N26, 2) >= 2
 }
 
+/// [`is_isthmus_1d`] and [`is_simple`] together, counting the object's 26-components once
+/// (the thinning asks both of every border voxel).
+#[inline]
+pub fn isthmus_and_simple(mask: u32) -> (bool, bool) {
+    let t26 = components(mask & N26, &ADJ26, N26, 2);
+    let simple = t26 == 1 && components(!mask & N18, &ADJ6_IN_N18, N6, 2) == 1;
+    (t26 >= 2, simple)
+}
+
 /// 2D simplicity of the centre of a 3 × 3 square, (8, 4) connectivity, given the 8-bit ring
 /// `ring` in the order of [`RING`]. A 256-entry table.
 #[inline]
@@ -479,6 +488,36 @@ mod tests {
             .filter(|p| *p != [0, 0, 0])
             .collect();
         assert!(is_simple(mask_of(&half)));
+    }
+
+    #[test]
+    fn isthmus_and_simple_together_answer_as_each_alone() {
+        // Random neighbourhoods of every density, and the known ones above.
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        for k in 0..200_000u64 {
+            // A density from 1/8 to 7/8: AND or OR of two or three random words.
+            let (a, b, c) = (next() as u32, next() as u32, next() as u32);
+            let m = [a & b & c, a & b, a, a | b, a | b | c][(k % 5) as usize] & ((1 << 27) - 1);
+            assert_eq!(
+                isthmus_and_simple(m),
+                (is_isthmus_1d(m), is_simple(m)),
+                "{m:#x}"
+            );
+        }
+        for m in [
+            0,
+            N26,
+            mask_of(&[[1, 0, 0]]),
+            mask_of(&[[-1, 0, 0], [1, 0, 0]]),
+        ] {
+            assert_eq!(isthmus_and_simple(m), (is_isthmus_1d(m), is_simple(m)));
+        }
     }
 
     #[test]

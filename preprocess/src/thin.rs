@@ -24,7 +24,7 @@
 
 use rayon::prelude::*;
 
-use crate::neighbourhood::{RING, bit, is_isthmus_1d, is_simple, is_simple_2d};
+use crate::neighbourhood::{RING, bit, is_simple_2d, isthmus_and_simple};
 
 /// Parameters of [`thin`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -114,7 +114,7 @@ pub fn thin(
                     return (false, false);
                 }
                 let (m, _) = masks_of(&flags, i);
-                (is_isthmus_1d(m), is_simple(m))
+                isthmus_and_simple(m)
             })
             .collect();
         let s16 = step.min(u16::MAX as u32 - 1) as u16;
