@@ -36,10 +36,10 @@ Modes:
                another visibility cluster (--gate-shape portal: the segment walks from
                cluster to cluster through the openings, at most --max-walk of them), or
                through a chain of at most --gate-hops gate disks (× --gate-oversize;
-               --gate-shape disk, the paper's), by
-               clustered shading (the paper's Table I passes: geometry pass, unique clusters
-               of --tile-px tiles × --depth-slices slices × visibility cluster, light
-               assignment into a pool of --light-entries, indirect lighting); GPU: ≤ 2 hops;
+               --gate-shape disk, the paper's), by clustered shading (the paper's Table I
+               passes: geometry pass, unique clusters of --tile-px tiles × --depth-slices
+               slices × visibility cluster, light assignment into a pool of
+               --light-entries, indirect lighting); GPU: ≤ 2 hops;
                --cpu: the CPU twin, per point. Pixels and VPLs outside every visibility
                cluster are not occluded (the pass report counts them)
   gates-per-pixel
