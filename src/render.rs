@@ -206,13 +206,21 @@ pub fn run(args: RenderArgs) -> Result<()> {
         .build()
         .context("cannot start the thread pool")?;
     let t = Instant::now();
-    let scene = crate::load_scene(
+    let mut scene = crate::load_scene(
         &args.scene,
         &ImportOptions {
             load_textures: true,
         },
     )?;
     let load_s = t.elapsed().as_secs_f64();
+    let baked = match &args.level {
+        Some(path) => Some(
+            visgate_formats::BakedLevel::read(path)
+                .with_context(|| format!("cannot read the level {}", path.display()))?,
+        ),
+        None => None,
+    };
+    crate::bare::light_if_bare(&mut scene, baked.as_ref(), &args.scene);
     let camera = crate::camera_of(&scene, &args.scene, args.camera.as_deref())?;
     if scene.lights.is_empty() {
         tracing::warn!(
@@ -220,12 +228,8 @@ pub fn run(args: RenderArgs) -> Result<()> {
             args.scene
         );
     }
-    let level = match (&args.level, job.mode().and_then(|m| m.gates())) {
-        (Some(path), Some(_)) => {
-            let level = visgate_formats::BakedLevel::read(path)
-                .with_context(|| format!("cannot read the level {}", path.display()))?;
-            Some(GateLevel::new(level, &scene)?)
-        }
+    let level = match (baked, job.mode().and_then(|m| m.gates())) {
+        (Some(level), Some(_)) => Some(GateLevel::new(level, &scene)?),
         _ => None,
     };
     let g_max = job.for_scene(&scene)?.params.g_max;

@@ -84,15 +84,38 @@ fn export_then_inspect_the_files_and_a_bare_mesh() {
     assert_eq!(v["triangles"], 36);
     assert_eq!(v["point_lights"], 0);
     assert_eq!(v["static_triangles"], 36);
-    // Rendering it: no camera, and the message says how to give it one.
-    let png = dir.path().join("bare.png");
+    // Rendering it: it gets a light and a camera in the open space inside the box (not in
+    // its blocks), and says so; the image is lit.
+    let png = dir.path().join("bare.exr");
     let o = visgate(&[
         "render",
         out.join("CornellBox-Original.obj").to_str().expect("utf8"),
         "--mode",
         "none",
+        "--size",
+        "32x24",
+        "--vpls",
+        "64",
         "-o",
         png.to_str().expect("utf8"),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stdout(&o).contains("no light and no camera") && stdout(&o).contains("[[light]]"),
+        "{}",
+        stdout(&o)
+    );
+    let img = image::open(&png).expect("exr").to_rgb32f();
+    let mean = img.pixels().map(|p| p.0.iter().sum::<f32>()).sum::<f32>() / (3.0 * 768.0);
+    assert!(mean > 0.05, "mean radiance {mean}");
+    // Compare needs the scene's own cameras: a bare mesh is told how to give it some.
+    let o = visgate(&[
+        "compare",
+        out.join("CornellBox-Original.obj").to_str().expect("utf8"),
+        "--modes",
+        "none",
+        "--out",
+        dir.path().join("cmp").to_str().expect("utf8"),
     ]);
     assert!(!o.status.success());
     assert!(

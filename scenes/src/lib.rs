@@ -9,6 +9,7 @@
 //! All generated levels use 0.1 m cells, 0.2 m thick walls, floors at y = 0, rooms 3 m and
 //! corridors 2.5 m high, doorways 1 m wide and 2.1 m high.
 
+pub mod bare;
 pub mod level;
 pub mod quads;
 

@@ -214,7 +214,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
             args.scene
         );
     }
-    let scene = crate::load_scene(
+    let mut scene = crate::load_scene(
         &args.scene,
         &ImportOptions {
             load_textures: true,
@@ -231,6 +231,11 @@ pub fn run(args: ViewArgs) -> Result<()> {
         }
         None => None,
     };
+    crate::bare::light_if_bare(
+        &mut scene,
+        level.as_ref().map(GateLevel::baked),
+        &args.scene,
+    );
     let camera = match args.camera.as_deref() {
         Some("level") => None,
         Some(name) => Some(

@@ -1,0 +1,147 @@
+//! What a bare mesh file needs to be looked at. An OBJ or glTF on its own carries no light and
+//! no camera, so every render of it is black (or refused for want of a camera). Such a scene
+//! gets a point light and a camera named `inside` at the same place: the centre of the
+//! level's largest empty ball where a baked level is given (inside its largest room, where a
+//! level's light belongs), else the enclosed point farthest from the geometry found by rays;
+//! the camera looks along the bounds' longest horizontal axis. The light's intensity gives the
+//! walls around it about 2 W/m² (`I = 2 d²` W/sr, `d` the mean distance to them).
+
+use glam::Vec3;
+use visgate_formats::vgate::BakedLevel;
+use visgate_formats::{Camera, Light, Scene};
+
+/// Name of the camera [`light_a_bare_scene`] adds.
+pub const INSIDE_CAMERA: &str = "inside";
+
+/// Directions a point is probed along: the 26 of a voxel's neighbours.
+pub fn probe_directions() -> Vec<Vec3> {
+    let mut out = Vec::with_capacity(26);
+    for z in -1..=1 {
+        for y in -1..=1 {
+            for x in -1..=1 {
+                if (x, y, z) != (0, 0, 0) {
+                    out.push(Vec3::new(x as f32, y as f32, z as f32).normalize());
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Gives `scene` a light where it has none and a camera where it has none (see the module
+/// notes); says what it added, or `None` when it needed nothing (or has no geometry).
+/// `probe(p)` is the nearest and the mean distance to the geometry along
+/// [`probe_directions`] from `p`, `None` where a ray escapes. Without a level, the place is the
+/// enclosed point of a 7³ lattice over the bounds farthest from the geometry (a point inside
+/// a closed solid is near its walls), else the farthest of all.
+pub fn light_a_bare_scene(
+    scene: &mut Scene,
+    level: Option<&BakedLevel>,
+    probe: &dyn Fn(Vec3) -> Option<(f32, f32)>,
+) -> Option<String> {
+    let (no_light, no_camera) = (scene.lights.is_empty(), scene.cameras.is_empty());
+    if !no_light && !no_camera {
+        return None;
+    }
+    let (lo, hi) = scene.bounds()?;
+    let ball = level.and_then(|l| {
+        l.topology
+            .skeleton
+            .nodes
+            .iter()
+            .max_by(|a, b| a.radius_m.total_cmp(&b.radius_m))
+            .filter(|n| n.radius_m > 0.0)
+            .map(|n| Vec3::from(n.position_m))
+    });
+    let (at, from) = match ball {
+        Some(p) => (p, "the centre of the level's largest empty ball"),
+        None => {
+            const N: usize = 7;
+            let lattice = (0..N * N * N).map(|i| {
+                let t = Vec3::new((i % N) as f32, ((i / N) % N) as f32, (i / (N * N)) as f32);
+                lo + (hi - lo) * (t + 0.5) / N as f32
+            });
+            let best = lattice
+                .filter_map(|p| probe(p).map(|(near, _)| (near, p)))
+                .max_by(|a, b| a.0.total_cmp(&b.0));
+            match best {
+                Some((_, p)) => (p, "the enclosed point farthest from the geometry"),
+                None => ((lo + hi) * 0.5, "the centre of the scene's bounds"),
+            }
+        }
+    };
+    // Walls at the mean distance around it get about 2 W/m².
+    let mean = probe(at).map_or(0.1 * (hi - lo).length(), |(_, mean)| mean);
+    let mut said = Vec::new();
+    if no_light {
+        let intensity = 2.0 * mean * mean;
+        scene.lights.push(Light::Point {
+            position: at,
+            intensity: Vec3::splat(intensity),
+        });
+        said.push(format!("a point light of {intensity:.3} W/sr"));
+    }
+    if no_camera {
+        let size = hi - lo;
+        let along = if size.x >= size.z { Vec3::X } else { Vec3::Z };
+        scene.cameras.push(Camera {
+            name: INSIDE_CAMERA.into(),
+            eye: at,
+            target: at + along,
+            up: Vec3::Y,
+            fov_x_rad: 70f32.to_radians(),
+        });
+        said.push(format!("a camera '{INSIDE_CAMERA}'"));
+    }
+    Some(format!(
+        "the scene has no {}: {} at ({:.3}, {:.3}, {:.3}) m, {from} (give [[light]]s and \
+         [[camera]]s in a scene TOML that names the mesh to choose your own)",
+        match (no_light, no_camera) {
+            (true, true) => "light and no camera",
+            (true, false) => "light",
+            _ => "camera",
+        },
+        said.join(" and "),
+        at.x,
+        at.y,
+        at.z
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_scene_gets_only_what_it_lacks_at_the_enclosed_point_farthest_from_its_walls() {
+        let mut scene = crate::Builtin::EmptyBox.scene().expect("builtin");
+        let (lo, hi) = scene.bounds().expect("bounds");
+        // Inside the room's box every ray hits a wall: the nearest is the distance to the
+        // nearest face, the mean a stand-in.
+        let probe = |p: Vec3| {
+            let near = (p - lo).min(hi - p).min_element();
+            (near > 0.0).then_some((near, 2.0 * near))
+        };
+        assert!(light_a_bare_scene(&mut scene, None, &probe).is_none());
+        let lights = scene.lights.clone();
+        scene.cameras.clear();
+        let said = light_a_bare_scene(&mut scene, None, &probe).expect("a camera");
+        assert!(
+            said.contains("no camera") && !said.contains("point light"),
+            "{said}"
+        );
+        assert_eq!(scene.lights, lights);
+        assert_eq!(scene.cameras.len(), 1);
+        scene.lights.clear();
+        scene.cameras.clear();
+        let said = light_a_bare_scene(&mut scene, None, &probe).expect("both");
+        assert!(said.contains("no light and no camera"), "{said}");
+        let [Light::Point { position, .. }] = scene.lights[..] else {
+            panic!("one point light: {:?}", scene.lights);
+        };
+        // The lattice point nearest the box's centre is the farthest from every face.
+        let c = (lo + hi) * 0.5;
+        assert!((position - c).abs().max_element() < (hi - lo).max_element() / 7.0);
+        assert_eq!(scene.cameras[0].eye, position);
+    }
+}

@@ -1,0 +1,29 @@
+//! A bare mesh made visible: `visgate_scenes::bare` with the scene's own rays as its probe.
+
+use visgate_formats::Scene;
+use visgate_formats::vgate::BakedLevel;
+use visgate_runtime::cpu::tracer::Tracer;
+use visgate_scenes::bare::{light_a_bare_scene, probe_directions};
+
+/// Gives a scene without a light or a camera both (see `visgate_scenes::bare`) and prints
+/// what it added, prefixed with the scene's argument.
+pub fn light_if_bare(scene: &mut Scene, level: Option<&BakedLevel>, arg: &str) {
+    if !scene.lights.is_empty() && !scene.cameras.is_empty() {
+        return;
+    }
+    let tracer = Tracer::new(scene);
+    let dirs = probe_directions();
+    let probe = |p: glam::Vec3| {
+        let mut near = f32::INFINITY;
+        let mut sum = 0.0;
+        for &d in &dirs {
+            let t = tracer.trace(p, d)?.t;
+            near = near.min(t);
+            sum += t;
+        }
+        Some((near, sum / dirs.len() as f32))
+    };
+    if let Some(note) = light_a_bare_scene(scene, level, &probe) {
+        println!("{arg}: {note}");
+    }
+}
