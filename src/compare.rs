@@ -321,12 +321,23 @@ fn level(
 }
 
 pub fn run_compare(args: CompareArgs) -> Result<()> {
-    let scene = crate::load_scene(
+    let mut scene = crate::load_scene(
         &args.scene,
         &ImportOptions {
             load_textures: true,
         },
     )?;
+    // A bare mesh gets a light and a camera where `visgate render` puts them.
+    if scene.lights.is_empty() || scene.cameras.is_empty() {
+        let baked = match &args.level {
+            Some(p) => Some(
+                BakedLevel::read(p)
+                    .with_context(|| format!("cannot read the level {}", p.display()))?,
+            ),
+            None => None,
+        };
+        crate::bare::light_if_bare(&mut scene, baked.as_ref(), &args.scene);
+    }
     let cameras = if args.cameras.iter().any(|c| c == "all") {
         scene.cameras.clone()
     } else {

@@ -108,21 +108,30 @@ fn export_then_inspect_the_files_and_a_bare_mesh() {
     let img = image::open(&png).expect("exr").to_rgb32f();
     let mean = img.pixels().map(|p| p.0.iter().sum::<f32>()).sum::<f32>() / (3.0 * 768.0);
     assert!(mean > 0.05, "mean radiance {mean}");
-    // Compare needs the scene's own cameras: a bare mesh is told how to give it some.
+    // Compare too: the same light and camera, one row against the reference.
+    let cmp = dir.path().join("cmp");
     let o = visgate(&[
         "compare",
         out.join("CornellBox-Original.obj").to_str().expect("utf8"),
         "--modes",
         "none",
+        "--vpls",
+        "64",
+        "--size",
+        "32x24",
+        "--spp",
+        "1",
         "--out",
-        dir.path().join("cmp").to_str().expect("utf8"),
+        cmp.to_str().expect("utf8"),
     ]);
-    assert!(!o.status.success());
+    assert!(o.status.success(), "{}", stderr(&o));
     assert!(
-        stderr(&o).contains("bare mesh carries no camera") && stderr(&o).contains("[[mesh]]"),
+        stdout(&o).contains("no light and no camera"),
         "{}",
-        stderr(&o)
+        stdout(&o)
     );
+    let report = std::fs::read_to_string(cmp.join("report.md")).expect("report");
+    assert!(report.contains("## Camera inside"), "{report}");
 }
 
 #[test]
