@@ -232,6 +232,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
         (Some(level), Some(_)) => Some(GateLevel::new(level, &scene)?),
         _ => None,
     };
+    let described = job.mode().map(|m| m.describe()).unwrap_or_default();
     let g_max = job.for_scene(&scene)?.params.g_max;
     match job.clamp {
         GeometryClamp::PerSquareMetre(_) => println!("geometry-term clamp g_max {g_max:.4} 1/m²"),
@@ -271,7 +272,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
                 }
                 f.image.write(&out, args.exposure)?;
                 let setup = setup.lock().unwrap_or_else(|e| e.into_inner()).clone();
-                print_frame(&args, &scene.name, &f, load_s, &setup);
+                print_frame(&args, (&scene.name, &described), &f, load_s, &setup);
                 println!("wrote {}", out.display());
                 Ok(())
             },
@@ -280,12 +281,22 @@ pub fn run(args: RenderArgs) -> Result<()> {
     Ok(())
 }
 
-/// Prints what a frame was and took.
-fn print_frame(args: &RenderArgs, scene: &str, f: &JobFrame, load_s: f64, setup: &str) {
+/// Prints what a frame was (the scene's name and the method's settings in words) and took.
+fn print_frame(
+    args: &RenderArgs,
+    (scene, described): (&str, &str),
+    f: &JobFrame,
+    load_s: f64,
+    setup: &str,
+) {
     let [bvh_s, vpl_s] = f.prep_s;
+    let mode = if described.is_empty() {
+        args.mode.to_string()
+    } else {
+        format!("{} ({described})", args.mode)
+    };
     println!(
-        "{scene} {} {}{}: {} VPLs ({:?}, {} asked, {} bounce(s))",
-        args.mode,
+        "{scene} {mode} {}{}: {} VPLs ({:?}, {} asked, {} bounce(s))",
         args.size,
         match f.stats {
             FrameStats::Gpu(_) => " (GPU)".to_string(),

@@ -765,10 +765,16 @@ fn render_gates_uses_a_baked_level_and_refuses_a_missing_or_stale_one() {
     let out = p("g.exr");
     let level = p("two.vgate");
     a.extend(["--level", &level, "--out", &out]);
-    // The default: the voxel walk (no clusters or lists, each VPL's end).
+    // The default: the voxel walk (no clusters or lists, each VPL's end), named in the
+    // frame's first line.
     let o = visgate(&a);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stdout(&o).contains("VPL walk ends"), "{}", stdout(&o));
+    assert!(
+        stdout(&o).contains("gates (voxel walk, 8×8 interleaved) 16x12"),
+        "{}",
+        stdout(&o)
+    );
     assert!(!stdout(&o).contains("unique clusters"), "{}", stdout(&o));
     a.extend(["--gate-shape", "portal"]);
     let o = visgate(&a);
