@@ -133,12 +133,12 @@ fn main() -> anyhow::Result<()> {
         view,
         camera,
         size: [w, h],
-        sight_grid: grid,
-        triangles,
+        scene,
     } = pairs::from_args("closed_voxel_triangles")?;
+    let grid = gates.baked().info.sight_grid;
     let sight = gates.sight();
     let t0 = std::time::Instant::now();
-    let closed = ClosedTriangles::new(grid, sight, triangles);
+    let closed = ClosedTriangles::new(grid, sight, scene.static_triangles().collect());
     let refs: usize = closed.by_voxel.values().map(Vec::len).sum();
     println!(
         "closed voxels with triangles {}, triangle references {refs}, built in {:.2} s",

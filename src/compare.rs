@@ -281,10 +281,12 @@ fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMod
     Ok(out)
 }
 
-/// The level for the gate modes: read, baked at the asked resolution, or baked at 128 when a
-/// gate mode wants one (left out if the scene does not bake); and its key.
+/// The level for the gate modes: `read` (--level, where the caller read it already) or read,
+/// baked at the asked resolution, or baked at 128 when a gate mode wants one (left out if the
+/// scene does not bake); and its key.
 fn level(
     args: &CompareArgs,
+    read: Option<BakedLevel>,
     scene: &Scene,
     modes: &mut Vec<CompareMode>,
 ) -> Result<Option<(GateLevel, String)>> {
@@ -292,9 +294,10 @@ fn level(
         return Ok(None);
     }
     let baked = match (&args.level, args.bake_resolution) {
-        (Some(p), _) => {
-            BakedLevel::read(p).with_context(|| format!("cannot read the level {}", p.display()))?
-        }
+        (Some(p), _) => match read {
+            Some(b) => b,
+            None => read_level(p)?,
+        },
         (None, n) => {
             let voxels = n.unwrap_or(128);
             println!("baking the level at {voxels} voxels on the longest axis");
@@ -320,6 +323,11 @@ fn level(
     Ok(Some((GateLevel::new(baked, scene)?, key)))
 }
 
+/// The baked level at `p`.
+fn read_level(p: &std::path::Path) -> Result<BakedLevel> {
+    BakedLevel::read(p).with_context(|| format!("cannot read the level {}", p.display()))
+}
+
 pub fn run_compare(args: CompareArgs) -> Result<()> {
     let mut scene = crate::load_scene(
         &args.scene,
@@ -327,16 +335,12 @@ pub fn run_compare(args: CompareArgs) -> Result<()> {
             load_textures: true,
         },
     )?;
-    // A bare mesh gets a light and a camera where `visgate render` puts them.
+    // A bare mesh gets a light and a camera where `visgate render` puts them (the level read
+    // for it is the gate modes' too).
+    let mut read = None;
     if scene.lights.is_empty() || scene.cameras.is_empty() {
-        let baked = match &args.level {
-            Some(p) => Some(
-                BakedLevel::read(p)
-                    .with_context(|| format!("cannot read the level {}", p.display()))?,
-            ),
-            None => None,
-        };
-        crate::bare::light_if_bare(&mut scene, baked.as_ref(), &args.scene);
+        read = args.level.as_deref().map(read_level).transpose()?;
+        crate::bare::light_if_bare(&mut scene, read.as_ref(), &args.scene);
     }
     let cameras = if args.cameras.iter().any(|c| c == "all") {
         scene.cameras.clone()
@@ -361,7 +365,7 @@ pub fn run_compare(args: CompareArgs) -> Result<()> {
             twice.1.label
         );
     }
-    let level = level(&args, &scene, &mut modes)?;
+    let level = level(&args, read, &scene, &mut modes)?;
     let ground_truth = args
         .ground_truth
         .iter()

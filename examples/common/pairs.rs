@@ -18,12 +18,9 @@ pub struct Pairs {
     /// The camera's name and the view's size.
     pub camera: String,
     pub size: [u32; 2],
-    /// The level's sight grid (read by `closed_voxel_triangles` alone, hence the allow).
+    /// The scene (read by `closed_voxel_triangles` alone, hence the allow).
     #[allow(dead_code)]
-    pub sight_grid: visgate_formats::vgate::GridMeta,
-    /// The scene's static triangles (likewise). [Units: m]
-    #[allow(dead_code)]
-    pub triangles: Vec<[glam::Vec3; 3]>,
+    pub scene: visgate_formats::Scene,
 }
 
 /// Reads the command line (`name` for the usage line). Defaults: 160x90, 1,024 paths.
@@ -39,9 +36,7 @@ pub fn from_args(name: &str) -> anyhow::Result<Pairs> {
         .ok_or_else(|| anyhow::anyhow!("size {size}: WIDTHxHEIGHT"))?;
     let paths = args.get(4).map_or(Ok(1024), |p| p.parse::<u32>())?;
     let scene = visgate_scenes::load(scene, &ImportOptions::default())?;
-    let baked = BakedLevel::read(std::path::Path::new(level))?;
-    let sight_grid = baked.info.sight_grid;
-    let gates = GateLevel::new(baked, &scene)?;
+    let gates = GateLevel::new(BakedLevel::read(std::path::Path::new(level))?, &scene)?;
     let tracer = Tracer::new(&scene);
     let params = PathParams {
         paths,
@@ -62,7 +57,6 @@ pub fn from_args(name: &str) -> anyhow::Result<Pairs> {
         view,
         camera: camera.clone(),
         size: [w, h],
-        sight_grid,
-        triangles: scene.static_triangles().collect(),
+        scene,
     })
 }

@@ -149,6 +149,9 @@ pub struct Frame<'a> {
     pub vpl_count: u32,
     /// The same VPLs on the CPU, where the caller gave them.
     pub vpls_cpu: Option<&'a [Vpl]>,
+    /// VPLs of a pixel's subset mode gates walks a draw ([`methods::walk_batch`]; also
+    /// [`Globals::walk_batch`], which the shader reads).
+    pub walk_batch: u32,
 }
 
 /// Every pass's pipelines.
@@ -477,6 +480,11 @@ impl GpuRenderer {
             GpuMode::VplClusters(..) => ShadeIndirect::VplClusters,
             _ => ShadeIndirect::DirectOnly,
         };
+        let walk_batch = methods::walk_batch(
+            &ctx.adapter_info.name,
+            &params.mode,
+            scene.level.as_ref().map(|l| l.sight_steps),
+        );
         let globals = Globals {
             view_proj: view.view_proj(scene.near_m).to_cols_array_2d(),
             eye: view.eye.extend(1.0).to_array(),
@@ -493,11 +501,7 @@ impl GpuRenderer {
             shade_mode: shade_mode as u32,
             shadow_size: params.shadows.size,
             direct_mode: params.direct.shader_id(),
-            walk_batch: methods::walk_batch(
-                &ctx.adapter_info.name,
-                &params.mode,
-                scene.level.as_ref().map(|l| l.sight_steps),
-            ),
+            walk_batch,
             _pad1: 0,
             _pad2: 0,
         };
@@ -525,6 +529,7 @@ impl GpuRenderer {
             vpls,
             vpl_count,
             vpls_cpu,
+            walk_batch,
         };
         (frame, &self.pipelines, pool)
     }

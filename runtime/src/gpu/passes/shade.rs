@@ -190,9 +190,7 @@ impl Shade {
             return out;
         };
         // Portals' batches ping-pong between two targets, each adding onto the other's sum.
-        let steps = f.scene.level.as_ref().map(|l| l.sight_steps);
-        let batch =
-            crate::gpu::methods::walk_batch(&f.ctx.adapter_info.name, &f.params.mode, steps);
+        let batch = f.walk_batch;
         let walks = f.params.mode.walks_per_pixel(f.vpl_count);
         let batches = if batch > 0 {
             walks.div_ceil(batch).max(1)
