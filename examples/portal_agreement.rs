@@ -52,13 +52,13 @@ fn changes(gates: &GateLevel, a: Vec3, b: Vec3) -> usize {
     n
 }
 
-/// How far along the walk from `x` to `y` (voxel coordinates) the first closed voxel lies from
-/// the nearer end, in voxels (bisection on where the walk stops being clear).
+/// How far along the walk from `x` to `y` (voxel coordinates) the voxel that blocks it lies
+/// from the nearer end, in voxels (bisection on where the walk stops being clear).
 fn block_from_end(sight: &VoxelSight, x: Vec3, y: Vec3) -> f32 {
     let (mut lo, mut hi) = (0.0f32, 1.0f32);
     for _ in 0..24 {
         let m = 0.5 * (lo + hi);
-        if sight.clear(x, x + (y - x) * m) {
+        if sight.clear(x, x + (y - x) * m, true) {
             lo = m;
         } else {
             hi = m;
@@ -99,15 +99,10 @@ fn main() -> anyhow::Result<()> {
             (true, true) => n.voxels[0] += 1,
             (true, false) => {
                 n.voxels[1] += 1;
-                let ends = (
-                    sight.end(pair.vpl, pair.vpl_normal),
-                    sight.end(pair.point, pair.point_normal),
-                );
-                if let (Some(x), Some(y)) = ends {
-                    let d = block_from_end(sight, x, y);
-                    n.voxels_blocked_from_end[[1.0, 2.0, 4.0, 8.0].partition_point(|&b| b <= d)] +=
-                        1;
-                }
+                let x = sight.true_end(pair.vpl, pair.vpl_normal);
+                let y = sight.true_end(pair.point, pair.point_normal);
+                let d = block_from_end(sight, x, y);
+                n.voxels_blocked_from_end[[1.0, 2.0, 4.0, 8.0].partition_point(|&b| b <= d)] += 1;
             }
             (false, true) => n.voxels[2] += 1,
             (false, false) => {}

@@ -1,10 +1,12 @@
 //! # visgate-formats
 //!
 //! Plain data and I/O shared by the bake (`visgate-preprocess`) and the runtime
-//! (`visgate-runtime`); no algorithms and no GPU:
+//! (`visgate-runtime`); no algorithms but one shared predicate, and no GPU:
 //!
 //! - [`desc`]: the scene description, a TOML file a user writes by hand (meshes, material
 //!   overrides, lights, cameras, up axis and units, whether the level is closed);
+//! - [`geom`]: the triangle–box test that the bake voxelizes with and the runtime lists
+//!   triangles by;
 //! - [`import`]: mesh import — OBJ (tobj, with MTL colours and diffuse textures) and glTF/GLB
 //!   (gltf, with base colour factor/texture and node transforms) — with every bad input turned
 //!   into a typed error or a counted warning;
@@ -16,6 +18,7 @@
 pub mod desc;
 pub mod error;
 pub mod export;
+pub mod geom;
 pub mod import;
 pub mod load;
 pub mod mitsuba;

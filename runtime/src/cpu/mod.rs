@@ -10,5 +10,6 @@ pub mod lightcluster;
 pub mod portal_walk;
 pub mod reference;
 pub mod sight;
+pub mod sight_triangles;
 pub mod tracer;
 pub mod val;

@@ -15,6 +15,11 @@
 //! shared levels at 512 voxels a walk took about 20 steps with 4³ bricks where the plain DDA
 //! takes 120–160.
 //!
+//! A closed voxel is where geometry may be, not where it is: the walk passes one where the true
+//! segment, between the two surface points, hits none of the triangles listed there
+//! ([`super::sight_triangles`]; the scene's triangles, listed when the level is loaded), so a
+//! segment that grazes a wall, a column or a door's edge within a voxel is not blocked.
+//!
 //! Each end starts off its own surface, whose closed voxels it may lie in: at the first of
 //! [`END_OFFSETS_VOXELS`] along its normal that lands in an open voxel (a segment from a plane
 //! that starts √3 voxels off it never enters that plane's voxels again), else at the centre of
@@ -24,6 +29,10 @@
 
 use glam::{BVec3, IVec3, Vec3};
 use visgate_formats::vgate::{GridMeta, VoxelBits};
+
+use super::sight_triangles::{
+    ClosedTriangles, TRIANGLE_TESTS_PER_WALK, TRUE_END_OFFSET_VOXELS, WalkTests,
+};
 
 /// Voxels along a brick's side (sight.wgsl's `SIGHT_BRICK`). 2³ bricks step near walls in
 /// fewer, shorter steps than 4³ ones and cost as many bytes as the open bits (a byte a
@@ -48,6 +57,8 @@ pub struct VoxelSight {
     /// Per brick, the chessboard distance in bricks to the nearest brick that holds a closed
     /// voxel (0: it holds one), at most 255; the grid's outside counts as closed.
     clear: Vec<u8>,
+    /// The triangles in the closed voxels (none: every closed voxel blocks).
+    triangles: ClosedTriangles,
 }
 
 /// `a` divided by `b`, rounded up.
@@ -95,7 +106,25 @@ impl VoxelSight {
             words,
             bricks,
             clear: chessboard(bricks, &closed),
+            triangles: ClosedTriangles::default(),
         }
+    }
+
+    /// The same walk, passing a closed voxel where neither segment hits one of the `triangles`
+    /// (m, the level's static geometry) that touch it ([`super::sight_triangles`]).
+    pub fn with_triangles(self, grid: &GridMeta, triangles: &[[Vec3; 3]]) -> VoxelSight {
+        let triangles = ClosedTriangles::new(grid, |v| self.open(v), triangles);
+        VoxelSight { triangles, ..self }
+    }
+
+    /// The triangles in the closed voxels.
+    pub fn triangles(&self) -> &ClosedTriangles {
+        &self.triangles
+    }
+
+    /// Point `p` (m) in voxel coordinates.
+    pub fn to_voxels(&self, p: Vec3) -> Vec3 {
+        (p - self.origin_m) / self.voxel_m
     }
 
     /// Whether voxel `v` is open (false outside the grid).
@@ -119,7 +148,7 @@ impl VoxelSight {
     /// Where the walk from or to surface point `p` (normal `n`) starts, in voxel coordinates
     /// (the grid's minimum corner at 0, a voxel 1 wide); `None` with no open voxel near.
     pub fn end(&self, p: Vec3, n: Vec3) -> Option<Vec3> {
-        let q = (p - self.origin_m) / self.voxel_m;
+        let q = self.to_voxels(p);
         for k in END_OFFSETS_VOXELS {
             let s = q + n * k;
             if self.open(s.floor().as_ivec3()) {
@@ -154,9 +183,12 @@ impl VoxelSight {
         (self.dims.x + self.dims.y + self.dims.z + 1) as u32
     }
 
-    /// Whether the segment from `a` to `b` (voxel coordinates, both in open voxels) crosses
-    /// open voxels alone: the brick march described in the module docs.
-    pub fn clear(&self, a: Vec3, b: Vec3) -> bool {
+    /// Whether the segment from `a` to `b` (voxel coordinates) crosses open voxels alone — the
+    /// brick march described in the module docs — or, with `lists`, also closed voxels where
+    /// it hits none of the triangles listed there, within [`TRIANGLE_TESTS_PER_WALK`] list
+    /// entries ([`super::sight_triangles`]).
+    pub fn clear(&self, a: Vec3, b: Vec3, lists: bool) -> bool {
+        let mut tests = WalkTests::new(if lists { TRIANGLE_TESTS_PER_WALK } else { 0 });
         let d = b - a;
         let (moves, up) = (d.cmpne(Vec3::ZERO), d.cmpgt(Vec3::ZERO));
         // An axis the segment does not move along is never the one it leaves a cube across.
@@ -168,7 +200,7 @@ impl VoxelSight {
             let c = self.brick_clear(brick);
             let (lo, hi) = if c > 0 {
                 ((brick - (c - 1)) * BRICK, (brick + c) * BRICK - 1)
-            } else if self.open(v) {
+            } else if self.open(v) || self.passes(v, (a, b), &mut tests) {
                 (v, v)
             } else {
                 return false;
@@ -201,39 +233,61 @@ impl VoxelSight {
         false
     }
 
-    /// Whether light passes between surface points `a` (normal `na`) and `b` (normal `nb`):
-    /// the walk between their ends; unoccluded when either has no open voxel near.
-    pub fn visible(&self, a: Vec3, na: Vec3, b: Vec3, nb: Vec3) -> bool {
-        match (self.end(a, na), self.end(b, nb)) {
-            (Some(x), Some(y)) => self.clear(x, y),
-            _ => true,
+    /// Whether a walk passes closed voxel `v` (inside the grid) on its triangles.
+    fn passes(&self, v: IVec3, segment: (Vec3, Vec3), tests: &mut WalkTests) -> bool {
+        if tests.left == 0 || v.cmplt(IVec3::ZERO).any() || v.cmpge(self.dims).any() {
+            return false;
         }
+        let i = (v.x + self.dims.x * (v.y + self.dims.y * v.z)) as usize;
+        self.triangles.pass(i, segment, tests)
+    }
+
+    /// The true segment's end at surface point `p` (normal `n`), in voxel coordinates.
+    pub fn true_end(&self, p: Vec3, n: Vec3) -> Vec3 {
+        self.to_voxels(p) + n * TRUE_END_OFFSET_VOXELS
+    }
+
+    /// Whether light passes between surface points `a` (normal `na`) and `b` (normal `nb`):
+    /// the walk along the segment between them (each end a hair off its surface), through the
+    /// closed voxels whose listed triangles it misses; unoccluded when either has no open
+    /// voxel near.
+    pub fn visible(&self, a: Vec3, na: Vec3, b: Vec3, nb: Vec3) -> bool {
+        if self.end(a, na).is_none() || self.end(b, nb).is_none() {
+            return true;
+        }
+        self.clear(self.true_end(a, na), self.true_end(b, nb), true)
     }
 
     /// The walk's tables packed into words for sight.wgsl: `[nx, ny, nz, bricks x, y, z, word
-    /// offset of the clearances, 0, origin x, y, z (m, f32 bits), voxel edge (m, f32 bits)]`,
-    /// the open bits (32 a word), then the bricks' clearances, four bytes a word
-    /// (little-endian).
+    /// offset of the clearances, triangle tests a walk, origin x, y, z (m, f32 bits), voxel
+    /// edge (m, f32 bits), word offsets of the closed voxels' marks, lists, triangle indices
+    /// and triangles (0: no lists)]`, the open bits (32 a word), the bricks'
+    /// clearances, four bytes a word (little-endian), then the triangle lists
+    /// ([`ClosedTriangles::words`]).
     pub fn words(&self) -> Vec<u32> {
         let clear_at = SIGHT_HEADER_WORDS + self.words.len();
-        let mut w = Vec::with_capacity(clear_at + self.clear.len().div_ceil(4));
+        let lists_at = clear_at + self.clear.len().div_ceil(4);
+        let (lists, at) = self.triangles.words(lists_at);
+        let mut w = Vec::with_capacity(lists_at + lists.len());
         w.extend(self.dims.to_array().map(|x| x as u32));
         w.extend(self.bricks.to_array().map(|x| x as u32));
-        w.extend([clear_at as u32, 0]);
+        w.extend([clear_at as u32, TRIANGLE_TESTS_PER_WALK]);
         w.extend(self.origin_m.to_array().map(f32::to_bits));
         w.push(self.voxel_m.to_bits());
+        w.extend(at);
         w.extend(&self.words);
         w.extend(self.clear.chunks(4).map(|c| {
             let mut b = [0u8; 4];
             b[..c.len()].copy_from_slice(c);
             u32::from_le_bytes(b)
         }));
+        w.extend(lists);
         w
     }
 }
 
 /// Words before the open bits in [`VoxelSight::words`].
-pub const SIGHT_HEADER_WORDS: usize = 12;
+pub const SIGHT_HEADER_WORDS: usize = 16;
 
 /// Voxel `i` of a grid of `dims` (x fastest).
 fn voxel_of(i: usize, dims: IVec3) -> IVec3 {
@@ -291,6 +345,7 @@ fn chessboard(dims: IVec3, closed: &[bool]) -> Vec<u8> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::cpu::sight_triangles::TRIANGLE_WORDS;
 
     fn grid(dims: [u32; 3]) -> GridMeta {
         GridMeta {
@@ -400,7 +455,7 @@ mod tests {
                 }
                 pairs += 1;
                 assert_eq!(
-                    s.clear(a, b),
+                    s.clear(a, b, false),
                     dda_clear(&s, a, b),
                     "level {level}: {a} → {b}"
                 );
@@ -451,6 +506,64 @@ mod tests {
             floor(3.0, 5.0),
             Vec3::Y
         ));
+    }
+
+    #[test]
+    fn a_segment_over_a_walls_top_passes_its_closed_voxels_and_one_through_it_does_not() {
+        // A single-sided wall in the plane x = 10.1, 5.2 high, across the whole depth; the
+        // voxels its triangles touch are closed (the top ones are crossed by no segment that
+        // meets the wall).
+        let dims = [20u32, 10, 10];
+        let wall = [
+            [
+                Vec3::new(10.1, 0.0, 0.0),
+                Vec3::new(10.1, 5.2, 0.0),
+                Vec3::new(10.1, 0.0, 10.0),
+            ],
+            [
+                Vec3::new(10.1, 5.2, 0.0),
+                Vec3::new(10.1, 5.2, 10.0),
+                Vec3::new(10.1, 0.0, 10.0),
+            ],
+        ];
+        let touched = |v: IVec3| {
+            wall.iter().any(|t| {
+                visgate_formats::geom::tri_box_overlap(
+                    v.as_dvec3() + 0.5,
+                    0.5,
+                    t.map(|p| p.as_dvec3()),
+                )
+            })
+        };
+        let open = VoxelBits::from_fn(2000, |i| !touched(voxel_of(i, IVec3::new(20, 10, 10))));
+        let bare = VoxelSight::new(&grid(dims), &open);
+        let s = bare.clone().with_triangles(&grid(dims), &wall);
+        // Every closed voxel touched by the same one or two triangles: a few shared lists.
+        let lists = s.triangles();
+        assert!(lists.voxels() >= 60 && lists.lists() <= 3 && lists.references() <= 4);
+        let (a, b) = (Vec3::new(8.5, 6.5, 5.0), Vec3::new(11.5, 5.4, 5.0));
+        assert!(!bare.open(IVec3::new(10, 5, 5)));
+        assert!(!bare.clear(a, b, true), "no lists: closed voxels block");
+        assert!(!s.clear(a, b, false), "lists not read: closed voxels block");
+        assert!(s.clear(a, b, true));
+        assert!(s.visible(a, Vec3::X, b, -Vec3::X));
+        // Through the wall.
+        let (c, d) = (Vec3::new(8.5, 3.5, 5.0), Vec3::new(11.5, 3.5, 5.0));
+        assert!(!s.clear(c, d, true));
+        // From a point on the wall, whose walk starts in the wall's closed voxels: its own side
+        // sees the room and not past the wall, the other side the reverse.
+        let on = Vec3::new(10.1, 2.0, 5.0);
+        let (room, beyond) = (Vec3::new(3.0, 5.0, 5.0), Vec3::new(16.0, 3.0, 7.0));
+        assert!(s.visible(on, -Vec3::X, room, Vec3::X));
+        assert!(!s.visible(on, -Vec3::X, beyond, -Vec3::X));
+        assert!(s.visible(on, Vec3::X, beyond, -Vec3::X));
+        assert!(!s.visible(on, Vec3::X, room, Vec3::X));
+        // The packed words carry the lists after the clearances.
+        let w = s.words();
+        assert_eq!(w[7], TRIANGLE_TESTS_PER_WALK);
+        assert_eq!(w[12] as usize, w[6] as usize + bare.clear.len().div_ceil(4));
+        assert_eq!(w[15] as usize + TRIANGLE_WORDS * wall.len(), w.len());
+        assert_eq!(&bare.words()[12..16], &[0; 4]);
     }
 
     #[test]

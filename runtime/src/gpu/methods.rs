@@ -7,6 +7,7 @@
 
 use crate::RenderError;
 use crate::cpu::gates::{GateParams, GateShape};
+use crate::cpu::sight_triangles::TRIANGLE_TESTS_PER_WALK;
 use crate::cpu::val::ValParams;
 
 pub use super::passes::clustered_gates::GatesParams;
@@ -403,14 +404,17 @@ const SOFTWARE_LOOP_ITERATIONS: u32 = 65_535 - 256;
 /// `adapter`: 0 (all in one) but on a software rasterizer, where portals take
 /// [`SOFTWARE_WALK_BATCH`] and voxel walks as many as fit the loop limit when each takes the
 /// most steps one can, `sight_steps` (the sight grid's dims summed, plus one; the level's
-/// [`LevelBuffers::sight_steps`](super::passes::clustered_gates::LevelBuffers)): a draw costs
-/// a pass over the frame, so fewer draws are faster (e2m3's 21 cm grid: 52 walks a draw; its
-/// hall at 512 x 512, 16,384 VPLs: indirect pass 3,466 -> 3,040 ms against 16 a draw).
+/// [`LevelBuffers::sight_steps`](super::passes::clustered_gates::LevelBuffers)), and the
+/// triangle tests a walk may add in closed voxels: a draw costs a pass over the frame, so
+/// fewer draws are faster (e2m3's 21 cm grid: 49 walks a draw; its hall at 512 x 512, 16,384
+/// VPLs, before the triangle tests: indirect pass 3,466 -> 3,040 ms against 16 a draw).
 pub fn walk_batch(adapter: &str, mode: &GpuMode, sight_steps: Option<u32>) -> u32 {
     match mode {
         GpuMode::Gates(p) if p.gates.shape != GateShape::Disk && software(adapter) => {
             match (p.gates.shape, sight_steps) {
-                (GateShape::Voxels, Some(steps)) => (SOFTWARE_LOOP_ITERATIONS / (steps + 1)).max(1),
+                (GateShape::Voxels, Some(steps)) => {
+                    (SOFTWARE_LOOP_ITERATIONS / (steps + 1 + TRIANGLE_TESTS_PER_WALK)).max(1)
+                }
                 _ => SOFTWARE_WALK_BATCH,
             }
         }
@@ -470,13 +474,14 @@ mod tests {
         let mut voxels = portals;
         voxels.gates.shape = GateShape::Voxels;
         let voxels = GpuMode::Gates(voxels);
-        assert_eq!(walk_batch(llvmpipe, &voxels, Some(1251)), 52);
-        assert_eq!(walk_batch(llvmpipe, &voxels, Some(99)), 652);
+        assert_eq!(walk_batch(llvmpipe, &voxels, Some(1251)), 49);
+        assert_eq!(walk_batch(llvmpipe, &voxels, Some(99)), 398);
         assert_eq!(walk_batch(llvmpipe, &voxels, Some(200_000)), 1);
         assert_eq!(walk_batch(llvmpipe, &voxels, None), SOFTWARE_WALK_BATCH);
         for steps in [3, 100, 1251, 4000] {
             let batch = walk_batch(llvmpipe, &voxels, Some(steps));
-            assert!(batch * (steps + 1) + 256 <= 65_535, "{steps}: {batch}");
+            let walk = steps + 1 + TRIANGLE_TESTS_PER_WALK;
+            assert!(batch * walk + 256 <= 65_535, "{steps}: {batch}");
         }
         assert_eq!(walk_batch("NVIDIA H100 80GB HBM3", &voxels, Some(1251)), 0);
     }

@@ -290,10 +290,12 @@ fn portal_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, j: u32, s
     var sum = vec3<f32>(0.0);
     var first = j;
     var end = globals.vpl_count;
-    // The voxel walk's end at p (off its face), the same for every VPL.
+    // The voxel walk's end at p (a hair off its face; w = 0: no open voxel near), the same for
+    // every VPL.
     var at_p = vec4<f32>(0.0);
     if gate_shape() == GATE_VOXELS {
-        at_p = sight_end(p, face_normal(px));
+        let n_face = face_normal(px);
+        at_p = vec4<f32>(sight_true_end(p, n_face), sight_end(p, n_face).w);
     }
     if globals.walk_batch > 0u {
         first = j + batch * globals.walk_batch * subsets;

@@ -1,9 +1,13 @@
 // The voxel walk (runtime::cpu::sight::VoxelSight is its CPU twin): whether the segment between
 // a VPL and a surface point crosses open voxels alone. It reads the including pass's
 // `sight_words: array<u32>` (VoxelSight::words: [nx, ny, nz, bricks x, y, z, offset of the
-// clearances, 0, origin xyz (m), voxel edge (m)], the open bits 32 a word, then each brick's
-// chessboard distance in bricks to the nearest brick holding a closed voxel, a byte each). A
-// step crosses the cube of bricks that a brick's clearance proves open, or one open voxel.
+// clearances, triangle tests a walk, origin xyz (m), voxel edge (m), offsets of the closed
+// voxels' marks, list offsets, triangle indices and corners (0: no lists)], the open bits 32 a
+// word, each brick's chessboard distance in bricks to the nearest brick holding a closed voxel,
+// a byte each, then the triangle lists (runtime::cpu::sight_triangles::ClosedTriangles). A
+// step crosses the cube of bricks that a brick's clearance proves open, one open voxel, or a
+// closed voxel where the segment hits no listed triangle. The segment runs between the surface
+// points themselves, each a hair off its surface (runtime::cpu::sight_triangles).
 
 // SIGHT_BRICK (voxels along a brick's side) and SIGHT_BITS (VoxelSight's header words) are
 // injected from runtime::cpu::sight.
@@ -22,11 +26,80 @@ fn sight_open(v: vec3<i32>) -> bool {
     return ((sight_words[SIGHT_BITS + i / 32u] >> (i % 32u)) & 1u) == 1u;
 }
 
-// Where the walk from or to surface point p (normal n) starts, in voxel coordinates; w = 0:
-// no open voxel near (VoxelSight::end).
-fn sight_end(p: vec3<f32>, n: vec3<f32>) -> vec4<f32> {
+// Point p (m) in voxel coordinates.
+fn sight_voxels(p: vec3<f32>) -> vec3<f32> {
     let origin = bitcast<vec3<f32>>(vec3<u32>(sight_words[8], sight_words[9], sight_words[10]));
-    let q = (p - origin) / bitcast<f32>(sight_words[11]);
+    return (p - origin) / bitcast<f32>(sight_words[11]);
+}
+
+// The true segment's end at surface point p (normal n), in voxel coordinates
+// (VoxelSight::true_end; TRUE_END_OFFSET_VOXELS is 1e-3).
+fn sight_true_end(p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
+    return sight_voxels(p) + n * 1e-3;
+}
+
+// Word w of listed triangle t as a float (runtime::cpu::sight_triangles::TRIANGLE_WORDS a
+// triangle: its plane's normal and offset, its first corner, its two edges).
+fn sight_tri(t: u32, w: u32) -> f32 {
+    return bitcast<f32>(sight_words[sight_words[15] + 13u * t + w]);
+}
+
+fn sight_tri3(t: u32, w: u32) -> vec3<f32> {
+    return vec3<f32>(sight_tri(t, w), sight_tri(t, w + 1u), sight_tri(t, w + 2u));
+}
+
+// Whether segment a-b hits listed triangle t strictly between its ends: the ends on either side
+// of its plane, then Möller-Trumbore (runtime::cpu::sight_triangles::hits).
+fn sight_hits(t: u32, a: vec3<f32>, b: vec3<f32>) -> bool {
+    let n = sight_tri3(t, 0u);
+    let plane = sight_tri(t, 3u);
+    if (dot(n, a) - plane) * (dot(n, b) - plane) >= 0.0 {
+        return false;
+    }
+    let c0 = sight_tri3(t, 4u);
+    let e1 = sight_tri3(t, 7u);
+    let e2 = sight_tri3(t, 10u);
+    let d = b - a;
+    let p = cross(d, e2);
+    let det = dot(e1, p);
+    if abs(det) < 1e-12 {
+        return false;
+    }
+    let s = a - c0;
+    let u = dot(s, p) / det;
+    let q = cross(s, e1);
+    let w = dot(d, q) / det;
+    let h = dot(e2, q) / det;
+    return u >= 0.0 && w >= 0.0 && u + w <= 1.0 && h > 1e-4 && h < 1.0 - 1e-4;
+}
+
+// The list of closed voxel i (its index in the grid): its id, and [first, end) of the triangle
+// indices; id 0xffffffff where it has none (ClosedTriangles::list).
+fn sight_list(i: u32) -> vec3<u32> {
+    let marks_at = sight_words[12];
+    if marks_at == 0u {
+        return vec3<u32>(0xffffffffu, 0u, 0u);
+    }
+    let mask = sight_words[marks_at + 2u * (i / 32u)];
+    let bit = 1u << (i % 32u);
+    if (mask & bit) == 0u {
+        return vec3<u32>(0xffffffffu, 0u, 0u);
+    }
+    let k = sight_words[marks_at + 2u * (i / 32u) + 1u] + countOneBits(mask & (bit - 1u));
+    // The list packed: its start in the indices (high 24 bits), its length less one (low 8);
+    // a voxel whose list overflowed (255 + 1 entries) blocks (LIST_MAX).
+    let id = sight_words[sight_words[13] + k];
+    let len = (id & 0xffu) + 1u;
+    if len > 255u {
+        return vec3<u32>(0xffffffffu, 0u, 0u);
+    }
+    return vec3<u32>(id, id >> 8u, (id >> 8u) + len);
+}
+
+// An open voxel's point off surface point p (normal n), in voxel coordinates; w = 0: no open
+// voxel near, where the bake knows nothing (VoxelSight::end).
+fn sight_end(p: vec3<f32>, n: vec3<f32>) -> vec4<f32> {
+    let q = sight_voxels(p);
     // END_OFFSETS_VOXELS: 1.25, 2.25, 3.25.
     for (var k = 0; k < 3; k++) {
         let s = q + n * (1.25 + f32(k));
@@ -54,8 +127,11 @@ fn sight_end(p: vec3<f32>, n: vec3<f32>) -> vec4<f32> {
     return best;
 }
 
-// Whether the segment a → b (voxel coordinates, both in open voxels) crosses open voxels alone
-// (VoxelSight::clear, step for step).
+// Whether the segment a → b (voxel coordinates) crosses open voxels, or closed ones whose
+// listed triangles it misses (VoxelSight::clear with the lists, step for step). One loop: an
+// iteration is a step of the march or a list entry of the closed voxel it stands in, so that
+// on a GPU's SIMD lanes a walk testing a list does not hold the others' steps (a loop per list
+// inside the march's ran the light room of ajar-door 1.6x as long on lavapipe).
 fn sight_clear(a: vec3<f32>, b: vec3<f32>) -> bool {
     let d = b - a;
     let moves = d != vec3<f32>(0.0);
@@ -66,23 +142,63 @@ fn sight_clear(a: vec3<f32>, b: vec3<f32>) -> bool {
     let dims = sight_dims();
     let bricks = vec3<i32>(i32(sight_words[3]), i32(sight_words[4]), i32(sight_words[5]));
     let clear_at = sight_words[6];
-    let most = dims.x + dims.y + dims.z + 1;
-    for (var step = 0; step < most; step++) {
-        if any(v < vec3<i32>(0)) || any(v >= dims) {
-            return false;
-        }
-        let brick = v / SIGHT_BRICK;
-        let k = u32(brick.x + bricks.x * (brick.y + bricks.y * brick.z));
-        let c = i32((sight_words[clear_at + k / 4u] >> (8u * (k % 4u))) & 0xffu);
+    let refs_at = sight_words[14];
+    // List entries the walk may still read; the closed voxel's entries still to read [r, r_end)
+    // of list `list`, the last list read whole, the last two triangles tested
+    // (runtime::cpu::sight_triangles::WalkTests).
+    var left = sight_words[7];
+    var r = 0u;
+    var r_end = 0u;
+    var list = 0xffffffffu;
+    var passed = 0xffffffffu;
+    var last0 = 0xffffffffu;
+    var last1 = 0xffffffffu;
+    let most = u32(dims.x + dims.y + dims.z + 1) + left;
+    for (var step = 0u; step < most; step++) {
         var lo = v;
         var hi = v;
-        if c > 0 {
-            lo = (brick - (c - 1)) * SIGHT_BRICK;
-            hi = (brick + c) * SIGHT_BRICK - 1;
-        } else {
-            let i = u32(v.x + dims.x * (v.y + dims.y * v.z));
-            if ((sight_words[SIGHT_BITS + i / 32u] >> (i % 32u)) & 1u) == 0u {
+        if r < r_end {
+            if left == 0u {
                 return false;
+            }
+            left -= 1u;
+            let t = sight_words[refs_at + r];
+            r += 1u;
+            if t != last0 && t != last1 {
+                last1 = last0;
+                last0 = t;
+                if sight_hits(t, a, b) {
+                    return false;
+                }
+            }
+            if r < r_end {
+                continue;
+            }
+            passed = list;
+        } else {
+            if any(v < vec3<i32>(0)) || any(v >= dims) {
+                return false;
+            }
+            let brick = v / SIGHT_BRICK;
+            let k = u32(brick.x + bricks.x * (brick.y + bricks.y * brick.z));
+            let c = i32((sight_words[clear_at + k / 4u] >> (8u * (k % 4u))) & 0xffu);
+            if c > 0 {
+                lo = (brick - (c - 1)) * SIGHT_BRICK;
+                hi = (brick + c) * SIGHT_BRICK - 1;
+            } else {
+                let i = u32(v.x + dims.x * (v.y + dims.y * v.z));
+                if ((sight_words[SIGHT_BITS + i / 32u] >> (i % 32u)) & 1u) == 0u {
+                    let found = sight_list(i);
+                    if found.x == 0xffffffffu || (found.x != passed && left == 0u) {
+                        return false;
+                    }
+                    if found.x != passed {
+                        list = found.x;
+                        r = found.y;
+                        r_end = found.z;
+                        continue;
+                    }
+                }
             }
         }
         if all(end >= lo) && all(end <= hi) {
@@ -106,13 +222,12 @@ fn sight_clear(a: vec3<f32>, b: vec3<f32>) -> bool {
     return false;
 }
 
-// Whether light passes between surface points a (normal na) and b (normal nb): the walk
-// between their ends; unoccluded when either has no open voxel near (VoxelSight::visible).
+// Whether light passes between surface points a (normal na) and b (normal nb): the walk along
+// the segment between them, each end a hair off its surface; unoccluded when either has no
+// open voxel near (VoxelSight::visible).
 fn voxel_sight(a: vec3<f32>, na: vec3<f32>, b: vec3<f32>, nb: vec3<f32>) -> bool {
-    let x = sight_end(a, na);
-    let y = sight_end(b, nb);
-    if x.w == 0.0 || y.w == 0.0 {
+    if sight_end(a, na).w == 0.0 || sight_end(b, nb).w == 0.0 {
         return true;
     }
-    return sight_clear(x.xyz, y.xyz);
+    return sight_clear(sight_true_end(a, na), sight_true_end(b, nb));
 }
