@@ -406,7 +406,7 @@ const SOFTWARE_LOOP_ITERATIONS: u32 = 65_535 - 256;
 /// most steps one can, `sight_steps` (the sight grid's dims summed, plus one; the level's
 /// [`LevelBuffers::sight_steps`](super::passes::clustered_gates::LevelBuffers)), and the
 /// triangle tests a walk may add in closed voxels: a draw costs a pass over the frame, so
-/// fewer draws are faster (e2m3's 21 cm grid: 49 walks a draw; its hall at 512 x 512, 16,384
+/// fewer draws are faster (e2m3's 21 cm grid: 37 walks a draw; its hall at 512 x 512, 16,384
 /// VPLs, before the triangle tests: indirect pass 3,466 -> 3,040 ms against 16 a draw).
 pub fn walk_batch(adapter: &str, mode: &GpuMode, sight_steps: Option<u32>) -> u32 {
     match mode {
@@ -474,8 +474,8 @@ mod tests {
         let mut voxels = portals;
         voxels.gates.shape = GateShape::Voxels;
         let voxels = GpuMode::Gates(voxels);
-        assert_eq!(walk_batch(llvmpipe, &voxels, Some(1251)), 49);
-        assert_eq!(walk_batch(llvmpipe, &voxels, Some(99)), 398);
+        assert_eq!(walk_batch(llvmpipe, &voxels, Some(1251)), 37);
+        assert_eq!(walk_batch(llvmpipe, &voxels, Some(99)), 106);
         assert_eq!(walk_batch(llvmpipe, &voxels, Some(200_000)), 1);
         assert_eq!(walk_batch(llvmpipe, &voxels, None), SOFTWARE_WALK_BATCH);
         for steps in [3, 100, 1251, 4000] {
