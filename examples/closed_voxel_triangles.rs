@@ -3,7 +3,8 @@
 //! (as `portal_agreement`), walked three ways and measured against the shadow ray — between
 //! ends set off the surfaces with closed voxels blocking (the walk before the lists), the same
 //! ends with a closed voxel passed where the segment misses the triangles listed in it, and the
-//! mode's walk, along the true segment between the surface points, with the lists.
+//! walk of `--closed-voxel-triangles`, along the true segment between the surface points, with
+//! the lists.
 //!
 //! `cargo run --release --example closed_voxel_triangles -- SCENE LEVEL.vgate CAMERA [WxH] [PATHS]`
 
@@ -33,7 +34,7 @@ fn main() -> anyhow::Result<()> {
     const WAYS: [&str; 3] = [
         "closed voxels block (ends off the surfaces)",
         "+ triangles in closed voxels (ends off the surfaces)",
-        "the mode: the true segment walked, triangles in closed voxels",
+        "the true segment walked with the triangles (--closed-voxel-triangles)",
     ];
     // Per way: [exact][walk] pair counts.
     let mut n = [[[0u64; 2]; 2]; 3];

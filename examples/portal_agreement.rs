@@ -58,7 +58,7 @@ fn block_from_end(sight: &VoxelSight, x: Vec3, y: Vec3) -> f32 {
     let (mut lo, mut hi) = (0.0f32, 1.0f32);
     for _ in 0..24 {
         let m = 0.5 * (lo + hi);
-        if sight.clear(x, x + (y - x) * m, true) {
+        if sight.clear(x, x + (y - x) * m, false) {
             lo = m;
         } else {
             hi = m;
@@ -93,16 +93,22 @@ fn main() -> anyhow::Result<()> {
         n.seconds[0] += t.elapsed().as_secs_f64();
         let t = std::time::Instant::now();
         let sight = gates.sight();
-        let through = sight.visible(pair.vpl, pair.vpl_normal, pair.point, pair.point_normal);
+        let through =
+            sight.visible_blocking(pair.vpl, pair.vpl_normal, pair.point, pair.point_normal);
         n.seconds[1] += t.elapsed().as_secs_f64();
         match (pair.exact, through) {
             (true, true) => n.voxels[0] += 1,
             (true, false) => {
                 n.voxels[1] += 1;
-                let x = sight.true_end(pair.vpl, pair.vpl_normal);
-                let y = sight.true_end(pair.point, pair.point_normal);
-                let d = block_from_end(sight, x, y);
-                n.voxels_blocked_from_end[[1.0, 2.0, 4.0, 8.0].partition_point(|&b| b <= d)] += 1;
+                let ends = (
+                    sight.end(pair.vpl, pair.vpl_normal),
+                    sight.end(pair.point, pair.point_normal),
+                );
+                if let (Some(x), Some(y)) = ends {
+                    let d = block_from_end(sight, x, y);
+                    n.voxels_blocked_from_end[[1.0, 2.0, 4.0, 8.0].partition_point(|&b| b <= d)] +=
+                        1;
+                }
             }
             (false, true) => n.voxels[2] += 1,
             (false, false) => {}

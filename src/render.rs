@@ -30,10 +30,11 @@ Modes:
                --ism-map-size² paraboloid maps, holes filled by --ism-pull-push levels; one
                hard lookup per VPL (the cheap twin of per-vpl-shadow-maps)
   gates        GPU: a VPL lights a point along the baked --level's open voxels
-               (--gate-shape voxels, the default: in a voxel the bake's voxelization
-               closed, blocked where the segment hits one of the scene's triangles listed
-               there, so what stands inside a cluster blocks too), or only through its
-               portals when the point lies in
+               (--gate-shape voxels, the default: blocked by the first voxel the bake's
+               voxelization closed, so what stands inside a cluster blocks too; with
+               --closed-voxel-triangles only where the true segment hits a triangle in
+               one: near-exact, several times slower), or only through its portals when
+               the point lies in
                another visibility cluster (--gate-shape portal: the segment walks from
                cluster to cluster through the openings, at most --max-walk of them), or
                through a chain of at most --gate-hops gate disks (× --gate-oversize;

@@ -173,6 +173,13 @@ pub struct MethodArgs {
     /// lowest error and mostly the fastest), the baked portals, walked, or the paper's disks.
     #[arg(long, value_enum, default_value_t = GateShapeArg::Voxels)]
     pub gate_shape: GateShapeArg,
+    /// --gate-shape voxels: walk the true segment between the surface points and pass a
+    /// closed voxel where it hits none of the scene's triangles listed there (listed when the
+    /// level loads): near-exact visibility (99.3-100 % of pixel-VPL pairs agree with shadow
+    /// rays on the levels measured, against 88-99 % without), at several times the walk's cost
+    /// on a software rasterizer.
+    #[arg(long)]
+    pub closed_voxel_triangles: bool,
     /// Portals one walk may pass before it is given up and counted as occluded (--gate-shape
     /// portal), 1..=1024.
     #[arg(long, default_value_t = 64)]
@@ -402,6 +409,7 @@ impl MethodArgs {
                         GateShapeArg::Voxels => GateShape::Voxels,
                     },
                     max_walk: self.max_walk,
+                    triangles: self.closed_voxel_triangles,
                 },
                 clusters: ClusterParams {
                     tile_px: self.tile_px,

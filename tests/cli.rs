@@ -776,6 +776,39 @@ fn render_gates_uses_a_baked_level_and_refuses_a_missing_or_stale_one() {
         stdout(&o)
     );
     assert!(!stdout(&o).contains("unique clusters"), "{}", stdout(&o));
+    // With the triangles in the closed voxels, named too, and the same room as bright (the
+    // two rooms' walls are thick, so the walk sees what it saw).
+    let mean = |o: &std::process::Output| {
+        let line = stdout(o)
+            .lines()
+            .find(|l| l.starts_with("mean radiance"))
+            .map(String::from);
+        line.expect("mean radiance")
+    };
+    let mut t = a.clone();
+    t.push("--closed-voxel-triangles");
+    let ot = visgate(&t);
+    assert!(ot.status.success(), "{}", stderr(&ot));
+    assert!(
+        stdout(&ot).contains("gates (voxel walk + triangles, 8×8 interleaved) 16x12"),
+        "{}",
+        stdout(&ot)
+    );
+    let radiance = |o| -> Vec<f32> {
+        let m = mean(o);
+        m.split_whitespace()
+            .skip(2)
+            .map(|x| x.parse().expect("a number"))
+            .collect()
+    };
+    for (x, y) in radiance(&o).iter().zip(radiance(&ot)) {
+        assert!(
+            (x - y).abs() <= 0.02 * x.max(1e-3),
+            "{} / {}",
+            mean(&o),
+            mean(&ot)
+        );
+    }
     a.extend(["--gate-shape", "portal"]);
     let o = visgate(&a);
     assert!(o.status.success(), "{}", stderr(&o));

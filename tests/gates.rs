@@ -199,20 +199,23 @@ fn gpu_gates_agree_with_the_cpu_twin() {
             "gates without a level must be refused"
         );
         gpu.set_level(&ctx, &gates).expect("level upload");
-        for (clustered, hops, shape) in [
-            (true, 1, GateShape::Disk),
-            (true, 2, GateShape::Disk),
-            (false, 1, GateShape::Disk),
-            (false, 2, GateShape::Disk),
-            (true, 2, GateShape::Portal),
-            (false, 2, GateShape::Portal),
-            (true, 2, GateShape::Voxels),
-            (false, 2, GateShape::Voxels),
+        for (clustered, hops, shape, triangles) in [
+            (true, 1, GateShape::Disk, false),
+            (true, 2, GateShape::Disk, false),
+            (false, 1, GateShape::Disk, false),
+            (false, 2, GateShape::Disk, false),
+            (true, 2, GateShape::Portal, false),
+            (false, 2, GateShape::Portal, false),
+            (true, 2, GateShape::Voxels, false),
+            (false, 2, GateShape::Voxels, false),
+            (true, 2, GateShape::Voxels, true),
+            (false, 2, GateShape::Voxels, true),
         ] {
             let gp = GateParams {
                 oversize: 1.5,
                 max_hops: hops,
                 shape,
+                triangles,
                 ..GateParams::default()
             };
             let mode = if clustered {
@@ -229,7 +232,7 @@ fn gpu_gates_agree_with_the_cpu_twin() {
             let cpu = cpu_twin(&tracer, &scene.lights, &vpls, &view, (&gates, gp));
             let e = errors(&img, &cpu).expect("same size");
             eprintln!(
-                "{} {} {shape:?} {hops} hop(s): {e:?}",
+                "{} {} {shape:?} {hops} hop(s), triangles {triangles}: {e:?}",
                 b.name(),
                 mode.name()
             );

@@ -56,18 +56,29 @@ fn agreement_with(b: Builtin, bake: &BakeParams, params: &[GateParams]) -> Vec<V
     all
 }
 
-/// Portals, disks, then voxels.
-fn shapes() -> [GateParams; 3] {
-    [GateShape::Portal, GateShape::Disk, GateShape::Voxels].map(|shape| GateParams {
-        shape,
-        ..GateParams::default()
-    })
+/// Portals, disks, voxels, then voxels with the closed voxels' triangles.
+fn shapes() -> [GateParams; 4] {
+    let [p, d, v] =
+        [GateShape::Portal, GateShape::Disk, GateShape::Voxels].map(|shape| GateParams {
+            shape,
+            ..GateParams::default()
+        });
+    [
+        p,
+        d,
+        v,
+        GateParams {
+            triangles: true,
+            ..v
+        },
+    ]
 }
 
-fn print(name: &str, camera: usize, [p, d, v]: [&Agreement; 3]) {
+fn print(name: &str, camera: usize, [p, d, v, t]: [&Agreement; 4]) {
     println!(
         "{name} camera {camera}: {} pairs; portals agree {:.2} % ({} false visible, {} false \
-         occluded); disks {:.2} % ({} / {}); voxels {:.2} % ({} / {})",
+         occluded); disks {:.2} % ({} / {}); voxels {:.2} % ({} / {}); with triangles {:.2} % \
+         ({} / {})",
         p.pairs,
         100.0 * p.rate(),
         p.false_visible,
@@ -77,7 +88,10 @@ fn print(name: &str, camera: usize, [p, d, v]: [&Agreement; 3]) {
         d.false_occluded,
         100.0 * v.rate(),
         v.false_visible,
-        v.false_occluded
+        v.false_occluded,
+        100.0 * t.rate(),
+        t.false_visible,
+        t.false_occluded
     );
 }
 
@@ -86,8 +100,10 @@ fn ajar_door_portal_visibility_agrees_with_shadow_rays() {
     let cameras = agreement(Builtin::AjarDoor, 128, &shapes());
     assert_eq!(cameras.len(), 3);
     for (camera, found) in cameras.iter().enumerate() {
-        let [p, d, v] = found[..] else { unreachable!() };
-        print("ajar-door", camera, [&p, &d, &v]);
+        let [p, d, v, t] = found[..] else {
+            unreachable!()
+        };
+        print("ajar-door", camera, [&p, &d, &v, &t]);
         assert!(p.pairs > 10_000, "{p:?}");
         // Measured 95.6, 93.2 and 98.2 % (disks 93.8, 86.8, 97.0 %; 95.9, 92.3 and 98.3 %
         // before clusters were split where their nodes do not see each other and a voxel kept
@@ -97,17 +113,20 @@ fn ajar_door_portal_visibility_agrees_with_shadow_rays() {
             p.rate() > d.rate(),
             "camera {camera}: portals {p:?} disks {d:?}"
         );
-        // The voxel walk on the level's 512 sight grid (1.6 cm), voxelized thin, along the
-        // true segment, testing it against the triangles in the closed voxels it meets:
-        // measured 100.00 % on each camera (3 to 6 disagreeing pairs). With closed voxels
-        // blocking and the ends set off the surfaces, 99.14, 98.29 and 99.90 %, almost every
-        // disagreement a pair the voxels close (the door's 33 cm gap narrows by under half a
-        // voxel at each edge, the 5 cm slit above it by more).
-        assert!(v.rate() >= 0.999, "camera {camera}: {v:?}");
+        // The voxel walk on the level's 512 sight grid (1.6 cm), voxelized thin: measured
+        // 99.14, 98.29 and 99.90 %, almost every disagreement a pair the voxels close (the
+        // door's 33 cm gap narrows by under half a voxel at each edge, the 5 cm slit above it
+        // by more). The conservative voxelization gave 98.84, 97.69 and 99.85 %, under these
+        // floors on every camera.
+        let floor = [0.99, 0.98, 0.9987][camera];
+        assert!(v.rate() >= floor, "camera {camera}: {v:?}");
         assert!(
             v.rate() > p.rate(),
             "camera {camera}: voxels {v:?} portals {p:?}"
         );
+        // Along the true segment, with the triangles in the closed voxels it meets: 100.00 %
+        // on each camera (3 to 6 pairs differ).
+        assert!(t.rate() >= 0.999, "camera {camera}: {t:?}");
     }
 }
 
@@ -146,15 +165,16 @@ fn a_level_refined_from_a_coarser_partition_agrees_with_shadow_rays_better_than_
 fn four_rooms_portal_visibility_agrees_with_shadow_rays_on_99_percent_of_pairs() {
     // Thick walls and plain doorways: the portals are the doorways, one plane each.
     let found = agreement(Builtin::FourRooms, 128, &shapes());
-    let [p, d, v] = found[0][..] else {
+    let [p, d, v, t] = found[0][..] else {
         unreachable!()
     };
-    print("four-rooms", 0, [&p, &d, &v]);
+    print("four-rooms", 0, [&p, &d, &v, &t]);
     assert!(p.pairs > 100_000, "{p:?}");
     assert!(p.rate() >= 0.99 && p.rate() > d.rate(), "{p:?} {d:?}");
-    // The voxel walk: 100.00 % (99.35 % where closed voxels blocked: they close a doorway's
-    // edges a voxel wide).
-    assert!(v.rate() >= 0.999 && v.rate() > p.rate(), "{v:?} {p:?}");
+    // The voxels close a doorway's edges a voxel wide: 99.35 % (56 false visible pairs).
+    assert!(v.rate() >= 0.99 && v.rate() > p.rate(), "{v:?} {p:?}");
+    // With the triangles in the closed voxels: 100.00 % (2 pairs differ).
+    assert!(t.rate() >= 0.999, "{t:?}");
 }
 
 #[test]
@@ -166,15 +186,18 @@ fn pillared_hall_portal_visibility_agrees_with_shadow_rays_past_the_columns() {
     // (78.0 and 76.9 % before; disks 84.6 and 96.8 %). What is left: from the part of a gap on
     // one side of its gate, a segment can reach the column's flank inside that side's cluster.
     let cameras = agreement(Builtin::PillaredHall, 128, &shapes());
-    // The voxel walk sees the columns themselves: 99.95 and 100.00 % (99.1 and 99.8 % where
-    // closed voxels blocked).
+    // The voxel walk sees the columns themselves: 99.1 and 99.8 %.
     let floor = [0.85, 0.93];
     for (camera, found) in cameras.iter().enumerate() {
-        let [p, d, v] = found[..] else { unreachable!() };
-        print("pillared-hall", camera, [&p, &d, &v]);
+        let [p, d, v, t] = found[..] else {
+            unreachable!()
+        };
+        print("pillared-hall", camera, [&p, &d, &v, &t]);
         assert!(p.pairs > 10_000, "{p:?}");
         assert!(p.rate() >= floor[camera], "camera {camera}: {p:?}");
-        assert!(v.rate() >= 0.999, "camera {camera}: {v:?}");
+        assert!(v.rate() >= [0.99, 0.995][camera], "camera {camera}: {v:?}");
+        // With the triangles: 99.96 and 100.00 %.
+        assert!(t.rate() >= 0.999, "camera {camera}: {t:?}");
     }
 }
 

@@ -15,10 +15,13 @@
 //! shared levels at 512 voxels a walk took about 20 steps with 4³ bricks where the plain DDA
 //! takes 120–160.
 //!
-//! A closed voxel is where geometry may be, not where it is: the walk passes one where the true
-//! segment, between the two surface points, hits none of the triangles listed there
-//! ([`super::sight_triangles`]; the scene's triangles, listed when the level is loaded), so a
-//! segment that grazes a wall, a column or a door's edge within a voxel is not blocked.
+//! A closed voxel is where geometry may be, not where it is: with the scene's triangles listed
+//! in the closed voxels ([`super::sight_triangles`], when the level is loaded), the walk of
+//! [`VoxelSight::visible`] runs along the true segment, between the two surface points, and
+//! passes a closed voxel where the segment hits none of them, so a segment that grazes a wall, a
+//! column or a door's edge within a voxel is not blocked; [`VoxelSight::visible_blocking`] is
+//! the walk without them, between the ends described next (the default: several times
+//! faster).
 //!
 //! Each end starts off its own surface, whose closed voxels it may lie in: at the first of
 //! [`END_OFFSETS_VOXELS`] along its normal that lands in an open voxel (a segment from a plane
@@ -256,6 +259,16 @@ impl VoxelSight {
             return true;
         }
         self.clear(self.true_end(a, na), self.true_end(b, nb), true)
+    }
+
+    /// Whether light passes between surface points `a` (normal `na`) and `b` (normal `nb`),
+    /// every closed voxel blocking: the walk between their ends off the surfaces
+    /// ([`VoxelSight::end`]); unoccluded when either has no open voxel near.
+    pub fn visible_blocking(&self, a: Vec3, na: Vec3, b: Vec3, nb: Vec3) -> bool {
+        match (self.end(a, na), self.end(b, nb)) {
+            (Some(x), Some(y)) => self.clear(x, y, false),
+            _ => true,
+        }
     }
 
     /// The walk's tables packed into words for sight.wgsl: `[nx, ny, nz, bricks x, y, z, word

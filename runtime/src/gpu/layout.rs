@@ -165,6 +165,15 @@ gpu_struct! {
         pub shape: u32,
         /// Portals a walk may pass before it is given up.
         pub max_walk: u32,
+        /// The voxel walk: 1 along the true segment with the closed voxels' triangles, 0
+        /// between ends off the surfaces, every closed voxel blocking.
+        pub triangles: u32,
+        /// Padding.
+        pub _pad0: u32,
+        /// Padding.
+        pub _pad1: u32,
+        /// Padding.
+        pub _pad2: u32,
     }
 }
 

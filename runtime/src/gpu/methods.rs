@@ -205,6 +205,7 @@ impl GpuMode {
         let gates = |g: &GateParams| match g.shape {
             GateShape::Portal => format!("portals, walk ≤ {}", g.max_walk),
             GateShape::Disk => format!("disks ×{}, {} hop(s)", g.oversize, g.max_hops),
+            GateShape::Voxels if g.triangles => "voxel walk + triangles".to_string(),
             GateShape::Voxels => "voxel walk".to_string(),
         };
         // The VAL clustering's settings where they are not the paper's (Dong et al.'s).
@@ -405,15 +406,21 @@ const SOFTWARE_LOOP_ITERATIONS: u32 = 65_535 - 256;
 /// [`SOFTWARE_WALK_BATCH`] and voxel walks as many as fit the loop limit when each takes the
 /// most steps one can, `sight_steps` (the sight grid's dims summed, plus one; the level's
 /// [`LevelBuffers::sight_steps`](super::passes::clustered_gates::LevelBuffers)), and the
-/// triangle tests a walk may add in closed voxels: a draw costs a pass over the frame, so
-/// fewer draws are faster (e2m3's 21 cm grid: 37 walks a draw; its hall at 512 x 512, 16,384
-/// VPLs, before the triangle tests: indirect pass 3,466 -> 3,040 ms against 16 a draw).
+/// list entries a walk may read in closed voxels with the triangles: a draw costs a pass over
+/// the frame, so fewer draws are faster (e2m3's 21 cm grid: 52 walks a draw, 37 with the
+/// triangles; its hall at 512 x 512, 16,384 VPLs: indirect pass 3,466 -> 3,040 ms against 16 a
+/// draw).
 pub fn walk_batch(adapter: &str, mode: &GpuMode, sight_steps: Option<u32>) -> u32 {
     match mode {
         GpuMode::Gates(p) if p.gates.shape != GateShape::Disk && software(adapter) => {
             match (p.gates.shape, sight_steps) {
                 (GateShape::Voxels, Some(steps)) => {
-                    (SOFTWARE_LOOP_ITERATIONS / (steps + 1 + TRIANGLE_TESTS_PER_WALK)).max(1)
+                    let lists = if p.gates.triangles {
+                        TRIANGLE_TESTS_PER_WALK
+                    } else {
+                        0
+                    };
+                    (SOFTWARE_LOOP_ITERATIONS / (steps + 1 + lists)).max(1)
                 }
                 _ => SOFTWARE_WALK_BATCH,
             }
@@ -474,14 +481,22 @@ mod tests {
         let mut voxels = portals;
         voxels.gates.shape = GateShape::Voxels;
         let voxels = GpuMode::Gates(voxels);
-        assert_eq!(walk_batch(llvmpipe, &voxels, Some(1251)), 37);
-        assert_eq!(walk_batch(llvmpipe, &voxels, Some(99)), 106);
+        assert_eq!(walk_batch(llvmpipe, &voxels, Some(1251)), 52);
+        assert_eq!(walk_batch(llvmpipe, &voxels, Some(99)), 652);
+        // With the triangles, a walk may read 512 list entries too.
+        let mut triangles = portals;
+        triangles.gates.shape = GateShape::Voxels;
+        triangles.gates.triangles = true;
+        let triangles = GpuMode::Gates(triangles);
+        assert_eq!(walk_batch(llvmpipe, &triangles, Some(1251)), 37);
+        assert_eq!(walk_batch(llvmpipe, &triangles, Some(99)), 106);
         assert_eq!(walk_batch(llvmpipe, &voxels, Some(200_000)), 1);
         assert_eq!(walk_batch(llvmpipe, &voxels, None), SOFTWARE_WALK_BATCH);
         for steps in [3, 100, 1251, 4000] {
-            let batch = walk_batch(llvmpipe, &voxels, Some(steps));
-            let walk = steps + 1 + TRIANGLE_TESTS_PER_WALK;
-            assert!(batch * walk + 256 <= 65_535, "{steps}: {batch}");
+            for (mode, lists) in [(&voxels, 0), (&triangles, TRIANGLE_TESTS_PER_WALK)] {
+                let batch = walk_batch(llvmpipe, mode, Some(steps));
+                assert!(batch * (steps + 1 + lists) + 256 <= 65_535, "{steps}: {batch}");
+            }
         }
         assert_eq!(walk_batch("NVIDIA H100 80GB HBM3", &voxels, Some(1251)), 0);
     }

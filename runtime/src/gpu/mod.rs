@@ -516,6 +516,10 @@ impl GpuRenderer {
             max_hops: gates.max_hops,
             shape: gates.shape.shader_id(),
             max_walk: gates.max_walk,
+            triangles: u32::from(gates.triangles),
+            _pad0: 0,
+            _pad1: 0,
+            _pad2: 0,
         };
         let uniform = wgpu::BufferUsages::UNIFORM;
         let pool = &mut self.pool;

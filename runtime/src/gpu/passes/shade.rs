@@ -20,9 +20,9 @@ pub const HDR: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 pub struct Shade {
     pipeline: wgpu::RenderPipeline,
     /// The interleaved gates' indirect pass, a pipeline per gate shape (shade.wgsl's
-    /// `GATE_SHAPE`, by [`crate::cpu::gates::GateShape::shader_id`]), each made when first
-    /// used.
-    gates_indirect: [std::sync::OnceLock<wgpu::RenderPipeline>; 3],
+    /// `GATE_SHAPE`, by [`crate::cpu::gates::GateShape::shader_id`]) and one for the voxel
+    /// walk with the closed voxels' triangles (`SIGHT_TRIANGLES`), each made when first used.
+    gates_indirect: [std::sync::OnceLock<wgpu::RenderPipeline>; 4],
     module: wgpu::ShaderModule,
     vpl_clusters_indirect: wgpu::RenderPipeline,
 }
@@ -137,9 +137,17 @@ impl Shade {
         })
     }
 
-    /// The interleaved gates' indirect pipeline for gate shape `shape` (its shader id).
-    fn gates_indirect(&self, d: &wgpu::Device, shape: u32) -> &wgpu::RenderPipeline {
-        self.gates_indirect[shape as usize].get_or_init(|| {
+    /// The interleaved gates' indirect pipeline for gate shape `shape` (its shader id), the
+    /// voxel walk with the closed voxels' `triangles` or without.
+    fn gates_indirect(
+        &self,
+        d: &wgpu::Device,
+        shape: u32,
+        triangles: bool,
+    ) -> &wgpu::RenderPipeline {
+        let triangles = triangles && shape == GateShape::Voxels.shader_id();
+        let k = if triangles { 3 } else { shape as usize };
+        self.gates_indirect[k].get_or_init(|| {
             render_pipeline_with(
                 d,
                 "gates indirect (interleaved)",
@@ -147,7 +155,10 @@ impl Shade {
                 ("vs_batch", "fs_gates_indirect"),
                 &[],
                 (&[HDR], None),
-                &[("GATE_SHAPE", f64::from(shape))],
+                &[
+                    ("GATE_SHAPE", f64::from(shape)),
+                    ("SIGHT_TRIANGLES", f64::from(u8::from(triangles))),
+                ],
             )
         })
     }
@@ -210,7 +221,8 @@ impl Shade {
             _ => frame_target(f, pool, "indirect irradiance (batches)"),
         };
         let targets = [out, earlier];
-        let pipeline = self.gates_indirect(&f.ctx.device, shape.shader_id());
+        let triangles = f.params.mode.gates().is_some_and(|g| g.triangles);
+        let pipeline = self.gates_indirect(&f.ctx.device, shape.shader_id(), triangles);
         let pipeline = (pipeline, Some(&GATES_INDIRECT_BINDINGS[..]));
         self.draw_batches(f, rec, inputs, pipeline, (&targets, name), batches);
         targets[(batches as usize - 1) % 2].clone()

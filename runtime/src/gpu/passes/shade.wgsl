@@ -102,6 +102,19 @@ fn face_normal(px: vec2<i32>) -> vec3<f32> {
 override GATE_SHAPE: u32 = 3u;
 const GATE_SHAPE_AT_RUNTIME: u32 = 3u;
 
+// The voxel walk along the true segment with the closed voxels' triangles (1) or between ends
+// off the surfaces, closed voxels blocking (0): fixed with the interleaved pass's pipeline, or
+// SIGHT_TRIANGLES_AT_RUNTIME: the frame's (grid.triangles).
+override SIGHT_TRIANGLES: u32 = 2u;
+const SIGHT_TRIANGLES_AT_RUNTIME: u32 = 2u;
+
+fn sight_triangles() -> bool {
+    if SIGHT_TRIANGLES != SIGHT_TRIANGLES_AT_RUNTIME {
+        return SIGHT_TRIANGLES == 1u;
+    }
+    return grid.triangles != 0u;
+}
+
 fn gate_shape() -> u32 {
     if GATE_SHAPE != GATE_SHAPE_AT_RUNTIME {
         return GATE_SHAPE;
@@ -113,7 +126,7 @@ fn gate_shape() -> u32 {
 // the voxels (GateLevel::visible; the voxel walk starts off p's face).
 fn lit_through(v: Vpl, px: vec2<i32>, p: vec3<f32>, here: u32) -> bool {
     if gate_shape() == GATE_VOXELS {
-        return voxel_sight(v.position, v.normal, p, face_normal(px));
+        return voxel_sight(v.position, v.normal, p, face_normal(px), sight_triangles());
     }
     return through_gates(v.position, cluster_at(v.position, v.normal), p, here);
 }
@@ -290,12 +303,16 @@ fn portal_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, j: u32, s
     var sum = vec3<f32>(0.0);
     var first = j;
     var end = globals.vpl_count;
-    // The voxel walk's end at p (a hair off its face; w = 0: no open voxel near), the same for
-    // every VPL.
+    // The voxel walk's end at p (off its face, or a hair off it along the true segment; w = 0:
+    // no open voxel near), the same for every VPL.
     var at_p = vec4<f32>(0.0);
+    let triangles = sight_triangles();
     if gate_shape() == GATE_VOXELS {
         let n_face = face_normal(px);
-        at_p = vec4<f32>(sight_true_end(p, n_face), sight_end(p, n_face).w);
+        at_p = sight_end(p, n_face);
+        if triangles {
+            at_p = vec4<f32>(sight_true_end(p, n_face), at_p.w);
+        }
     }
     if globals.walk_batch > 0u {
         first = j + batch * globals.walk_batch * subsets;
@@ -309,7 +326,12 @@ fn portal_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, j: u32, s
         }
         if gate_shape() == GATE_VOXELS {
             let at_v = vpl_ends[k];
-            if at_v.w != 0.0 && at_p.w != 0.0 && !sight_clear(at_v.xyz, at_p.xyz) {
+            if at_v.w == 0.0 || at_p.w == 0.0 {
+            } else if triangles {
+                if !sight_clear_lists(sight_true_end(v.position, v.normal), at_p.xyz) {
+                    continue;
+                }
+            } else if !sight_clear(at_v.xyz, at_p.xyz) {
                 continue;
             }
         } else {

@@ -1,8 +1,8 @@
 //! include: vpl.wgsl sight.wgsl
-// Each VPL's end of the voxel walk (sight.wgsl's sight_true_end, and whether sight_end finds
-// an open voxel near), once a frame: mode gates with voxels reads them for every pixel's walks
-// instead of finding each VPL's end again (shade.wgsl's portal_gather;
-// runtime::cpu::sight::VoxelSight::visible is the CPU twin).
+// Each VPL's end of the voxel walk off its surface (sight.wgsl's sight_end; w = 0: no open
+// voxel near), once a frame: mode gates with voxels reads them for every pixel's walks instead
+// of finding each VPL's end again (shade.wgsl's portal_gather; runtime::cpu::sight::VoxelSight
+// is the CPU twin). The walk along the true segment takes only w from it.
 
 @group(0) @binding(0) var<storage, read> vpls: array<Vpl>;
 @group(0) @binding(1) var<storage, read> sight_words: array<u32>;
@@ -13,6 +13,6 @@
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x < min(arrayLength(&vpls), arrayLength(&vpl_ends)) {
         let v = vpls[id.x];
-        vpl_ends[id.x] = vec4<f32>(sight_true_end(v.position, v.normal), sight_end(v.position, v.normal).w);
+        vpl_ends[id.x] = sight_end(v.position, v.normal);
     }
 }

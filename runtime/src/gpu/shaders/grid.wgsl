@@ -19,6 +19,12 @@ struct Grid {
     shape: u32,
     // Portals a walk may pass before it is given up.
     max_walk: u32,
+    // The voxel walk: 1 along the true segment with the closed voxels' triangles, 0 between
+    // ends off the surfaces, every closed voxel blocking.
+    triangles: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 };
 
 // Grid.shape's values (runtime::cpu::gates::GateShape).

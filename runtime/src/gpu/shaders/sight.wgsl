@@ -127,12 +127,65 @@ fn sight_end(p: vec3<f32>, n: vec3<f32>) -> vec4<f32> {
     return best;
 }
 
-// Whether the segment a → b (voxel coordinates) crosses open voxels, or closed ones whose
-// listed triangles it misses (VoxelSight::clear with the lists, step for step). One loop: an
+// Whether the segment a → b (voxel coordinates, both in open voxels) crosses open voxels alone
+// (VoxelSight::clear without the lists, step for step; sight_clear_lists is the walk with them,
+// a function of its own so that a pipeline without them runs none of their code).
+fn sight_clear(a: vec3<f32>, b: vec3<f32>) -> bool {
+    let d = b - a;
+    let moves = d != vec3<f32>(0.0);
+    let up = d > vec3<f32>(0.0);
+    let inv = select(vec3<f32>(0.0), 1.0 / select(vec3<f32>(1.0), d, moves), moves);
+    let end = vec3<i32>(floor(b));
+    var v = vec3<i32>(floor(a));
+    let dims = sight_dims();
+    let bricks = vec3<i32>(i32(sight_words[3]), i32(sight_words[4]), i32(sight_words[5]));
+    let clear_at = sight_words[6];
+    let most = dims.x + dims.y + dims.z + 1;
+    for (var step = 0; step < most; step++) {
+        if any(v < vec3<i32>(0)) || any(v >= dims) {
+            return false;
+        }
+        let brick = v / SIGHT_BRICK;
+        let k = u32(brick.x + bricks.x * (brick.y + bricks.y * brick.z));
+        let c = i32((sight_words[clear_at + k / 4u] >> (8u * (k % 4u))) & 0xffu);
+        var lo = v;
+        var hi = v;
+        if c > 0 {
+            lo = (brick - (c - 1)) * SIGHT_BRICK;
+            hi = (brick + c) * SIGHT_BRICK - 1;
+        } else {
+            let i = u32(v.x + dims.x * (v.y + dims.y * v.z));
+            if ((sight_words[SIGHT_BITS + i / 32u] >> (i % 32u)) & 1u) == 0u {
+                return false;
+            }
+        }
+        if all(end >= lo) && all(end <= hi) {
+            return true;
+        }
+        let face = select(vec3<f32>(lo), vec3<f32>(hi + 1), up);
+        let t = select(vec3<f32>(3.4e38), (face - a) * inv, moves);
+        let te = min(t.x, min(t.y, t.z));
+        if te >= 1.0 {
+            return true;
+        }
+        var across = vec3<bool>(false, false, true);
+        if t.x <= t.y && t.x <= t.z {
+            across = vec3<bool>(true, false, false);
+        } else if t.y <= t.z {
+            across = vec3<bool>(false, true, false);
+        }
+        let inside = clamp(vec3<i32>(floor(a + d * te)), lo, hi);
+        v = select(inside, select(lo - 1, hi + 1, up), across);
+    }
+    return false;
+}
+
+// Whether the segment a → b (voxel coordinates) crosses open voxels, or closed ones whose listed
+// triangles it misses (VoxelSight::clear with the lists, step for step). One loop: an
 // iteration is a step of the march or a list entry of the closed voxel it stands in, so that
 // on a GPU's SIMD lanes a walk testing a list does not hold the others' steps (a loop per list
 // inside the march's ran the light room of ajar-door 1.6x as long on lavapipe).
-fn sight_clear(a: vec3<f32>, b: vec3<f32>) -> bool {
+fn sight_clear_lists(a: vec3<f32>, b: vec3<f32>) -> bool {
     let d = b - a;
     let moves = d != vec3<f32>(0.0);
     let up = d > vec3<f32>(0.0);
@@ -222,12 +275,19 @@ fn sight_clear(a: vec3<f32>, b: vec3<f32>) -> bool {
     return false;
 }
 
-// Whether light passes between surface points a (normal na) and b (normal nb): the walk along
-// the segment between them, each end a hair off its surface; unoccluded when either has no
-// open voxel near (VoxelSight::visible).
-fn voxel_sight(a: vec3<f32>, na: vec3<f32>, b: vec3<f32>, nb: vec3<f32>) -> bool {
-    if sight_end(a, na).w == 0.0 || sight_end(b, nb).w == 0.0 {
+// Whether light passes between surface points a (normal na) and b (normal nb): with
+// `triangles`, the walk along the segment between them, each end a hair off its surface,
+// through the closed voxels whose listed triangles it misses (VoxelSight::visible); else the
+// walk between their ends off the surfaces, every closed voxel blocking
+// (VoxelSight::visible_blocking). Unoccluded when either has no open voxel near.
+fn voxel_sight(a: vec3<f32>, na: vec3<f32>, b: vec3<f32>, nb: vec3<f32>, triangles: bool) -> bool {
+    let x = sight_end(a, na);
+    let y = sight_end(b, nb);
+    if x.w == 0.0 || y.w == 0.0 {
         return true;
     }
-    return sight_clear(sight_true_end(a, na), sight_true_end(b, nb));
+    if triangles {
+        return sight_clear_lists(sight_true_end(a, na), sight_true_end(b, nb));
+    }
+    return sight_clear(x.xyz, y.xyz);
 }
