@@ -495,7 +495,10 @@ mod tests {
         for steps in [3, 100, 1251, 4000] {
             for (mode, lists) in [(&voxels, 0), (&triangles, TRIANGLE_TESTS_PER_WALK)] {
                 let batch = walk_batch(llvmpipe, mode, Some(steps));
-                assert!(batch * (steps + 1 + lists) + 256 <= 65_535, "{steps}: {batch}");
+                assert!(
+                    batch * (steps + 1 + lists) + 256 <= 65_535,
+                    "{steps}: {batch}"
+                );
             }
         }
         assert_eq!(walk_batch("NVIDIA H100 80GB HBM3", &voxels, Some(1251)), 0);
