@@ -22,9 +22,9 @@ struct Grid {
     // The voxel walk: 1 along the true segment with the closed voxels' triangles, 0 between
     // ends off the surfaces, every closed voxel blocking.
     triangles: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 };
 
 // Grid.shape's values (runtime::cpu::gates::GateShape).
