@@ -34,14 +34,13 @@ Modes:
                voxelization closed, so what stands inside a cluster blocks too; with
                --closed-voxel-triangles only where the true segment hits a triangle in
                one: near-exact, several times slower), or only through its portals when
-               the point lies in
-               another visibility cluster (--gate-shape portal: the segment walks from
-               cluster to cluster through the openings, at most --max-walk of them), or
-               through a chain of at most --gate-hops gate disks (× --gate-oversize;
-               --gate-shape disk, the paper's), by clustered shading (the paper's Table I
-               passes: geometry pass, unique clusters of --tile-px tiles × --depth-slices
-               slices × visibility cluster, light assignment into a pool of
-               --light-entries, indirect lighting); GPU: ≤ 2 hops;
+               the point lies in another visibility cluster (--gate-shape portal: the
+               segment walks from cluster to cluster through the openings, at most
+               --max-walk of them), or through a chain of at most --gate-hops gate disks
+               (× --gate-oversize; --gate-shape disk, the paper's), by clustered shading
+               (the paper's Table I passes: geometry pass, unique clusters of --tile-px
+               tiles × --depth-slices slices × visibility cluster, light assignment into a
+               pool of --light-entries, indirect lighting); GPU: ≤ 2 hops;
                --cpu: the CPU twin, per point. Pixels and VPLs outside every visibility
                cluster are not occluded (the pass report counts them)
   gates-per-pixel
