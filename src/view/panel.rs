@@ -28,6 +28,12 @@ pub fn method_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
             } else if g.shape == GateShape::Disk {
                 ui.add(egui::Slider::new(&mut g.max_hops, 1..=2).text("gate hops"));
                 ui.add(egui::Slider::new(&mut g.oversize, 0.5..=3.0).text("gate oversize"));
+            } else {
+                ui.checkbox(&mut g.triangles, "triangles in closed voxels")
+                    .on_hover_text(
+                        "the walk along the true segment, tested against the scene's triangles \
+                         in the closed voxels it crosses: near-exact, several times slower",
+                    );
             }
             if mode == "gates" {
                 ui.add(interleave_block(&mut s.vals.interleave.block));

@@ -26,6 +26,9 @@ pub struct SavedView {
     /// The gate shape: `voxels`, `portal` or `disk` (absent in older files: [`Self::shape`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub gate_shape: Option<String>,
+    /// The voxel walk with the closed voxels' triangles (absent in older files: off).
+    #[serde(default)]
+    pub closed_voxel_triangles: bool,
     /// Older files: gates as disks (read, no longer written).
     #[serde(default, skip_serializing)]
     pub disks: bool,
@@ -124,6 +127,7 @@ mod tests {
             layers: [true, false, true, false, true, false, true],
             settings: [2.0, 1.5, 30.0, 8.0, 4.0, 128.0, 256.0, 32.0],
             gate_shape: (mode == "gates").then(|| SavedView::shape_name(GateShape::Disk)),
+            closed_voxel_triangles: mode == "gates",
             disks: false,
             voxels: false,
             vals_layer: mode == "val-ism",
@@ -134,6 +138,14 @@ mod tests {
         assert_eq!(all.get("a"), Some(&state("gates")));
         assert_eq!(all.get("b"), Some(&state("val-cssm")));
         assert_eq!(all["a"].shape(), GateShape::Disk);
+        assert!(all["a"].closed_voxel_triangles && !all["b"].closed_voxel_triangles);
+        // A file from before the triangles: off.
+        let mut json: serde_json::Value = serde_json::to_value(state("gates")).expect("json");
+        json.as_object_mut()
+            .expect("object")
+            .remove("closed_voxel_triangles");
+        let older: SavedView = serde_json::from_value(json).expect("an older state");
+        assert!(!older.closed_voxel_triangles);
         // A file from before the shape was named: disks and voxels as chosen, else today's
         // default.
         let old = |disks: bool, voxels: bool| SavedView {

@@ -38,6 +38,7 @@ impl ViewerApp {
                 p.batch as f32,
             ],
             gate_shape: Some(SavedView::shape_name(g.shape)),
+            closed_voxel_triangles: g.triangles,
             disks: false,
             voxels: false,
             vals_layer: l.vals,
@@ -58,6 +59,7 @@ impl ViewerApp {
         );
         g.max_hops = hops as u32;
         g.shape = s.shape();
+        g.triangles = s.closed_voxel_triangles;
         g.oversize = oversize;
         v.vals.count = vals as u32;
         v.vals.iterations = iterations as u32;

@@ -4,6 +4,7 @@
 //! they change only when asked (`UPDATE_SNAPSHOTS=1 cargo test --bin visgate snapshots`), and a
 //! failure writes the new image and the difference beside them (`*.new.png`, `*.diff.png`).
 
+use egui_kittest::kittest::Queryable;
 use egui_kittest::{Harness, SnapshotOptions};
 use visgate_formats::vgate::{BakeParams, Resolution};
 use visgate_preprocess::bake::{BakeOptions, bake};
@@ -162,6 +163,27 @@ fn the_viewer_with_the_indirect_light_alone() {
 #[test]
 fn the_viewer_beside_the_reference() {
     snapshot("viewer_compare", Layers::default(), true);
+}
+
+#[test]
+fn the_viewer_walks_with_the_closed_voxels_triangles_once_ticked() {
+    let mut harness = first_frame(viewer(Layers::default(), false));
+    assert!(!harness.state().settings.gates.gates.triangles);
+    let before = harness.state().frames;
+    harness.get_by_label("triangles in closed voxels").click();
+    for _ in 0..600 {
+        harness.step();
+        if harness.state().frames > before {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let app = harness.state();
+    assert!(app.settings.gates.gates.triangles);
+    assert_eq!(app.error, None);
+    assert!(app.frames > before, "no frame with the triangles");
+    let (_, times) = app.last.as_ref().expect("a frame");
+    assert!(times.passes.iter().any(|p| p.name == "indirect lighting"));
 }
 
 #[test]
