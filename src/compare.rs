@@ -17,10 +17,11 @@ use crate::settings::{LightArgs, MethodArgs};
 pub const COMPARE_HELP: &str = "\
 Modes (--modes, comma-separated, or all): every GPU method of `visgate render --mode`
 (none, per-vpl-shadow-maps, gates, gates-per-pixel, val-hard, val-cssm, direct-only) and
-gates-voxels, gates-portal and gates-disk (mode gates walking the level's open voxels, walking
-its portals, or with the paper's disks, whatever --gate-shape says; gates takes --gate-shape,
-voxels by default). `all`: every one but direct-only, gates once a shape; the gate modes only
-with a level (given, or baked here).
+gates-voxels, gates-triangles, gates-portal and gates-disk (mode gates walking the level's open
+voxels, walking them along the true segment with the closed voxels' triangles
+(--closed-voxel-triangles), walking its portals, or with the paper's disks, whatever
+--gate-shape says; gates takes --gate-shape, voxels by default). `all`: every one but
+direct-only, gates once a shape; the gate modes only with a level (given, or baked here).
 
 Every mode renders at every --vpls count from every camera, beside the CPU reference with the
 very same VPLs (a shadow ray per VPL and pixel sample; --spp samples). OUT/report.md and
@@ -223,32 +224,35 @@ fn lightcluster_modes(
     Ok(out)
 }
 
-/// The shaped gate modes of `visgate compare`, each gates with one --gate-shape.
-const SHAPED: [(&str, GateShape); 3] = [
-    ("gates-voxels", GateShape::Voxels),
-    ("gates-portal", GateShape::Portal),
-    ("gates-disk", GateShape::Disk),
+/// The shaped gate modes of `visgate compare`, each gates with one --gate-shape (and the voxel
+/// walk with and without --closed-voxel-triangles).
+const SHAPED: [(&str, GateShape, bool); 4] = [
+    ("gates-voxels", GateShape::Voxels, false),
+    ("gates-triangles", GateShape::Voxels, true),
+    ("gates-portal", GateShape::Portal, false),
+    ("gates-disk", GateShape::Disk, false),
 ];
 
 /// The modes `names` ask for (`all` expanded: gates with --gate-shape, then each other shape
-/// by its own name; `gates-voxels`, `gates-portal` and `gates-disk` are gates with that
-/// shape).
+/// by its own name; `gates-voxels`, `gates-triangles`, `gates-portal` and `gates-disk` are
+/// gates with that shape).
 fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMode>> {
     let s = settings.settings();
-    let shaped = |shape| {
+    let shaped = |shape, triangles| {
         let mut g = s.gates;
         g.gates.shape = shape;
+        g.gates.triangles = triangles;
         GpuMode::Gates(g)
     };
     let named = |name: &str| -> Result<CompareMode> {
-        let shape = SHAPED.iter().find(|(n, _)| *n == name).map(|&(_, g)| g);
+        let shape = SHAPED.iter().find(|(n, ..)| *n == name);
         let mode = match (shape, method(name)) {
-            (Some(g), _) => shaped(g),
+            (Some(&(_, g, t)), _) => shaped(g, t),
             (_, Some(m)) => (m.make)(&s),
             (None, None) => bail!(
                 "--modes {name}: give all or some of {}, {}",
                 METHODS.map(|m| m.name).join(", "),
-                SHAPED.map(|(n, _)| n).join(", ")
+                SHAPED.map(|(n, ..)| n).join(", ")
             ),
         };
         Ok(CompareMode {
@@ -263,8 +267,11 @@ fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMod
             for m in METHODS.iter().filter(|m| m.name != "direct-only") {
                 out.push(named(m.name)?);
                 if m.name == "gates" {
-                    for (n, g) in SHAPED {
-                        if g != s.gates.gates.shape {
+                    let gates = s.gates.gates;
+                    let same =
+                        |g, t| g == gates.shape && (g != GateShape::Voxels || t == gates.triangles);
+                    for (n, g, t) in SHAPED {
+                        if !same(g, t) {
                             out.push(named(n)?);
                         }
                     }
@@ -458,4 +465,44 @@ pub fn run_compare(args: CompareArgs) -> Result<()> {
     }
     println!("wrote {}", args.out.join("report.md").display());
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The mode labels `--modes all` gives with `flags` after a compare command line.
+    fn all_with(flags: &[&str]) -> Vec<String> {
+        let argv = ["visgate", "compare", "builtin:four-rooms", "--out", "x"]
+            .iter()
+            .chain(flags);
+        let args = crate::compare_args_from(argv.map(|s| s.to_string())).expect("args");
+        let modes = named_modes(&["all".to_string()], &args.method).expect("modes");
+        modes.into_iter().map(|m| m.label).collect()
+    }
+
+    #[test]
+    fn all_runs_gates_once_a_shape_the_triangles_included() {
+        let gates = |labels: &[String]| -> Vec<String> {
+            labels
+                .iter()
+                .filter(|l| l.starts_with("gates-") && *l != "gates-per-pixel")
+                .cloned()
+                .collect()
+        };
+        let plain = all_with(&[]);
+        assert!(plain.contains(&"gates".to_string()));
+        assert_eq!(
+            gates(&plain),
+            ["gates-triangles", "gates-portal", "gates-disk"]
+        );
+        // Gates walking with the triangles already: gates-voxels walks without them.
+        let with = all_with(&["--closed-voxel-triangles"]);
+        assert_eq!(gates(&with), ["gates-voxels", "gates-portal", "gates-disk"]);
+        let portal = all_with(&["--gate-shape", "portal"]);
+        assert_eq!(
+            gates(&portal),
+            ["gates-voxels", "gates-triangles", "gates-disk"]
+        );
+    }
 }
