@@ -236,9 +236,10 @@ impl VoxelSight {
         false
     }
 
-    /// Whether a walk passes closed voxel `v` (inside the grid) on its triangles.
+    /// Whether a walk passes closed voxel `v` on its triangles (never outside the grid; a voxel
+    /// with the list the walk last read whole passes unread, out of tests or not, as on the GPU).
     fn passes(&self, v: IVec3, segment: (Vec3, Vec3), tests: &mut WalkTests) -> bool {
-        if tests.left == 0 || v.cmplt(IVec3::ZERO).any() || v.cmpge(self.dims).any() {
+        if v.cmplt(IVec3::ZERO).any() || v.cmpge(self.dims).any() {
             return false;
         }
         let i = (v.x + self.dims.x * (v.y + self.dims.y * v.z)) as usize;

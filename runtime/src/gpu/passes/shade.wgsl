@@ -326,12 +326,13 @@ fn portal_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, j: u32, s
         }
         if gate_shape() == GATE_VOXELS {
             let at_v = vpl_ends[k];
-            if at_v.w == 0.0 || at_p.w == 0.0 {
-            } else if triangles {
-                if !sight_clear_lists(sight_true_end(v.position, v.normal), at_p.xyz) {
-                    continue;
-                }
-            } else if !sight_clear(at_v.xyz, at_p.xyz) {
+            // Either end where the bake knows nothing: unoccluded.
+            let known = at_v.w != 0.0 && at_p.w != 0.0;
+            if known && triangles
+                && !sight_clear_lists(sight_true_end(v.position, v.normal), at_p.xyz) {
+                continue;
+            }
+            if known && !triangles && !sight_clear(at_v.xyz, at_p.xyz) {
                 continue;
             }
         } else {
