@@ -43,7 +43,7 @@ fn dominant(m: glam::Mat3) -> (Vec3, f32) {
 fn cut_normal(
     scratch: &mut Flood,
     meta: &GridMeta,
-    (empty, radius_vx): Space,
+    space: Space,
     g: &GateDisk,
     narrow: f32,
 ) -> Vec3 {
@@ -53,14 +53,13 @@ fn cut_normal(
     // followed the narrow strip along every wall of the level within the band.
     let near = SLOT_SEARCH_REACHES * (3.0 * g.radius + vs);
     let pts: Vec<Vec3> = scratch
-        .run(meta, g.centre, |i, p| {
+        .spans(meta, g.centre, |i, p| {
             // The arithmetic first: most voxels tried lie off the band, and their grid reads wait
             // on memory.
             let d = p - g.centre;
             d.dot(g.normal).abs() <= band
                 && d.length_squared() <= near * near
-                && empty[i]
-                && f32::from(radius_vx[i]) <= narrow
+                && space.narrow(i, narrow)
         })
         .into_iter()
         .map(|i| centre(meta, i))
@@ -68,12 +67,14 @@ fn cut_normal(
     if pts.len() < 8 {
         return g.normal;
     }
-    let mean = pts.iter().sum::<Vec3>() / pts.len() as f32;
-    let mut cov = glam::Mat3::ZERO;
+    // Summed in f64, so that the order the fill finds the voxels in does not show.
+    let mean = pts.iter().map(|p| p.as_dvec3()).sum::<glam::DVec3>() / pts.len() as f64;
+    let mut cov = glam::DMat3::ZERO;
     for p in &pts {
-        let d = *p - mean;
-        cov += glam::Mat3::from_cols(d * d.x, d * d.y, d * d.z);
+        let d = p.as_dvec3() - mean;
+        cov += glam::DMat3::from_cols(d * d.x, d * d.y, d * d.z);
     }
+    let cov = cov.as_mat3();
     let (a, l1) = dominant(cov);
     let deflated = cov - glam::Mat3::from_cols(a * a.x, a * a.y, a * a.z) * l1;
     let (_, l2) = dominant(deflated);
@@ -83,8 +84,28 @@ fn cut_normal(
     (g.normal - a * a.dot(g.normal)).normalize_or(g.normal)
 }
 
-/// The empty voxels and each voxel's largest-ball radius in whole voxels (saturated).
-type Space<'a> = (&'a [bool], &'a [u16]);
+/// The empty space as the cuts read it: a byte a voxel, 0 where not empty, else 1 + its
+/// largest-ball radius in whole voxels saturated at 254 ([`crate::sightline::PackedSight`]'s
+/// cells: one read a voxel where the flags and the radii took two, a third of the memory), and
+/// the radii themselves (saturated at `u16::MAX`) for the voxels whose byte saturated.
+#[derive(Debug, Clone, Copy)]
+pub struct Space<'a> {
+    /// A byte a voxel (see above).
+    pub cells: &'a [u8],
+    /// Each voxel's largest-ball radius in whole voxels (saturated).
+    pub radius_vx: &'a [u16],
+}
+
+impl Space<'_> {
+    /// Whether voxel `i` is empty with a largest ball of at most `narrow` voxels.
+    fn narrow(&self, i: usize, narrow: f32) -> bool {
+        match self.cells[i] {
+            0 => false,
+            u8::MAX => f32::from(self.radius_vx[i]) <= narrow,
+            c => f32::from(c - 1) <= narrow,
+        }
+    }
+}
 
 fn centre(meta: &GridMeta, i: usize) -> Vec3 {
     Vec3::from(meta.voxel_to_world(meta.coords(i as u32)))
@@ -176,11 +197,122 @@ impl Flood {
                 }
             }
         }
+        self.forget();
+        out
+    }
+
+    /// Clears the bits the current flood set.
+    fn forget(&mut self) {
         for &w in &self.touched {
             self.seen[w] = 0;
         }
         self.touched.clear();
+    }
+
+    /// The same voxels as [`Flood::run`], in another order: a scanline fill, a row's run of
+    /// accepted voxels at a time, that looks at the 8 rows beside a run once for all its voxels
+    /// (26 neighbour tests a voxel in the breadth-first flood: Crytek Sponza 256's gate cuts
+    /// 0.36 → 0.29 s). Past [`MAX_FLOOD`] voxels it gives the breadth-first flood's, whose cap keeps
+    /// those nearest the start.
+    fn spans(
+        &mut self,
+        meta: &GridMeta,
+        from: Vec3,
+        keep: impl Fn(usize, Vec3) -> bool,
+    ) -> Vec<usize> {
+        let dims = self.dims;
+        let o = Vec3::from(meta.origin_m);
+        let start = ((from - o) / meta.voxel_size_m)
+            .floor()
+            .as_i64vec3()
+            .to_array();
+        if (0..3).any(|a| start[a] < 0 || start[a] >= dims[a]) {
+            return Vec::new();
+        }
+        let mut fill = Fill {
+            flood: self,
+            meta,
+            keep,
+            out: Vec::new(),
+            runs: Vec::new(),
+        };
+        if fill.claim(start) {
+            fill.run_from(start);
+        }
+        while let Some((y, z, a, b)) = fill.runs.pop() {
+            if fill.out.len() > MAX_FLOOD {
+                break;
+            }
+            fill.beside(y, z, a, b);
+        }
+        let Fill { out, keep, .. } = fill;
+        self.forget();
+        if out.len() > MAX_FLOOD {
+            return self.run(meta, from, keep);
+        }
         out
+    }
+}
+
+/// A scanline fill in progress ([`Flood::spans`]).
+struct Fill<'a, K> {
+    flood: &'a mut Flood,
+    meta: &'a GridMeta,
+    keep: K,
+    /// The accepted voxels so far.
+    out: Vec<usize>,
+    /// Runs whose neighbouring rows are still to look at: y, z, first and last x.
+    runs: Vec<(i64, i64, i64, i64)>,
+}
+
+impl<K: Fn(usize, Vec3) -> bool> Fill<'_, K> {
+    fn index(&self, v: [i64; 3]) -> usize {
+        let d = self.flood.dims;
+        (v[0] + d[0] * (v[1] + d[1] * v[2])) as usize
+    }
+
+    /// Marks voxel `v` seen; whether it was not seen before and is accepted.
+    fn claim(&mut self, v: [i64; 3]) -> bool {
+        let i = self.index(v);
+        self.flood.insert(i)
+            && (self.keep)(i, Vec3::from(self.meta.voxel_to_world(v.map(|c| c as u32))))
+    }
+
+    /// Grows the run of accepted voxels through claimed voxel `v` along x, records it and
+    /// returns its last x.
+    fn run_from(&mut self, v: [i64; 3]) -> i64 {
+        let [x, y, z] = v;
+        let (mut a, mut b) = (x, x);
+        while a > 0 && self.claim([a - 1, y, z]) {
+            a -= 1;
+        }
+        while b + 1 < self.flood.dims[0] && self.claim([b + 1, y, z]) {
+            b += 1;
+        }
+        let first = self.index([a, y, z]);
+        self.out.extend(first..=first + (b - a) as usize);
+        self.runs.push((y, z, a, b));
+        b
+    }
+
+    /// Claims the voxels of the 8 rows beside run `a..=b` of row (y, z) that touch it.
+    fn beside(&mut self, y: i64, z: i64, a: i64, b: i64) {
+        let dims = self.flood.dims;
+        for dz in -1..=1 {
+            for dy in -1..=1 {
+                let (ry, rz) = (y + dy, z + dz);
+                if (dy, dz) == (0, 0) || ry < 0 || rz < 0 || ry >= dims[1] || rz >= dims[2] {
+                    continue;
+                }
+                let mut x = (a - 1).max(0);
+                while x <= (b + 1).min(dims[0] - 1) {
+                    if self.claim([x, ry, rz]) {
+                        x = self.run_from([x, ry, rz]);
+                    }
+                    x += 1;
+                }
+            }
+        }
     }
 }
 
@@ -196,7 +328,7 @@ pub fn gate_cut(meta: &GridMeta, space: Space, g: &GateDisk) -> Vec<usize> {
 pub fn gate_cut_with(
     scratch: &mut Flood,
     meta: &GridMeta,
-    (empty, radius_vx): Space,
+    space: Space,
     g: &GateDisk,
 ) -> Vec<usize> {
     let vs = meta.voxel_size_m;
@@ -204,18 +336,17 @@ pub fn gate_cut_with(
     // counts the same at every scale of the level (voxel units round differently).
     let reach = (3.0 * g.radius + vs) * (1.0 + 1e-4);
     let narrow = (1.5 * g.radius / vs + 1.0 + 1e-3).floor();
-    let normal = cut_normal(scratch, meta, (empty, radius_vx), g, narrow);
+    let normal = cut_normal(scratch, meta, space, g, narrow);
     // A voxel lies on the plane when the plane passes through its cube.
     let half = 0.5 * vs * normal.abs().element_sum();
     let on_cut = |i: usize, p: Vec3| {
         let d = p - g.centre;
         let along = d.dot(normal);
-        along.abs() <= half
-            && ((d - along * normal).length() <= reach
-                || (empty[i] && f32::from(radius_vx[i]) <= narrow))
+        along.abs() <= half && ((d - along * normal).length() <= reach || space.narrow(i, narrow))
     };
-    scratch.run(meta, g.centre, on_cut)
+    scratch.spans(meta, g.centre, on_cut)
 }
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -260,7 +391,17 @@ mod tests {
             path_index: 0,
         };
         let mut cut = empty.clone();
-        for i in gate_cut(&meta, (&empty, &radius), &g) {
+        let sight = crate::sightline::Sight {
+            meta: &meta,
+            empty: &empty,
+            clearance_vx: Some(&radius),
+        }
+        .packed();
+        let space = Space {
+            cells: sight.cells(),
+            radius_vx: &radius,
+        };
+        for i in gate_cut(&meta, space, &g) {
             cut[i] = false;
         }
         // Every slot voxel is cut, top to bottom; nothing off the plane is.
@@ -271,5 +412,37 @@ mod tests {
         }
         let removed = empty.iter().zip(&cut).filter(|(e, c)| **e && !**c).count();
         assert_eq!(removed, 3 * 26);
+    }
+
+    #[test]
+    fn the_scanline_fill_finds_the_breadth_first_floods_voxels() {
+        // Random grids, from sparse to dense, accepted voxels in a ball around a random start
+        // (the cuts' floods are bounded so): the same set, every voxel once.
+        let mut next = crate::xorshift32(0x5eed_1234);
+        let meta = GridMeta {
+            origin_m: [-1.0, 0.5, 2.0],
+            voxel_size_m: 0.25,
+            dims: [23, 17, 19],
+        };
+        let n = meta.dims.iter().product::<u32>() as usize;
+        let mut flood = Flood::new(&meta);
+        let mut found = 0;
+        for density in [20u32, 45, 60, 75, 90] {
+            for _ in 0..12 {
+                let open: Vec<bool> = (0..n).map(|_| next() % 100 < density).collect();
+                let from = Vec3::from(meta.voxel_to_world(meta.coords(next() % n as u32)));
+                let reach = 0.25 * (4 + next() % 12) as f32;
+                let keep = |i: usize, p: Vec3| open[i] && (p - from).length() <= reach;
+                let mut bfs = flood.run(&meta, from, keep);
+                let mut fill = flood.spans(&meta, from, keep);
+                assert!(flood.touched.is_empty() && flood.seen.iter().all(|&w| w == 0));
+                bfs.sort_unstable();
+                fill.sort_unstable();
+                assert_eq!(fill, bfs, "density {density}");
+                found += fill.len();
+            }
+        }
+        // Floods of every size ran, not only the start voxel.
+        assert!(found > 5000, "{found}");
     }
 }

@@ -59,7 +59,13 @@ pub fn flatten(input: &FlattenInput) -> Flattened {
     let cluster_gates = gates_by_cluster(input.gates, input.seeds_of.len());
     let (skel_cluster, nodes_moved) = nodes_across_gates(input, &cluster_gates);
     let mut voxel_cluster = assign_voxels(input, &cluster_gates, &skel_cluster);
-    let pieces = join_pieces(input, &skel_cluster, &mut voxel_cluster);
+    let sight = crate::sightline::Sight {
+        meta: input.meta,
+        empty: input.empty,
+        clearance_vx: Some(input.radius_vx),
+    }
+    .packed();
+    let pieces = join_pieces(input, &sight, &skel_cluster, &mut voxel_cluster);
     let meta = input.meta;
     let seed_at: Vec<[u32; 3]> = input
         .seeds_of
@@ -79,12 +85,6 @@ pub fn flatten(input: &FlattenInput) -> Flattened {
         let node = input.seg.skeleton.nodes[s].skeleton_node as usize;
         Some((input.node_cluster[s], meta.coords(input.graph.voxels[node])))
     };
-    let sight = crate::sightline::Sight {
-        meta,
-        empty: input.empty,
-        clearance_vx: Some(input.radius_vx),
-    }
-    .packed();
     let voxels_by_sight =
         crate::sightline::clusters_by_sight(&sight, &mut voxel_cluster, &seed_at, &anchor);
     let clusters = cluster_boxes(input, &voxel_cluster);
@@ -217,8 +217,17 @@ struct Pieces {
 /// whose skeleton nodes all lie in one cluster take that cluster whole, so a room's voxels that
 /// reached a doorway's node sideways join the room. Pieces that hold nodes of several clusters
 /// (a gate in open space that does not close its opening) keep the per-voxel rule.
-fn join_pieces(input: &FlattenInput, skel_cluster: &[u32], voxel_cluster: &mut [u32]) -> Pieces {
+fn join_pieces(
+    input: &FlattenInput,
+    sight: &crate::sightline::PackedSight,
+    skel_cluster: &[u32],
+    voxel_cluster: &mut [u32],
+) -> Pieces {
     let (meta, empty) = (input.meta, input.empty);
+    let space = crate::cut::Space {
+        cells: sight.cells(),
+        radius_vx: input.radius_vx,
+    };
     // The cut voxels, a bit each.
     let mut cut = vec![0u64; empty.len().div_ceil(64)];
     // Gates are independent: flooded in parallel, a few dozen at a time (a cut can hold a
@@ -228,7 +237,7 @@ fn join_pieces(input: &FlattenInput, skel_cluster: &[u32], voxel_cluster: &mut [
             .par_iter()
             .map_init(
                 || crate::cut::Flood::new(meta),
-                |scratch, g| crate::cut::gate_cut_with(scratch, meta, (empty, input.radius_vx), g),
+                |scratch, g| crate::cut::gate_cut_with(scratch, meta, space, g),
             )
             .collect();
         for i in cuts.into_iter().flatten() {
