@@ -199,6 +199,21 @@ fn gpu_gates_agree_with_the_cpu_twin() {
             "gates without a level must be refused"
         );
         gpu.set_level(&ctx, &gates).expect("level upload");
+        // A level loads without its closed voxels' triangle lists; the walk with them is
+        // refused until they are listed and uploaded.
+        let with_triangles = GpuMode::GatesPerPixel(GateParams {
+            shape: GateShape::Voxels,
+            triangles: true,
+            ..GateParams::default()
+        });
+        assert!(!gates.sight().triangles_listed());
+        let refused = gpu.render(&ctx, &view, &vpls, &GpuParams::with_mode(with_triangles));
+        assert!(
+            refused.is_err_and(|e| e.to_string().contains("list_triangles")),
+            "the triangle walk without lists must be refused"
+        );
+        gates.list_triangles();
+        gpu.set_level(&ctx, &gates).expect("level upload");
         for (clustered, hops, shape, triangles) in [
             (true, 1, GateShape::Disk, false),
             (true, 2, GateShape::Disk, false),

@@ -246,6 +246,13 @@ impl RenderJob {
         if let (Some(ctx), Some(g), Some(l)) = (&ctx, &mut gpu, level)
             && on_gpu
         {
+            if job
+                .mode()
+                .and_then(|m| m.gates())
+                .is_some_and(|g| g.triangles)
+            {
+                l.list_triangles();
+            }
             g.set_level(ctx, l)?;
         }
         setup(&JobSetup {

@@ -153,6 +153,13 @@ impl GateLevel {
         &self.sight
     }
 
+    /// Lists the scene's triangles in the closed voxels now (once; a walk with the triangles
+    /// on the CPU lists them when first needed), so that [`GateLevel::tables`] and
+    /// `GpuRenderer::set_level` carry them: the GPU's voxel walk with the triangles needs them.
+    pub fn list_triangles(&self) {
+        self.sight.list_triangles();
+    }
+
     /// Voxel edge of the level's grid. [Units: m]
     pub fn voxel_size(&self) -> f32 {
         self.grid.voxel_size_m
@@ -334,20 +341,11 @@ impl GateLevel {
     }
 }
 
-/// The level's voxel walk, with the scene's static triangles listed in its closed voxels.
+/// The level's voxel walk, with the scene's static triangles to list in its closed voxels when
+/// a walk first needs them.
 fn sight_with_triangles(level: &BakedLevel, scene: &Scene) -> VoxelSight {
-    let t0 = std::time::Instant::now();
-    let grid = &level.info.sight_grid;
     let triangles: Vec<[Vec3; 3]> = scene.static_triangles().collect();
-    let sight = VoxelSight::new(grid, &level.open).with_triangles(grid, &triangles);
-    let lists = sight.triangles();
-    tracing::info!(
-        "voxel walk: {} closed voxels list {} triangle references ({:.2} s)",
-        lists.voxels(),
-        lists.references(),
-        t0.elapsed().as_secs_f64()
-    );
-    sight
+    VoxelSight::new(&level.info.sight_grid, &level.open).with_triangles(&triangles)
 }
 
 /// One end of a segment that light may pass: a VPL or a surface point.

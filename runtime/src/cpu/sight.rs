@@ -60,8 +60,12 @@ pub struct VoxelSight {
     /// Per brick, the chessboard distance in bricks to the nearest brick that holds a closed
     /// voxel (0: it holds one), at most 255; the grid's outside counts as closed.
     clear: Vec<u8>,
-    /// The triangles in the closed voxels (none: every closed voxel blocks).
-    triangles: ClosedTriangles,
+    /// The static triangles (m) to list in the closed voxels (none: every closed voxel blocks).
+    source: std::sync::Arc<[[Vec3; 3]]>,
+    /// Their lists, made on the first walk that reads them or by [`VoxelSight::list_triangles`]
+    /// (0.8 s and 35 MB for Crytek Sponza at 512: a level that never walks with them pays
+    /// neither).
+    triangles: std::sync::OnceLock<ClosedTriangles>,
 }
 
 /// `a` divided by `b`, rounded up.
@@ -109,20 +113,51 @@ impl VoxelSight {
             words,
             bricks,
             clear: chessboard(bricks, &closed),
-            triangles: ClosedTriangles::default(),
+            source: std::sync::Arc::new([]),
+            triangles: std::sync::OnceLock::new(),
         }
     }
 
-    /// The same walk, passing a closed voxel where neither segment hits one of the `triangles`
-    /// (m, the level's static geometry) that touch it ([`super::sight_triangles`]).
-    pub fn with_triangles(self, grid: &GridMeta, triangles: &[[Vec3; 3]]) -> VoxelSight {
-        let triangles = ClosedTriangles::new(grid, |v| self.open(v), triangles);
-        VoxelSight { triangles, ..self }
+    /// The same walk, passing a closed voxel where the segment hits none of the `triangles`
+    /// (m, the level's static geometry) that touch it ([`super::sight_triangles`]); they are
+    /// listed by voxel when first needed.
+    pub fn with_triangles(self, triangles: &[[Vec3; 3]]) -> VoxelSight {
+        VoxelSight {
+            source: triangles.into(),
+            triangles: std::sync::OnceLock::new(),
+            ..self
+        }
     }
 
-    /// The triangles in the closed voxels.
+    /// The triangles in the closed voxels, listed now if they were not yet.
     pub fn triangles(&self) -> &ClosedTriangles {
-        &self.triangles
+        self.triangles.get_or_init(|| {
+            let t0 = std::time::Instant::now();
+            let grid = GridMeta {
+                origin_m: self.origin_m.to_array(),
+                voxel_size_m: self.voxel_m,
+                dims: self.dims.to_array().map(|d| d as u32),
+            };
+            let lists = ClosedTriangles::new(&grid, |v| self.open(v), &self.source);
+            tracing::info!(
+                "voxel walk: {} closed voxels list {} triangle references ({:.2} s)",
+                lists.voxels(),
+                lists.references(),
+                t0.elapsed().as_secs_f64()
+            );
+            lists
+        })
+    }
+
+    /// Lists the triangles in the closed voxels now, so that [`VoxelSight::words`] carries
+    /// them to the GPU.
+    pub fn list_triangles(&self) {
+        self.triangles();
+    }
+
+    /// Whether the triangles are listed (and [`VoxelSight::words`] carries them).
+    pub fn triangles_listed(&self) -> bool {
+        self.triangles.get().is_some()
     }
 
     /// Point `p` (m) in voxel coordinates.
@@ -243,7 +278,7 @@ impl VoxelSight {
             return false;
         }
         let i = (v.x + self.dims.x * (v.y + self.dims.y * v.z)) as usize;
-        self.triangles.pass(i, segment, tests)
+        self.triangles().pass(i, segment, tests)
     }
 
     /// The true segment's end at surface point `p` (normal `n`), in voxel coordinates.
@@ -277,11 +312,12 @@ impl VoxelSight {
     /// edge (m, f32 bits), word offsets of the closed voxels' marks, lists, triangle indices
     /// and triangles (0: no lists)]`, the open bits (32 a word), the bricks'
     /// clearances, four bytes a word (little-endian), then the triangle lists
-    /// ([`ClosedTriangles::words`]).
+    /// ([`ClosedTriangles::words`]) if they are listed ([`VoxelSight::list_triangles`]).
     pub fn words(&self) -> Vec<u32> {
         let clear_at = SIGHT_HEADER_WORDS + self.words.len();
         let lists_at = clear_at + self.clear.len().div_ceil(4);
-        let (lists, at) = self.triangles.words(lists_at);
+        let none = ClosedTriangles::default();
+        let (lists, at) = self.triangles.get().unwrap_or(&none).words(lists_at);
         let mut w = Vec::with_capacity(lists_at + lists.len());
         w.extend(self.dims.to_array().map(|x| x as u32));
         w.extend(self.bricks.to_array().map(|x| x as u32));
@@ -551,7 +587,7 @@ mod tests {
         };
         let open = VoxelBits::from_fn(2000, |i| !touched(voxel_of(i, IVec3::new(20, 10, 10))));
         let bare = VoxelSight::new(&grid(dims), &open);
-        let s = bare.clone().with_triangles(&grid(dims), &wall);
+        let s = bare.clone().with_triangles(&wall);
         // Every closed voxel touched by the same one or two triangles: a few shared lists.
         let lists = s.triangles();
         assert!(lists.voxels() >= 60 && lists.lists() <= 3 && lists.references() <= 4);

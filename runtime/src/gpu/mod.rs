@@ -406,7 +406,9 @@ impl GpuRenderer {
     }
 
     /// Uploads a baked level's gate tables for the gate modes; the voxel→cluster grid keeps
-    /// the smallest integer type that holds the level's clusters.
+    /// the smallest integer type that holds the level's clusters. The closed voxels' triangle
+    /// lists go up only if they are listed ([`GateLevel::list_triangles`]), which the voxel
+    /// walk with the triangles needs.
     pub fn set_level(&mut self, ctx: &GpuContext, level: &GateLevel) -> Result<(), RenderError> {
         self.scene.level = Some(LevelBuffers::upload(ctx, level)?);
         Ok(())
@@ -634,6 +636,17 @@ impl GpuRenderer {
                 "mode {} needs a baked level (GpuRenderer::set_level, --level)",
                 params.mode.name()
             )));
+        }
+        if let (Some(g), Some(l)) = (params.mode.gates(), &self.scene.level)
+            && g.shape == GateShape::Voxels
+            && g.triangles
+            && !l.triangles
+        {
+            return Err(RenderError::Param(
+                "the voxel walk with the closed voxels' triangles needs their lists on the GPU: \
+                 GateLevel::list_triangles before GpuRenderer::set_level"
+                    .into(),
+            ));
         }
         let vals = params.mode.vals();
         let val_count = vals.map(|v| v.count);

@@ -288,6 +288,19 @@ impl ViewerApp {
                 return;
             }
         };
+        // The closed voxels' triangles are listed and uploaded when the walk first needs them
+        // (the box ticked, or a kept view that had it): a level not walked with them pays
+        // neither the time nor the GPU memory.
+        if let Some(l) = &self.start.level
+            && params.mode.gates().is_some_and(|g| g.triangles)
+            && !l.sight().triangles_listed()
+        {
+            l.list_triangles();
+            if let Err(e) = self.gpu.set_level(&self.ctx, l) {
+                self.error = Some(e.to_string());
+                return;
+            }
+        }
         match (self.gpu).render_kept(&self.ctx, &view, input, &params, read_hdr) {
             Ok((img, times)) => {
                 self.last_view = Some(view);

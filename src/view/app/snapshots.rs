@@ -169,6 +169,14 @@ fn the_viewer_beside_the_reference() {
 fn the_viewer_walks_with_the_closed_voxels_triangles_once_ticked() {
     let mut harness = first_frame(viewer(Layers::default(), false));
     assert!(!harness.state().settings.gates.gates.triangles);
+    // The level loads without the lists: the tick lists and uploads them.
+    let listed = |app: &ViewerApp| {
+        app.start
+            .level
+            .as_ref()
+            .map(|l| l.sight().triangles_listed())
+    };
+    assert_eq!(listed(harness.state()), Some(false));
     let before = harness.state().frames;
     harness.get_by_label("triangles in closed voxels").click();
     for _ in 0..600 {
@@ -180,6 +188,7 @@ fn the_viewer_walks_with_the_closed_voxels_triangles_once_ticked() {
     }
     let app = harness.state();
     assert!(app.settings.gates.gates.triangles);
+    assert_eq!(listed(app), Some(true));
     assert_eq!(app.error, None);
     assert!(app.frames > before, "no frame with the triangles");
     let (_, times) = app.last.as_ref().expect("a frame");

@@ -115,6 +115,8 @@ pub struct LevelBuffers {
     pub sight_words: wgpu::Buffer,
     /// The most steps a voxel walk takes (`VoxelSight::most_steps`).
     pub sight_steps: u32,
+    /// Whether `sight_words` holds the closed voxels' triangle lists.
+    pub triangles: bool,
 }
 
 impl LevelBuffers {
@@ -182,6 +184,7 @@ impl LevelBuffers {
                 storage,
             ),
             sight_steps: t.sight_steps,
+            triangles: level.sight().triangles_listed(),
         })
     }
 }
