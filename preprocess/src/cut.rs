@@ -163,15 +163,10 @@ impl Flood {
         keep: impl Fn(usize, Vec3) -> bool,
     ) -> Vec<usize> {
         let dims = self.dims;
-        let o = Vec3::from(meta.origin_m);
-        let start = ((from - o) / meta.voxel_size_m)
-            .floor()
-            .as_i64vec3()
-            .to_array();
         let mut out = Vec::new();
-        if (0..3).any(|a| start[a] < 0 || start[a] >= dims[a]) {
+        let Some(start) = self.start(meta, from) else {
             return out;
-        }
+        };
         let index = |v: [i64; 3]| (v[0] + dims[0] * (v[1] + dims[1] * v[2])) as usize;
         self.insert(index(start));
         self.queue.push_back(start);
@@ -201,6 +196,18 @@ impl Flood {
         out
     }
 
+    /// The voxel of point `from` (m), if it lies in the grid: where a flood starts.
+    fn start(&self, meta: &GridMeta, from: Vec3) -> Option<[i64; 3]> {
+        let o = Vec3::from(meta.origin_m);
+        let start = ((from - o) / meta.voxel_size_m)
+            .floor()
+            .as_i64vec3()
+            .to_array();
+        (0..3)
+            .all(|a| (0..self.dims[a]).contains(&start[a]))
+            .then_some(start)
+    }
+
     /// Clears the bits the current flood set.
     fn forget(&mut self) {
         for &w in &self.touched {
@@ -212,23 +219,17 @@ impl Flood {
     /// The same voxels as [`Flood::run`], in another order: a scanline fill, a row's run of
     /// accepted voxels at a time, that looks at the 8 rows beside a run once for all its voxels
     /// (26 neighbour tests a voxel in the breadth-first flood: Crytek Sponza 256's gate cuts
-    /// 0.36 → 0.29 s). Past [`MAX_FLOOD`] voxels it gives the breadth-first flood's, whose cap keeps
-    /// those nearest the start.
+    /// 0.36 → 0.29 s). Past [`MAX_FLOOD`] voxels it gives the breadth-first flood's, whose cap
+    /// keeps those nearest the start.
     fn spans(
         &mut self,
         meta: &GridMeta,
         from: Vec3,
         keep: impl Fn(usize, Vec3) -> bool,
     ) -> Vec<usize> {
-        let dims = self.dims;
-        let o = Vec3::from(meta.origin_m);
-        let start = ((from - o) / meta.voxel_size_m)
-            .floor()
-            .as_i64vec3()
-            .to_array();
-        if (0..3).any(|a| start[a] < 0 || start[a] >= dims[a]) {
+        let Some(start) = self.start(meta, from) else {
             return Vec::new();
-        }
+        };
         let mut fill = Fill {
             flood: self,
             meta,
