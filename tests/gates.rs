@@ -206,7 +206,7 @@ fn gpu_gates_agree_with_the_cpu_twin() {
             triangles: true,
             ..GateParams::default()
         });
-        assert!(!gates.sight().triangles_listed());
+        assert!(!gates.sight().triangles_listed() && !gpu.level_has_triangles());
         let refused = gpu.render(&ctx, &view, &vpls, &GpuParams::with_mode(with_triangles));
         assert!(
             refused.is_err_and(|e| e.to_string().contains("list_triangles")),
@@ -214,6 +214,7 @@ fn gpu_gates_agree_with_the_cpu_twin() {
         );
         gates.list_triangles();
         gpu.set_level(&ctx, &gates).expect("level upload");
+        assert!(gpu.level_has_triangles());
         for (clustered, hops, shape, triangles) in [
             (true, 1, GateShape::Disk, false),
             (true, 2, GateShape::Disk, false),

@@ -414,6 +414,12 @@ impl GpuRenderer {
         Ok(())
     }
 
+    /// Whether the uploaded level carries the closed voxels' triangle lists (the voxel walk
+    /// with the triangles needs them; [`GpuRenderer::set_level`]).
+    pub fn level_has_triangles(&self) -> bool {
+        self.scene.level.as_ref().is_some_and(|l| l.triangles)
+    }
+
     /// GPU textures, buffers and query sets the renderer's frames have made so far (a frame
     /// with the same sizes and settings as the last makes none).
     pub fn resources_created(&self) -> u64 {

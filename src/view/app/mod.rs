@@ -293,7 +293,7 @@ impl ViewerApp {
         // neither the time nor the GPU memory.
         if let Some(l) = &self.start.level
             && params.mode.gates().is_some_and(|g| g.triangles)
-            && !l.sight().triangles_listed()
+            && !self.gpu.level_has_triangles()
         {
             l.list_triangles();
             if let Err(e) = self.gpu.set_level(&self.ctx, l) {

@@ -171,12 +171,14 @@ fn the_viewer_walks_with_the_closed_voxels_triangles_once_ticked() {
     assert!(!harness.state().settings.gates.gates.triangles);
     // The level loads without the lists: the tick lists and uploads them.
     let listed = |app: &ViewerApp| {
-        app.start
+        let cpu = app
+            .start
             .level
             .as_ref()
-            .map(|l| l.sight().triangles_listed())
+            .map(|l| l.sight().triangles_listed());
+        (cpu, app.gpu.level_has_triangles())
     };
-    assert_eq!(listed(harness.state()), Some(false));
+    assert_eq!(listed(harness.state()), (Some(false), false));
     let before = harness.state().frames;
     harness.get_by_label("triangles in closed voxels").click();
     for _ in 0..600 {
@@ -188,7 +190,7 @@ fn the_viewer_walks_with_the_closed_voxels_triangles_once_ticked() {
     }
     let app = harness.state();
     assert!(app.settings.gates.gates.triangles);
-    assert_eq!(listed(app), Some(true));
+    assert_eq!(listed(app), (Some(true), true));
     assert_eq!(app.error, None);
     assert!(app.frames > before, "no frame with the triangles");
     let (_, times) = app.last.as_ref().expect("a frame");
