@@ -1,7 +1,8 @@
 //! The deinterleaved layout of the interleaved indirect target (`vpl.wgsl`'s
 //! `deinterleave_axis` and `interleave_axis`), run on the GPU: for every block size and axis
 //! length tried, a bijection of [0, n) whose inverse is `interleave_axis`, with each residue's
-//! pixels side by side in order. The gates' indirect pass shades in this layout and the blur
+//! pixels side by side in order, which the blur's stepped form (`axis_run_next`, `axis_run_place`)
+//! finds too. The gates' indirect pass shades in this layout and the blur
 //! reads through it: a pixel mapped twice or never would be lit twice or left black.
 
 use visgate_runtime::gpu::context::{bind_group, compute_pipelines, init_buffer, read_buffer};
@@ -20,13 +21,21 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let s = deinterleave_axis(x, case_.b, case_.n);
-    out[2u * x] = s;
-    out[2u * x + 1u] = interleave_axis(s, case_.b, case_.n);
+    out[3u * x] = s;
+    out[3u * x + 1u] = interleave_axis(s, case_.b, case_.n);
+    // The blur's stepped form, from up to 2b + 1 pixels before x.
+    let x0 = x - min(x, 2u * case_.b + 1u);
+    var rk = vec2<u32>(x0 % case_.b, x0 / case_.b);
+    for (var k = x0; k < x; k++) {
+        rk = axis_run_next(rk, case_.b);
+    }
+    out[3u * x + 2u] = axis_run_place(rk, case_.n / case_.b, case_.n % case_.b);
 }
 ";
 
-/// For each (b, n): where `deinterleave_axis` sends every x, and `interleave_axis` of that.
-fn run(ctx: &GpuContext, cases: &[(u32, u32)]) -> Vec<Vec<[u32; 2]>> {
+/// For each (b, n): where `deinterleave_axis` sends every x, `interleave_axis` of that, and
+/// where the blur's stepped form (`axis_run_next`, `axis_run_place`) puts x.
+fn run(ctx: &GpuContext, cases: &[(u32, u32)]) -> Vec<Vec<[u32; 3]>> {
     let sources = ShaderSources::builtin();
     let src = compose_with("deinterleave test", ENTRY, &|n| sources.text(n)).expect("compose");
     let d = &ctx.device;
@@ -47,7 +56,7 @@ fn run(ctx: &GpuContext, cases: &[(u32, u32)]) -> Vec<Vec<[u32; 2]>> {
             let out = init_buffer(
                 d,
                 "out",
-                &vec![0xffu8; 8 * n as usize],
+                &vec![0xffu8; 12 * n as usize],
                 wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             );
             let group = bind_group(
@@ -67,7 +76,7 @@ fn run(ctx: &GpuContext, cases: &[(u32, u32)]) -> Vec<Vec<[u32; 2]>> {
             let bytes = read_buffer(ctx, &out).expect("read back");
             let words: &[u32] = bytemuck::cast_slice(&bytes);
             (0..n as usize)
-                .map(|x| [words[2 * x], words[2 * x + 1]])
+                .map(|x| [words[3 * x], words[3 * x + 1], words[3 * x + 2]])
                 .collect()
         })
         .collect()
@@ -84,8 +93,12 @@ fn the_deinterleaved_layout_is_a_bijection_inverted_by_interleave_axis_on_the_gp
     }
     for ((b, n), got) in cases.iter().zip(run(&ctx, &cases)) {
         let mut hit = vec![false; *n as usize];
-        for (x, [s, back]) in got.iter().enumerate() {
+        for (x, [s, back, stepped]) in got.iter().enumerate() {
             assert!(*s < *n, "b {b} n {n}: {x} -> {s}, outside");
+            assert_eq!(
+                stepped, s,
+                "b {b} n {n}: the blur's stepping puts {x} elsewhere"
+            );
             assert!(!hit[*s as usize], "b {b} n {n}: {s} taken twice");
             hit[*s as usize] = true;
             assert_eq!(

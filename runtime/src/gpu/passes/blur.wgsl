@@ -23,24 +23,37 @@ fn fs_compose(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     let albedo = textureLoad(g_albedo, px, 0).xyz;
     let b = i32(gather.block);
     let size = vec2<i32>(textureDimensions(indirect));
+    // The block around px, clipped to the target.
+    let lo = max(px - vec2<i32>(b / 2), vec2<i32>(0));
+    let hi = min(px + vec2<i32>(b - b / 2), size);
+    // Where a pixel lies in the deinterleaved target (vpl.wgsl's deinterleave_axis), stepped
+    // along each axis instead of divided at every tap: on llvmpipe the divisions were 40 % of
+    // the pass (e2m3's hall at 512², 4,096 VPLs, blur + compose 137 → 83 ms; the same image,
+    // bit for bit).
+    let bu = gather.block;
+    let q = vec2<u32>(size) / bu;
+    let m = vec2<u32>(size) % bu;
+    let deint = gather.deinterleaved == 1u;
+    var ry = vec2<u32>(u32(lo.y) % bu, u32(lo.y) / bu);
     var sum = vec3<f32>(0.0);
     var weight = 0.0;
-    for (var dy = -b / 2; dy < b - b / 2; dy++) {
-        for (var dx = -b / 2; dx < b - b / 2; dx++) {
-            let q = px + vec2<i32>(dx, dy);
-            if any(q < vec2<i32>(0)) || any(q >= size) {
-                continue;
-            }
-            let qp = textureLoad(g_position, q, 0);
+    for (var y = lo.y; y < hi.y; y++) {
+        let ay = i32(axis_run_place(ry, q.y, m.y));
+        ry = axis_run_next(ry, bu);
+        var rx = vec2<u32>(u32(lo.x) % bu, u32(lo.x) / bu);
+        for (var x = lo.x; x < hi.x; x++) {
+            let ax = i32(axis_run_place(rx, q.x, m.x));
+            rx = axis_run_next(rx, bu);
+            let tap = vec2<i32>(x, y);
+            let qp = textureLoad(g_position, tap, 0);
             if qp.w == 0.0 {
                 continue;
             }
-            let qn = normalize(textureLoad(g_normal, q, 0).xyz);
+            let qn = normalize(textureLoad(g_normal, tap, 0).xyz);
             if length(qp.xyz - pos.xyz) > gather.blur_distance || dot(qn, n) < gather.blur_normal {
                 continue;
             }
-            let at = select(q, deinterleaved(q, gather.block, vec2<u32>(size)), gather.deinterleaved == 1u);
-            sum += textureLoad(indirect, at, 0).xyz;
+            sum += textureLoad(indirect, select(tap, vec2<i32>(ax, ay), deint), 0).xyz;
             weight += 1.0;
         }
     }

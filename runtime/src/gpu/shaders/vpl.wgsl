@@ -28,6 +28,20 @@ fn deinterleave_axis(x: u32, b: u32, n: u32) -> u32 {
     return r * q + min(r, m) + x / b;
 }
 
+// deinterleave_axis along a run of pixels without dividing at each (blur.wgsl's taps): the
+// state (x mod b, x / b) of pixel x, stepped to x + 1, and where x lies given q = n / b and
+// m = n % b.
+fn axis_run_next(rk: vec2<u32>, b: u32) -> vec2<u32> {
+    if rk.x + 1u == b {
+        return vec2<u32>(0u, rk.y + 1u);
+    }
+    return vec2<u32>(rk.x + 1u, rk.y);
+}
+
+fn axis_run_place(rk: vec2<u32>, q: u32, m: u32) -> u32 {
+    return rk.x * q + min(rk.x, m) + rk.y;
+}
+
 fn interleave_axis(s: u32, b: u32, n: u32) -> u32 {
     let q = n / b;
     let m = n % b;
