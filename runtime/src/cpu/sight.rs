@@ -16,7 +16,7 @@
 //! takes 120–160.
 //!
 //! A closed voxel is where geometry may be, not where it is: with the scene's triangles listed
-//! in the closed voxels ([`super::sight_triangles`], when the level is loaded), the walk of
+//! in the closed voxels ([`super::sight_triangles`], when a walk first needs them), the walk of
 //! [`VoxelSight::visible`] runs along the true segment, between the two surface points, and
 //! passes a closed voxel where the segment hits none of them, so a segment that grazes a wall, a
 //! column or a door's edge within a voxel is not blocked; [`VoxelSight::visible_blocking`] is
