@@ -168,11 +168,17 @@ impl VoxelSight {
     /// Whether voxel `v` is open (false outside the grid).
     #[inline]
     pub fn open(&self, v: IVec3) -> bool {
+        self.index(v)
+            .is_some_and(|i| (self.words[i / 32] >> (i % 32)) & 1 == 1)
+    }
+
+    /// Voxel `v`'s index in the grid (x fastest), `None` outside it.
+    #[inline]
+    fn index(&self, v: IVec3) -> Option<usize> {
         if v.cmplt(IVec3::ZERO).any() || v.cmpge(self.dims).any() {
-            return false;
+            return None;
         }
-        let i = (v.x + self.dims.x * (v.y + self.dims.y * v.z)) as usize;
-        (self.words[i / 32] >> (i % 32)) & 1 == 1
+        Some((v.x + self.dims.x * (v.y + self.dims.y * v.z)) as usize)
     }
 
     /// A brick's clearance ([`VoxelSight::clear`]'s field), 0 outside the brick grid.
@@ -226,7 +232,7 @@ impl VoxelSight {
     /// it hits none of the triangles listed there, within [`TRIANGLE_TESTS_PER_WALK`] list
     /// entries ([`super::sight_triangles`]).
     pub fn clear(&self, a: Vec3, b: Vec3, lists: bool) -> bool {
-        let mut tests = WalkTests::new(if lists { TRIANGLE_TESTS_PER_WALK } else { 0 });
+        let mut tests = WalkTests::new(TRIANGLE_TESTS_PER_WALK);
         let d = b - a;
         let (moves, up) = (d.cmpne(Vec3::ZERO), d.cmpgt(Vec3::ZERO));
         // An axis the segment does not move along is never the one it leaves a cube across.
@@ -238,7 +244,7 @@ impl VoxelSight {
             let c = self.brick_clear(brick);
             let (lo, hi) = if c > 0 {
                 ((brick - (c - 1)) * BRICK, (brick + c) * BRICK - 1)
-            } else if self.open(v) || self.passes(v, (a, b), &mut tests) {
+            } else if self.open(v) || (lists && self.passes(v, (a, b), &mut tests)) {
                 (v, v)
             } else {
                 return false;
@@ -274,11 +280,8 @@ impl VoxelSight {
     /// Whether a walk passes closed voxel `v` on its triangles (never outside the grid; a voxel
     /// with the list the walk last read whole passes unread, out of tests or not, as on the GPU).
     fn passes(&self, v: IVec3, segment: (Vec3, Vec3), tests: &mut WalkTests) -> bool {
-        if v.cmplt(IVec3::ZERO).any() || v.cmpge(self.dims).any() {
-            return false;
-        }
-        let i = (v.x + self.dims.x * (v.y + self.dims.y * v.z)) as usize;
-        self.triangles().pass(i, segment, tests)
+        self.index(v)
+            .is_some_and(|i| self.triangles().pass(i, segment, tests))
     }
 
     /// The true segment's end at surface point `p` (normal `n`), in voxel coordinates.
@@ -588,10 +591,14 @@ mod tests {
         let open = VoxelBits::from_fn(2000, |i| !touched(voxel_of(i, IVec3::new(20, 10, 10))));
         let bare = VoxelSight::new(&grid(dims), &open);
         let s = bare.clone().with_triangles(&wall);
+        let (a, b) = (Vec3::new(8.5, 6.5, 5.0), Vec3::new(11.5, 5.4, 5.0));
+        // The walk that blocks at every closed voxel never lists the triangles.
+        assert!(!s.clear(a, b, false));
+        s.visible_blocking(a, Vec3::X, b, -Vec3::X);
+        assert!(!s.triangles_listed());
         // Every closed voxel touched by the same one or two triangles: a few shared lists.
         let lists = s.triangles();
         assert!(lists.voxels() >= 60 && lists.lists() <= 3 && lists.references() <= 4);
-        let (a, b) = (Vec3::new(8.5, 6.5, 5.0), Vec3::new(11.5, 5.4, 5.0));
         assert!(!bare.open(IVec3::new(10, 5, 5)));
         assert!(!bare.clear(a, b, true), "no lists: closed voxels block");
         assert!(!s.clear(a, b, false), "lists not read: closed voxels block");
