@@ -175,9 +175,9 @@ pub struct MethodArgs {
     pub gate_shape: GateShapeArg,
     /// --gate-shape voxels: walk the true segment between the surface points and pass a
     /// closed voxel where it hits none of the scene's triangles listed there (listed once, when
-    /// a walk first needs them: 0.8 s for Crytek Sponza at 512 on 2 cores): near-exact visibility (99.3-100 % of pixel-VPL pairs agree with shadow
-    /// rays on the levels measured, against 88-99 % without), at several times the walk's cost
-    /// on a software rasterizer.
+    /// a walk first needs them: 0.8 s for Crytek Sponza at 512 on 2 cores): near-exact
+    /// visibility (99.3-100 % of pixel-VPL pairs agree with shadow rays on the levels measured,
+    /// against 88-99 % without), at several times the walk's cost on a software rasterizer.
     #[arg(long)]
     pub closed_voxel_triangles: bool,
     /// Portals one walk may pass before it is given up and counted as occluded (--gate-shape

@@ -212,9 +212,9 @@ fn gpu_gates_agree_with_the_cpu_twin() {
             refused.is_err_and(|e| e.to_string().contains("list_triangles")),
             "the triangle walk without lists must be refused"
         );
-        gates.list_triangles();
-        gpu.set_level(&ctx, &gates).expect("level upload");
-        assert!(gpu.level_has_triangles());
+        gpu.level_for_mode(&ctx, &gates, &with_triangles)
+            .expect("level upload");
+        assert!(gates.sight().triangles_listed() && gpu.level_has_triangles());
         for (clustered, hops, shape, triangles) in [
             (true, 1, GateShape::Disk, false),
             (true, 2, GateShape::Disk, false),

@@ -243,17 +243,10 @@ impl RenderJob {
             Some(ctx) => Some(GpuRenderer::new(ctx, &first)?),
             None => None,
         };
-        if let (Some(ctx), Some(g), Some(l)) = (&ctx, &mut gpu, level)
-            && on_gpu
+        if let (Some(ctx), Some(g), Some(l), Renderer::Gpu(mode)) =
+            (&ctx, &mut gpu, level, &job.renderer)
         {
-            if job
-                .mode()
-                .and_then(|m| m.gates())
-                .is_some_and(|g| g.triangles)
-            {
-                l.list_triangles();
-            }
-            g.set_level(ctx, l)?;
+            g.level_for_mode(ctx, l, mode)?;
         }
         setup(&JobSetup {
             adapter: ctx

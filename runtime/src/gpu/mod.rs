@@ -420,6 +420,24 @@ impl GpuRenderer {
         self.scene.level.as_ref().is_some_and(|l| l.triangles)
     }
 
+    /// Makes the uploaded level serve `mode`: uploads `level` if none is up, and again with its
+    /// triangle lists (listed now) when `mode` walks with them and they are not up yet — the
+    /// first frame of that mode pays for them, a level never walked with them does not.
+    pub fn level_for_mode(
+        &mut self,
+        ctx: &GpuContext,
+        level: &GateLevel,
+        mode: &GpuMode,
+    ) -> Result<(), RenderError> {
+        let lists = mode.gates().is_some_and(|g| g.triangles);
+        if lists && !self.level_has_triangles() {
+            level.list_triangles();
+        } else if self.scene.level.is_some() {
+            return Ok(());
+        }
+        self.set_level(ctx, level)
+    }
+
     /// GPU textures, buffers and query sets the renderer's frames have made so far (a frame
     /// with the same sizes and settings as the last makes none).
     pub fn resources_created(&self) -> u64 {

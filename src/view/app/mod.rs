@@ -288,18 +288,13 @@ impl ViewerApp {
                 return;
             }
         };
-        // The closed voxels' triangles are listed and uploaded when the walk first needs them
-        // (the box ticked, or a kept view that had it): a level not walked with them pays
-        // neither the time nor the GPU memory.
+        // The closed voxels' triangles go up when the walk first needs them (the box ticked,
+        // or a kept view that had it).
         if let Some(l) = &self.start.level
-            && params.mode.gates().is_some_and(|g| g.triangles)
-            && !self.gpu.level_has_triangles()
+            && let Err(e) = self.gpu.level_for_mode(&self.ctx, l, &params.mode)
         {
-            l.list_triangles();
-            if let Err(e) = self.gpu.set_level(&self.ctx, l) {
-                self.error = Some(e.to_string());
-                return;
-            }
+            self.error = Some(e.to_string());
+            return;
         }
         match (self.gpu).render_kept(&self.ctx, &view, input, &params, read_hdr) {
             Ok((img, times)) => {
