@@ -778,12 +778,12 @@ fn render_gates_uses_a_baked_level_and_refuses_a_missing_or_stale_one() {
     assert!(!stdout(&o).contains("unique clusters"), "{}", stdout(&o));
     // With the triangles in the closed voxels, named too, and the same room as bright (the
     // two rooms' walls are thick, so the walk sees what it saw).
-    let mean = |o: &std::process::Output| {
-        let line = stdout(o)
-            .lines()
-            .find(|l| l.starts_with("mean radiance"))
-            .map(String::from);
-        line.expect("mean radiance")
+    // The "mean radiance R G B" line's values.
+    let radiance = |o: &std::process::Output| -> Vec<f32> {
+        let out = stdout(o);
+        let line = out.lines().find(|l| l.starts_with("mean radiance"));
+        let values = line.expect("mean radiance").split_whitespace().skip(2);
+        values.map(|x| x.parse().expect("a number")).collect()
     };
     let mut t = a.clone();
     t.push("--closed-voxel-triangles");
@@ -794,20 +794,10 @@ fn render_gates_uses_a_baked_level_and_refuses_a_missing_or_stale_one() {
         "{}",
         stdout(&ot)
     );
-    let radiance = |o| -> Vec<f32> {
-        let m = mean(o);
-        m.split_whitespace()
-            .skip(2)
-            .map(|x| x.parse().expect("a number"))
-            .collect()
-    };
-    for (x, y) in radiance(&o).iter().zip(radiance(&ot)) {
-        assert!(
-            (x - y).abs() <= 0.02 * x.max(1e-3),
-            "{} / {}",
-            mean(&o),
-            mean(&ot)
-        );
+    let (plain, with) = (radiance(&o), radiance(&ot));
+    assert_eq!(plain.len(), 3);
+    for (x, y) in plain.iter().zip(&with) {
+        assert!((x - y).abs() <= 0.02 * x.max(1e-3), "{plain:?} / {with:?}");
     }
     a.extend(["--gate-shape", "portal"]);
     let o = visgate(&a);
