@@ -49,8 +49,8 @@ fn a_folder_of_shaders_replaces_the_builtin_ones_and_errors_name_file_and_line()
     let blur = builtin("blur.wgsl");
     let line = blur
         .lines()
-        .position(|l| l.contains("fn "))
-        .expect("a function")
+        .position(|l| l.contains("fn compose("))
+        .expect("the blur's function")
         + 2;
     let bad = with_line(&blur, line, "    let wrong: u32 = 1.5;");
     std::fs::write(dir.path().join("blur.wgsl"), bad).expect("write");

@@ -97,9 +97,11 @@ impl GpuContext {
         device: wgpu::Device,
         queue: wgpu::Queue,
     ) -> GpuContext {
-        let timestamp_period = device
-            .features()
-            .contains(wgpu::Features::TIMESTAMP_QUERY)
+        // lavapipe writes a compute pass's closing timestamp without waiting for its
+        // dispatches (a 300 ms pass read 0.04 ms: examples/fragment_vs_compute.rs): on a CPU
+        // adapter each span is timed by waiting for it instead.
+        let timestamp_period = (device.features().contains(wgpu::Features::TIMESTAMP_QUERY)
+            && adapter_info.device_type != wgpu::DeviceType::Cpu)
             .then(|| queue.get_timestamp_period());
         GpuContext {
             device,
@@ -152,6 +154,28 @@ pub fn compute_pipelines<const N: usize>(
             compilation_options: Default::default(),
             cache: None,
         })
+    })
+}
+
+/// The compute pipeline (auto layout) of `module`'s entry point `entry` with the shader's
+/// pipeline-overridable `constants` set (WGSL `override`s, by name).
+pub fn compute_pipeline_with(
+    d: &wgpu::Device,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    entry: &str,
+    constants: &[(&str, f64)],
+) -> wgpu::ComputePipeline {
+    d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(label),
+        layout: None,
+        module,
+        entry_point: Some(entry),
+        compilation_options: wgpu::PipelineCompilationOptions {
+            constants,
+            ..Default::default()
+        },
+        cache: None,
     })
 }
 

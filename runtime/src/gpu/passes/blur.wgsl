@@ -1,8 +1,9 @@
-//! include: val.wgsl vpl.wgsl fullscreen.wgsl
+//! include: val.wgsl vpl.wgsl
 // Interleaving's other half: the interleaved indirect irradiance (val_gather.wgsl) blurred over
 // the b × b block where the geometry agrees (Laine et al.: positions closer than a fraction of
 // the scene, normals closer than a cosine), times albedo / π, added onto the image so far
-// (`previous`: ping-pong, 32-bit float targets are not blendable everywhere).
+// (`previous`: ping-pong, 32-bit float targets are not blendable everywhere). A compute pass,
+// as the gathers (shade.wgsl's cs_gates_indirect says why).
 
 @group(0) @binding(0) var<uniform> gather: ValGather;
 @group(0) @binding(3) var g_position: texture_2d<f32>;
@@ -10,10 +11,16 @@
 @group(0) @binding(5) var g_albedo: texture_2d<f32>;
 @group(0) @binding(6) var previous: texture_2d<f32>;
 @group(0) @binding(12) var indirect: texture_2d<f32>;
+@group(0) @binding(13) var composed: texture_storage_2d<rgba32float, write>;
 
-@fragment
-fn fs_compose(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
-    let px = vec2<i32>(frag.xy);
+@compute @workgroup_size(8, 8)
+fn cs_compose(@builtin(global_invocation_id) id: vec3<u32>) {
+    if all(id.xy < textureDimensions(previous)) {
+        textureStore(composed, id.xy, compose(vec2<i32>(id.xy)));
+    }
+}
+
+fn compose(px: vec2<i32>) -> vec4<f32> {
     let before = textureLoad(previous, px, 0);
     let pos = textureLoad(g_position, px, 0);
     if pos.w == 0.0 {

@@ -4,9 +4,9 @@
 //! a ping-pong target and a copy).
 
 use super::gbuffer::GBufferOutput;
-use super::shade::{HDR, frame_target, fullscreen};
+use super::shade::frame_texture;
 use crate::RenderError;
-use crate::gpu::context::{Pool, bind_group, render_pipeline};
+use crate::gpu::context::{Pool, bind_group, compute_pipelines};
 use crate::gpu::layout::ValGather;
 use crate::gpu::shaders::ShaderSources;
 use crate::gpu::timing::Recorder;
@@ -68,14 +68,14 @@ impl InterleaveParams {
 
 /// The blur-and-compose pipeline.
 pub struct InterleaveBlur {
-    pipeline: wgpu::RenderPipeline,
+    pipeline: wgpu::ComputePipeline,
 }
 
 impl InterleaveBlur {
     /// Builds the pipeline.
     pub fn new(d: &wgpu::Device, s: &ShaderSources) -> Result<InterleaveBlur, RenderError> {
         let module = shaders::module(d, s, "blur.wgsl")?;
-        let pipeline = render_pipeline(d, "blur", &module, ("vs", "fs_compose"), &[], &[HDR], None);
+        let [pipeline] = compute_pipelines(d, &module, ["cs_compose"]);
         Ok(InterleaveBlur { pipeline })
     }
 
@@ -121,11 +121,13 @@ impl InterleaveBlur {
         ),
     ) {
         let d = &f.ctx.device;
-        let other = frame_target(f, pool, "hdr (ping-pong)");
+        let storage = wgpu::TextureUsages::STORAGE_BINDING;
+        let other = frame_texture(f, pool, "hdr (composed)", storage);
         let tex = wgpu::BindingResource::TextureView;
-        let (out_view, indirect_view) = (
+        let (out_view, indirect_view, other_view) = (
             out.create_view(&Default::default()),
             indirect.create_view(&Default::default()),
+            other.create_view(&Default::default()),
         );
         let bg = bind_group(
             d,
@@ -138,17 +140,20 @@ impl InterleaveBlur {
                 (5, tex(&g.views[2])),
                 (6, tex(&out_view)),
                 (12, tex(&indirect_view)),
+                (13, tex(&other_view)),
             ],
         );
         let span = rec.begin("blur + compose");
-        fullscreen(
-            &mut rec.enc,
-            "blur + compose",
-            &other.create_view(&Default::default()),
-            &self.pipeline,
-            &bg,
-            span.render(true, true),
-        );
+        {
+            let mut pass = rec.enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("blur + compose"),
+                timestamp_writes: span.compute(),
+            });
+            pass.set_pipeline(&self.pipeline);
+            pass.set_bind_group(0, &bg, &[]);
+            let [w, h] = f.view.size;
+            pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
+        }
         rec.enc
             .copy_texture_to_texture(other.as_image_copy(), out.as_image_copy(), out.size());
         rec.end();

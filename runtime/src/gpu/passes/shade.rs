@@ -8,7 +8,10 @@ use super::light_cluster::LcOutput;
 use super::shadow_maps::ShadowOutput;
 use crate::RenderError;
 use crate::cpu::gates::GateShape;
-use crate::gpu::context::{Pool, array_view, bind_group, render_pipeline, render_pipeline_with};
+use crate::gpu::context::{
+    Pool, array_view, bind_group, compute_pipeline_with, render_pipeline, slice,
+};
+use crate::gpu::layout::{UNIFORM_STRIDE, strided};
 use crate::gpu::shaders::ShaderSources;
 use crate::gpu::timing::Recorder;
 use crate::gpu::{Frame, shaders};
@@ -19,10 +22,10 @@ pub const HDR: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 /// The shading pipelines: direct + the mode's indirect, and interleaved gates' indirect alone.
 pub struct Shade {
     pipeline: wgpu::RenderPipeline,
-    /// The interleaved gates' indirect pass, a pipeline per gate shape (shade.wgsl's
+    /// The interleaved gates' indirect pass (compute), a pipeline per gate shape (shade.wgsl's
     /// `GATE_SHAPE`, by [`crate::cpu::gates::GateShape::shader_id`]) and one for the voxel
     /// walk with the closed voxels' triangles (`SIGHT_TRIANGLES`), each made when first used.
-    gates_indirect: [std::sync::OnceLock<wgpu::RenderPipeline>; 4],
+    gates_indirect: [std::sync::OnceLock<wgpu::ComputePipeline>; 4],
     module: wgpu::ShaderModule,
     vpl_clusters_indirect: wgpu::RenderPipeline,
 }
@@ -35,18 +38,6 @@ pub fn fullscreen(
     pipeline: &wgpu::RenderPipeline,
     bind_group: &wgpu::BindGroup,
     timestamps: Option<wgpu::RenderPassTimestampWrites>,
-) {
-    fullscreen_batch(enc, label, target, (pipeline, bind_group), timestamps, 0);
-}
-
-/// [`fullscreen`] as instance `batch` (shade.wgsl's `vs_batch` passes it on).
-fn fullscreen_batch(
-    enc: &mut wgpu::CommandEncoder,
-    label: &str,
-    target: &wgpu::TextureView,
-    (pipeline, bind_group): (&wgpu::RenderPipeline, &wgpu::BindGroup),
-    timestamps: Option<wgpu::RenderPassTimestampWrites>,
-    batch: u32,
 ) {
     let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
         label: Some(label),
@@ -66,11 +57,22 @@ fn fullscreen_batch(
     });
     pass.set_pipeline(pipeline);
     pass.set_bind_group(0, bind_group, &[]);
-    pass.draw(0..3, batch..batch + 1);
+    pass.draw(0..3, 0..1);
 }
 
 /// A full-frame RGBA32F target `label` of the frame's size (kept in `pool`).
 pub fn frame_target(f: &Frame, pool: &mut Pool, label: &'static str) -> wgpu::Texture {
+    frame_texture(f, pool, label, wgpu::TextureUsages::RENDER_ATTACHMENT)
+}
+
+/// A full-frame RGBA32F texture `label` that a pass writes with `written` (render attachment or
+/// storage binding), read back, copied and read by later passes (kept in `pool`).
+pub fn frame_texture(
+    f: &Frame,
+    pool: &mut Pool,
+    label: &'static str,
+    written: wgpu::TextureUsages,
+) -> wgpu::Texture {
     let [w, h] = f.view.size;
     pool.texture(
         &f.ctx.device,
@@ -78,7 +80,7 @@ pub fn frame_target(f: &Frame, pool: &mut Pool, label: &'static str) -> wgpu::Te
         [w, h, 1],
         1,
         HDR,
-        wgpu::TextureUsages::RENDER_ATTACHMENT
+        written
             | wgpu::TextureUsages::COPY_SRC
             | wgpu::TextureUsages::COPY_DST
             | wgpu::TextureUsages::TEXTURE_BINDING,
@@ -105,8 +107,8 @@ pub struct Gathers<'a> {
     pub vpl_ends: Option<&'a wgpu::Buffer>,
 }
 
-/// The bindings of shade.wgsl's `fs_gates_indirect` (an automatic layout holds only what an
-/// entry point uses).
+/// The bindings of shade.wgsl's `cs_gates_indirect` (an automatic layout holds only what an
+/// entry point uses) but its batch index (24) and its output (25).
 const GATES_INDIRECT_BINDINGS: [u32; 15] = [0, 2, 5, 6, 7, 8, 10, 12, 13, 14, 15, 16, 21, 22, 23];
 /// The bindings of shade.wgsl's `fs`: all but the batches' sum.
 const SHADE_BINDINGS: [u32; 23] = [
@@ -144,17 +146,15 @@ impl Shade {
         d: &wgpu::Device,
         shape: u32,
         triangles: bool,
-    ) -> &wgpu::RenderPipeline {
+    ) -> &wgpu::ComputePipeline {
         let triangles = triangles && shape == GateShape::Voxels.shader_id();
         let k = if triangles { 3 } else { shape as usize };
         self.gates_indirect[k].get_or_init(|| {
-            render_pipeline_with(
+            compute_pipeline_with(
                 d,
                 "gates indirect (interleaved)",
                 &self.module,
-                ("vs_batch", "fs_gates_indirect"),
-                &[],
-                (&[HDR], None),
+                "cs_gates_indirect",
                 &[
                     ("GATE_SHAPE", f64::from(shape)),
                     ("SIGHT_TRIANGLES", f64::from(u8::from(triangles))),
@@ -174,7 +174,7 @@ impl Shade {
     ) -> wgpu::Texture {
         let out = frame_target(f, pool, "hdr");
         let pipeline = (&self.pipeline, Some(&SHADE_BINDINGS[..]));
-        self.draw(f, rec, inputs, pipeline, (std::slice::from_ref(&out), name));
+        self.draw(f, rec, inputs, pipeline, (&out, name));
         out
     }
 
@@ -190,17 +190,16 @@ impl Shade {
         inputs: Inputs,
         gates: Option<GateShape>,
     ) -> wgpu::Texture {
-        let out = frame_target(f, pool, "indirect irradiance");
         let name = "indirect lighting";
         let Some(shape) = gates else {
+            let out = frame_target(f, pool, "indirect irradiance");
             let pipeline = (
                 &self.vpl_clusters_indirect,
                 Some(&VPL_CLUSTERS_INDIRECT_BINDINGS[..]),
             );
-            self.draw(f, rec, inputs, pipeline, (std::slice::from_ref(&out), name));
+            self.draw(f, rec, inputs, pipeline, (&out, name));
             return out;
         };
-        // Portals' batches ping-pong between two targets, each adding onto the other's sum.
         let batch = f.walk_batch;
         let walks = f.params.mode.walks_per_pixel(f.vpl_count);
         let batches = if batch > 0 {
@@ -208,24 +207,9 @@ impl Shade {
         } else {
             1
         };
-        // One pass reads no earlier batches: a texel stands in for the second target.
-        let earlier = match batches {
-            1 => pool.texture(
-                &f.ctx.device,
-                "no earlier batches",
-                [1, 1, 1],
-                1,
-                HDR,
-                wgpu::TextureUsages::TEXTURE_BINDING,
-            ),
-            _ => frame_target(f, pool, "indirect irradiance (batches)"),
-        };
-        let targets = [out, earlier];
         let triangles = f.params.mode.gates().is_some_and(|g| g.triangles);
         let pipeline = self.gates_indirect(&f.ctx.device, shape.shader_id(), triangles);
-        let pipeline = (pipeline, Some(&GATES_INDIRECT_BINDINGS[..]));
-        self.draw_batches(f, rec, inputs, pipeline, (&targets, name), batches);
-        targets[(batches as usize - 1) % 2].clone()
+        self.walk_batches(f, pool, rec, inputs, pipeline, batches)
     }
 
     /// A fullscreen pass of shade.wgsl with `pipeline` (and the bindings it uses, all if
@@ -235,32 +219,126 @@ impl Shade {
         f: &Frame,
         rec: &mut Recorder,
         inputs: Inputs,
-        pipeline: (&wgpu::RenderPipeline, Option<&[u32]>),
-        (out, name): (&[wgpu::Texture], &'static str),
+        (pipeline, used): (&wgpu::RenderPipeline, Option<&[u32]>),
+        (out, name): (&wgpu::Texture, &'static str),
     ) {
-        self.draw_batches(f, rec, inputs, pipeline, (out, name), 1);
+        let views = Views::new(f, inputs);
+        let resources = views.resources(f, inputs, None, used);
+        let group = bind_group(
+            &f.ctx.device,
+            &pipeline.get_bind_group_layout(0),
+            name,
+            resources,
+        );
+        let span = rec.begin(name);
+        let target = out.create_view(&Default::default());
+        fullscreen(
+            &mut rec.enc,
+            name,
+            &target,
+            pipeline,
+            &group,
+            span.render(true, true),
+        );
+        rec.end();
     }
 
-    /// `batches` fullscreen passes of shade.wgsl with `pipeline` (and the bindings it uses),
-    /// timed together as `name`: pass `i` is instance `i`, writes `targets[i % 2]` and reads
-    /// the other as the batches' sum so far (binding 21; one target: one pass, no sum).
-    fn draw_batches(
+    /// The gates' indirect pass: `batches` dispatches of `pipeline` in one compute pass, timed
+    /// as one span; dispatch `i` walks batch `i`, writes target `i % 2` and reads the other as
+    /// the batches' sum so far (one batch: a texel stands in for it). Returns the last target.
+    fn walk_batches(
         &self,
         f: &Frame,
+        pool: &mut Pool,
         rec: &mut Recorder,
-        (shadows, g, gathers, lc, vpl_lc): Inputs,
-        (pipeline, used): (&wgpu::RenderPipeline, Option<&[u32]>),
-        (targets, name): (&[wgpu::Texture], &'static str),
+        inputs: Inputs,
+        pipeline: &wgpu::ComputePipeline,
         batches: u32,
-    ) {
+    ) -> wgpu::Texture {
         let d = &f.ctx.device;
+        let storage = wgpu::TextureUsages::STORAGE_BINDING;
+        let first = frame_texture(f, pool, "indirect irradiance (walks)", storage);
+        let second = match batches {
+            1 => pool.texture(
+                d,
+                "no earlier batches",
+                [1, 1, 1],
+                1,
+                HDR,
+                wgpu::TextureUsages::TEXTURE_BINDING,
+            ),
+            _ => frame_texture(f, pool, "indirect irradiance (walk batches)", storage),
+        };
+        let targets = [first, second];
+        let targets_view = targets
+            .each_ref()
+            .map(|t| t.create_view(&Default::default()));
+        let indices: Vec<[u32; 4]> = (0..batches).map(|i| [i, 0, 0, 0]).collect();
+        let index_buf = pool.upload(
+            f.ctx,
+            "walk batch indices",
+            &strided(&indices),
+            wgpu::BufferUsages::UNIFORM,
+        );
+        let views = Views::new(f, inputs);
+        let layout = pipeline.get_bind_group_layout(0);
+        let groups: Vec<wgpu::BindGroup> = (0..batches as usize)
+            .map(|i| {
+                let (out, earlier) = (&targets_view[i % 2], &targets_view[(i + 1) % 2]);
+                let mut resources =
+                    views.resources(f, inputs, Some(earlier), Some(&GATES_INDIRECT_BINDINGS[..]));
+                resources.push((24, slice(&index_buf, (i * UNIFORM_STRIDE) as u64, 16)));
+                resources.push((25, wgpu::BindingResource::TextureView(out)));
+                bind_group(d, &layout, "gates indirect", resources)
+            })
+            .collect();
+        let [w, h] = f.view.size;
+        let span = rec.begin("indirect lighting");
+        {
+            let mut pass = rec.enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("gates indirect"),
+                timestamp_writes: span.compute(),
+            });
+            pass.set_pipeline(pipeline);
+            for group in &groups {
+                pass.set_bind_group(0, group, &[]);
+                pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
+            }
+        }
+        rec.end();
+        targets[(batches as usize - 1) % 2].clone()
+    }
+}
+
+/// The texture views shade.wgsl's passes read beside the G-buffer's.
+struct Views {
+    maps: wgpu::TextureView,
+    vis: wgpu::TextureView,
+    vpl_vis: wgpu::TextureView,
+}
+
+impl Views {
+    fn new(f: &Frame, (shadows, _, _, lc, vpl_lc): Inputs) -> Views {
+        let no_vis = array_view(&f.scene.no_visibility);
+        Views {
+            maps: array_view(&shadows.maps),
+            vis: lc.map_or_else(|| no_vis.clone(), |o| array_view(&o.visibility)),
+            vpl_vis: vpl_lc.map_or(no_vis, |o| array_view(&o.visibility)),
+        }
+    }
+
+    /// shade.wgsl's group 0 but bindings 24 and 25 (`used` alone where given), with `earlier`
+    /// as the batches' sum (binding 21, left out when `None`).
+    fn resources<'a>(
+        &'a self,
+        f: &'a Frame,
+        (shadows, g, gathers, lc, vpl_lc): Inputs<'a>,
+        earlier: Option<&'a wgpu::TextureView>,
+        used: Option<&[u32]>,
+    ) -> Vec<(u32, wgpu::BindingResource<'a>)> {
         let level = f.scene.level.as_ref();
         let lists = gathers.lists;
         let none = &f.scene.no_level;
-        let maps = array_view(&shadows.maps);
-        let no_vis = array_view(&f.scene.no_visibility);
-        let vis = lc.map_or_else(|| no_vis.clone(), |o| array_view(&o.visibility));
-        let vpl_vis = vpl_lc.map_or(no_vis, |o| array_view(&o.visibility));
         let buffers: [(u32, &wgpu::Buffer); 17] = [
             (0, &f.globals),
             (1, &shadows.lights),
@@ -280,48 +358,24 @@ impl Shade {
             (22, level.map_or(none, |l| &l.sight_words)),
             (23, gathers.vpl_ends.unwrap_or(none)),
         ];
-        let views: Vec<wgpu::TextureView> = targets
+        let textures = [
+            (4, &self.maps),
+            (5, &g.views[0]),
+            (6, &g.views[1]),
+            (7, &g.views[2]),
+            (17, &self.vis),
+            (19, &self.vpl_vis),
+        ];
+        buffers
             .iter()
-            .map(|t| t.create_view(&Default::default()))
-            .collect();
-        // One bind group a target written: the batches' sum is the other target.
-        let groups: Vec<wgpu::BindGroup> = (0..views.len().min(batches as usize))
-            .map(|i| {
-                let earlier = &views[(i + 1) % views.len()];
-                let textures = [
-                    (4, &maps),
-                    (5, &g.views[0]),
-                    (6, &g.views[1]),
-                    (7, &g.views[2]),
-                    (17, &vis),
-                    (19, &vpl_vis),
-                    (21, earlier),
-                ];
-                let resources = buffers
-                    .iter()
-                    .map(|&(k, b)| (k, b.as_entire_binding()))
-                    .chain(
-                        textures
-                            .iter()
-                            .map(|&(k, v)| (k, wgpu::BindingResource::TextureView(v))),
-                    )
-                    .filter(|(k, _)| used.is_none_or(|u| u.contains(k)))
-                    .collect();
-                bind_group(d, &pipeline.get_bind_group_layout(0), name, resources)
-            })
-            .collect();
-        let span = rec.begin(name);
-        for i in 0..batches as usize {
-            let k = i % views.len();
-            fullscreen_batch(
-                &mut rec.enc,
-                name,
-                &views[k],
-                (pipeline, &groups[k]),
-                span.render(i == 0, i + 1 == batches as usize),
-                i as u32,
-            );
-        }
-        rec.end();
+            .map(|&(k, b)| (k, b.as_entire_binding()))
+            .chain(
+                textures
+                    .into_iter()
+                    .chain(earlier.map(|v| (21, v)))
+                    .map(|(k, v)| (k, wgpu::BindingResource::TextureView(v))),
+            )
+            .filter(|(k, _)| used.is_none_or(|u| u.contains(k)))
+            .collect()
     }
 }

@@ -51,12 +51,12 @@ struct GeometryCluster {
 // SHADE_VPL_CLUSTERS: the VPLs' clusters' visibility and each VPL's cluster (NONE: no flux).
 @group(0) @binding(19) var vpl_lc_visibility: texture_2d_array<f32>;
 @group(0) @binding(20) var<storage, read> vpl_lc_cluster: array<u32>;
-// Portals walked in batches (fs_gates_indirect): the sum of the batches before, in the
+// Walks in batches (cs_gates_indirect): the sum of the batches before, in the
 // (deinterleaved) layout of the indirect target.
 @group(0) @binding(21) var earlier_batches: texture_2d<f32>;
 // The level's open voxels and their bricks' clearance, for the voxel walk (sight.wgsl).
 @group(0) @binding(22) var<storage, read> sight_words: array<u32>;
-// Each VPL's end of the voxel walk (sight_ends.wgsl), for fs_gates_indirect.
+// Each VPL's end of the voxel walk (sight_ends.wgsl), for cs_gates_indirect.
 @group(0) @binding(23) var<storage, read> vpl_ends: array<vec4<f32>>;
 
 // SHADE_VPL_CLUSTERS: the VPLs first, first + step, … (every VPL, or an interleaving subset),
@@ -363,40 +363,36 @@ fn subset_start(first: u32, end: u32, subsets: u32, j: u32) -> u32 {
 }
 
 // Interleaved clustered gates: a pixel's subset's irradiance × B alone (no albedo / π), into
-// the indirect target that blur.wgsl composes, deinterleaved: the fragment at s shades the
+// the indirect target that blur.wgsl composes, deinterleaved: the invocation at s shades the
 // pixel that s holds, so that a GPU's neighbouring lanes walk the same VPLs.
 //
-// Portals on a software rasterizer walk a pixel's VPLs in batches, a draw each (the instance
-// index is the batch), each adding its light to the batches' before: llvmpipe ends a shader
-// invocation's loops after 65,535 iterations in all, which a pixel walking hundreds of VPLs
-// reaches, losing the light of the rest.
-struct BatchOut {
-    @builtin(position) position: vec4<f32>,
-    @location(0) @interpolate(flat) batch: u32,
-};
+// A compute pass, not a fullscreen draw: the same loop ran 30× slower as a fragment shader on
+// an NVIDIA H200 (examples/fragment_vs_compute.rs; data-centre GPUs rasterize on a few of
+// their units) and as fast on lavapipe.
+//
+// Walks on a software rasterizer run a pixel's VPLs in batches, a dispatch each
+// (walk_batch_index.x is the batch), each adding its light to the batches' before (read from
+// earlier_batches): llvmpipe ends a shader invocation's loops after 65,535 iterations in all,
+// which a pixel walking hundreds of VPLs reaches, losing the light of the rest.
+@group(0) @binding(24) var<uniform> walk_batch_index: vec4<u32>;
+@group(0) @binding(25) var indirect_out: texture_storage_2d<rgba32float, write>;
 
-@vertex
-fn vs_batch(@builtin(vertex_index) i: u32, @builtin(instance_index) batch: u32) -> BatchOut {
-    var out: BatchOut;
-    // fullscreen.wgsl's triangle.
-    let uv = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u));
-    out.position = vec4<f32>(uv * 2.0 - 1.0, 0.0, 1.0);
-    out.batch = batch;
-    return out;
-}
-
-@fragment
-fn fs_gates_indirect(@builtin(position) frag: vec4<f32>, @location(0) @interpolate(flat) batch: u32) -> @location(0) vec4<f32> {
+@compute @workgroup_size(8, 8)
+fn cs_gates_indirect(@builtin(global_invocation_id) id: vec3<u32>) {
+    if any(id.xy >= textureDimensions(g_position)) {
+        return;
+    }
+    let batch = walk_batch_index.x;
     var sum = vec3<f32>(0.0);
     if batch > 0u {
-        sum = textureLoad(earlier_batches, vec2<i32>(frag.xy), 0).xyz;
+        sum = textureLoad(earlier_batches, vec2<i32>(id.xy), 0).xyz;
     }
-    let s = interleaved_surface(frag);
-    if s.position.w == 0.0 {
-        return vec4<f32>(sum, 1.0);
+    let s = interleaved_surface(vec2<f32>(id.xy) + 0.5);
+    if s.position.w != 0.0 {
+        let here = decode_cluster(s.position.w);
+        sum += clustered_gather(s.px, s.position.xyz, s.normal, here, batch);
     }
-    let here = decode_cluster(s.position.w);
-    return vec4<f32>(sum + clustered_gather(s.px, s.position.xyz, s.normal, here, batch), 1.0);
+    textureStore(indirect_out, id.xy, vec4<f32>(sum, 1.0));
 }
 
 // The pixel a deinterleaved fragment shades, and its G-buffer surface (w 0: none).
@@ -406,7 +402,7 @@ struct Surface {
     normal: vec3<f32>,
 };
 
-fn interleaved_surface(frag: vec4<f32>) -> Surface {
+fn interleaved_surface(frag: vec2<f32>) -> Surface {
     let b = max(globals.interleave_block, 1u);
     var s: Surface;
     s.px = interleaved(vec2<i32>(frag.xy), b, textureDimensions(g_position));
@@ -415,10 +411,10 @@ fn interleaved_surface(frag: vec4<f32>) -> Surface {
     return s;
 }
 
-// Interleaved VPL clusters: as fs_gates_indirect, each pixel its subset of the VPLs.
+// Interleaved VPL clusters: as cs_gates_indirect, each pixel its subset of the VPLs.
 @fragment
 fn fs_vpl_clusters_indirect(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
-    let s = interleaved_surface(frag);
+    let s = interleaved_surface(frag.xy);
     if s.position.w == 0.0 {
         return vec4<f32>(0.0);
     }

@@ -1,18 +1,18 @@
 //! The VAL modes after the direct light (val_gather.wgsl; Dong et al. §4): a paraboloid distance
 //! map per VAL (one render pass per layer: wgpu has no layered rendering without multiview),
 //! for `val-cssm` its convolution basis ([`super::cssm`]), then every VPL gathered through its
-//! VAL's visibility — hard (`fs_hard`) or soft (`fs_cssm`) — into an indirect target, each pixel
+//! VAL's visibility — hard (`cs_hard`) or soft (`cs_cssm`) — into an indirect target, each pixel
 //! with its interleaving subset, and the blur composing it ([`super::interleave_blur`]).
 
 use super::cssm::{Cssm, CssmParams};
 use super::gbuffer::GBufferOutput;
 use super::interleave_blur::{InterleaveBlur, InterleaveParams};
 use super::per_vpl_maps::ParaboloidMaps;
-use super::shade::{HDR, frame_target, fullscreen};
+use super::shade::frame_texture;
 use super::vals::{ValClustering, ValInput};
 use crate::RenderError;
 use crate::cpu::val::ValParams;
-use crate::gpu::context::{Pool, array_view, bind_group, render_pipeline};
+use crate::gpu::context::{Pool, array_view, bind_group, compute_pipelines};
 use crate::gpu::layout::ValGather;
 use crate::gpu::shaders::ShaderSources;
 use crate::gpu::timing::Recorder;
@@ -55,8 +55,8 @@ impl ValModeParams {
 
 /// The VAL gathers (hard and CSSM).
 pub struct ValGathers {
-    hard: wgpu::RenderPipeline,
-    cssm: wgpu::RenderPipeline,
+    hard: wgpu::ComputePipeline,
+    cssm: wgpu::ComputePipeline,
     sampler: wgpu::Sampler,
 }
 
@@ -76,25 +76,10 @@ impl ValGathers {
     /// Builds the pipelines.
     pub fn new(d: &wgpu::Device, s: &ShaderSources) -> Result<ValGathers, RenderError> {
         let m = shaders::module(d, s, "val_gather.wgsl")?;
+        let [hard, cssm] = compute_pipelines(d, &m, ["cs_hard", "cs_cssm"]);
         Ok(ValGathers {
-            hard: render_pipeline(
-                d,
-                "val gather (hard)",
-                &m,
-                ("vs", "fs_hard"),
-                &[],
-                &[HDR],
-                None,
-            ),
-            cssm: render_pipeline(
-                d,
-                "val gather (cssm)",
-                &m,
-                ("vs", "fs_cssm"),
-                &[],
-                &[HDR],
-                None,
-            ),
+            hard,
+            cssm,
             sampler: super::cssm::sampler(d),
         })
     }
@@ -169,7 +154,9 @@ impl ValGathers {
             bytemuck::bytes_of(&constants),
             wgpu::BufferUsages::UNIFORM,
         );
-        let indirect = frame_target(f, pool, "indirect irradiance");
+        let storage = wgpu::TextureUsages::STORAGE_BINDING;
+        let indirect = frame_texture(f, pool, "indirect irradiance (VALs)", storage);
+        let indirect_view = indirect.create_view(&Default::default());
         let maps_view = array_view(&maps);
         let tex = wgpu::BindingResource::TextureView;
         let mut entries: Vec<(u32, wgpu::BindingResource)> = vec![
@@ -179,6 +166,7 @@ impl ValGathers {
             (4, tex(&g.views[1])),
             (7, b.order.as_entire_binding()),
             (8, b.vals.as_entire_binding()),
+            (12, tex(&indirect_view)),
         ];
         let pipeline = match &basis {
             Some(basis) => {
@@ -194,14 +182,16 @@ impl ValGathers {
         };
         let bg = bind_group(d, &pipeline.get_bind_group_layout(0), "val gather", entries);
         let span = rec.begin("indirect lighting");
-        fullscreen(
-            &mut rec.enc,
-            "val gather",
-            &indirect.create_view(&Default::default()),
-            pipeline,
-            &bg,
-            span.render(true, true),
-        );
+        {
+            let mut pass = rec.enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("val gather"),
+                timestamp_writes: span.compute(),
+            });
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, &bg, &[]);
+            let [w, h] = f.view.size;
+            pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
+        }
         rec.end();
         passes
             .blur

@@ -1,0 +1,75 @@
+#!/usr/bin/env bash
+# The timing table of issue 19 (the gates paper's Table I, extended): GPU ms of the frame after
+# one warm-up for every visibility mode, at several VPL counts and sizes, on the shared levels
+# baked at 256, and a table of them.
+#
+#   bench/gpu_sweep.sh VISGATE OUT [LEVEL...]
+#
+# VISGATE: the visgate binary (a release build). OUT: a folder; it gets OUT/LEVEL.vgate,
+# OUT/log.txt (every render's report) and OUT/table.md (level, camera, size, VPLs, mode, GPU ms
+# of the frame, of its indirect pass). LEVEL: e2m3, sponza (default both). In the environment:
+# RUNS="SIZE:COUNTS ..." (default "512x512:4096,1024,16384 1280x720:4096"), MODES (the labels
+# below, default all), LIMIT (seconds a render may take, default 60). A render that fails or runs
+# past LIMIT is written as such in the table. Needs ../shared/scenes beside the repository.
+set -uo pipefail
+if [ $# -lt 2 ]; then
+    sed -n '2,/^set /p' "$0" | grep '^#' | sed 's/^# \{0,1\}//'
+    exit 2
+fi
+bin=$1 out=$2
+shift 2
+levels=${*:-e2m3 sponza}
+runs=${RUNS:-512x512:4096,1024,16384 1280x720:4096}
+modes=${MODES:-none direct-only gates gates-triangles gates-portal gates-disk val-hard val-cssm per-vpl-shadow-maps}
+limit=${LIMIT:-60}
+mkdir -p "$out"
+log="$out/log.txt" table="$out/table.md"
+[ -f "$table" ] || printf '| level | camera | size | VPLs | mode | frame (GPU ms) | indirect (GPU ms) |\n|---|---|---|---|---|---|---|\n' >"$table"
+
+args_of() { # LABEL -> render arguments
+    case $1 in
+    gates-triangles) echo "--mode gates --closed-voxel-triangles" ;;
+    gates-portal) echo "--mode gates --gate-shape portal" ;;
+    gates-disk) echo "--mode gates --gate-shape disk" ;;
+    *) echo "--mode $1" ;;
+    esac
+}
+
+scene_of() { # LEVEL -> scene camera
+    case $1 in
+    e2m3) echo "scenes/shared/librequake-e2m3.toml hall" ;;
+    sponza) echo "scenes/shared/crytek-sponza.toml gallery" ;;
+    *) echo "unknown level $1" >&2 && exit 2 ;;
+    esac
+}
+
+for level in $levels; do
+    read -r scene _ <<<"$(scene_of "$level")" || exit 2
+    [ -f "$out/$level.vgate" ] ||
+        "$bin" bake "$scene" --resolution 256 -o "$out/$level.vgate" >>"$log" 2>&1 || exit 1
+done
+# The first run's first count on every level before the rest, so that a stopped sweep has it.
+for run in $runs; do
+    size=${run%%:*} counts=${run#*:}
+    for n in ${counts//,/ }; do
+        for level in $levels; do
+            read -r scene camera <<<"$(scene_of "$level")"
+            for mode in $modes; do
+                echo "== $level $camera $size $n $mode" >>"$log"
+                # shellcheck disable=SC2046
+                res=$(timeout "$limit" "$bin" render "$scene" --camera "$camera" \
+                    --level "$out/$level.vgate" --size "$size" --vpls "$n" --warmup 1 \
+                    --out "$out/frame.exr" $(args_of "$mode") 2>&1)
+                rc=$?
+                echo "$res" >>"$log"
+                frame=$(echo "$res" | awk '$1 == "frame" { print $2 }')
+                ind=$(echo "$res" | awk '/indirect lighting/ { print $(NF - 1) }')
+                [ $rc -eq 124 ] && frame="over ${limit} s"
+                [ $rc -ne 0 ] && [ $rc -ne 124 ] && frame="failed ($rc)"
+                echo "| $level | $camera | $size | $n | $mode | ${frame:-?} | ${ind:--} |" |
+                    tee -a "$table"
+            done
+        done
+    done
+done
+rm -f "$out/frame.exr"
