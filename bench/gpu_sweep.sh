@@ -7,9 +7,11 @@
 #
 # VISGATE: the visgate binary (a release build). OUT: a folder; it gets OUT/LEVEL.vgate,
 # OUT/log.txt (every render's report) and OUT/table.md (level, camera, size, VPLs, mode, GPU ms
-# of the frame, of its indirect pass). LEVEL: e2m3, sponza (default both). In the environment:
-# RUNS="SIZE:COUNTS ..." (default "512x512:4096,1024,16384 1280x720:4096"), MODES (the labels
-# below, default all), LIMIT (seconds a render may take, default 60). A render that fails or runs
+# of the frame, of its indirect pass). LEVEL: e2m3, sponza (default both). Modes: none,
+# direct-only, gates (voxel walk), gates-triangles, gates-portal, gates-disk, gates-i4 and
+# val-hard-i4 (4 × 4 interleaving), val-hard, val-cssm, per-vpl-shadow-maps. In the environment:
+# RUNS="SIZE:COUNTS ..." (default "512x512:4096,1024,16384 1280x720:4096"), MODES (of those,
+# default all but the 4 × 4 ones), LIMIT (seconds a render may take, default 60). A render that fails or runs
 # past LIMIT is written as such in the table. Needs ../shared/scenes beside the repository.
 set -uo pipefail
 if [ $# -lt 2 ]; then
@@ -31,6 +33,8 @@ args_of() { # LABEL -> render arguments
     gates-triangles) echo "--mode gates --closed-voxel-triangles" ;;
     gates-portal) echo "--mode gates --gate-shape portal" ;;
     gates-disk) echo "--mode gates --gate-shape disk" ;;
+    gates-i4) echo "--mode gates --interleave 4" ;;
+    val-hard-i4) echo "--mode val-hard --interleave 4" ;;
     *) echo "--mode $1" ;;
     esac
 }

@@ -490,8 +490,9 @@ pub fn pass_table(t: &PassTimes) -> String {
         }
     }
     if t.passes.iter().all(|p| p.gpu_s.is_none()) {
-        s += "(the adapter has no timestamp queries: each pass was submitted and waited for \
-              alone, for its CPU wall time)\n";
+        s += "(no timestamp queries used on this adapter — none, or a CPU one's, which are \
+              wrong for compute passes: each pass was submitted and waited for alone, for its CPU \
+              wall time)\n";
     }
     if let Some(l) = t.lists {
         s += &format!(

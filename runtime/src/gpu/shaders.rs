@@ -17,7 +17,7 @@
 use crate::RenderError;
 
 /// The include files (`gpu/shaders/`).
-const INCLUDES: [(&str, &str); 12] = [
+const INCLUDES: [(&str, &str); 11] = [
     ("globals.wgsl", include_str!("shaders/globals.wgsl")),
     ("lights.wgsl", include_str!("shaders/lights.wgsl")),
     ("vpl.wgsl", include_str!("shaders/vpl.wgsl")),
@@ -26,7 +26,6 @@ const INCLUDES: [(&str, &str); 12] = [
     ("portals.wgsl", include_str!("shaders/portals.wgsl")),
     ("sight.wgsl", include_str!("shaders/sight.wgsl")),
     ("val.wgsl", include_str!("shaders/val.wgsl")),
-    ("fullscreen.wgsl", include_str!("shaders/fullscreen.wgsl")),
     ("lc.wgsl", include_str!("shaders/lc.wgsl")),
     ("pcss.wgsl", include_str!("shaders/pcss.wgsl")),
     ("ism.wgsl", include_str!("shaders/ism.wgsl")),

@@ -1,4 +1,4 @@
-//! include: vpl.wgsl val.wgsl fullscreen.wgsl
+//! include: vpl.wgsl val.wgsl
 // Indirect light of one batch of VPLs with their paraboloid shadow maps (mode
 // per-vpl-shadow-maps), added to the image so far (`previous`, ping-pong: 32-bit float targets
 // are not blendable everywhere). The gather term is vpl.wgsl's vpl_light.
@@ -25,6 +25,8 @@ struct Batch {
 @group(0) @binding(4) var g_normal: texture_2d<f32>;
 @group(0) @binding(5) var g_albedo: texture_2d<f32>;
 @group(0) @binding(6) var previous: texture_2d<f32>;
+// The image with this batch (a compute pass, as shade.wgsl's cs_gates_indirect says why).
+@group(0) @binding(7) var out_image: texture_storage_2d<rgba32float, write>;
 
 fn visibility(layer: u32, v: Vpl, p: vec3<f32>, n: vec3<f32>) -> f32 {
     let size = f32(batch.map_size);
@@ -50,9 +52,14 @@ fn visibility(layer: u32, v: Vpl, p: vec3<f32>, n: vec3<f32>) -> f32 {
     return lit / 9.0;
 }
 
-@fragment
-fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
-    let px = vec2<i32>(frag.xy);
+@compute @workgroup_size(8, 8)
+fn cs(@builtin(global_invocation_id) id: vec3<u32>) {
+    if all(id.xy < textureDimensions(previous)) {
+        textureStore(out_image, id.xy, gather_batch(vec2<i32>(id.xy)));
+    }
+}
+
+fn gather_batch(px: vec2<i32>) -> vec4<f32> {
     let before = textureLoad(previous, px, 0);
     let pos = textureLoad(g_position, px, 0);
     if pos.w == 0.0 {

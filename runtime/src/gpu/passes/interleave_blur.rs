@@ -4,7 +4,7 @@
 //! a ping-pong target and a copy).
 
 use super::gbuffer::GBufferOutput;
-use super::shade::frame_texture;
+use super::shade::{frame_pass, frame_target};
 use crate::RenderError;
 use crate::gpu::context::{Pool, bind_group, compute_pipelines};
 use crate::gpu::layout::ValGather;
@@ -121,8 +121,7 @@ impl InterleaveBlur {
         ),
     ) {
         let d = &f.ctx.device;
-        let storage = wgpu::TextureUsages::STORAGE_BINDING;
-        let other = frame_texture(f, pool, "hdr (composed)", storage);
+        let other = frame_target(f, pool, "hdr (ping-pong)");
         let tex = wgpu::BindingResource::TextureView;
         let (out_view, indirect_view, other_view) = (
             out.create_view(&Default::default()),
@@ -144,16 +143,15 @@ impl InterleaveBlur {
             ],
         );
         let span = rec.begin("blur + compose");
-        {
-            let mut pass = rec.enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("blur + compose"),
-                timestamp_writes: span.compute(),
-            });
-            pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, &bg, &[]);
-            let [w, h] = f.view.size;
-            pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
-        }
+        let size = f.view.size;
+        frame_pass(
+            &mut rec.enc,
+            "blur + compose",
+            &self.pipeline,
+            &[&bg],
+            span.compute(),
+            size,
+        );
         rec.enc
             .copy_texture_to_texture(other.as_image_copy(), out.as_image_copy(), out.size());
         rec.end();

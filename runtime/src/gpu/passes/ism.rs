@@ -14,10 +14,10 @@
 use super::gbuffer::GBufferOutput;
 use super::interleave_blur::InterleaveBlur;
 pub use super::ism_params::{DiskLight, ISM_MAP_SIZE, IsmParams, ValIsmParams, VplIsmParams};
-use super::shade::{HDR, frame_target, fullscreen};
+use super::shade::{frame_pass, frame_target};
 use super::vals::{ValClustering, ValInput};
 use crate::RenderError;
-use crate::gpu::context::{Pool, bind_group, compute_pipelines, render_pipeline, slice};
+use crate::gpu::context::{Pool, bind_group, compute_pipelines, slice};
 use crate::gpu::layout::{IsmFrame, IsmLevel, UNIFORM_STRIDE, strided};
 use crate::gpu::shaders::{self, ShaderSources, WG_LINEAR};
 use crate::gpu::timing::Recorder;
@@ -30,8 +30,8 @@ pub struct Isms {
     splat: wgpu::ComputePipeline,
     pull: wgpu::ComputePipeline,
     push: wgpu::ComputePipeline,
-    gather_vpl: wgpu::RenderPipeline,
-    gather_val: wgpu::RenderPipeline,
+    gather_vpl: wgpu::ComputePipeline,
+    gather_val: wgpu::ComputePipeline,
 }
 
 /// The maps of a frame.
@@ -157,16 +157,15 @@ impl Isms {
         let [emit, sample, splat, pull, push] =
             compute_pipelines(d, &maps, ["emit", "sample", "splat", "pull", "push"]);
         let gather = shaders::module(d, s, "ism_gather.wgsl")?;
-        let pipeline =
-            |label, fs| render_pipeline(d, label, &gather, ("vs", fs), &[], &[HDR], None);
+        let [gather_vpl, gather_val] = compute_pipelines(d, &gather, ["cs_vpl", "cs_val"]);
         Ok(Isms {
             emit,
             sample,
             splat,
             pull,
             push,
-            gather_vpl: pipeline("per-vpl ism gather", "fs_vpl"),
-            gather_val: pipeline("val ism gather", "fs_val"),
+            gather_vpl,
+            gather_val,
         })
     }
 
@@ -321,6 +320,7 @@ impl Isms {
     ) {
         let d = &f.ctx.device;
         let indirect = frame_target(f, pool, "indirect irradiance");
+        let indirect_view = indirect.create_view(&Default::default());
         let tex = wgpu::BindingResource::TextureView;
         let (pipeline, emitters) = match vals {
             Some(v) => (&self.gather_val, (2, v)),
@@ -337,16 +337,17 @@ impl Isms {
                 (4, maps.atlas.as_entire_binding()),
                 (5, tex(&g.views[0])),
                 (6, tex(&g.views[1])),
+                (7, tex(&indirect_view)),
             ],
         );
         let span = rec.begin("indirect lighting");
-        fullscreen(
+        frame_pass(
             &mut rec.enc,
             "ism gather",
-            &indirect.create_view(&Default::default()),
             pipeline,
-            &bg,
-            span.render(true, true),
+            &[&bg],
+            span.compute(),
+            f.view.size,
         );
         rec.end();
         let uniform = InterleaveBlur::uniform(f, interleave, pool, false);

@@ -1,10 +1,10 @@
-//! include: vpl.wgsl val.wgsl fullscreen.wgsl ism.wgsl pcss.wgsl
+//! include: vpl.wgsl val.wgsl ism.wgsl pcss.wgsl
 // Indirect light through imperfect shadow maps, into an indirect target that blur.wgsl
 // composes (each pixel lights itself with its interleaving subset: emitter i lights subset
 // i mod b², the paper's round robin over the split G-buffer's tiles):
-//   fs_vpl  mode per-vpl-ism (Ritschel et al.): every VPL's point light through one hard
+//   cs_vpl  mode per-vpl-ism (Ritschel et al.): every VPL's point light through one hard
 //           lookup of its ISM
-//   fs_val  mode val-ism (Weinzierl-Heigl §6): every VAL as a disk of its area A_c — the
+//   cs_val  mode val-ism (Weinzierl-Heigl §6): every VAL as a disk of its area A_c — the
 //           point-to-disk form factor cos θx·cos θc / (π‖x − c‖² + A_c) in place of the point
 //           light's — through PCSS on its ISM, the disk's radius √(A_c/π) sizing the blocker
 //           search and the penumbra
@@ -16,6 +16,8 @@
 @group(0) @binding(4) var<storage, read> atlas: array<u32>;
 @group(0) @binding(5) var g_position: texture_2d<f32>;
 @group(0) @binding(6) var g_normal: texture_2d<f32>;
+// The indirect target (compute passes, as shade.wgsl's cs_gates_indirect says why).
+@group(0) @binding(7) var out_image: texture_storage_2d<rgba32float, write>;
 
 // Distance from emitter k to the nearest surface along unit direction w ("very far" behind
 // its plane or where nothing was seen).
@@ -149,8 +151,7 @@ struct Pixel {
     found: bool,
 };
 
-fn pixel(frag: vec4<f32>) -> Pixel {
-    let px = vec2<i32>(frag.xy);
+fn pixel(px: vec2<i32>) -> Pixel {
     var s: Pixel;
     let pos = textureLoad(g_position, px, 0);
     s.found = pos.w != 0.0;
@@ -160,9 +161,15 @@ fn pixel(frag: vec4<f32>) -> Pixel {
     return s;
 }
 
-@fragment
-fn fs_vpl(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
-    let s = pixel(frag);
+@compute @workgroup_size(8, 8)
+fn cs_vpl(@builtin(global_invocation_id) id: vec3<u32>) {
+    if all(id.xy < textureDimensions(g_position)) {
+        textureStore(out_image, id.xy, gather_vpl(id.xy));
+    }
+}
+
+fn gather_vpl(px: vec2<u32>) -> vec4<f32> {
+    let s = pixel(vec2<i32>(px));
     if !s.found {
         return vec4<f32>(0.0);
     }
@@ -176,9 +183,15 @@ fn fs_vpl(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
     return vec4<f32>(sum * f32(frame.subsets), 1.0);
 }
 
-@fragment
-fn fs_val(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
-    let s = pixel(frag);
+@compute @workgroup_size(8, 8)
+fn cs_val(@builtin(global_invocation_id) id: vec3<u32>) {
+    if all(id.xy < textureDimensions(g_position)) {
+        textureStore(out_image, id.xy, gather_val(id.xy));
+    }
+}
+
+fn gather_val(px: vec2<u32>) -> vec4<f32> {
+    let s = pixel(vec2<i32>(px));
     if !s.found {
         return vec4<f32>(0.0);
     }
@@ -188,7 +201,7 @@ fn fs_val(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
         let area = max(v.flux.w, 0.0);
         let light = disk_light_parts(v.flux.xyz, area, v.position.xyz, v.normal.xyz, s.p, s.n);
         if any(light > vec3<f32>(0.0)) {
-            sum += light * ism_pcss(k, s.p, s.n, sqrt(area / PI), vec2<u32>(frag.xy));
+            sum += light * ism_pcss(k, s.p, s.n, sqrt(area / PI), px);
         }
     }
     return vec4<f32>(sum * f32(frame.subsets), 1.0);

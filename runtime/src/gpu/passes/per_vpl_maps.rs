@@ -5,10 +5,12 @@
 //! everywhere). Memory stays bounded by the batch; each batch is submitted when recorded.
 
 use super::gbuffer::GBufferOutput;
-use super::shade::{HDR, frame_target, fullscreen};
+use super::shade::{frame_pass, frame_target};
 use super::shadow_maps::DistancePass;
 use crate::RenderError;
-use crate::gpu::context::{Pool, array_view, bind_group, layer_view, render_pipeline, slice};
+use crate::gpu::context::{
+    Pool, array_view, bind_group, compute_pipelines, layer_view, render_pipeline, slice,
+};
 use crate::gpu::geometry::positions;
 use crate::gpu::layout::{Batch, MapParams, UNIFORM_STRIDE, strided};
 use crate::gpu::shaders::ShaderSources;
@@ -52,7 +54,7 @@ pub struct ParaboloidMaps {
     pub vpl: wgpu::RenderPipeline,
     /// A VAL's map: vertex entry `vs_val`.
     pub val: wgpu::RenderPipeline,
-    gather: wgpu::RenderPipeline,
+    gather: wgpu::ComputePipeline,
 }
 
 impl ParaboloidMaps {
@@ -61,6 +63,7 @@ impl ParaboloidMaps {
         let maps = shaders::module(d, s, "vpl_shadow.wgsl")?;
         let r32 = [wgpu::TextureFormat::R32Float];
         let gather = shaders::module(d, s, "gather_batch.wgsl")?;
+        let [gather] = compute_pipelines(d, &gather, ["cs"]);
         Ok(ParaboloidMaps {
             vpl: render_pipeline(
                 d,
@@ -80,7 +83,7 @@ impl ParaboloidMaps {
                 &r32,
                 Some(wgpu::CompareFunction::Less),
             ),
-            gather: render_pipeline(d, "gather batch", &gather, ("vs", "fs"), &[], &[HDR], None),
+            gather,
         })
     }
 
@@ -184,16 +187,18 @@ impl ParaboloidMaps {
                     (4, tex(&g.views[1])),
                     (5, tex(&g.views[2])),
                     (6, tex(&pair[current])),
+                    (7, tex(&pair[1 - current])),
                 ],
             );
             let span = rec.begin("VPL gather");
-            fullscreen(
+            let size = f.view.size;
+            frame_pass(
                 &mut rec.enc,
                 "gather batch",
-                &pair[1 - current],
                 &self.gather,
-                &bg,
-                span.render(true, true),
+                &[&bg],
+                span.compute(),
+                size,
             );
             rec.end();
             current = 1 - current;

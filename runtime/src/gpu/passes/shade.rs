@@ -9,7 +9,7 @@ use super::shadow_maps::ShadowOutput;
 use crate::RenderError;
 use crate::cpu::gates::GateShape;
 use crate::gpu::context::{
-    Pool, array_view, bind_group, compute_pipeline_with, render_pipeline, slice,
+    Pool, array_view, bind_group, compute_pipeline_with, compute_pipelines, slice,
 };
 use crate::gpu::layout::{UNIFORM_STRIDE, strided};
 use crate::gpu::shaders::ShaderSources;
@@ -21,58 +21,41 @@ pub const HDR: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
 /// The shading pipelines: direct + the mode's indirect, and interleaved gates' indirect alone.
 pub struct Shade {
-    pipeline: wgpu::RenderPipeline,
+    pipeline: wgpu::ComputePipeline,
     /// The interleaved gates' indirect pass (compute), a pipeline per gate shape (shade.wgsl's
     /// `GATE_SHAPE`, by [`crate::cpu::gates::GateShape::shader_id`]) and one for the voxel
     /// walk with the closed voxels' triangles (`SIGHT_TRIANGLES`), each made when first used.
     gates_indirect: [std::sync::OnceLock<wgpu::ComputePipeline>; 4],
     module: wgpu::ShaderModule,
-    vpl_clusters_indirect: wgpu::RenderPipeline,
+    vpl_clusters_indirect: wgpu::ComputePipeline,
 }
 
-/// A fullscreen triangle into `target` (cleared to black) with `pipeline` and `bind_group`.
-pub fn fullscreen(
+/// A compute pass of `pipeline` over the frame's pixels, 8 × 8 a workgroup (the `cs_*` entry
+/// points of the passes that shade the frame: compute, not fullscreen draws, because the same
+/// loop ran 30× slower as a fragment shader on an NVIDIA H200 — examples/fragment_vs_compute.rs
+/// — and as fast on lavapipe), one dispatch per bind group of `groups`, in order.
+pub fn frame_pass(
     enc: &mut wgpu::CommandEncoder,
     label: &str,
-    target: &wgpu::TextureView,
-    pipeline: &wgpu::RenderPipeline,
-    bind_group: &wgpu::BindGroup,
-    timestamps: Option<wgpu::RenderPassTimestampWrites>,
+    pipeline: &wgpu::ComputePipeline,
+    groups: &[&wgpu::BindGroup],
+    timestamps: Option<wgpu::ComputePassTimestampWrites>,
+    [w, h]: [u32; 2],
 ) {
-    let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
+    let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
         label: Some(label),
-        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-            view: target,
-            depth_slice: None,
-            resolve_target: None,
-            ops: wgpu::Operations {
-                load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                store: wgpu::StoreOp::Store,
-            },
-        })],
-        depth_stencil_attachment: None,
         timestamp_writes: timestamps,
-        occlusion_query_set: None,
-        multiview_mask: None,
     });
     pass.set_pipeline(pipeline);
-    pass.set_bind_group(0, bind_group, &[]);
-    pass.draw(0..3, 0..1);
+    for group in groups {
+        pass.set_bind_group(0, *group, &[]);
+        pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
+    }
 }
 
-/// A full-frame RGBA32F target `label` of the frame's size (kept in `pool`).
+/// A full-frame RGBA32F image `label` of the frame's size (kept in `pool`), written by a
+/// compute pass, read, copied and read back.
 pub fn frame_target(f: &Frame, pool: &mut Pool, label: &'static str) -> wgpu::Texture {
-    frame_texture(f, pool, label, wgpu::TextureUsages::RENDER_ATTACHMENT)
-}
-
-/// A full-frame RGBA32F texture `label` that a pass writes with `written` (render attachment or
-/// storage binding), read back, copied and read by later passes (kept in `pool`).
-pub fn frame_texture(
-    f: &Frame,
-    pool: &mut Pool,
-    label: &'static str,
-    written: wgpu::TextureUsages,
-) -> wgpu::Texture {
     let [w, h] = f.view.size;
     pool.texture(
         &f.ctx.device,
@@ -80,7 +63,7 @@ pub fn frame_texture(
         [w, h, 1],
         1,
         HDR,
-        written
+        wgpu::TextureUsages::STORAGE_BINDING
             | wgpu::TextureUsages::COPY_SRC
             | wgpu::TextureUsages::COPY_DST
             | wgpu::TextureUsages::TEXTURE_BINDING,
@@ -114,23 +97,15 @@ const GATES_INDIRECT_BINDINGS: [u32; 15] = [0, 2, 5, 6, 7, 8, 10, 12, 13, 14, 15
 const SHADE_BINDINGS: [u32; 23] = [
     0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20, 22, 23,
 ];
-/// The bindings of shade.wgsl's `fs_vpl_clusters_indirect`.
+/// The bindings of shade.wgsl's `cs_vpl_clusters_indirect` but its output (25).
 const VPL_CLUSTERS_INDIRECT_BINDINGS: [u32; 6] = [0, 2, 5, 6, 19, 20];
 
 impl Shade {
     /// Builds the pipelines.
     pub fn new(d: &wgpu::Device, s: &ShaderSources) -> Result<Shade, RenderError> {
         let module = shaders::module(d, s, "shade.wgsl")?;
-        let pipeline = render_pipeline(d, "shade", &module, ("vs", "fs"), &[], &[HDR], None);
-        let vpl_clusters_indirect = render_pipeline(
-            d,
-            "VPL clusters indirect (interleaved)",
-            &module,
-            ("vs", "fs_vpl_clusters_indirect"),
-            &[],
-            &[HDR],
-            None,
-        );
+        let [pipeline, vpl_clusters_indirect] =
+            compute_pipelines(d, &module, ["cs_shade", "cs_vpl_clusters_indirect"]);
         Ok(Shade {
             pipeline,
             gates_indirect: Default::default(),
@@ -212,33 +187,30 @@ impl Shade {
         self.walk_batches(f, pool, rec, inputs, pipeline, batches)
     }
 
-    /// A fullscreen pass of shade.wgsl with `pipeline` (and the bindings it uses, all if
+    /// A pass of shade.wgsl with `pipeline` (and the bindings it uses but its output, all if
     /// `None`) into `out`, timed as `name`.
     fn draw(
         &self,
         f: &Frame,
         rec: &mut Recorder,
         inputs: Inputs,
-        (pipeline, used): (&wgpu::RenderPipeline, Option<&[u32]>),
+        (pipeline, used): (&wgpu::ComputePipeline, Option<&[u32]>),
         (out, name): (&wgpu::Texture, &'static str),
     ) {
         let views = Views::new(f, inputs);
-        let resources = views.resources(f, inputs, None, used);
-        let group = bind_group(
-            &f.ctx.device,
-            &pipeline.get_bind_group_layout(0),
-            name,
-            resources,
-        );
-        let span = rec.begin(name);
         let target = out.create_view(&Default::default());
-        fullscreen(
+        let mut resources = views.resources(f, inputs, None, used);
+        resources.push((25, wgpu::BindingResource::TextureView(&target)));
+        let layout = pipeline.get_bind_group_layout(0);
+        let group = bind_group(&f.ctx.device, &layout, name, resources);
+        let span = rec.begin(name);
+        frame_pass(
             &mut rec.enc,
             name,
-            &target,
             pipeline,
-            &group,
-            span.render(true, true),
+            &[&group],
+            span.compute(),
+            f.view.size,
         );
         rec.end();
     }
@@ -256,8 +228,7 @@ impl Shade {
         batches: u32,
     ) -> wgpu::Texture {
         let d = &f.ctx.device;
-        let storage = wgpu::TextureUsages::STORAGE_BINDING;
-        let first = frame_texture(f, pool, "indirect irradiance (walks)", storage);
+        let first = frame_target(f, pool, "indirect irradiance");
         let second = match batches {
             1 => pool.texture(
                 d,
@@ -267,7 +238,7 @@ impl Shade {
                 HDR,
                 wgpu::TextureUsages::TEXTURE_BINDING,
             ),
-            _ => frame_texture(f, pool, "indirect irradiance (walk batches)", storage),
+            _ => frame_target(f, pool, "indirect irradiance (batches)"),
         };
         let targets = [first, second];
         let targets_view = targets
@@ -292,19 +263,17 @@ impl Shade {
                 bind_group(d, &layout, "gates indirect", resources)
             })
             .collect();
-        let [w, h] = f.view.size;
+        let groups: Vec<&wgpu::BindGroup> = groups.iter().collect();
         let span = rec.begin("indirect lighting");
-        {
-            let mut pass = rec.enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("gates indirect"),
-                timestamp_writes: span.compute(),
-            });
-            pass.set_pipeline(pipeline);
-            for group in &groups {
-                pass.set_bind_group(0, group, &[]);
-                pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
-            }
-        }
+        let size = f.view.size;
+        frame_pass(
+            &mut rec.enc,
+            "gates indirect",
+            pipeline,
+            &groups,
+            span.compute(),
+            size,
+        );
         rec.end();
         targets[(batches as usize - 1) % 2].clone()
     }

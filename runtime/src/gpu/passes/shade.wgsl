@@ -1,4 +1,4 @@
-//! include: globals.wgsl lights.wgsl vpl.wgsl gates.wgsl portals.wgsl sight.wgsl fullscreen.wgsl
+//! include: globals.wgsl lights.wgsl vpl.wgsl gates.wgsl portals.wgsl sight.wgsl
 // Deferred shading: direct light from point and spot lights with shadow-map PCF (3 × 3), and
 // the indirect sum over VPLs without visibility (SHADE_ALL), through the gates of a baked
 // level per pixel (SHADE_GATES_PER_PIXEL) or by clustered light lists (SHADE_GATES_CLUSTERED),
@@ -199,9 +199,16 @@ fn shadow(l: Light, p: vec3<f32>, n: vec3<f32>) -> f32 {
     return lit / 9.0;
 }
 
-@fragment
-fn fs(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
-    let px = vec2<i32>(frag.xy);
+// The shading pass (a compute pass, as every pass over the frame's pixels: cs_gates_indirect
+// says why).
+@compute @workgroup_size(8, 8)
+fn cs_shade(@builtin(global_invocation_id) id: vec3<u32>) {
+    if all(id.xy < textureDimensions(g_position)) {
+        textureStore(out_image, id.xy, shade(vec2<i32>(id.xy)));
+    }
+}
+
+fn shade(px: vec2<i32>) -> vec4<f32> {
     let pos = textureLoad(g_position, px, 0);
     if pos.w == 0.0 {
         return vec4<f32>(0.0, 0.0, 0.0, 1.0);
@@ -375,7 +382,8 @@ fn subset_start(first: u32, end: u32, subsets: u32, j: u32) -> u32 {
 // earlier_batches): llvmpipe ends a shader invocation's loops after 65,535 iterations in all,
 // which a pixel walking hundreds of VPLs reaches, losing the light of the rest.
 @group(0) @binding(24) var<uniform> walk_batch_index: vec4<u32>;
-@group(0) @binding(25) var indirect_out: texture_storage_2d<rgba32float, write>;
+// The pass's output (every compute entry point here writes it).
+@group(0) @binding(25) var out_image: texture_storage_2d<rgba32float, write>;
 
 @compute @workgroup_size(8, 8)
 fn cs_gates_indirect(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -392,7 +400,7 @@ fn cs_gates_indirect(@builtin(global_invocation_id) id: vec3<u32>) {
         let here = decode_cluster(s.position.w);
         sum += clustered_gather(s.px, s.position.xyz, s.normal, here, batch);
     }
-    textureStore(indirect_out, id.xy, vec4<f32>(sum, 1.0));
+    textureStore(out_image, id.xy, vec4<f32>(sum, 1.0));
 }
 
 // The pixel a deinterleaved fragment shades, and its G-buffer surface (w 0: none).
@@ -412,15 +420,19 @@ fn interleaved_surface(frag: vec2<f32>) -> Surface {
 }
 
 // Interleaved VPL clusters: as cs_gates_indirect, each pixel its subset of the VPLs.
-@fragment
-fn fs_vpl_clusters_indirect(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
-    let s = interleaved_surface(frag.xy);
-    if s.position.w == 0.0 {
-        return vec4<f32>(0.0);
+@compute @workgroup_size(8, 8)
+fn cs_vpl_clusters_indirect(@builtin(global_invocation_id) id: vec3<u32>) {
+    if any(id.xy >= textureDimensions(g_position)) {
+        return;
     }
-    let b = max(globals.interleave_block, 1u);
-    let j = interleave_subset(s.px, b);
-    return vec4<f32>(gather_vpl_clusters(s.position.xyz, s.normal, s.px, j, b * b), 1.0);
+    let s = interleaved_surface(vec2<f32>(id.xy) + 0.5);
+    var sum = vec3<f32>(0.0);
+    if s.position.w != 0.0 {
+        let b = max(globals.interleave_block, 1u);
+        let j = interleave_subset(s.px, b);
+        sum = gather_vpl_clusters(s.position.xyz, s.normal, s.px, j, b * b);
+    }
+    textureStore(out_image, id.xy, vec4<f32>(sum, 1.0));
 }
 
 // SHADE_ALL: every VPL, no visibility.

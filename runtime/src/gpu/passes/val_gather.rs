@@ -8,7 +8,7 @@ use super::cssm::{Cssm, CssmParams};
 use super::gbuffer::GBufferOutput;
 use super::interleave_blur::{InterleaveBlur, InterleaveParams};
 use super::per_vpl_maps::ParaboloidMaps;
-use super::shade::frame_texture;
+use super::shade::{frame_pass, frame_target};
 use super::vals::{ValClustering, ValInput};
 use crate::RenderError;
 use crate::cpu::val::ValParams;
@@ -154,8 +154,7 @@ impl ValGathers {
             bytemuck::bytes_of(&constants),
             wgpu::BufferUsages::UNIFORM,
         );
-        let storage = wgpu::TextureUsages::STORAGE_BINDING;
-        let indirect = frame_texture(f, pool, "indirect irradiance (VALs)", storage);
+        let indirect = frame_target(f, pool, "indirect irradiance");
         let indirect_view = indirect.create_view(&Default::default());
         let maps_view = array_view(&maps);
         let tex = wgpu::BindingResource::TextureView;
@@ -182,16 +181,14 @@ impl ValGathers {
         };
         let bg = bind_group(d, &pipeline.get_bind_group_layout(0), "val gather", entries);
         let span = rec.begin("indirect lighting");
-        {
-            let mut pass = rec.enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("val gather"),
-                timestamp_writes: span.compute(),
-            });
-            pass.set_pipeline(pipeline);
-            pass.set_bind_group(0, &bg, &[]);
-            let [w, h] = f.view.size;
-            pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
-        }
+        frame_pass(
+            &mut rec.enc,
+            "val gather",
+            pipeline,
+            &[&bg],
+            span.compute(),
+            f.view.size,
+        );
         rec.end();
         passes
             .blur
