@@ -7,7 +7,7 @@
 #
 # VISGATE: the visgate binary (a release build). OUT: a folder; it gets OUT/LEVEL.vgate,
 # OUT/log.txt (every render's report) and OUT/table.md (level, camera, size, VPLs, mode, GPU ms
-# of the frame, of its indirect pass). LEVEL: e2m3, sponza (default both). Modes: none,
+# of the frame, of its indirect pass; wall ms where the adapter's timestamps are not used). LEVEL: e2m3, sponza (default both). Modes: none,
 # direct-only, gates (voxel walk), gates-triangles, gates-portal, gates-disk, gates-i4 and
 # val-hard-i4 (4 × 4 interleaving), val-hard, val-cssm, per-vpl-shadow-maps. In the environment:
 # RUNS="SIZE:COUNTS ..." (default "512x512:4096,1024,16384 1280x720:4096"), MODES (of those,
@@ -66,8 +66,9 @@ for run in $runs; do
                     --out "$out/frame.exr" $(args_of "$mode") 2>&1)
                 rc=$?
                 echo "$res" >>"$log"
-                frame=$(echo "$res" | awk '$1 == "frame" { print $2 }')
-                ind=$(echo "$res" | awk '/indirect lighting/ { print $(NF - 1) }')
+                # GPU ms, or the pass's wall ms where the report has no GPU time (lavapipe).
+                frame=$(echo "$res" | awk '$1 == "frame" { print ($2 == "-" ? $3 " (wall)" : $2) }')
+                ind=$(echo "$res" | awk '/indirect lighting/ { print ($(NF - 1) == "-" ? $NF : $(NF - 1)) }')
                 [ $rc -eq 124 ] && frame="over ${limit} s"
                 [ $rc -ne 0 ] && [ $rc -ne 124 ] && frame="failed ($rc)"
                 echo "| $level | $camera | $size | $n | $mode | ${frame:-?} | ${ind:--} |" |

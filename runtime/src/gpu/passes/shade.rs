@@ -93,7 +93,8 @@ pub struct Gathers<'a> {
 /// The bindings of shade.wgsl's `cs_gates_indirect` (an automatic layout holds only what an
 /// entry point uses) but its batch index (24) and its output (25).
 const GATES_INDIRECT_BINDINGS: [u32; 15] = [0, 2, 5, 6, 7, 8, 10, 12, 13, 14, 15, 16, 21, 22, 23];
-/// The bindings of shade.wgsl's `fs`: all but the batches' sum.
+/// The bindings of shade.wgsl's `cs_shade` but its output (25): all but the batches' sum and
+/// the batch index.
 const SHADE_BINDINGS: [u32; 23] = [
     0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20, 22, 23,
 ];

@@ -255,7 +255,7 @@ fn shade(px: vec2<i32>) -> vec4<f32> {
 }
 
 // SHADE_GATES_CLUSTERED: the VPL light at p through its geometry cluster's list (without albedo / π). An
-// entry with gates is tested here, per fragment; a VPL whose light passes by several chains
+// entry with gates is tested here, per pixel; a VPL whose light passes by several chains
 // counts once (a list is ordered by (VPL mod B, VPL)). With interleaving (B = b² subsets) the
 // pixel takes only its subset's run of the list, found by binary search, and the sum is × B.
 fn clustered_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, batch: u32) -> vec3<f32> {
@@ -403,7 +403,8 @@ fn cs_gates_indirect(@builtin(global_invocation_id) id: vec3<u32>) {
     textureStore(out_image, id.xy, vec4<f32>(sum, 1.0));
 }
 
-// The pixel a deinterleaved fragment shades, and its G-buffer surface (w 0: none).
+// The pixel that the invocation at place `frag` of the deinterleaved target shades, and its
+// G-buffer surface (w 0: none).
 struct Surface {
     px: vec2<i32>,
     position: vec4<f32>,
