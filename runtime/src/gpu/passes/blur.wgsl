@@ -30,9 +30,11 @@ fn compose(px: vec2<i32>) -> vec4<f32> {
     let albedo = textureLoad(g_albedo, px, 0).xyz;
     let b = i32(gather.block);
     let size = vec2<i32>(textureDimensions(indirect));
-    // The block around px, clipped to the target.
-    let lo = max(px - vec2<i32>(b / 2), vec2<i32>(0));
-    let hi = min(px + vec2<i32>(b - b / 2), size);
+    // The b × b block around px, moved inside the target at its edges (not clipped: a block
+    // holds every one of the b² VPL subsets, so that the few VPLs that light a place reach the
+    // pixels on the image's border too).
+    let lo = clamp(px - vec2<i32>(b / 2), vec2<i32>(0), max(size - vec2<i32>(b), vec2<i32>(0)));
+    let hi = min(lo + vec2<i32>(b), size);
     // Where a pixel lies in the deinterleaved target (vpl.wgsl's deinterleave_axis), stepped
     // along each axis instead of divided at every tap: on llvmpipe the divisions were 40 % of
     // the pass (e2m3's hall at 512², 4,096 VPLs, blur + compose 137 → 83 ms; the same image,
