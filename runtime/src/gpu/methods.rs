@@ -31,11 +31,11 @@ pub enum GpuMode {
     /// [`super::GpuRenderer::set_level`], the paper's clustered shading: geometry clusters
     /// (tiles × depth slices × visibility cluster), light lists of (VPL, gate chain) assigned
     /// by cones through the gates, the gather over each pixel's list with the chain tested per
-    /// fragment (at most 2 hops), or with portals the walk from the VPL's cluster; with
+    /// pixel (at most 2 hops), or with portals the walk from the VPL's cluster; with
     /// interleaved sampling (`interleave`, as the VAL modes) each pixel gathers one VPL subset
     /// and the geometry-aware blur follows.
     Gates(GatesParams),
-    /// The same gate test, brute force: every fragment tests every VPL (for comparison).
+    /// The same gate test, brute force: every pixel tests every VPL (for comparison).
     GatesPerPixel(GateParams),
     /// Every VPL lights every pixel with the visibility of its virtual area light: VPLs
     /// clustered into VALs on the GPU, one hard paraboloid shadow map per VAL (the banding
