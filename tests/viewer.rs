@@ -208,7 +208,21 @@ fn without_a_display_the_viewer_says_what_to_do_or_renders_headless() {
     );
     assert!(o.status.success(), "{}", text(&o));
     assert!(text(&o).contains("headless"), "{}", text(&o));
+    assert!(text(&o).contains("16 asked"), "{}", text(&o));
     assert!(std::fs::metadata(&out).expect("written").len() > 100);
+    // Without --vpls, `visgate render`'s 1,024 light paths.
+    let o = visgate(
+        &[
+            "view",
+            "builtin:cornell-box",
+            "--render-size",
+            "32x24",
+            "--or-render",
+            out.to_str().expect("utf-8"),
+        ],
+        None,
+    );
+    assert!(text(&o).contains("1024 asked"), "{}", text(&o));
     // Bad arguments are refused before any window.
     let o = visgate(&["view", "builtin:cornell-box", "--mode", "gates"], None);
     assert!(text(&o).contains("--level"), "{}", text(&o));
