@@ -197,28 +197,35 @@ fn walk<C: Cells + ?Sized>(dims: [u32; 3], cells: &C, from: [u32; 3], to: [u32; 
             (2 * n + 1) * q[k]
         }
     };
-    let (mut n, mut cell) = ([0i64; 3], from);
-    let mut t = [0, 1, 2].map(|k| crossing(k, 0));
+    // Each axis's next crossing, its period and the index's move at it, as scalars: the
+    // step picks one by comparisons, not by an index into arrays (kept in memory, that cost
+    // the bake's sight lines a fifth of their time).
+    let [mut t0, mut t1, mut t2] = [0, 1, 2].map(|k| crossing(k, 0));
+    let [p0, p1, p2] = q.map(|x| 2 * x);
+    let [m0, m1, m2] = [0, 1, 2].map(|k| step[k] * stride[k]);
     let (mut i, end) = (index(from) as i64, index(to) as i64);
     let line = Line::between(from, d);
     // A proof is tried again only past the narrow place where the last one stopped.
     let mut retry_from = 0i64;
     loop {
         // The axis whose boundary comes first, the lowest on a tie.
-        let k = if t[0] <= t[1] {
-            if t[0] <= t[2] { 0 } else { 2 }
-        } else if t[1] <= t[2] {
-            1
+        let entered;
+        if t0 <= t1 && t0 <= t2 {
+            entered = t0;
+            t0 += p0;
+            i += m0;
+        } else if t1 <= t2 {
+            entered = t1;
+            t1 += p1;
+            i += m1;
         } else {
-            2
-        };
-        if t[k] > two_p {
+            entered = t2;
+            t2 += p2;
+            i += m2;
+        }
+        if entered > two_p {
             return true;
         }
-        let entered = t[k];
-        n[k] += 1;
-        t[k] += 2 * q[k];
-        i += step[k] * stride[k];
         if i == end {
             return true;
         }
@@ -229,20 +236,17 @@ fn walk<C: Cells + ?Sized>(dims: [u32; 3], cells: &C, from: [u32; 3], to: [u32; 
         if entered < retry_from || here < MIN_PROOF_CLEARANCE {
             continue;
         }
-        let t0 = entered as f64 / two_p as f64;
-        match prove_clear(&|i| cells.clearance(i), dims, &line, t0 as f32, here) {
+        let t_start = entered as f64 / two_p as f64;
+        match prove_clear(&|i| cells.clearance(i), dims, &line, t_start as f32, here) {
             Ok(()) => return true,
             Err(stopped) => {
                 // Every crossing up to `stopped` is proved clear: jump past them.
                 let tau = ((f64::from(stopped) * two_p as f64).floor() as i64).min(two_p);
                 if tau > entered {
-                    for k in 0..3 {
-                        if q[k] != 0 {
-                            n[k] = (tau / q[k] + 1) / 2;
-                            cell[k] = from[k] + step[k] * n[k];
-                            t[k] = crossing(k, n[k]);
-                        }
-                    }
+                    // Crossings made along each axis by then, and the voxel reached.
+                    let n = q.map(|qk| if qk == 0 { 0 } else { (tau / qk + 1) / 2 });
+                    [t0, t1, t2] = [0, 1, 2].map(|k| crossing(k, n[k]));
+                    let cell: [i64; 3] = std::array::from_fn(|k| from[k] + step[k] * n[k]);
                     i = index(cell) as i64;
                     if i == end {
                         return true;
