@@ -167,11 +167,10 @@ impl Flood {
         let Some(start) = self.start(meta, from) else {
             return out;
         };
-        let index = |v: [i64; 3]| (v[0] + dims[0] * (v[1] + dims[1] * v[2])) as usize;
-        self.insert(index(start));
+        self.insert(self.index(start));
         self.queue.push_back(start);
         while let Some(v) = self.queue.pop_front() {
-            let i = index(v);
+            let i = self.index(v);
             let p = Vec3::from(meta.voxel_to_world(v.map(|c| c as u32)));
             if !keep(i, p) || out.len() >= MAX_FLOOD {
                 continue;
@@ -184,7 +183,7 @@ impl Flood {
                     for dx in -1..=1 {
                         let w = [v[0] + dx, v[1] + dy, v[2] + dz];
                         if (interior || (0..3).all(|a| w[a] >= 0 && w[a] < dims[a]))
-                            && self.insert(index(w))
+                            && self.insert(self.index(w))
                         {
                             self.queue.push_back(w);
                         }
@@ -194,6 +193,12 @@ impl Flood {
         }
         self.forget();
         out
+    }
+
+    /// Voxel `v`'s linear index (x fastest).
+    fn index(&self, v: [i64; 3]) -> usize {
+        let d = self.dims;
+        (v[0] + d[0] * (v[1] + d[1] * v[2])) as usize
     }
 
     /// The voxel of point `from` (m), if it lies in the grid: where a flood starts.
@@ -267,14 +272,9 @@ struct Fill<'a, K> {
 }
 
 impl<K: Fn(usize, Vec3) -> bool> Fill<'_, K> {
-    fn index(&self, v: [i64; 3]) -> usize {
-        let d = self.flood.dims;
-        (v[0] + d[0] * (v[1] + d[1] * v[2])) as usize
-    }
-
     /// Marks voxel `v` seen; whether it was not seen before and is accepted.
     fn claim(&mut self, v: [i64; 3]) -> bool {
-        let i = self.index(v);
+        let i = self.flood.index(v);
         self.flood.insert(i)
             && (self.keep)(i, Vec3::from(self.meta.voxel_to_world(v.map(|c| c as u32))))
     }
@@ -290,7 +290,7 @@ impl<K: Fn(usize, Vec3) -> bool> Fill<'_, K> {
         while b + 1 < self.flood.dims[0] && self.claim([b + 1, y, z]) {
             b += 1;
         }
-        let first = self.index([a, y, z]);
+        let first = self.flood.index([a, y, z]);
         self.out.extend(first..=first + (b - a) as usize);
         self.runs.push((y, z, a, b));
         b

@@ -145,16 +145,7 @@ pub fn compute_pipelines<const N: usize>(
     module: &wgpu::ShaderModule,
     entries: [&str; N],
 ) -> [wgpu::ComputePipeline; N] {
-    entries.map(|entry| {
-        d.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some(entry),
-            layout: None,
-            module,
-            entry_point: Some(entry),
-            compilation_options: Default::default(),
-            cache: None,
-        })
-    })
+    entries.map(|entry| compute_pipeline_with(d, entry, module, entry, &[]))
 }
 
 /// The compute pipeline (auto layout) of `module`'s entry point `entry` with the shader's
@@ -186,30 +177,11 @@ pub fn render_pipeline(
     d: &wgpu::Device,
     label: &str,
     module: &wgpu::ShaderModule,
-    entries: (&str, &str),
+    (vertex, fragment): (&str, &str),
     buffers: &[Option<wgpu::VertexBufferLayout>],
     targets: &[wgpu::TextureFormat],
     depth: Option<wgpu::CompareFunction>,
 ) -> wgpu::RenderPipeline {
-    let fixed = (targets, depth);
-    render_pipeline_with(d, label, module, entries, buffers, fixed, &[])
-}
-
-/// [`render_pipeline`] with the shader's pipeline-overridable `constants` set (WGSL
-/// `override`s, by name): a branch on one is decided when the pipeline is compiled.
-pub fn render_pipeline_with(
-    d: &wgpu::Device,
-    label: &str,
-    module: &wgpu::ShaderModule,
-    (vertex, fragment): (&str, &str),
-    buffers: &[Option<wgpu::VertexBufferLayout>],
-    (targets, depth): (&[wgpu::TextureFormat], Option<wgpu::CompareFunction>),
-    constants: &[(&str, f64)],
-) -> wgpu::RenderPipeline {
-    let compilation_options = wgpu::PipelineCompilationOptions {
-        constants,
-        ..Default::default()
-    };
     let targets: Vec<Option<wgpu::ColorTargetState>> = targets
         .iter()
         .map(|&format| {
@@ -227,7 +199,7 @@ pub fn render_pipeline_with(
             module,
             entry_point: Some(vertex),
             buffers,
-            compilation_options: compilation_options.clone(),
+            compilation_options: Default::default(),
         },
         primitive: wgpu::PrimitiveState::default(),
         depth_stencil: depth.map(|compare| wgpu::DepthStencilState {
@@ -242,7 +214,7 @@ pub fn render_pipeline_with(
             module,
             entry_point: Some(fragment),
             targets: &targets,
-            compilation_options: compilation_options.clone(),
+            compilation_options: Default::default(),
         }),
         multiview_mask: None,
         cache: None,
