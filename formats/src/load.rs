@@ -16,14 +16,63 @@ use crate::scene::{
     SceneSpace, local_matrix, parent_dir,
 };
 
+/// The longest a bare mesh may be, read in metres, before it is read in smaller units
+/// ([`bare_mesh_units`]): longer than any indoor level. [Units: m]
+pub const BARE_LEVEL_MAX_M: f64 = 1000.0;
+
+/// Metres per unit of a bare mesh (no scene file, so no stated units) whose longest extent is
+/// `longest` of its units: metres, unless that makes a level longer than [`BARE_LEVEL_MAX_M`];
+/// then centimetres (Crytek Sponza's OBJ and GLB, Unreal, Maya and 3ds Max exports), or
+/// millimetres where centimetres still do (a level under 100 m modelled in millimetres is
+/// read in centimetres, 10× too large: the warning says which units were read). glTF states
+/// metres, but exporters write centimetres there too, so a glTF file is read the same way. A
+/// scene TOML's `metres_per_unit` chooses.
+pub fn bare_mesh_units(longest: f64) -> f64 {
+    [1.0, 0.01]
+        .into_iter()
+        .find(|m| longest * m <= BARE_LEVEL_MAX_M)
+        .unwrap_or(0.001)
+}
+
+/// The longest side of the box around every vertex of `models`, in their own units (`None`:
+/// no finite vertex).
+fn longest_extent(models: &[ImportedModel]) -> Option<f64> {
+    let mut points = models
+        .iter()
+        .flat_map(|m| &m.meshes)
+        .flat_map(|m| &m.positions)
+        .filter(|p| p.is_finite());
+    let first = *points.next()?;
+    let (lo, hi) = points.fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+    Some((hi - lo).max_element() as f64)
+}
+
+/// What a user reads when a bare mesh is not read in metres.
+fn units_warning(path: &Path, longest: f64, metres_per_unit: f64) -> String {
+    let unit = if metres_per_unit == 0.01 {
+        "centimetres"
+    } else {
+        "millimetres"
+    };
+    format!(
+        "{}: a bare mesh states no units, and in metres its longest side ({longest:.0} units) \
+         would make a {:.1} km level: read in {unit} ({:.1} m). To choose the units, name the \
+         mesh in a scene TOML with `metres_per_unit` (README, Scenes)",
+        path.display(),
+        longest / 1000.0,
+        longest * metres_per_unit,
+    )
+}
+
 impl Scene {
-    /// Loads a scene TOML, or a bare OBJ/glTF/GLB file as one static mesh with no lights.
+    /// Loads a scene TOML, or a bare OBJ/glTF/GLB file as one static mesh with no lights, in
+    /// the units [`bare_mesh_units`] picks from its size.
     pub fn load(path: &Path, options: &ImportOptions) -> Result<Scene, SceneError> {
         let start = Instant::now();
-        let (desc, base) = match FileKind::of(path) {
-            Some(FileKind::SceneToml) => (SceneDesc::read(path)?, parent_dir(path)),
+        let (mut desc, base, bare) = match FileKind::of(path) {
+            Some(FileKind::SceneToml) => (SceneDesc::read(path)?, parent_dir(path), false),
             Some(FileKind::Obj | FileKind::Gltf) => {
-                (SceneDesc::for_mesh_file(path), parent_dir(path))
+                (SceneDesc::for_mesh_file(path), parent_dir(path), true)
             }
             _ => {
                 return Err(SceneError::UnknownFileType {
@@ -36,7 +85,17 @@ impl Scene {
             .iter()
             .map(|m| import::import_file(&base.join(&m.path), options))
             .collect::<Result<Vec<_>, _>>()?;
+        let mut units_note = None;
+        if bare && let Some(longest) = longest_extent(&models) {
+            desc.metres_per_unit = bare_mesh_units(longest);
+            if desc.metres_per_unit != 1.0 {
+                let note = units_warning(path, longest, desc.metres_per_unit);
+                tracing::warn!("{note}");
+                units_note = Some(note);
+            }
+        }
         let mut scene = Scene::assemble(&desc, models, path)?;
+        scene.report.warnings.extend(units_note);
         scene.report.load_seconds = start.elapsed().as_secs_f64();
         Ok(scene)
     }
