@@ -241,6 +241,12 @@ pub struct MethodArgs {
     /// Blur: leave out neighbours whose normals' cosine is below this.
     #[arg(long, default_value_t = 0.8, allow_hyphen_values = true)]
     pub blur_normal: f32,
+    /// Gates, interleaved: a pixel whose blur block holds fewer pixels than this that agree
+    /// with it (a door jamb, a strip along a wall) walks, in a second pass, the VPL subsets of
+    /// the pixels that do not agree, so that every VPL counts once there; 0: off (default),
+    /// at most --interleave². Costs 5-13x the frame on lavapipe at 64; see the README.
+    #[arg(long, default_value_t = 0)]
+    pub starved_taps: u32,
     /// Per-VPL paraboloid map size (GPU), texels.
     #[arg(long, default_value_t = 128)]
     pub vpl_map_size: u32,
@@ -339,6 +345,7 @@ impl MethodArgs {
             block: self.interleave,
             blur_distance: self.blur_distance,
             blur_normal: self.blur_normal,
+            starved_taps: self.starved_taps,
         }
     }
 

@@ -914,6 +914,7 @@ fn render_val_modes_print_their_passes_and_refuse_bad_settings() {
         for (flag, value, says) in [
             ("--vals", "0", "VALs 0"),
             ("--interleave", "0", "interleaving block 0"),
+            ("--starved-taps", "65", "starved taps 65"),
             ("--cssm-terms", "0", "terms 0"),
         ] {
             if flag == "--cssm-terms" && mode == "val-hard" {

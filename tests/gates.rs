@@ -801,6 +801,59 @@ fn interleaved_gates_keep_the_light_of_every_vpl_gather() {
 }
 
 #[test]
+fn starved_pixels_walk_the_subsets_their_block_lacks_and_count_every_vpl_once() {
+    use visgate_runtime::gpu::InterleaveParams;
+    use visgate_runtime::gpu::{GatesParams, GpuContext, GpuMode, GpuParams, GpuRenderer};
+    use visgate_runtime::metrics::errors;
+    let ctx = GpuContext::new().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"));
+    let (scene, gates, _, vpls, _) = fixture(Builtin::FourRooms, 128);
+    let view = visgate_runtime::camera::View::new(&scene.cameras[0], [96, 72]).expect("view");
+    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    gpu.set_level(&ctx, &gates).expect("level");
+    let render = |gpu: &mut GpuRenderer, mode| {
+        gpu.render(&ctx, &view, &vpls, &GpuParams::with_mode(mode))
+            .expect("render")
+    };
+    for shape in [GateShape::Voxels, GateShape::Portal] {
+        let with = |block: u32, blur_distance: f32, starved_taps: u32| {
+            let mut p = GatesParams {
+                interleave: InterleaveParams {
+                    block,
+                    blur_distance,
+                    starved_taps,
+                    ..InterleaveParams::default()
+                },
+                ..GatesParams::default()
+            };
+            p.gates.shape = shape;
+            GpuMode::Gates(p)
+        };
+        let (full, _) = render(&mut gpu, with(1, 0.1, 0));
+        for block in [4, 8] {
+            // No tap but the pixel itself agrees (blur distance 0): every pixel is starved and
+            // walks the other b² − 1 subsets itself, so the image is every VPL's gather.
+            let (img, t) = render(&mut gpu, with(block, 0.0, block * block));
+            let names: Vec<&str> = t.passes.iter().map(|p| p.name).collect();
+            assert!(
+                names.contains(&"indirect lighting: starved pixels"),
+                "{names:?}"
+            );
+            let e = errors(&img, &full).expect("same size");
+            eprintln!(
+                "{shape:?} block {block}: rel. MSE {:.2e} to every VPL's",
+                e.rel_mse
+            );
+            assert!(e.rel_mse < 1e-8, "{shape:?} block {block}: {}", e.rel_mse);
+            // Without it the same blur leaves each pixel its own subset, × b².
+            let (alone, t) = render(&mut gpu, with(block, 0.0, 0));
+            assert!(!t.passes.iter().any(|p| p.name.contains("starved")));
+            let e = errors(&alone, &full).expect("same size");
+            assert!(e.rel_mse > 1e-3, "{shape:?} block {block}: {}", e.rel_mse);
+        }
+    }
+}
+
+#[test]
 fn the_light_list_pool_grows_to_what_a_frame_needs() {
     // Disks keep lists; portals keep none (their pool stays at one entry).
     use visgate_runtime::gpu::{GatesParams, GpuContext, GpuMode, GpuParams, GpuRenderer};

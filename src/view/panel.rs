@@ -36,7 +36,17 @@ pub fn method_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
                     );
             }
             if mode == "gates" {
-                ui.add(interleave_block(&mut s.vals.interleave.block));
+                let il = &mut s.vals.interleave;
+                ui.add(interleave_block(&mut il.block));
+                if il.block > 1 {
+                    let most = il.block * il.block;
+                    ui.add(egui::Slider::new(&mut il.starved_taps, 0..=most).text("starved taps"))
+                        .on_hover_text(
+                            "a pixel whose blur block holds fewer pixels than this that agree \
+                             with it walks the VPLs of the rest itself: fewer black strips along \
+                             walls and jambs, several times slower; 0: off",
+                        );
+                }
             }
         }
         "val-hard" | "val-cssm" => {
@@ -87,7 +97,9 @@ pub fn method_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
         }
         _ => {}
     }
-    s.gates.interleave = s.vals.interleave;
+    let il = &mut s.vals.interleave;
+    il.starved_taps = il.starved_taps.min(il.block * il.block);
+    s.gates.interleave = *il;
 }
 
 /// The direct lights' shadows: each light's maps, or LightCluster with its clustering, disk

@@ -225,7 +225,14 @@ impl GpuMode {
             GpuMode::PerVplShadowMaps(p) => {
                 format!("{0}² maps, batches of {1}", p.map_size, p.batch)
             }
-            GpuMode::Gates(p) => format!("{}, {}", gates(&p.gates), il(&p.interleave)),
+            GpuMode::Gates(p) => {
+                let mut s = format!("{}, {}", gates(&p.gates), il(&p.interleave));
+                let t = p.interleave.starved_taps;
+                if t > 0 && p.interleave.block > 1 {
+                    s += &format!(", under {t} agreeing walk the rest");
+                }
+                s
+            }
             GpuMode::GatesPerPixel(g) => gates(g),
             GpuMode::ValHard(v) => format!(
                 "{}, {}² maps, {}",

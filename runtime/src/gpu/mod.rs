@@ -278,13 +278,20 @@ fn record_passes(
             let indirect = p
                 .shade
                 .record_indirect(f, pool, rec, inputs, Some(gp.gates.shape));
-            let uniform = InterleaveBlur::uniform(f, &gp.interleave, pool, true);
-            p.blur.record(f, pool, rec, (&g, &uniform, &indirect, &hdr));
+            let il = &gp.interleave;
+            let starved = (il.block > 1 && il.starved_taps > 0).then(|| {
+                p.shade
+                    .record_starved(f, pool, rec, inputs, (gp.gates.shape, il))
+            });
+            let uniform = InterleaveBlur::uniform(f, il, pool, true);
+            let targets = (&g, &uniform, &indirect, &hdr);
+            p.blur.record(f, pool, rec, targets, starved.as_ref());
         }
         GpuMode::VplClusters(_, il) if il.block > 1 => {
             let indirect = p.shade.record_indirect(f, pool, rec, inputs, None);
             let uniform = InterleaveBlur::uniform(f, il, pool, true);
-            p.blur.record(f, pool, rec, (&g, &uniform, &indirect, &hdr));
+            p.blur
+                .record(f, pool, rec, (&g, &uniform, &indirect, &hdr), None);
         }
         GpuMode::PerVplShadowMaps(pv) => p.maps.record(f, pv, pool, rec, (&g, &hdr)),
         GpuMode::PerVplIsm(pi) => p.isms.record_vpls(f, pi, &p.blur, pool, rec, (&g, &hdr))?,

@@ -12,6 +12,10 @@
 @group(0) @binding(6) var previous: texture_2d<f32>;
 @group(0) @binding(12) var indirect: texture_2d<f32>;
 @group(0) @binding(13) var composed: texture_storage_2d<rgba32float, write>;
+// Interleaved gates: at the pixels whose block holds too few taps that agree with them (w 1),
+// the light of the subsets of the taps that do not, which they walked themselves (shade.wgsl's
+// cs_gates_starved); a 1 × 1 texture of zeros for the other modes.
+@group(0) @binding(14) var starved_sums: texture_2d<f32>;
 
 @compute @workgroup_size(8, 8)
 fn cs_compose(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -66,5 +70,9 @@ fn compose(px: vec2<i32>) -> vec4<f32> {
             weight += 1.0;
         }
     }
-    return vec4<f32>(before.xyz + albedo / PI * sum / max(weight, 1.0), 1.0);
+    // A starved pixel (w 1) walked the subsets of the taps that do not agree itself: each
+    // agreeing tap's subset (its light × B) once, and those.
+    let walked = textureLoad(starved_sums, min(px, vec2<i32>(textureDimensions(starved_sums)) - 1), 0);
+    let e = select(sum / max(weight, 1.0), sum / f32(gather.subsets) + walked.xyz, walked.w == 1.0);
+    return vec4<f32>(before.xyz + albedo / PI * e, 1.0);
 }

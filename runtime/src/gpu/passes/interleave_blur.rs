@@ -4,7 +4,7 @@
 //! a ping-pong target and a copy).
 
 use super::gbuffer::GBufferOutput;
-use super::shade::{frame_pass, frame_target};
+use super::shade::{HDR, frame_pass, frame_target};
 use crate::RenderError;
 use crate::gpu::context::{Pool, bind_group, compute_pipelines};
 use crate::gpu::layout::ValGather;
@@ -24,6 +24,11 @@ pub struct InterleaveParams {
     /// Blur: neighbours whose normal's cosine to the pixel's is below this are left out (Laine
     /// et al.: 0.8). [Limit: −1..=1]
     pub blur_normal: f32,
+    /// Gates: a pixel whose block holds fewer taps than this that agree with it (the blur's
+    /// test) walks every VPL itself, and that sum replaces the block's average there (a door
+    /// jamb, a strip along a wall: the few subsets the blur would average may hold none of the
+    /// VPLs that light it); 0: none. [Limit: 0..=block²]
+    pub starved_taps: u32,
 }
 
 impl Default for InterleaveParams {
@@ -32,6 +37,7 @@ impl Default for InterleaveParams {
             block: 8,
             blur_distance: 0.1,
             blur_normal: 0.8,
+            starved_taps: 0,
         }
     }
 }
@@ -53,6 +59,14 @@ impl InterleaveParams {
             return Err(RenderError::Param(format!(
                 "interleaving block {} must be 1..=16 pixels (1: every VPL at every pixel)",
                 self.block
+            )));
+        }
+        if self.starved_taps > self.subsets() {
+            return Err(RenderError::Param(format!(
+                "starved taps {} must be at most the block's {} pixels (0: no pixel gathers \
+                 every VPL itself)",
+                self.starved_taps,
+                self.subsets()
             )));
         }
         let (d, n) = (self.blur_distance, self.blur_normal);
@@ -107,7 +121,8 @@ impl InterleaveBlur {
     }
 
     /// Records the blur of `indirect` composed onto `out`, with the gather's constants
-    /// `uniform` (a `ValGather`).
+    /// `uniform` (a `ValGather`), and the starved pixels' own sums where gates have them
+    /// (`Shade::record_starved`).
     pub fn record(
         &self,
         f: &Frame,
@@ -119,10 +134,24 @@ impl InterleaveBlur {
             &wgpu::Texture,
             &wgpu::Texture,
         ),
+        starved: Option<&wgpu::Texture>,
     ) {
         let d = &f.ctx.device;
         let other = frame_target(f, pool, "hdr (ping-pong)");
         let tex = wgpu::BindingResource::TextureView;
+        // Modes without starved pixels read a texel of zeros (w 0: none starved).
+        let starved = match starved {
+            Some(t) => t.clone(),
+            None => pool.texture(
+                d,
+                "no starved pixels",
+                [1, 1, 1],
+                1,
+                HDR,
+                wgpu::TextureUsages::TEXTURE_BINDING,
+            ),
+        };
+        let starved_view = starved.create_view(&Default::default());
         let (out_view, indirect_view, other_view) = (
             out.create_view(&Default::default()),
             indirect.create_view(&Default::default()),
@@ -140,6 +169,7 @@ impl InterleaveBlur {
                 (6, tex(&out_view)),
                 (12, tex(&indirect_view)),
                 (13, tex(&other_view)),
+                (14, tex(&starved_view)),
             ],
         );
         let span = rec.begin("blur + compose");

@@ -351,7 +351,7 @@ impl Isms {
         );
         rec.end();
         let uniform = InterleaveBlur::uniform(f, interleave, pool, false);
-        blur.record(f, pool, rec, (g, &uniform, &indirect, out));
+        blur.record(f, pool, rec, (g, &uniform, &indirect, out), None);
     }
 
     /// Mode per-vpl-ism onto `out`.

@@ -4,6 +4,7 @@
 
 use super::clustered_gates::ListBuffers;
 use super::gbuffer::GBufferOutput;
+use super::interleave_blur::InterleaveParams;
 use super::light_cluster::LcOutput;
 use super::shadow_maps::ShadowOutput;
 use crate::RenderError;
@@ -26,6 +27,8 @@ pub struct Shade {
     /// `GATE_SHAPE`, by [`crate::cpu::gates::GateShape::shader_id`]) and one for the voxel
     /// walk with the closed voxels' triangles (`SIGHT_TRIANGLES`), each made when first used.
     gates_indirect: [std::sync::OnceLock<wgpu::ComputePipeline>; 4],
+    /// The starved pixels' gathers (`cs_gates_starved`), likewise.
+    gates_starved: [std::sync::OnceLock<wgpu::ComputePipeline>; 4],
     module: wgpu::ShaderModule,
     vpl_clusters_indirect: wgpu::ComputePipeline,
 }
@@ -93,6 +96,9 @@ pub struct Gathers<'a> {
 /// The bindings of shade.wgsl's `cs_gates_indirect` (an automatic layout holds only what an
 /// entry point uses) but its batch index (24) and its output (25).
 const GATES_INDIRECT_BINDINGS: [u32; 15] = [0, 2, 5, 6, 7, 8, 10, 12, 13, 14, 15, 16, 21, 22, 23];
+/// The bindings of shade.wgsl's `cs_gates_starved` but its batch index (24) and its output
+/// (25): the walks' without the disks' lists, and the starved test's constants (26).
+const GATES_STARVED_BINDINGS: [u32; 12] = [0, 2, 5, 6, 7, 8, 15, 16, 21, 22, 23, 26];
 /// The bindings of shade.wgsl's `cs_shade` but its output (25): all but the batches' sum and
 /// the batch index.
 const SHADE_BINDINGS: [u32; 23] = [
@@ -110,6 +116,7 @@ impl Shade {
         Ok(Shade {
             pipeline,
             gates_indirect: Default::default(),
+            gates_starved: Default::default(),
             module,
             vpl_clusters_indirect,
         })
@@ -123,14 +130,30 @@ impl Shade {
         shape: u32,
         triangles: bool,
     ) -> &wgpu::ComputePipeline {
+        self.gates_pipeline(d, "cs_gates_indirect", shape, triangles)
+    }
+
+    /// Entry point `entry` (`cs_gates_indirect` or `cs_gates_starved`) for gate shape `shape`,
+    /// with or without the triangles, made when first asked for.
+    fn gates_pipeline(
+        &self,
+        d: &wgpu::Device,
+        entry: &'static str,
+        shape: u32,
+        triangles: bool,
+    ) -> &wgpu::ComputePipeline {
         let triangles = triangles && shape == GateShape::Voxels.shader_id();
         let k = if triangles { 3 } else { shape as usize };
-        self.gates_indirect[k].get_or_init(|| {
+        let cache = match entry {
+            "cs_gates_starved" => &self.gates_starved,
+            _ => &self.gates_indirect,
+        };
+        cache[k].get_or_init(|| {
             compute_pipeline_with(
                 d,
-                "gates indirect (interleaved)",
+                entry,
                 &self.module,
-                "cs_gates_indirect",
+                entry,
                 &[
                     ("GATE_SHAPE", f64::from(shape)),
                     ("SIGHT_TRIANGLES", f64::from(u8::from(triangles))),
@@ -185,7 +208,65 @@ impl Shade {
         };
         let triangles = f.params.mode.gates().is_some_and(|g| g.triangles);
         let pipeline = self.gates_indirect(&f.ctx.device, shape.shader_id(), triangles);
-        self.walk_batches(f, pool, rec, inputs, pipeline, batches)
+        let batched = Batched {
+            pipeline,
+            batches,
+            used: &GATES_INDIRECT_BINDINGS,
+            names: ["indirect irradiance", "indirect irradiance (batches)"],
+            span: "indirect lighting",
+            extra: None,
+        };
+        self.walk_batches(f, pool, rec, inputs, batched)
+    }
+
+    /// Records interleaved gates' second gather ([`InterleaveParams::starved_taps`]): every
+    /// VPL walked at the pixels whose blur block holds fewer than that many taps that agree
+    /// with them, in pixel order (w 1 there) for the blur to take instead of its average.
+    pub fn record_starved(
+        &self,
+        f: &Frame,
+        pool: &mut Pool,
+        rec: &mut Recorder,
+        inputs: Inputs,
+        (shape, il): (GateShape, &InterleaveParams),
+    ) -> wgpu::Texture {
+        let batch = f.walk_batch;
+        let batches = if batch > 0 {
+            f.vpl_count.div_ceil(batch).max(1)
+        } else {
+            1
+        };
+        let triangles = f.params.mode.gates().is_some_and(|g| g.triangles);
+        let pipeline = self.gates_pipeline(
+            &f.ctx.device,
+            "cs_gates_starved",
+            shape.shader_id(),
+            triangles,
+        );
+        let constants = [
+            il.blur_distance_m(f),
+            il.blur_normal,
+            il.starved_taps as f32,
+            0.0,
+        ];
+        let uniform = pool.upload(
+            f.ctx,
+            "starved pixels' test",
+            bytemuck::cast_slice(&constants),
+            wgpu::BufferUsages::UNIFORM,
+        );
+        let batched = Batched {
+            pipeline,
+            batches,
+            used: &GATES_STARVED_BINDINGS,
+            names: [
+                "starved pixels' irradiance",
+                "starved pixels' irradiance (batches)",
+            ],
+            span: "indirect lighting: starved pixels",
+            extra: Some(&uniform),
+        };
+        self.walk_batches(f, pool, rec, inputs, batched)
     }
 
     /// A pass of shade.wgsl with `pipeline` (and the bindings it uses but its output, all if
@@ -216,20 +297,28 @@ impl Shade {
         rec.end();
     }
 
-    /// The gates' indirect pass: `batches` dispatches of `pipeline` in one compute pass, timed
-    /// as one span; dispatch `i` walks batch `i`, writes target `i % 2` and reads the other as
-    /// the batches' sum so far (one batch: a texel stands in for it). Returns the last target.
+    /// A gates gather in batches: `b.batches` dispatches of `b.pipeline` in one compute pass,
+    /// timed as one span; dispatch `i` walks batch `i`, writes target `i % 2` and reads the
+    /// other as the batches' sum so far (one batch: a texel stands in for it). Returns the last
+    /// target.
     fn walk_batches(
         &self,
         f: &Frame,
         pool: &mut Pool,
         rec: &mut Recorder,
         inputs: Inputs,
-        pipeline: &wgpu::ComputePipeline,
-        batches: u32,
+        b: Batched,
     ) -> wgpu::Texture {
+        let Batched {
+            pipeline,
+            batches,
+            used,
+            names,
+            span,
+            extra,
+        } = b;
         let d = &f.ctx.device;
-        let first = frame_target(f, pool, "indirect irradiance");
+        let first = frame_target(f, pool, names[0]);
         let second = match batches {
             1 => pool.texture(
                 d,
@@ -239,7 +328,7 @@ impl Shade {
                 HDR,
                 wgpu::TextureUsages::TEXTURE_BINDING,
             ),
-            _ => frame_target(f, pool, "indirect irradiance (batches)"),
+            _ => frame_target(f, pool, names[1]),
         };
         let targets = [first, second];
         let targets_view = targets
@@ -257,27 +346,36 @@ impl Shade {
         let groups: Vec<wgpu::BindGroup> = (0..batches as usize)
             .map(|i| {
                 let (out, earlier) = (&targets_view[i % 2], &targets_view[(i + 1) % 2]);
-                let mut resources =
-                    views.resources(f, inputs, Some(earlier), Some(&GATES_INDIRECT_BINDINGS[..]));
+                let mut resources = views.resources(f, inputs, Some(earlier), Some(used));
                 resources.push((24, slice(&index_buf, (i * UNIFORM_STRIDE) as u64, 16)));
                 resources.push((25, wgpu::BindingResource::TextureView(out)));
-                bind_group(d, &layout, "gates indirect", resources)
+                resources.extend(extra.map(|u| (26, u.as_entire_binding())));
+                bind_group(d, &layout, span, resources)
             })
             .collect();
         let groups: Vec<&wgpu::BindGroup> = groups.iter().collect();
-        let span = rec.begin("indirect lighting");
+        let timed = rec.begin(span);
         let size = f.view.size;
-        frame_pass(
-            &mut rec.enc,
-            "gates indirect",
-            pipeline,
-            &groups,
-            span.compute(),
-            size,
-        );
+        frame_pass(&mut rec.enc, span, pipeline, &groups, timed.compute(), size);
         rec.end();
         targets[(batches as usize - 1) % 2].clone()
     }
+}
+
+/// A gates gather in batches ([`Shade::walk_batches`]).
+struct Batched<'a> {
+    /// Its entry point's pipeline.
+    pipeline: &'a wgpu::ComputePipeline,
+    /// Dispatches, a batch of walks each.
+    batches: u32,
+    /// The bindings the entry point uses but 24, 25 and `extra`'s.
+    used: &'a [u32],
+    /// Its two targets' names in the pool (the result, the batches' sum).
+    names: [&'static str; 2],
+    /// The pass's name in the timings.
+    span: &'static str,
+    /// A uniform at binding 26, for the entry points that read one.
+    extra: Option<&'a wgpu::Buffer>,
 }
 
 /// The texture views shade.wgsl's passes read beside the G-buffer's.

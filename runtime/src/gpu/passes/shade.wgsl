@@ -307,25 +307,35 @@ fn clustered_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, batch:
 // (portals) or through the open voxels (voxels), × B; of them, batch `batch` of
 // globals.walk_batch (0: all in one).
 fn portal_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, j: u32, subsets: u32, batch: u32) -> vec3<f32> {
-    var sum = vec3<f32>(0.0);
     var first = j;
     var end = globals.vpl_count;
-    // The voxel walk's end at p (off its face, or a hair off it along the true segment; w = 0:
-    // no open voxel near), the same for every VPL.
-    var at_p = vec4<f32>(0.0);
-    let triangles = sight_triangles();
-    if gate_shape() == GATE_VOXELS {
-        let n_face = face_normal(px);
-        at_p = sight_end(p, n_face);
-        if triangles {
-            at_p = vec4<f32>(sight_true_end(p, n_face), at_p.w);
-        }
-    }
     if globals.walk_batch > 0u {
         first = j + batch * globals.walk_batch * subsets;
         end = min(end, first + globals.walk_batch * subsets);
     }
-    for (var k = first; k < end; k += subsets) {
+    return walk_range(p, n, here, walk_end_at(px, p), first, end, subsets) * f32(subsets);
+}
+
+// The voxel walk's end at p (off its face, or a hair off it along the true segment; w = 0:
+// no open voxel near), the same for every VPL; unused by the portal walk.
+fn walk_end_at(px: vec2<i32>, p: vec3<f32>) -> vec4<f32> {
+    var at_p = vec4<f32>(0.0);
+    if gate_shape() == GATE_VOXELS {
+        let n_face = face_normal(px);
+        at_p = sight_end(p, n_face);
+        if sight_triangles() {
+            at_p = vec4<f32>(sight_true_end(p, n_face), at_p.w);
+        }
+    }
+    return at_p;
+}
+
+// The light at p (normal n, cluster `here`, walk end at_p) of VPLs first, first + step, …
+// below end, each that the walk finds visible.
+fn walk_range(p: vec3<f32>, n: vec3<f32>, here: u32, at_p: vec4<f32>, first: u32, end: u32, step: u32) -> vec3<f32> {
+    var sum = vec3<f32>(0.0);
+    let triangles = sight_triangles();
+    for (var k = first; k < end; k += step) {
         let v = vpls[k];
         let l = vpl_light(v, p, n, globals.g_max);
         if all(l == vec3<f32>(0.0)) {
@@ -351,7 +361,7 @@ fn portal_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, j: u32, s
         }
         sum += l;
     }
-    return sum * f32(subsets);
+    return sum;
 }
 
 // The first entry of [first, end) whose VPL is in subset j or later (VPL mod B >= j).
@@ -401,6 +411,88 @@ fn cs_gates_indirect(@builtin(global_invocation_id) id: vec3<u32>) {
         sum += clustered_gather(s.px, s.position.xyz, s.normal, here, batch);
     }
     textureStore(out_image, id.xy, vec4<f32>(sum, 1.0));
+}
+
+// Starved pixels (cs_gates_starved): x the blur's distance (m), y its normals' cosine, z the
+// fewest taps of a pixel's b × b block that must agree with it (blur.wgsl's test) before it
+// walks the subsets of those that do not itself.
+@group(0) @binding(26) var<uniform> starved_params: vec4<f32>;
+
+// px's blur block (blur.wgsl's: b × b around px, moved inside the image): [lo, hi).
+fn blur_block(px: vec2<i32>, b: i32) -> vec4<i32> {
+    let size = vec2<i32>(textureDimensions(g_position));
+    let lo = clamp(px - vec2<i32>(b / 2), vec2<i32>(0), max(size - vec2<i32>(b), vec2<i32>(0)));
+    return vec4<i32>(lo, min(lo + vec2<i32>(b), size));
+}
+
+// Whether tap q's surface agrees with p (normal n) by the blur's test.
+fn blur_agrees(q: vec2<i32>, p: vec3<f32>, n: vec3<f32>) -> bool {
+    let qp = textureLoad(g_position, q, 0);
+    let qn = normalize(textureLoad(g_normal, q, 0).xyz);
+    return qp.w != 0.0 && length(qp.xyz - p) <= starved_params.x && dot(qn, n) >= starved_params.y;
+}
+
+// Interleaved gates' second gather. The blur averages a pixel's block where the geometry
+// agrees, each tap lit by one of the b² VPL subsets; where few taps agree (a door jamb, a strip
+// along a wall) it averages a handful of subsets, and where a few VPLs light the place those
+// may hold none of them. A pixel whose block holds fewer than starved_params.z agreeing taps
+// walks, itself, the subsets of the taps that do not agree, and blur.wgsl adds them to the
+// agreeing taps' subsets: every VPL counted once. In pixel order: xyz those subsets' light, w 1
+// where the pixel is starved (decided in the first batch, carried in w), 0 elsewhere. Batches
+// (software rasterizers' loop limit) split the pixel's walks, taken in the block's order.
+@compute @workgroup_size(8, 8)
+fn cs_gates_starved(@builtin(global_invocation_id) id: vec3<u32>) {
+    if any(id.xy >= textureDimensions(g_position)) {
+        return;
+    }
+    let px = vec2<i32>(id.xy);
+    let batch = walk_batch_index.x;
+    var out = vec4<f32>(0.0);
+    if batch > 0u {
+        out = textureLoad(earlier_batches, px, 0);
+    }
+    let pos = textureLoad(g_position, px, 0);
+    let n = normalize(textureLoad(g_normal, px, 0).xyz);
+    let bu = max(globals.interleave_block, 1u);
+    let block = blur_block(px, i32(bu));
+    if batch == 0u && pos.w != 0.0 {
+        var agree = 0.0;
+        for (var y = block.y; y < block.w; y++) {
+            for (var x = block.x; x < block.z; x++) {
+                agree += f32(blur_agrees(vec2<i32>(x, y), pos.xyz, n));
+            }
+        }
+        out.w = f32(agree < starved_params.z);
+    }
+    if out.w == 1.0 {
+        let subsets = bu * bu;
+        let at_p = walk_end_at(px, pos.xyz);
+        let here = decode_cluster(pos.w);
+        // This batch's walks of the pixel's list: skip the earlier batches', take walk_batch.
+        let wb = globals.walk_batch;
+        var skip = batch * wb;
+        var left = select(globals.vpl_count, wb, wb > 0u);
+        for (var y = block.y; y < block.w && left > 0u; y++) {
+            for (var x = block.x; x < block.z && left > 0u; x++) {
+                let q = vec2<i32>(x, y);
+                let j = interleave_subset(q, bu);
+                if j >= globals.vpl_count || blur_agrees(q, pos.xyz, n) {
+                    continue;
+                }
+                let count = (globals.vpl_count - j + subsets - 1u) / subsets;
+                if skip >= count {
+                    skip -= count;
+                    continue;
+                }
+                let take = min(count - skip, left);
+                let first = j + skip * subsets;
+                out = vec4<f32>(out.xyz + walk_range(pos.xyz, n, here, at_p, first, first + take * subsets, subsets), 1.0);
+                left -= take;
+                skip = 0u;
+            }
+        }
+    }
+    textureStore(out_image, id.xy, out);
 }
 
 // The pixel that the invocation at place `frag` of the deinterleaved target shades, and its

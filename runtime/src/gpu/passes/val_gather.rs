@@ -192,7 +192,7 @@ impl ValGathers {
         rec.end();
         passes
             .blur
-            .record(f, pool, rec, (g, &uniform_buf, &indirect, out));
+            .record(f, pool, rec, (g, &uniform_buf, &indirect, out), None);
         Ok(Some(b.state))
     }
 }
