@@ -63,10 +63,11 @@ impl InterleaveParams {
         }
         if self.starved_taps > self.subsets() {
             return Err(RenderError::Param(format!(
-                "starved taps {} must be at most the block's {} pixels (0: no pixel gathers \
-                 every VPL itself)",
+                "starved taps {} must be at most the interleaving block's {} pixels ({}²; 0 \
+                 turns the starved pixels' walks off)",
                 self.starved_taps,
-                self.subsets()
+                self.subsets(),
+                self.block
             )));
         }
         let (d, n) = (self.blur_distance, self.blur_normal);
