@@ -20,8 +20,11 @@ Modes (--modes, comma-separated, or all): every GPU method of `visgate render --
 gates-voxels, gates-triangles, gates-portal and gates-disk (mode gates walking the level's open
 voxels, walking them along the true segment with the closed voxels' triangles
 (--closed-voxel-triangles), walking its portals, or with the paper's disks, whatever
---gate-shape says; gates takes --gate-shape, voxels by default). `all`: every one but
-direct-only, gates once a shape; the gate modes only with a level (given, or baked here).
+--gate-shape says; gates takes --gate-shape, voxels by default), and gates-starved (gates as
+set, its starved pixels walking what their blur block lacks: --starved-taps, or 3/4 of the
+block's pixels where that is 0). `all`: every one but direct-only, gates once a shape, and
+gates-starved where gates interleave without it; the gate modes only with a level (given, or
+baked here).
 
 Every mode renders at every --vpls count from every camera, beside the CPU reference with the
 very same VPLs (a shadow ray per VPL and pixel sample; --spp samples). OUT/report.md and
@@ -233,9 +236,13 @@ const SHAPED: [(&str, GateShape, bool); 4] = [
     ("gates-disk", GateShape::Disk, false),
 ];
 
+/// Mode gates with its starved pixels walking what their blur block lacks, in `visgate
+/// compare`: the gates' own --starved-taps, or 3/4 of the block's pixels where that is 0.
+const STARVED: &str = "gates-starved";
+
 /// The modes `names` ask for (`all` expanded: gates with --gate-shape, then each other shape
-/// by its own name; `gates-voxels`, `gates-triangles`, `gates-portal` and `gates-disk` are
-/// gates with that shape).
+/// by its own name, then gates-starved where gates interleave without it; `gates-voxels`,
+/// `gates-triangles`, `gates-portal` and `gates-disk` are gates with that shape).
 fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMode>> {
     let s = settings.settings();
     let shaped = |shape, triangles| {
@@ -244,13 +251,22 @@ fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMod
         g.gates.triangles = triangles;
         GpuMode::Gates(g)
     };
+    let starved = || {
+        let mut g = s.gates;
+        let il = &mut g.interleave;
+        if il.starved_taps == 0 {
+            il.starved_taps = 3 * il.block * il.block / 4;
+        }
+        GpuMode::Gates(g)
+    };
     let named = |name: &str| -> Result<CompareMode> {
         let shape = SHAPED.iter().find(|(n, ..)| *n == name);
         let mode = match (shape, method(name)) {
             (Some(&(_, g, t)), _) => shaped(g, t),
+            _ if name == STARVED => starved(),
             (_, Some(m)) => (m.make)(&s),
             (None, None) => bail!(
-                "--modes {name}: give all or some of {}, {}",
+                "--modes {name}: give all or some of {}, {}, {STARVED}",
                 METHODS.map(|m| m.name).join(", "),
                 SHAPED.map(|(n, ..)| n).join(", ")
             ),
@@ -274,6 +290,10 @@ fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMod
                         if !same(g, t) {
                             out.push(named(n)?);
                         }
+                    }
+                    let il = s.gates.interleave;
+                    if il.block > 1 && il.starved_taps == 0 {
+                        out.push(named(STARVED)?);
                     }
                 }
             }
@@ -482,6 +502,24 @@ mod tests {
     }
 
     #[test]
+    fn gates_starved_walks_three_quarters_of_the_block_unless_told() {
+        let taps = |flags: &[&str]| {
+            let argv = ["visgate", "compare", "builtin:four-rooms", "--out", "x"]
+                .iter()
+                .chain(flags);
+            let args = crate::compare_args_from(argv.map(|s| s.to_string())).expect("args");
+            let modes = named_modes(&[STARVED.to_string()], &args.method).expect("modes");
+            match &modes[0].mode {
+                GpuMode::Gates(g) => g.interleave.starved_taps,
+                m => panic!("{STARVED} is not gates: {}", m.name()),
+            }
+        };
+        assert_eq!(taps(&[]), 48, "8 x 8 by default");
+        assert_eq!(taps(&["--interleave", "4"]), 12);
+        assert_eq!(taps(&["--starved-taps", "20"]), 20);
+    }
+
+    #[test]
     fn all_runs_gates_once_a_shape_the_triangles_included() {
         let gates = |labels: &[String]| -> Vec<String> {
             labels
@@ -494,15 +532,38 @@ mod tests {
         assert!(plain.contains(&"gates".to_string()));
         assert_eq!(
             gates(&plain),
-            ["gates-triangles", "gates-portal", "gates-disk"]
+            [
+                "gates-triangles",
+                "gates-portal",
+                "gates-disk",
+                "gates-starved"
+            ]
         );
         // Gates walking with the triangles already: gates-voxels walks without them.
         let with = all_with(&["--closed-voxel-triangles"]);
-        assert_eq!(gates(&with), ["gates-voxels", "gates-portal", "gates-disk"]);
+        assert_eq!(
+            gates(&with),
+            [
+                "gates-voxels",
+                "gates-portal",
+                "gates-disk",
+                "gates-starved"
+            ]
+        );
         let portal = all_with(&["--gate-shape", "portal"]);
         assert_eq!(
             gates(&portal),
-            ["gates-voxels", "gates-triangles", "gates-disk"]
+            [
+                "gates-voxels",
+                "gates-triangles",
+                "gates-disk",
+                "gates-starved"
+            ]
         );
+        // Gates starved already, or not interleaved: no second row of the same.
+        for flags in [["--starved-taps", "16"], ["--interleave", "1"]] {
+            let labels = all_with(&flags);
+            assert!(!labels.contains(&"gates-starved".to_string()), "{flags:?}");
+        }
     }
 }
