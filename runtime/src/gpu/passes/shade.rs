@@ -219,9 +219,10 @@ impl Shade {
         self.walk_batches(f, pool, rec, inputs, batched)
     }
 
-    /// Records interleaved gates' second gather ([`InterleaveParams::starved_taps`]): every
-    /// VPL walked at the pixels whose blur block holds fewer than that many taps that agree
-    /// with them, in pixel order (w 1 there) for the blur to take instead of its average.
+    /// Records interleaved gates' second gather ([`InterleaveParams::starved_taps`]): at the
+    /// pixels whose blur block holds fewer than that many taps that agree with them, the VPL
+    /// subsets of the taps that do not, walked; in pixel order (w 1 there), for the blur to
+    /// add to the agreeing taps' subsets.
     pub fn record_starved(
         &self,
         f: &Frame,
