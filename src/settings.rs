@@ -241,6 +241,11 @@ pub struct MethodArgs {
     /// Blur: leave out neighbours whose normals' cosine is below this.
     #[arg(long, default_value_t = 0.8, allow_hyphen_values = true)]
     pub blur_normal: f32,
+    /// Blur: a neighbour that does not agree with the pixel gives way to the nearest copy of
+    /// its VPL subset a block away that does (along a wall's edge, a jamb), so that the
+    /// average holds more of the VPLs; every interleaved mode.
+    #[arg(long)]
+    pub blur_fill: bool,
     /// Gates, interleaved: a pixel whose blur block holds fewer pixels than this that agree
     /// with it (a door jamb, a strip along a wall) walks, in a second pass, the VPL subsets of
     /// the pixels that do not agree, so that every VPL counts once there; 0: off (default),
@@ -345,6 +350,7 @@ impl MethodArgs {
             block: self.interleave,
             blur_distance: self.blur_distance,
             blur_normal: self.blur_normal,
+            fill: self.blur_fill,
             starved_taps: self.starved_taps,
         }
     }

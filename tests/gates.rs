@@ -854,6 +854,57 @@ fn starved_pixels_walk_the_subsets_their_block_lacks_and_count_every_vpl_once() 
 }
 
 #[test]
+fn the_blur_filled_from_the_next_blocks_is_nearer_every_vpls_gather_and_leaves_agreeing_taps() {
+    use visgate_runtime::gpu::InterleaveParams;
+    use visgate_runtime::gpu::{GatesParams, GpuContext, GpuMode, GpuParams, GpuRenderer};
+    use visgate_runtime::metrics::errors;
+    let ctx = GpuContext::new().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"));
+    let (scene, gates, _, vpls, _) = fixture(Builtin::FourRooms, 128);
+    let view = visgate_runtime::camera::View::new(&scene.cameras[0], [96, 72]).expect("view");
+    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    gpu.set_level(&ctx, &gates).expect("level");
+    let mut render = |block: u32, fill: bool, (blur_distance, blur_normal): (f32, f32)| {
+        let p = GatesParams {
+            interleave: InterleaveParams {
+                block,
+                blur_distance,
+                blur_normal,
+                fill,
+                ..InterleaveParams::default()
+            },
+            ..GatesParams::default()
+        };
+        let params = GpuParams::with_mode(GpuMode::Gates(p));
+        gpu.render(&ctx, &view, &vpls, &params).expect("render").0
+    };
+    let laine = (0.1, 0.8);
+    let full = render(1, false, laine);
+    for block in [4, 8] {
+        // Along the rooms' edges and the doorways a block holds taps that do not agree; their
+        // subsets' copies a block away that do bring the average nearer every VPL's.
+        let plain = errors(&render(block, false, laine), &full).expect("size");
+        let filled = errors(&render(block, true, laine), &full).expect("size");
+        eprintln!(
+            "block {block}: rel. MSE to every VPL's {:.3e} -> {:.3e} filled",
+            plain.rel_mse, filled.rel_mse
+        );
+        assert!(
+            filled.rel_mse < 0.9 * plain.rel_mse,
+            "block {block}: {} vs {}",
+            filled.rel_mse,
+            plain.rel_mse
+        );
+        // Where every tap agrees nothing is filled: the same image, bit for bit.
+        let all = (1e9, -1.0);
+        assert_eq!(
+            render(block, true, all),
+            render(block, false, all),
+            "block {block}"
+        );
+    }
+}
+
+#[test]
 fn the_light_list_pool_grows_to_what_a_frame_needs() {
     // Disks keep lists; portals keep none (their pool stays at one entry).
     use visgate_runtime::gpu::{GatesParams, GpuContext, GpuMode, GpuParams, GpuRenderer};

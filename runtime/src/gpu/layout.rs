@@ -430,8 +430,9 @@ gpu_struct! {
         /// Layout of the interleaved indirect target: 0 pixel order, 1 deinterleaved (each
         /// VPL subset's pixels side by side; `vpl.wgsl`'s `deinterleaved`).
         pub deinterleaved: u32,
-        /// Padding.
-        pub _pad1: u32,
+        /// Blur: 1 where a tap that does not agree gives way to its subset's nearest copy a
+        /// block away that does, 0 where it is left out.
+        pub blur_fill: u32,
         /// Blur: neighbours farther than this are left out. [Units: m]
         pub blur_distance: f32,
         /// Blur: neighbours whose normals' cosine is below this are left out.

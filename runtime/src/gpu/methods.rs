@@ -200,6 +200,7 @@ impl GpuMode {
         use crate::cpu::gates::GateShape;
         let il = |i: &InterleaveParams| match i.block {
             1 => "every VPL per pixel".to_string(),
+            b if i.fill => format!("{b}×{b} interleaved, blur filled"),
             b => format!("{b}×{b} interleaved"),
         };
         let gates = |g: &GateParams| match g.shape {

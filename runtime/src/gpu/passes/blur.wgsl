@@ -48,6 +48,10 @@ fn compose(px: vec2<i32>) -> vec4<f32> {
     let m = vec2<u32>(size) % bu;
     let deint = gather.deinterleaved == 1u;
     var ry = vec2<u32>(u32(lo.y) % bu, u32(lo.y) / bu);
+    // A starved pixel (w 1) walked the subsets of the taps that do not agree itself: each
+    // agreeing tap's subset (its light × B) once, and those; it fills none.
+    let walked = textureLoad(starved_sums, min(px, vec2<i32>(textureDimensions(starved_sums)) - 1), 0);
+    let fill = gather.blur_fill == 1u && walked.w != 1.0;
     var sum = vec3<f32>(0.0);
     var weight = 0.0;
     for (var y = lo.y; y < hi.y; y++) {
@@ -58,21 +62,60 @@ fn compose(px: vec2<i32>) -> vec4<f32> {
             let ax = i32(axis_run_place(rx, q.x, m.x));
             rx = axis_run_next(rx, bu);
             let tap = vec2<i32>(x, y);
-            let qp = textureLoad(g_position, tap, 0);
-            if qp.w == 0.0 {
-                continue;
+            var at = select(tap, vec2<i32>(ax, ay), deint);
+            if !blur_agrees(tap, pos.xyz, n) {
+                if !fill {
+                    continue;
+                }
+                let copy = blur_copy(px, tap, pos.xyz, n, size);
+                if copy.x == NO_COPY {
+                    continue;
+                }
+                // A block's side away, a deinterleaved pixel away (vpl.wgsl's layout).
+                at = select(tap + copy * b, vec2<i32>(ax, ay) + copy, deint);
             }
-            let qn = normalize(textureLoad(g_normal, tap, 0).xyz);
-            if length(qp.xyz - pos.xyz) > gather.blur_distance || dot(qn, n) < gather.blur_normal {
-                continue;
-            }
-            sum += textureLoad(indirect, select(tap, vec2<i32>(ax, ay), deint), 0).xyz;
+            sum += textureLoad(indirect, at, 0).xyz;
             weight += 1.0;
         }
     }
-    // A starved pixel (w 1) walked the subsets of the taps that do not agree itself: each
-    // agreeing tap's subset (its light × B) once, and those.
-    let walked = textureLoad(starved_sums, min(px, vec2<i32>(textureDimensions(starved_sums)) - 1), 0);
     let e = select(sum / max(weight, 1.0), sum / f32(gather.subsets) + walked.xyz, walked.w == 1.0);
     return vec4<f32>(before.xyz + albedo / PI * e, 1.0);
+}
+
+// Whether tap t's surface agrees with p (normal n): nearer than the blur's distance, its
+// normal within the blur's cosine.
+fn blur_agrees(t: vec2<i32>, p: vec3<f32>, n: vec3<f32>) -> bool {
+    let qp = textureLoad(g_position, t, 0);
+    if qp.w == 0.0 {
+        return false;
+    }
+    let qn = normalize(textureLoad(g_normal, t, 0).xyz);
+    return length(qp.xyz - p) <= gather.blur_distance && dot(qn, n) >= gather.blur_normal;
+}
+
+const NO_COPY: i32 = 99;
+
+// Of the copies of tap t's VPL subset one block away (t + o·b, o each of the 8 steps to a
+// neighbouring block), the step o to the one nearest pixel px that agrees with it (surface p,
+// normal n) and lies inside the target; NO_COPY where none does.
+fn blur_copy(px: vec2<i32>, t: vec2<i32>, p: vec3<f32>, n: vec3<f32>, size: vec2<i32>) -> vec2<i32> {
+    let b = i32(gather.block);
+    var best = vec2<i32>(NO_COPY);
+    var best_d2 = 1 << 30;
+    for (var oy = -1; oy <= 1; oy++) {
+        for (var ox = -1; ox <= 1; ox++) {
+            let o = vec2<i32>(ox, oy);
+            let c = t + o * b;
+            let d = c - px;
+            let d2 = dot(d, d);
+            if (ox == 0 && oy == 0) || any(c < vec2<i32>(0)) || any(c >= size) || d2 >= best_d2 {
+                continue;
+            }
+            if blur_agrees(c, p, n) {
+                best = o;
+                best_d2 = d2;
+            }
+        }
+    }
+    return best;
 }

@@ -25,10 +25,14 @@ pub struct InterleaveParams {
     /// et al.: 0.8). [Limit: −1..=1]
     pub blur_normal: f32,
     /// Gates: a pixel whose block holds fewer taps than this that agree with it (the blur's
-    /// test) walks every VPL itself, and that sum replaces the block's average there (a door
-    /// jamb, a strip along a wall: the few subsets the blur would average may hold none of the
-    /// VPLs that light it); 0: none. [Limit: 0..=block²]
+    /// test) walks the VPL subsets of those that do not itself, and the blur adds them to the
+    /// agreeing taps' subsets (a door jamb, a strip along a wall: the few subsets the blur
+    /// would average may hold none of the VPLs that light it); 0: none. [Limit: 0..=block²]
     pub starved_taps: u32,
+    /// Blur: a tap that does not agree with the pixel gives way to the nearest copy of its
+    /// VPL subset one block away (a block's side along x, y or both) that does, so that the
+    /// average holds more of the b² subsets; off: it is left out (Laine et al.).
+    pub fill: bool,
 }
 
 impl Default for InterleaveParams {
@@ -38,6 +42,7 @@ impl Default for InterleaveParams {
             blur_distance: 0.1,
             blur_normal: 0.8,
             starved_taps: 0,
+            fill: false,
         }
     }
 }
@@ -111,6 +116,7 @@ impl InterleaveBlur {
             blur_distance: p.blur_distance_m(f),
             blur_normal: p.blur_normal,
             deinterleaved: u32::from(deinterleaved),
+            blur_fill: u32::from(p.fill),
             ..bytemuck::Zeroable::zeroed()
         };
         pool.upload(

@@ -146,6 +146,7 @@ impl ValGathers {
             subsets: il.subsets(),
             blur_distance: il.blur_distance_m(f),
             blur_normal: il.blur_normal,
+            blur_fill: u32::from(il.fill),
             ..bytemuck::Zeroable::zeroed()
         };
         let uniform_buf = pool.upload(

@@ -55,7 +55,9 @@ struct ValGather {
     subsets: u32,
     // Layout of the interleaved indirect target: 0 pixel order, 1 deinterleaved.
     deinterleaved: u32,
-    pad1: u32,
+    // Blur: 1 where a tap that does not agree gives way to its subset's nearest copy a block
+    // away that does (blur.wgsl), 0 where it is left out.
+    blur_fill: u32,
     // Blur thresholds: distance (m) and normal cosine.
     blur_distance: f32,
     blur_normal: f32,
