@@ -799,6 +799,14 @@ fn render_gates_uses_a_baked_level_and_refuses_a_missing_or_stale_one() {
     for (x, y) in plain.iter().zip(&with) {
         assert!((x - y).abs() <= 0.02 * x.max(1e-3), "{plain:?} / {with:?}");
     }
+    // The blur filled from the next blocks and the starved pixels' walks, named.
+    let mut f = a.clone();
+    f.extend(["--blur-fill", "--starved-taps", "40"]);
+    let of = visgate(&f);
+    assert!(of.status.success(), "{}", stderr(&of));
+    let named = "gates (voxel walk, 8×8 interleaved, blur filled, under 40 agreeing walk the rest)";
+    assert!(stdout(&of).contains(named), "{}", stdout(&of));
+    assert!(stdout(&of).contains("starved pixels"), "{}", stdout(&of));
     a.extend(["--gate-shape", "portal"]);
     let o = visgate(&a);
     assert!(o.status.success(), "{}", stderr(&o));

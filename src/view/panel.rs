@@ -6,7 +6,8 @@ use eframe::egui;
 use visgate_formats::Scene;
 use visgate_runtime::cpu::gates::GateShape;
 use visgate_runtime::gpu::{
-    DirectLight, DiskLight, IsmParams, LcDisk, LightClusterGpuParams, MethodSettings, PassTimes,
+    DirectLight, DiskLight, InterleaveParams, IsmParams, LcDisk, LightClusterGpuParams,
+    MethodSettings, PassTimes,
 };
 
 use super::camera::FlyCamera;
@@ -37,7 +38,7 @@ pub fn method_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
             }
             if mode == "gates" {
                 let il = &mut s.vals.interleave;
-                ui.add(interleave_block(&mut il.block));
+                interleave(ui, il);
                 if il.block > 1 {
                     let most = il.block * il.block;
                     ui.add(egui::Slider::new(&mut il.starved_taps, 0..=most).text("starved taps"))
@@ -59,16 +60,16 @@ pub fn method_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
                     "off: the paper's restart from evenly spaced VPLs every frame; on: steadier, \
                      but VALs emptied as the light moves stay empty (the live count is below)",
                 );
-            ui.add(interleave_block(&mut v.interleave.block));
+            interleave(ui, &mut v.interleave);
             ui.add(egui::Slider::new(&mut v.map_size, 32..=512).text("VAL map size"));
         }
         "vpl-clusters" => {
             lc_controls(ui, &mut s.vpl_clusters);
-            ui.add(interleave_block(&mut s.vals.interleave.block));
+            interleave(ui, &mut s.vals.interleave);
         }
         "per-vpl-ism" => {
             ism_controls(ui, &mut s.vpl_ism.ism);
-            ui.add(interleave_block(&mut s.vpl_ism.interleave.block));
+            interleave(ui, &mut s.vpl_ism.interleave);
         }
         "val-ism" => {
             let v = &mut s.val_ism;
@@ -89,7 +90,7 @@ pub fn method_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
                 );
             }
             ism_controls(ui, &mut v.ism);
-            ui.add(interleave_block(&mut v.interleave.block));
+            interleave(ui, &mut v.interleave);
         }
         "per-vpl-shadow-maps" => {
             ui.add(egui::Slider::new(&mut s.per_vpl.map_size, 16..=512).text("map size"));
@@ -165,9 +166,17 @@ fn ism_controls(ui: &mut egui::Ui, p: &mut IsmParams) {
     ui.add(egui::Slider::new(&mut p.bias, 0.0..=16.0).text("ISM bias (texels)"));
 }
 
-/// The interleaving block's slider.
-fn interleave_block(b: &mut u32) -> egui::Slider<'_> {
-    egui::Slider::new(b, 1..=8).text("interleave block")
+/// The interleaving block's slider and, while it is over 1, the blur's fill.
+fn interleave(ui: &mut egui::Ui, il: &mut InterleaveParams) {
+    ui.add(egui::Slider::new(&mut il.block, 1..=8).text("interleave block"));
+    if il.block > 1 {
+        ui.checkbox(&mut il.fill, "blur filled from the next blocks")
+            .on_hover_text(
+                "a neighbour whose surface does not agree with the pixel gives way to the \
+                 nearest copy of its VPL subset a block away that does: the average holds more \
+                 of the VPLs along edges and jambs, at a few % of the frame",
+            );
+    }
 }
 
 /// The camera: speed, field of view, the scene's cameras as bookmarks, framing the level.
