@@ -95,9 +95,11 @@ fn blur_agrees(t: vec2<i32>, p: vec3<f32>, n: vec3<f32>) -> bool {
 
 const NO_COPY: i32 = 99;
 
-// Of the copies of tap t's VPL subset one block away (t + o·b, o each of the 8 steps to a
-// neighbouring block), the step o to the one nearest pixel px that agrees with it (surface p,
-// normal n) and lies inside the target; NO_COPY where none does.
+// Of the copies of tap t's VPL subset one block away (t + o·b, o each of the 4 steps along
+// an axis to a neighbouring block), the step o to the one nearest pixel px that agrees with it
+// (surface p, normal n) and lies inside the target; NO_COPY where none does. The diagonal
+// steps too gained less over 10 cameras: 1.5 blocks away is farther than the light is alike
+// (Crytek Sponza's gallery +3.6 % indirect MSE with them, −2.4 % without; README).
 fn blur_copy(px: vec2<i32>, t: vec2<i32>, p: vec3<f32>, n: vec3<f32>, size: vec2<i32>) -> vec2<i32> {
     let b = i32(gather.block);
     var best = vec2<i32>(NO_COPY);
@@ -108,7 +110,8 @@ fn blur_copy(px: vec2<i32>, t: vec2<i32>, p: vec3<f32>, n: vec3<f32>, size: vec2
             let c = t + o * b;
             let d = c - px;
             let d2 = dot(d, d);
-            if (ox == 0 && oy == 0) || any(c < vec2<i32>(0)) || any(c >= size) || d2 >= best_d2 {
+            // Neither the tap itself nor a diagonal step.
+            if (ox == 0) == (oy == 0) || any(c < vec2<i32>(0)) || any(c >= size) || d2 >= best_d2 {
                 continue;
             }
             if blur_agrees(c, p, n) {

@@ -30,8 +30,8 @@ pub struct InterleaveParams {
     /// would average may hold none of the VPLs that light it); 0: none. [Limit: 0..=block²]
     pub starved_taps: u32,
     /// Blur: a tap that does not agree with the pixel gives way to the nearest copy of its
-    /// VPL subset one block away (a block's side along x, y or both) that does, so that the
-    /// average holds more of the b² subsets; off: it is left out (Laine et al.).
+    /// VPL subset one block away (a block's side along x or y) that does, so that the average
+    /// holds more of the b² subsets; off: it is left out (Laine et al.).
     pub fill: bool,
 }
 
