@@ -20,11 +20,12 @@ Modes (--modes, comma-separated, or all): every GPU method of `visgate render --
 gates-voxels, gates-triangles, gates-portal and gates-disk (mode gates walking the level's open
 voxels, walking them along the true segment with the closed voxels' triangles
 (--closed-voxel-triangles), walking its portals, or with the paper's disks, whatever
---gate-shape says; gates takes --gate-shape, voxels by default), and gates-starved (gates as
-set, its starved pixels walking what their blur block lacks: --starved-taps, or 3/4 of the
-block's pixels where that is 0). `all`: every one but direct-only, gates once a shape, and
-gates-starved where gates interleave without it; the gate modes only with a level (given, or
-baked here).
+--gate-shape says; gates takes --gate-shape, voxels by default), gates-filled (gates as set,
+its blur filled from the next blocks: --blur-fill) and gates-starved (gates as set, its
+starved pixels walking what their blur block lacks: --starved-taps, or 3/4 of the block's
+pixels where that is 0). `all`: every one but direct-only, gates once a shape, and
+gates-filled and gates-starved where gates interleave without them; the gate modes only with
+a level (given, or baked here).
 
 Every mode renders at every --vpls count from every camera, beside the CPU reference with the
 very same VPLs (a shadow ray per VPL and pixel sample; --spp samples). OUT/report.md and
@@ -239,9 +240,12 @@ const SHAPED: [(&str, GateShape, bool); 4] = [
 /// Mode gates with its starved pixels walking what their blur block lacks, in `visgate
 /// compare`: the gates' own --starved-taps, or 3/4 of the block's pixels where that is 0.
 const STARVED: &str = "gates-starved";
+/// Mode gates with its blur filled from the next blocks (--blur-fill), in `visgate compare`.
+const FILLED: &str = "gates-filled";
 
 /// The modes `names` ask for (`all` expanded: gates with --gate-shape, then each other shape
-/// by its own name, then gates-starved where gates interleave without it; `gates-voxels`,
+/// by its own name, then gates-filled and gates-starved where gates interleave without them;
+/// `gates-voxels`,
 /// `gates-triangles`, `gates-portal` and `gates-disk` are gates with that shape).
 fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMode>> {
     let s = settings.settings();
@@ -264,9 +268,14 @@ fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMod
         let mode = match (shape, method(name)) {
             (Some(&(_, g, t)), _) => shaped(g, t),
             _ if name == STARVED => starved(),
+            _ if name == FILLED => {
+                let mut g = s.gates;
+                g.interleave.fill = true;
+                GpuMode::Gates(g)
+            }
             (_, Some(m)) => (m.make)(&s),
             (None, None) => bail!(
-                "--modes {name}: give all or some of {}, {}, {STARVED}",
+                "--modes {name}: give all or some of {}, {}, {FILLED}, {STARVED}",
                 METHODS.map(|m| m.name).join(", "),
                 SHAPED.map(|(n, ..)| n).join(", ")
             ),
@@ -292,6 +301,9 @@ fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMod
                         }
                     }
                     let il = s.gates.interleave;
+                    if il.block > 1 && !il.fill {
+                        out.push(named(FILLED)?);
+                    }
                     if il.block > 1 && il.starved_taps == 0 {
                         out.push(named(STARVED)?);
                     }
@@ -536,6 +548,7 @@ mod tests {
                 "gates-triangles",
                 "gates-portal",
                 "gates-disk",
+                "gates-filled",
                 "gates-starved"
             ]
         );
@@ -547,6 +560,7 @@ mod tests {
                 "gates-voxels",
                 "gates-portal",
                 "gates-disk",
+                "gates-filled",
                 "gates-starved"
             ]
         );
@@ -557,13 +571,18 @@ mod tests {
                 "gates-voxels",
                 "gates-triangles",
                 "gates-disk",
+                "gates-filled",
                 "gates-starved"
             ]
         );
-        // Gates starved already, or not interleaved: no second row of the same.
-        for flags in [["--starved-taps", "16"], ["--interleave", "1"]] {
-            let labels = all_with(&flags);
-            assert!(!labels.contains(&"gates-starved".to_string()), "{flags:?}");
+        // Gates starved or filled already, or not interleaved: no second row of the same.
+        let has = |flags: &[&str], label: &str| all_with(flags).contains(&label.to_string());
+        assert!(!has(&["--starved-taps", "16"], "gates-starved"));
+        assert!(has(&["--starved-taps", "16"], "gates-filled"));
+        assert!(!has(&["--blur-fill"], "gates-filled"));
+        assert!(has(&["--blur-fill"], "gates-starved"));
+        for label in ["gates-starved", "gates-filled"] {
+            assert!(!has(&["--interleave", "1"], label), "{label}");
         }
     }
 }
