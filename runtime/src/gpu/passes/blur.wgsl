@@ -34,11 +34,9 @@ fn compose(px: vec2<i32>) -> vec4<f32> {
     let albedo = textureLoad(g_albedo, px, 0).xyz;
     let b = i32(gather.block);
     let size = vec2<i32>(textureDimensions(indirect));
-    // The b × b block around px, moved inside the target at its edges (not clipped: a block
-    // holds every one of the b² VPL subsets, so that the few VPLs that light a place reach the
-    // pixels on the image's border too).
-    let lo = clamp(px - vec2<i32>(b / 2), vec2<i32>(0), max(size - vec2<i32>(b), vec2<i32>(0)));
-    let hi = min(lo + vec2<i32>(b), size);
+    let block = interleave_block_around(px, b, size);
+    let lo = block.xy;
+    let hi = block.zw;
     // Where a pixel lies in the deinterleaved target (vpl.wgsl's deinterleave_axis), stepped
     // along each axis instead of divided at every tap: on llvmpipe the divisions were 40 % of
     // the pass (e2m3's hall at 512², 4,096 VPLs, blur + compose 137 → 83 ms; the same image,
@@ -82,15 +80,11 @@ fn compose(px: vec2<i32>) -> vec4<f32> {
     return vec4<f32>(before.xyz + albedo / PI * e, 1.0);
 }
 
-// Whether tap t's surface agrees with p (normal n): nearer than the blur's distance, its
-// normal within the blur's cosine.
+// Whether tap t's surface agrees with p (normal n) by the blur's test (vpl.wgsl).
 fn blur_agrees(t: vec2<i32>, p: vec3<f32>, n: vec3<f32>) -> bool {
     let qp = textureLoad(g_position, t, 0);
-    if qp.w == 0.0 {
-        return false;
-    }
     let qn = normalize(textureLoad(g_normal, t, 0).xyz);
-    return length(qp.xyz - p) <= gather.blur_distance && dot(qn, n) >= gather.blur_normal;
+    return blur_surfaces_agree(qp, qn, p, n, gather.blur_distance, gather.blur_normal);
 }
 
 const NO_COPY: i32 = 99;
@@ -102,22 +96,19 @@ const NO_COPY: i32 = 99;
 // (Crytek Sponza's gallery +3.6 % indirect MSE with them, −2.4 % without; README).
 fn blur_copy(px: vec2<i32>, t: vec2<i32>, p: vec3<f32>, n: vec3<f32>, size: vec2<i32>) -> vec2<i32> {
     let b = i32(gather.block);
+    var steps = array<vec2<i32>, 4>(vec2<i32>(0, -1), vec2<i32>(-1, 0), vec2<i32>(1, 0), vec2<i32>(0, 1));
     var best = vec2<i32>(NO_COPY);
     var best_d2 = 1 << 30;
-    for (var oy = -1; oy <= 1; oy++) {
-        for (var ox = -1; ox <= 1; ox++) {
-            let o = vec2<i32>(ox, oy);
-            let c = t + o * b;
-            let d = c - px;
-            let d2 = dot(d, d);
-            // Neither the tap itself nor a diagonal step.
-            if (ox == 0) == (oy == 0) || any(c < vec2<i32>(0)) || any(c >= size) || d2 >= best_d2 {
-                continue;
-            }
-            if blur_agrees(c, p, n) {
-                best = o;
-                best_d2 = d2;
-            }
+    for (var k = 0; k < 4; k++) {
+        let c = t + steps[k] * b;
+        let d = c - px;
+        let d2 = dot(d, d);
+        if any(c < vec2<i32>(0)) || any(c >= size) || d2 >= best_d2 {
+            continue;
+        }
+        if blur_agrees(c, p, n) {
+            best = steps[k];
+            best_d2 = d2;
         }
     }
     return best;

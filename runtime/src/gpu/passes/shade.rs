@@ -122,32 +122,23 @@ impl Shade {
         })
     }
 
-    /// The interleaved gates' indirect pipeline for gate shape `shape` (its shader id), the
-    /// voxel walk with the closed voxels' `triangles` or without.
-    fn gates_indirect(
-        &self,
-        d: &wgpu::Device,
-        shape: u32,
-        triangles: bool,
-    ) -> &wgpu::ComputePipeline {
-        self.gates_pipeline(d, "cs_gates_indirect", shape, triangles)
-    }
-
-    /// Entry point `entry` (`cs_gates_indirect` or `cs_gates_starved`) for gate shape `shape`,
-    /// with or without the triangles, made when first asked for.
+    /// Gather `gather`'s pipeline for gate shape `shape`, the voxel walk with the closed
+    /// voxels' triangles where frame `f`'s mode asks for them, made when first asked for.
     fn gates_pipeline(
         &self,
-        d: &wgpu::Device,
-        entry: &'static str,
-        shape: u32,
-        triangles: bool,
+        f: &Frame,
+        gather: GatesGather,
+        shape: GateShape,
     ) -> &wgpu::ComputePipeline {
-        let triangles = triangles && shape == GateShape::Voxels.shader_id();
+        let shape = shape.shader_id();
+        let triangles = f.params.mode.gates().is_some_and(|g| g.triangles)
+            && shape == GateShape::Voxels.shader_id();
         let k = if triangles { 3 } else { shape as usize };
-        let cache = match entry {
-            "cs_gates_starved" => &self.gates_starved,
-            _ => &self.gates_indirect,
+        let (cache, entry) = match gather {
+            GatesGather::Indirect => (&self.gates_indirect, "cs_gates_indirect"),
+            GatesGather::Starved => (&self.gates_starved, "cs_gates_starved"),
         };
+        let d = &f.ctx.device;
         cache[k].get_or_init(|| {
             compute_pipeline_with(
                 d,
@@ -199,18 +190,10 @@ impl Shade {
             self.draw(f, rec, inputs, pipeline, (&out, name));
             return out;
         };
-        let batch = f.walk_batch;
         let walks = f.params.mode.walks_per_pixel(f.vpl_count);
-        let batches = if batch > 0 {
-            walks.div_ceil(batch).max(1)
-        } else {
-            1
-        };
-        let triangles = f.params.mode.gates().is_some_and(|g| g.triangles);
-        let pipeline = self.gates_indirect(&f.ctx.device, shape.shader_id(), triangles);
         let batched = Batched {
-            pipeline,
-            batches,
+            pipeline: self.gates_pipeline(f, GatesGather::Indirect, shape),
+            batches: batch_count(f, walks),
             used: &GATES_INDIRECT_BINDINGS,
             names: ["indirect irradiance", "indirect irradiance (batches)"],
             span: "indirect lighting",
@@ -231,19 +214,6 @@ impl Shade {
         inputs: Inputs,
         (shape, il): (GateShape, &InterleaveParams),
     ) -> wgpu::Texture {
-        let batch = f.walk_batch;
-        let batches = if batch > 0 {
-            f.vpl_count.div_ceil(batch).max(1)
-        } else {
-            1
-        };
-        let triangles = f.params.mode.gates().is_some_and(|g| g.triangles);
-        let pipeline = self.gates_pipeline(
-            &f.ctx.device,
-            "cs_gates_starved",
-            shape.shader_id(),
-            triangles,
-        );
         let constants = [
             il.blur_distance_m(f),
             il.blur_normal,
@@ -256,9 +226,10 @@ impl Shade {
             bytemuck::cast_slice(&constants),
             wgpu::BufferUsages::UNIFORM,
         );
+        // A starved pixel may walk every VPL but its own subset's.
         let batched = Batched {
-            pipeline,
-            batches,
+            pipeline: self.gates_pipeline(f, GatesGather::Starved, shape),
+            batches: batch_count(f, f.vpl_count),
             used: &GATES_STARVED_BINDINGS,
             names: [
                 "starved pixels' irradiance",
@@ -360,6 +331,24 @@ impl Shade {
         frame_pass(&mut rec.enc, span, pipeline, &groups, timed.compute(), size);
         rec.end();
         targets[(batches as usize - 1) % 2].clone()
+    }
+}
+
+/// The gates' two gathers (shade.wgsl's entry points).
+#[derive(Debug, Clone, Copy)]
+enum GatesGather {
+    /// `cs_gates_indirect`: each pixel its subset's VPLs (or every VPL).
+    Indirect,
+    /// `cs_gates_starved`: the starved pixels' walks of what their block lacks.
+    Starved,
+}
+
+/// The dispatches a gather of up to `walks` walks a pixel takes: batches of `f.walk_batch`
+/// walks on a software rasterizer (its loop limit), one elsewhere.
+fn batch_count(f: &Frame, walks: u32) -> u32 {
+    match f.walk_batch {
+        0 => 1,
+        batch => walks.div_ceil(batch).max(1),
     }
 }
 

@@ -418,18 +418,11 @@ fn cs_gates_indirect(@builtin(global_invocation_id) id: vec3<u32>) {
 // walks the subsets of those that do not itself.
 @group(0) @binding(26) var<uniform> starved_params: vec4<f32>;
 
-// px's blur block (blur.wgsl's: b × b around px, moved inside the image): [lo, hi).
-fn blur_block(px: vec2<i32>, b: i32) -> vec4<i32> {
-    let size = vec2<i32>(textureDimensions(g_position));
-    let lo = clamp(px - vec2<i32>(b / 2), vec2<i32>(0), max(size - vec2<i32>(b), vec2<i32>(0)));
-    return vec4<i32>(lo, min(lo + vec2<i32>(b), size));
-}
-
-// Whether tap q's surface agrees with p (normal n) by the blur's test.
+// Whether tap q's surface agrees with p (normal n) by the blur's test (vpl.wgsl).
 fn blur_agrees(q: vec2<i32>, p: vec3<f32>, n: vec3<f32>) -> bool {
     let qp = textureLoad(g_position, q, 0);
     let qn = normalize(textureLoad(g_normal, q, 0).xyz);
-    return qp.w != 0.0 && length(qp.xyz - p) <= starved_params.x && dot(qn, n) >= starved_params.y;
+    return blur_surfaces_agree(qp, qn, p, n, starved_params.x, starved_params.y);
 }
 
 // Interleaved gates' second gather. The blur averages a pixel's block where the geometry
@@ -454,7 +447,7 @@ fn cs_gates_starved(@builtin(global_invocation_id) id: vec3<u32>) {
     let pos = textureLoad(g_position, px, 0);
     let n = normalize(textureLoad(g_normal, px, 0).xyz);
     let bu = max(globals.interleave_block, 1u);
-    let block = blur_block(px, i32(bu));
+    let block = interleave_block_around(px, i32(bu), vec2<i32>(textureDimensions(g_position)));
     if batch == 0u && pos.w != 0.0 {
         var agree = 0.0;
         for (var y = block.y; y < block.w; y++) {

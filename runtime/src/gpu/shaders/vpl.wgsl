@@ -17,6 +17,22 @@ fn interleave_subset(px: vec2<i32>, b: u32) -> u32 {
     return u32(px.x) % b + b * (u32(px.y) % b);
 }
 
+// The blur's b × b block around px in an image of `size` pixels, moved inside it at its edges
+// (not clipped: a block holds every one of the b² VPL subsets, so that the few VPLs that light
+// a place reach the pixels on the image's border too): lo in xy, hi (past the end) in zw.
+fn interleave_block_around(px: vec2<i32>, b: i32, size: vec2<i32>) -> vec4<i32> {
+    let lo = clamp(px - vec2<i32>(b / 2), vec2<i32>(0), max(size - vec2<i32>(b), vec2<i32>(0)));
+    return vec4<i32>(lo, min(lo + vec2<i32>(b), size));
+}
+
+// The blur's test (Laine et al.): a tap's surface (position qp, w 0 where there is none;
+// normal qn) agrees with the pixel's (p, n) when nearer than `distance` and its normal within
+// cosine `cosine`. blur.wgsl averages the taps that agree; shade.wgsl's starved pixels count
+// them by the same rule.
+fn blur_surfaces_agree(qp: vec4<f32>, qn: vec3<f32>, p: vec3<f32>, n: vec3<f32>, distance: f32, cosine: f32) -> bool {
+    return qp.w != 0.0 && length(qp.xyz - p) <= distance && dot(qn, n) >= cosine;
+}
+
 // The deinterleaved layout (Segovia et al.) of an n-pixel axis: the pixels x ≡ r (mod b) side
 // by side, residue after residue, so that neighbouring fragments light with one VPL subset and
 // walk alike (a GPU runs 32 neighbours in lockstep; interleaved, each took another path). A
