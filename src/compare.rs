@@ -245,8 +245,8 @@ const FILLED: &str = "gates-filled";
 
 /// The modes `names` ask for (`all` expanded: gates with --gate-shape, then each other shape
 /// by its own name, then gates-filled and gates-starved where gates interleave without them;
-/// `gates-voxels`,
-/// `gates-triangles`, `gates-portal` and `gates-disk` are gates with that shape).
+/// `gates-voxels`, `gates-triangles`, `gates-portal` and `gates-disk` are gates with that
+/// shape).
 fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMode>> {
     let s = settings.settings();
     let shaped = |shape, triangles| {
@@ -255,11 +255,14 @@ fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMod
         g.gates.triangles = triangles;
         GpuMode::Gates(g)
     };
-    let starved = || {
+    // Gates with their interleaving changed: the starved pixels' walks or the blur's fill.
+    let interleaved = |name: &str| {
         let mut g = s.gates;
         let il = &mut g.interleave;
-        if il.starved_taps == 0 {
-            il.starved_taps = 3 * il.block * il.block / 4;
+        match name {
+            STARVED if il.starved_taps == 0 => il.starved_taps = 3 * il.block * il.block / 4,
+            FILLED => il.fill = true,
+            _ => {}
         }
         GpuMode::Gates(g)
     };
@@ -267,12 +270,7 @@ fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMod
         let shape = SHAPED.iter().find(|(n, ..)| *n == name);
         let mode = match (shape, method(name)) {
             (Some(&(_, g, t)), _) => shaped(g, t),
-            _ if name == STARVED => starved(),
-            _ if name == FILLED => {
-                let mut g = s.gates;
-                g.interleave.fill = true;
-                GpuMode::Gates(g)
-            }
+            _ if name == STARVED || name == FILLED => interleaved(name),
             (_, Some(m)) => (m.make)(&s),
             (None, None) => bail!(
                 "--modes {name}: give all or some of {}, {}, {FILLED}, {STARVED}",
