@@ -31,6 +31,25 @@ fn fixture(
     gate_support::fixture(b, res, 0)
 }
 
+/// The four rooms baked at 128 on the GPU with their level, the fixture's VPLs and a view of
+/// its first camera at `size` (the interleaving tests' set-up).
+fn four_rooms_on_the_gpu(
+    size: [u32; 2],
+) -> (
+    visgate_runtime::gpu::GpuContext,
+    visgate_runtime::gpu::GpuRenderer,
+    Vec<visgate_runtime::vpl::Vpl>,
+    visgate_runtime::camera::View,
+) {
+    use visgate_runtime::gpu::{GpuContext, GpuRenderer};
+    let ctx = GpuContext::new().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"));
+    let (scene, gates, _, vpls, _) = fixture(Builtin::FourRooms, 128);
+    let view = visgate_runtime::camera::View::new(&scene.cameras[0], size).expect("view");
+    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    gpu.set_level(&ctx, &gates).expect("level");
+    (ctx, gpu, vpls, view)
+}
+
 #[test]
 fn two_rooms_a_vpl_in_a_lights_b_only_through_the_doorway_gates() {
     let (scene, level) = baked(Builtin::TwoRooms, 96);
@@ -756,13 +775,9 @@ fn the_pass_report_counts_pixels_and_vpls_outside_every_cluster() {
 #[test]
 fn interleaved_gates_keep_the_light_of_every_vpl_gather() {
     use visgate_runtime::gpu::InterleaveParams;
-    use visgate_runtime::gpu::{GatesParams, GpuContext, GpuMode, GpuParams, GpuRenderer};
+    use visgate_runtime::gpu::{GatesParams, GpuMode, GpuParams, GpuRenderer};
     use visgate_runtime::metrics::errors;
-    let ctx = GpuContext::new().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"));
-    let (scene, gates, _, vpls, _) = fixture(Builtin::FourRooms, 128);
-    let view = visgate_runtime::camera::View::new(&scene.cameras[0], [128, 96]).expect("view");
-    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
-    gpu.set_level(&ctx, &gates).expect("level");
+    let (ctx, mut gpu, vpls, view) = four_rooms_on_the_gpu([128, 96]);
     let render = |gpu: &mut GpuRenderer, mode| {
         gpu.render(&ctx, &view, &vpls, &GpuParams::with_mode(mode))
             .expect("render")
@@ -803,13 +818,9 @@ fn interleaved_gates_keep_the_light_of_every_vpl_gather() {
 #[test]
 fn starved_pixels_walk_the_subsets_their_block_lacks_and_count_every_vpl_once() {
     use visgate_runtime::gpu::InterleaveParams;
-    use visgate_runtime::gpu::{GatesParams, GpuContext, GpuMode, GpuParams, GpuRenderer};
+    use visgate_runtime::gpu::{GatesParams, GpuMode, GpuParams, GpuRenderer};
     use visgate_runtime::metrics::errors;
-    let ctx = GpuContext::new().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"));
-    let (scene, gates, _, vpls, _) = fixture(Builtin::FourRooms, 128);
-    let view = visgate_runtime::camera::View::new(&scene.cameras[0], [96, 72]).expect("view");
-    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
-    gpu.set_level(&ctx, &gates).expect("level");
+    let (ctx, mut gpu, vpls, view) = four_rooms_on_the_gpu([96, 72]);
     let render = |gpu: &mut GpuRenderer, mode| {
         gpu.render(&ctx, &view, &vpls, &GpuParams::with_mode(mode))
             .expect("render")
@@ -856,13 +867,9 @@ fn starved_pixels_walk_the_subsets_their_block_lacks_and_count_every_vpl_once() 
 #[test]
 fn the_blur_filled_from_the_next_blocks_is_nearer_every_vpls_gather_and_leaves_agreeing_taps() {
     use visgate_runtime::gpu::InterleaveParams;
-    use visgate_runtime::gpu::{GatesParams, GpuContext, GpuMode, GpuParams, GpuRenderer};
+    use visgate_runtime::gpu::{GatesParams, GpuMode, GpuParams};
     use visgate_runtime::metrics::errors;
-    let ctx = GpuContext::new().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"));
-    let (scene, gates, _, vpls, _) = fixture(Builtin::FourRooms, 128);
-    let view = visgate_runtime::camera::View::new(&scene.cameras[0], [96, 72]).expect("view");
-    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
-    gpu.set_level(&ctx, &gates).expect("level");
+    let (ctx, mut gpu, vpls, view) = four_rooms_on_the_gpu([96, 72]);
     let mut render = |block: u32, fill: bool, (blur_distance, blur_normal): (f32, f32)| {
         let p = GatesParams {
             interleave: InterleaveParams {
