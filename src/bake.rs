@@ -7,7 +7,6 @@ use std::sync::Mutex;
 use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
-use visgate_formats::ImportOptions;
 use visgate_formats::vgate::{
     AlphaRule, BakeParams, CurvatureTo, GatePlacement, MaxBall, Resolution,
 };
@@ -198,12 +197,7 @@ pub fn run(args: BakeArgs) -> Result<()> {
         memory_limit_bytes: (args.memory_limit_gib * (1u64 << 30) as f64) as u64,
         keep_solid_grid: args.debug_dir.is_some(),
     };
-    let scene = crate::load_scene(
-        &args.scene,
-        &ImportOptions {
-            load_textures: false,
-        },
-    )?;
+    let scene = crate::load_scene(&args.scene, false)?;
     // The importer has logged the scene's warnings (degenerate triangles dropped, …) once.
     let mut pool = rayon::ThreadPoolBuilder::new();
     if let Some(t) = args.threads {

@@ -23,7 +23,8 @@ pub fn light_if_bare(scene: &mut Scene, level: Option<&BakedLevel>, arg: &str) {
         }
         Some((near, sum / dirs.len() as f32))
     };
-    if let Some(note) = light_a_bare_scene(scene, level, &probe) {
+    let reach = |p: glam::Vec3, d: glam::Vec3| tracer.trace(p, d).map(|h| h.t);
+    if let Some(note) = light_a_bare_scene(scene, level, &probe, &reach) {
         println!("{arg}: {note}");
     }
 }

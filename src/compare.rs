@@ -6,7 +6,7 @@ use anyhow::{Context, Result, bail};
 use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 use visgate_formats::vgate::{BakeParams, Resolution};
-use visgate_formats::{BakedLevel, ImportOptions, Scene};
+use visgate_formats::{BakedLevel, Scene};
 use visgate_runtime::compare::{CompareMode, CompareSpec, ErrorMetric, Step, report, run};
 use visgate_runtime::cpu::gates::{GateLevel, GateShape};
 use visgate_runtime::gpu::{DirectLight, GpuMode, METHODS, method};
@@ -366,12 +366,7 @@ fn read_level(p: &std::path::Path) -> Result<BakedLevel> {
 }
 
 pub fn run_compare(args: CompareArgs) -> Result<()> {
-    let mut scene = crate::load_scene(
-        &args.scene,
-        &ImportOptions {
-            load_textures: true,
-        },
-    )?;
+    let mut scene = crate::load_scene(&args.scene, true)?;
     // A bare mesh gets a light and a camera where `visgate render` puts them (the level read
     // for it is the gate modes' too).
     let mut read = None;

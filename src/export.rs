@@ -4,7 +4,6 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, Subcommand};
-use visgate_formats::ImportOptions;
 use visgate_formats::mitsuba::{MitsubaOptions, write};
 
 pub const EXPORT_HELP: &str = "\
@@ -50,12 +49,7 @@ pub fn run(action: ExportAction) -> Result<()> {
     if args.spp == 0 || args.max_depth < 2 {
         bail!("--spp must be ≥ 1 and --max-depth ≥ 2 (2: direct light, 3: one bounce)");
     }
-    let scene = crate::load_scene(
-        &args.scene,
-        &ImportOptions {
-            load_textures: true,
-        },
-    )?;
+    let scene = crate::load_scene(&args.scene, true)?;
     if scene.cameras.is_empty() {
         tracing::warn!(
             "{}: no camera; the scene file has no sensor to render",

@@ -6,7 +6,7 @@ use anyhow::{Context, Result};
 use serde::Serialize;
 use visgate_formats::scene::FileKind;
 use visgate_formats::vgate::{BakeParams, BakedLevel, GridMeta, SectionKind};
-use visgate_formats::{ImportOptions, Light, Scene};
+use visgate_formats::{Light, Scene};
 
 /// The summary of a scene, as printed and as JSON.
 #[derive(Serialize)]
@@ -71,10 +71,7 @@ pub fn run(arg: &str, json: bool, no_textures: bool) -> Result<()> {
     if !arg.starts_with("builtin:") && FileKind::of(path) == Some(FileKind::Vgate) {
         return inspect_baked(path, json);
     }
-    let options = ImportOptions {
-        load_textures: !no_textures,
-    };
-    let scene = crate::load_scene(arg, &options)?;
+    let scene = crate::load_scene(arg, !no_textures)?;
     let s = summarise(&scene);
     if json {
         println!("{}", serde_json::to_string_pretty(&s)?);

@@ -15,7 +15,8 @@ use std::process::ExitCode;
 
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
-use visgate_formats::{ImportOptions, Scene};
+use visgate_formats::desc::UpAxis;
+use visgate_formats::{BareMesh, ImportOptions, Scene};
 use visgate_scenes::Builtin;
 
 const AFTER_HELP: &str = "\
@@ -44,6 +45,44 @@ Logs go to stderr; set RUST_LOG=debug for more.";
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// For a bare mesh file (a SCENE that is an OBJ, glTF or GLB, no scene TOML): metres per
+    /// unit of the file (0.01 centimetres, 0.0254 inches, 0.001 millimetres). Default: metres,
+    /// or centimetres (then millimetres) where metres would make the level longer than 1 km.
+    #[arg(long, global = true, value_name = "M", allow_negative_numbers = true)]
+    metres_per_unit: Option<f64>,
+    /// For a bare mesh file: the axis that points up. Default: y for glTF (its convention);
+    /// for OBJ, z where more of its area faces ±z than ±y (floors, ceilings) and it is lower
+    /// along z, else y. The bake, the renders and the viewer must read a mesh the same way.
+    #[arg(long, global = true, value_enum)]
+    up: Option<UpArg>,
+}
+
+/// An up axis on the command line.
+#[derive(Debug, Clone, Copy, clap::ValueEnum)]
+enum UpArg {
+    /// +Y up (glTF, most OBJ exporters).
+    Y,
+    /// +Z up (Blender's scenes, Quake, 3ds Max, Unreal): read with (x, y, z) → (x, z, −y).
+    Z,
+}
+
+/// The bare-mesh reading the command line asked for, set once before the command runs.
+static BARE_MESH: std::sync::OnceLock<BareMesh> = std::sync::OnceLock::new();
+
+/// The command line's `--metres-per-unit` and `--up`, checked.
+fn bare_mesh_of(cli: &Cli) -> Result<BareMesh> {
+    if let Some(m) = cli.metres_per_unit
+        && !(m.is_finite() && m > 0.0)
+    {
+        anyhow::bail!("--metres-per-unit {m} must be a number > 0 (0.01 for centimetres)");
+    }
+    Ok(BareMesh {
+        metres_per_unit: cli.metres_per_unit,
+        up: cli.up.map(|u| match u {
+            UpArg::Y => UpAxis::Y,
+            UpArg::Z => UpAxis::Z,
+        }),
+    })
 }
 
 #[derive(Subcommand)]
@@ -136,6 +175,8 @@ fn main() -> ExitCode {
 }
 
 fn run(cli: Cli) -> Result<()> {
+    // Set once, here: a second set could only come from a second parse of the same line.
+    let _ = BARE_MESH.set(bare_mesh_of(&cli)?);
     match cli.command {
         Command::Bake(args) => bake::run(args),
         Command::Render(args) => render::run(args),
@@ -173,8 +214,14 @@ fn builtin_or_err(name: &str) -> Result<Builtin> {
 }
 
 /// Loads a SCENE argument: `builtin:NAME`, a scene TOML, or a bare OBJ/glTF/GLB file.
-pub fn load_scene(arg: &str, options: &ImportOptions) -> Result<Scene> {
-    Ok(visgate_scenes::load(arg, options)?)
+/// `load_textures`: decode the diffuse textures (the bake needs none). A bare mesh is read with
+/// the command line's `--metres-per-unit` and `--up`.
+pub fn load_scene(arg: &str, load_textures: bool) -> Result<Scene> {
+    let options = ImportOptions {
+        load_textures,
+        bare: BARE_MESH.get().copied().unwrap_or_default(),
+    };
+    Ok(visgate_scenes::load(arg, &options)?)
 }
 
 /// The camera named `name` of `scene` (loaded from `arg`), or its first.

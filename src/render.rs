@@ -6,7 +6,6 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressStyle};
-use visgate_formats::ImportOptions;
 
 use crate::settings::{LightArgs, MethodArgs};
 use visgate_runtime::cpu::gates::GateLevel;
@@ -207,12 +206,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
         .build()
         .context("cannot start the thread pool")?;
     let t = Instant::now();
-    let mut scene = crate::load_scene(
-        &args.scene,
-        &ImportOptions {
-            load_textures: true,
-        },
-    )?;
+    let mut scene = crate::load_scene(&args.scene, true)?;
     let load_s = t.elapsed().as_secs_f64();
     let baked = match &args.level {
         Some(path) => Some(

@@ -134,6 +134,80 @@ fn export_then_inspect_the_files_and_a_bare_mesh() {
     assert!(report.contains("## Camera inside"), "{report}");
 }
 
+/// The JSON summary's size of the scene's box, metres.
+fn size_of(v: &serde_json::Value) -> [f64; 3] {
+    let at = |k: &str, a: usize| v[k][a].as_f64().expect("bounds");
+    [0, 1, 2].map(|a| at("bounds_max_m", a) - at("bounds_min_m", a))
+}
+
+#[test]
+fn a_bare_obj_modelled_z_up_in_millimetres_is_read_as_its_flags_say() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("tr");
+    let o = visgate(&["scenes", "export", "two-rooms", out.to_str().expect("utf8")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // The two rooms (8.6 × 3.4 × 4.4 m outside, Y up) as a Z-up exporter in millimetres
+    // writes them.
+    let obj = std::fs::read_to_string(out.join("two-rooms.obj")).expect("obj");
+    let zup: String = obj
+        .lines()
+        .map(|l| match l.strip_prefix("v ") {
+            Some(v) => {
+                let c: Vec<f64> = v
+                    .split_whitespace()
+                    .map(|x| x.parse().expect("f64"))
+                    .collect();
+                format!("v {} {} {}\n", 1e3 * c[0], -1e3 * c[2], 1e3 * c[1])
+            }
+            None => format!("{l}\n"),
+        })
+        .collect();
+    let mesh = out.join("zup.obj");
+    std::fs::write(&mesh, zup).expect("write");
+    let mesh = mesh.to_str().expect("utf8");
+    let inspect = |extra: &[&str]| {
+        let o = visgate(&[&["inspect", "--json", mesh][..], extra].concat());
+        assert!(o.status.success(), "{}", stderr(&o));
+        serde_json::from_slice::<serde_json::Value>(&o.stdout).expect("json")
+    };
+    // Unsaid: read Z up (floors face z, the level is low along z) and, 8,000 units long, in
+    // centimetres; both said in its warnings.
+    let v = inspect(&[]);
+    let size = size_of(&v);
+    assert!(
+        (size[0] - 86.0).abs() < 1e-3 && (size[1] - 34.0).abs() < 1e-3,
+        "{size:?}"
+    );
+    let warnings = v["warnings"].to_string();
+    assert!(
+        warnings.contains("read Z up") && warnings.contains("--metres-per-unit"),
+        "{warnings}"
+    );
+    // Said: millimetres, Y up as written (the rooms then lie on their side), no warning.
+    let v = inspect(&["--metres-per-unit", "0.001", "--up", "y"]);
+    let size = size_of(&v);
+    assert!(
+        (size[1] - 4.4).abs() < 1e-6 && (size[2] - 3.4).abs() < 1e-6,
+        "{size:?}"
+    );
+    assert_eq!(v["warnings"].as_array().map(Vec::len), Some(0), "{v}");
+    // The flags read a bare mesh only, and a unit must be a length.
+    let o = visgate(&["inspect", "builtin:two-rooms", "--up", "z"]);
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("read a bare mesh file"),
+        "{}",
+        stderr(&o)
+    );
+    let o = visgate(&["inspect", mesh, "--metres-per-unit", "0"]);
+    assert!(!o.status.success());
+    assert!(
+        stderr(&o).contains("must be a number > 0"),
+        "{}",
+        stderr(&o)
+    );
+}
+
 #[test]
 fn inspect_a_baked_file_and_refuse_a_broken_one() {
     use visgate_formats::vgate::*;

@@ -14,6 +14,7 @@ pub fn scene_and_level(
         &scene_arg,
         &ImportOptions {
             load_textures: true,
+            ..ImportOptions::default()
         },
     )?;
     let level = match args.next() {

@@ -23,12 +23,15 @@ pub const DEFAULT_ALBEDO: f32 = 0.5;
 pub struct ImportOptions {
     /// Decode diffuse textures (the bake does not need them).
     pub load_textures: bool,
+    /// How a bare mesh file is read where the user says it (a scene TOML states its own).
+    pub bare: crate::load::BareMesh,
 }
 
 impl Default for ImportOptions {
     fn default() -> Self {
         ImportOptions {
             load_textures: true,
+            bare: crate::load::BareMesh::default(),
         }
     }
 }
@@ -141,6 +144,7 @@ pub fn import_obj_str(
     let mut reader = std::io::Cursor::new(obj.as_bytes());
     let options = ImportOptions {
         load_textures: false,
+        ..ImportOptions::default()
     };
     import_obj_reader(name, &mut reader, Path::new("."), &options, |lib| {
         let text = mtl(lib).ok_or(tobj::LoadError::OpenFileFailed)?;

@@ -28,6 +28,6 @@ pub mod vgate;
 pub use desc::SceneDesc;
 pub use error::{SceneError, VgateError};
 pub use import::{ImportOptions, ImportedModel};
-pub use load::{BARE_LEVEL_MAX_M, bare_mesh_units};
+pub use load::{BARE_LEVEL_MAX_M, BareMesh, bare_mesh_units, bare_mesh_up};
 pub use scene::{Camera, GeometryHash, Light, Material, Mesh, Scene, Texture};
 pub use vgate::BakedLevel;

@@ -47,6 +47,92 @@ fn longest_extent(models: &[ImportedModel]) -> Option<f64> {
     Some((hi - lo).max_element() as f64)
 }
 
+/// How a bare mesh file (no scene TOML) is read where the user says it (`visgate --up z
+/// --metres-per-unit 0.001 …`); what is left `None` is chosen from the mesh.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct BareMesh {
+    /// Metres per unit of the file; `None`: [`bare_mesh_units`].
+    pub metres_per_unit: Option<f64>,
+    /// The axis that points up; `None`: +Y for glTF (its convention), [`bare_mesh_up`] for OBJ.
+    pub up: Option<UpAxis>,
+}
+
+impl BareMesh {
+    /// Whether the user said anything.
+    pub fn is_set(&self) -> bool {
+        self.metres_per_unit.is_some() || self.up.is_some()
+    }
+}
+
+/// How much more of the triangles' area must face ±Z than ±Y, and how much lower the level
+/// must be along Z than along Y, before a bare OBJ is read Z up. [Units: ratio]
+const Z_UP_AREA_RATIO: f64 = 1.0;
+/// See [`Z_UP_AREA_RATIO`]. [Units: ratio]
+const Z_UP_EXTENT_RATIO: f64 = 0.8;
+
+/// Each axis's share of the triangles' area, weighted by how squarely they face it (Σ area ·
+/// n_k², normalised), and the extent of their box, in the file's axes.
+fn facing_and_extent(models: &[ImportedModel]) -> Option<([f64; 3], [f64; 3])> {
+    let (mut facing, mut lo, mut hi) = (DVec3::ZERO, DVec3::MAX, DVec3::MIN);
+    for mesh in models.iter().flat_map(|m| &m.meshes) {
+        for t in &mesh.triangles {
+            let [a, b, c] = t.map(|i| mesh.positions[i as usize].as_dvec3());
+            if !(a.is_finite() && b.is_finite() && c.is_finite()) {
+                continue;
+            }
+            let n = (b - a).cross(c - a);
+            // |n| is twice the area; area · n̂² = n² / (2 |n|).
+            let len = n.length();
+            if len > 0.0 {
+                facing += n * n / (2.0 * len);
+            }
+            for p in [a, b, c] {
+                (lo, hi) = (lo.min(p), hi.max(p));
+            }
+        }
+    }
+    let total = facing.element_sum();
+    (total > 0.0).then(|| ((facing / total).to_array(), (hi - lo).to_array()))
+}
+
+/// Above this share of ±Y's area facing ±Z a bare OBJ read +Y up gets a note that it may lie
+/// on its side (a Cornell box, a cube, has 1.006). [Units: ratio]
+const SIDE_NOTE_AREA_RATIO: f64 = 1.05;
+
+/// The up axis of a bare OBJ, which states none: +Z where more of its area faces ±Z than ±Y
+/// (floors and ceilings face up and down) and it is lower along Z than along Y (levels are
+/// wider than tall), else +Y, visgate's and most exporters' convention. A cube of a room reads
+/// +Y. Returns the axis and what a user should read: why Z, or, read Y up where the area
+/// alone says Z, that it may lie on its side.
+pub fn bare_mesh_up(models: &[ImportedModel]) -> (UpAxis, Option<String>) {
+    let Some((facing, extent)) = facing_and_extent(models) else {
+        return (UpAxis::Y, None);
+    };
+    let areas = format!(
+        "{:.0} % of its area faces ±z against {:.0} % ±y",
+        100.0 * facing[2],
+        100.0 * facing[1]
+    );
+    let (by_area, lower) = (
+        facing[2] > Z_UP_AREA_RATIO * facing[1],
+        extent[2] < Z_UP_EXTENT_RATIO * extent[1],
+    );
+    if by_area && lower {
+        let why = format!(
+            "read Z up ({areas}, and it is {:.2} of its y extent high along z)",
+            extent[2] / extent[1]
+        );
+        (UpAxis::Z, Some(why))
+    } else if facing[2] > SIDE_NOTE_AREA_RATIO * facing[1] {
+        let why = format!(
+            "read Y up, though {areas}: if it lies on its side (floors as walls), it is Z up"
+        );
+        (UpAxis::Y, Some(why))
+    } else {
+        (UpAxis::Y, None)
+    }
+}
+
 /// What a user reads when a bare mesh is not read in metres.
 fn units_warning(path: &Path, longest: f64, metres_per_unit: f64) -> String {
     let unit = if metres_per_unit == 0.01 {
@@ -56,7 +142,8 @@ fn units_warning(path: &Path, longest: f64, metres_per_unit: f64) -> String {
     };
     format!(
         "{}: a bare mesh states no units, and in metres its longest side ({longest:.0} units) \
-         would make a {:.1} km level: read in {unit} ({:.1} m). To choose the units, name the \
+         would make a {:.1} km level: read in {unit} ({:.1} m). To choose the units, pass \
+         --metres-per-unit (0.01 centimetres, 0.0254 inches, 0.001 millimetres) or name the \
          mesh in a scene TOML with `metres_per_unit` (README, Scenes)",
         path.display(),
         longest / 1000.0,
@@ -64,12 +151,58 @@ fn units_warning(path: &Path, longest: f64, metres_per_unit: f64) -> String {
     )
 }
 
+/// What a user reads when the up axis of a bare OBJ is in doubt or Z.
+fn up_warning(path: &Path, why: &str) -> String {
+    format!(
+        "{}: a bare OBJ states no up axis; {why}. To choose, pass --up y or --up z, or name the \
+         mesh in a scene TOML with `up` (README, Scenes)",
+        path.display()
+    )
+}
+
+/// A bare mesh's units and up axis: the user's where given, else chosen from `models`; the
+/// warnings for what was chosen that a user may not expect.
+fn read_bare(
+    desc: &mut SceneDesc,
+    models: &[ImportedModel],
+    path: &Path,
+    kind: FileKind,
+    said: BareMesh,
+) -> Vec<String> {
+    let mut notes = Vec::new();
+    match said.metres_per_unit {
+        Some(m) => desc.metres_per_unit = m,
+        None => {
+            if let Some(longest) = longest_extent(models) {
+                desc.metres_per_unit = bare_mesh_units(longest);
+                if desc.metres_per_unit != 1.0 {
+                    notes.push(units_warning(path, longest, desc.metres_per_unit));
+                }
+            }
+        }
+    }
+    desc.up = match (said.up, kind) {
+        (Some(up), _) => up,
+        (None, FileKind::Obj) => {
+            let (up, why) = bare_mesh_up(models);
+            notes.extend(why.map(|why| up_warning(path, &why)));
+            up
+        }
+        (None, _) => UpAxis::Y,
+    };
+    for note in &notes {
+        tracing::warn!("{note}");
+    }
+    notes
+}
+
 impl Scene {
     /// Loads a scene TOML, or a bare OBJ/glTF/GLB file as one static mesh with no lights, in
     /// the units [`bare_mesh_units`] picks from its size.
     pub fn load(path: &Path, options: &ImportOptions) -> Result<Scene, SceneError> {
         let start = Instant::now();
-        let (mut desc, base, bare) = match FileKind::of(path) {
+        let kind = FileKind::of(path);
+        let (mut desc, base, bare) = match kind {
             Some(FileKind::SceneToml) => (SceneDesc::read(path)?, parent_dir(path), false),
             Some(FileKind::Obj | FileKind::Gltf) => {
                 (SceneDesc::for_mesh_file(path), parent_dir(path), true)
@@ -80,22 +213,25 @@ impl Scene {
                 });
             }
         };
+        if !bare && options.bare.is_set() {
+            return Err(SceneError::Invalid {
+                file: path.to_path_buf(),
+                what: "--up and --metres-per-unit read a bare mesh file (OBJ, glTF, GLB); a \
+                       scene TOML states its own `up` and `metres_per_unit`"
+                    .into(),
+            });
+        }
         let models = desc
             .meshes
             .iter()
             .map(|m| import::import_file(&base.join(&m.path), options))
             .collect::<Result<Vec<_>, _>>()?;
-        let mut units_note = None;
-        if bare && let Some(longest) = longest_extent(&models) {
-            desc.metres_per_unit = bare_mesh_units(longest);
-            if desc.metres_per_unit != 1.0 {
-                let note = units_warning(path, longest, desc.metres_per_unit);
-                tracing::warn!("{note}");
-                units_note = Some(note);
-            }
-        }
+        let notes = match kind {
+            Some(k) if bare => read_bare(&mut desc, &models, path, k, options.bare),
+            _ => Vec::new(),
+        };
         let mut scene = Scene::assemble(&desc, models, path)?;
-        scene.report.warnings.extend(units_note);
+        scene.report.warnings.extend(notes);
         scene.report.load_seconds = start.elapsed().as_secs_f64();
         Ok(scene)
     }
@@ -297,5 +433,68 @@ impl Scene {
             });
         }
         Ok(scene)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::import::RawMesh;
+
+    /// An open-topped box of size `s` (its floor and four walls; `lid`: its ceiling too), as
+    /// one model.
+    fn room(s: [f32; 3], lid: bool) -> Vec<ImportedModel> {
+        let c =
+            |x: u32, y: u32, z: u32| Vec3::new(x as f32 * s[0], y as f32 * s[1], z as f32 * s[2]);
+        let positions: Vec<Vec3> = (0..8).map(|i| c(i & 1, (i >> 1) & 1, i >> 2)).collect();
+        // Quads by corner index (bit 0 x, bit 1 y, bit 2 z): -y floor, +y lid, ±x, ±z walls.
+        let mut quads = vec![
+            [0, 1, 5, 4],
+            [0, 4, 6, 2],
+            [1, 3, 7, 5],
+            [0, 2, 3, 1],
+            [4, 5, 7, 6],
+        ];
+        if lid {
+            quads.push([2, 6, 7, 3]);
+        }
+        let triangles = quads
+            .iter()
+            .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+            .collect();
+        vec![ImportedModel {
+            meshes: vec![RawMesh {
+                name: "room".into(),
+                normals: vec![Vec3::Y; 8],
+                uvs: vec![glam::Vec2::ZERO; 8],
+                positions,
+                triangles,
+                material: 0,
+            }],
+            ..ImportedModel::default()
+        }]
+    }
+
+    #[test]
+    fn a_bare_obj_is_read_z_up_only_when_its_floors_and_its_shape_both_say_so() {
+        // A hall 20 × 4 × 12 written Y up, then Z up: floor and ceiling face the short axis.
+        assert_eq!(
+            bare_mesh_up(&room([20.0, 4.0, 12.0], true)),
+            (UpAxis::Y, None)
+        );
+        let (up, why) = bare_mesh_up(&room([20.0, 12.0, 4.0], true));
+        assert_eq!(up, UpAxis::Z);
+        assert!(why.is_some_and(|w| w.contains("read Z up")));
+        // A cube: nothing to tell, Y and no note.
+        assert_eq!(
+            bare_mesh_up(&room([5.0, 5.0, 5.0], true)),
+            (UpAxis::Y, None)
+        );
+        // As deep along z as high along y, with no ceiling: its ±z walls outweigh its floor
+        // (480 against 240 m²) but its shape says nothing: Y, with the note that it may lie on
+        // its side.
+        let (up, why) = bare_mesh_up(&room([20.0, 12.0, 12.0], false));
+        assert_eq!(up, UpAxis::Y);
+        assert!(why.is_some_and(|w| w.contains("lies on its side")));
     }
 }

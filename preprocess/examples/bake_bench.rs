@@ -26,6 +26,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         Path::new(&path),
         &ImportOptions {
             load_textures: false,
+            ..ImportOptions::default()
         },
     )?;
     let params = BakeParams {

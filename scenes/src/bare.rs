@@ -3,8 +3,10 @@
 //! gets a point light and a camera named `inside` at the same place: the centre of the
 //! level's largest empty ball where a baked level is given (inside its largest room, where a
 //! level's light belongs), else the enclosed point farthest from the geometry found by rays;
-//! the camera looks along the bounds' longest horizontal axis. The light's intensity gives the
-//! walls around it about 2 W/m² (`I = 2 d²` W/sr, `d` the mean distance to them).
+//! the camera looks level, the way that sees deepest into the level (of 16 horizontal
+//! directions, the one whose rays within 22.5° of it reach farthest on average), so that its
+//! first picture is not a wall a metre away. The light's intensity gives the walls around it
+//! about 2 W/m² (`I = 2 d²` W/sr, `d` the mean distance to them).
 
 use glam::Vec3;
 use visgate_formats::vgate::BakedLevel;
@@ -28,16 +30,41 @@ pub fn probe_directions() -> Vec<Vec3> {
     out
 }
 
+/// Horizontal directions the camera may look along. [Units: count]
+const LOOK_DIRECTIONS: usize = 16;
+
+/// The horizontal direction from `eye` whose rays within one step of it (22.5°) reach farthest
+/// on average; `reach(p, d)` is how far the ray from `p` along `d` goes before it meets the
+/// geometry (escaping rays count as `cap`). Ties go to the first, +X.
+fn deepest_look(eye: Vec3, reach: &dyn Fn(Vec3, Vec3) -> Option<f32>, cap: f32) -> Vec3 {
+    let dirs: Vec<Vec3> = (0..LOOK_DIRECTIONS)
+        .map(|i| {
+            let a = std::f32::consts::TAU * i as f32 / LOOK_DIRECTIONS as f32;
+            Vec3::new(a.cos(), 0.0, a.sin())
+        })
+        .collect();
+    let far: Vec<f32> = dirs
+        .iter()
+        .map(|&d| reach(eye, d).map_or(cap, |t| t.min(cap)))
+        .collect();
+    let n = LOOK_DIRECTIONS;
+    let score = |i: usize| far[(i + n - 1) % n] + far[i] + far[(i + 1) % n];
+    let best = (0..n).fold(0, |b, i| if score(i) > score(b) { i } else { b });
+    dirs[best]
+}
+
 /// Gives `scene` a light where it has none and a camera where it has none (see the module
 /// notes); says what it added, or `None` when it needed nothing (or has no geometry).
 /// `probe(p)` is the nearest and the mean distance to the geometry along
-/// [`probe_directions`] from `p`, `None` where a ray escapes. Without a level, the place is the
-/// enclosed point of a 7³ lattice over the bounds farthest from the geometry (a point inside
-/// a closed solid is near its walls), else the farthest of all.
+/// [`probe_directions`] from `p`, `None` where a ray escapes; `reach(p, d)` the distance along
+/// one ray, `None` where it escapes. Without a level, the place is the enclosed point of a 7³
+/// lattice over the bounds farthest from the geometry (a point inside a closed solid is near
+/// its walls), else the farthest of all.
 pub fn light_a_bare_scene(
     scene: &mut Scene,
     level: Option<&BakedLevel>,
     probe: &dyn Fn(Vec3) -> Option<(f32, f32)>,
+    reach: &dyn Fn(Vec3, Vec3) -> Option<f32>,
 ) -> Option<String> {
     let (no_light, no_camera) = (scene.lights.is_empty(), scene.cameras.is_empty());
     if !no_light && !no_camera {
@@ -82,8 +109,7 @@ pub fn light_a_bare_scene(
         said.push(format!("a point light of {intensity:.3} W/sr"));
     }
     if no_camera {
-        let size = hi - lo;
-        let along = if size.x >= size.z { Vec3::X } else { Vec3::Z };
+        let along = deepest_look(at, reach, (hi - lo).length());
         scene.cameras.push(Camera {
             name: INSIDE_CAMERA.into(),
             eye: at,
@@ -112,6 +138,39 @@ pub fn light_a_bare_scene(
 mod tests {
     use super::*;
 
+    /// How far a ray from `p` inside the box `lo..hi` goes along `d` before it meets a face.
+    fn to_the_box(lo: Vec3, hi: Vec3) -> impl Fn(Vec3, Vec3) -> Option<f32> {
+        move |p: Vec3, d: Vec3| {
+            let t = (0..3)
+                .filter(|&a| d[a] != 0.0)
+                .map(|a| if d[a] > 0.0 { hi[a] - p[a] } else { p[a] - lo[a] } / d[a].abs())
+                .fold(f32::INFINITY, f32::min);
+            t.is_finite().then_some(t)
+        }
+    }
+
+    #[test]
+    fn the_camera_looks_level_the_way_that_sees_deepest() {
+        // A corridor-like room 8 m long in x, 2 m wide in z; from its centre the deepest view
+        // is along ±x (the window around +x reaches 4.2 m on average, a diagonal 3.1 m).
+        let (lo, hi) = (Vec3::new(0.0, 0.0, 0.0), Vec3::new(8.0, 3.0, 2.0));
+        let reach = to_the_box(lo, hi);
+        let eye = Vec3::new(4.0, 1.5, 1.0);
+        let d = deepest_look(eye, &reach, 100.0);
+        assert!(d.y == 0.0 && d.x.abs() > 0.999, "{d}");
+        // Off-centre towards +x, it looks back along -x, the longer way.
+        let d = deepest_look(Vec3::new(6.5, 1.5, 1.0), &reach, 100.0);
+        assert!(d.x < -0.999, "{d}");
+        // Rotated: 2 m in x, 8 m in z: along ±z.
+        let reach = to_the_box(lo, Vec3::new(2.0, 3.0, 8.0));
+        let d = deepest_look(Vec3::new(1.0, 1.5, 4.0), &reach, 100.0);
+        assert!(d.z.abs() > 0.999, "{d}");
+        // A ray that escapes counts as the cap: an open side wins.
+        let open = |p: Vec3, d: Vec3| if d.z < -0.9 { None } else { reach(p, d) };
+        let d = deepest_look(Vec3::new(1.0, 1.5, 4.0), &open, 100.0);
+        assert!(d.z < -0.999, "{d}");
+    }
+
     #[test]
     fn a_scene_gets_only_what_it_lacks_at_the_enclosed_point_farthest_from_its_walls() {
         let mut scene = crate::Builtin::EmptyBox.scene().expect("builtin");
@@ -122,10 +181,11 @@ mod tests {
             let near = (p - lo).min(hi - p).min_element();
             (near > 0.0).then_some((near, 2.0 * near))
         };
-        assert!(light_a_bare_scene(&mut scene, None, &probe).is_none());
+        let reach = to_the_box(lo, hi);
+        assert!(light_a_bare_scene(&mut scene, None, &probe, &reach).is_none());
         let lights = scene.lights.clone();
         scene.cameras.clear();
-        let said = light_a_bare_scene(&mut scene, None, &probe).expect("a camera");
+        let said = light_a_bare_scene(&mut scene, None, &probe, &reach).expect("a camera");
         assert!(
             said.contains("no camera") && !said.contains("point light"),
             "{said}"
@@ -134,7 +194,7 @@ mod tests {
         assert_eq!(scene.cameras.len(), 1);
         scene.lights.clear();
         scene.cameras.clear();
-        let said = light_a_bare_scene(&mut scene, None, &probe).expect("both");
+        let said = light_a_bare_scene(&mut scene, None, &probe, &reach).expect("both");
         assert!(said.contains("no light and no camera"), "{said}");
         let [Light::Point { position, .. }] = scene.lights[..] else {
             panic!("one point light: {:?}", scene.lights);

@@ -612,6 +612,14 @@ pub fn builtin(name: &str) -> Result<Builtin, SceneError> {
 /// or a bare OBJ/glTF/GLB file (one static mesh, no lights).
 pub fn load(arg: &str, options: &visgate_formats::ImportOptions) -> Result<Scene, SceneError> {
     if let Some(name) = arg.strip_prefix("builtin:") {
+        if options.bare.is_set() {
+            return Err(SceneError::Invalid {
+                file: PathBuf::from(arg),
+                what: "--up and --metres-per-unit read a bare mesh file (OBJ, glTF, GLB); a \
+                       built-in scene is in metres, Y up"
+                    .into(),
+            });
+        }
         let start = std::time::Instant::now();
         let mut scene = builtin(name)?.scene()?;
         scene.report.load_seconds = start.elapsed().as_secs_f64();

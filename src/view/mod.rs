@@ -16,7 +16,6 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, Parser};
-use visgate_formats::ImportOptions;
 use visgate_runtime::cpu::gates::GateLevel;
 use visgate_runtime::gpu::{GpuContext, MethodInfo, method};
 
@@ -215,12 +214,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
             args.scene
         );
     }
-    let mut scene = crate::load_scene(
-        &args.scene,
-        &ImportOptions {
-            load_textures: true,
-        },
-    )?;
+    let mut scene = crate::load_scene(&args.scene, true)?;
     let persist = !args.fresh && args.screenshot.is_none() && args.benchmark.is_none();
     let saved = persist.then(|| state::load(&scene.name)).flatten();
     let info = start_mode(&args, saved.as_ref())?;

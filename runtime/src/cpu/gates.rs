@@ -104,12 +104,28 @@ impl GateLevel {
     /// Takes `level` for `scene`; refuses a level baked from other static geometry.
     pub fn new(level: BakedLevel, scene: &Scene) -> Result<GateLevel, RenderError> {
         if level.info.geometry_hash != scene.static_geometry_hash() {
+            // A bare mesh read in other units or on another axis than at the bake is other
+            // geometry too.
+            let bare = scene.source.as_ref().is_some_and(|p| {
+                matches!(
+                    visgate_formats::scene::FileKind::of(p),
+                    Some(
+                        visgate_formats::scene::FileKind::Obj
+                            | visgate_formats::scene::FileKind::Gltf
+                    )
+                )
+            });
             return Err(RenderError::Param(format!(
                 "the level was baked from other static geometry than scene '{}' (hash {} vs \
-                 {}): re-bake it with `visgate bake`",
+                 {}): re-bake it with `visgate bake`{}",
                 scene.name,
                 level.info.geometry_hash,
-                scene.static_geometry_hash()
+                scene.static_geometry_hash(),
+                if bare {
+                    ", or read the mesh as the bake did (the same --up and --metres-per-unit)"
+                } else {
+                    ""
+                }
             )));
         }
         let clusters = level.topology.clusters.len();
