@@ -47,7 +47,11 @@ fn a_bare_mesh_in_centimetres_is_read_as_such_and_says_so() {
     let m = Scene::load(&write_obj(dir.path(), "m.obj", 120.0), &options).expect("load");
     assert!((longest_m(&m) - 120.0).abs() < 1e-3);
     let units = |w: &String| w.contains("units");
-    assert!(!m.report.warnings.iter().any(units), "{:?}", m.report.warnings);
+    assert!(
+        !m.report.warnings.iter().any(units),
+        "{:?}",
+        m.report.warnings
+    );
     // A scene TOML's units are the user's: never guessed.
     let toml = dir.path().join("s.toml");
     std::fs::write(

@@ -35,18 +35,16 @@ const LOOK_DIRECTIONS: usize = 16;
 
 /// The horizontal direction from `eye` whose rays within one step of it (22.5°) reach farthest
 /// on average; `reach(p, d)` is how far the ray from `p` along `d` goes before it meets the
-/// geometry (escaping rays count as `cap`). Ties go to the first, +X.
-fn deepest_look(eye: Vec3, reach: &dyn Fn(Vec3, Vec3) -> Option<f32>, cap: f32) -> Vec3 {
+/// geometry, `None` where it escapes: through a window to the void, which shows nothing of the
+/// level, so it counts as 0. Ties go to the first, +X.
+fn deepest_look(eye: Vec3, reach: &dyn Fn(Vec3, Vec3) -> Option<f32>) -> Vec3 {
     let dirs: Vec<Vec3> = (0..LOOK_DIRECTIONS)
         .map(|i| {
             let a = std::f32::consts::TAU * i as f32 / LOOK_DIRECTIONS as f32;
             Vec3::new(a.cos(), 0.0, a.sin())
         })
         .collect();
-    let far: Vec<f32> = dirs
-        .iter()
-        .map(|&d| reach(eye, d).map_or(cap, |t| t.min(cap)))
-        .collect();
+    let far: Vec<f32> = dirs.iter().map(|&d| reach(eye, d).unwrap_or(0.0)).collect();
     let n = LOOK_DIRECTIONS;
     let score = |i: usize| far[(i + n - 1) % n] + far[i] + far[(i + 1) % n];
     let best = (0..n).fold(0, |b, i| if score(i) > score(b) { i } else { b });
@@ -109,7 +107,7 @@ pub fn light_a_bare_scene(
         said.push(format!("a point light of {intensity:.3} W/sr"));
     }
     if no_camera {
-        let along = deepest_look(at, reach, (hi - lo).length());
+        let along = deepest_look(at, reach);
         scene.cameras.push(Camera {
             name: INSIDE_CAMERA.into(),
             eye: at,
@@ -156,19 +154,19 @@ mod tests {
         let (lo, hi) = (Vec3::new(0.0, 0.0, 0.0), Vec3::new(8.0, 3.0, 2.0));
         let reach = to_the_box(lo, hi);
         let eye = Vec3::new(4.0, 1.5, 1.0);
-        let d = deepest_look(eye, &reach, 100.0);
+        let d = deepest_look(eye, &reach);
         assert!(d.y == 0.0 && d.x.abs() > 0.999, "{d}");
         // Off-centre towards +x, it looks back along -x, the longer way.
-        let d = deepest_look(Vec3::new(6.5, 1.5, 1.0), &reach, 100.0);
+        let d = deepest_look(Vec3::new(6.5, 1.5, 1.0), &reach);
         assert!(d.x < -0.999, "{d}");
         // Rotated: 2 m in x, 8 m in z: along ±z.
         let reach = to_the_box(lo, Vec3::new(2.0, 3.0, 8.0));
-        let d = deepest_look(Vec3::new(1.0, 1.5, 4.0), &reach, 100.0);
+        let d = deepest_look(Vec3::new(1.0, 1.5, 4.0), &reach);
         assert!(d.z.abs() > 0.999, "{d}");
-        // A ray that escapes counts as the cap: an open side wins.
+        // A window to the void at -z: it looks the other way, into the room.
         let open = |p: Vec3, d: Vec3| if d.z < -0.9 { None } else { reach(p, d) };
-        let d = deepest_look(Vec3::new(1.0, 1.5, 4.0), &open, 100.0);
-        assert!(d.z < -0.999, "{d}");
+        let d = deepest_look(Vec3::new(1.0, 1.5, 4.0), &open);
+        assert!(d.z > 0.999, "{d}");
     }
 
     #[test]
