@@ -252,6 +252,13 @@ pub struct MethodArgs {
     /// at most --interleave². Costs 5-13x the frame on lavapipe at 64; see the README.
     #[arg(long, default_value_t = 0)]
     pub starved_taps: u32,
+    /// Gates with portals or voxels: Russian roulette on the walks. A VPL that brings a pixel
+    /// less than this share of its VPL subset's unshadowed light is walked by chance, with
+    /// probability its share / this, and counts as much more where visible: the same light on
+    /// average in at most 2 / this walks a pixel on average (0.05: 40, where 16,384 VPLs in 8
+    /// x 8 blocks walk 256), with noise the blur evens out. 0: every VPL walked (default).
+    #[arg(long, default_value_t = 0.0)]
+    pub walk_roulette: f32,
     /// Per-VPL paraboloid map size (GPU), texels.
     #[arg(long, default_value_t = 128)]
     pub vpl_map_size: u32,
@@ -430,6 +437,8 @@ impl MethodArgs {
                 },
                 light_entries: self.light_entries,
                 interleave: self.interleave_params(),
+                walk_roulette: self.walk_roulette,
+                walk_seed: 0,
             },
             vals: ValModeParams {
                 vals: ValParams {

@@ -138,10 +138,11 @@ gpu_struct! {
         /// one draw; on a software rasterizer, what its loop limit allows,
         /// [`crate::gpu::methods::walk_batch`]).
         pub walk_batch: u32,
-        /// Padding.
-        pub _pad1: u32,
-        /// Padding.
-        pub _pad2: u32,
+        /// Portals and voxels: the walks' Russian roulette, a share of a pixel's light (0:
+        /// off; [`crate::gpu::passes::clustered_gates::GatesParams::walk_roulette`]).
+        pub walk_roulette: f32,
+        /// The roulette's seed.
+        pub walk_seed: u32,
     }
 }
 

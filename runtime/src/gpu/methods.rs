@@ -417,8 +417,9 @@ const SOFTWARE_LOOP_ITERATIONS: u32 = 65_535 - 256;
 /// list entries a walk may read in closed voxels with the triangles: a draw costs a pass over
 /// the frame, so fewer draws are faster (e2m3's 21 cm grid: 52 walks a draw, 37 with the
 /// triangles; its hall at 512 x 512, 16,384 VPLs: indirect pass 3,466 -> 3,040 ms against 16 a
-/// draw).
-pub fn walk_batch(adapter: &str, mode: &GpuMode, sight_steps: Option<u32>) -> u32 {
+/// draw). With the walks' roulette a draw first sums its pixel's whole subset of `vpls` (one
+/// iteration a VPL), which the voxel walks' share of the limit leaves out.
+pub fn walk_batch(adapter: &str, mode: &GpuMode, sight_steps: Option<u32>, vpls: u32) -> u32 {
     match mode {
         GpuMode::Gates(p) if p.gates.shape != GateShape::Disk && software(adapter) => {
             match (p.gates.shape, sight_steps) {
@@ -428,7 +429,12 @@ pub fn walk_batch(adapter: &str, mode: &GpuMode, sight_steps: Option<u32>) -> u3
                     } else {
                         0
                     };
-                    (SOFTWARE_LOOP_ITERATIONS / (steps + 1 + lists)).max(1)
+                    let summed = if p.walk_roulette > 0.0 {
+                        vpls.div_ceil(p.interleave.subsets())
+                    } else {
+                        0
+                    };
+                    (SOFTWARE_LOOP_ITERATIONS.saturating_sub(summed) / (steps + 1 + lists)).max(1)
                 }
                 _ => SOFTWARE_WALK_BATCH,
             }
@@ -473,15 +479,18 @@ mod tests {
         let llvmpipe = "llvmpipe (LLVM 19.1.7, 256 bits)";
         let gates = GpuMode::Gates(portals);
         assert_eq!(
-            walk_batch(llvmpipe, &gates, Some(1251)),
+            walk_batch(llvmpipe, &gates, Some(1251), 1024),
             SOFTWARE_WALK_BATCH
         );
-        assert_eq!(walk_batch("NVIDIA H100 80GB HBM3", &gates, Some(1251)), 0);
+        assert_eq!(
+            walk_batch("NVIDIA H100 80GB HBM3", &gates, Some(1251), 1024),
+            0
+        );
         let mut disks = portals;
         disks.gates.shape = GateShape::Disk;
-        assert_eq!(walk_batch(llvmpipe, &GpuMode::Gates(disks), None), 0);
+        assert_eq!(walk_batch(llvmpipe, &GpuMode::Gates(disks), None, 1024), 0);
         assert_eq!(
-            walk_batch(llvmpipe, &GpuMode::GatesPerPixel(portals.gates), None),
+            walk_batch(llvmpipe, &GpuMode::GatesPerPixel(portals.gates), None, 1024),
             0
         );
         // Voxel walks: as many as fit the loop limit at the sight grid's longest walk, at
@@ -489,27 +498,44 @@ mod tests {
         let mut voxels = portals;
         voxels.gates.shape = GateShape::Voxels;
         let voxels = GpuMode::Gates(voxels);
-        assert_eq!(walk_batch(llvmpipe, &voxels, Some(1251)), 52);
-        assert_eq!(walk_batch(llvmpipe, &voxels, Some(99)), 652);
+        assert_eq!(walk_batch(llvmpipe, &voxels, Some(1251), 1024), 52);
+        assert_eq!(walk_batch(llvmpipe, &voxels, Some(99), 1024), 652);
         // With the triangles, a walk may read 512 list entries too.
         let mut triangles = portals;
         triangles.gates.shape = GateShape::Voxels;
         triangles.gates.triangles = true;
         let triangles = GpuMode::Gates(triangles);
-        assert_eq!(walk_batch(llvmpipe, &triangles, Some(1251)), 37);
-        assert_eq!(walk_batch(llvmpipe, &triangles, Some(99)), 106);
-        assert_eq!(walk_batch(llvmpipe, &voxels, Some(200_000)), 1);
-        assert_eq!(walk_batch(llvmpipe, &voxels, None), SOFTWARE_WALK_BATCH);
+        assert_eq!(walk_batch(llvmpipe, &triangles, Some(1251), 1024), 37);
+        assert_eq!(walk_batch(llvmpipe, &triangles, Some(99), 1024), 106);
+        assert_eq!(walk_batch(llvmpipe, &voxels, Some(200_000), 1024), 1);
+        assert_eq!(
+            walk_batch(llvmpipe, &voxels, None, 1024),
+            SOFTWARE_WALK_BATCH
+        );
+        // The roulette's sum over a pixel's subset (16,384 VPLs in 8 × 8: 256) first.
+        let GpuMode::Gates(mut roulette) = voxels else {
+            unreachable!()
+        };
+        roulette.walk_roulette = 0.05;
+        let roulette = GpuMode::Gates(roulette);
+        assert_eq!(walk_batch(llvmpipe, &roulette, Some(1251), 1024), 52);
+        assert_eq!(
+            walk_batch(llvmpipe, &roulette, Some(99), 16_384),
+            (65_279 - 256) / 100
+        );
         for steps in [3, 100, 1251, 4000] {
             for (mode, lists) in [(&voxels, 0), (&triangles, TRIANGLE_TESTS_PER_WALK)] {
-                let batch = walk_batch(llvmpipe, mode, Some(steps));
+                let batch = walk_batch(llvmpipe, mode, Some(steps), 1024);
                 assert!(
                     batch * (steps + 1 + lists) + 256 <= 65_535,
                     "{steps}: {batch}"
                 );
             }
         }
-        assert_eq!(walk_batch("NVIDIA H100 80GB HBM3", &voxels, Some(1251)), 0);
+        assert_eq!(
+            walk_batch("NVIDIA H100 80GB HBM3", &voxels, Some(1251), 1024),
+            0
+        );
     }
 
     #[test]

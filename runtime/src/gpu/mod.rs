@@ -517,6 +517,7 @@ impl GpuRenderer {
             &ctx.adapter_info.name,
             &params.mode,
             scene.level.as_ref().map(|l| l.sight_steps),
+            vpl_count,
         );
         let globals = Globals {
             view_proj: view.view_proj(scene.near_m).to_cols_array_2d(),
@@ -535,8 +536,14 @@ impl GpuRenderer {
             shadow_size: params.shadows.size,
             direct_mode: params.direct.shader_id(),
             walk_batch,
-            _pad1: 0,
-            _pad2: 0,
+            walk_roulette: match params.mode {
+                GpuMode::Gates(gp) => gp.walk_roulette,
+                _ => 0.0,
+            },
+            walk_seed: match params.mode {
+                GpuMode::Gates(gp) => gp.walk_seed,
+                _ => 0,
+            },
         };
         let level = scene.level.as_ref();
         let gates = params.mode.gates().unwrap_or_default();

@@ -46,6 +46,16 @@ pub struct GatesParams {
     /// Interleaved sampling and the geometry-aware blur, as the VAL modes have them (the same
     /// defaults: 8 × 8 blocks); block 1 gathers every VPL at every pixel.
     pub interleave: InterleaveParams,
+    /// Portals and voxels, Russian roulette on the walks: a VPL that brings a pixel less than
+    /// this share of its subset's unshadowed light is walked with probability (its share ÷
+    /// this) and, found visible, counts 1 ÷ that probability — the same light on average, in
+    /// at most 2 ÷ this walks a pixel's subset on average instead of every VPL. 0: every VPL
+    /// walked (the CPU twin always walks every VPL); the starved pixels' second pass walks
+    /// every VPL. [Limit: 0 ≤ share < 1] [Units: share of the light]
+    pub walk_roulette: f32,
+    /// The roulette's random numbers: a hash of the pixel, the VPL and this seed (a frame's
+    /// noise is the same each time it is rendered; another seed draws other walks).
+    pub walk_seed: u32,
 }
 
 /// Checks gate parameters against what the GPU's test does (≤ 2 hops).
@@ -86,6 +96,13 @@ impl GatesParams {
                 "tile side {} px must be 1..={WG_TILE} on the GPU (one workgroup per tile) and \
                  depth slices {} 1..=256",
                 cp.tile_px, cp.depth_slices
+            )));
+        }
+        let r = self.walk_roulette;
+        if !(0.0..1.0).contains(&r) {
+            return Err(RenderError::Param(format!(
+                "walk roulette {r} must be a share of a pixel's light in 0..1 (0: every VPL \
+                 walked; 0.05: VPLs under 5 % of it walked by chance)"
             )));
         }
         if self.light_entries == Some(0) {

@@ -19,6 +19,7 @@ struct Globals {
     direct_mode: u32,
     // Portals: VPLs of a pixel's subset walked a draw (0: all in one draw).
     walk_batch: u32,
-    pad1: u32,
-    pad2: u32,
+    // Portals and voxels: Russian roulette on the walks, a share of a pixel's light (0: off).
+    walk_roulette: f32,
+    walk_seed: u32,
 };
