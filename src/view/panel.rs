@@ -48,6 +48,15 @@ pub fn method_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
                              walls and jambs, several times slower; 0: off",
                         );
                 }
+                if g.shape != GateShape::Disk {
+                    let r = &mut s.gates.walk_roulette;
+                    ui.add(egui::Slider::new(r, 0.0..=0.5).text("walk roulette"))
+                        .on_hover_text(
+                            "a VPL bringing a pixel less than this share of its subset's light \
+                             is walked by chance and weighted up: the same light on average in \
+                             fewer walks, with noise; 0: every VPL walked",
+                        );
+                }
             }
         }
         "val-hard" | "val-cssm" => {

@@ -232,6 +232,9 @@ impl GpuMode {
                 if t > 0 && p.interleave.block > 1 {
                     s += &format!(", under {t} agreeing walk the rest");
                 }
+                if p.walk_roulette > 0.0 && p.gates.shape != GateShape::Disk {
+                    s += &format!(", roulette under {}", p.walk_roulette);
+                }
                 s
             }
             GpuMode::GatesPerPixel(g) => gates(g),
