@@ -509,30 +509,36 @@ pub fn run_compare(args: CompareArgs) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use visgate_runtime::gpu::GatesParams;
 
-    /// The mode labels `--modes all` gives with `flags` after a compare command line.
-    fn all_with(flags: &[&str]) -> Vec<String> {
+    /// The modes `names` give with `flags` after a compare command line.
+    fn modes_with(names: &str, flags: &[&str]) -> Vec<CompareMode> {
         let argv = ["visgate", "compare", "builtin:four-rooms", "--out", "x"]
             .iter()
             .chain(flags);
         let args = crate::compare_args_from(argv.map(|s| s.to_string())).expect("args");
-        let modes = named_modes(&["all".to_string()], &args.method).expect("modes");
-        modes.into_iter().map(|m| m.label).collect()
+        named_modes(&[names.to_string()], &args.method).expect("modes")
+    }
+
+    /// The mode labels `--modes all` gives with `flags` after a compare command line.
+    fn all_with(flags: &[&str]) -> Vec<String> {
+        modes_with("all", flags)
+            .into_iter()
+            .map(|m| m.label)
+            .collect()
+    }
+
+    /// The gates' settings of mode `name` with `flags`.
+    fn gates_of(name: &str, flags: &[&str]) -> GatesParams {
+        match modes_with(name, flags)[0].mode {
+            GpuMode::Gates(g) => g,
+            ref m => panic!("{name} is not gates: {}", m.name()),
+        }
     }
 
     #[test]
     fn gates_starved_walks_three_quarters_of_the_block_unless_told() {
-        let taps = |flags: &[&str]| {
-            let argv = ["visgate", "compare", "builtin:four-rooms", "--out", "x"]
-                .iter()
-                .chain(flags);
-            let args = crate::compare_args_from(argv.map(|s| s.to_string())).expect("args");
-            let modes = named_modes(&[STARVED.to_string()], &args.method).expect("modes");
-            match &modes[0].mode {
-                GpuMode::Gates(g) => g.interleave.starved_taps,
-                m => panic!("{STARVED} is not gates: {}", m.name()),
-            }
-        };
+        let taps = |flags: &[&str]| gates_of(STARVED, flags).interleave.starved_taps;
         assert_eq!(taps(&[]), 48, "8 x 8 by default");
         assert_eq!(taps(&["--interleave", "4"]), 12);
         assert_eq!(taps(&["--starved-taps", "20"]), 20);
@@ -540,17 +546,7 @@ mod tests {
 
     #[test]
     fn gates_roulette_walks_by_chance_under_a_twentieth_unless_told() {
-        let share = |flags: &[&str]| {
-            let argv = ["visgate", "compare", "builtin:four-rooms", "--out", "x"]
-                .iter()
-                .chain(flags);
-            let args = crate::compare_args_from(argv.map(|s| s.to_string())).expect("args");
-            let modes = named_modes(&[ROULETTE.to_string()], &args.method).expect("modes");
-            match &modes[0].mode {
-                GpuMode::Gates(g) => g.walk_roulette,
-                m => panic!("{ROULETTE} is not gates: {}", m.name()),
-            }
-        };
+        let share = |flags: &[&str]| gates_of(ROULETTE, flags).walk_roulette;
         assert_eq!(share(&[]), ROULETTE_SHARE);
         assert_eq!(share(&["--walk-roulette", "0.2"]), 0.2);
     }
