@@ -341,21 +341,22 @@ fn roulette_total(p: vec3<f32>, n: vec3<f32>, j: u32, subsets: u32) -> f32 {
     return total;
 }
 
-// A uniform number in [0, 1) for pixel px and VPL k (PCG, O'Neill, as a hash; the seed
-// draws other numbers), the same for the pixels of one 8 × 8 tile of the deinterleaved
-// target (8 b × 8 b pixels): a workgroup's lanes then walk or skip a VPL together, where
-// numbers of their own left nearly every VPL walked by some lane, which the others wait for
-// (e2m3's hall, 16,384 VPLs, roulette 0.05: indirect pass 3,737 → 3,188 ms on lavapipe's
-// 8 lanes; a GPU's 32 lanes would wait for more). The blur averages pixels of 64 tiles.
+// A uniform number in [0, 1) for pixel px and VPL k: a Weyl sequence over the VPLs (k times
+// the golden ratio, mod 1) shifted by a hash (PCG, O'Neill) of the seed and the pixel's 8 × 8
+// tile of the deinterleaved target (8 b × 8 b pixels). Each VPL's number is uniform; a pixel's
+// VPLs' numbers spread evenly over [0, 1), so the weak VPLs it walks number about what they
+// should. The tile's lanes (a workgroup) walk or skip a VPL together, for a GPU's warps, where
+// one lane's walk holds up the others (on lavapipe's 8 lanes it changed nothing). The blur
+// averages pixels of 64 tiles.
 fn roulette_unit(px: vec2<i32>, k: u32) -> f32 {
     let t = px / i32(8u * max(globals.interleave_block, 1u));
-    var h = (u32(t.x) * 73856093u) ^ (u32(t.y) * 19349663u) ^ (k * 83492791u) ^ globals.walk_seed;
+    var h = (u32(t.x) * 73856093u) ^ (u32(t.y) * 19349663u) ^ globals.walk_seed;
     for (var r = 0; r < 2; r++) {
         let state = h * 747796405u + 2891336453u;
         let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
         h = (word >> 22u) ^ word;
     }
-    return f32(h >> 8u) * (1.0 / 16777216.0);
+    return f32((k * 2654435769u + h) >> 8u) * (1.0 / 16777216.0);
 }
 
 // The voxel walk's end at p (off its face, or a hair off it along the true segment; w = 0:
