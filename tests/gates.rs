@@ -918,8 +918,6 @@ fn the_walks_roulette_gives_every_walks_light_on_average_over_its_seeds() {
     use visgate_runtime::metrics::errors;
     let (ctx, mut gpu, vpls, view) = four_rooms_on_the_gpu([96, 72]);
     // Every VPL at every pixel (no blur to hide a bias): the roulette's noise is all there is.
-    // On a software rasterizer a pixel's 256 VPLs walk in batches, each resuming where the
-    // last stopped (restarting at the list's head instead triples the light).
     let mut render = |walk_roulette: f32, walk_seed: u32| {
         let p = GatesParams {
             interleave: InterleaveParams {

@@ -420,9 +420,8 @@ const SOFTWARE_LOOP_ITERATIONS: u32 = 65_535 - 256;
 /// list entries a walk may read in closed voxels with the triangles: a draw costs a pass over
 /// the frame, so fewer draws are faster (e2m3's 21 cm grid: 52 walks a draw, 37 with the
 /// triangles; its hall at 512 x 512, 16,384 VPLs: indirect pass 3,466 -> 3,040 ms against 16 a
-/// draw). With the walks' roulette a draw may go through its pixel's whole subset of `vpls`
-/// twice, one iteration a VPL (the first draw's sum, and the VPLs it skips on its way to its
-/// walks), which the voxel walks' share of the limit leaves out.
+/// draw). With the walks' roulette a draw first sums its pixel's whole subset of `vpls` (one
+/// iteration a VPL), which the voxel walks' share of the limit leaves out.
 pub fn walk_batch(adapter: &str, mode: &GpuMode, sight_steps: Option<u32>, vpls: u32) -> u32 {
     match mode {
         GpuMode::Gates(p) if p.gates.shape != GateShape::Disk && software(adapter) => {
@@ -434,7 +433,7 @@ pub fn walk_batch(adapter: &str, mode: &GpuMode, sight_steps: Option<u32>, vpls:
                         0
                     };
                     let summed = if p.walk_roulette > 0.0 {
-                        2 * vpls.div_ceil(p.interleave.subsets())
+                        vpls.div_ceil(p.interleave.subsets())
                     } else {
                         0
                     };
@@ -516,7 +515,7 @@ mod tests {
             walk_batch(llvmpipe, &voxels, None, 1024),
             SOFTWARE_WALK_BATCH
         );
-        // The roulette's sum over a pixel's subset (16,384 VPLs in 8 × 8: 256) and its skips.
+        // The roulette's sum over a pixel's subset (16,384 VPLs in 8 × 8: 256) first.
         let GpuMode::Gates(mut roulette) = voxels else {
             unreachable!()
         };

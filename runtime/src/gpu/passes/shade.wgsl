@@ -306,56 +306,22 @@ fn clustered_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, batch:
 // Portals or voxels: the VPLs of subset j (VPL mod B = j), each walked from its cluster to p
 // (portals) or through the open voxels (voxels), × B; of them, batch `batch` of
 // globals.walk_batch (0: all in one).
-// Returns the light × B (xyz) and what the later batches take as `carried` (w): the subset's
-// unshadowed light for the walks' roulette (roulette_total, which batch 0 sums) and, with the
-// roulette, where the pixel's walks stopped (roulette_state). With the roulette a batch walks
-// on from there until it has walked globals.walk_batch VPLs, not a fixed stretch of the list:
-// batches sized for every VPL walked then find most pixels done (e2m3's hall, 512², 16,384
-// VPLs, roulette 0.05: indirect pass 1,488 → … ms on lavapipe).
-fn portal_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, j: u32, subsets: u32, batch: u32, carried: f32) -> vec4<f32> {
+// Returns the light × B (xyz) and the subset's unshadowed light for the walks' roulette (w:
+// roulette_total), which batch 0 sums and the later batches take as `total_before`.
+fn portal_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, j: u32, subsets: u32, batch: u32, total_before: f32) -> vec4<f32> {
     var first = j;
     var end = globals.vpl_count;
-    var total = roulette_total_of(carried);
-    var walks = 0xffffffffu;
-    let resume = globals.walk_roulette > 0.0 && globals.walk_batch > 0u
-        && (end - min(j, end)) / subsets < ROULETTE_RESUME_LIMIT;
-    if batch == 0u {
-        total = roulette_total(p, n, j, subsets);
-    }
-    if resume {
-        if batch > 0u {
-            first = j + roulette_resume_of(carried) * subsets;
-        }
-        walks = globals.walk_batch;
-    } else if globals.walk_batch > 0u {
+    if globals.walk_batch > 0u {
         first = j + batch * globals.walk_batch * subsets;
         end = min(end, first + globals.walk_batch * subsets);
     }
-    if first >= end {
-        return vec4<f32>(0.0, 0.0, 0.0, carried);
+    var total = total_before;
+    if batch == 0u {
+        total = roulette_total(p, n, j, subsets);
     }
     let cut = globals.walk_roulette * total;
-    let w = walk_range(px, p, n, here, walk_end_at(px, p), first, end, subsets, cut, walks);
-    return vec4<f32>(w.light * f32(subsets), roulette_state(total, (w.next - j) / subsets));
-}
-
-// A subset's walks resume at their place in it (the m-th VPL) where it holds fewer VPLs than
-// this, which roulette_state's 16 bits hold.
-const ROULETTE_RESUME_LIMIT: u32 = 0xffffu;
-
-// The roulette's total and a resume place m (< 2^16) in one float: the total's upper 16 bits
-// (sign, exponent and 7 bits of mantissa: a cut within 1 %, which any cut may be) and m in the
-// lower 16. The upper bits of a finite total make a finite float whatever the lower ones.
-fn roulette_state(total: f32, m: u32) -> f32 {
-    return bitcast<f32>((bitcast<u32>(total) & 0xffff0000u) | min(m, 0xffffu));
-}
-
-fn roulette_total_of(state: f32) -> f32 {
-    return bitcast<f32>(bitcast<u32>(state) & 0xffff0000u);
-}
-
-fn roulette_resume_of(state: f32) -> u32 {
-    return bitcast<u32>(state) & 0xffffu;
+    let lit = walk_range(px, p, n, here, walk_end_at(px, p), first, end, subsets, cut);
+    return vec4<f32>(lit * f32(subsets), total);
 }
 
 // The walks' Russian roulette (globals.walk_roulette = s > 0) at p: the unshadowed light of
@@ -407,22 +373,14 @@ fn walk_end_at(px: vec2<i32>, p: vec3<f32>) -> vec4<f32> {
     return at_p;
 }
 
-// What walk_range gathered, and the first VPL it did not look at.
-struct Walked {
-    light: vec3<f32>,
-    next: u32,
-};
-
 // The light at pixel px's p (normal n, cluster `here`, walk end at_p) of VPLs first,
-// first + step, … below end, each that the walk finds visible, stopping after `walks` walks;
-// a VPL whose light sums under `cut` (roulette_total; 0: none) is walked with probability (its
-// light / cut) and counts 1 / that probability.
-fn walk_range(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, at_p: vec4<f32>, first: u32, end: u32, step: u32, cut: f32, walks: u32) -> Walked {
+// first + step, … below end, each that the walk finds visible; a VPL whose light sums under
+// `cut` (roulette_cut; 0: none) is walked with probability (its light / cut) and counts
+// 1 / that probability.
+fn walk_range(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, at_p: vec4<f32>, first: u32, end: u32, step: u32, cut: f32) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
     let triangles = sight_triangles();
-    var walked = 0u;
-    var k = first;
-    for (; k < end && walked < walks; k += step) {
+    for (var k = first; k < end; k += step) {
         let v = vpls[k];
         var l = vpl_light(v, p, n, globals.g_max);
         if all(l == vec3<f32>(0.0)) {
@@ -436,7 +394,6 @@ fn walk_range(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, at_p: vec4<f
             }
             l /= keep;
         }
-        walked += 1u;
         if gate_shape() == GATE_VOXELS {
             let at_v = vpl_ends[k];
             // Either end where the bake knows nothing: unoccluded.
@@ -457,7 +414,7 @@ fn walk_range(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, at_p: vec4<f
         }
         sum += l;
     }
-    return Walked(sum, k);
+    return sum;
 }
 
 // The first entry of [first, end) whose VPL is in subset j or later (VPL mod B >= j).
@@ -585,8 +542,8 @@ fn cs_gates_starved(@builtin(global_invocation_id) id: vec3<u32>) {
                 let take = min(count - skip, left);
                 let first = j + skip * subsets;
                 // Every VPL walked here (no roulette): these pixels are where light is scarce.
-                let w = walk_range(px, pos.xyz, n, here, at_p, first, first + take * subsets, subsets, 0.0, 0xffffffffu);
-                out = vec4<f32>(out.xyz + w.light, 1.0);
+                let lit = walk_range(px, pos.xyz, n, here, at_p, first, first + take * subsets, subsets, 0.0);
+                out = vec4<f32>(out.xyz + lit, 1.0);
                 left -= take;
                 skip = 0u;
             }
