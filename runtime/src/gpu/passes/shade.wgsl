@@ -341,14 +341,12 @@ fn roulette_total(p: vec3<f32>, n: vec3<f32>, j: u32, subsets: u32) -> f32 {
     return total;
 }
 
-// A uniform number in [0, 1) for pixel px and VPL k: a Weyl sequence over the VPLs (k times
-// the golden ratio, mod 1) shifted by a hash (PCG, O'Neill) of the seed and the pixel's 8 × 8
-// tile of the deinterleaved target (8 b × 8 b pixels). Each VPL's number is uniform; a pixel's
-// VPLs' numbers spread evenly over [0, 1), so the weak VPLs it walks number about what they
-// should. The tile's lanes (a workgroup) walk or skip a VPL together, for a GPU's warps, where
-// one lane's walk holds up the others (on lavapipe's 8 lanes it changed nothing). The blur
-// averages pixels of 64 tiles.
-fn roulette_unit(px: vec2<i32>, k: u32) -> f32 {
+// The roulette's numbers for pixel px: a hash (PCG, O'Neill) of the seed and the pixel's
+// 8 × 8 tile of the deinterleaved target (8 b × 8 b pixels), which roulette_unit shifts a Weyl
+// sequence by. The tile's lanes (a workgroup) walk or skip a VPL together, for a GPU's warps,
+// where one lane's walk holds up the others (on lavapipe's 8 lanes it changed nothing). The
+// blur averages pixels of 64 tiles.
+fn roulette_hash(px: vec2<i32>) -> u32 {
     let t = px / i32(8u * max(globals.interleave_block, 1u));
     var h = (u32(t.x) * 73856093u) ^ (u32(t.y) * 19349663u) ^ globals.walk_seed;
     for (var r = 0; r < 2; r++) {
@@ -356,6 +354,13 @@ fn roulette_unit(px: vec2<i32>, k: u32) -> f32 {
         let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
         h = (word >> 22u) ^ word;
     }
+    return h;
+}
+
+// A uniform number in [0, 1) for VPL k at a pixel whose roulette_hash is h: the Weyl sequence
+// k times the golden ratio, mod 1, shifted by h. Each VPL's number is uniform; a pixel's VPLs'
+// numbers spread evenly over [0, 1), so the weak VPLs it walks number about what they should.
+fn roulette_unit(h: u32, k: u32) -> f32 {
     return f32((k * 2654435769u + h) >> 8u) * (1.0 / 16777216.0);
 }
 
@@ -380,6 +385,7 @@ fn walk_end_at(px: vec2<i32>, p: vec3<f32>) -> vec4<f32> {
 fn walk_range(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, at_p: vec4<f32>, first: u32, end: u32, step: u32, cut: f32) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
     let triangles = sight_triangles();
+    let h = roulette_hash(px);
     for (var k = first; k < end; k += step) {
         let v = vpls[k];
         var l = vpl_light(v, p, n, globals.g_max);
@@ -389,7 +395,7 @@ fn walk_range(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, at_p: vec4<f
         let y = l.x + l.y + l.z;
         if y < cut {
             let keep = y / cut;
-            if roulette_unit(px, k) >= keep {
+            if roulette_unit(h, k) >= keep {
                 continue;
             }
             l /= keep;
