@@ -380,8 +380,8 @@ fn walk_end_at(px: vec2<i32>, p: vec3<f32>) -> vec4<f32> {
 
 // The light at pixel px's p (normal n, cluster `here`, walk end at_p) of VPLs first,
 // first + step, … below end, each that the walk finds visible; a VPL whose light sums under
-// `cut` (roulette_cut; 0: none) is walked with probability (its light / cut) and counts
-// 1 / that probability.
+// `cut` (the roulette's share of roulette_total; 0: none) is walked with probability (its
+// light / cut) and counts 1 / that probability.
 fn walk_range(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, at_p: vec4<f32>, first: u32, end: u32, step: u32, cut: f32) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
     let triangles = sight_triangles();
