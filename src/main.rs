@@ -239,10 +239,7 @@ pub fn camera_of(scene: &Scene, arg: &str, name: Option<&str>) -> Result<visgate
             )
         }),
         None => scene.cameras.first().cloned().with_context(|| {
-            let bare = [".obj", ".gltf", ".glb"]
-                .iter()
-                .any(|e| arg.to_ascii_lowercase().ends_with(e));
-            if bare {
+            if scene.is_bare_mesh() {
                 format!(
                     "{arg}: a bare mesh carries no camera (nor lights); write a scene TOML \
                      beside it that names it ([[mesh]] path = \"…\") and adds a [[camera]] and \

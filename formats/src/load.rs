@@ -34,9 +34,9 @@ pub fn bare_mesh_units(longest: f64) -> f64 {
         .unwrap_or(0.001)
 }
 
-/// The longest side of the box around every vertex of `models`, in their own units (`None`:
-/// no finite vertex).
-fn longest_extent(models: &[ImportedModel]) -> Option<f64> {
+/// The size of the box around every finite vertex of `models`, in their own units and axes
+/// (`None`: no finite vertex).
+fn vertex_extent(models: &[ImportedModel]) -> Option<DVec3> {
     let mut points = models
         .iter()
         .flat_map(|m| &m.meshes)
@@ -44,7 +44,13 @@ fn longest_extent(models: &[ImportedModel]) -> Option<f64> {
         .filter(|p| p.is_finite());
     let first = *points.next()?;
     let (lo, hi) = points.fold((first, first), |(lo, hi), &p| (lo.min(p), hi.max(p)));
-    Some((hi - lo).max_element() as f64)
+    Some((hi - lo).as_dvec3())
+}
+
+/// The longest side of the box around every vertex of `models`, in their own units (`None`:
+/// no finite vertex).
+fn longest_extent(models: &[ImportedModel]) -> Option<f64> {
+    vertex_extent(models).map(|e| e.max_element())
 }
 
 /// How a bare mesh file (no scene TOML) is read where the user says it (`visgate --up z
@@ -71,28 +77,22 @@ const Z_UP_AREA_RATIO: f64 = 1.0;
 const Z_UP_EXTENT_RATIO: f64 = 0.8;
 
 /// Each axis's share of the triangles' area, weighted by how squarely they face it (Σ area ·
-/// n_k², normalised), and the extent of their box, in the file's axes.
-fn facing_and_extent(models: &[ImportedModel]) -> Option<([f64; 3], [f64; 3])> {
-    let (mut facing, mut lo, mut hi) = (DVec3::ZERO, DVec3::MAX, DVec3::MIN);
+/// n_k², normalised), in the file's axes (`None`: no area).
+fn facing_shares(models: &[ImportedModel]) -> Option<DVec3> {
+    let mut facing = DVec3::ZERO;
     for mesh in models.iter().flat_map(|m| &m.meshes) {
         for t in &mesh.triangles {
             let [a, b, c] = t.map(|i| mesh.positions[i as usize].as_dvec3());
-            if !(a.is_finite() && b.is_finite() && c.is_finite()) {
-                continue;
-            }
             let n = (b - a).cross(c - a);
             // |n| is twice the area; area · n̂² = n² / (2 |n|).
             let len = n.length();
-            if len > 0.0 {
+            if len > 0.0 && len.is_finite() {
                 facing += n * n / (2.0 * len);
-            }
-            for p in [a, b, c] {
-                (lo, hi) = (lo.min(p), hi.max(p));
             }
         }
     }
     let total = facing.element_sum();
-    (total > 0.0).then(|| ((facing / total).to_array(), (hi - lo).to_array()))
+    (total > 0.0).then(|| facing / total)
 }
 
 /// Above this share of ±Y's area facing ±Z a bare OBJ read +Y up gets a note that it may lie
@@ -105,7 +105,7 @@ const SIDE_NOTE_AREA_RATIO: f64 = 1.05;
 /// +Y. Returns the axis and what a user should read: why Z, or, read Y up where the area
 /// alone says Z, that it may lie on its side.
 pub fn bare_mesh_up(models: &[ImportedModel]) -> (UpAxis, Option<String>) {
-    let Some((facing, extent)) = facing_and_extent(models) else {
+    let (Some(facing), Some(extent)) = (facing_shares(models), vertex_extent(models)) else {
         return (UpAxis::Y, None);
     };
     let areas = format!(

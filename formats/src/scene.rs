@@ -308,6 +308,15 @@ impl FileKind {
 }
 
 impl Scene {
+    /// Whether it was loaded from a bare mesh file (OBJ, glTF, GLB), not a scene TOML or a
+    /// built-in: its units and up axis were chosen at load (`--metres-per-unit`, `--up`).
+    pub fn is_bare_mesh(&self) -> bool {
+        self.source
+            .as_deref()
+            .and_then(FileKind::of)
+            .is_some_and(|k| matches!(k, FileKind::Obj | FileKind::Gltf))
+    }
+
     /// Whether anything moves.
     pub fn is_animated(&self) -> bool {
         !self.animation.meshes.is_empty() || !self.animation.lights.is_empty()

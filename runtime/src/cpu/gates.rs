@@ -106,22 +106,13 @@ impl GateLevel {
         if level.info.geometry_hash != scene.static_geometry_hash() {
             // A bare mesh read in other units or on another axis than at the bake is other
             // geometry too.
-            let bare = scene.source.as_ref().is_some_and(|p| {
-                matches!(
-                    visgate_formats::scene::FileKind::of(p),
-                    Some(
-                        visgate_formats::scene::FileKind::Obj
-                            | visgate_formats::scene::FileKind::Gltf
-                    )
-                )
-            });
             return Err(RenderError::Param(format!(
                 "the level was baked from other static geometry than scene '{}' (hash {} vs \
                  {}): re-bake it with `visgate bake`{}",
                 scene.name,
                 level.info.geometry_hash,
                 scene.static_geometry_hash(),
-                if bare {
+                if scene.is_bare_mesh() {
                     ", or read the mesh as the bake did (the same --up and --metres-per-unit)"
                 } else {
                     ""

@@ -519,6 +519,10 @@ impl GpuRenderer {
             scene.level.as_ref().map(|l| l.sight_steps),
             vpl_count,
         );
+        let (walk_roulette, walk_seed) = match params.mode {
+            GpuMode::Gates(gp) => (gp.walk_roulette, gp.walk_seed),
+            _ => (0.0, 0),
+        };
         let globals = Globals {
             view_proj: view.view_proj(scene.near_m).to_cols_array_2d(),
             eye: view.eye.extend(1.0).to_array(),
@@ -536,14 +540,8 @@ impl GpuRenderer {
             shadow_size: params.shadows.size,
             direct_mode: params.direct.shader_id(),
             walk_batch,
-            walk_roulette: match params.mode {
-                GpuMode::Gates(gp) => gp.walk_roulette,
-                _ => 0.0,
-            },
-            walk_seed: match params.mode {
-                GpuMode::Gates(gp) => gp.walk_seed,
-                _ => 0,
-            },
+            walk_roulette,
+            walk_seed,
         };
         let level = scene.level.as_ref();
         let gates = params.mode.gates().unwrap_or_default();

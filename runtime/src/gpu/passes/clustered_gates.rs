@@ -53,8 +53,9 @@ pub struct GatesParams {
     /// walked (the CPU twin always walks every VPL); the starved pixels' second pass walks
     /// every VPL. [Limit: 0 ≤ share < 1] [Units: share of the light]
     pub walk_roulette: f32,
-    /// The roulette's random numbers: a hash of the pixel, the VPL and this seed (a frame's
-    /// noise is the same each time it is rendered; another seed draws other walks).
+    /// The roulette's random numbers: a Weyl sequence over the VPLs shifted by a hash of this
+    /// seed and the pixel's tile (shade.wgsl's `roulette_hash`; a frame's noise is the same
+    /// each time it is rendered, another seed draws other walks).
     pub walk_seed: u32,
 }
 
