@@ -265,8 +265,9 @@ fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMod
         g.gates.triangles = triangles;
         GpuMode::Gates(g)
     };
-    // Gates with their interleaving changed: the starved pixels' walks or the blur's fill.
-    let interleaved = |name: &str| {
+    // Gates with one setting changed: the starved pixels' walks, the blur's fill or the walks'
+    // roulette.
+    let varied = |name: &str| {
         let mut g = s.gates;
         let il = &mut g.interleave;
         match name {
@@ -281,7 +282,7 @@ fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMod
         let shape = SHAPED.iter().find(|(n, ..)| *n == name);
         let mode = match (shape, method(name)) {
             (Some(&(_, g, t)), _) => shaped(g, t),
-            _ if [STARVED, FILLED, ROULETTE].contains(&name) => interleaved(name),
+            _ if [STARVED, FILLED, ROULETTE].contains(&name) => varied(name),
             (_, Some(m)) => (m.make)(&s),
             (None, None) => bail!(
                 "--modes {name}: give all or some of {}, {}, {FILLED}, {STARVED}, {ROULETTE}",
