@@ -209,6 +209,11 @@ fn without_a_display_the_viewer_says_what_to_do_or_renders_headless() {
     for want in ["no display", "visgate render", "Xvfb", "--or-render"] {
         assert!(text(&o).contains(want), "missing '{want}': {}", text(&o));
     }
+    // A scene that is not there is the error, not the display.
+    let o = visgate(&["view", "builtin:no-such-scene"], None);
+    assert!(!o.status.success());
+    assert!(text(&o).contains("no-such-scene"), "{}", text(&o));
+    assert!(!text(&o).contains("no display"), "{}", text(&o));
     let dir = tempfile::tempdir().expect("tempdir");
     let out = dir.path().join("headless.png");
     let o = visgate(

@@ -207,6 +207,8 @@ pub fn run(args: ViewArgs) -> Result<()> {
             println!("no display: rendering {} headless instead", out.display());
             return render_instead(&args, mode, out);
         }
+        // A scene that cannot load says so first: the advice below would only lead to it.
+        crate::load_scene(&args.scene, false)?;
         bail!(
             "no display to open a window on (DISPLAY and WAYLAND_DISPLAY are unset): use \
              `visgate render {} --out image.png`, run the viewer under Xvfb (`Xvfb :99 & \
