@@ -89,8 +89,10 @@ pub struct BakeParams {
     /// The skeleton, clusters and gates are made on a grid of this voxel size when the
     /// level's voxels are finer, and each fine voxel then takes the cluster of its space: the
     /// partition stays that of this scale at any finer resolution. 0 partitions the level's
-    /// own grid. `None` asks the bake for 0.125 m or 1/128 of the level's longest extent,
-    /// whichever is smaller; a baked file stores the value used. [Limit: [0, 10]] [Units: m]
+    /// own grid. `None` asks the bake for the least whole multiple of the level's voxel that
+    /// reaches 0.125 m, or 1/128 of the level's longest extent if that is smaller
+    /// (`visgate_preprocess::bake::default_partition_voxel`); a baked file stores the value
+    /// used. [Limit: [0, 10]] [Units: m]
     pub partition_voxel_m: Option<f32>,
     /// A cluster whose largest max ball is smaller than this is merged into the neighbour
     /// across its widest gate: a roof slab, a crack or a niche where nobody stands is no room
