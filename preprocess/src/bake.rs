@@ -406,10 +406,10 @@ fn level_scaled(params: &BakeParams, bounds: (glam::Vec3, glam::Vec3), voxel_m: 
 /// of its length where that is under [`PARTITION_VOXEL_M`] (a small level), else the least
 /// whole multiple of its voxel over one that reaches [`PARTITION_VOXEL_M`] (to 1 %), or
 /// [`PARTITION_VOXEL_M`] itself where the level's voxel reaches it (then the partition is made
-/// on the level's own grid: [`partition_grid`]). A whole multiple keeps the partition a property of the level, not of the
-/// resolution: Crytek Sponza is partitioned on 14.6 cm voxels at 256, 512 and 1024 (1, 2 and 4
-/// of its voxels), where on 12.5 cm voxels at 512 it made 89 clusters against 73 at 256 and
-/// baked in 3.8–4.5 s instead of 2.9.
+/// on the level's own grid: [`partition_grid`]). A whole multiple keeps the partition's voxels
+/// one size at every resolution: Crytek Sponza is partitioned on 14.6 cm voxels at 256, 512
+/// and 1024 (1, 2 and 4 of its voxels; 73, 84 and 84 clusters), where on 12.5 cm voxels at 512
+/// it made 89 and baked in 3.8–4.5 s instead of 2.9.
 pub fn default_partition_voxel(longest: f32, voxel_m: f32) -> f32 {
     let small = longest / PARTITION_PARTS as f32;
     if small < PARTITION_VOXEL_M {
