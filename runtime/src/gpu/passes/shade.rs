@@ -99,10 +99,11 @@ const GATES_INDIRECT_BINDINGS: [u32; 15] = [0, 2, 5, 6, 7, 8, 10, 12, 13, 14, 15
 /// The bindings of shade.wgsl's `cs_gates_starved` but its batch index (24) and its output
 /// (25): the walks' without the disks' lists, and the starved test's constants (26).
 const GATES_STARVED_BINDINGS: [u32; 12] = [0, 2, 5, 6, 7, 8, 15, 16, 21, 22, 23, 26];
-/// The bindings of shade.wgsl's `cs_shade` but its output (25): all but the batches' sum and
-/// the batch index.
-const SHADE_BINDINGS: [u32; 23] = [
-    0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 18, 19, 20, 22, 23,
+/// The bindings of shade.wgsl's `cs_shade` but its output (25): all but the batches' sum, the
+/// batch index, and the VPLs' clusters and walk ends (clustered gates walk apart, in
+/// `cs_gates_indirect`; `cs_shade` gathers their disks and gates per pixel).
+const SHADE_BINDINGS: [u32; 21] = [
+    0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 17, 18, 19, 20, 22,
 ];
 /// The bindings of shade.wgsl's `cs_vpl_clusters_indirect` but its output (25).
 const VPL_CLUSTERS_INDIRECT_BINDINGS: [u32; 6] = [0, 2, 5, 6, 19, 20];

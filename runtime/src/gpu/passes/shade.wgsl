@@ -249,22 +249,20 @@ fn shade(px: vec2<i32>) -> vec4<f32> {
     } else if mode == SHADE_VPL_CLUSTERS && globals.interleave_block <= 1u {
         radiance += albedo / PI * gather_vpl_clusters(p, n, px, 0u, 1u);
     } else if mode == SHADE_GATES_CLUSTERED && globals.interleave_block <= 1u && gate_shape() == GATE_DISKS {
-        radiance += albedo / PI * clustered_gather(px, p, n, decode_cluster(pos.w), 0u);
+        radiance += albedo / PI * clustered_gather(px, p, n, decode_cluster(pos.w));
     }
     return vec4<f32>(radiance, 1.0);
 }
 
-// SHADE_GATES_CLUSTERED: the VPL light at p through its geometry cluster's list (without albedo / π). An
+// SHADE_GATES_CLUSTERED with disks (portals and voxels walk in portal_gather, from
+// cs_gates_indirect): the VPL light at p through its geometry cluster's list (without albedo / π). An
 // entry with gates is tested here, per pixel; a VPL whose light passes by several chains
 // counts once (a list is ordered by (VPL mod B, VPL)). With interleaving (B = b² subsets) the
 // pixel takes only its subset's run of the list, found by binary search, and the sum is × B.
-fn clustered_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, batch: u32) -> vec3<f32> {
+fn clustered_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32) -> vec3<f32> {
     let b = max(globals.interleave_block, 1u);
     let subsets = b * b;
     let j = interleave_subset(px, b);
-    if gate_shape() != GATE_DISKS {
-        return portal_gather(px, p, n, here, j, subsets, batch, 0.0).xyz;
-    }
     let width = textureDimensions(g_position).x;
     let gc = pixel_cluster[u32(px.x) + u32(px.y) * width];
     if gc == NONE {
@@ -475,7 +473,7 @@ fn cs_gates_indirect(@builtin(global_invocation_id) id: vec3<u32>) {
             let g = portal_gather(s.px, s.position.xyz, s.normal, here, j, b * b, batch, sum.w);
             sum = vec4<f32>(sum.xyz + g.xyz, g.w);
         } else {
-            sum = vec4<f32>(sum.xyz + clustered_gather(s.px, s.position.xyz, s.normal, here, batch), 0.0);
+            sum = vec4<f32>(sum.xyz + clustered_gather(s.px, s.position.xyz, s.normal, here), 0.0);
         }
     }
     textureStore(out_image, id.xy, sum);
