@@ -9,9 +9,10 @@
 # OUT/log.txt (every render's report) and OUT/table.md (level, camera, size, VPLs, mode, GPU ms
 # of the frame, of its indirect pass; wall ms where the adapter's timestamps are not used). LEVEL: e2m3, sponza (default both). Modes: none,
 # direct-only, gates (voxel walk), gates-triangles, gates-portal, gates-disk, gates-i4 and
-# val-hard-i4 (4 × 4 interleaving), val-hard, val-cssm, per-vpl-shadow-maps. In the environment:
+# val-hard-i4 (4 × 4 interleaving), gates-rr0, gates-rr05 and gates-rr10 (Russian roulette on
+# the walks off, S = 0.05 and 0.1; gates: the default, auto), val-hard, val-cssm, per-vpl-shadow-maps. In the environment:
 # RUNS="SIZE:COUNTS ..." (default "512x512:4096,1024,16384 1280x720:4096"), MODES (of those,
-# default all but the 4 × 4 ones), LIMIT (seconds a render may take, default 60). A render that fails or runs
+# default all but the 4 × 4 and roulette ones), LIMIT (seconds a render may take, default 60). A render that fails or runs
 # past LIMIT is written as such in the table. Needs ../shared/scenes beside the repository.
 set -uo pipefail
 if [ $# -lt 2 ]; then
@@ -34,6 +35,9 @@ args_of() { # LABEL -> render arguments
     gates-portal) echo "--mode gates --gate-shape portal" ;;
     gates-disk) echo "--mode gates --gate-shape disk" ;;
     gates-i4) echo "--mode gates --interleave 4" ;;
+    gates-rr0) echo "--mode gates --walk-roulette 0" ;;
+    gates-rr05) echo "--mode gates --walk-roulette 0.05" ;;
+    gates-rr10) echo "--mode gates --walk-roulette 0.1" ;;
     val-hard-i4) echo "--mode val-hard --interleave 4" ;;
     *) echo "--mode $1" ;;
     esac

@@ -9,7 +9,7 @@ use visgate_formats::vgate::{BakeParams, Resolution};
 use visgate_formats::{BakedLevel, Scene};
 use visgate_runtime::compare::{CompareMode, CompareSpec, ErrorMetric, Step, report, run};
 use visgate_runtime::cpu::gates::{GateLevel, GateShape};
-use visgate_runtime::gpu::{DirectLight, GpuMode, METHODS, method};
+use visgate_runtime::gpu::{DirectLight, GpuMode, METHODS, WalkRoulette, method};
 use visgate_runtime::hdr::HdrImage;
 
 use crate::settings::{LightArgs, MethodArgs};
@@ -24,7 +24,7 @@ voxels, walking them along the true segment with the closed voxels' triangles
 its blur filled from the next blocks: --blur-fill), gates-starved (gates as set, its
 starved pixels walking what their blur block lacks: --starved-taps, or 3/4 of the block's
 pixels where that is 0) and gates-roulette (gates as set, its walks by Russian roulette:
---walk-roulette, or 0.05 where that is 0). `all`: every one but direct-only, gates once a
+--walk-roulette, or 0.05 where that is 0 or auto). `all`: every one but direct-only, gates once a
 shape, gates-filled and gates-starved where gates interleave without them, and
 gates-roulette where gates walk (voxels, portals) without it; the gate modes only with a level
 (given, or baked here).
@@ -245,7 +245,7 @@ const STARVED: &str = "gates-starved";
 /// Mode gates with its blur filled from the next blocks (--blur-fill), in `visgate compare`.
 const FILLED: &str = "gates-filled";
 /// Mode gates with Russian roulette on its walks: the gates' own --walk-roulette, or
-/// [`ROULETTE_SHARE`] where that is 0.
+/// [`ROULETTE_SHARE`] where that is 0 or auto.
 const ROULETTE: &str = "gates-roulette";
 /// The share of a pixel's light under which gates-roulette walks a VPL by chance, unless told:
 /// on the Quake level at 4,096 VPLs it made gates faster than val-hard with the indirect MSE
@@ -273,7 +273,9 @@ fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMod
         match name {
             STARVED if il.starved_taps == 0 => il.starved_taps = 3 * il.block * il.block / 4,
             FILLED => il.fill = true,
-            ROULETTE if g.walk_roulette == 0.0 => g.walk_roulette = ROULETTE_SHARE,
+            ROULETTE if !g.walk_roulette.is_fixed() => {
+                g.walk_roulette = WalkRoulette::Share(ROULETTE_SHARE)
+            }
             _ => {}
         }
         GpuMode::Gates(g)
@@ -317,7 +319,7 @@ fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMod
                     if il.block > 1 && il.starved_taps == 0 {
                         out.push(named(STARVED)?);
                     }
-                    if gates.shape != GateShape::Disk && s.gates.walk_roulette == 0.0 {
+                    if gates.shape != GateShape::Disk && !s.gates.walk_roulette.is_fixed() {
                         out.push(named(ROULETTE)?);
                     }
                 }
@@ -548,8 +550,9 @@ mod tests {
     #[test]
     fn gates_roulette_walks_by_chance_under_a_twentieth_unless_told() {
         let share = |flags: &[&str]| gates_of(ROULETTE, flags).walk_roulette;
-        assert_eq!(share(&[]), ROULETTE_SHARE);
-        assert_eq!(share(&["--walk-roulette", "0.2"]), 0.2);
+        assert_eq!(share(&[]), WalkRoulette::Share(ROULETTE_SHARE));
+        assert_eq!(share(&["--walk-roulette", "0"]), share(&[]));
+        assert_eq!(share(&["--walk-roulette", "0.2"]), WalkRoulette::Share(0.2));
     }
 
     #[test]

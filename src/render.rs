@@ -227,7 +227,6 @@ pub fn run(args: RenderArgs) -> Result<()> {
         (Some(level), Some(_)) => Some(GateLevel::new(level, &scene)?),
         _ => None,
     };
-    let described = job.mode().map(|m| m.describe()).unwrap_or_default();
     let g_max = job.for_scene(&scene)?.params.g_max;
     match job.clamp {
         GeometryClamp::PerSquareMetre(_) => println!("geometry-term clamp g_max {g_max:.4} 1/m²"),
@@ -267,6 +266,8 @@ pub fn run(args: RenderArgs) -> Result<()> {
                 }
                 f.image.write(&out, args.exposure)?;
                 let setup = setup.lock().unwrap_or_else(|e| e.into_inner()).clone();
+                let described = job.mode().map(|m| m.describe_for(f.vpl_count as u32));
+                let described = described.unwrap_or_default();
                 print_frame(&args, (&scene.name, &described), &f, load_s, &setup);
                 println!("wrote {}", out.display());
                 Ok(())

@@ -881,6 +881,20 @@ fn render_gates_uses_a_baked_level_and_refuses_a_missing_or_stale_one() {
     let named = "gates (voxel walk, 8×8 interleaved, blur filled, under 40 agreeing walk the rest)";
     assert!(stdout(&of).contains(named), "{}", stdout(&of));
     assert!(stdout(&of).contains("starved pixels"), "{}", stdout(&of));
+    // The roulette on the walks: on by default at 128 VPLs a pixel (8,192 in 8 × 8 blocks),
+    // named as it acts; --walk-roulette 0 turns it off.
+    let mut r = a.clone();
+    let vpls = r.iter().position(|x| *x == "64").expect("vpls");
+    r[vpls] = "8192";
+    let or = visgate(&r);
+    assert!(or.status.success(), "{}", stderr(&or));
+    let named = "gates (voxel walk, 8×8 interleaved, roulette under 0.05 (auto)) 16x12";
+    assert!(stdout(&or).contains(named), "{}", stdout(&or));
+    r.extend(["--walk-roulette", "0"]);
+    let or = visgate(&r);
+    assert!(or.status.success(), "{}", stderr(&or));
+    let named = "gates (voxel walk, 8×8 interleaved) 16x12";
+    assert!(stdout(&or).contains(named), "{}", stdout(&or));
     a.extend(["--gate-shape", "portal"]);
     let o = visgate(&a);
     assert!(o.status.success(), "{}", stderr(&o));

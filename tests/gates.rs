@@ -818,7 +818,7 @@ fn interleaved_gates_keep_the_light_of_every_vpl_gather() {
 #[test]
 fn starved_pixels_walk_the_subsets_their_block_lacks_and_count_every_vpl_once() {
     use visgate_runtime::gpu::InterleaveParams;
-    use visgate_runtime::gpu::{GatesParams, GpuMode, GpuParams, GpuRenderer};
+    use visgate_runtime::gpu::{GatesParams, GpuMode, GpuParams, GpuRenderer, WalkRoulette};
     use visgate_runtime::metrics::errors;
     let (ctx, mut gpu, vpls, view) = four_rooms_on_the_gpu([96, 72]);
     let render = |gpu: &mut GpuRenderer, mode| {
@@ -827,6 +827,7 @@ fn starved_pixels_walk_the_subsets_their_block_lacks_and_count_every_vpl_once() 
     };
     for shape in [GateShape::Voxels, GateShape::Portal] {
         let with = |block: u32, blur_distance: f32, starved_taps: u32| {
+            // Every VPL walked (no roulette at 256 VPLs a pixel): the sums are exact.
             let mut p = GatesParams {
                 interleave: InterleaveParams {
                     block,
@@ -834,6 +835,7 @@ fn starved_pixels_walk_the_subsets_their_block_lacks_and_count_every_vpl_once() 
                     starved_taps,
                     ..InterleaveParams::default()
                 },
+                walk_roulette: WalkRoulette::Share(0.0),
                 ..GatesParams::default()
             };
             p.gates.shape = shape;
@@ -914,7 +916,7 @@ fn the_blur_filled_from_the_next_blocks_is_nearer_every_vpls_gather_and_leaves_a
 #[test]
 fn the_walks_roulette_gives_every_walks_light_on_average_over_its_seeds() {
     use visgate_runtime::gpu::InterleaveParams;
-    use visgate_runtime::gpu::{GatesParams, GpuMode, GpuParams};
+    use visgate_runtime::gpu::{GatesParams, GpuMode, GpuParams, WalkRoulette};
     use visgate_runtime::metrics::errors;
     let (ctx, mut gpu, vpls, view) = four_rooms_on_the_gpu([96, 72]);
     // Every VPL at every pixel (no blur to hide a bias): the roulette's noise is all there is.
@@ -924,7 +926,7 @@ fn the_walks_roulette_gives_every_walks_light_on_average_over_its_seeds() {
                 block: 1,
                 ..InterleaveParams::default()
             },
-            walk_roulette,
+            walk_roulette: WalkRoulette::Share(walk_roulette),
             walk_seed,
             ..GatesParams::default()
         };

@@ -6,11 +6,39 @@ use eframe::egui;
 use visgate_formats::Scene;
 use visgate_runtime::cpu::gates::GateShape;
 use visgate_runtime::gpu::{
-    DirectLight, DiskLight, InterleaveParams, IsmParams, LcDisk, LightClusterGpuParams,
-    MethodSettings, PassTimes,
+    AUTO_ROULETTE_SHARE, AUTO_ROULETTE_VPLS, DirectLight, DiskLight, InterleaveParams, IsmParams,
+    LcDisk, LightClusterGpuParams, MethodSettings, PassTimes, WalkRoulette,
 };
 
 use super::camera::FlyCamera;
+
+/// The gates' roulette on the walks: auto, or a share of a pixel's light.
+fn walk_roulette(ui: &mut egui::Ui, r: &mut WalkRoulette) {
+    let mut auto = *r == WalkRoulette::Auto;
+    ui.horizontal(|ui| {
+        let hint = format!(
+            "{AUTO_ROULETTE_SHARE} where a pixel's subset holds {AUTO_ROULETTE_VPLS} VPLs or more \
+             (16,384 VPLs in 8 × 8 blocks), else every VPL walked"
+        );
+        if ui.checkbox(&mut auto, "auto").on_hover_text(hint).changed() {
+            *r = if auto {
+                WalkRoulette::Auto
+            } else {
+                WalkRoulette::Share(AUTO_ROULETTE_SHARE)
+            };
+        }
+        if let WalkRoulette::Share(share) = r {
+            ui.add(egui::Slider::new(share, 0.0..=0.5).text("walk roulette"))
+                .on_hover_text(
+                    "a VPL bringing a pixel less than this share of its subset's light is \
+                     walked by chance and weighted up: the same light on average in fewer \
+                     walks, with noise; 0: every VPL walked",
+                );
+        } else {
+            ui.label("walk roulette");
+        }
+    });
+}
 
 /// The settings of method `mode` (by its registry name). Clustered gates and the VAL modes
 /// share one interleaving block, so that their speed compares like with like.
@@ -49,13 +77,7 @@ pub fn method_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
                         );
                 }
                 if g.shape != GateShape::Disk {
-                    let r = &mut s.gates.walk_roulette;
-                    ui.add(egui::Slider::new(r, 0.0..=0.5).text("walk roulette"))
-                        .on_hover_text(
-                            "a VPL bringing a pixel less than this share of its subset's light \
-                             is walked by chance and weighted up: the same light on average in \
-                             fewer walks, with noise; 0: every VPL walked",
-                        );
+                    walk_roulette(ui, &mut s.gates.walk_roulette);
                 }
             }
         }

@@ -80,7 +80,15 @@ pub struct CompareMode {
 impl CompareMode {
     /// The method's settings in words, LightCluster's included.
     pub fn describe(&self) -> String {
-        let mode = self.mode.describe();
+        self.describe_with(self.mode.describe())
+    }
+
+    /// [`Self::describe`] for a frame of `vpls` VPLs ([`GpuMode::describe_for`]).
+    pub fn describe_for(&self, vpls: u32) -> String {
+        self.describe_with(self.mode.describe_for(vpls))
+    }
+
+    fn describe_with(&self, mode: String) -> String {
         let DirectLight::LightCluster(p) = &self.direct else {
             return mode;
         };
@@ -642,10 +650,10 @@ fn settings_of(
     store: &Store,
     camera: &Camera,
     m: &CompareMode,
-    vpl_clusters: Option<u32>,
+    kept: &Kept,
 ) -> Result<String, RenderError> {
-    let mut s = m.describe();
-    if let Some(n) = vpl_clusters {
+    let mut s = m.describe_for(kept.vpl_count as u32);
+    if let Some(n) = kept.vpl_clusters {
         s += &format!(" → {n} clusters");
     }
     if let DirectLight::LightCluster(p) = &m.direct {
@@ -708,7 +716,7 @@ fn measure(
     Ok(Row {
         camera: camera.name.clone(),
         mode: m.label.clone(),
-        settings: settings_of(store, camera, m, kept.vpl_clusters)?,
+        settings: settings_of(store, camera, m, &kept)?,
         vpls,
         vpl_count: kept.vpl_count,
         passes: kept.passes,

@@ -139,7 +139,7 @@ gpu_struct! {
         /// [`crate::gpu::methods::walk_batch`]).
         pub walk_batch: u32,
         /// Portals and voxels: the walks' Russian roulette, a share of a pixel's light (0:
-        /// off; [`crate::gpu::passes::clustered_gates::GatesParams::walk_roulette`]).
+        /// off; [`crate::gpu::passes::clustered_gates::GatesParams::roulette_share`]).
         pub walk_roulette: f32,
         /// The roulette's seed.
         pub walk_seed: u32,

@@ -10,7 +10,7 @@ use crate::cpu::gates::{GateParams, GateShape};
 use crate::cpu::sight_triangles::TRIANGLE_TESTS_PER_WALK;
 use crate::cpu::val::ValParams;
 
-pub use super::passes::clustered_gates::GatesParams;
+pub use super::passes::clustered_gates::{GatesParams, WalkRoulette};
 pub use super::passes::cssm::CssmParams;
 pub use super::passes::interleave_blur::InterleaveParams;
 pub use super::passes::ism_params::{DiskLight, IsmParams, ValIsmParams, VplIsmParams};
@@ -194,6 +194,21 @@ impl GpuMode {
         }
     }
 
+    /// [`Self::describe`] for a frame of `vpls` VPLs: the gates' automatic roulette as it acts
+    /// there ("roulette under 0.05 (auto)", or nothing where it is off).
+    pub fn describe_for(&self, vpls: u32) -> String {
+        match *self {
+            GpuMode::Gates(mut p) if p.walk_roulette == WalkRoulette::Auto => {
+                let share = p.roulette_share(vpls);
+                p.walk_roulette = WalkRoulette::Share(share);
+                let s = GpuMode::Gates(p).describe();
+                let on = share > 0.0 && p.gates.shape != GateShape::Disk;
+                if on { s + " (auto)" } else { s }
+            }
+            _ => self.describe(),
+        }
+    }
+
     /// The method's settings in a few words, for reports ("portals, walk ≤ 64, 8×8
     /// interleaved"); empty for methods without any.
     pub fn describe(&self) -> String {
@@ -232,8 +247,12 @@ impl GpuMode {
                 if t > 0 && p.interleave.block > 1 {
                     s += &format!(", under {t} agreeing walk the rest");
                 }
-                if p.walk_roulette > 0.0 && p.gates.shape != GateShape::Disk {
-                    s += &format!(", roulette under {}", p.walk_roulette);
+                if p.gates.shape != GateShape::Disk {
+                    match p.walk_roulette {
+                        WalkRoulette::Share(r) if r > 0.0 => s += &format!(", roulette under {r}"),
+                        WalkRoulette::Share(_) => {}
+                        WalkRoulette::Auto => s += ", roulette auto",
+                    }
                 }
                 s
             }
@@ -432,7 +451,7 @@ pub fn walk_batch(adapter: &str, mode: &GpuMode, sight_steps: Option<u32>, vpls:
                     } else {
                         0
                     };
-                    let summed = if p.walk_roulette > 0.0 {
+                    let summed = if p.roulette_share(vpls) > 0.0 {
                         vpls.div_ceil(p.interleave.subsets())
                     } else {
                         0
@@ -468,6 +487,39 @@ pub fn warn_software_loop_limit(adapter: &str, mode: &GpuMode, vpls: u32) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_default_roulette_is_on_where_an_interleaved_pixel_walks_many_vpls() {
+        use super::super::passes::clustered_gates::AUTO_ROULETTE_SHARE as AUTO;
+        let mut p = GatesParams::default();
+        assert_eq!(p.walk_roulette, WalkRoulette::Auto);
+        assert_eq!(p.interleave.block, 8);
+        assert_eq!(p.roulette_share(4_096), 0.0, "64 VPLs a pixel");
+        assert_eq!(p.roulette_share(8_192), AUTO);
+        assert_eq!(p.roulette_share(16_384), AUTO);
+        p.interleave.block = 4;
+        assert_eq!(p.roulette_share(2_048), AUTO);
+        assert_eq!(p.roulette_share(2_032), 0.0, "127 VPLs a pixel");
+        // Reports name it as it acts.
+        let described = |vpls| GpuMode::Gates(p).describe_for(vpls);
+        assert_eq!(
+            described(2_048),
+            "voxel walk, 4×4 interleaved, roulette under 0.05 (auto)"
+        );
+        assert_eq!(described(1_024), "voxel walk, 4×4 interleaved");
+        assert!(GpuMode::Gates(p).describe().ends_with("roulette auto"));
+        p.interleave.block = 1;
+        assert_eq!(
+            p.roulette_share(16_384),
+            0.0,
+            "no blur, no roulette unless asked"
+        );
+        p.walk_roulette = WalkRoulette::Share(0.1);
+        assert_eq!(p.roulette_share(16), 0.1);
+        p.walk_roulette = WalkRoulette::Share(0.0);
+        p.interleave.block = 8;
+        assert_eq!(p.roulette_share(16_384), 0.0, "off when asked");
+    }
 
     /// Gates with the portal walk.
     fn portals() -> GatesParams {
@@ -519,11 +571,16 @@ mod tests {
         let GpuMode::Gates(mut roulette) = voxels else {
             unreachable!()
         };
-        roulette.walk_roulette = 0.05;
+        roulette.walk_roulette = WalkRoulette::Share(0.05);
         let roulette = GpuMode::Gates(roulette);
         assert_eq!(walk_batch(llvmpipe, &roulette, Some(1251), 1024), 52);
         assert_eq!(
             walk_batch(llvmpipe, &roulette, Some(99), 16_384),
+            (65_279 - 256) / 100
+        );
+        // The default roulette, on at 256 VPLs a pixel, sums them too.
+        assert_eq!(
+            walk_batch(llvmpipe, &voxels, Some(99), 16_384),
             (65_279 - 256) / 100
         );
         for steps in [3, 100, 1251, 4000] {

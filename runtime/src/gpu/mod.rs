@@ -78,7 +78,9 @@ pub use methods::{
     IsmParams, LcDisk, LightClusterGpuParams, METHODS, MethodInfo, MethodSettings, PcssParams,
     PerVplParams, ShadowParams, ValIsmParams, ValModeParams, VplIsmParams, method,
 };
-pub use passes::clustered_gates::{MAX_CLUSTERS, MAX_GATES};
+pub use passes::clustered_gates::{
+    AUTO_ROULETTE_SHARE, AUTO_ROULETTE_VPLS, MAX_CLUSTERS, MAX_GATES, WalkRoulette,
+};
 pub use passes::display::{DISPLAY_FORMAT, read_display};
 pub use passes::light_cluster::{MAX_LC_CLUSTERS, MAX_LC_LIGHTS};
 pub use passes::rsm_vpls::RsmParams;
@@ -520,7 +522,7 @@ impl GpuRenderer {
             vpl_count,
         );
         let (walk_roulette, walk_seed) = match params.mode {
-            GpuMode::Gates(gp) => (gp.walk_roulette, gp.walk_seed),
+            GpuMode::Gates(gp) => (gp.roulette_share(vpl_count), gp.walk_seed),
             _ => (0.0, 0),
         };
         let globals = Globals {

@@ -46,17 +46,53 @@ pub struct GatesParams {
     /// Interleaved sampling and the geometry-aware blur, as the VAL modes have them (the same
     /// defaults: 8 × 8 blocks); block 1 gathers every VPL at every pixel.
     pub interleave: InterleaveParams,
-    /// Portals and voxels, Russian roulette on the walks: a VPL that brings a pixel less than
-    /// this share of its subset's unshadowed light is walked with probability (its share ÷
-    /// this) and, found visible, counts 1 ÷ that probability — the same light on average, in
-    /// at most 2 ÷ this walks a pixel's subset on average instead of every VPL. 0: every VPL
-    /// walked (the CPU twin always walks every VPL); the starved pixels' second pass walks
-    /// every VPL. [Limit: 0 ≤ share < 1] [Units: share of the light]
-    pub walk_roulette: f32,
+    /// Portals and voxels, Russian roulette on the walks ([`WalkRoulette`]; by default
+    /// [`WalkRoulette::Auto`]: on where a pixel walks many VPLs).
+    pub walk_roulette: WalkRoulette,
     /// The roulette's random numbers: a Weyl sequence over the VPLs shifted by a hash of this
     /// seed and the pixel's tile (shade.wgsl's `roulette_hash`; a frame's noise is the same
     /// each time it is rendered, another seed draws other walks).
     pub walk_seed: u32,
+}
+
+/// Russian roulette on the walks of portals and voxels: a VPL that brings a pixel less than a
+/// share S of its subset's unshadowed light is walked with probability (its share ÷ S) and,
+/// found visible, counts 1 ÷ that probability — the same light on average, in at most 2 ÷ S
+/// walks a pixel's subset on average instead of every VPL. The CPU twin always walks every
+/// VPL; the starved pixels' second pass walks every VPL.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum WalkRoulette {
+    /// [`AUTO_ROULETTE_SHARE`] where the frame is interleaved (the blur evens out the noise)
+    /// and a pixel's VPL subset holds [`AUTO_ROULETTE_VPLS`] or more (16,384 VPLs in 8 × 8
+    /// blocks, 4,096 in 4 × 4), else every VPL walked: there it halves the frame on a GPU and
+    /// moves the indirect MSE by a few per cent (at most +27 % measured); with fewer it saves
+    /// less and costs more (README).
+    #[default]
+    Auto,
+    /// This share S; 0: every VPL walked. [Limit: 0 ≤ S < 1] [Units: share of the light]
+    Share(f32),
+}
+
+/// The share [`WalkRoulette::Auto`] takes. [Units: share of a pixel's light]
+pub const AUTO_ROULETTE_SHARE: f32 = 0.05;
+/// The VPLs a pixel's subset must hold for [`WalkRoulette::Auto`] to take its share.
+pub const AUTO_ROULETTE_VPLS: u32 = 128;
+
+impl WalkRoulette {
+    /// The share S for a frame whose pixels each light `subset_vpls` VPLs, `blurred` where it
+    /// is interleaved (0: off).
+    pub fn share(self, subset_vpls: u32, blurred: bool) -> f32 {
+        match self {
+            Self::Share(s) => s,
+            Self::Auto if blurred && subset_vpls >= AUTO_ROULETTE_VPLS => AUTO_ROULETTE_SHARE,
+            Self::Auto => 0.0,
+        }
+    }
+
+    /// A share above 0, whatever the VPLs (not auto, not off).
+    pub fn is_fixed(self) -> bool {
+        matches!(self, Self::Share(s) if s > 0.0)
+    }
 }
 
 /// Checks gate parameters against what the GPU's test does (≤ 2 hops).
@@ -79,6 +115,13 @@ pub fn check_gates(g: &GateParams) -> Result<(), RenderError> {
 }
 
 impl GatesParams {
+    /// The roulette's share S for a frame of `vpls` VPLs (0: every VPL walked).
+    pub fn roulette_share(&self, vpls: u32) -> f32 {
+        let il = self.interleave;
+        self.walk_roulette
+            .share(vpls.div_ceil(il.subsets()), il.block > 1)
+    }
+
     /// Whether the indirect light is gathered in a pass of its own and composed by the blur
     /// (interleaved, or walks — portals or voxels —, which run in batches on a software
     /// rasterizer), not in the shading pass (disks gathering every VPL at every pixel).
@@ -99,8 +142,9 @@ impl GatesParams {
                 cp.tile_px, cp.depth_slices
             )));
         }
-        let r = self.walk_roulette;
-        if !(0.0..1.0).contains(&r) {
+        if let WalkRoulette::Share(r) = self.walk_roulette
+            && !(0.0..1.0).contains(&r)
+        {
             return Err(RenderError::Param(format!(
                 "walk roulette {r} must be a share of a pixel's light in 0..1 (0: every VPL \
                  walked; 0.05: VPLs under 5 % of it walked by chance)"
