@@ -7,13 +7,15 @@
 #
 # VISGATE: the visgate binary (a release build). OUT: a folder; it gets OUT/LEVEL.vgate,
 # OUT/log.txt (every render's report) and OUT/table.md (level, camera, size, VPLs, mode, GPU ms
-# of the frame, of its indirect pass; wall ms where the adapter's timestamps are not used). LEVEL: e2m3, sponza (default both). Modes: none,
-# direct-only, gates (voxel walk), gates-triangles, gates-portal, gates-disk, gates-i4 and
-# val-hard-i4 (4 × 4 interleaving), gates-rr0, gates-rr05 and gates-rr10 (Russian roulette on
-# the walks off, S = 0.05 and 0.1; gates: the default, auto), val-hard, val-cssm, per-vpl-shadow-maps. In the environment:
-# RUNS="SIZE:COUNTS ..." (default "512x512:4096,1024,16384 1280x720:4096"), MODES (of those,
-# default all but the 4 × 4 and roulette ones), LIMIT (seconds a render may take, default 60). A render that fails or runs
-# past LIMIT is written as such in the table. Needs ../shared/scenes beside the repository.
+# of the frame, of its indirect pass; wall ms where the adapter's timestamps are not used).
+# LEVEL: e2m3, sponza (default both). Modes: none, direct-only, gates (voxel walk, the walks'
+# roulette auto), gates-rr0, gates-rr05 and gates-rr10 (the roulette off, S = 0.05 and 0.1),
+# gates-triangles, gates-portal, gates-disk, gates-i4, gates-i4-rr0 and val-hard-i4 (4 × 4
+# interleaving; rr0: every VPL walked), val-hard, val-cssm, per-vpl-shadow-maps. In the
+# environment: RUNS="SIZE:COUNTS ..." (default "512x512:4096,1024,16384 1280x720:4096"), MODES
+# (of those, default all but the 4 × 4 and roulette ones), LIMIT (seconds a render may take,
+# default 60). A render that fails or runs past LIMIT is written as such in the table. Needs
+# ../shared/scenes beside the repository.
 set -uo pipefail
 if [ $# -lt 2 ]; then
     sed -n '2,/^set /p' "$0" | grep '^#' | sed 's/^# \{0,1\}//'
@@ -35,6 +37,7 @@ args_of() { # LABEL -> render arguments
     gates-portal) echo "--mode gates --gate-shape portal" ;;
     gates-disk) echo "--mode gates --gate-shape disk" ;;
     gates-i4) echo "--mode gates --interleave 4" ;;
+    gates-i4-rr0) echo "--mode gates --interleave 4 --walk-roulette 0" ;;
     gates-rr0) echo "--mode gates --walk-roulette 0" ;;
     gates-rr05) echo "--mode gates --walk-roulette 0.05" ;;
     gates-rr10) echo "--mode gates --walk-roulette 0.1" ;;
