@@ -257,9 +257,10 @@ pub struct MethodArgs {
     /// probability its share / this, and counts as much more where visible: the same light on
     /// average in at most 2 / this walks a pixel on average (0.05: 40, where 16,384 VPLs in 8
     /// x 8 blocks walk 256), with noise the blur evens out. 0: every VPL walked. auto: 0.05
-    /// where the frame is interleaved and a pixel's subset holds 128 VPLs or more (16,384 VPLs
-    /// in 8 x 8 blocks, 4,096 in 4 x 4: there it halves the frame on a GPU and moves the
-    /// indirect error by a few per cent, at most +27 % measured; see the README), else 0.
+    /// where the frame is interleaved in blocks of 8 x 8 or more and a pixel's subset holds 128
+    /// VPLs or more (8,192 VPLs in 8 x 8 blocks: there it halves the frame on a GPU and moves
+    /// the indirect error by a few per cent, at most +27 % measured; in 4 x 4 blocks it leaves
+    /// blotches; see the README), else 0.
     #[arg(long, value_name = "auto|SHARE", value_parser = walk_roulette, default_value = "auto")]
     pub walk_roulette: WalkRoulette,
     /// Per-VPL paraboloid map size (GPU), texels.

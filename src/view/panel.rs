@@ -17,8 +17,8 @@ fn walk_roulette(ui: &mut egui::Ui, r: &mut WalkRoulette) {
     let mut auto = *r == WalkRoulette::Auto;
     ui.horizontal(|ui| {
         let hint = format!(
-            "{AUTO_ROULETTE_SHARE} where a pixel's subset holds {AUTO_ROULETTE_VPLS} VPLs or more \
-             (16,384 VPLs in 8 × 8 blocks), else every VPL walked"
+            "{AUTO_ROULETTE_SHARE} in blocks of 8 × 8 or more where a pixel's subset holds \
+             {AUTO_ROULETTE_VPLS} VPLs or more (8,192 VPLs in 8 × 8 blocks), else every VPL walked"
         );
         if ui.checkbox(&mut auto, "auto").on_hover_text(hint).changed() {
             *r = if auto {

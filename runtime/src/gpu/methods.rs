@@ -497,23 +497,23 @@ mod tests {
         assert_eq!(p.roulette_share(4_096), 0.0, "64 VPLs a pixel");
         assert_eq!(p.roulette_share(8_192), AUTO);
         assert_eq!(p.roulette_share(16_384), AUTO);
-        p.interleave.block = 4;
-        assert_eq!(p.roulette_share(2_048), AUTO);
-        assert_eq!(p.roulette_share(2_032), 0.0, "127 VPLs a pixel");
+        assert_eq!(p.roulette_share(8_128), 0.0, "127 VPLs a pixel");
         // Reports name it as it acts.
-        let described = |vpls| GpuMode::Gates(p).describe_for(vpls);
+        let described = |p, vpls| GpuMode::Gates(p).describe_for(vpls);
         assert_eq!(
-            described(2_048),
-            "voxel walk, 4×4 interleaved, roulette under 0.05 (auto)"
+            described(p, 8_192),
+            "voxel walk, 8×8 interleaved, roulette under 0.05 (auto)"
         );
-        assert_eq!(described(1_024), "voxel walk, 4×4 interleaved");
+        assert_eq!(described(p, 4_096), "voxel walk, 8×8 interleaved");
         assert!(GpuMode::Gates(p).describe().ends_with("roulette auto"));
-        p.interleave.block = 1;
-        assert_eq!(
-            p.roulette_share(16_384),
-            0.0,
-            "no blur, no roulette unless asked"
-        );
+        p.interleave.block = 16;
+        assert_eq!(p.roulette_share(32_768), AUTO);
+        // 4 × 4 blocks blur too few subsets to hide it; no blur, none at all.
+        for block in [1, 4] {
+            p.interleave.block = block;
+            assert_eq!(p.roulette_share(16_384), 0.0, "{block}");
+            assert!(!described(p, 16_384).contains("roulette"), "{block}");
+        }
         p.walk_roulette = WalkRoulette::Share(0.1);
         assert_eq!(p.roulette_share(16), 0.1);
         p.walk_roulette = WalkRoulette::Share(0.0);

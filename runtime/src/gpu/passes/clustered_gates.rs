@@ -62,11 +62,12 @@ pub struct GatesParams {
 /// VPL; the starved pixels' second pass walks every VPL.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub enum WalkRoulette {
-    /// [`AUTO_ROULETTE_SHARE`] where the frame is interleaved (the blur evens out the noise)
-    /// and a pixel's VPL subset holds [`AUTO_ROULETTE_VPLS`] or more (16,384 VPLs in 8 × 8
-    /// blocks, 4,096 in 4 × 4), else every VPL walked: there it halves the frame on a GPU and
-    /// moves the indirect MSE by a few per cent (at most +27 % measured); with fewer it saves
-    /// less and costs more (README).
+    /// [`AUTO_ROULETTE_SHARE`] where the frame is interleaved in blocks of at least
+    /// [`AUTO_ROULETTE_BLOCK`]² (the blur evens out the noise over as many subsets) and a
+    /// pixel's VPL subset holds [`AUTO_ROULETTE_VPLS`] or more (8,192 VPLs in 8 × 8 blocks),
+    /// else every VPL walked: there it halves the frame on a GPU and moves the indirect MSE by
+    /// a few per cent (at most +27 % measured); with fewer VPLs it saves less and costs more,
+    /// and in 4 × 4 blocks it leaves blotches (README).
     #[default]
     Auto,
     /// This share S; 0: every VPL walked. [Limit: 0 ≤ S < 1] [Units: share of the light]
@@ -77,14 +78,18 @@ pub enum WalkRoulette {
 pub const AUTO_ROULETTE_SHARE: f32 = 0.05;
 /// The VPLs a pixel's subset must hold for [`WalkRoulette::Auto`] to take its share.
 pub const AUTO_ROULETTE_VPLS: u32 = 128;
+/// The least interleaving block side at which [`WalkRoulette::Auto`] takes its share.
+pub const AUTO_ROULETTE_BLOCK: u32 = 8;
 
 impl WalkRoulette {
-    /// The share S for a frame whose pixels each light `subset_vpls` VPLs, `blurred` where it
-    /// is interleaved (0: off).
-    pub fn share(self, subset_vpls: u32, blurred: bool) -> f32 {
+    /// The share S for a frame interleaved in blocks of side `block` whose pixels each light
+    /// `subset_vpls` VPLs (0: off).
+    pub fn share(self, subset_vpls: u32, block: u32) -> f32 {
         match self {
             Self::Share(s) => s,
-            Self::Auto if blurred && subset_vpls >= AUTO_ROULETTE_VPLS => AUTO_ROULETTE_SHARE,
+            Self::Auto if block >= AUTO_ROULETTE_BLOCK && subset_vpls >= AUTO_ROULETTE_VPLS => {
+                AUTO_ROULETTE_SHARE
+            }
             Self::Auto => 0.0,
         }
     }
@@ -119,7 +124,7 @@ impl GatesParams {
     pub fn roulette_share(&self, vpls: u32) -> f32 {
         let il = self.interleave;
         self.walk_roulette
-            .share(vpls.div_ceil(il.subsets()), il.block > 1)
+            .share(vpls.div_ceil(il.subsets()), il.block)
     }
 
     /// Whether the indirect light is gathered in a pass of its own and composed by the blur
