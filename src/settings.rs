@@ -471,18 +471,10 @@ impl MethodArgs {
     }
 }
 
-/// `--walk-roulette auto|SHARE`.
+/// `--walk-roulette auto|SHARE` ([`WalkRoulette`]'s own parser and limits).
 fn walk_roulette(text: &str) -> Result<WalkRoulette, String> {
-    if text == "auto" {
-        return Ok(WalkRoulette::Auto);
-    }
-    match text.parse::<f32>() {
-        Ok(s) if (0.0..1.0).contains(&s) => Ok(WalkRoulette::Share(s)),
-        _ => Err(format!(
-            "{text:?}: give auto, or a share of a pixel's light in 0..1 (0: every VPL walked; \
-             0.05: VPLs under 5 % of it walked by chance)"
-        )),
-    }
+    text.parse()
+        .map_err(|e: visgate_runtime::RenderError| e.to_string())
 }
 
 /// `--ism-val-weights P,N,F`: three numbers, comma-separated.

@@ -6,8 +6,9 @@ use eframe::egui;
 use visgate_formats::Scene;
 use visgate_runtime::cpu::gates::GateShape;
 use visgate_runtime::gpu::{
-    AUTO_ROULETTE_SHARE, AUTO_ROULETTE_VPLS, DirectLight, DiskLight, InterleaveParams, IsmParams,
-    LcDisk, LightClusterGpuParams, MethodSettings, PassTimes, WalkRoulette,
+    AUTO_ROULETTE_BLOCK, AUTO_ROULETTE_SHARE, AUTO_ROULETTE_VPLS, DirectLight, DiskLight,
+    InterleaveParams, IsmParams, LcDisk, LightClusterGpuParams, MethodSettings, PassTimes,
+    WalkRoulette,
 };
 
 use super::camera::FlyCamera;
@@ -16,9 +17,11 @@ use super::camera::FlyCamera;
 fn walk_roulette(ui: &mut egui::Ui, r: &mut WalkRoulette) {
     let mut auto = *r == WalkRoulette::Auto;
     ui.horizontal(|ui| {
+        let (b, n) = (AUTO_ROULETTE_BLOCK, AUTO_ROULETTE_VPLS);
         let hint = format!(
-            "{AUTO_ROULETTE_SHARE} in blocks of 8 × 8 or more where a pixel's subset holds \
-             {AUTO_ROULETTE_VPLS} VPLs or more (8,192 VPLs in 8 × 8 blocks), else every VPL walked"
+            "{AUTO_ROULETTE_SHARE} in blocks of {b} × {b} or more where a pixel's subset holds \
+             {n} VPLs or more ({} VPLs in {b} × {b} blocks), else every VPL walked",
+            n * b * b
         );
         if ui.checkbox(&mut auto, "auto").on_hover_text(hint).changed() {
             *r = if auto {

@@ -78,17 +78,10 @@ pub struct CompareMode {
 }
 
 impl CompareMode {
-    /// The method's settings in words, LightCluster's included.
-    pub fn describe(&self) -> String {
-        self.describe_with(self.mode.describe())
-    }
-
-    /// [`Self::describe`] for a frame of `vpls` VPLs ([`GpuMode::describe_for`]).
+    /// The method's settings in words for a frame of `vpls` VPLs ([`GpuMode::describe_for`]),
+    /// LightCluster's included.
     pub fn describe_for(&self, vpls: u32) -> String {
-        self.describe_with(self.mode.describe_for(vpls))
-    }
-
-    fn describe_with(&self, mode: String) -> String {
+        let mode = self.mode.describe_for(vpls);
         let DirectLight::LightCluster(p) = &self.direct else {
             return mode;
         };

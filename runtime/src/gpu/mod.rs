@@ -79,7 +79,8 @@ pub use methods::{
     PerVplParams, ShadowParams, ValIsmParams, ValModeParams, VplIsmParams, method,
 };
 pub use passes::clustered_gates::{
-    AUTO_ROULETTE_SHARE, AUTO_ROULETTE_VPLS, MAX_CLUSTERS, MAX_GATES, WalkRoulette,
+    AUTO_ROULETTE_BLOCK, AUTO_ROULETTE_SHARE, AUTO_ROULETTE_VPLS, MAX_CLUSTERS, MAX_GATES,
+    WalkRoulette,
 };
 pub use passes::display::{DISPLAY_FORMAT, read_display};
 pub use passes::light_cluster::{MAX_LC_CLUSTERS, MAX_LC_LIGHTS};

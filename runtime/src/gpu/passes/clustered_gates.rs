@@ -98,6 +98,35 @@ impl WalkRoulette {
     pub fn is_fixed(self) -> bool {
         matches!(self, Self::Share(s) if s > 0.0)
     }
+
+    /// Checks a share's limits (0 ≤ S < 1); auto is always within them.
+    pub fn check(self) -> Result<(), RenderError> {
+        match self {
+            Self::Share(s) if !(0.0..1.0).contains(&s) => Err(RenderError::Param(format!(
+                "walk roulette {s}: give auto or a share of a pixel's light in 0..1 (0: every \
+                 VPL walked; 0.05: VPLs under 5 % of it walked by chance)"
+            ))),
+            _ => Ok(()),
+        }
+    }
+}
+
+impl std::str::FromStr for WalkRoulette {
+    type Err = RenderError;
+
+    /// `auto`, or a share within [`WalkRoulette::check`]'s limits.
+    fn from_str(text: &str) -> Result<Self, RenderError> {
+        if text == "auto" {
+            return Ok(Self::Auto);
+        }
+        let share = text.parse::<f32>().map_err(|e| {
+            RenderError::Param(format!(
+                "walk roulette {text:?}: {e}; give auto or a share of a pixel's light in 0..1"
+            ))
+        })?;
+        let r = Self::Share(share);
+        r.check().map(|()| r)
+    }
 }
 
 /// Checks gate parameters against what the GPU's test does (≤ 2 hops).
@@ -147,14 +176,7 @@ impl GatesParams {
                 cp.tile_px, cp.depth_slices
             )));
         }
-        if let WalkRoulette::Share(r) = self.walk_roulette
-            && !(0.0..1.0).contains(&r)
-        {
-            return Err(RenderError::Param(format!(
-                "walk roulette {r} must be a share of a pixel's light in 0..1 (0: every VPL \
-                 walked; 0.05: VPLs under 5 % of it walked by chance)"
-            )));
-        }
+        self.walk_roulette.check()?;
         if self.light_entries == Some(0) {
             return Err(RenderError::Param(
                 "the light-entry pool (--light-entries) must hold at least 1 entry".into(),
