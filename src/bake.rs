@@ -11,6 +11,7 @@ use visgate_formats::vgate::{
     AlphaRule, BakeParams, CurvatureTo, GatePlacement, MaxBall, Resolution,
 };
 use visgate_preprocess::bake::{BakeOptions, Progress, bake};
+use visgate_preprocess::empty::INSIDE;
 
 /// Options of `visgate bake`.
 #[derive(Args)]
@@ -263,6 +264,15 @@ pub fn run(args: BakeArgs) -> Result<()> {
     }
     for o in &baked.openings {
         eprintln!("warning: leak: {}", o.describe());
+    }
+    if baked.openings.iter().any(|o| o.from == INSIDE) {
+        eprintln!(
+            "warning: the scene names no camera or light, so the bake kept as the level's \
+             inside the empty space that the most triangles face, and that space reaches the \
+             scene's bounds as above. If the level is meant to be sealed, close it there; in a \
+             scene file (`visgate scenes export`), `closed = true` with a camera or light inside \
+             makes the bake stop on a leak"
+        );
     }
     if let (Some(dir), false) = (&args.debug_dir, baked.openings.is_empty()) {
         write_leak_ply(dir, &baked.openings)?;

@@ -496,6 +496,55 @@ fn a_leak_is_printed_where_it_is_and_written_as_a_path() {
 }
 
 #[test]
+fn a_bare_mesh_is_baked_around_its_inside_and_told_where_that_leaks() {
+    // The leaky room's mesh alone: no camera, no light, not declared closed.
+    let dir = tempfile::tempdir().expect("tempdir");
+    leaky_room(dir.path());
+    let (mesh, out, debug, report) = (
+        dir.path().join("room.obj"),
+        dir.path().join("l.vgate"),
+        dir.path().join("debug"),
+        dir.path().join("bake.json"),
+    );
+    let path = |p: &std::path::Path| p.to_str().expect("utf-8").to_string();
+    let args = [
+        "bake".to_string(),
+        path(&mesh),
+        "-o".into(),
+        path(&out),
+        "--resolution".into(),
+        "64".into(),
+        "--debug-dir".into(),
+        path(&debug),
+        "--report".into(),
+        path(&report),
+    ];
+    let o = visgate(&args.iter().map(String::as_str).collect::<Vec<_>>());
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("warning: leak: the level's inside at (")
+            && err.contains("reaches the outside through an opening near (4."),
+        "{err}"
+    );
+    assert!(
+        err.contains("the most triangles face") && err.contains("`closed = true`"),
+        "{err}"
+    );
+    assert!(debug.join("leak.ply").exists());
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).expect("report")).expect("json");
+    let inside = json["empty_space"]["inside_m"]
+        .as_array()
+        .expect("inside_m");
+    let x = inside[0].as_f64().expect("x");
+    assert!(
+        (0.0..4.0).contains(&x),
+        "the inside's point {inside:?} is not in the room"
+    );
+}
+
+#[test]
 fn bake_takes_the_papers_readings_and_records_them_in_the_file() {
     let dir = tempfile::tempdir().expect("tempdir");
     let out = dir.path().join("ring.vgate");

@@ -315,6 +315,7 @@ pub fn bake(
             "components": es.components,
             "leaks": es.leaks,
             "openings": es.openings,
+            "inside_m": es.inside.map(|s| s.position_m),
             "hung_objects": es.threads,
             "seeds_outside_grid": es.seeds_outside,
         }),

@@ -24,6 +24,9 @@ use visgate_formats::vgate::GridMeta;
 use crate::BakeError;
 use crate::neighbourhood::{Conn, grid_components};
 
+/// What a leak found from the level's inside (a scene without camera or light) starts from.
+pub const INSIDE: &str = "the level's inside";
+
 /// Parameters of [`empty_space`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EmptySpaceParams {
@@ -98,9 +101,13 @@ pub struct EmptySpace {
     pub components: Vec<ComponentReport>,
     /// Leaks of a closed scene (empty when not closed or sealed).
     pub leaks: Vec<Leak>,
-    /// Where they leak: the shortest paths from the cameras and lights to the outside, and
-    /// the openings they pass.
+    /// Where they leak: the widest paths from the cameras and lights to the outside, and the
+    /// openings they pass; for a scene that names none, from the level's inside where its
+    /// space reaches the bounds.
     pub openings: Vec<crate::leak::LeakPath>,
+    /// The point of the level's inside, for a scene that names no camera and no light, where
+    /// its space reaches the bounds (inside.rs).
+    pub inside: Option<crate::inside::Inside>,
     /// Floating objects that were hung.
     pub threads: Vec<Thread>,
     /// Seeds that fell outside the grid or in solid with no empty voxel next to them.
@@ -174,24 +181,54 @@ pub fn empty_space(
             None => seeds_outside.push(s.what.clone()),
         }
     }
-    // Facing: which side of each triangle each component lies on.
+    // Facing: which side of each triangle each component lies on, 0.75 voxel off its
+    // centroid along its normal and against it.
     let mut faced = vec![[0u64; 2]; n];
-    let step = 0.75 * meta.voxel_size_m;
+    // For a bare mesh's inside, the triangles that face each component, seen from the first
+    // voxel off the centroid that is not solid (0.75, 1.5 or 2.25 voxels along the normal): a
+    // wall that lies on a voxel boundary is voxelized into the layers on both sides of it, so
+    // 0.75 voxel off it is its own solid and the vote above counts it for no side.
+    let bare = seeds.is_empty() && !params.closed;
+    let mut fronts = vec![0u64; if bare { n } else { 0 }];
+    let vs = meta.voxel_size_m;
+    let label_at = |p: Vec3| {
+        let i = meta.index(meta.world_to_voxel(p.to_array())?);
+        Some((solid[i], comps.label(i)))
+    };
     for t in triangles {
         let nrm = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
         if nrm == Vec3::ZERO {
             continue;
         }
         let c = (t[0] + t[1] + t[2]) / 3.0;
-        for (side, p) in [(0, c + nrm * step), (1, c - nrm * step)] {
-            if let Some(l) = meta
-                .world_to_voxel(p.to_array())
-                .and_then(|v| comps.label(meta.index(v)))
-            {
+        for (side, dir) in [(0, nrm), (1, -nrm)] {
+            if let Some((_, Some(l))) = label_at(c + dir * (0.75 * vs)) {
                 faced[l as usize][side] += 1;
             }
         }
+        if bare {
+            let first_open = [0.75, 1.5, 2.25]
+                .into_iter()
+                .find_map(|k| label_at(c + nrm * (k * vs)).filter(|&(s, _)| !s));
+            if let Some((_, Some(l))) = first_open {
+                fronts[l as usize] += 1;
+            }
+        }
     }
+    // A scene that names no camera and no light (a bare mesh): the level's inside keeps its
+    // component, as a camera would (inside.rs).
+    let inside_component = bare
+        .then(|| crate::inside::inside_component(&fronts, &voxels))
+        .flatten();
+    // One distance field for the inside's point and its leaks (the border ring open: a
+    // voxel by a window to the void is wide, but its rays escape).
+    // Only where it reaches the bounds: a sealed level's inside needs no point.
+    let walls = inside_component
+        .filter(|&c| at_bounds[c as usize])
+        .map(|_| crate::leak::clearance_to_walls(meta, &empty));
+    let inside = inside_component.zip(walls.as_ref()).and_then(|(c, d2)| {
+        crate::inside::find_inside(meta, &empty, d2, &|i| comps.label(i) == Some(c))
+    });
     let to_m = |v: [u32; 3], corner: f32| -> [f32; 3] {
         std::array::from_fn(|a| meta.origin_m[a] + (v[a] as f32 + corner) * meta.voxel_size_m)
     };
@@ -199,6 +236,19 @@ pub fn empty_space(
         .map(|c| {
             let (kept, reason) = if !seeds_in[c].is_empty() {
                 (true, format!("holds {}", seeds_in[c].join(", ")))
+            } else if inside_component == Some(c as u32) {
+                let point = inside.map_or(String::new(), |s| {
+                    let p = s.position_m;
+                    format!("; its point ({:.2}, {:.2}, {:.2}) m", p[0], p[1], p[2])
+                });
+                (
+                    true,
+                    format!(
+                        "the level's inside: the most triangles face it ({} of them; no camera \
+                         or light named){point}",
+                        fronts[c]
+                    ),
+                )
             } else if params.closed && at_bounds[c] {
                 (
                     false,
@@ -315,6 +365,13 @@ pub fn empty_space(
             });
         }
     }
+    // The inside's space reaching the bounds: where, from the inside, as for a camera.
+    if let (Some(s), Some(c), Some(d2)) = (inside, inside_component, &walls)
+        && at_bounds[c as usize]
+    {
+        let from = (INSIDE.to_string(), s.position_m, s.voxel);
+        openings = crate::leak::find_openings_with(meta, &empty, d2, &[from]);
+    }
     components.sort_by_key(|c| std::cmp::Reverse(c.voxels));
     let threads = hang_floating_objects(meta, &mut empty);
     let empty_voxels = empty.iter().filter(|&&e| e).count() as u64;
@@ -329,6 +386,7 @@ pub fn empty_space(
         components,
         leaks,
         openings,
+        inside,
         threads,
         seeds_outside,
     })

@@ -26,6 +26,7 @@ pub mod empty;
 pub mod flatten;
 pub mod gate_step;
 pub mod graph;
+pub mod inside;
 pub mod leak;
 pub mod memory;
 pub mod neighbourhood;

@@ -640,7 +640,8 @@ fn a_leak_is_found_at_its_opening_and_a_sealed_room_does_not_leak() {
         let (lo, hi) = (Vec3::new(4.0, 1.2, 1.7), Vec3::new(4.0, 1.8, 2.3));
         assert!(
             p.cmpge(lo - vx).all() && p.cmple(hi + vx).all(),
-            "at {res}: opening {p} not within a voxel of the window"
+            "at {res}: opening {p} not within a voxel of the window: {}",
+            o.describe()
         );
         assert!(
             (0.18..=0.9).contains(&o.width_m),
@@ -830,5 +831,107 @@ fn the_sight_grid_is_the_thin_voxelization_s_open_voxels_never_coarser_than_the_
             matches!(bake_scene(&scene, &p), Err(BakeError::Param(_))),
             "{v}"
         );
+    }
+}
+
+/// `model` as a bare mesh: no camera, no light, not declared closed.
+fn bare(name: &str, model: ImportedModel) -> Scene {
+    let mut desc = SceneDesc::for_mesh_file(Path::new(&format!("{name}.obj")));
+    desc.closed = false;
+    desc.cameras.clear();
+    desc.lights.clear();
+    Scene::assemble(&desc, vec![model], Path::new(name)).expect("assemble")
+}
+
+/// Adds to `model` a slab 5 cm thick standing on the ground outside the room of
+/// [`room_with_windows`] (x 6.5 … 6.55 m, 2.5 m off the window: no narrower place on the way
+/// out than the window), its two faces split into `n` × `n` quads each and
+/// facing into it, as a Quake brush thinner than a voxel does: the void beside it sees their
+/// backs, many of them.
+fn add_inward_slab(model: &mut ImportedModel, n: u32) {
+    let m = &mut model.meshes[0];
+    for (x, sign) in [(6.5f32, 1.0f32), (6.55, -1.0)] {
+        for i in 0..n {
+            for j in 0..n {
+                let (y0, y1) = (
+                    0.5 + 2.0 * i as f32 / n as f32,
+                    0.5 + 2.0 * (i + 1) as f32 / n as f32,
+                );
+                let (z0, z1) = (
+                    0.5 + 3.0 * j as f32 / n as f32,
+                    0.5 + 3.0 * (j + 1) as f32 / n as f32,
+                );
+                let b = m.positions.len() as u32;
+                // Wound so that the normal is +x at x = 6.5 and -x at 6.55: into the slab.
+                let (yb, zb) = if sign > 0.0 { (y1, z0) } else { (y0, z1) };
+                m.positions.extend([
+                    Vec3::new(x, y0, z0),
+                    Vec3::new(x, yb, zb),
+                    Vec3::new(x, y1, z1),
+                    Vec3::new(x, y0 + y1 - yb, z0 + z1 - zb),
+                ]);
+                m.triangles.extend([[b, b + 1, b + 2], [b, b + 2, b + 3]]);
+            }
+        }
+    }
+    let k = m.positions.len();
+    m.normals.resize(k, Vec3::X);
+    m.uvs.resize(k, Vec2::ZERO);
+}
+
+#[test]
+fn a_bare_mesh_keeps_the_level_s_inside_and_says_where_it_leaks() {
+    let room = Vec3::new(2.0, 1.5, 2.0);
+    // Without the window: the room is kept as the level's inside, and nothing leaks.
+    let sealed = bake_scene(&bare("sealed", room_with_windows(0)), &params(64)).expect("bake");
+    assert!(sealed.openings.is_empty());
+    assert!(cluster_at(&sealed.level, room).is_some());
+    let reasons = sealed.report.empty_space["components"].to_string();
+    assert!(reasons.contains("the level's inside"), "{reasons}");
+    // With the window onto the ground outside and a slab out there whose many faces turn their
+    // backs to the void: the room and the void are one component that the facing vote alone
+    // would drop (more backs than fronts), as a bare Quake level's interior was dropped.
+    let mut model = room_with_windows(1);
+    add_inward_slab(&mut model, 12);
+    let scene = bare("window", model);
+    for res in [64, 96, 128] {
+        let b = bake_scene(&scene, &params(res)).unwrap_or_else(|e| panic!("at {res}: {e}"));
+        assert!(
+            cluster_at(&b.level, room).is_some(),
+            "at {res}: the room dropped"
+        );
+        let comps = b.report.empty_space["components"]
+            .as_array()
+            .expect("components");
+        let inside = comps
+            .iter()
+            .find(|c| {
+                c["reason"]
+                    .as_str()
+                    .is_some_and(|r| r.contains("the level's inside"))
+            })
+            .unwrap_or_else(|| panic!("at {res}: no inside in {comps:?}"));
+        let faced = &inside["faced_by"];
+        assert!(
+            faced[1].as_u64() > faced[0].as_u64(),
+            "at {res}: the vote would keep it anyway: {faced}"
+        );
+        assert_eq!(b.openings.len(), 1, "at {res}: {:?}", b.openings);
+        let o = &b.openings[0];
+        assert_eq!(o.from, visgate_preprocess::empty::INSIDE);
+        let vx = 8.0 / res as f32;
+        let p = Vec3::from(o.opening_m);
+        let (lo, hi) = (Vec3::new(4.0, 1.2, 1.7), Vec3::new(4.0, 1.8, 2.3));
+        assert!(
+            p.cmpge(lo - vx).all() && p.cmple(hi + vx).all(),
+            "at {res}: opening {p} not within a voxel of the window: {}",
+            o.describe()
+        );
+        let from = Vec3::from(o.from_m);
+        assert!(
+            from.cmpge(Vec3::ZERO).all() && from.cmple(Vec3::new(4.0, 3.0, 4.0)).all(),
+            "at {res}: the inside's point {from} is not in the room"
+        );
+        eprintln!("at {res}: {}", o.describe());
     }
 }
