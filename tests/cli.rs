@@ -436,21 +436,19 @@ fn bake_says_each_import_warning_once() {
     );
 }
 
-#[test]
-fn a_leak_is_printed_where_it_is_and_written_as_a_path() {
-    let dir = tempfile::tempdir().expect("tempdir");
-    let scene = leaky_room(dir.path());
-    let (out, debug, report) = (
-        dir.path().join("l.vgate"),
-        dir.path().join("debug"),
-        dir.path().join("bake.json"),
-    );
+/// `visgate bake SCENE -o DIR/l.vgate --resolution 64 --debug-dir DIR/debug --report
+/// DIR/bake.json`, and those two paths.
+fn bake_at_64_with_debug(
+    scene: &std::path::Path,
+    dir: &std::path::Path,
+) -> (Vec<String>, std::path::PathBuf, std::path::PathBuf) {
+    let (debug, report) = (dir.join("debug"), dir.join("bake.json"));
     let path = |p: &std::path::Path| p.to_str().expect("utf-8").to_string();
     let args = [
         "bake".to_string(),
-        path(&scene),
+        path(scene),
         "-o".into(),
-        path(&out),
+        path(&dir.join("l.vgate")),
         "--resolution".into(),
         "64".into(),
         "--debug-dir".into(),
@@ -458,6 +456,14 @@ fn a_leak_is_printed_where_it_is_and_written_as_a_path() {
         "--report".into(),
         path(&report),
     ];
+    (args.to_vec(), debug, report)
+}
+
+#[test]
+fn a_leak_is_printed_where_it_is_and_written_as_a_path() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let scene = leaky_room(dir.path());
+    let (args, debug, report) = bake_at_64_with_debug(&scene, dir.path());
     let args: Vec<&str> = args.iter().map(String::as_str).collect();
     let o = visgate(&args);
     assert!(!o.status.success());
@@ -500,25 +506,7 @@ fn a_bare_mesh_is_baked_around_its_inside_and_told_where_that_leaks() {
     // The leaky room's mesh alone: no camera, no light, not declared closed.
     let dir = tempfile::tempdir().expect("tempdir");
     leaky_room(dir.path());
-    let (mesh, out, debug, report) = (
-        dir.path().join("room.obj"),
-        dir.path().join("l.vgate"),
-        dir.path().join("debug"),
-        dir.path().join("bake.json"),
-    );
-    let path = |p: &std::path::Path| p.to_str().expect("utf-8").to_string();
-    let args = [
-        "bake".to_string(),
-        path(&mesh),
-        "-o".into(),
-        path(&out),
-        "--resolution".into(),
-        "64".into(),
-        "--debug-dir".into(),
-        path(&debug),
-        "--report".into(),
-        path(&report),
-    ];
+    let (args, debug, report) = bake_at_64_with_debug(&dir.path().join("room.obj"), dir.path());
     let o = visgate(&args.iter().map(String::as_str).collect::<Vec<_>>());
     assert!(o.status.success(), "{}", stderr(&o));
     let err = stderr(&o);

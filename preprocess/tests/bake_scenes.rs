@@ -622,6 +622,19 @@ fn room_with_windows(windows: u32) -> ImportedModel {
     raw("room", pos, tris)
 }
 
+/// Asserts that opening `o`, found on a grid of `res` voxels over [`room_with_windows`]'s
+/// 8 m, lies within a voxel of its first window (y 1.2 … 1.8, z 1.7 … 2.3 m in the plane x = 4).
+fn assert_at_the_window(o: &visgate_preprocess::leak::LeakPath, res: u32) {
+    let vx = 8.0 / res as f32;
+    let p = Vec3::from(o.opening_m);
+    let (lo, hi) = (Vec3::new(4.0, 1.2, 1.7), Vec3::new(4.0, 1.8, 2.3));
+    assert!(
+        p.cmpge(lo - vx).all() && p.cmple(hi + vx).all(),
+        "at {res}: opening {p} not within a voxel of the window: {}",
+        o.describe()
+    );
+}
+
 #[test]
 fn a_leak_is_found_at_its_opening_and_a_sealed_room_does_not_leak() {
     let scene = |n| custom("window", room_with_windows(n), true, [2.0, 1.5, 2.0], 1.0);
@@ -635,14 +648,7 @@ fn a_leak_is_found_at_its_opening_and_a_sealed_room_does_not_leak() {
         };
         assert_eq!(openings.len(), 1, "at {res}: {msg}");
         let o = &openings[0];
-        let vx = 8.0 / res as f32;
-        let p = Vec3::from(o.opening_m);
-        let (lo, hi) = (Vec3::new(4.0, 1.2, 1.7), Vec3::new(4.0, 1.8, 2.3));
-        assert!(
-            p.cmpge(lo - vx).all() && p.cmple(hi + vx).all(),
-            "at {res}: opening {p} not within a voxel of the window: {}",
-            o.describe()
-        );
+        assert_at_the_window(o, res);
         assert!(
             (0.18..=0.9).contains(&o.width_m),
             "at {res}: {} m wide",
@@ -919,14 +925,7 @@ fn a_bare_mesh_keeps_the_level_s_inside_and_says_where_it_leaks() {
         assert_eq!(b.openings.len(), 1, "at {res}: {:?}", b.openings);
         let o = &b.openings[0];
         assert_eq!(o.from, visgate_preprocess::empty::INSIDE);
-        let vx = 8.0 / res as f32;
-        let p = Vec3::from(o.opening_m);
-        let (lo, hi) = (Vec3::new(4.0, 1.2, 1.7), Vec3::new(4.0, 1.8, 2.3));
-        assert!(
-            p.cmpge(lo - vx).all() && p.cmple(hi + vx).all(),
-            "at {res}: opening {p} not within a voxel of the window: {}",
-            o.describe()
-        );
+        assert_at_the_window(o, res);
         let from = Vec3::from(o.from_m);
         assert!(
             from.cmpge(Vec3::ZERO).all() && from.cmple(Vec3::new(4.0, 3.0, 4.0)).all(),
