@@ -368,6 +368,7 @@ pub fn empty_space(
     // The inside's space reaching the bounds: where, from the inside, as for a camera.
     if let (Some(s), Some(c), Some(d2)) = (inside, inside_component, &walls)
         && at_bounds[c as usize]
+        && s.enclosed
     {
         let from = (INSIDE.to_string(), s.position_m, s.voxel);
         openings = crate::leak::find_openings_with(meta, &empty, d2, &[from]);

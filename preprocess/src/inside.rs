@@ -11,7 +11,8 @@
 //! at most [`MAX_ESCAPES`] reach the grid's border without meeting solid (a window or a doorway
 //! to the void lets a few out; a courtyard or a roof open to the sky lets many) — so the middle
 //! of the level's largest room, or its widest voxel where none is enclosed. Where the inside
-//! reaches the bounds, the bake says where it leaks, from that point.
+//! reaches the bounds and its point is enclosed, the bake says where it leaks, from that point
+//! (a space open all round — the air around a building — has openings, not leaks).
 
 use visgate_formats::vgate::GridMeta;
 
@@ -28,6 +29,9 @@ pub struct Inside {
     pub voxel: usize,
     /// The voxel's centre. [Units: m]
     pub position_m: [f32; 3],
+    /// Whether it is enclosed; else the widest voxel of a space open all round (the air
+    /// around a building, whose openings are no leak).
+    pub enclosed: bool,
 }
 
 /// Of the rays from voxel `v` along the 26 neighbour directions through the `empty` voxels,
@@ -83,11 +87,12 @@ pub fn find_inside(
     candidates.select_nth_unstable_by(take - 1, by_width);
     candidates.truncate(take);
     candidates.par_sort_unstable_by(by_width);
-    let inside = |i: u32| {
+    let inside = |i: u32, enclosed: bool| {
         let v = meta.coords(i);
         Inside {
             voxel: i as usize,
             position_m: meta.voxel_to_world(v),
+            enclosed,
         }
     };
     // In parallel chunks, in order: the first enclosed candidate of the first chunk holding one.
@@ -96,7 +101,10 @@ pub fn find_inside(
             .iter()
             .find(|&&(_, i)| escapes(meta, empty, meta.coords(i), MAX_ESCAPES + 1) <= MAX_ESCAPES)
     });
-    Some(inside(enclosed.unwrap_or(&candidates[0]).1))
+    Some(match enclosed {
+        Some(&(_, i)) => inside(i, true),
+        None => inside(candidates[0].1, false),
+    })
 }
 
 /// The component of the level's inside: the one that the most triangles face (`fronts`),
