@@ -933,4 +933,40 @@ fn a_bare_mesh_keeps_the_level_s_inside_and_says_where_it_leaks() {
         );
         eprintln!("at {res}: {}", o.describe());
     }
+    // A block standing on a ground, its faces outward: the air around it is the inside, open
+    // all round (no voxel of it enclosed) — openings, not leaks.
+    let v = Vec3::new;
+    let mut pos = vec![v(0., 0., 0.), v(0., 0., 8.), v(8., 0., 8.), v(8., 0., 0.)];
+    let mut tris = vec![[0, 1, 2], [0, 2, 3]];
+    let (lo, hi) = (v(3., 0., 3.), v(5., 3., 5.));
+    for axis in 0..3 {
+        for side in [0.0f32, 1.0] {
+            // The face's corners, wound so that its normal points out of the block.
+            let (u, w) = ((axis + 1) % 3, (axis + 2) % 3);
+            let corner = |a: f32, b: f32| {
+                let mut p = [0.0f32; 3];
+                p[axis] = lo[axis] + side * (hi[axis] - lo[axis]);
+                p[u] = lo[u] + a * (hi[u] - lo[u]);
+                p[w] = lo[w] + b * (hi[w] - lo[w]);
+                Vec3::from(p)
+            };
+            let n = pos.len() as u32;
+            let quad = [
+                corner(0., 0.),
+                corner(1., 0.),
+                corner(1., 1.),
+                corner(0., 1.),
+            ];
+            pos.extend(if side > 0.5 {
+                quad
+            } else {
+                [quad[0], quad[3], quad[2], quad[1]]
+            });
+            tris.extend([[n, n + 1, n + 2], [n, n + 2, n + 3]]);
+        }
+    }
+    let b = bake_scene(&bare("block", raw("block", pos, tris)), &params(64)).expect("bake");
+    let comps = b.report.empty_space["components"].to_string();
+    assert!(comps.contains("the level's inside"), "{comps}");
+    assert!(b.openings.is_empty(), "{:?}", b.openings);
 }
