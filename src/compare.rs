@@ -27,7 +27,8 @@ pixels where that is 0) and gates-roulette (gates as set, its walks by Russian r
 --walk-roulette, or 0.05 where that is 0 or auto). `all`: every one but direct-only, gates once a
 shape, gates-filled and gates-starved where gates interleave without them, and
 gates-roulette where gates walk (voxels, portals) without it; the gate modes only with a level
-(given, or baked here).
+(given, or baked here). A mode that would render another's very frame (gates-roulette where
+gates' auto roulette takes the same share, 8,192 VPLs or more) takes that mode's row instead.
 
 Every mode renders at every --vpls count from every camera, beside the CPU reference with the
 very same VPLs (a shadow ray per VPL and pixel sample; --spp samples). OUT/report.md and

@@ -575,3 +575,61 @@ fn variants_are_rows_of_a_mode_with_the_runs_settings_and_their_own_flags() {
         );
     }
 }
+
+#[test]
+fn a_mode_that_renders_another_s_frame_takes_its_row_instead_of_a_second_render() {
+    // At 16,384 VPLs gates' auto roulette is gates-roulette's share: one frame, two rows; at
+    // 64 it is off, and gates-roulette renders its own.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("same");
+    visgate(&[
+        "compare",
+        "builtin:two-rooms",
+        "--bake-resolution",
+        "32",
+        "--modes",
+        "gates,gates-roulette",
+        "--vpls",
+        "64,16384",
+        "--size",
+        "24x18",
+        "--spp",
+        "1",
+        "--out",
+        out.to_str().expect("utf-8"),
+    ]);
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).expect("json"))
+            .expect("parses");
+    let rows = report["rows"].as_array().expect("rows");
+    let row = |mode: &str, vpls: u64| {
+        rows.iter()
+            .find(|r| r["camera"] == "main" && r["mode"] == mode && r["vpls"] == vpls)
+            .unwrap_or_else(|| panic!("no row {mode} at {vpls}: {rows:?}"))
+    };
+    let (g, r) = (row("gates", 16384), row("gates-roulette", 16384));
+    let settings = r["settings"].as_str().expect("settings");
+    assert!(settings.contains("the frame of gates"), "{settings}");
+    assert_eq!(g["indirect_mse"], r["indirect_mse"]);
+    assert_eq!(g["image"], r["image"]);
+    let (g, r) = (row("gates", 64), row("gates-roulette", 64));
+    assert!(
+        !r["settings"]
+            .as_str()
+            .expect("settings")
+            .contains("the frame of")
+    );
+    assert_ne!(g["image"], r["image"]);
+    // No image of its own for the shared frame.
+    let renders = out.join("renders").join("main");
+    let files: Vec<String> = std::fs::read_dir(&renders)
+        .expect("renders of camera main")
+        .flatten()
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(
+        files.iter().any(|f| f.contains("gates-roulette-64"))
+            && !files.iter().any(|f| f.contains("gates-roulette-16384")),
+        "{files:?}"
+    );
+}

@@ -604,7 +604,11 @@ fn camera_rows(
             ground_truth_rel_mse: gt.map(|e| e.rel_mse),
             image: path_string(&rel.with_extension("png")),
         });
-        for (m, own) in spec.modes.iter().zip(&own_direct) {
+        for (k, (m, own)) in spec.modes.iter().zip(&own_direct).enumerate() {
+            if let Some(row) = same_frame(&report.rows, &spec.modes[..k], m, &camera.name, vpls) {
+                report.rows.push(row);
+                continue;
+            }
             let name = format!("{}-{vpls}", file_name(&m.label));
             let mode_job = m.job(&job(Renderer::Gpu(m.mode), vpls));
             let direct = Direct {
@@ -635,6 +639,31 @@ fn camera_rows(
         }
     }
     Ok(())
+}
+
+/// The row of `m` where an earlier mode of the run (`before`) rendered the same frame for
+/// `camera` at `vpls` (its settings resolved for the VPLs that frame made: `gates` with the
+/// auto roulette on and `gates-roulette`): that mode's row under `m`'s label, its settings
+/// naming the frame it shares, instead of a second render of it.
+fn same_frame(
+    rows: &[Row],
+    before: &[CompareMode],
+    m: &CompareMode,
+    camera: &str,
+    vpls: u32,
+) -> Option<Row> {
+    before.iter().find_map(|b| {
+        let row = rows
+            .iter()
+            .find(|r| r.camera == camera && r.vpls == vpls && r.mode == b.label)?;
+        let n = row.vpl_count as u32;
+        let same = b.direct == m.direct && b.mode.resolved_for(n) == m.mode.resolved_for(n);
+        same.then(|| Row {
+            mode: m.label.clone(),
+            settings: format!("{} — the frame of {}", m.describe_for(n), b.label),
+            ..row.clone()
+        })
+    })
 }
 
 /// The method's settings in words, with its clusters: the VPLs' as the render counted them,

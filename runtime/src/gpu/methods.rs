@@ -198,14 +198,26 @@ impl GpuMode {
     /// there ("roulette under 0.05 (auto)", or nothing where it is off).
     pub fn describe_for(&self, vpls: u32) -> String {
         match *self {
-            GpuMode::Gates(mut p) if p.walk_roulette == WalkRoulette::Auto => {
-                let share = p.roulette_share(vpls);
-                p.walk_roulette = WalkRoulette::Share(share);
-                let s = GpuMode::Gates(p).describe();
-                let on = share > 0.0 && p.gates.shape != GateShape::Disk;
+            GpuMode::Gates(p) if p.walk_roulette == WalkRoulette::Auto => {
+                let resolved = self.resolved_for(vpls);
+                let s = resolved.describe();
+                let on = p.roulette_share(vpls) > 0.0 && p.gates.shape != GateShape::Disk;
                 if on { s + " (auto)" } else { s }
             }
             _ => self.describe(),
+        }
+    }
+
+    /// The mode as it renders a frame of `vpls` VPLs: the gates' automatic roulette resolved
+    /// to the share it takes there (0: every VPL walked), so that two modes that render the
+    /// same frame compare equal (`gates` and `gates-roulette` at 8,192 VPLs or more).
+    pub fn resolved_for(&self, vpls: u32) -> GpuMode {
+        match *self {
+            GpuMode::Gates(mut p) => {
+                p.walk_roulette = WalkRoulette::Share(p.roulette_share(vpls));
+                GpuMode::Gates(p)
+            }
+            m => m,
         }
     }
 
