@@ -1,4 +1,5 @@
-//! What the viewer keeps across runs, per scene: the method and its settings, the VPLs, the
+//! What the viewer keeps across runs, per scene: the method and its settings (the gates' walk
+//! roulette among them), the VPLs, the
 //! exposure, the layers and the camera — in `$XDG_CONFIG_HOME/visgate/viewer.json` (else
 //! `~/.config/…`). Scripted runs (`--screenshot`, `--benchmark`) and `--fresh` neither read
 //! nor write it, so that they stay reproducible.
@@ -38,6 +39,9 @@ pub struct SavedView {
     /// The VAL layer (absent in older files: off).
     #[serde(default)]
     pub vals_layer: bool,
+    /// The gates' walk roulette, `auto` or a share (absent in older files: the run's own).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub walk_roulette: Option<String>,
 }
 
 impl SavedView {
@@ -131,6 +135,7 @@ mod tests {
             disks: false,
             voxels: false,
             vals_layer: mode == "val-ism",
+            walk_roulette: (mode == "gates").then(|| "0.1".into()),
         };
         save_to(&p, "a", state("gates"));
         save_to(&p, "b", state("val-cssm"));
@@ -146,6 +151,22 @@ mod tests {
             .remove("closed_voxel_triangles");
         let older: SavedView = serde_json::from_value(json).expect("an older state");
         assert!(!older.closed_voxel_triangles);
+        // The roulette as the runtime reads it back; a file from before it: none (the run's).
+        use visgate_runtime::gpu::WalkRoulette;
+        for r in [
+            WalkRoulette::Auto,
+            WalkRoulette::Share(0.05),
+            WalkRoulette::Share(0.0),
+        ] {
+            assert_eq!(r.to_string().parse::<WalkRoulette>().ok(), Some(r));
+        }
+        assert_eq!(all["a"].walk_roulette.as_deref(), Some("0.1"));
+        let mut json: serde_json::Value = serde_json::to_value(state("gates")).expect("json");
+        json.as_object_mut()
+            .expect("object")
+            .remove("walk_roulette");
+        let older: SavedView = serde_json::from_value(json).expect("an older state");
+        assert_eq!(older.walk_roulette, None);
         // A file from before the shape was named: disks and voxels as chosen, else today's
         // default.
         let old = |disks: bool, voxels: bool| SavedView {

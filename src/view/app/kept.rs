@@ -42,6 +42,7 @@ impl ViewerApp {
             disks: false,
             voxels: false,
             vals_layer: l.vals,
+            walk_roulette: Some(self.settings.gates.walk_roulette.to_string()),
         }
     }
 
@@ -68,6 +69,10 @@ impl ViewerApp {
         p.map_size = map as u32;
         p.batch = batch as u32;
         self.settings.gates.interleave = self.settings.vals.interleave;
+        // A share this build refuses (a file edited by hand) keeps the run's own.
+        if let Some(r) = s.walk_roulette.as_deref().and_then(|t| t.parse().ok()) {
+            self.settings.gates.walk_roulette = r;
+        }
     }
 
     /// Saves the state when it changed, at most once a second (and at exit).

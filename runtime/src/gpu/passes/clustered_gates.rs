@@ -111,6 +111,16 @@ impl WalkRoulette {
     }
 }
 
+impl std::fmt::Display for WalkRoulette {
+    /// `auto`, or the share: what [`FromStr`](std::str::FromStr) reads back.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Auto => f.write_str("auto"),
+            Self::Share(s) => write!(f, "{s}"),
+        }
+    }
+}
+
 impl std::str::FromStr for WalkRoulette {
     type Err = RenderError;
 
