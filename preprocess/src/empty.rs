@@ -181,40 +181,8 @@ pub fn empty_space(
             None => seeds_outside.push(s.what.clone()),
         }
     }
-    // Facing: which side of each triangle each component lies on, 0.75 voxel off its
-    // centroid along its normal and against it.
-    let mut faced = vec![[0u64; 2]; n];
-    // For a bare mesh's inside, the triangles that face each component, seen from the first
-    // voxel off the centroid that is not solid (0.75, 1.5 or 2.25 voxels along the normal): a
-    // wall that lies on a voxel boundary is voxelized into the layers on both sides of it, so
-    // 0.75 voxel off it is its own solid and the vote above counts it for no side.
     let bare = seeds.is_empty() && !params.closed;
-    let mut fronts = vec![0u64; if bare { n } else { 0 }];
-    let vs = meta.voxel_size_m;
-    let label_at = |p: Vec3| {
-        let i = meta.index(meta.world_to_voxel(p.to_array())?);
-        Some((solid[i], comps.label(i)))
-    };
-    for t in triangles {
-        let nrm = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
-        if nrm == Vec3::ZERO {
-            continue;
-        }
-        let c = (t[0] + t[1] + t[2]) / 3.0;
-        for (side, dir) in [(0, nrm), (1, -nrm)] {
-            if let Some((_, Some(l))) = label_at(c + dir * (0.75 * vs)) {
-                faced[l as usize][side] += 1;
-            }
-        }
-        if bare {
-            let first_open = [0.75, 1.5, 2.25]
-                .into_iter()
-                .find_map(|k| label_at(c + nrm * (k * vs)).filter(|&(s, _)| !s));
-            if let Some((_, Some(l))) = first_open {
-                fronts[l as usize] += 1;
-            }
-        }
-    }
+    let (faced, fronts) = facing(meta, solid, &comps, triangles, bare);
     // A scene that names no camera and no light (a bare mesh): the level's inside keeps its
     // component, as a camera would (inside.rs).
     let inside_component = bare
@@ -305,40 +273,7 @@ pub fn empty_space(
     let mut leaks = Vec::new();
     let mut openings = Vec::new();
     if params.closed {
-        const SIDES: [&str; 6] = ["-x", "+x", "-y", "+y", "-z", "+z"];
-        let mut acc: Vec<(u64, [u32; 3], [u32; 3])> = vec![(0, [u32::MAX; 3], [0; 3]); 6];
-        for z in 1..nz - 1 {
-            for y in 1..ny - 1 {
-                for x in 1..nx - 1 {
-                    if !empty[x + nx * (y + ny * z)] {
-                        continue;
-                    }
-                    let v = [x, y, z];
-                    for a in 0..3 {
-                        for (s, edge) in [(2 * a, 1), (2 * a + 1, dims[a] as usize - 2)] {
-                            if v[a] == edge {
-                                let e = &mut acc[s];
-                                e.0 += 1;
-                                for (b, &c) in v.iter().enumerate() {
-                                    e.1[b] = e.1[b].min(c as u32);
-                                    e.2[b] = e.2[b].max(c as u32);
-                                }
-                            }
-                        }
-                    }
-                }
-            }
-        }
-        for (s, (count, l, h)) in acc.into_iter().enumerate() {
-            if count > 0 {
-                leaks.push(Leak {
-                    side: SIDES[s],
-                    voxels: count,
-                    bounds_min_m: to_m(l, 0.0),
-                    bounds_max_m: to_m(h, 1.0),
-                });
-            }
-        }
+        leaks = leaks_by_side(meta, &empty);
         if !leaks.is_empty() {
             openings = crate::leak::find_openings(meta, &empty, &seed_voxels);
         }
@@ -391,6 +326,94 @@ pub fn empty_space(
         threads,
         seeds_outside,
     })
+}
+
+/// Where the kept `empty` voxels of a closed scene touch each side of the bounds (the voxels
+/// next to the border ring): a leak per side touched, with its count and box.
+fn leaks_by_side(meta: &GridMeta, empty: &[bool]) -> Vec<Leak> {
+    const SIDES: [&str; 6] = ["-x", "+x", "-y", "+y", "-z", "+z"];
+    let dims = meta.dims;
+    let [nx, ny, nz] = dims.map(|d| d as usize);
+    let mut acc: Vec<(u64, [u32; 3], [u32; 3])> = vec![(0, [u32::MAX; 3], [0; 3]); 6];
+    for z in 1..nz - 1 {
+        for y in 1..ny - 1 {
+            for x in 1..nx - 1 {
+                if !empty[x + nx * (y + ny * z)] {
+                    continue;
+                }
+                let v = [x, y, z];
+                for a in 0..3 {
+                    for (s, edge) in [(2 * a, 1), (2 * a + 1, dims[a] as usize - 2)] {
+                        if v[a] == edge {
+                            let e = &mut acc[s];
+                            e.0 += 1;
+                            for (b, &c) in v.iter().enumerate() {
+                                e.1[b] = e.1[b].min(c as u32);
+                                e.2[b] = e.2[b].max(c as u32);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let to_m = |v: [u32; 3], corner: f32| -> [f32; 3] {
+        std::array::from_fn(|a| meta.origin_m[a] + (v[a] as f32 + corner) * meta.voxel_size_m)
+    };
+    acc.into_iter()
+        .enumerate()
+        .filter(|(_, (count, ..))| *count > 0)
+        .map(|(s, (count, l, h))| Leak {
+            side: SIDES[s],
+            voxels: count,
+            bounds_min_m: to_m(l, 0.0),
+            bounds_max_m: to_m(h, 1.0),
+        })
+        .collect()
+}
+
+/// Which side of each triangle each of `comps`' components lies on (`[front, back]`
+/// counts), sampled 0.75 voxel off the triangle's centroid along its normal and against it;
+/// and, for a bare mesh (`bare`), the triangles that face each component seen from the first
+/// voxel off the centroid that is not solid (0.75, 1.5 or 2.25 voxels along the normal): a
+/// wall that lies on a voxel boundary is voxelized into the layers on both sides of it, so
+/// 0.75 voxel off it is its own solid and the first count gives it to no side.
+fn facing(
+    meta: &GridMeta,
+    solid: &[bool],
+    comps: &crate::neighbourhood::Components,
+    triangles: &[[Vec3; 3]],
+    bare: bool,
+) -> (Vec<[u64; 2]>, Vec<u64>) {
+    let n = comps.count as usize;
+    let mut faced = vec![[0u64; 2]; n];
+    let mut fronts = vec![0u64; if bare { n } else { 0 }];
+    let vs = meta.voxel_size_m;
+    let label_at = |p: Vec3| {
+        let i = meta.index(meta.world_to_voxel(p.to_array())?);
+        Some((solid[i], comps.label(i)))
+    };
+    for t in triangles {
+        let nrm = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
+        if nrm == Vec3::ZERO {
+            continue;
+        }
+        let c = (t[0] + t[1] + t[2]) / 3.0;
+        for (side, dir) in [(0, nrm), (1, -nrm)] {
+            if let Some((_, Some(l))) = label_at(c + dir * (0.75 * vs)) {
+                faced[l as usize][side] += 1;
+            }
+        }
+        if bare {
+            let first_open = [0.75, 1.5, 2.25]
+                .into_iter()
+                .find_map(|k| label_at(c + nrm * (k * vs)).filter(|&(s, _)| !s));
+            if let Some((_, Some(l))) = first_open {
+                fronts[l as usize] += 1;
+            }
+        }
+    }
+    (faced, fronts)
 }
 
 /// Hangs every solid 6-component that does not reach the grid border (see module notes).
