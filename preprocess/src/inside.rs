@@ -1,18 +1,19 @@
 //! The level's inside, for a scene that names no camera and no light (a bare mesh file): the
 //! component a bake keeps as it would keep a camera's, and a point in it.
 //!
-//! Rule: the inside is the empty component that **the most triangles face** (the fronts of
-//! the level's walls look into its rooms; the void around a level sees their backs, the inside
-//! of a thick wall backs only; by count, not area: the air around Crytek Sponza's bare OBJ is
-//! faced by more area, its large outer walls and roofs, and its rooms by 32× the triangles) —
-//! kept whatever the facing vote says, since a level's rooms joined to the void through a
-//! window are one component that may see more backs than fronts. Its point is the voxel of it farthest from the solid among those
-//! that are **enclosed** — of the 26 rays from its centre along a voxel's neighbour directions,
-//! at most [`MAX_ESCAPES`] reach the grid's border without meeting solid (a window or a doorway
-//! to the void lets a few out; a courtyard or a roof open to the sky lets many) — so the middle
-//! of the level's largest room, or its widest voxel where none is enclosed. Where the inside
-//! reaches the bounds and its point is enclosed, the bake says where it leaks, from that point
-//! (a space open all round — the air around a building — has openings, not leaks).
+//! Rule: the inside is the empty component that **the most triangles face** (the fronts of the
+//! level's walls look into its rooms; the void around a level sees their backs, the inside of a
+//! thick wall backs only; by count, not area: the space around and over Crytek Sponza's rooms
+//! is faced by more area, its large outer walls and roofs, and its rooms by 32× the triangles)
+//! — kept whatever the facing vote says, since a level's rooms joined to the void through a
+//! window are one component that may see more backs than fronts. Its point is the voxel of it
+//! farthest from the solid among those that are **enclosed** — of the 26 rays from its centre
+//! along a voxel's neighbour directions, at most [`MAX_ESCAPES`] reach the grid's border
+//! without meeting solid (a window or a doorway to the void lets a few out; a courtyard or a
+//! roof open to the sky lets many) — so the middle of the level's largest room, or its widest
+//! voxel where none is enclosed. Where the inside reaches the bounds and its point is enclosed,
+//! the bake says where it leaks, from that point (a space open all round — the air around a
+//! building — has openings, not leaks).
 
 use visgate_formats::vgate::GridMeta;
 
@@ -187,9 +188,9 @@ mod tests {
 
     #[test]
     fn the_inside_is_the_component_the_most_triangles_face() {
-        // Crytek Sponza's bare OBJ at 256: the air around the building, faced by its large
+        // Crytek Sponza's bare OBJ at 256: the space around and over the rooms, faced by large
         // outer walls and roofs (3,443 m² of 2,791 triangles), and its rooms and galleries,
-        // by 90,668 smaller ones (the area alone would choose the air).
+        // by 90,668 smaller ones (the area alone would choose that space).
         let fronts = [2_791, 90_668, 13];
         let voxels = [2_392_584, 1_045_046, 270_354];
         assert_eq!(inside_component(&fronts, &voxels), Some(1));

@@ -1,17 +1,18 @@
 //! Where a closed level leaks: the openings through which its kept empty space reaches the
 //! outside, found as Quake's map compiler finds them for its point file — a path through the
-//! empty voxels from a camera or light that keeps the space to the grid's bounds.
+//! empty voxels from a camera or light that keeps the space (or a bare mesh's inside,
+//! inside.rs) to the grid's bounds.
 //!
 //! The path is the **widest** one out (the one whose narrowest point is widest: a bottleneck
 //! search over the clearance of each voxel, its distance to the nearest voxel that is not
 //! empty; the outside beyond the bounds counts as empty), so it runs through the middle of the
-//! largest opening. Its narrowest voxel, the one
-//! nearest the outside among equals, is the **opening** — a window, a gap under a door, a
-//! missing wall — about twice its clearance less a voxel wide. Separate openings are found one
-//! after another: each found opening is closed (a ball of √2 its clearance and two voxels
-//! more: a square window's corners too) and the search runs again, up to [`MAX_OPENINGS`]; a path out within twice that ball of an
-//! opening already found (the corners of a square window the ball left open) is that opening
-//! again, closed but not listed.
+//! largest opening. Its narrowest voxel, the one nearest the outside among equals, is the
+//! **opening** — a window, a gap under a door, a missing wall — about twice its clearance less
+//! a voxel wide. Separate openings are found one after another: each found opening is closed
+//! (a ball of √2 its clearance and two voxels more: a square window's corners too) and the
+//! search runs again, up to [`MAX_OPENINGS`]; a path out within twice an opening's ball (what
+//! it left open of a long window, the rest of a roof open to the sky) is that opening again,
+//! closed with a ball twice as wide and not listed.
 
 use std::cmp::Reverse;
 use std::collections::BinaryHeap;
