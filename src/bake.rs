@@ -145,6 +145,13 @@ pub const AFTER_HELP: &str = "\
 Stages: load static meshes → voxelize → empty space → distance → thin → skeleton graph →
 segment → clusters → gates → flatten. A timing tree and a summary are printed at the end.
 
+What is kept: the empty space around each camera and light (without any, as for a bare mesh,
+the space the most triangles face: the level's inside), and any other the geometry faces more
+than it turns its back to (not a thick wall's inside) of --min-component-voxels or more. A
+scene declared `closed = true` stops where its space reaches the bounds and names the opening
+(--allow-leaks bakes on); a bare mesh's inside that reaches them is baked, the opening named
+in a warning (and in leak.ply with --debug-dir).
+
 Examples:
   visgate bake builtin:two-rooms -o two-rooms.vgate
   visgate bake ../shared/scenes/crytek_sponza/sponza.glb -o sponza.vgate --resolution 256 \\
