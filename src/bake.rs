@@ -272,6 +272,15 @@ pub fn run(args: BakeArgs) -> Result<()> {
     for o in &baked.openings {
         eprintln!("warning: leak: {}", o.describe());
     }
+    if baked.report.empty_space["inside_leaks_not_looked_for"] == true {
+        eprintln!(
+            "warning: the scene names no camera or light, and the empty space kept as the \
+             level's inside (the one the most triangles face) reaches the scene's bounds; its \
+             openings are looked for on grids of up to {} M voxels: bake at a lower \
+             --resolution to have them named",
+            visgate_preprocess::empty::INSIDE_LEAK_MAX_VOXELS >> 20
+        );
+    }
     if baked.openings.iter().any(|o| o.from == INSIDE) {
         eprintln!(
             "warning: the scene names no camera or light, so the bake kept as the level's \

@@ -243,11 +243,22 @@ pub fn bake(
     let (sight_grid, open) = cx.stage("sight grid", 0, |_| {
         sight_grid(&input, &meta, &params, options)
     })?;
+    let pm = partition_grid(input.bounds, &meta, &params, options)?;
+    // A bare mesh's openings are looked for on the partition grid where there is one: on the
+    // level's finer grid the search costs seconds and hundreds of MiB (empty::INSIDE_LEAK_MAX_VOXELS).
     let es = cx.stage("empty space", 0, |_| {
-        stages::empty(scene, &meta, &solid.solid, &input.triangles, &params)
+        let locate = pm.is_none();
+        stages::empty(
+            scene,
+            &meta,
+            &solid.solid,
+            &input.triangles,
+            &params,
+            locate,
+        )
     })?;
     let solid = options.keep_solid_grid.then_some(solid);
-    let part = match partition_grid(input.bounds, &meta, &params, options)? {
+    let part = match pm {
         None => partition(&mut cx, &meta, &es, input.hash, &mut params)?,
         Some(pm) => {
             let fine = (&meta, &es);
@@ -300,6 +311,9 @@ pub fn bake(
         components: skeleton_counts[2],
     };
     let stages = cx.into_stages();
+    // A bare mesh's inside and openings: the level grid's, or the partition grid's where that
+    // looked for them.
+    let (inside, openings, inside_unlocated) = inside_leaks(&es, part_es);
     let report = BakeReport {
         scene: scene.name.clone(),
         params,
@@ -314,8 +328,9 @@ pub fn bake(
         empty_space: json!({
             "components": es.components,
             "leaks": es.leaks,
-            "openings": es.openings,
-            "inside_m": es.inside.map(|s| s.position_m),
+            "openings": openings,
+            "inside_m": inside.map(|s| s.position_m),
+            "inside_leaks_not_looked_for": inside_unlocated,
             "hung_objects": es.threads,
             "seeds_outside_grid": es.seeds_outside,
         }),
@@ -334,7 +349,7 @@ pub fn bake(
     Ok(Baked {
         level,
         report,
-        openings: es.openings,
+        openings,
         grids: BakeGrids {
             solid,
             skeleton,
@@ -452,6 +467,23 @@ fn sight_grid(
     Ok(((grid, bits), counts))
 }
 
+/// The point of a bare mesh's inside and its openings, from the level's grid `es` or, where
+/// that did not look for them, from the partition grid's `part`; and whether the inside reaches
+/// the bounds with its openings looked for on neither (a grid too large, no coarser one).
+fn inside_leaks(
+    es: &EmptySpace,
+    part: &EmptySpace,
+) -> (
+    Option<crate::inside::Inside>,
+    Vec<crate::leak::LeakPath>,
+    bool,
+) {
+    let coarser = es.inside_at_bounds && es.inside.is_none() && part.inside.is_some();
+    let from = if coarser { part } else { es };
+    let unlocated = es.inside_at_bounds && from.inside.is_none();
+    (from.inside, from.openings.clone(), unlocated)
+}
+
 /// The partition grid: the level's bounds at [`BakeParams::partition_voxel_m`], when that is
 /// coarser than the level's voxels (by more than 1 %); `None` partitions the level's grid.
 fn partition_grid(
@@ -485,7 +517,7 @@ fn refined_partition(
     let (meta, es) = fine;
     let pes = cx.stage("partition grid: voxelize, empty space", 0, |_| {
         let s = voxelize(*pm, &input.triangles);
-        stages::empty(scene, pm, &s.solid, &input.triangles, params)
+        stages::empty(scene, pm, &s.solid, &input.triangles, params, true)
     })?;
     let mut part = partition(cx, pm, &pes, input.hash, params)?;
     let voxel_cluster = cx.stage("refine", 0, |_| {

@@ -36,7 +36,16 @@ pub struct EmptySpaceParams {
     pub closed: bool,
     /// Bake a leaking closed scene anyway (the leaks are still reported).
     pub allow_leaks: bool,
+    /// Look for the openings of a bare mesh's inside that reaches the bounds (off where a
+    /// coarser partition grid looks for them, and on grids over [`INSIDE_LEAK_MAX_VOXELS`]).
+    pub locate_inside_leaks: bool,
 }
+
+/// A bare mesh's inside is not searched for openings on grids of more voxels: the search's
+/// distance field, paths and heap take about 20 bytes a voxel and seconds at 512³ (Crytek
+/// Sponza's bare OBJ at 512: 0.18 → 5.4 s and 320 → 970 MiB for the empty-space stage; its
+/// partition grid looks for them instead). [Units: voxels]
+pub const INSIDE_LEAK_MAX_VOXELS: u64 = 1 << 25;
 
 /// A named point that must be in kept empty space (a camera's eye, a light).
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -106,8 +115,10 @@ pub struct EmptySpace {
     /// space reaches the bounds.
     pub openings: Vec<crate::leak::LeakPath>,
     /// The point of the level's inside, for a scene that names no camera and no light, where
-    /// its space reaches the bounds (inside.rs).
+    /// its space reaches the bounds and its openings are looked for (inside.rs).
     pub inside: Option<crate::inside::Inside>,
+    /// Whether a bare mesh's inside reaches the bounds (its openings looked for or not).
+    pub inside_at_bounds: bool,
     /// Floating objects that were hung.
     pub threads: Vec<Thread>,
     /// Seeds that fell outside the grid or in solid with no empty voxel next to them.
@@ -191,11 +202,24 @@ pub fn empty_space(
     // One distance field for the inside's point and its leaks (the border ring open: a
     // voxel by a window to the void is wide, but its rays escape).
     // Only where it reaches the bounds: a sealed level's inside needs no point.
-    let walls = inside_component
-        .filter(|&c| at_bounds[c as usize])
-        .map(|_| crate::leak::clearance_to_walls(meta, &empty));
+    let inside_at_bounds = inside_component.is_some_and(|c| at_bounds[c as usize]);
+    let locate = params.locate_inside_leaks
+        && meta
+            .voxel_count()
+            .is_some_and(|v| v <= INSIDE_LEAK_MAX_VOXELS);
+    let walls = (inside_at_bounds && locate).then(|| crate::leak::clearance_to_walls(meta, &empty));
     let inside = inside_component.zip(walls.as_ref()).and_then(|(c, d2)| {
-        crate::inside::find_inside(meta, &empty, d2, &|i| comps.label(i) == Some(c))
+        // The inside's voxels, run by run: a label looked up a voxel cost seconds at 512³.
+        let visit = |f: &mut dyn FnMut(usize)| {
+            for r in 0..ny * nz {
+                for (a, b, l) in comps.row(r) {
+                    if l == c {
+                        (a..=b).for_each(|x| f(r * nx + x as usize));
+                    }
+                }
+            }
+        };
+        crate::inside::find_inside(meta, d2, &visit)
     });
     let to_m = |v: [u32; 3], corner: f32| -> [f32; 3] {
         std::array::from_fn(|a| meta.origin_m[a] + (v[a] as f32 + corner) * meta.voxel_size_m)
@@ -323,6 +347,7 @@ pub fn empty_space(
         leaks,
         openings,
         inside,
+        inside_at_bounds,
         threads,
         seeds_outside,
     })

@@ -35,9 +35,9 @@ pub struct Inside {
     pub enclosed: bool,
 }
 
-/// Of the rays from voxel `v` along the 26 neighbour directions through the `empty` voxels,
-/// how many reach the border ring (stopping at `limit`).
-pub fn escapes(meta: &GridMeta, empty: &[bool], v: [u32; 3], limit: u32) -> u32 {
+/// Of the rays from voxel `v` along the 26 neighbour directions through the voxels that are
+/// `empty`, how many reach the border ring (stopping at `limit`).
+pub fn escapes(meta: &GridMeta, empty: &dyn Fn(usize) -> bool, v: [u32; 3], limit: u32) -> u32 {
     let dims = meta.dims.map(i64::from);
     let mut out = 0;
     for k in 0..27i64 {
@@ -52,7 +52,7 @@ pub fn escapes(meta: &GridMeta, empty: &[bool], v: [u32; 3], limit: u32) -> u32 
                 out += 1;
                 break;
             }
-            if !empty[meta.index(c.map(|x| x as u32))] {
+            if !empty(meta.index(c.map(|x| x as u32))) {
                 break;
             }
         }
@@ -63,48 +63,56 @@ pub fn escapes(meta: &GridMeta, empty: &[bool], v: [u32; 3], limit: u32) -> u32 
     out
 }
 
+/// Calls its argument on each voxel (index) of a set.
+pub type Visit<'a> = dyn Fn(&mut dyn FnMut(usize)) + 'a;
+
 /// The point of the level's inside (see the module notes): `d2` is each voxel's squared
-/// distance to the nearest voxel that is not empty, `within(i)` whether voxel `i` is of the
-/// inside's component. The widest of its voxels where none of the widest [`MAX_TESTS`] is
-/// enclosed; `None` where it has no empty voxel.
+/// distance to the nearest voxel that is not empty, `visit(f)` calls `f` on each voxel of the
+/// inside's component (twice: a histogram of `d2` finds the widest [`MAX_TESTS`], then they
+/// are tested). The widest of its voxels where none of those is enclosed; `None` where it has
+/// no voxel.
 pub fn find_inside(
     meta: &GridMeta,
-    empty: &[bool],
     d2: &[u64],
-    within: &(dyn Fn(usize) -> bool + Sync),
+    visit: &Visit,
 ) -> Option<Inside> {
     use rayon::prelude::*;
-    let mut candidates: Vec<(u64, u32)> = (0..empty.len())
-        .into_par_iter()
-        .filter(|&i| empty[i] && within(i))
-        .map(|i| (d2[i], i as u32))
-        .collect();
-    // Widest first, then the lowest index: the same answer whatever the thread count.
-    let take = candidates.len().min(MAX_TESTS);
-    if take == 0 {
-        return None;
-    }
-    let by_width = |a: &(u64, u32), b: &(u64, u32)| b.0.cmp(&a.0).then(a.1.cmp(&b.1));
-    candidates.select_nth_unstable_by(take - 1, by_width);
-    candidates.truncate(take);
-    candidates.par_sort_unstable_by(by_width);
-    let inside = |i: u32, enclosed: bool| {
-        let v = meta.coords(i);
-        Inside {
-            voxel: i as usize,
-            position_m: meta.voxel_to_world(v),
-            enclosed,
+    // The least squared clearance that keeps at most MAX_TESTS voxels (all of the widest).
+    let mut counts: std::collections::BTreeMap<u64, usize> = Default::default();
+    visit(&mut |i| *counts.entry(d2[i]).or_default() += 1);
+    let mut kept = 0;
+    let mut floor = 0;
+    for (&d, &n) in counts.iter().rev() {
+        if kept > 0 && kept + n > MAX_TESTS {
+            break;
         }
+        kept += n;
+        floor = d;
+    }
+    let mut candidates: Vec<(u64, u32)> = Vec::with_capacity(kept);
+    visit(&mut |i| {
+        if d2[i] >= floor {
+            candidates.push((d2[i], i as u32));
+        }
+    });
+    // Widest first, then the lowest index: the same answer whatever the thread count.
+    candidates.par_sort_unstable_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)));
+    let widest = *candidates.first()?;
+    let empty_at = |i: usize| d2[i] > 0;
+    let inside = |i: u32, enclosed: bool| Inside {
+        voxel: i as usize,
+        position_m: meta.voxel_to_world(meta.coords(i)),
+        enclosed,
     };
     // In parallel chunks, in order: the first enclosed candidate of the first chunk holding one.
     let enclosed = candidates.par_chunks(256).find_map_first(|chunk| {
-        chunk
-            .iter()
-            .find(|&&(_, i)| escapes(meta, empty, meta.coords(i), MAX_ESCAPES + 1) <= MAX_ESCAPES)
+        chunk.iter().find(|&&(_, i)| {
+            escapes(meta, &empty_at, meta.coords(i), MAX_ESCAPES + 1) <= MAX_ESCAPES
+        })
     });
     Some(match enclosed {
         Some(&(_, i)) => inside(i, true),
-        None => inside(candidates[0].1, false),
+        None => inside(widest.1, false),
     })
 }
 
@@ -167,17 +175,23 @@ mod tests {
         );
         let solid: Vec<bool> = empty.iter().map(|&e| !e).collect();
         let d2 = crate::distance::squared_distance(dims, &solid);
-        let inside = find_inside(&m, &empty, &d2, &|_| true).expect("an inside");
+        let all = |f: &mut dyn FnMut(usize)| (0..empty.len()).filter(|&i| empty[i]).for_each(f);
+        let inside = find_inside(&m, &d2, &all).expect("an inside");
+        let empty_at = |i: usize| empty[i];
         let v = m.coords(inside.voxel as u32);
         assert!(v[0] <= 10, "{v:?} lies in the void");
-        assert!(escapes(&m, &empty, v, 27) <= MAX_ESCAPES);
+        assert!(escapes(&m, &empty_at, v, 27) <= MAX_ESCAPES);
         // The room's centre sees the window straight ahead along +x: one ray out of 26.
-        assert_eq!(escapes(&m, &empty, [6, 9, 9], 27), 1);
+        assert_eq!(escapes(&m, &empty_at, [6, 9, 9], 27), 1);
         // A voxel of the void: many rays out.
-        assert!(escapes(&m, &empty, [25, 9, 9], 27) > MAX_ESCAPES);
+        assert!(escapes(&m, &empty_at, [25, 9, 9], 27) > MAX_ESCAPES);
         // Only the void to choose from: its widest voxel.
-        let void = |i: usize| m.coords(i as u32)[0] >= 12;
-        let widest = find_inside(&m, &empty, &d2, &void).expect("the void's widest");
+        let void = |f: &mut dyn FnMut(usize)| {
+            (0..empty.len())
+                .filter(|&i| empty[i] && m.coords(i as u32)[0] >= 12)
+                .for_each(f)
+        };
+        let widest = find_inside(&m, &d2, &void).expect("the void's widest");
         let v = m.coords(widest.voxel as u32);
         assert!(
             v[0] >= 12 && d2[widest.voxel] == 81,

@@ -69,6 +69,7 @@ pub fn empty(
     solid: &[bool],
     triangles: &[[Vec3; 3]],
     params: &BakeParams,
+    locate_inside_leaks: bool,
 ) -> Result<Counted<EmptySpace, EmptyCounts>, BakeError> {
     let es = empty_space(
         meta,
@@ -79,6 +80,7 @@ pub fn empty(
             min_component_voxels: params.min_component_voxels,
             closed: scene.closed,
             allow_leaks: params.allow_leaks,
+            locate_inside_leaks,
         },
     )?;
     let counts = EmptyCounts {

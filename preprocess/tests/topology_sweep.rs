@@ -149,6 +149,7 @@ fn run(dims: [u32; 3], empty: &[bool]) -> (Vec<bool>, Thinned) {
             min_component_voxels: 0,
             closed: false,
             allow_leaks: true,
+            locate_inside_leaks: true,
         },
     )
     .expect("the layout has empty space");
