@@ -71,11 +71,7 @@ pub type Visit<'a> = dyn Fn(&mut dyn FnMut(usize)) + 'a;
 /// inside's component (twice: a histogram of `d2` finds the widest [`MAX_TESTS`], then they
 /// are tested). The widest of its voxels where none of those is enclosed; `None` where it has
 /// no voxel.
-pub fn find_inside(
-    meta: &GridMeta,
-    d2: &[u64],
-    visit: &Visit,
-) -> Option<Inside> {
+pub fn find_inside(meta: &GridMeta, d2: &[u64], visit: &Visit) -> Option<Inside> {
     use rayon::prelude::*;
     // The least squared clearance that keeps at most MAX_TESTS voxels (all of the widest).
     let mut counts: std::collections::BTreeMap<u64, usize> = Default::default();

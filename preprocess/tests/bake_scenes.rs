@@ -970,3 +970,34 @@ fn a_bare_mesh_keeps_the_level_s_inside_and_says_where_it_leaks() {
     assert!(comps.contains("the level's inside"), "{comps}");
     assert!(b.openings.is_empty(), "{:?}", b.openings);
 }
+
+#[test]
+fn a_bare_mesh_s_inside_is_searched_for_openings_only_where_asked() {
+    use visgate_preprocess::empty::{EmptySpaceParams, empty_space};
+    use visgate_preprocess::voxelize::{grid_for, voxelize};
+    let model = room_with_windows(1);
+    let m = &model.meshes[0];
+    let triangles: Vec<[Vec3; 3]> = m
+        .triangles
+        .iter()
+        .map(|t| t.map(|i| m.positions[i as usize]))
+        .collect();
+    let bounds = (Vec3::ZERO, Vec3::new(8.0, 3.0, 4.0));
+    let meta = grid_for(bounds, Resolution::LongestAxisVoxels(64), u64::MAX).expect("grid");
+    let solid = voxelize(meta, &triangles).solid;
+    let run = |locate_inside_leaks: bool| {
+        let params = EmptySpaceParams {
+            min_component_voxels: 64,
+            closed: false,
+            allow_leaks: false,
+            locate_inside_leaks,
+        };
+        empty_space(&meta, &solid, &triangles, &[], &params).expect("empty space")
+    };
+    // Asked: the inside's point and the window. Not asked (a partition grid looks, or the grid
+    // is too large): the inside still reaches the bounds, and nothing is searched.
+    let (asked, not) = (run(true), run(false));
+    assert!(asked.inside_at_bounds && asked.inside.is_some() && asked.openings.len() == 1);
+    assert!(not.inside_at_bounds && not.inside.is_none() && not.openings.is_empty());
+    assert_eq!(asked.empty, not.empty);
+}
