@@ -236,8 +236,8 @@ pub fn empty_space(
                 (
                     true,
                     format!(
-                        "the level's inside: the most triangles face it ({} of them; no camera \
-                         or light named){point}",
+                        "{INSIDE}: the most triangles face it ({} of them; no camera or light \
+                         named){point}",
                         fronts[c]
                     ),
                 )
