@@ -468,8 +468,10 @@ fn sight_grid(
 }
 
 /// The point of a bare mesh's inside and its openings, from the level's grid `es` or, where
-/// that did not look for them, from the partition grid's `part`; and whether the inside reaches
-/// the bounds with its openings looked for on neither (a grid too large, no coarser one).
+/// that did not look for them (its inside reaches the bounds and has no point), from the
+/// partition grid's `part` (the same as `es` where there is none); and whether the grid they
+/// come from did not look either (too large). A partition grid that finds its inside sealed
+/// (its coarser voxels close a crack) says nothing.
 fn inside_leaks(
     es: &EmptySpace,
     part: &EmptySpace,
@@ -478,9 +480,9 @@ fn inside_leaks(
     Vec<crate::leak::LeakPath>,
     bool,
 ) {
-    let coarser = es.inside_at_bounds && es.inside.is_none() && part.inside.is_some();
-    let from = if coarser { part } else { es };
-    let unlocated = es.inside_at_bounds && from.inside.is_none();
+    let unsearched = |e: &EmptySpace| e.inside_at_bounds && e.inside.is_none();
+    let from = if unsearched(es) { part } else { es };
+    let unlocated = unsearched(from);
     (from.inside, from.openings.clone(), unlocated)
 }
 
@@ -597,6 +599,49 @@ fn partition(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_bare_mesh_s_openings_come_from_the_grid_that_looked_for_them() {
+        use crate::inside::Inside;
+        let space = |at_bounds: bool, point: Option<[f32; 3]>| EmptySpace {
+            empty: Vec::new(),
+            empty_voxels: 0,
+            components: Vec::new(),
+            leaks: Vec::new(),
+            openings: Vec::new(),
+            inside: point.map(|p| Inside {
+                voxel: 0,
+                position_m: p,
+                enclosed: true,
+            }),
+            inside_at_bounds: at_bounds,
+            threads: Vec::new(),
+            seeds_outside: Vec::new(),
+        };
+        let point = |r: (Option<Inside>, Vec<crate::leak::LeakPath>, bool)| {
+            (r.0.map(|s| s.position_m), r.2)
+        };
+        let (fine, coarse) = ([1.0; 3], [2.0; 3]);
+        // Looked for on the level's grid: its point.
+        let searched = space(true, Some(fine));
+        assert_eq!(
+            point(inside_leaks(&searched, &searched)),
+            (Some(fine), false)
+        );
+        // Left to the partition grid: its point; sealed there, nothing and no warning.
+        let left = space(true, None);
+        let part = space(true, Some(coarse));
+        assert_eq!(point(inside_leaks(&left, &part)), (Some(coarse), false));
+        assert_eq!(
+            point(inside_leaks(&left, &space(false, None))),
+            (None, false)
+        );
+        // Looked for on neither (too large): said so.
+        assert_eq!(point(inside_leaks(&left, &left)), (None, true));
+        // Sealed on the level's grid: nothing to say.
+        let sealed = space(false, None);
+        assert_eq!(point(inside_leaks(&sealed, &part)), (None, false));
+    }
 
     #[test]
     fn the_default_partition_voxel_is_a_whole_multiple_of_a_large_levels_voxel() {

@@ -43,7 +43,7 @@ pub struct EmptySpaceParams {
 
 /// A bare mesh's inside is not searched for openings on grids of more voxels: the search's
 /// distance field, paths and heap take about 20 bytes a voxel and seconds at 512³ (Crytek
-/// Sponza's bare OBJ at 512: 0.18 → 5.4 s and 320 → 970 MiB for the empty-space stage; its
+/// Sponza's bare OBJ at 512, the machine busy: 0.18 → 5.4 s and 320 → 970 MiB; its
 /// partition grid looks for them instead). [Units: voxels]
 pub const INSIDE_LEAK_MAX_VOXELS: u64 = 1 << 25;
 
@@ -199,9 +199,9 @@ pub fn empty_space(
     let inside_component = bare
         .then(|| crate::inside::inside_component(&fronts, &voxels))
         .flatten();
-    // One distance field for the inside's point and its leaks (the border ring open: a
-    // voxel by a window to the void is wide, but its rays escape).
-    // Only where it reaches the bounds: a sealed level's inside needs no point.
+    // Only where the inside reaches the bounds (a sealed level's inside needs no point), one
+    // distance field for its point and its leaks (the border ring open: a voxel by a window to
+    // the void is wide, but its rays escape).
     let inside_at_bounds = inside_component.is_some_and(|c| at_bounds[c as usize]);
     let locate = params.locate_inside_leaks
         && meta
@@ -325,8 +325,7 @@ pub fn empty_space(
         }
     }
     // The inside's space reaching the bounds: where, from the inside, as for a camera.
-    if let (Some(s), Some(c), Some(d2)) = (inside, inside_component, &walls)
-        && at_bounds[c as usize]
+    if let (Some(s), Some(d2)) = (inside, &walls)
         && s.enclosed
     {
         let from = (INSIDE.to_string(), s.position_m, s.voxel);

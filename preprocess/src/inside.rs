@@ -20,7 +20,8 @@ use visgate_formats::vgate::GridMeta;
 /// Rays of the 26 that may escape from an enclosed voxel.
 pub const MAX_ESCAPES: u32 = 3;
 
-/// Candidates tested at most (widest first): the search stops there and takes none.
+/// Candidates tested at most (widest first): where none of them is enclosed, the widest is
+/// taken, not enclosed.
 const MAX_TESTS: usize = 50_000;
 
 /// The level's inside: its voxel (index) and centre.
@@ -73,17 +74,24 @@ pub type Visit<'a> = dyn Fn(&mut dyn FnMut(usize)) + 'a;
 /// no voxel.
 pub fn find_inside(meta: &GridMeta, d2: &[u64], visit: &Visit) -> Option<Inside> {
     use rayon::prelude::*;
-    // The least squared clearance that keeps at most MAX_TESTS voxels (all of the widest).
-    let mut counts: std::collections::BTreeMap<u64, usize> = Default::default();
-    visit(&mut |i| *counts.entry(d2[i]).or_default() += 1);
+    // The least squared clearance that keeps at most MAX_TESTS voxels (all of the widest): a
+    // count per value (squared distances in voxels, under 3 × 2048² on any grid).
+    let mut counts: Vec<usize> = Vec::new();
+    visit(&mut |i| {
+        let d = d2[i] as usize;
+        if d >= counts.len() {
+            counts.resize(d + 1, 0);
+        }
+        counts[d] += 1;
+    });
     let mut kept = 0;
     let mut floor = 0;
-    for (&d, &n) in counts.iter().rev() {
+    for (d, &n) in counts.iter().enumerate().rev().filter(|&(_, &n)| n > 0) {
         if kept > 0 && kept + n > MAX_TESTS {
             break;
         }
         kept += n;
-        floor = d;
+        floor = d as u64;
     }
     let mut candidates: Vec<(u64, u32)> = Vec::with_capacity(kept);
     visit(&mut |i| {
@@ -94,6 +102,8 @@ pub fn find_inside(meta: &GridMeta, d2: &[u64], visit: &Visit) -> Option<Inside>
     // Widest first, then the lowest index: the same answer whatever the thread count.
     candidates.par_sort_unstable_by(|a, b| b.0.cmp(&a.0).then(a.1.cmp(&b.1)));
     let widest = *candidates.first()?;
+    // A voxel that is not empty has no clearance (the border ring has some, but the rays stop
+    // at it by their coordinates first).
     let empty_at = |i: usize| d2[i] > 0;
     let inside = |i: u32, enclosed: bool| Inside {
         voxel: i as usize,
@@ -194,6 +204,7 @@ mod tests {
             "{v:?} {}",
             d2[widest.voxel]
         );
+        assert!(inside.enclosed && !widest.enclosed);
     }
 
     #[test]

@@ -200,9 +200,13 @@ impl GpuMode {
         match *self {
             GpuMode::Gates(p) if p.walk_roulette == WalkRoulette::Auto => {
                 let resolved = self.resolved_for(vpls);
+                let on = matches!(resolved, GpuMode::Gates(r) if r.walk_roulette.is_fixed());
                 let s = resolved.describe();
-                let on = p.roulette_share(vpls) > 0.0 && p.gates.shape != GateShape::Disk;
-                if on { s + " (auto)" } else { s }
+                if on && p.gates.shape != GateShape::Disk {
+                    s + " (auto)"
+                } else {
+                    s
+                }
             }
             _ => self.describe(),
         }
