@@ -13,6 +13,8 @@ use visgate_formats::vgate::{
 use visgate_preprocess::bake::{BakeOptions, Progress, bake};
 use visgate_preprocess::empty::INSIDE;
 
+use crate::bake_warnings::warnings;
+
 /// Options of `visgate bake`.
 #[derive(Args)]
 pub struct BakeArgs {
@@ -151,6 +153,10 @@ than it turns its back to (not a thick wall's inside) of --min-component-voxels 
 scene declared `closed = true` stops where its space reaches the bounds and names the opening
 (--allow-leaks bakes on); a bare mesh's inside that reaches them is baked, the opening named
 in a warning (and in leak.ply with --debug-dir).
+
+Warnings, each with what to do: most of the space dropped as a wall's inside; a camera sealed
+off from every light (a doorway the voxels close); a grid too coarse for the level (its widest
+space under 6 voxels across), with the --resolution to use instead.
 
 Examples:
   visgate bake builtin:two-rooms -o two-rooms.vgate
@@ -293,7 +299,7 @@ pub fn run(args: BakeArgs) -> Result<()> {
     if let (Some(dir), false) = (&args.debug_dir, baked.openings.is_empty()) {
         write_leak_ply(dir, &baked.openings)?;
     }
-    if let Some(w) = most_dropped(&baked.report.empty_space, &baked.level.info.grid) {
+    for w in warnings(&baked.report) {
         eprintln!("warning: {w}");
     }
     println!("wrote {}", args.output.display());
@@ -325,90 +331,4 @@ fn write_leak_ply(
     write().with_context(|| format!("cannot write {}", path.display()))?;
     eprintln!("wrote {} (the paths to the outside)", path.display());
     Ok(())
-}
-
-/// A warning when the bake dropped an enclosed part of the empty space larger than all it
-/// kept (the outside, which reaches the grid's bounds, is meant to go): that part, why, and
-/// what to do (the reason also sits in the JSON report). None where a bare mesh's inside was
-/// kept: that is the space the most triangles face, and a larger part dropped faces fewer (the
-/// space around and over Crytek Sponza's rooms, from its bare GLB at 128).
-fn most_dropped(
-    empty_space: &serde_json::Value,
-    grid: &visgate_formats::vgate::GridMeta,
-) -> Option<String> {
-    let comps = empty_space["components"].as_array()?;
-    let voxels = |c: &serde_json::Value| c["voxels"].as_u64().unwrap_or(0);
-    let at = |c: &serde_json::Value, key: &str, a: usize| c[key][a].as_f64().unwrap_or(0.0);
-    let (o, vs) = (grid.origin_m, grid.voxel_size_m as f64);
-    // Within a voxel and a half of the grid's faces: next to its solid border, the outside.
-    let outside = |c: &serde_json::Value| {
-        (0..3).any(|a| {
-            at(c, "bounds_min_m", a) <= o[a] as f64 + 1.5 * vs
-                || at(c, "bounds_max_m", a) >= o[a] as f64 + (grid.dims[a] as f64 - 1.5) * vs
-        })
-    };
-    let inside =
-        |c: &serde_json::Value| c["reason"].as_str().is_some_and(|r| r.starts_with(INSIDE));
-    if comps.iter().any(inside) {
-        return None;
-    }
-    let kept: u64 = comps.iter().filter(|c| c["kept"] == true).map(voxels).sum();
-    let largest = comps
-        .iter()
-        .filter(|c| c["kept"] != true && !outside(c))
-        .max_by_key(|c| voxels(c))?;
-    (voxels(largest) > kept).then(|| {
-        format!(
-            "kept {kept} empty voxels, and dropped an enclosed part larger than that ({} voxels, \
-             {} .. {} m) as {}. If that is the level's inside, put a camera or a light in it (a \
-             scene file: see `visgate scenes export`), or check that the mesh's normals face \
-             into the rooms",
-            voxels(largest),
-            largest["bounds_min_m"],
-            largest["bounds_max_m"],
-            largest["reason"].as_str().unwrap_or("?")
-        )
-    })
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use serde_json::json;
-
-    #[test]
-    fn an_enclosed_part_dropped_and_larger_than_all_kept_is_named_and_the_outside_is_not() {
-        let grid = visgate_formats::vgate::GridMeta {
-            origin_m: [0.0; 3],
-            voxel_size_m: 1.0,
-            dims: [100, 40, 100],
-        };
-        let comp = |voxels: u64, lo: f32, hi: f32, kept: bool, reason: &str| {
-            json!({ "voxels": voxels, "bounds_min_m": [lo, lo, lo],
-                    "bounds_max_m": [hi, hi.min(38.0), hi], "kept": kept, "reason": reason })
-        };
-        // The outside (next to the grid's faces) dropped, rooms kept: nothing to say.
-        let fine = json!({ "components": [
-            comp(300_000, 1.0, 99.0, false, "outside the closed level"),
-            comp(5_000, 10.0, 30.0, true, "holds light 0"),
-        ]});
-        assert_eq!(most_dropped(&fine, &grid), None);
-        // The level's inside dropped as a wall's, four pockets kept: the warning names it.
-        let lost = json!({ "components": [
-            comp(60_000, 5.0, 90.0, false, "inside closed geometry: 12191 triangles turn their back to it, 10929 face it"),
-            comp(300, 40.0, 45.0, true, "large and faced by the geometry"),
-        ]});
-        let w = most_dropped(&lost, &grid).expect("a warning");
-        assert!(
-            w.contains("kept 300 empty voxels") && w.contains("60000 voxels"),
-            "{w}"
-        );
-        assert!(w.contains("12191 triangles turn their back"), "{w}");
-        // A bare mesh's inside kept: the larger part dropped is not it.
-        let bare = json!({ "components": [
-            comp(60_000, 5.0, 90.0, false, "inside closed geometry: 9925 triangles turn their back to it, 6984 face it"),
-            comp(3_000, 40.0, 45.0, true, "the level's inside: the most triangles face it (90668 of them; no camera or light named)"),
-        ]});
-        assert_eq!(most_dropped(&bare, &grid), None);
-    }
 }

@@ -362,7 +362,12 @@ fn level(
             };
             let opts = visgate_preprocess::bake::BakeOptions::default();
             match visgate_preprocess::bake::bake(scene, &params, &opts, &|_| {}) {
-                Ok(b) => b.level,
+                Ok(b) => {
+                    for w in crate::bake_warnings::warnings(&b.report) {
+                        eprintln!("warning: the bake at {voxels}: {w}");
+                    }
+                    b.level
+                }
                 Err(e) if n.is_none() => {
                     eprintln!(
                         "warning: the scene does not bake ({e}); the gate modes are left out"

@@ -2,6 +2,7 @@
 //! scenes, meshes and baked levels, and list or export the built-in scenes.
 
 mod bake;
+mod bake_warnings;
 mod bare;
 mod compare;
 mod export;

@@ -605,6 +605,49 @@ fn a_clean_bake_writes_nothing_on_stderr() {
 }
 
 #[test]
+fn a_bake_too_coarse_for_its_level_says_so_and_what_resolution_to_use() {
+    // `ajar-door` at 16 voxels: 0.5 m voxels close the door, the cameras' room is sealed off
+    // from the light's, two clusters and no gate. At 32 the rooms are wide enough, the door
+    // still closed; at 64 it is open: nothing to say.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("x.vgate");
+    let bake = |res: &str| {
+        visgate(&[
+            "bake",
+            "builtin:ajar-door",
+            "-o",
+            out.to_str().expect("utf-8"),
+            "--resolution",
+            res,
+        ])
+    };
+    let o = bake("16");
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains("warning: camera 'main' and camera 'door' are in a part of the empty space that no light is in")
+            && err.contains("--resolution 32 or more"),
+        "{err}"
+    );
+    assert!(
+        err.contains("warning: the grid is too coarse for this level: its widest empty space is 4.0 voxels across")
+            && err.contains("the 2 cluster(s)")
+            && err.contains("--resolution 48 or more"),
+        "{err}"
+    );
+    let o = bake("32");
+    let err = stderr(&o);
+    assert!(
+        err.contains("no light is in") && err.contains("--resolution 64 or more"),
+        "{err}"
+    );
+    assert!(!err.contains("too coarse"), "{err}");
+    let o = bake("64");
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(stderr(&o), "", "stderr of a bake fine enough");
+}
+
+#[test]
 fn a_refined_bake_says_where_its_partition_was_made() {
     let dir = tempfile::tempdir().expect("tempdir");
     let out = dir.path().join("x.vgate");

@@ -1,0 +1,271 @@
+//! What `visgate bake` warns of after a bake that succeeded but that a user would not want:
+//! most of the level's space dropped, a camera sealed off from every light, a grid too coarse
+//! for the level's rooms and doorways. Each warning says why and what to do; the figures also
+//! sit in the JSON report.
+
+use serde_json::Value;
+use visgate_formats::vgate::GridMeta;
+use visgate_preprocess::empty::INSIDE;
+use visgate_preprocess::report::BakeReport;
+
+/// Under this largest-ball radius the kept space is a few voxels across: its clusters follow
+/// the voxels rather than the rooms (LibreQuake e2m3 baked at 24 and 32: 2.0 and 2.2 voxels,
+/// 2 and 6 clusters, 104 at 128; `ajar-door` at 16: 2.0, its door closed; `four-rooms` at 16,
+/// 3.0, still has its 4 rooms). [Units: voxels]
+pub const COARSE_RADIUS_VX: f64 = 3.0;
+
+/// The largest-ball radius a suggested resolution aims at. [Units: voxels]
+const SUGGESTED_RADIUS_VX: f64 = 6.0;
+
+/// Every warning for `report`, in the order they are printed.
+pub fn warnings(report: &BakeReport) -> Vec<String> {
+    let es = &report.empty_space;
+    let mut out = Vec::new();
+    out.extend(most_dropped(es, &report.grid));
+    out.extend(cut_off_cameras(es, &report.grid));
+    let radius = report
+        .stages
+        .iter()
+        .find(|s| s.name == "distance")
+        .and_then(|s| s.counts["largest_radius_vx"].as_f64());
+    if let Some(r) = radius {
+        out.extend(too_coarse(r, report.summary.clusters, &report.grid));
+    }
+    out
+}
+
+/// The resolution (voxels on the longest axis) at which space `radius_vx` voxels wide now
+/// would be `aim` voxels wide, rounded up to a multiple of 8.
+fn resolution_for(grid: &GridMeta, radius_vx: f64, aim: f64) -> u32 {
+    // The grid holds a voxel of border on each side.
+    let longest = grid
+        .dims
+        .iter()
+        .max()
+        .copied()
+        .unwrap_or(2)
+        .saturating_sub(2) as f64;
+    let r = (longest * aim / radius_vx.max(0.5)).ceil() as u32;
+    r.div_ceil(8) * 8
+}
+
+/// A warning when the kept space's widest ball is under [`COARSE_RADIUS_VX`] voxels: the bake
+/// found fewer clusters than the level has rooms, or clusters that follow the voxels.
+fn too_coarse(radius_vx: f64, clusters: u64, grid: &GridMeta) -> Option<String> {
+    (radius_vx < COARSE_RADIUS_VX).then(|| {
+        let r = resolution_for(grid, radius_vx, SUGGESTED_RADIUS_VX);
+        format!(
+            "the grid is too coarse for this level: its widest empty space is {:.1} voxels \
+             across (voxels of {:.3} m), so doorways narrower than a voxel or two are closed \
+             and the {clusters} cluster(s) follow the voxels, not the rooms. Bake at \
+             --resolution {r} or more (voxels of about {:.3} m)",
+            2.0 * radius_vx,
+            grid.voxel_size_m,
+            grid.voxel_size_m as f64 * radius_vx / SUGGESTED_RADIUS_VX
+        )
+    })
+}
+
+/// A warning for each kept part of the empty space that holds a camera and no light while
+/// another kept part holds one: sealed off from the lights at this resolution (a doorway
+/// closed by the voxels), it gets no indirect light from them under gates or the VPL modes,
+/// though the level lets light through.
+fn cut_off_cameras(empty_space: &Value, grid: &GridMeta) -> Vec<String> {
+    let Some(comps) = empty_space["components"].as_array() else {
+        return Vec::new();
+    };
+    let seeds = |c: &Value| -> Vec<String> {
+        let list = c["seeds"].as_array().into_iter().flatten();
+        list.filter_map(|s| s.as_str().map(str::to_string))
+            .collect()
+    };
+    let is_camera = |s: &String| s.starts_with("camera ");
+    let kept: Vec<Vec<String>> = comps
+        .iter()
+        .filter(|c| c["kept"] == true)
+        .map(seeds)
+        .collect();
+    if !kept.iter().any(|s| s.iter().any(|x| !is_camera(x))) {
+        return Vec::new(); // no light in any kept part: nothing is cut off from one
+    }
+    let res = resolution_for(grid, 1.0, 2.0);
+    kept.iter()
+        .filter(|s| !s.is_empty() && s.iter().all(is_camera))
+        .map(|cams| {
+            format!(
+                "{} in a part of the empty space that no light is in: at this resolution \
+                 (voxels of {:.3} m) it is sealed off from the lights, so gates and the VPL \
+                 modes give it no indirect light from them. A doorway or window narrower than \
+                 about two voxels closes: bake at --resolution {res} or more, or if the part \
+                 is meant to be sealed, ignore this",
+                join_and(cams),
+                grid.voxel_size_m
+            )
+        })
+        .collect()
+}
+
+/// A point of the JSON report, `(x, y, z)` to the centimetre.
+fn metres(p: &Value) -> String {
+    let c = |a: usize| p[a].as_f64().unwrap_or(f64::NAN);
+    format!("({:.2}, {:.2}, {:.2})", c(0), c(1), c(2))
+}
+
+/// `a`, `a and b`, `a, b and c`, with "is"/"are" after.
+fn join_and(items: &[String]) -> String {
+    match items {
+        [one] => format!("{one} is"),
+        [rest @ .., last] => format!("{} and {last} are", rest.join(", ")),
+        [] => String::new(),
+    }
+}
+
+/// A warning when the bake dropped an enclosed part of the empty space larger than all it
+/// kept (the outside, which reaches the grid's bounds, is meant to go): that part, why, and
+/// what to do (the reason also sits in the JSON report). None where a bare mesh's inside was
+/// kept: that is the space the most triangles face, and a larger part dropped faces fewer (the
+/// space around and over Crytek Sponza's rooms, from its bare GLB at 128).
+fn most_dropped(
+    empty_space: &serde_json::Value,
+    grid: &visgate_formats::vgate::GridMeta,
+) -> Option<String> {
+    let comps = empty_space["components"].as_array()?;
+    let voxels = |c: &serde_json::Value| c["voxels"].as_u64().unwrap_or(0);
+    let at = |c: &serde_json::Value, key: &str, a: usize| c[key][a].as_f64().unwrap_or(0.0);
+    let (o, vs) = (grid.origin_m, grid.voxel_size_m as f64);
+    // Within a voxel and a half of the grid's faces: next to its solid border, the outside.
+    let outside = |c: &serde_json::Value| {
+        (0..3).any(|a| {
+            at(c, "bounds_min_m", a) <= o[a] as f64 + 1.5 * vs
+                || at(c, "bounds_max_m", a) >= o[a] as f64 + (grid.dims[a] as f64 - 1.5) * vs
+        })
+    };
+    let inside =
+        |c: &serde_json::Value| c["reason"].as_str().is_some_and(|r| r.starts_with(INSIDE));
+    if comps.iter().any(inside) {
+        return None;
+    }
+    let kept: u64 = comps.iter().filter(|c| c["kept"] == true).map(voxels).sum();
+    let largest = comps
+        .iter()
+        .filter(|c| c["kept"] != true && !outside(c))
+        .max_by_key(|c| voxels(c))?;
+    (voxels(largest) > kept).then(|| {
+        format!(
+            "kept {kept} empty voxels, and dropped an enclosed part larger than that ({} voxels, \
+             {} .. {} m) as {}. If that is the level's inside, put a camera or a light in it (a \
+             scene file: see `visgate scenes export`), or check that the mesh's normals face \
+             into the rooms",
+            voxels(largest),
+            metres(&largest["bounds_min_m"]),
+            metres(&largest["bounds_max_m"]),
+            largest["reason"].as_str().unwrap_or("?")
+        )
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    #[test]
+    fn an_enclosed_part_dropped_and_larger_than_all_kept_is_named_and_the_outside_is_not() {
+        let grid = visgate_formats::vgate::GridMeta {
+            origin_m: [0.0; 3],
+            voxel_size_m: 1.0,
+            dims: [100, 40, 100],
+        };
+        let comp = |voxels: u64, lo: f32, hi: f32, kept: bool, reason: &str| {
+            json!({ "voxels": voxels, "bounds_min_m": [lo, lo, lo],
+                    "bounds_max_m": [hi, hi.min(38.0), hi], "kept": kept, "reason": reason })
+        };
+        // The outside (next to the grid's faces) dropped, rooms kept: nothing to say.
+        let fine = json!({ "components": [
+            comp(300_000, 1.0, 99.0, false, "outside the closed level"),
+            comp(5_000, 10.0, 30.0, true, "holds light 0"),
+        ]});
+        assert_eq!(most_dropped(&fine, &grid), None);
+        // The level's inside dropped as a wall's, four pockets kept: the warning names it.
+        let lost = json!({ "components": [
+            comp(60_000, 5.0, 90.0, false, "inside closed geometry: 12191 triangles turn their back to it, 10929 face it"),
+            comp(300, 40.0, 45.0, true, "large and faced by the geometry"),
+        ]});
+        let w = most_dropped(&lost, &grid).expect("a warning");
+        assert!(
+            w.contains("kept 300 empty voxels") && w.contains("60000 voxels"),
+            "{w}"
+        );
+        assert!(w.contains("12191 triangles turn their back"), "{w}");
+        // A bare mesh's inside kept: the larger part dropped is not it.
+        let bare = json!({ "components": [
+            comp(60_000, 5.0, 90.0, false, "inside closed geometry: 9925 triangles turn their back to it, 6984 face it"),
+            comp(3_000, 40.0, 45.0, true, "the level's inside: the most triangles face it (90668 of them; no camera or light named)"),
+        ]});
+        assert_eq!(most_dropped(&bare, &grid), None);
+    }
+
+    fn grid(longest: u32, voxel_size_m: f32) -> GridMeta {
+        GridMeta {
+            origin_m: [0.0; 3],
+            voxel_size_m,
+            dims: [longest + 2, longest / 2 + 2, longest + 2],
+        }
+    }
+
+    #[test]
+    fn a_grid_whose_widest_space_is_under_three_voxels_is_too_coarse() {
+        let g = grid(24, 4.5);
+        let w = too_coarse(2.0, 2, &g).expect("a warning at 2 voxels");
+        // 24 voxels × 6 / 2 = 72, a multiple of 8; voxels of 4.5 × 2 / 6 m.
+        assert!(
+            w.contains("4.0 voxels across") && w.contains("the 2 cluster(s)"),
+            "{w}"
+        );
+        assert!(
+            w.contains("--resolution 72 or more (voxels of about 1.500 m)"),
+            "{w}"
+        );
+        assert_eq!(
+            too_coarse(3.0, 4, &g),
+            None,
+            "four-rooms at 16: 3 voxels is enough"
+        );
+        assert_eq!(
+            resolution_for(&grid(32, 1.0), 2.236, 6.0),
+            88,
+            "86 rounded up to 8s"
+        );
+    }
+
+    #[test]
+    fn a_camera_sealed_off_from_every_light_is_named_and_one_with_a_light_is_not() {
+        let g = grid(24, 4.5);
+        let comp = |seeds: &[&str], kept: bool| json!({ "seeds": seeds, "kept": kept });
+        let cut = json!({ "components": [
+            comp(&["camera 'lit'", "point light 0"], true),
+            comp(&["camera 'hall'"], true),
+            comp(&[], false),
+        ]});
+        let w = cut_off_cameras(&cut, &g);
+        assert_eq!(w.len(), 1, "{w:?}");
+        assert!(w[0].starts_with("camera 'hall' is in a part") && w[0].contains("--resolution 48"));
+        // Both cameras with the light: nothing. No light in any kept part: nothing cut off.
+        let together = json!({ "components": [
+            comp(&["camera 'lit'", "camera 'hall'", "spot light 1"], true),
+        ]});
+        assert!(cut_off_cameras(&together, &g).is_empty());
+        let unlit =
+            json!({ "components": [comp(&["camera 'a'"], true), comp(&["camera 'b'"], true)]});
+        assert!(cut_off_cameras(&unlit, &g).is_empty());
+        let two = json!({ "components": [
+            comp(&["point light 0"], true),
+            comp(&["camera 'a'", "camera 'b'", "camera 'c'"], true),
+        ]});
+        let w = cut_off_cameras(&two, &g);
+        assert!(
+            w[0].starts_with("camera 'a', camera 'b' and camera 'c' are in"),
+            "{w:?}"
+        );
+    }
+}
