@@ -195,6 +195,22 @@ impl Flood {
         out
     }
 
+    /// The first voxel from `i` to `last` (linear indices) not yet seen, or `last + 1`.
+    fn next_unseen(&self, i: usize, last: usize) -> usize {
+        let mut w = i / 64;
+        let mut free = !self.seen[w] >> (i % 64) << (i % 64);
+        loop {
+            if free != 0 {
+                return (w * 64 + free.trailing_zeros() as usize).min(last + 1);
+            }
+            w += 1;
+            if w * 64 > last {
+                return last + 1;
+            }
+            free = !self.seen[w];
+        }
+    }
+
     /// Voxel `v`'s linear index (x fastest).
     fn index(&self, v: [i64; 3]) -> usize {
         let d = self.dims;
@@ -305,8 +321,21 @@ impl<K: Fn(usize, Vec3) -> bool> Fill<'_, K> {
                 if (dy, dz) == (0, 0) || ry < 0 || rz < 0 || ry >= dims[1] || rz >= dims[2] {
                     continue;
                 }
+                let row = self.flood.index([0, ry, rz]);
+                let last = (b + 1).min(dims[0] - 1);
                 let mut x = (a - 1).max(0);
-                while x <= (b + 1).min(dims[0] - 1) {
+                // A run claimed here may end past `last` (at the row's end).
+                while x <= last {
+                    // Voxels already seen are skipped a word of the bitset at a time: most of a
+                    // neighbouring row was claimed by the runs beside it.
+                    x = self
+                        .flood
+                        .next_unseen(row + x as usize, row + last as usize)
+                        as i64
+                        - row as i64;
+                    if x > last {
+                        break;
+                    }
                     if self.claim([x, ry, rz]) {
                         x = self.run_from([x, ry, rz]);
                     }
@@ -418,21 +447,26 @@ mod tests {
     #[test]
     fn the_scanline_fill_finds_the_breadth_first_floods_voxels() {
         // Random grids, from sparse to dense, accepted voxels in a ball around a random start
-        // (the cuts' floods are bounded so): the same set, every voxel once.
+        // (the cuts' floods are bounded so) or anywhere: the same set, every voxel once.
         let mut next = crate::xorshift32(0x5eed_1234);
         let meta = GridMeta {
             origin_m: [-1.0, 0.5, 2.0],
             voxel_size_m: 0.25,
-            dims: [23, 17, 19],
+            // 7,296 voxels, a whole number of the bitset's words: a run that ends the grid ends it.
+            dims: [24, 16, 19],
         };
         let n = meta.dims.iter().product::<u32>() as usize;
         let mut flood = Flood::new(&meta);
         let mut found = 0;
-        for density in [20u32, 45, 60, 75, 90] {
+        for density in [20u32, 45, 60, 75, 90, 100] {
             for _ in 0..12 {
                 let open: Vec<bool> = (0..n).map(|_| next() % 100 < density).collect();
                 let from = Vec3::from(meta.voxel_to_world(meta.coords(next() % n as u32)));
-                let reach = 0.25 * (4 + next() % 12) as f32;
+                // A quarter unbounded: runs then reach the rows' ends, the grid's last voxel.
+                let reach = match next() % 4 {
+                    0 => f32::INFINITY,
+                    _ => 0.25 * (4 + next() % 12) as f32,
+                };
                 let keep = |i: usize, p: Vec3| open[i] && (p - from).length() <= reach;
                 let mut bfs = flood.run(&meta, from, keep);
                 let mut fill = flood.spans(&meta, from, keep);
