@@ -24,7 +24,7 @@ pub struct BakeArgs {
     #[arg(short, long)]
     pub output: PathBuf,
     /// Voxels on the longest axis of the static bounds (8..=2048). On 2 cores Crytek Sponza
-    /// bakes in about 2 s at 256, 4.3 s and 0.35 GB at 512, 14 s and 1.8 GB at 1024.
+    /// bakes in about 1.7 s at 256, 2.7 s and 0.33 GB at 512, 10 s and 1.9 GB at 1024.
     #[arg(long, default_value_t = 128, conflicts_with = "voxel_size")]
     pub resolution: u32,
     /// Voxel edge length in metres, instead of --resolution.
