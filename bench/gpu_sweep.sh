@@ -8,10 +8,13 @@
 # VISGATE: the visgate binary (a release build). OUT: a folder; it gets OUT/LEVEL.vgate,
 # OUT/log.txt (every render's report) and OUT/table.md (level, camera, size, VPLs, mode, GPU ms
 # of the frame, of its indirect pass; wall ms where the adapter's timestamps are not used).
-# LEVEL: e2m3, sponza (default both). Modes: none, direct-only, gates (voxel walk, the walks'
+# LEVEL: e2m3, sponza (default both), pillared (builtin:pillared-hall, camera side-room), ajar
+# (builtin:ajar-door, camera main). Modes: none, direct-only, gates (voxel walk, the walks'
 # roulette auto), gates-rr0, gates-rr05 and gates-rr10 (the roulette off, S = 0.05 and 0.1),
 # gates-triangles, gates-portal, gates-disk, gates-i4, gates-i4-rr0 and val-hard-i4 (4 × 4
-# interleaving; rr0: every VPL walked), val-hard, val-cssm, per-vpl-shadow-maps. In the
+# interleaving; rr0: every VPL walked), gates-starved48, gates-starved64 (--starved-taps 48,
+# 64), gates-filled (--blur-fill), gates-tri-starved64 (the triangles and 64 starved taps),
+# val-hard, val-cssm, per-vpl-shadow-maps. In the
 # environment: RUNS="SIZE:COUNTS ..." (default "512x512:4096,1024,16384 1280x720:4096"), MODES
 # (of those, default all but the 4 × 4 and roulette ones), LIMIT (seconds a render may take,
 # default 60). A render that fails or runs past LIMIT is written as such in the table. Needs
@@ -42,6 +45,10 @@ args_of() { # LABEL -> render arguments
     gates-rr05) echo "--mode gates --walk-roulette 0.05" ;;
     gates-rr10) echo "--mode gates --walk-roulette 0.1" ;;
     val-hard-i4) echo "--mode val-hard --interleave 4" ;;
+    gates-starved48) echo "--mode gates --starved-taps 48" ;;
+    gates-starved64) echo "--mode gates --starved-taps 64" ;;
+    gates-filled) echo "--mode gates --blur-fill" ;;
+    gates-tri-starved64) echo "--mode gates --closed-voxel-triangles --starved-taps 64" ;;
     *) echo "--mode $1" ;;
     esac
 }
@@ -50,6 +57,8 @@ scene_of() { # LEVEL -> scene camera
     case $1 in
     e2m3) echo "scenes/shared/librequake-e2m3.toml hall" ;;
     sponza) echo "scenes/shared/crytek-sponza.toml gallery" ;;
+    pillared) echo "builtin:pillared-hall side-room" ;;
+    ajar) echo "builtin:ajar-door main" ;;
     *) echo "unknown level $1" >&2 && exit 2 ;;
     esac
 }
@@ -75,7 +84,8 @@ for run in $runs; do
                 echo "$res" >>"$log"
                 # GPU ms, or the pass's wall ms where the report has no GPU time (lavapipe).
                 frame=$(echo "$res" | awk '$1 == "frame" { print ($2 == "-" ? $3 " (wall)" : $2) }')
-                ind=$(echo "$res" | awk '/indirect lighting/ { print ($(NF - 1) == "-" ? $NF : $(NF - 1)) }')
+                # The indirect pass alone (not the starved pixels' second pass, in the frame's).
+                ind=$(echo "$res" | awk '$1 == "indirect" && $2 == "lighting" { print ($(NF - 1) == "-" ? $NF : $(NF - 1)) }')
                 [ $rc -eq 124 ] && frame="over ${limit} s"
                 [ $rc -ne 0 ] && [ $rc -ne 124 ] && frame="failed ($rc)"
                 echo "| $level | $camera | $size | $n | $mode | ${frame:-?} | ${ind:--} |" |
