@@ -20,6 +20,11 @@ use crate::scene::{
 /// ([`bare_mesh_units`]): longer than any indoor level. [Units: m]
 pub const BARE_LEVEL_MAX_M: f64 = 1000.0;
 
+/// A bare mesh read in metres and longer than this gets a note that it may be modelled in
+/// centimetres (a two-room level of 800 cm reads as 800 m): most indoor levels are shorter.
+/// [Units: m]
+pub const BARE_LEVEL_NOTE_M: f64 = 200.0;
+
 /// Metres per unit of a bare mesh (no scene file, so no stated units) whose longest extent is
 /// `longest` of its units: metres, unless that makes a level longer than [`BARE_LEVEL_MAX_M`];
 /// then centimetres (Crytek Sponza's OBJ and GLB, Unreal, Maya and 3ds Max exports), or
@@ -151,6 +156,18 @@ fn units_warning(path: &Path, longest: f64, metres_per_unit: f64) -> String {
     )
 }
 
+/// What a user reads when a bare mesh read in metres is longer than [`BARE_LEVEL_NOTE_M`].
+fn metres_note(path: &Path, longest: f64) -> String {
+    format!(
+        "{}: a bare mesh states no units; read in metres, its longest side makes a {longest:.0} m \
+         level, longer than most indoor levels. If it is modelled in centimetres (a {:.1} m \
+         level), pass --metres-per-unit 0.01, or name the mesh in a scene TOML with \
+         `metres_per_unit` (README, Scenes)",
+        path.display(),
+        longest * 0.01,
+    )
+}
+
 /// What a user reads when the up axis of a bare OBJ is in doubt or Z.
 fn up_warning(path: &Path, why: &str) -> String {
     format!(
@@ -177,6 +194,8 @@ fn read_bare(
                 desc.metres_per_unit = bare_mesh_units(longest);
                 if desc.metres_per_unit != 1.0 {
                     notes.push(units_warning(path, longest, desc.metres_per_unit));
+                } else if longest > BARE_LEVEL_NOTE_M {
+                    notes.push(metres_note(path, longest));
                 }
             }
         }

@@ -1,6 +1,7 @@
 //! A bare mesh states no units: it is read in metres unless that would make a level longer
-//! than any indoor level, then in centimetres or millimetres, with a warning; a scene TOML's
-//! `metres_per_unit` chooses.
+//! than any indoor level, then in centimetres or millimetres, with a warning (and in metres
+//! with a note where that makes it longer than most); a scene TOML's `metres_per_unit`
+//! chooses.
 
 use std::path::{Path, PathBuf};
 
@@ -52,6 +53,16 @@ fn a_bare_mesh_in_centimetres_is_read_as_such_and_says_so() {
         "{:?}",
         m.report.warnings
     );
+    // 800 units, read in metres (under a kilometre), but longer than most indoor levels: a
+    // note says what centimetres would make it.
+    let long = Scene::load(&write_obj(dir.path(), "long.obj", 800.0), &options).expect("load");
+    assert!((longest_m(&long) - 800.0).abs() < 1e-3);
+    let w = long.report.warnings.join("\n");
+    assert!(
+        w.contains("long.obj") && w.contains("makes a 800 m level") && w.contains("a 8.0 m level"),
+        "{w}"
+    );
+    assert!(w.contains("--metres-per-unit 0.01"), "{w}");
     // A scene TOML's units are the user's: never guessed.
     let toml = dir.path().join("s.toml");
     std::fs::write(
