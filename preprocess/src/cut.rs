@@ -464,6 +464,27 @@ mod tests {
     }
 
     #[test]
+    fn the_next_unseen_voxel_is_found_across_words_and_never_past_the_range() {
+        let meta = GridMeta {
+            origin_m: [0.0; 3],
+            voxel_size_m: 1.0,
+            dims: [64, 2, 2],
+        };
+        let mut flood = Flood::new(&meta);
+        // Seen: 3..=70 and 130..=255 (the grid's last voxel).
+        (3..=70).chain(130..256).for_each(|i| {
+            flood.insert(i);
+        });
+        assert_eq!(flood.next_unseen(0, 10), 0);
+        assert_eq!(flood.next_unseen(3, 200), 71, "across a word's end");
+        assert_eq!(flood.next_unseen(5, 60), 61, "none in range: one past it");
+        assert_eq!(flood.next_unseen(130, 255), 256, "seen to the grid's end");
+        assert_eq!(flood.next_unseen(100, 140), 100);
+        flood.forget();
+        assert_eq!(flood.next_unseen(5, 60), 5);
+    }
+
+    #[test]
     fn the_scanline_fill_finds_the_breadth_first_floods_voxels() {
         // Random grids, from sparse to dense, accepted voxels in a ball around a random start
         // (the cuts' floods are bounded so) or anywhere: the same set, every voxel once.
