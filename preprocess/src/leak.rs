@@ -45,15 +45,26 @@ pub struct LeakPath {
 impl LeakPath {
     /// One line for the terminal.
     pub fn describe(&self) -> String {
-        let p = |v: [f32; 3]| format!("({:.2}, {:.2}, {:.2})", v[0], v[1], v[2]);
+        // To the centimetre, or finer where the opening is under 10 cm wide (a level modelled
+        // small: 8 mm read "0.01 m wide" at a place given to the centimetre).
+        let d = decimals_for(self.width_m);
+        let p = |v: [f32; 3]| format!("({:.d$}, {:.d$}, {:.d$})", v[0], v[1], v[2]);
         format!(
-            "{} at {} m reaches the outside through an opening near {} m, about {:.2} m wide",
+            "{} at {} m reaches the outside through an opening near {} m, about {:.d$} m wide",
             self.from,
             p(self.from_m),
             p(self.opening_m),
             self.width_m
         )
     }
+}
+
+/// Decimals that show two significant digits of `width` (metres), at least 2, at most 6.
+fn decimals_for(width: f32) -> usize {
+    if width.is_nan() || width <= 0.0 {
+        return 2;
+    }
+    ((-width.log10()).ceil() as i32 + 1).clamp(2, 6) as usize
 }
 
 /// The openings as a clause for a message: `: leak: …; leak: …` (nothing when there are none).
@@ -280,4 +291,33 @@ pub fn write_ply(w: &mut dyn Write, paths: &[LeakPath]) -> io::Result<()> {
         base += p.path_m.len() + 1;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_leak_is_told_to_two_digits_of_its_width_at_every_scale() {
+        let leak = |scale: f32| LeakPath {
+            from: "light 0".to_string(),
+            from_m: [5.84 * scale, 1.47 * scale, -2.53 * scale],
+            opening_m: [7.97 * scale, 1.53 * scale, -1.97 * scale],
+            width_m: 0.81 * scale,
+            path_m: Vec::new(),
+        };
+        assert_eq!(
+            leak(1.0).describe(),
+            "light 0 at (5.84, 1.47, -2.53) m reaches the outside through an opening near \
+             (7.97, 1.53, -1.97) m, about 0.81 m wide"
+        );
+        // The same level modelled 1/100 the size: 8.1 mm, not "0.01 m".
+        let small = leak(0.01).describe();
+        assert!(
+            small.contains("(0.0797, 0.0153, -0.0197) m") && small.ends_with("about 0.0081 m wide"),
+            "{small}"
+        );
+        // 100 times the size: to the centimetre still.
+        assert!(leak(100.0).describe().ends_with("about 81.00 m wide"));
+    }
 }
