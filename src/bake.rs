@@ -11,7 +11,6 @@ use visgate_formats::vgate::{
     AlphaRule, BakeParams, CurvatureTo, GatePlacement, MaxBall, Resolution,
 };
 use visgate_preprocess::bake::{BakeOptions, Progress, bake};
-use visgate_preprocess::empty::INSIDE;
 
 use crate::bake_warnings::warnings;
 
@@ -277,24 +276,6 @@ pub fn run(args: BakeArgs) -> Result<()> {
     }
     for o in &baked.openings {
         eprintln!("warning: leak: {}", o.describe());
-    }
-    if baked.report.empty_space["inside_leaks_not_looked_for"] == true {
-        eprintln!(
-            "warning: the scene names no camera or light, and the empty space kept as the \
-             level's inside (the one the most triangles face) reaches the scene's bounds; its \
-             openings are looked for on grids of up to {} M voxels: bake at a lower \
-             --resolution to have them named",
-            visgate_preprocess::empty::INSIDE_LEAK_MAX_VOXELS >> 20
-        );
-    }
-    if baked.openings.iter().any(|o| o.from == INSIDE) {
-        eprintln!(
-            "warning: the scene names no camera or light, so the bake kept as the level's \
-             inside the empty space that the most triangles face, and that space reaches the \
-             scene's bounds as above. If the level is meant to be sealed, close it there; in a \
-             scene file (`visgate scenes export`), `closed = true` with a camera or light inside \
-             makes the bake stop on a leak"
-        );
     }
     if let (Some(dir), false) = (&args.debug_dir, baked.openings.is_empty()) {
         write_leak_ply(dir, &baked.openings)?;

@@ -1,11 +1,12 @@
 //! What `visgate bake` warns of after a bake that succeeded but that a user would not want:
-//! most of the level's space dropped, a camera sealed off from every light, a grid too coarse
-//! for the level's rooms and doorways. Each warning says why and what to do; the figures also
+//! a bare mesh's inside that reaches the bounds, most of the level's space dropped, a camera
+//! sealed off from every light, a grid too coarse for the level's rooms and doorways. Each warning says why and what to do; the figures also
 //! sit in the JSON report.
 
 use serde_json::Value;
 use visgate_formats::vgate::GridMeta;
-use visgate_preprocess::empty::INSIDE;
+use visgate_preprocess::bake::is_camera_seed;
+use visgate_preprocess::empty::{INSIDE, INSIDE_LEAK_MAX_VOXELS};
 use visgate_preprocess::report::BakeReport;
 
 /// Under this largest-ball radius the kept space is a few voxels across: its clusters follow
@@ -20,7 +21,7 @@ const SUGGESTED_RADIUS_VX: f64 = 6.0;
 /// Every warning for `report`, in the order they are printed.
 pub fn warnings(report: &BakeReport) -> Vec<String> {
     let es = &report.empty_space;
-    let mut out = Vec::new();
+    let mut out = inside_warnings(es);
     out.extend(most_dropped(es, &report.grid));
     out.extend(cut_off_cameras(es, &report.grid));
     let radius = report
@@ -30,6 +31,34 @@ pub fn warnings(report: &BakeReport) -> Vec<String> {
         .and_then(|s| s.counts["largest_radius_vx"].as_f64());
     if let Some(r) = radius {
         out.extend(too_coarse(r, report.summary.clusters, &report.grid));
+    }
+    out
+}
+
+/// What to say of a bare mesh's inside (kept as the level's, no camera or light named) that
+/// reaches the scene's bounds: that its openings were not looked for on so large a grid, or,
+/// where they were (the `leak:` lines before), what to do about them.
+fn inside_warnings(empty_space: &Value) -> Vec<String> {
+    let mut out = Vec::new();
+    if empty_space["inside_leaks_not_looked_for"] == true {
+        out.push(format!(
+            "the scene names no camera or light, and the empty space kept as the level's \
+             inside (the one the most triangles face) reaches the scene's bounds; its openings \
+             are looked for on grids of up to {} M voxels: bake at a lower --resolution to have \
+             them named",
+            INSIDE_LEAK_MAX_VOXELS >> 20
+        ));
+    }
+    let openings = empty_space["openings"].as_array().into_iter().flatten();
+    if openings.into_iter().any(|o| o["from"] == INSIDE) {
+        out.push(
+            "the scene names no camera or light, so the bake kept as the level's inside the \
+             empty space that the most triangles face, and that space reaches the scene's \
+             bounds as above. If the level is meant to be sealed, close it there; in a scene \
+             file (`visgate scenes export`), `closed = true` with a camera or light inside \
+             makes the bake stop on a leak"
+                .to_string(),
+        );
     }
     out
 }
@@ -79,7 +108,7 @@ fn cut_off_cameras(empty_space: &Value, grid: &GridMeta) -> Vec<String> {
         list.filter_map(|s| s.as_str().map(str::to_string))
             .collect()
     };
-    let is_camera = |s: &String| s.starts_with("camera ");
+    let is_camera = |s: &String| is_camera_seed(s);
     let kept: Vec<Vec<String>> = comps
         .iter()
         .filter(|c| c["kept"] == true)
@@ -88,6 +117,7 @@ fn cut_off_cameras(empty_space: &Value, grid: &GridMeta) -> Vec<String> {
     if !kept.iter().any(|s| s.iter().any(|x| !is_camera(x))) {
         return Vec::new(); // no light in any kept part: nothing is cut off from one
     }
+    // Twice this resolution: a doorway a voxel wide is then two.
     let res = resolution_for(grid, 1.0, 2.0);
     kept.iter()
         .filter(|s| !s.is_empty() && s.iter().all(is_camera))
@@ -125,23 +155,19 @@ fn join_and(items: &[String]) -> String {
 /// what to do (the reason also sits in the JSON report). None where a bare mesh's inside was
 /// kept: that is the space the most triangles face, and a larger part dropped faces fewer (the
 /// space around and over Crytek Sponza's rooms, from its bare GLB at 128).
-fn most_dropped(
-    empty_space: &serde_json::Value,
-    grid: &visgate_formats::vgate::GridMeta,
-) -> Option<String> {
+fn most_dropped(empty_space: &Value, grid: &GridMeta) -> Option<String> {
     let comps = empty_space["components"].as_array()?;
-    let voxels = |c: &serde_json::Value| c["voxels"].as_u64().unwrap_or(0);
-    let at = |c: &serde_json::Value, key: &str, a: usize| c[key][a].as_f64().unwrap_or(0.0);
+    let voxels = |c: &Value| c["voxels"].as_u64().unwrap_or(0);
+    let at = |c: &Value, key: &str, a: usize| c[key][a].as_f64().unwrap_or(0.0);
     let (o, vs) = (grid.origin_m, grid.voxel_size_m as f64);
     // Within a voxel and a half of the grid's faces: next to its solid border, the outside.
-    let outside = |c: &serde_json::Value| {
+    let outside = |c: &Value| {
         (0..3).any(|a| {
             at(c, "bounds_min_m", a) <= o[a] as f64 + 1.5 * vs
                 || at(c, "bounds_max_m", a) >= o[a] as f64 + (grid.dims[a] as f64 - 1.5) * vs
         })
     };
-    let inside =
-        |c: &serde_json::Value| c["reason"].as_str().is_some_and(|r| r.starts_with(INSIDE));
+    let inside = |c: &Value| c["reason"].as_str().is_some_and(|r| r.starts_with(INSIDE));
     if comps.iter().any(inside) {
         return None;
     }
@@ -267,5 +293,20 @@ mod tests {
             w[0].starts_with("camera 'a', camera 'b' and camera 'c' are in"),
             "{w:?}"
         );
+    }
+
+    #[test]
+    fn a_bare_mesh_s_inside_at_the_bounds_is_said_searched_or_not() {
+        let none = json!({ "openings": [], "inside_leaks_not_looked_for": false });
+        assert!(inside_warnings(&none).is_empty());
+        // A closed scene's leak from a light: its own error or warning, not this one.
+        let light = json!({ "openings": [{ "from": "point light 0" }] });
+        assert!(inside_warnings(&light).is_empty());
+        let found = json!({ "openings": [{ "from": INSIDE }] });
+        let w = inside_warnings(&found);
+        assert!(w.len() == 1 && w[0].contains("`closed = true`"), "{w:?}");
+        let unsearched = json!({ "openings": [], "inside_leaks_not_looked_for": true });
+        let w = inside_warnings(&unsearched);
+        assert!(w.len() == 1 && w[0].contains("up to 32 M voxels"), "{w:?}");
     }
 }

@@ -194,13 +194,21 @@ fn check_params(p: &BakeParams) -> Result<(), BakeError> {
     Ok(())
 }
 
+/// How a camera's seed is named (`camera 'main'`): the bake's report lists seeds by name.
+const CAMERA_SEED: &str = "camera '";
+
+/// Whether seed `what` (a [`Seed::what`], as the report lists it) is a camera's, not a light's.
+pub fn is_camera_seed(what: &str) -> bool {
+    what.starts_with(CAMERA_SEED)
+}
+
 /// Seeds of the scene: camera eyes and light positions.
 pub fn scene_seeds(scene: &Scene) -> Vec<Seed> {
     let mut seeds: Vec<Seed> = scene
         .cameras
         .iter()
         .map(|c| Seed {
-            what: format!("camera '{}'", c.name),
+            what: format!("{CAMERA_SEED}{}'", c.name),
             position_m: c.eye.to_array(),
         })
         .collect();

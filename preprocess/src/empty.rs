@@ -221,9 +221,6 @@ pub fn empty_space(
         };
         crate::inside::find_inside(meta, d2, &visit)
     });
-    let to_m = |v: [u32; 3], corner: f32| -> [f32; 3] {
-        std::array::from_fn(|a| meta.origin_m[a] + (v[a] as f32 + corner) * meta.voxel_size_m)
-    };
     let mut components: Vec<ComponentReport> = (0..n)
         .map(|c| {
             let (kept, reason) = if !seeds_in[c].is_empty() {
@@ -275,8 +272,8 @@ pub fn empty_space(
             };
             ComponentReport {
                 voxels: voxels[c],
-                bounds_min_m: to_m(lo[c], 0.0),
-                bounds_max_m: to_m(hi[c], 1.0),
+                bounds_min_m: box_m(meta, lo[c], 0.0),
+                bounds_max_m: box_m(meta, hi[c], 1.0),
                 seeds: seeds_in[c].clone(),
                 faced_by: faced[c],
                 kept,
@@ -352,6 +349,12 @@ pub fn empty_space(
     })
 }
 
+/// A corner of voxel `v`'s cube in metres: its low corner at `corner` 0, its high one at 1 (a
+/// box of voxels from its lowest and highest).
+fn box_m(meta: &GridMeta, v: [u32; 3], corner: f32) -> [f32; 3] {
+    std::array::from_fn(|a| meta.origin_m[a] + (v[a] as f32 + corner) * meta.voxel_size_m)
+}
+
 /// Where the kept `empty` voxels of a closed scene touch each side of the bounds (the voxels
 /// next to the border ring): a leak per side touched, with its count and box.
 fn leaks_by_side(meta: &GridMeta, empty: &[bool]) -> Vec<Leak> {
@@ -381,17 +384,14 @@ fn leaks_by_side(meta: &GridMeta, empty: &[bool]) -> Vec<Leak> {
             }
         }
     }
-    let to_m = |v: [u32; 3], corner: f32| -> [f32; 3] {
-        std::array::from_fn(|a| meta.origin_m[a] + (v[a] as f32 + corner) * meta.voxel_size_m)
-    };
     acc.into_iter()
         .enumerate()
         .filter(|(_, (count, ..))| *count > 0)
         .map(|(s, (count, l, h))| Leak {
             side: SIDES[s],
             voxels: count,
-            bounds_min_m: to_m(l, 0.0),
-            bounds_max_m: to_m(h, 1.0),
+            bounds_min_m: box_m(meta, l, 0.0),
+            bounds_max_m: box_m(meta, h, 1.0),
         })
         .collect()
 }
