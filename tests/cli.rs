@@ -961,6 +961,12 @@ fn render_gates_uses_a_baked_level_and_refuses_a_missing_or_stale_one() {
     let named = "gates (voxel walk, 8×8 interleaved, blur filled, under 40 agreeing walk the rest)";
     assert!(stdout(&of).contains(named), "{}", stdout(&of));
     assert!(stdout(&of).contains("starved pixels"), "{}", stdout(&of));
+    // How many pixels were starved and the pairs they walked, counted.
+    assert!(
+        stdout(&of).contains("(pixel, subset) pairs (list of"),
+        "{}",
+        stdout(&of)
+    );
     // The roulette on the walks: on by default at 128 VPLs a pixel (8,192 in 8 × 8 blocks),
     // named as it acts; --walk-roulette 0 turns it off.
     let mut r = a.clone();

@@ -851,10 +851,21 @@ fn starved_pixels_walk_the_subsets_their_block_lacks_and_count_every_vpl_once() 
                 names.contains(&"indirect lighting: starved pixels"),
                 "{names:?}"
             );
+            // A (pixel, subset) pair for each of the b² − 1 other taps of every lit pixel's
+            // block, in a list that grew from four pairs a pixel to hold them all.
+            let st = t.starved.expect("starved pixels' stats");
+            let lit = img.pixels.iter().filter(|p| p.max_element() > 0.0).count() as u32;
+            assert!(st.pixels > 0 && st.pixels <= 96 * 72 && st.pixels + 96 * 72 / 10 >= lit);
+            assert_eq!(
+                st.pairs,
+                u64::from(st.pixels) * u64::from(block * block - 1)
+            );
+            assert!(u64::from(st.capacity) >= st.pairs && st.capacity > 4 * 96 * 72);
             let e = errors(&img, &full).expect("same size");
             eprintln!(
-                "{shape:?} block {block}: rel. MSE {:.2e} to every VPL's",
-                e.rel_mse
+                "{shape:?} block {block}: rel. MSE {:.2e} to every VPL's, {} starved pixels, \
+                 {} pairs (list of {})",
+                e.rel_mse, st.pixels, st.pairs, st.capacity
             );
             assert!(e.rel_mse < 1e-8, "{shape:?} block {block}: {}", e.rel_mse);
             // Without it the same blur leaves each pixel its own subset, × b².

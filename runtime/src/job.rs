@@ -494,6 +494,16 @@ pub fn pass_table(t: &PassTimes) -> String {
               wrong for compute passes: each pass was submitted and waited for alone, for its CPU \
               wall time)\n";
     }
+    if let Some(st) = t.starved {
+        s += &format!(
+            "starved pixels: {} walked the subsets of their block's other taps themselves, {} \
+             (pixel, subset) pairs (list of {}, {:.1} % used)\n",
+            st.pixels,
+            st.pairs,
+            st.capacity,
+            st.pairs as f64 / f64::from(st.capacity.max(1)) * 100.0
+        );
+    }
     if let Some(l) = t.lists {
         s += &format!(
             "light lists: {} geometry clusters, {} entries ({:.1} per cluster), pool {} entries \

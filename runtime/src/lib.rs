@@ -68,6 +68,18 @@ pub enum RenderError {
         /// Geometry clusters in view.
         clusters: u32,
     },
+    /// The starved pixels' walks need more (pixel, subset) pairs than their list holds (the
+    /// renderer grows it and renders the frame again; the light is never cut).
+    #[error(
+        "the starved pixels' walks need {needed} (pixel, subset) pairs, more than the list's \
+         {capacity}: lower --starved-taps, use a smaller image or a smaller --interleave block"
+    )]
+    StarvedPairsFull {
+        /// Pairs the frame needs.
+        needed: u64,
+        /// The list's capacity.
+        capacity: u32,
+    },
     /// Reading or writing a file.
     #[error("{path}: {message}")]
     Io {

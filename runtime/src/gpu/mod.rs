@@ -155,6 +155,8 @@ pub struct Frame<'a> {
     /// VPLs of a pixel's subset mode gates walks a draw ([`methods::walk_batch`]; also
     /// [`Globals::walk_batch`], which the shader reads).
     pub walk_batch: u32,
+    /// The starved pixels' list of (pixel, subset) pairs: its capacity.
+    pub starved_pairs: u32,
 }
 
 /// Every pass's pipelines.
@@ -205,6 +207,9 @@ pub struct GpuRenderer {
     val_warm: Option<u32>,
     /// The light-list pool's capacity when it grows on its own (mode gates).
     light_entries: u32,
+    /// The starved pixels' pairs' list's capacity once a frame outgrew its first (0: none
+    /// yet, [`passes::starved::FIRST_PAIRS_PER_PIXEL`] a pixel).
+    starved_pairs: u32,
     /// The last frame's HDR target (in the pool: the next frame of its size overwrites it).
     last_hdr: Option<wgpu::Texture>,
 }
@@ -219,6 +224,8 @@ struct Recorded {
     lc_args: Option<wgpu::Buffer>,
     /// The same of the VPLs' clusters (mode vpl-clusters).
     vpl_lc_args: Option<wgpu::Buffer>,
+    /// Interleaved gates' starved pixels, with `--starved-taps`.
+    starved: Option<passes::starved::StarvedOutput>,
 }
 
 /// The frame as its passes (after the VPLs): shadow maps, G-buffer, the mode's passes,
@@ -276,19 +283,24 @@ fn record_passes(
     let inputs = (&shadows, &g, gathers, lc.as_ref(), vpl_lc.as_ref());
     let hdr = p.shade.record(f, pool, rec, inputs, shading);
     let mut val_state = None;
+    let mut starved = None;
     match &f.params.mode {
         GpuMode::Gates(gp) if gp.gathers_apart() => {
             let indirect = p
                 .shade
                 .record_indirect(f, pool, rec, inputs, Some(gp.gates.shape));
             let il = &gp.interleave;
-            let starved = (il.block > 1 && il.starved_taps > 0).then(|| {
-                p.shade
-                    .record_starved(f, pool, rec, inputs, (gp.gates.shape, il))
-            });
+            starved = match il.block > 1 && il.starved_taps > 0 {
+                true => Some(
+                    p.shade
+                        .record_starved(f, pool, rec, inputs, (gp.gates.shape, il))?,
+                ),
+                false => None,
+            };
             let uniform = InterleaveBlur::uniform(f, il, pool, true);
             let targets = (&g, &uniform, &indirect, &hdr);
-            p.blur.record(f, pool, rec, targets, starved.as_ref());
+            let sums = starved.as_ref().map(|s| &s.sums);
+            p.blur.record(f, pool, rec, targets, sums);
         }
         GpuMode::VplClusters(_, il) if il.block > 1 => {
             let indirect = p.shade.record_indirect(f, pool, rec, inputs, None);
@@ -326,7 +338,21 @@ fn record_passes(
         val_state,
         lc_args: lc.map(|o| o.clusters.args),
         vpl_lc_args: vpl_lc.map(|o| o.clusters.args),
+        starved,
     })
+}
+
+/// The starved pixels' pairs' list's first capacity for an image of `size`, within the
+/// adapter's storage binding limit.
+fn first_starved_pairs(ctx: &GpuContext, [w, h]: [u32; 2]) -> u32 {
+    let pairs = u64::from(w) * u64::from(h) * passes::starved::FIRST_PAIRS_PER_PIXEL;
+    pairs.min(max_starved_pairs(ctx)) as u32
+}
+
+/// The most (pixel, subset) pairs the starved pixels' list may hold on the adapter.
+fn max_starved_pairs(ctx: &GpuContext) -> u64 {
+    let binding = ctx.device.limits().max_storage_buffer_binding_size;
+    (binding / passes::starved::PAIR_BYTES).min(u64::from(u32::MAX))
 }
 
 impl GpuRenderer {
@@ -381,6 +407,7 @@ impl GpuRenderer {
             pool: Pool::default(),
             val_warm: None,
             light_entries: passes::clustered_gates::AUTO_LIGHT_ENTRIES,
+            starved_pairs: 0,
             last_hdr: None,
         })
     }
@@ -575,6 +602,7 @@ impl GpuRenderer {
             vpl_count,
             vpls_cpu,
             walk_batch,
+            starved_pairs: self.starved_pairs.max(first_starved_pairs(ctx, view.size)),
         };
         (frame, &self.pipelines, pool)
     }
@@ -608,25 +636,32 @@ impl GpuRenderer {
         let run = |r: &mut Self, p: &GpuParams| {
             context::scoped(ctx, || r.frame_unscoped(ctx, view, vpls, p, read_hdr))
         };
-        // Only disks keep lists; a pool of a set size fails when full.
-        let g = match params.mode {
-            GpuMode::Gates(g) if g.light_entries.is_none() && g.gates.shape == GateShape::Disk => g,
-            _ => return run(self, params),
+        // Pools that grow: the frame again with the capacity it needed (a quarter more, for
+        // the next frames' changes), up to the adapter's limit: the disks' light lists when
+        // their size is not set, the starved pixels' pairs.
+        let auto_lists = match params.mode {
+            GpuMode::Gates(g) if g.light_entries.is_none() && g.gates.shape == GateShape::Disk => {
+                Some(g)
+            }
+            _ => None,
         };
-        // A pool that grows: the frame again with the capacity it needed (a quarter more,
-        // for the next frames' changes), up to the adapter's limit.
         let max = (ctx.device.limits().max_storage_buffer_binding_size / 8).min(u32::MAX as u64);
-        for _ in 0..2 {
+        let max_pairs = max_starved_pairs(ctx);
+        for _ in 0..3 {
             let mut p = *params;
-            p.mode = GpuMode::Gates(GatesParams {
-                light_entries: Some(self.light_entries),
-                ..g
-            });
+            if let Some(g) = auto_lists {
+                p.mode = GpuMode::Gates(GatesParams {
+                    light_entries: Some(self.light_entries),
+                    ..g
+                });
+            }
             match run(self, &p) {
-                Err(RenderError::LightListsFull { needed, .. }) if needed <= max => {
+                Err(RenderError::LightListsFull { needed, .. })
+                    if auto_lists.is_some() && needed <= max =>
+                {
                     self.light_entries = (needed + needed / 4).min(max) as u32;
                 }
-                Err(RenderError::LightListsFull { needed, .. }) => {
+                Err(RenderError::LightListsFull { needed, .. }) if auto_lists.is_some() => {
                     return Err(RenderError::Param(format!(
                         "the light lists need {needed} entries ({} bytes), more than the \
                          adapter's storage binding limit allows ({max} entries): use fewer VPLs, \
@@ -634,11 +669,15 @@ impl GpuRenderer {
                         needed * 8
                     )));
                 }
+                Err(RenderError::StarvedPairsFull { needed, capacity }) if needed <= max_pairs => {
+                    let room = (needed + needed / 4).min(max_pairs) as u32;
+                    self.starved_pairs = room.max(capacity);
+                }
                 r => return r,
             }
         }
         Err(RenderError::Gpu(
-            "the light lists kept outgrowing their pool".into(),
+            "the light lists or the starved pixels' pairs kept outgrowing their pools".into(),
         ))
     }
 
@@ -727,11 +766,17 @@ impl GpuRenderer {
         let lc_read = (out.lc_args.as_ref()).map(|a| read_back("lc args readback", a, 64));
         let vpl_lc_read =
             (out.vpl_lc_args.as_ref()).map(|a| read_back("vpl lc args readback", a, 64));
+        let starved_read =
+            (out.starved.as_ref()).map(|s| read_back("starved count readback", &s.count, 16));
         let mut times = rec.finish(pool)?;
         let t1 = Instant::now();
         if let (Some(l), Some(r)) = (&out.lists, &counter_read) {
             let c: Vec<u32> = bytemuck::cast_slice(&map_read(ctx, r)?).to_vec();
             times.lists = Some(l.stats(&c)?);
+        }
+        if let (Some(s), Some(r)) = (&out.starved, &starved_read) {
+            let c: Vec<u32> = bytemuck::cast_slice(&map_read(ctx, r)?).to_vec();
+            times.starved = Some(passes::starved::stats(&c, s.capacity)?);
         }
         if let (Some(r), Some(v)) = (&state_read, vals) {
             let c: Vec<u32> = bytemuck::cast_slice(&map_read(ctx, r)?).to_vec();

@@ -60,6 +60,8 @@ pub struct PassTimes {
     pub direct_clusters: Option<LcCounts>,
     /// Mode vpl-clusters: the VPLs' clusters.
     pub vpl_clusters: Option<LcCounts>,
+    /// Interleaved gates with `--starved-taps`: the starved pixels' walks.
+    pub starved: Option<crate::gpu::passes::starved::StarvedStats>,
 }
 
 /// How LightCluster clustered a frame's lights (or VPLs).
@@ -261,6 +263,7 @@ impl<'c> Recorder<'c> {
             vals: None,
             direct_clusters: None,
             vpl_clusters: None,
+            starved: None,
         })
     }
 }

@@ -14,7 +14,7 @@
 @group(0) @binding(13) var composed: texture_storage_2d<rgba32float, write>;
 // Interleaved gates: at the pixels whose block holds too few taps that agree with them (w 1),
 // the light of the subsets of the taps that do not, which they walked themselves (shade.wgsl's
-// cs_gates_starved); a 1 × 1 texture of zeros for the other modes.
+// cs_starved_sums); a 1 × 1 texture of zeros for the other modes.
 @group(0) @binding(14) var starved_sums: texture_2d<f32>;
 
 @compute @workgroup_size(8, 8)

@@ -15,5 +15,6 @@ pub mod rsm_vpls;
 pub mod shade;
 pub mod shadow_maps;
 pub mod sight_ends;
+pub mod starved;
 pub mod val_gather;
 pub mod vals;

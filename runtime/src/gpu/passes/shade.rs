@@ -4,7 +4,6 @@
 
 use super::clustered_gates::ListBuffers;
 use super::gbuffer::GBufferOutput;
-use super::interleave_blur::InterleaveParams;
 use super::light_cluster::LcOutput;
 use super::shadow_maps::ShadowOutput;
 use crate::RenderError;
@@ -27,8 +26,10 @@ pub struct Shade {
     /// `GATE_SHAPE`, by [`crate::cpu::gates::GateShape::shader_id`]) and one for the voxel
     /// walk with the closed voxels' triangles (`SIGHT_TRIANGLES`), each made when first used.
     gates_indirect: [std::sync::OnceLock<wgpu::ComputePipeline>; 4],
-    /// The starved pixels' gathers (`cs_gates_starved`), likewise.
+    /// The starved pixels' walks (`cs_starved_walks`), likewise.
     gates_starved: [std::sync::OnceLock<wgpu::ComputePipeline>; 4],
+    /// The starved pixels' other passes (starved.rs).
+    pub(super) starved: super::starved::StarvedPipelines,
     module: wgpu::ShaderModule,
     vpl_clusters_indirect: wgpu::ComputePipeline,
 }
@@ -96,9 +97,6 @@ pub struct Gathers<'a> {
 /// The bindings of shade.wgsl's `cs_gates_indirect` (an automatic layout holds only what an
 /// entry point uses) but its batch index (24) and its output (25).
 const GATES_INDIRECT_BINDINGS: [u32; 15] = [0, 2, 5, 6, 7, 8, 10, 12, 13, 14, 15, 16, 21, 22, 23];
-/// The bindings of shade.wgsl's `cs_gates_starved` but its batch index (24) and its output
-/// (25): the walks' without the disks' lists, and the starved test's constants (26).
-const GATES_STARVED_BINDINGS: [u32; 12] = [0, 2, 5, 6, 7, 8, 15, 16, 21, 22, 23, 26];
 /// The bindings of shade.wgsl's `cs_shade` but its output (25): all but the batches' sum, the
 /// batch index, and the VPLs' clusters and walk ends (clustered gates walk apart, in
 /// `cs_gates_indirect`; `cs_shade` gathers their disks and gates per pixel).
@@ -118,6 +116,7 @@ impl Shade {
             pipeline,
             gates_indirect: Default::default(),
             gates_starved: Default::default(),
+            starved: super::starved::StarvedPipelines::new(d, &module),
             module,
             vpl_clusters_indirect,
         })
@@ -125,7 +124,7 @@ impl Shade {
 
     /// Gather `gather`'s pipeline for gate shape `shape`, the voxel walk with the closed
     /// voxels' triangles where frame `f`'s mode asks for them, made when first asked for.
-    fn gates_pipeline(
+    pub(super) fn gates_pipeline(
         &self,
         f: &Frame,
         gather: GatesGather,
@@ -137,7 +136,7 @@ impl Shade {
         let k = if triangles { 3 } else { shape as usize };
         let (cache, entry) = match gather {
             GatesGather::Indirect => (&self.gates_indirect, "cs_gates_indirect"),
-            GatesGather::Starved => (&self.gates_starved, "cs_gates_starved"),
+            GatesGather::Starved => (&self.gates_starved, "cs_starved_walks"),
         };
         let d = &f.ctx.device;
         cache[k].get_or_init(|| {
@@ -199,45 +198,6 @@ impl Shade {
             names: ["indirect irradiance", "indirect irradiance (batches)"],
             span: "indirect lighting",
             extra: None,
-        };
-        self.walk_batches(f, pool, rec, inputs, batched)
-    }
-
-    /// Records interleaved gates' second gather ([`InterleaveParams::starved_taps`]): at the
-    /// pixels whose blur block holds fewer than that many taps that agree with them, the VPL
-    /// subsets of the taps that do not, walked; in pixel order (w 1 there), for the blur to
-    /// add to the agreeing taps' subsets.
-    pub fn record_starved(
-        &self,
-        f: &Frame,
-        pool: &mut Pool,
-        rec: &mut Recorder,
-        inputs: Inputs,
-        (shape, il): (GateShape, &InterleaveParams),
-    ) -> wgpu::Texture {
-        let constants = [
-            il.blur_distance_m(f),
-            il.blur_normal,
-            il.starved_taps as f32,
-            0.0,
-        ];
-        let uniform = pool.upload(
-            f.ctx,
-            "starved pixels' test",
-            bytemuck::cast_slice(&constants),
-            wgpu::BufferUsages::UNIFORM,
-        );
-        // A starved pixel may walk every VPL but its own subset's.
-        let batched = Batched {
-            pipeline: self.gates_pipeline(f, GatesGather::Starved, shape),
-            batches: batch_count(f, f.vpl_count),
-            used: &GATES_STARVED_BINDINGS,
-            names: [
-                "starved pixels' irradiance",
-                "starved pixels' irradiance (batches)",
-            ],
-            span: "indirect lighting: starved pixels",
-            extra: Some(&uniform),
         };
         self.walk_batches(f, pool, rec, inputs, batched)
     }
@@ -337,16 +297,16 @@ impl Shade {
 
 /// The gates' two gathers (shade.wgsl's entry points).
 #[derive(Debug, Clone, Copy)]
-enum GatesGather {
+pub(super) enum GatesGather {
     /// `cs_gates_indirect`: each pixel its subset's VPLs (or every VPL).
     Indirect,
-    /// `cs_gates_starved`: the starved pixels' walks of what their block lacks.
+    /// `cs_starved_walks`: the starved pixels' walks of what their block lacks.
     Starved,
 }
 
 /// The dispatches a gather of up to `walks` walks a pixel takes: batches of `f.walk_batch`
 /// walks on a software rasterizer (its loop limit), one elsewhere.
-fn batch_count(f: &Frame, walks: u32) -> u32 {
+pub(super) fn batch_count(f: &Frame, walks: u32) -> u32 {
     match f.walk_batch {
         0 => 1,
         batch => walks.div_ceil(batch).max(1),
@@ -370,14 +330,14 @@ struct Batched<'a> {
 }
 
 /// The texture views shade.wgsl's passes read beside the G-buffer's.
-struct Views {
+pub(super) struct Views {
     maps: wgpu::TextureView,
     vis: wgpu::TextureView,
     vpl_vis: wgpu::TextureView,
 }
 
 impl Views {
-    fn new(f: &Frame, (shadows, _, _, lc, vpl_lc): Inputs) -> Views {
+    pub(super) fn new(f: &Frame, (shadows, _, _, lc, vpl_lc): Inputs) -> Views {
         let no_vis = array_view(&f.scene.no_visibility);
         Views {
             maps: array_view(&shadows.maps),
@@ -388,7 +348,7 @@ impl Views {
 
     /// shade.wgsl's group 0 but bindings 24 and 25 (`used` alone where given), with `earlier`
     /// as the batches' sum (binding 21, left out when `None`).
-    fn resources<'a>(
+    pub(super) fn resources<'a>(
         &'a self,
         f: &'a Frame,
         (shadows, g, gathers, lc, vpl_lc): Inputs<'a>,

@@ -1,0 +1,261 @@
+//! Interleaved gates' second gather (shade.wgsl's `cs_starved_*`): the pixels whose blur block
+//! holds too few taps that agree with them walk the VPL subsets of the taps that do not, a
+//! (pixel, subset) pair an invocation, so that a starved pixel's walks spread over as many
+//! lanes as it has subsets instead of holding up its warp ([`InterleaveParams::starved_taps`]).
+
+use super::interleave_blur::InterleaveParams;
+use super::shade::{Inputs, Shade, frame_target};
+use crate::RenderError;
+use crate::cpu::gates::GateShape;
+use crate::gpu::Frame;
+use crate::gpu::context::{Pool, bind_group, slice};
+use crate::gpu::layout::{UNIFORM_STRIDE, strided};
+use crate::gpu::timing::Recorder;
+
+/// The pairs' list's first capacity: four a pixel (the pillared hall's side room at T = 48
+/// needed 1.7, e2m3's hall 6.8, Crytek Sponza's gallery at T = 64 6.4; a frame that needs more
+/// is rendered again with room, once). [Units: pairs per pixel]
+pub const FIRST_PAIRS_PER_PIXEL: u64 = 4;
+/// A pair's bytes in the list (its light and its pixel × 256 + subset).
+pub const PAIR_BYTES: u64 = 16;
+/// The most pixels a frame with starved pixels may have: a pair holds its pixel × 256 + its
+/// subset in 32 bits (4,096 × 4,096).
+pub const MAX_STARVED_PIXELS: u64 = 1 << 24;
+
+/// The bindings of shade.wgsl's `cs_starved_pairs`: globals, the G-buffer's positions and
+/// normals, the starved test's constants (26), the count, pairs and runs (27–29).
+const PAIRS_BINDINGS: [u32; 3] = [0, 5, 6];
+/// The bindings of `cs_starved_walks` from the shading's resources (the walks' without the
+/// disks' lists); the batch index (24), count (27) and pairs (28) besides.
+const WALKS_BINDINGS: [u32; 10] = [0, 2, 5, 6, 7, 8, 15, 16, 22, 23];
+
+/// What the starved pixels' passes leave: the image the blur reads (xyz the walked subsets'
+/// light, w 1 where starved) and the counters (pairs needed, pixels that did not fit, starved
+/// pixels) for the readback.
+pub struct StarvedOutput {
+    /// In pixel order.
+    pub sums: wgpu::Texture,
+    /// Four words: pairs reserved, pixels whose pairs did not fit, starved pixels.
+    pub count: wgpu::Buffer,
+    /// The pairs' list's capacity.
+    pub capacity: u32,
+}
+
+impl Shade {
+    /// Records interleaved gates' second gather ([`InterleaveParams::starved_taps`]): at the
+    /// pixels whose blur block holds fewer than that many taps that agree with them, the VPL
+    /// subsets of the taps that do not, walked, a pair an invocation; in pixel order (w 1
+    /// there), for the blur to add to the agreeing taps' subsets. The pairs' list holds
+    /// `f.starved_pairs`; a frame that needs more says so in its counters.
+    pub fn record_starved(
+        &self,
+        f: &Frame,
+        pool: &mut Pool,
+        rec: &mut Recorder,
+        inputs: Inputs,
+        (shape, il): (GateShape, &InterleaveParams),
+    ) -> Result<StarvedOutput, RenderError> {
+        let d = &f.ctx.device;
+        let [w, h] = f.view.size;
+        let pixels = u64::from(w) * u64::from(h);
+        if pixels > MAX_STARVED_PIXELS {
+            return Err(RenderError::Param(format!(
+                "the starved pixels' walks (--starved-taps) take images of at most {} pixels; \
+                 this one has {pixels} ({w} × {h})",
+                MAX_STARVED_PIXELS
+            )));
+        }
+        let constants = [
+            il.blur_distance_m(f),
+            il.blur_normal,
+            il.starved_taps as f32,
+            0.0,
+        ];
+        let uniform = wgpu::BufferUsages::UNIFORM;
+        let test = pool.upload(
+            f.ctx,
+            "starved pixels' test",
+            bytemuck::cast_slice(&constants),
+            uniform,
+        );
+        let storage = wgpu::BufferUsages::STORAGE;
+        let count = pool.buffer(
+            d,
+            "starved pixels' count",
+            16,
+            storage | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+        );
+        let capacity = f.starved_pairs;
+        let pairs = pool.buffer(
+            d,
+            "starved pixels' pairs",
+            u64::from(capacity) * PAIR_BYTES,
+            storage,
+        );
+        let runs = pool.buffer(d, "starved pixels' runs", pixels * 8, storage);
+        let args = pool.buffer(
+            d,
+            "starved walks' dispatch",
+            12,
+            storage | wgpu::BufferUsages::INDIRECT,
+        );
+        let sums = frame_target(f, pool, "starved pixels' irradiance");
+        let sums_view = sums.create_view(&Default::default());
+        // The walks' batches: a pair walks one subset, up to ⌈VPLs / B⌉ VPLs.
+        let batches = super::shade::batch_count(f, f.vpl_count.div_ceil(il.subsets()));
+        let indices: Vec<[u32; 4]> = (0..batches).map(|i| [i, 0, 0, 0]).collect();
+        let index_buf = pool.upload(f.ctx, "starved walk batches", &strided(&indices), uniform);
+
+        let p = &self.starved;
+        let walks = self.gates_pipeline(f, super::shade::GatesGather::Starved, shape);
+        let views = super::shade::Views::new(f, inputs);
+        fn whole(b: &wgpu::Buffer) -> wgpu::BindingResource<'_> {
+            b.as_entire_binding()
+        }
+        let group = |pipeline: &wgpu::ComputePipeline, mut resources: Vec<_>, extra: Vec<_>| {
+            resources.extend(extra);
+            bind_group(d, &pipeline.get_bind_group_layout(0), "starved", resources)
+        };
+        let pairs_group = group(
+            &p.pairs,
+            views.resources(f, inputs, None, Some(&PAIRS_BINDINGS)),
+            vec![
+                (26, whole(&test)),
+                (27, whole(&count)),
+                (28, whole(&pairs)),
+                (29, whole(&runs)),
+            ],
+        );
+        let args_group = group(
+            &p.args,
+            Vec::new(),
+            vec![(27, whole(&count)), (28, whole(&pairs)), (30, whole(&args))],
+        );
+        let walk_groups: Vec<wgpu::BindGroup> = (0..batches as usize)
+            .map(|i| {
+                group(
+                    walks,
+                    views.resources(f, inputs, None, Some(&WALKS_BINDINGS)),
+                    vec![
+                        (24, slice(&index_buf, (i * UNIFORM_STRIDE) as u64, 16)),
+                        (27, whole(&count)),
+                        (28, whole(&pairs)),
+                    ],
+                )
+            })
+            .collect();
+        let sums_group = group(
+            &p.sums,
+            views.resources(f, inputs, None, Some(&[5])),
+            vec![
+                (25, wgpu::BindingResource::TextureView(&sums_view)),
+                (28, whole(&pairs)),
+                (29, whole(&runs)),
+            ],
+        );
+
+        rec.enc.clear_buffer(&count, 0, None);
+        let span = "indirect lighting: starved pixels";
+        let timed = rec.begin(span);
+        {
+            let mut pass = rec.enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(span),
+                timestamp_writes: timed.compute(),
+            });
+            let tiles = [w.div_ceil(8), h.div_ceil(8)];
+            pass.set_pipeline(&p.pairs);
+            pass.set_bind_group(0, &pairs_group, &[]);
+            pass.dispatch_workgroups(tiles[0], tiles[1], 1);
+            pass.set_pipeline(&p.args);
+            pass.set_bind_group(0, &args_group, &[]);
+            pass.dispatch_workgroups(1, 1, 1);
+            pass.set_pipeline(walks);
+            for g in &walk_groups {
+                pass.set_bind_group(0, g, &[]);
+                pass.dispatch_workgroups_indirect(&args, 0);
+            }
+            pass.set_pipeline(&p.sums);
+            pass.set_bind_group(0, &sums_group, &[]);
+            pass.dispatch_workgroups(tiles[0], tiles[1], 1);
+        }
+        rec.end();
+        Ok(StarvedOutput {
+            sums,
+            count,
+            capacity,
+        })
+    }
+}
+
+/// The pipelines of the starved pixels' passes but the walks' (made per gate shape, as the
+/// gathers', [`Shade`]).
+pub struct StarvedPipelines {
+    pairs: wgpu::ComputePipeline,
+    args: wgpu::ComputePipeline,
+    sums: wgpu::ComputePipeline,
+}
+
+impl StarvedPipelines {
+    /// Built from shade.wgsl's module.
+    pub fn new(d: &wgpu::Device, module: &wgpu::ShaderModule) -> StarvedPipelines {
+        let [pairs, args, sums] = crate::gpu::context::compute_pipelines(
+            d,
+            module,
+            ["cs_starved_pairs", "cs_starved_args", "cs_starved_sums"],
+        );
+        StarvedPipelines { pairs, args, sums }
+    }
+}
+
+/// How a frame's starved pixels came out (`PassTimes::starved`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct StarvedStats {
+    /// Pixels that walked what their block lacks.
+    pub pixels: u32,
+    /// (pixel, subset) pairs they walked.
+    pub pairs: u64,
+    /// The pairs' list's capacity.
+    pub capacity: u32,
+}
+
+/// A frame's stats from the count's words and the list's `capacity`; an error with the pairs
+/// needed when some pixels' did not fit (the renderer then renders the frame again with room).
+pub fn stats(c: &[u32], capacity: u32) -> Result<StarvedStats, RenderError> {
+    if c[1] > 0 {
+        return Err(RenderError::StarvedPairsFull {
+            needed: u64::from(c[0]),
+            capacity,
+        });
+    }
+    Ok(StarvedStats {
+        pixels: c[2],
+        pairs: u64::from(c[0]),
+        capacity,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_list_too_short_says_how_many_pairs_the_frame_needs() {
+        let fits = stats(&[1_200, 0, 40, 0], 2_000).expect("fits");
+        assert_eq!((fits.pixels, fits.pairs, fits.capacity), (40, 1_200, 2_000));
+        match stats(&[2_600, 3, 40, 0], 2_000) {
+            Err(
+                e @ RenderError::StarvedPairsFull {
+                    needed: 2_600,
+                    capacity: 2_000,
+                },
+            ) => {
+                let said = e.to_string();
+                assert!(
+                    said.contains("2600") && said.contains("--starved-taps"),
+                    "{said}"
+                );
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+}
