@@ -92,34 +92,49 @@ pub fn thin(
     let mut deleted_total = 0u64;
     let mut border_visits = 0u64;
     let mut step: u32 = 0;
-    // Object and candidate bits of the neighbourhood of `i`.
-    let masks_of = |flags: &[u8], i: usize| -> (u32, u32) {
-        let (mut xm, mut cm) = (0u32, 0u32);
+    // Object bits of the neighbourhood of `i`.
+    let object_mask = |flags: &[u8], i: usize| -> u32 {
+        let mut xm = 0u32;
         for (k, &o) in off.iter().enumerate() {
-            let f = flags[(i as isize + o) as usize];
-            xm |= u32::from(f & X) << k;
-            cm |= u32::from((f & CAND) >> 2) << k;
+            xm |= u32::from(flags[(i as isize + o) as usize] & X) << k;
         }
-        (xm, cm)
+        xm
+    };
+    // Candidate bits of the object voxels `xm` above `i` and of `i` itself (a candidate): all
+    // a clique through `i` may hold (critical_cliques).
+    let candidate_mask = |flags: &[u8], i: usize, xm: u32| -> u32 {
+        let mut cm = CENTRE_BIT;
+        let mut above = xm & ABOVE_CENTRE;
+        while above != 0 {
+            let k = above.trailing_zeros();
+            above &= above - 1;
+            if flags[(i as isize + off[k as usize]) as usize] & CAND != 0 {
+                cm |= 1 << k;
+            }
+        }
+        cm
     };
     loop {
         step += 1;
         border_visits += border.len() as u64;
         // 1–2: isthmuses and simple voxels.
-        let status: Vec<(bool, bool)> = border
+        let status: Vec<(bool, bool, u32)> = border
             .par_iter()
             .map(|&i| {
                 let i = i as usize;
                 if flags[i] & K != 0 {
-                    return (false, false);
+                    return (false, false, 0);
                 }
-                let (m, _) = masks_of(&flags, i);
-                isthmus_and_simple(m)
+                let m = object_mask(&flags, i);
+                let (isthmus, simple) = isthmus_and_simple(m);
+                (isthmus, simple, m)
             })
             .collect();
         let s16 = step.min(u16::MAX as u32 - 1) as u16;
+        // The candidates and their object masks (their neighbours' objects stay until step 4).
         let mut candidates = Vec::new();
-        for (&i, &(isthmus, simple)) in border.iter().zip(&status) {
+        let mut candidate_xm = Vec::new();
+        for (&i, &(isthmus, simple, xm)) in border.iter().zip(&status) {
             let i = i as usize;
             if isthmus {
                 if birth[i] == u16::MAX {
@@ -132,6 +147,7 @@ pub fn thin(
             if simple && flags[i] & K == 0 {
                 flags[i] |= CAND;
                 candidates.push(i as u32);
+                candidate_xm.push(xm);
             }
         }
         if candidates.is_empty() {
@@ -141,8 +157,9 @@ pub fn thin(
         // then by candidate, then by template.
         let by_phase: [Vec<Clique>; 3] = candidates
             .par_iter()
-            .fold(Default::default, |mut out: [Vec<Clique>; 3], &i| {
-                let (xm, cm) = masks_of(&flags, i as usize);
+            .zip(&candidate_xm)
+            .fold(Default::default, |mut out: [Vec<Clique>; 3], (&i, &xm)| {
+                let cm = candidate_mask(&flags, i as usize, xm);
                 critical_cliques(xm, cm, |phase, mut bits| {
                     let mut c = Clique {
                         members: [0; 8],
@@ -441,7 +458,8 @@ const ABOVE_CENTRE: u32 = !((1 << 14) - 1) & ((1 << 27) - 1);
 const CENTRE_BIT: u32 = 1 << 13;
 
 /// Critical cliques through the centre of neighbourhood `xm` (object bits) whose object
-/// members are all candidates (`cm`) and whose lowest-index member is the centre. Phases:
+/// members are all candidates (`cm`, read only above the centre and at it) and whose
+/// lowest-index member is the centre. Phases:
 /// 0 = 2-cliques, 1 = 1-cliques, 2 = 0-cliques. Members are returned as bit masks.
 fn critical_cliques(xm: u32, cm: u32, mut emit: impl FnMut(u8, u32)) {
     // Every clique has a member besides the centre (a face neighbour, or the other end of a
