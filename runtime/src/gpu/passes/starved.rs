@@ -41,6 +41,80 @@ pub struct StarvedOutput {
     pub capacity: u32,
 }
 
+/// The starved pixels' buffers for one frame.
+struct Buffers {
+    /// The starved test's constants (26).
+    test: wgpu::Buffer,
+    /// Pairs reserved, pixels that did not fit, starved pixels (27).
+    count: wgpu::Buffer,
+    /// The pairs (28).
+    pairs: wgpu::Buffer,
+    /// Each pixel's run of pairs (29).
+    runs: wgpu::Buffer,
+    /// The walks' dispatch (30).
+    args: wgpu::Buffer,
+    /// Each batch's index (24), strided.
+    batches: wgpu::Buffer,
+}
+
+impl Buffers {
+    /// The buffers of frame `f`, its walks in `batches` batches.
+    fn new(f: &Frame, pool: &mut Pool, il: &InterleaveParams, batches: u32) -> Buffers {
+        let d = &f.ctx.device;
+        let [w, h] = f.view.size;
+        let constants = [
+            il.blur_distance_m(f),
+            il.blur_normal,
+            il.starved_taps as f32,
+            0.0,
+        ];
+        let uniform = wgpu::BufferUsages::UNIFORM;
+        let storage = wgpu::BufferUsages::STORAGE;
+        let indices: Vec<[u32; 4]> = (0..batches).map(|i| [i, 0, 0, 0]).collect();
+        let copies = wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST;
+        Buffers {
+            test: pool.upload(
+                f.ctx,
+                "starved pixels' test",
+                bytemuck::cast_slice(&constants),
+                uniform,
+            ),
+            count: pool.buffer(d, "starved pixels' count", 16, storage | copies),
+            pairs: pool.buffer(
+                d,
+                "starved pixels' pairs",
+                u64::from(f.starved_pairs) * PAIR_BYTES,
+                storage,
+            ),
+            runs: pool.buffer(
+                d,
+                "starved pixels' runs",
+                u64::from(w) * u64::from(h) * 8,
+                storage,
+            ),
+            args: pool.buffer(
+                d,
+                "starved walks' dispatch",
+                12,
+                storage | wgpu::BufferUsages::INDIRECT,
+            ),
+            batches: pool.upload(f.ctx, "starved walk batches", &strided(&indices), uniform),
+        }
+    }
+}
+
+/// The bind groups of the four passes, the walks' one a batch.
+struct Groups {
+    pairs: wgpu::BindGroup,
+    args: wgpu::BindGroup,
+    walks: Vec<wgpu::BindGroup>,
+    sums: wgpu::BindGroup,
+}
+
+fn whole(b: &wgpu::Buffer) -> wgpu::BindingResource<'_> {
+    b.as_entire_binding()
+}
+
 impl Shade {
     /// Records interleaved gates' second gather ([`InterleaveParams::starved_taps`]): at the
     /// pixels whose blur block holds fewer than that many taps that agree with them, the VPL
@@ -55,7 +129,6 @@ impl Shade {
         inputs: Inputs,
         (shape, il): (GateShape, &InterleaveParams),
     ) -> Result<StarvedOutput, RenderError> {
-        let d = &f.ctx.device;
         let [w, h] = f.view.size;
         let pixels = u64::from(w) * u64::from(h);
         if pixels > MAX_STARVED_PIXELS {
@@ -65,96 +138,14 @@ impl Shade {
                 MAX_STARVED_PIXELS
             )));
         }
-        let constants = [
-            il.blur_distance_m(f),
-            il.blur_normal,
-            il.starved_taps as f32,
-            0.0,
-        ];
-        let uniform = wgpu::BufferUsages::UNIFORM;
-        let test = pool.upload(
-            f.ctx,
-            "starved pixels' test",
-            bytemuck::cast_slice(&constants),
-            uniform,
-        );
-        let storage = wgpu::BufferUsages::STORAGE;
-        let count = pool.buffer(
-            d,
-            "starved pixels' count",
-            16,
-            storage | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-        );
-        let capacity = f.starved_pairs;
-        let pairs = pool.buffer(
-            d,
-            "starved pixels' pairs",
-            u64::from(capacity) * PAIR_BYTES,
-            storage,
-        );
-        let runs = pool.buffer(d, "starved pixels' runs", pixels * 8, storage);
-        let args = pool.buffer(
-            d,
-            "starved walks' dispatch",
-            12,
-            storage | wgpu::BufferUsages::INDIRECT,
-        );
-        let sums = frame_target(f, pool, "starved pixels' irradiance");
-        let sums_view = sums.create_view(&Default::default());
         // The walks' batches: a pair walks one subset, up to ⌈VPLs / B⌉ VPLs.
         let batches = super::shade::batch_count(f, f.vpl_count.div_ceil(il.subsets()));
-        let indices: Vec<[u32; 4]> = (0..batches).map(|i| [i, 0, 0, 0]).collect();
-        let index_buf = pool.upload(f.ctx, "starved walk batches", &strided(&indices), uniform);
-
-        let p = &self.starved;
+        let b = Buffers::new(f, pool, il, batches);
+        let sums = frame_target(f, pool, "starved pixels' irradiance");
         let walks = self.gates_pipeline(f, super::shade::GatesGather::Starved, shape);
-        let views = super::shade::Views::new(f, inputs);
-        fn whole(b: &wgpu::Buffer) -> wgpu::BindingResource<'_> {
-            b.as_entire_binding()
-        }
-        let group = |pipeline: &wgpu::ComputePipeline, mut resources: Vec<_>, extra: Vec<_>| {
-            resources.extend(extra);
-            bind_group(d, &pipeline.get_bind_group_layout(0), "starved", resources)
-        };
-        let pairs_group = group(
-            &p.pairs,
-            views.resources(f, inputs, None, Some(&PAIRS_BINDINGS)),
-            vec![
-                (26, whole(&test)),
-                (27, whole(&count)),
-                (28, whole(&pairs)),
-                (29, whole(&runs)),
-            ],
-        );
-        let args_group = group(
-            &p.args,
-            Vec::new(),
-            vec![(27, whole(&count)), (28, whole(&pairs)), (30, whole(&args))],
-        );
-        let walk_groups: Vec<wgpu::BindGroup> = (0..batches as usize)
-            .map(|i| {
-                group(
-                    walks,
-                    views.resources(f, inputs, None, Some(&WALKS_BINDINGS)),
-                    vec![
-                        (24, slice(&index_buf, (i * UNIFORM_STRIDE) as u64, 16)),
-                        (27, whole(&count)),
-                        (28, whole(&pairs)),
-                    ],
-                )
-            })
-            .collect();
-        let sums_group = group(
-            &p.sums,
-            views.resources(f, inputs, None, Some(&[5])),
-            vec![
-                (25, wgpu::BindingResource::TextureView(&sums_view)),
-                (28, whole(&pairs)),
-                (29, whole(&runs)),
-            ],
-        );
-
-        rec.enc.clear_buffer(&count, 0, None);
+        let g = self.starved_groups(f, inputs, (&b, batches), walks, &sums);
+        let p = &self.starved;
+        rec.enc.clear_buffer(&b.count, 0, None);
         let span = "indirect lighting: starved pixels";
         let timed = rec.begin(span);
         {
@@ -164,26 +155,86 @@ impl Shade {
             });
             let tiles = [w.div_ceil(8), h.div_ceil(8)];
             pass.set_pipeline(&p.pairs);
-            pass.set_bind_group(0, &pairs_group, &[]);
+            pass.set_bind_group(0, &g.pairs, &[]);
             pass.dispatch_workgroups(tiles[0], tiles[1], 1);
             pass.set_pipeline(&p.args);
-            pass.set_bind_group(0, &args_group, &[]);
+            pass.set_bind_group(0, &g.args, &[]);
             pass.dispatch_workgroups(1, 1, 1);
             pass.set_pipeline(walks);
-            for g in &walk_groups {
-                pass.set_bind_group(0, g, &[]);
-                pass.dispatch_workgroups_indirect(&args, 0);
+            for group in &g.walks {
+                pass.set_bind_group(0, group, &[]);
+                pass.dispatch_workgroups_indirect(&b.args, 0);
             }
             pass.set_pipeline(&p.sums);
-            pass.set_bind_group(0, &sums_group, &[]);
+            pass.set_bind_group(0, &g.sums, &[]);
             pass.dispatch_workgroups(tiles[0], tiles[1], 1);
         }
         rec.end();
         Ok(StarvedOutput {
             sums,
-            count,
-            capacity,
+            count: b.count,
+            capacity: f.starved_pairs,
         })
+    }
+
+    /// The starved passes' bind groups: the shading's resources each reads, and `b`'s.
+    fn starved_groups(
+        &self,
+        f: &Frame,
+        inputs: Inputs,
+        (b, batches): (&Buffers, u32),
+        walks: &wgpu::ComputePipeline,
+        sums: &wgpu::Texture,
+    ) -> Groups {
+        let d = &f.ctx.device;
+        let p = &self.starved;
+        let views = super::shade::Views::new(f, inputs);
+        let sums_view = sums.create_view(&Default::default());
+        let group = |pipeline: &wgpu::ComputePipeline, used: &[u32], extra: Vec<_>| {
+            let mut resources = views.resources(f, inputs, None, Some(used));
+            resources.extend(extra);
+            bind_group(d, &pipeline.get_bind_group_layout(0), "starved", resources)
+        };
+        Groups {
+            pairs: group(
+                &p.pairs,
+                &PAIRS_BINDINGS,
+                vec![
+                    (26, whole(&b.test)),
+                    (27, whole(&b.count)),
+                    (28, whole(&b.pairs)),
+                    (29, whole(&b.runs)),
+                ],
+            ),
+            args: group(
+                &p.args,
+                &[],
+                vec![
+                    (27, whole(&b.count)),
+                    (28, whole(&b.pairs)),
+                    (30, whole(&b.args)),
+                ],
+            ),
+            walks: (0..batches as usize)
+                .map(|i| {
+                    let index = slice(&b.batches, (i * UNIFORM_STRIDE) as u64, 16);
+                    group(
+                        walks,
+                        &WALKS_BINDINGS,
+                        vec![(24, index), (27, whole(&b.count)), (28, whole(&b.pairs))],
+                    )
+                })
+                .collect(),
+            sums: group(
+                &p.sums,
+                &[5],
+                vec![
+                    (25, wgpu::BindingResource::TextureView(&sums_view)),
+                    (28, whole(&b.pairs)),
+                    (29, whole(&b.runs)),
+                ],
+            ),
+        }
     }
 }
 
