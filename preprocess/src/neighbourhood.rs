@@ -136,13 +136,67 @@ pub fn is_isthmus_1d(mask: u32) -> bool {
     components(mask & N26, &ADJ26, N26, 2) >= 2
 }
 
-/// [`is_isthmus_1d`] and [`is_simple`] together, counting the object's 26-components once
-/// (the thinning asks both of every border voxel).
+/// [`is_isthmus_1d`] and [`is_simple`] together (the thinning asks both of every border
+/// voxel), by growing one component a layer at a time with shifts of the whole mask: the
+/// object's component of its first neighbour is all of it or not (`T26` is 1 or at least 2),
+/// and the background's component of its first face neighbour holds every face neighbour of
+/// the background or not (`T6bar` is 1 or at least 2). The same answers as counting the
+/// components a voxel at a time ([`components`]; tested on random masks) in fewer steps.
 #[inline]
 pub fn isthmus_and_simple(mask: u32) -> (bool, bool) {
-    let t26 = components(mask & N26, &ADJ26, N26, 2);
-    let simple = t26 == 1 && components(!mask & N18, &ADJ6_IN_N18, N6, 2) == 1;
-    (t26 >= 2, simple)
+    let object = mask & N26;
+    if object == 0 {
+        return (false, false);
+    }
+    let first = grow(object, object & object.wrapping_neg(), dilate26);
+    if first != object {
+        return (true, false);
+    }
+    let background = !mask & N18;
+    let faces = background & N6;
+    let simple = faces != 0 && {
+        let reached = grow(background, faces & faces.wrapping_neg(), dilate6);
+        faces & !reached == 0
+    };
+    (false, simple)
+}
+
+/// Bits of the 3 × 3 × 3 block at x = 0, at x = 2, at y = 0, at y = 2.
+const X_LOW: u32 = 0b001_001_001 * (1 | 1 << 9 | 1 << 18);
+const X_HIGH: u32 = X_LOW << 2;
+const Y_LOW: u32 = 0b111 * (1 | 1 << 9 | 1 << 18);
+const Y_HIGH: u32 = Y_LOW << 6;
+const BLOCK: u32 = (1 << 27) - 1;
+
+/// `seed`'s component in `set` under the adjacency whose one step is `dilate`.
+#[inline]
+fn grow(set: u32, seed: u32, dilate: fn(u32) -> u32) -> u32 {
+    let mut c = seed;
+    loop {
+        let next = dilate(c) & set;
+        if next == c {
+            return c;
+        }
+        c = next;
+    }
+}
+
+/// The bits of `m` and their 26 neighbours in the block.
+#[inline]
+fn dilate26(m: u32) -> u32 {
+    // Each axis's shifts kept in the block before the next axis's, which would bring bits
+    // shifted out of it back in.
+    let m = (m | (m << 1 & !X_LOW) | (m >> 1 & !X_HIGH)) & BLOCK;
+    let m = (m | (m << 3 & !Y_LOW) | (m >> 3 & !Y_HIGH)) & BLOCK;
+    (m | m << 9 | m >> 9) & BLOCK
+}
+
+/// The bits of `m` and their 6 face neighbours in the block.
+#[inline]
+fn dilate6(m: u32) -> u32 {
+    let x = m << 1 & !X_LOW | m >> 1 & !X_HIGH;
+    let y = m << 3 & !Y_LOW | m >> 3 & !Y_HIGH;
+    (m | x | y | m << 9 | m >> 9) & BLOCK
 }
 
 /// 2D simplicity of the centre of a 3 × 3 square, (8, 4) connectivity, given the 8-bit ring
