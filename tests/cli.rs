@@ -967,6 +967,17 @@ fn render_gates_uses_a_baked_level_and_refuses_a_missing_or_stale_one() {
         "{}",
         stdout(&of)
     );
+    // An image too large for the pairs' pixel numbers is refused before anything is made.
+    let mut big = f.clone();
+    let size = big.iter().position(|x| *x == "--size").expect("size");
+    big[size + 1] = "4097x4097";
+    let ob = visgate(&big);
+    assert!(!ob.status.success());
+    assert!(
+        stderr(&ob).contains("at most 16777216 pixels"),
+        "{}",
+        stderr(&ob)
+    );
     // The roulette on the walks: on by default at 128 VPLs a pixel (8,192 in 8 × 8 blocks),
     // named as it acts; --walk-roulette 0 turns it off.
     let mut r = a.clone();

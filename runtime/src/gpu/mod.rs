@@ -709,6 +709,12 @@ impl GpuRenderer {
     ) -> Result<(Option<HdrImage>, PassTimes), RenderError> {
         let t0 = Instant::now();
         params.check()?;
+        if let GpuMode::Gates(g) = params.mode
+            && g.interleave.block > 1
+            && g.interleave.starved_taps > 0
+        {
+            passes::starved::check_size(view.size)?;
+        }
         if params.mode.gates().is_some() && self.scene.level.is_none() {
             return Err(RenderError::Param(format!(
                 "mode {} needs a baked level (GpuRenderer::set_level, --level)",

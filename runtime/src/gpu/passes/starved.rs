@@ -41,6 +41,19 @@ pub struct StarvedOutput {
     pub capacity: u32,
 }
 
+/// Refuses an image of more than [`MAX_STARVED_PIXELS`] pixels (checked before a frame
+/// allocates anything).
+pub fn check_size([w, h]: [u32; 2]) -> Result<(), RenderError> {
+    let pixels = u64::from(w) * u64::from(h);
+    if pixels > MAX_STARVED_PIXELS {
+        return Err(RenderError::Param(format!(
+            "the starved pixels' walks (--starved-taps) take images of at most {MAX_STARVED_PIXELS} \
+             pixels; this one has {pixels} ({w} x {h}): render it smaller or without them"
+        )));
+    }
+    Ok(())
+}
+
 /// The starved pixels' buffers for one frame.
 struct Buffers {
     /// The starved test's constants (26).
@@ -130,14 +143,7 @@ impl Shade {
         (shape, il): (GateShape, &InterleaveParams),
     ) -> Result<StarvedOutput, RenderError> {
         let [w, h] = f.view.size;
-        let pixels = u64::from(w) * u64::from(h);
-        if pixels > MAX_STARVED_PIXELS {
-            return Err(RenderError::Param(format!(
-                "the starved pixels' walks (--starved-taps) take images of at most {} pixels; \
-                 this one has {pixels} ({w} × {h})",
-                MAX_STARVED_PIXELS
-            )));
-        }
+        check_size(f.view.size)?;
         // The walks' batches: a pair walks one subset, up to ⌈VPLs / B⌉ VPLs.
         let batches = super::shade::batch_count(f, f.vpl_count.div_ceil(il.subsets()));
         let b = Buffers::new(f, pool, il, batches);
