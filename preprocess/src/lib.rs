@@ -39,6 +39,7 @@ pub mod sightline;
 pub mod simplify;
 pub mod stages;
 pub mod thin;
+mod thin_next;
 pub mod voxelize;
 
 /// Everything that can stop a bake.

@@ -25,6 +25,7 @@
 use rayon::prelude::*;
 
 use crate::neighbourhood::{RING, bit, is_simple_2d, isthmus_and_simple};
+use crate::thin_next::{Marks, next_by_lists, next_by_words};
 
 /// Parameters of [`thin`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -48,8 +49,8 @@ pub struct Thinned {
     pub border_visits: u64,
 }
 
-const X: u8 = 1;
-const K: u8 = 2;
+pub(crate) const X: u8 = 1;
+pub(crate) const K: u8 = 2;
 const CAND: u8 = 4;
 const SEL: u8 = 8;
 
@@ -100,20 +101,6 @@ pub fn thin(
         }
         xm
     };
-    // Candidate bits of the object voxels `xm` above `i` and of `i` itself (a candidate): all
-    // a clique through `i` may hold (critical_cliques).
-    let candidate_mask = |flags: &[u8], i: usize, xm: u32| -> u32 {
-        let mut cm = CENTRE_BIT;
-        let mut above = xm & ABOVE_CENTRE;
-        while above != 0 {
-            let k = above.trailing_zeros();
-            above &= above - 1;
-            if flags[(i as isize + off[k as usize]) as usize] & CAND != 0 {
-                cm |= 1 << k;
-            }
-        }
-        cm
-    };
     loop {
         step += 1;
         border_visits += border.len() as u64;
@@ -153,46 +140,9 @@ pub fn thin(
         if candidates.is_empty() {
             break;
         }
-        // 3: critical cliques of candidates, found in parallel, resolved in order: by phase,
-        // then by candidate, then by template.
-        let by_phase: [Vec<Clique>; 3] = candidates
-            .par_iter()
-            .zip(&candidate_xm)
-            .fold(Default::default, |mut out: [Vec<Clique>; 3], (&i, &xm)| {
-                let cm = candidate_mask(&flags, i as usize, xm);
-                critical_cliques(xm, cm, |phase, mut bits| {
-                    let mut c = Clique {
-                        members: [0; 8],
-                        len: 0,
-                    };
-                    while bits != 0 {
-                        let k = bits.trailing_zeros();
-                        bits &= bits - 1;
-                        c.members[c.len as usize] = (i as isize + off[k as usize]) as u32;
-                        c.len += 1;
-                    }
-                    out[phase as usize].push(c);
-                });
-                out
-            })
-            .reduce(Default::default, |mut a, b| {
-                for (a, mut b) in a.iter_mut().zip(b) {
-                    a.append(&mut b);
-                }
-                a
-            });
-        for c in by_phase.iter().flatten() {
-            let members = &c.members[..c.len as usize];
-            if members.iter().any(|&m| flags[m as usize] & SEL != 0) {
-                continue;
-            }
-            let best = members
-                .iter()
-                .copied()
-                .max_by(|&a, &b| dist2[a as usize].cmp(&dist2[b as usize]).then(b.cmp(&a)))
-                .unwrap_or(members[0]);
-            flags[best as usize] |= SEL;
-        }
+        // 3: critical cliques of candidates, found in parallel, resolved in order.
+        let by_phase = find_cliques(&flags, &off, &candidates, &candidate_xm);
+        keep_one_of_each(&mut flags, dist2, &by_phase);
         // 4: delete the candidates not kept.
         let mut deleted = Vec::new();
         for &i in &candidates {
@@ -216,7 +166,7 @@ pub fn thin(
             .copied()
             .filter(|&i| flags[i as usize] & (X | K) == X && birth[i as usize] != u16::MAX)
             .collect();
-        let next = match deleted.len() >= 2 * marks.0.len() {
+        let next = match deleted.len() >= 2 * marks.words() {
             true => next_by_words(&flags, [nx, ny], &deleted, &waiting),
             false => next_by_lists(&flags, &mut marks, &deleted, &waiting, &off),
         };
@@ -236,141 +186,72 @@ pub fn thin(
     }
 }
 
-/// One bit a voxel, set at most once between clears from any thread: the voxels listed for the
-/// next step.
-struct Marks(Vec<std::sync::atomic::AtomicU64>);
-
-impl Marks {
-    fn new(voxels: usize) -> Marks {
-        Marks(
-            (0..voxels.div_ceil(64))
-                .map(|_| Default::default())
-                .collect(),
-        )
-    }
-
-    /// Marks voxel `i`; whether it was not marked before.
-    fn mark(&self, i: usize) -> bool {
-        let bit = 1 << (i % 64);
-        self.0[i / 64].fetch_or(bit, std::sync::atomic::Ordering::Relaxed) & bit == 0
-    }
-
-    /// Clears the marks of `voxels`.
-    fn clear(&mut self, voxels: &[u32]) {
-        for &i in voxels {
-            *self.0[i as usize / 64].get_mut() = 0;
-        }
-    }
-}
-
-/// The next step's voxels (ascending): `waiting` and the voxels around `deleted` (at offsets
-/// `off`) still in the object and not constrained, each once — found voxel by voxel, marked
-/// in `marks` (cleared again), in parallel, then sorted.
-fn next_by_lists(
+/// The critical cliques through `candidates` (with their object masks `xm`) whose members are
+/// all candidates: by phase, then by candidate, then by template — the order they are
+/// resolved in.
+fn find_cliques(
     flags: &[u8],
-    marks: &mut Marks,
-    deleted: &[u32],
-    waiting: &[u32],
     off: &[isize; 27],
-) -> Vec<u32> {
-    let mut next: Vec<u32> = waiting
-        .iter()
-        .copied()
-        .filter(|&i| marks.mark(i as usize))
-        .collect();
-    let around: Vec<u32> = deleted
-        .par_chunks(4096)
-        .flat_map_iter(|chunk| {
-            let mut found = Vec::new();
-            for &i in chunk {
-                for o in off {
-                    let j = (i as isize + o) as usize;
-                    if flags[j] & (X | K) == X && marks.mark(j) {
-                        found.push(j as u32);
-                    }
-                }
+    candidates: &[u32],
+    xm: &[u32],
+) -> [Vec<Clique>; 3] {
+    // Candidate bits of the object voxels above `i` and of `i` itself (a candidate): all a
+    // clique through `i` may hold (critical_cliques).
+    let candidate_mask = |i: usize, xm: u32| -> u32 {
+        let mut cm = CENTRE_BIT;
+        let mut above = xm & ABOVE_CENTRE;
+        while above != 0 {
+            let k = above.trailing_zeros();
+            above &= above - 1;
+            if flags[(i as isize + off[k as usize]) as usize] & CAND != 0 {
+                cm |= 1 << k;
             }
-            found
+        }
+        cm
+    };
+    candidates
+        .par_iter()
+        .zip(xm)
+        .fold(Default::default, |mut out: [Vec<Clique>; 3], (&i, &xm)| {
+            let cm = candidate_mask(i as usize, xm);
+            critical_cliques(xm, cm, |phase, mut bits| {
+                let mut c = Clique {
+                    members: [0; 8],
+                    len: 0,
+                };
+                while bits != 0 {
+                    let k = bits.trailing_zeros();
+                    bits &= bits - 1;
+                    c.members[c.len as usize] = (i as isize + off[k as usize]) as u32;
+                    c.len += 1;
+                }
+                out[phase as usize].push(c);
+            });
+            out
         })
-        .collect();
-    next.extend(around);
-    next.par_sort_unstable();
-    marks.clear(&next);
-    next
+        .reduce(Default::default, |mut a, b| {
+            for (a, mut b) in a.iter_mut().zip(b) {
+                a.append(&mut b);
+            }
+            a
+        })
 }
 
-/// [`next_by_lists`] a word of 64 voxels along x at a time, for steps that delete many voxels
-/// (the first steps delete most of the empty space, and looking at each deleted voxel's 26
-/// neighbours and sorting them took a third of the thinning): the deleted voxels as a bitset,
-/// dilated along x by shifts and along y and z by the words of the 9 rows around, the
-/// voxels in the object and not constrained kept. Comes out in order.
-fn next_by_words(flags: &[u8], [nx, ny]: [usize; 2], deleted: &[u32], waiting: &[u32]) -> Vec<u32> {
-    let words = flags.len().div_ceil(64);
-    let mut del = vec![0u64; words];
-    for &i in deleted {
-        del[i as usize / 64] |= 1 << (i % 64);
-    }
-    let word = |b: &[u64], w: isize| -> u64 {
-        if w < 0 {
-            0
-        } else {
-            b.get(w as usize).copied().unwrap_or(0)
+/// Marks SEL one voxel of each clique of `by_phase` that holds none yet: the farthest from the
+/// solid (`dist2`), then the lowest index.
+fn keep_one_of_each(flags: &mut [u8], dist2: &[u64], by_phase: &[Vec<Clique>; 3]) {
+    for c in by_phase.iter().flatten() {
+        let members = &c.members[..c.len as usize];
+        if members.iter().any(|&m| flags[m as usize] & SEL != 0) {
+            continue;
         }
-    };
-    let along_x: Vec<u64> = (0..words as isize)
-        .into_par_iter()
-        .map(|w| {
-            let d = del[w as usize];
-            d | d << 1 | word(&del, w - 1) >> 63 | d >> 1 | word(&del, w + 1) << 63
-        })
-        .collect();
-    // The 64 bits of `along_x` from bit `p` on (0 outside the grid).
-    let bits_from = |p: isize| -> u64 {
-        let (q, s) = (p.div_euclid(64), p.rem_euclid(64) as u32);
-        match s {
-            0 => word(&along_x, q),
-            _ => word(&along_x, q) >> s | word(&along_x, q + 1) << (64 - s),
-        }
-    };
-    let (nx, plane) = (nx as isize, (nx * ny) as isize);
-    let rows: [isize; 9] =
-        std::array::from_fn(|k| (k as isize % 3 - 1) * nx + (k as isize / 3 - 1) * plane);
-    let mut next: Vec<u64> = (0..words)
-        .into_par_iter()
-        .map(|w| {
-            let mut near = rows
-                .iter()
-                .fold(0, |a, &o| a | bits_from(w as isize * 64 + o));
-            let mut kept = 0u64;
-            while near != 0 {
-                let b = near.trailing_zeros();
-                near &= near - 1;
-                if flags
-                    .get(w * 64 + b as usize)
-                    .is_some_and(|&f| f & (X | K) == X)
-                {
-                    kept |= 1 << b;
-                }
-            }
-            kept
-        })
-        .collect();
-    for &i in waiting {
-        next[i as usize / 64] |= 1 << (i % 64);
+        let best = members
+            .iter()
+            .copied()
+            .max_by(|&a, &b| dist2[a as usize].cmp(&dist2[b as usize]).then(b.cmp(&a)))
+            .unwrap_or(members[0]);
+        flags[best as usize] |= SEL;
     }
-    next.par_iter()
-        .enumerate()
-        .flat_map_iter(|(w, &m)| {
-            let mut m = m;
-            std::iter::from_fn(move || {
-                (m != 0).then(|| {
-                    let b = m.trailing_zeros();
-                    m &= m - 1;
-                    (w * 64) as u32 + b
-                })
-            })
-        })
-        .collect()
 }
 
 /// A clique's object members: the bits of the finder's neighbourhood, then voxel indices.
