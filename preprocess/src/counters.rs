@@ -6,7 +6,7 @@
 
 use serde::Serialize;
 
-use crate::neighbourhood::Betti;
+use crate::betti::Betti;
 
 /// Stage 1, load.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]

@@ -5,7 +5,7 @@ use serde::Serialize;
 use serde_json::Value;
 use visgate_formats::vgate::{BakeParams, GridMeta, Resolution};
 
-use crate::neighbourhood::Betti;
+use crate::betti::Betti;
 
 /// One timed stage.
 #[derive(Debug, Clone, Serialize)]

@@ -12,6 +12,7 @@ use visgate_formats::vgate::{
 };
 
 use crate::bake::{BakeContext, scene_seeds};
+use crate::betti::{Betti, betti};
 use crate::clusters::{ClusterParams, clusters};
 use crate::convex::{SplitInput, split_unseen};
 use crate::counters::{
@@ -21,7 +22,6 @@ use crate::counters::{
 use crate::empty::{EmptySpace, EmptySpaceParams, empty_space};
 use crate::gate_step::{GateInput, GateStep, gate_step};
 use crate::graph::{SkeletonGraph, nearest_node, skeleton_graph};
-use crate::neighbourhood::{Betti, betti};
 use crate::portals::Portals;
 use crate::segment::{SegmentParams, Segmented, segment};
 use crate::simplify::simplify;

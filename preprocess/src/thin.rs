@@ -499,13 +499,13 @@ mod tests {
         }
     }
 
-    fn thinned(dims: [u32; 3], obj: &[bool]) -> (Thinned, crate::neighbourhood::Betti) {
+    fn thinned(dims: [u32; 3], obj: &[bool]) -> (Thinned, crate::betti::Betti) {
         let solid: Vec<bool> = obj.iter().map(|&o| !o).collect();
         let d = crate::distance::squared_distance(dims, &solid);
         let t = thin(dims, obj, &d, &ThinParams { persistence: 0 }, &|_, _| {});
         let mut s = vec![false; obj.len()];
         t.skeleton.iter().for_each(|&i| s[i as usize] = true);
-        let b = crate::neighbourhood::betti(dims, &s);
+        let b = crate::betti::betti(dims, &s);
         (t, b)
     }
 

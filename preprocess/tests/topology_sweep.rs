@@ -5,10 +5,11 @@
 //! result does not depend on the number of threads.
 
 use visgate_formats::vgate::GridMeta;
+use visgate_preprocess::betti::betti;
 use visgate_preprocess::distance::squared_distance;
 use visgate_preprocess::empty::{EmptySpaceParams, empty_space};
 use visgate_preprocess::graph::{nearest_node, skeleton_graph};
-use visgate_preprocess::neighbourhood::{Conn, betti, bit, is_simple, label_components};
+use visgate_preprocess::neighbourhood::{Conn, bit, is_simple, label_components};
 use visgate_preprocess::thin::{ThinParams, Thinned, thin};
 
 /// A tiny deterministic generator (xorshift), so the sweep needs no extra crate.
