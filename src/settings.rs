@@ -249,7 +249,7 @@ pub struct MethodArgs {
     /// Gates, interleaved: a pixel whose blur block holds fewer pixels than this that agree
     /// with it (a door jamb, a strip along a wall) walks, in a second pass, the VPL subsets of
     /// the pixels that do not agree, so that every VPL counts once there (a pair of pixel and
-    /// subset a GPU thread); 0: off (default), at most --interleave². Costs 1.7-3x the frame
+    /// subset a GPU thread); 0: off (default), at most --interleave². Costs 2-7x the frame
     /// on lavapipe at 48-64; `render` prints how many pixels starved. See the README.
     #[arg(long, default_value_t = 0)]
     pub starved_taps: u32,

@@ -76,7 +76,7 @@ pub fn method_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
                         .on_hover_text(
                             "a pixel whose blur block holds fewer pixels than this that agree \
                              with it walks the VPLs of the rest itself: fewer black strips along \
-                             walls and jambs, 1.7-3x the frame on lavapipe; 0: off",
+                             walls and jambs, 2-7x the frame on lavapipe; 0: off",
                         );
                 }
                 if g.shape != GateShape::Disk {

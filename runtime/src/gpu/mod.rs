@@ -37,6 +37,7 @@ mod inspect;
 pub mod layout;
 pub mod methods;
 pub mod passes;
+mod record;
 pub mod shaders;
 pub mod timing;
 
@@ -53,7 +54,7 @@ use crate::vpl::Vpl;
 use context::{Pool, init_buffer, map_read, row_bytes, texels};
 use geometry::{Geometry, albedo_array};
 use layout::{Globals, Grid};
-use passes::clustered_gates::{ClusteredGates, LevelBuffers, ListBuffers};
+use passes::clustered_gates::{ClusteredGates, LevelBuffers};
 use passes::cssm::Cssm;
 use passes::display::Display;
 use passes::gbuffer::GBuffer;
@@ -62,10 +63,10 @@ use passes::ism::Isms;
 use passes::light_cluster::LightCluster;
 use passes::per_vpl_maps::ParaboloidMaps;
 use passes::rsm_vpls::RsmVpls;
-use passes::shade::{Gathers, Shade};
+use passes::shade::Shade;
 use passes::shadow_maps::ShadowMaps;
 use passes::sight_ends::SightEnds;
-use passes::val_gather::{ValGathers, ValPasses};
+use passes::val_gather::ValGathers;
 use passes::vals::ValClustering;
 use shaders::ShadeIndirect;
 pub use shaders::ShaderSources;
@@ -212,147 +213,6 @@ pub struct GpuRenderer {
     starved_pairs: u32,
     /// The last frame's HDR target (in the pool: the next frame of its size overwrites it).
     last_hdr: Option<wgpu::Texture>,
-}
-
-/// What [`record_passes`] leaves: the image, and the light lists of mode gates.
-struct Recorded {
-    hdr: wgpu::Texture,
-    lists: Option<ListBuffers>,
-    /// The VAL clustering's convergence words, in the VAL modes.
-    val_state: Option<wgpu::Buffer>,
-    /// LightCluster's args (its counts), with `--direct lightcluster`.
-    lc_args: Option<wgpu::Buffer>,
-    /// The same of the VPLs' clusters (mode vpl-clusters).
-    vpl_lc_args: Option<wgpu::Buffer>,
-    /// Interleaved gates' starved pixels, with `--starved-taps`.
-    starved: Option<passes::starved::StarvedOutput>,
-}
-
-/// The frame as its passes (after the VPLs): shadow maps, G-buffer, the mode's passes,
-/// shading. `warm`: the VAL clustering may start from last frame's centres.
-fn record_passes(
-    p: &Pipelines,
-    f: &Frame,
-    pool: &mut Pool,
-    rec: &mut Recorder,
-    warm: bool,
-) -> Result<Recorded, RenderError> {
-    let lc_params = match f.params.direct {
-        DirectLight::LightCluster(lp) => Some(lp),
-        DirectLight::PerLight => None,
-    };
-    let shadows = p.shadow_maps.record(f, pool, rec, lc_params.is_none())?;
-    let g = p.gbuffer.record(f, pool, rec);
-    let lc = match &lc_params {
-        Some(lp) => Some(
-            p.light_cluster
-                .record(f, lp, &shadows.lights, &g, pool, rec)?,
-        ),
-        None => None,
-    };
-    let vpl_lc = match &f.params.mode {
-        GpuMode::VplClusters(vp, _) => Some(p.light_cluster.record_vpls(f, vp, &g, pool, rec)?),
-        _ => None,
-    };
-    // The voxel walk needs no geometry clusters, lists or VPL clusters: the VPLs' ends.
-    let (lists, vpl_ends) = match &f.params.mode {
-        GpuMode::Gates(gp) if gp.gates.shape == GateShape::Voxels => {
-            let level = passes::clustered_gates::LevelBuffers::of(f)?;
-            let ends = p.sight_ends.record(f, &level.sight_words, pool, rec)?;
-            (None, Some(ends))
-        }
-        GpuMode::Gates(gp) => (
-            Some(p.clustered.record(f, gp, pool, rec, &g.views[0])?),
-            None,
-        ),
-        _ => (None, None),
-    };
-    let shading = match f.params.mode {
-        GpuMode::Gates(gp) if gp.gathers_apart() => "shading: direct lighting",
-        GpuMode::VplClusters(_, i) if i.block > 1 => "shading: direct lighting",
-        GpuMode::None
-        | GpuMode::Gates(_)
-        | GpuMode::GatesPerPixel(_)
-        | GpuMode::VplClusters(..) => "shading: direct + indirect lighting",
-        _ => "shading: direct lighting",
-    };
-    let gathers = Gathers {
-        lists: lists.as_ref(),
-        vpl_ends: vpl_ends.as_ref(),
-    };
-    let inputs = (&shadows, &g, gathers, lc.as_ref(), vpl_lc.as_ref());
-    let hdr = p.shade.record(f, pool, rec, inputs, shading);
-    let mut val_state = None;
-    let mut starved = None;
-    match &f.params.mode {
-        GpuMode::Gates(gp) if gp.gathers_apart() => {
-            let indirect = p
-                .shade
-                .record_indirect(f, pool, rec, inputs, Some(gp.gates.shape));
-            let il = &gp.interleave;
-            starved = match il.block > 1 && il.starved_taps > 0 {
-                true => Some(
-                    p.shade
-                        .record_starved(f, pool, rec, inputs, (gp.gates.shape, il))?,
-                ),
-                false => None,
-            };
-            let uniform = InterleaveBlur::uniform(f, il, pool, true);
-            let targets = (&g, &uniform, &indirect, &hdr);
-            let sums = starved.as_ref().map(|s| &s.sums);
-            p.blur.record(f, pool, rec, targets, sums);
-        }
-        GpuMode::VplClusters(_, il) if il.block > 1 => {
-            let indirect = p.shade.record_indirect(f, pool, rec, inputs, None);
-            let uniform = InterleaveBlur::uniform(f, il, pool, true);
-            p.blur
-                .record(f, pool, rec, (&g, &uniform, &indirect, &hdr), None);
-        }
-        GpuMode::PerVplShadowMaps(pv) => p.maps.record(f, pv, pool, rec, (&g, &hdr)),
-        GpuMode::PerVplIsm(pi) => p.isms.record_vpls(f, pi, &p.blur, pool, rec, (&g, &hdr))?,
-        GpuMode::ValIsm(vi) => {
-            val_state = p
-                .isms
-                .record_vals(f, vi, &p.vals, &p.blur, warm, pool, rec, (&g, &hdr))?;
-        }
-        GpuMode::ValHard(v) | GpuMode::ValCssm(v, _) => {
-            let cssm = match &f.params.mode {
-                GpuMode::ValCssm(_, c) => Some(c),
-                _ => None,
-            };
-            let passes = ValPasses {
-                clustering: &p.vals,
-                maps: &p.maps,
-                cssm: &p.cssm,
-                blur: &p.blur,
-            };
-            val_state = p
-                .val_gather
-                .record(f, v, cssm, warm, &passes, pool, rec, (&g, &hdr))?;
-        }
-        _ => {}
-    }
-    Ok(Recorded {
-        hdr,
-        lists,
-        val_state,
-        lc_args: lc.map(|o| o.clusters.args),
-        vpl_lc_args: vpl_lc.map(|o| o.clusters.args),
-        starved,
-    })
-}
-
-/// The starved pixels' pairs' list's first capacity for an image of `size`, within the
-/// adapter's storage binding limit.
-fn first_starved_pairs(ctx: &GpuContext, [w, h]: [u32; 2]) -> u32 {
-    let pairs = u64::from(w) * u64::from(h) * passes::starved::FIRST_PAIRS_PER_PIXEL;
-    pairs.min(max_starved_pairs(ctx)) as u32
-}
-
-/// The most (pixel, subset) pairs the starved pixels' list may hold on the adapter.
-fn max_starved_pairs(ctx: &GpuContext) -> u64 {
-    let binding = ctx.device.limits().max_storage_buffer_binding_size;
-    (binding / passes::starved::PAIR_BYTES).min(u64::from(u32::MAX))
 }
 
 impl GpuRenderer {
@@ -602,7 +462,9 @@ impl GpuRenderer {
             vpl_count,
             vpls_cpu,
             walk_batch,
-            starved_pairs: self.starved_pairs.max(first_starved_pairs(ctx, view.size)),
+            starved_pairs: self
+                .starved_pairs
+                .max(passes::starved::first_capacity(ctx, view.size)),
         };
         (frame, &self.pipelines, pool)
     }
@@ -646,7 +508,7 @@ impl GpuRenderer {
             _ => None,
         };
         let max = (ctx.device.limits().max_storage_buffer_binding_size / 8).min(u32::MAX as u64);
-        let max_pairs = max_starved_pairs(ctx);
+        let max_pairs = passes::starved::max_capacity(ctx);
         for _ in 0..3 {
             let mut p = *params;
             if let Some(g) = auto_lists {
@@ -669,9 +531,9 @@ impl GpuRenderer {
                         needed * 8
                     )));
                 }
-                Err(RenderError::StarvedPairsFull { needed, capacity }) if needed <= max_pairs => {
-                    let room = (needed + needed / 4).min(max_pairs) as u32;
-                    self.starved_pairs = room.max(capacity);
+                // `needed` counts every pair reserved, so it is over the capacity that failed.
+                Err(RenderError::StarvedPairsFull { needed, .. }) if needed <= max_pairs => {
+                    self.starved_pairs = (needed + needed / 4).min(max_pairs) as u32;
                 }
                 r => return r,
             }
@@ -710,8 +572,7 @@ impl GpuRenderer {
         let t0 = Instant::now();
         params.check()?;
         if let GpuMode::Gates(g) = params.mode
-            && g.interleave.block > 1
-            && g.interleave.starved_taps > 0
+            && g.interleave.walks_starved()
         {
             passes::starved::check_size(view.size)?;
         }
@@ -744,7 +605,7 @@ impl GpuRenderer {
         };
         let [w, h] = view.size;
         let (frame, pipelines, pool) = self.frame(ctx, view, params, (vpl_buf, count, cpu));
-        let out = record_passes(pipelines, &frame, pool, &mut rec, warm)?;
+        let out = record::record_passes(pipelines, &frame, pool, &mut rec, warm)?;
         let read = read_hdr.then(|| {
             let read = pool.buffer(
                 &ctx.device,

@@ -53,6 +53,12 @@ impl InterleaveParams {
         self.block * self.block
     }
 
+    /// Whether starved pixels walk what their block lacks: an interleaved block and a
+    /// [`InterleaveParams::starved_taps`] set.
+    pub fn walks_starved(&self) -> bool {
+        self.block > 1 && self.starved_taps > 0
+    }
+
     /// The blur's distance threshold in metres for frame `f` (a fraction of the scene's size).
     pub fn blur_distance_m(&self, f: &Frame) -> f32 {
         self.blur_distance * f.scene.far_m / 4.0

@@ -7,10 +7,10 @@ use super::interleave_blur::InterleaveParams;
 use super::shade::{Inputs, Shade, frame_target};
 use crate::RenderError;
 use crate::cpu::gates::GateShape;
-use crate::gpu::Frame;
 use crate::gpu::context::{Pool, bind_group, slice};
 use crate::gpu::layout::{UNIFORM_STRIDE, strided};
 use crate::gpu::timing::Recorder;
+use crate::gpu::{Frame, GpuContext};
 
 /// The pairs' list's first capacity: four a pixel (the pillared hall's side room at T = 48
 /// needed 1.7, e2m3's hall 6.8, Crytek Sponza's gallery at T = 64 6.4; a frame that needs more
@@ -39,6 +39,19 @@ pub struct StarvedOutput {
     pub count: wgpu::Buffer,
     /// The pairs' list's capacity.
     pub capacity: u32,
+}
+
+/// The pairs' list's first capacity for an image of `size`, within the adapter's storage
+/// binding limit.
+pub fn first_capacity(ctx: &GpuContext, [w, h]: [u32; 2]) -> u32 {
+    let pairs = u64::from(w) * u64::from(h) * FIRST_PAIRS_PER_PIXEL;
+    pairs.min(max_capacity(ctx)) as u32
+}
+
+/// The most pairs the list may hold on the adapter.
+pub fn max_capacity(ctx: &GpuContext) -> u64 {
+    let binding = ctx.device.limits().max_storage_buffer_binding_size;
+    (binding / PAIR_BYTES).min(u64::from(u32::MAX))
 }
 
 /// Refuses an image of more than [`MAX_STARVED_PIXELS`] pixels (checked before a frame
@@ -141,9 +154,10 @@ impl Shade {
         rec: &mut Recorder,
         inputs: Inputs,
         (shape, il): (GateShape, &InterleaveParams),
-    ) -> Result<StarvedOutput, RenderError> {
+    ) -> StarvedOutput {
+        // The renderer refused an image too large for the pairs ([`check_size`]) before the
+        // frame made anything.
         let [w, h] = f.view.size;
-        check_size(f.view.size)?;
         // The walks' batches: a pair walks one subset, up to ⌈VPLs / B⌉ VPLs.
         let batches = super::shade::batch_count(f, f.vpl_count.div_ceil(il.subsets()));
         let b = Buffers::new(f, pool, il, batches);
@@ -176,11 +190,11 @@ impl Shade {
             pass.dispatch_workgroups(tiles[0], tiles[1], 1);
         }
         rec.end();
-        Ok(StarvedOutput {
+        StarvedOutput {
             sums,
             count: b.count,
             capacity: f.starved_pairs,
-        })
+        }
     }
 
     /// The starved passes' bind groups: the shading's resources each reads, and `b`'s.
