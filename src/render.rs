@@ -411,7 +411,9 @@ pub fn diff(args: DiffArgs) -> Result<()> {
             i.energy_ratio
         );
         println!(
-            "black where lit  {:.6} %  (of the pixels the reference lights indirectly)",
+            "black where lit  {:.6} %  (of the pixels the reference lights indirectly, every \
+             pixel counted: compare leaves out those whose reference samples see several \
+             surfaces)",
             i.black_where_lit * 100.0
         );
     }

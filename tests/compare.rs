@@ -81,6 +81,7 @@ fn the_report_holds_every_table_plot_and_panel_with_the_figures_of_render_and_di
             .expect("parses");
     let rows = json["rows"].as_array().expect("rows");
     assert_eq!(rows.len(), 4, "2 modes × 2 VPL counts × 1 camera");
+    assert_eq!(json["references"][0]["mixed_share"].as_f64(), Some(0.0));
     let md = std::fs::read_to_string(out.join("report.md")).expect("md");
     let html = std::fs::read_to_string(out.join("report.html")).expect("html");
     assert!(md.contains("## Camera main") && md.contains("| mode | settings | VPLs |"));
@@ -121,6 +122,8 @@ fn the_report_holds_every_table_plot_and_panel_with_the_figures_of_render_and_di
             "energy_ratio",
         ];
         assert!(cells.iter().all(|c| !r[c].is_null()), "{r}");
+        // One sample a pixel: no pixel is mixed, the two black-where-lit shares agree.
+        assert_eq!(r["black_where_lit"], r["black_where_lit_all"], "{r}");
         assert_eq!(
             md.matches(&format!("| {} |", r["mode"].as_str().expect("mode")))
                 .count(),
@@ -190,6 +193,49 @@ fn the_report_holds_every_table_plot_and_panel_with_the_figures_of_render_and_di
     more.extend(["--vals", "8"]);
     let changed = stdout(&visgate(&more));
     assert!(changed.contains("2 renders made, 6 read back"), "{changed}");
+}
+
+#[test]
+fn with_several_samples_a_pixel_the_mixed_pixels_are_left_out_of_black_where_lit() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("cmp");
+    let args = [
+        "compare",
+        "builtin:two-rooms",
+        "--modes",
+        "none,val-hard",
+        "--vpls",
+        "16",
+        "--size",
+        "48x36",
+        "--spp",
+        "4",
+        "--cameras",
+        "main",
+        "--out",
+        out.to_str().expect("utf-8"),
+    ];
+    visgate(&args);
+    let json: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("report.json")).expect("json"))
+            .expect("parses");
+    // The room's corners and the door's edges: a few percent of the pixels.
+    let share = json["references"][0]["mixed_share"]
+        .as_f64()
+        .expect("share");
+    assert!(share > 0.01 && share < 0.3, "{share}");
+    let md = std::fs::read_to_string(out.join("report.md")).expect("md");
+    assert!(md.contains("of its pixels see several surfaces"), "{md}");
+    for r in json["rows"].as_array().expect("rows") {
+        let (b, all) = (
+            r["black_where_lit"].as_f64().expect("share"),
+            r["black_where_lit_all"].as_f64().expect("share"),
+        );
+        assert!(
+            (0.0..=1.0).contains(&b) && (0.0..=1.0).contains(&all),
+            "{r}"
+        );
+    }
 }
 
 #[test]

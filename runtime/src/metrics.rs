@@ -67,7 +67,11 @@ pub struct IndirectErrors {
     pub energy_ratio: f64,
     /// Of the pixels whose reference indirect light is at least a tenth of its mean, the share
     /// where the image's is under a tenth of the reference's there: black where it is lit.
+    /// Pixels whose reference samples saw more than one surface are left out
+    /// ([`IndirectMap::leave_out_mixed`]).
     pub black_where_lit: f64,
+    /// [`IndirectErrors::black_where_lit`] over every pixel, the mixed ones too.
+    pub black_where_lit_all: f64,
 }
 
 /// [`IndirectErrors`] of `a` against reference `r`, both less the direct light `direct`.
@@ -94,34 +98,73 @@ pub enum Lit {
 pub struct IndirectMap {
     /// Each pixel's class, rows from the top.
     pub class: Vec<Lit>,
+    /// The pixels left out of [`IndirectErrors::black_where_lit`]: those where the reference's
+    /// pixel samples saw more than one surface (empty: none).
+    pub mixed: Vec<bool>,
     /// Mean indirect light (r + g + b) of the image.
     pub mean_a: f64,
     /// Mean indirect light (r + g + b) of the reference.
     pub mean_r: f64,
 }
 
+/// The black map's colour of a pixel black where lit but left out as mixed (dark yellow).
+pub const MIXED_BLACK: [u8; 3] = [150, 120, 0];
+
 impl IndirectMap {
-    /// The energy ratio and the black-where-lit share.
+    /// Leaves the pixels where `mixed` is true out of the black-where-lit share: a pixel whose
+    /// reference samples saw several surfaces (a silhouette, a crease) averages their light,
+    /// where a method that shades one point a pixel sees one of them, and the darker one's
+    /// indirect light may be under a tenth of the average with no visibility error at all.
+    pub fn leave_out_mixed(mut self, mixed: Vec<bool>) -> Result<IndirectMap, RenderError> {
+        if !mixed.is_empty() && mixed.len() != self.class.len() {
+            return Err(RenderError::Param(format!(
+                "a mask of {} pixels for an image of {}",
+                mixed.len(),
+                self.class.len()
+            )));
+        }
+        self.mixed = mixed;
+        Ok(self)
+    }
+
+    /// Whether pixel `i` is left out as mixed.
+    fn is_mixed(&self, i: usize) -> bool {
+        self.mixed.get(i).copied().unwrap_or(false)
+    }
+
+    /// The energy ratio and the black-where-lit shares.
     pub fn errors(&self) -> IndirectErrors {
-        let lit = self.class.iter().filter(|c| **c != Lit::Not).count();
-        let black = self.class.iter().filter(|c| **c == Lit::Black).count();
+        let share = |keep: &dyn Fn(usize) -> bool| {
+            let (mut lit, mut black) = (0usize, 0usize);
+            for (i, c) in self.class.iter().enumerate() {
+                if *c != Lit::Not && keep(i) {
+                    lit += 1;
+                    black += usize::from(*c == Lit::Black);
+                }
+            }
+            black as f64 / lit.max(1) as f64
+        };
         IndirectErrors {
             energy_ratio: if self.mean_r > 0.0 {
                 self.mean_a / self.mean_r
             } else {
                 1.0
             },
-            black_where_lit: black as f64 / lit.max(1) as f64,
+            black_where_lit: share(&|i| !self.is_mixed(i)),
+            black_where_lit_all: share(&|_| true),
         }
     }
 
-    /// The classes as a picture: red where black where lit, grey where lit, dark grey where
-    /// the reference's indirect light is not counted.
+    /// The classes as a picture: red where black where lit, dark yellow ([`MIXED_BLACK`])
+    /// where so but left out as mixed, grey where lit, dark grey where the reference's
+    /// indirect light is not counted.
     pub fn to_image(&self, width: u32, height: u32) -> image::RgbImage {
         image::ImageBuffer::from_fn(width, height, |x, y| {
-            image::Rgb(match self.class[(y * width + x) as usize] {
+            let i = (y * width + x) as usize;
+            image::Rgb(match self.class[i] {
                 Lit::Not => [32, 32, 32],
                 Lit::Lit => [150, 150, 150],
+                Lit::Black if self.is_mixed(i) => MIXED_BLACK,
                 Lit::Black => [255, 0, 0],
             })
         })
@@ -162,6 +205,7 @@ pub fn indirect_map(
         .collect();
     Ok(IndirectMap {
         class,
+        mixed: Vec::new(),
         mean_a,
         mean_r,
     })
@@ -246,5 +290,16 @@ mod tests {
             .map(|p| p.0 == [255, 0, 0])
             .collect::<Vec<_>>();
         assert_eq!(red, [false, true, true, false]);
+        // The third pixel mixed: left out of the share (one black of three lit), counted in
+        // the share over every pixel, and dark yellow in the picture.
+        let mixed = map
+            .leave_out_mixed(vec![false, false, true, false])
+            .expect("same size");
+        let e = mixed.errors();
+        assert!((e.black_where_lit - 1.0 / 3.0).abs() < 1e-12, "{e:?}");
+        assert!((e.black_where_lit_all - 0.5).abs() < 1e-12, "{e:?}");
+        assert_eq!(mixed.to_image(4, 1).get_pixel(2, 0).0, MIXED_BLACK);
+        let wrong = indirect_map(&method, &reference, &direct).expect("same size");
+        assert!(wrong.leave_out_mixed(vec![false; 3]).is_err());
     }
 }

@@ -158,7 +158,8 @@ pub fn pareto(
 }
 
 /// Reference | method | FLIP map (black 0 … white 1) | black where lit (red: the method's
-/// indirect light under a tenth of the reference's where that counts, grey: lit and counted;
+/// indirect light under a tenth of the reference's where that counts, dark yellow: so where
+/// the reference's samples see several surfaces, left out; grey: lit and counted;
 /// [`crate::metrics::IndirectMap::to_image`]) side by side under `title`, both images tone
 /// mapped at `exposure` stops.
 pub fn panel(
@@ -192,7 +193,7 @@ pub fn panel(
             "reference",
             "method",
             "FLIP (black 0 … white 1)",
-            "red: black where lit",
+            "red: black where lit · yellow: mixed",
         ]
         .iter()
         .enumerate()

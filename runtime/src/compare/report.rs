@@ -4,7 +4,7 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use super::{CompareReport, Row};
+use super::{CompareReport, ReferenceRow, Row};
 use crate::RenderError;
 
 /// The Pareto plot's file in the folder.
@@ -57,6 +57,34 @@ fn marks(r: &Row) -> String {
     m.join(", ")
 }
 
+/// Black where lit, and in brackets over every pixel where the mixed ones change it.
+fn black_cell(r: &Row) -> String {
+    let (b, all) = (r.black_where_lit * 100.0, r.black_where_lit_all * 100.0);
+    if format!("{b:.1}") == format!("{all:.1}") {
+        format!("{b:.1} %")
+    } else {
+        format!("{b:.1} % ({all:.1} %)")
+    }
+}
+
+/// A reference's line: its VPLs, time, rays, error against the ground truth and mixed pixels.
+fn reference_text(rf: &ReferenceRow) -> String {
+    let mut t = format!(
+        "reference at {} VPLs: {:.2} s on the CPU, {} shadow rays",
+        rf.vpl_count, rf.seconds, rf.shadow_rays
+    );
+    if let Some(g) = rf.ground_truth_rel_mse {
+        t += &format!("; its rel. MSE against the ground truth {}", sci(g));
+    }
+    if rf.mixed_share > 0.0 {
+        t += &format!(
+            "; {:.1} % of its pixels see several surfaces (left out of black where lit)",
+            rf.mixed_share * 100.0
+        );
+    }
+    t
+}
+
 /// The cells of a row's line, in [`HEADER`]'s order (the last only with ground truth).
 fn cells(r: &Row, ground_truth: bool) -> Vec<String> {
     let mut c = vec![
@@ -71,7 +99,7 @@ fn cells(r: &Row, ground_truth: bool) -> Vec<String> {
         sci(r.rel_mse),
         format!("{:.4}", r.flip),
         format!("{:.3}", r.energy_ratio),
-        format!("{:.1} %", r.black_where_lit * 100.0),
+        black_cell(r),
     ];
     if ground_truth {
         c.push(r.ground_truth_rel_mse.map_or("-".into(), sci));
@@ -114,7 +142,10 @@ the total is the frame. Indirect energy: the method's mean indirect light over t
 (its own direct light taken out). Indirect MSE: the MSE of the image with its own direct light \
 replaced by the reference's, the error of the indirect light alone (GPU shadow maps and CPU \
 shadow rays differ at shadow edges alike for every method). Black where lit: of the pixels the reference lights \
-indirectly at ≥ 0.1 of its mean, the share where the method gives < 0.1 of the reference. \
+indirectly at ≥ 0.1 of its mean, the share where the method gives < 0.1 of the reference, \
+leaving out the pixels whose reference samples see several surfaces (silhouettes, creases: \
+the reference averages them where a method shades one point a pixel; in brackets the share \
+over every pixel where they change it; dark yellow in the panels' black map). \
 ◆ front: no other setting is both faster and more accurate (means over the cameras). \
 × per-VPL maps: per-VPL shadow maps' frame time over this one's.";
 
@@ -204,15 +235,7 @@ fn markdown(r: &CompareReport) -> String {
     for cam in &r.cameras {
         let _ = writeln!(md, "## Camera {cam}\n");
         for rf in r.references.iter().filter(|x| &x.camera == cam) {
-            let _ = write!(
-                md,
-                "- reference at {} VPLs: {:.2} s on the CPU, {} shadow rays",
-                rf.vpl_count, rf.seconds, rf.shadow_rays
-            );
-            if let Some(g) = rf.ground_truth_rel_mse {
-                let _ = write!(md, "; its rel. MSE against the ground truth {}", sci(g));
-            }
-            md.push('\n');
+            let _ = writeln!(md, "- {}", reference_text(rf));
         }
         let h = header(gt);
         let _ = writeln!(md, "\n| {} |", h.join(" | "));
@@ -306,17 +329,7 @@ fn html(r: &CompareReport) -> String {
     for cam in &r.cameras {
         let _ = writeln!(h, "<h2>Camera {}</h2><ul>", esc(cam));
         for rf in r.references.iter().filter(|x| &x.camera == cam) {
-            let _ = writeln!(
-                h,
-                "<li>reference at {} VPLs: {:.2} s on the CPU, {} shadow rays{}</li>",
-                rf.vpl_count,
-                rf.seconds,
-                rf.shadow_rays,
-                rf.ground_truth_rel_mse.map_or(String::new(), |g| format!(
-                    "; rel. MSE against the ground truth {}",
-                    sci(g)
-                ))
-            );
+            let _ = writeln!(h, "<li>{}</li>", esc(&reference_text(rf)));
         }
         h += "</ul><table><tr>";
         for c in header(gt) {

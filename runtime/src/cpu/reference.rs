@@ -150,12 +150,7 @@ pub fn render_cancellable(
             for x in 0..w {
                 let mut sum = Vec3::ZERO;
                 for s in 0..spp {
-                    let j = if spp == 1 {
-                        Vec2::splat(0.5)
-                    } else {
-                        halton2(s as u64 + 1, 2, 3, Vec2::ZERO)
-                    };
-                    let dir = view.ray_dir(Vec2::new(x as f32, y as f32) + j);
+                    let dir = view.ray_dir(Vec2::new(x as f32, y as f32) + sample(s, spp));
                     let Some(surf) = tracer.trace(view.eye, dir) else {
                         continue;
                     };
@@ -234,6 +229,52 @@ pub fn render_cancellable(
             seconds: t0.elapsed().as_secs_f64(),
         },
     ))
+}
+
+/// Where in its pixel the reference's sample `s` of `spp` lies: the centre for one, else a
+/// Halton pattern. [Units: pixels]
+fn sample(s: u32, spp: u32) -> Vec2 {
+    if spp == 1 {
+        Vec2::splat(0.5)
+    } else {
+        halton2(s as u64 + 1, 2, 3, Vec2::ZERO)
+    }
+}
+
+/// Normals of one surface agree to this cosine (25°): a column's facets within a pixel do, a
+/// wall and the floor it stands on do not.
+const SAME_SURFACE_COS: f32 = 0.9;
+/// A sample lies on the first sample's surface when within this share of the first's distance
+/// from its tangent plane: a pillar's edge before a wall is metres off it. [Units: ratio]
+const SAME_SURFACE_DEPTH: f32 = 0.01;
+
+/// The pixels of `view` whose `spp` reference samples (the pattern [`render_reference`]
+/// takes) see more than one surface: some hit and some miss, or their geometric normals or
+/// planes differ — silhouettes and creases, where the reference averages the light of two
+/// surfaces and a method that shades one point a pixel shows one of them. All false for one
+/// sample a pixel. Rows from the top.
+pub fn mixed_pixels(tracer: &Tracer, view: &View, spp: u32) -> Vec<bool> {
+    let [w, h] = view.size;
+    let pixel = |x: u32, y: u32| {
+        let hit = |s: u32| {
+            let at = Vec2::new(x as f32, y as f32) + sample(s, spp);
+            tracer.trace(view.eye, view.ray_dir(at))
+        };
+        let first = hit(0);
+        (1..spp).any(|s| match (first, hit(s)) {
+            (None, None) => false,
+            (Some(a), Some(b)) => {
+                a.geometric_normal.dot(b.geometric_normal) < SAME_SURFACE_COS
+                    || a.geometric_normal.dot(b.position - a.position).abs()
+                        > SAME_SURFACE_DEPTH * a.t
+            }
+            _ => true,
+        })
+    };
+    (0..h)
+        .into_par_iter()
+        .flat_map_iter(|y| (0..w).map(move |x| pixel(x, y)))
+        .collect()
 }
 
 /// The radiance of one surface point seen along a ray, for tests: direct (with shadow rays)
