@@ -538,8 +538,10 @@ pub fn run(
         resumed: [0, 0],
     };
     // With several samples a pixel, the pixels whose samples see several surfaces are left out
-    // of black-where-lit (the primary rays alone: a second of a 262 k-triangle level's BVH).
-    let tracer = (spec.base.spp > 1).then(|| crate::cpu::tracer::Tracer::new(scene));
+    // of black-where-lit (the primary rays alone, on the scene posed as the renders pose it: a
+    // second for a 262 k-triangle level's BVH).
+    let tracer =
+        (spec.base.spp > 1).then(|| crate::cpu::tracer::Tracer::new(&scene.at(spec.base.time)));
     for (ci, camera) in spec.cameras.iter().enumerate() {
         let mixed = match &tracer {
             Some(t) => {
