@@ -451,8 +451,8 @@ pub fn run_compare(args: CompareArgs) -> Result<()> {
         ground_truth,
         stability_frames: args.stability_frames,
         exposure: args.exposure,
-        command: std::iter::once("visgate")
-            .chain(command_line.iter().skip(1).map(String::as_str))
+        command: std::iter::once("visgate".to_string())
+            .chain(command_line.iter().skip(1).map(|a| shell_word(a)))
             .collect::<Vec<_>>()
             .join(" "),
     };
@@ -518,10 +518,34 @@ pub fn run_compare(args: CompareArgs) -> Result<()> {
     Ok(())
 }
 
+/// `arg` as a POSIX shell reads it back: as it is when it holds only characters no shell
+/// treats specially, else in single quotes (a quote in it closed, escaped and reopened), so
+/// that the report's command runs again as given (a `--variant "LABEL=MODE FLAGS"`).
+fn shell_word(arg: &str) -> String {
+    let plain = |c: char| c.is_ascii_alphanumeric() || "-_./:=,@%+".contains(c);
+    if !arg.is_empty() && arg.chars().all(plain) {
+        arg.to_string()
+    } else {
+        format!("'{}'", arg.replace('\'', r"'\''"))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use visgate_runtime::gpu::GatesParams;
+
+    #[test]
+    fn the_reports_command_quotes_what_a_shell_would_split() {
+        assert_eq!(shell_word("--vpls"), "--vpls");
+        assert_eq!(shell_word("scenes/a-b_c.toml"), "scenes/a-b_c.toml");
+        assert_eq!(
+            shell_word("st64=gates --starved-taps 64"),
+            "'st64=gates --starved-taps 64'"
+        );
+        assert_eq!(shell_word("it's"), r"'it'\''s'");
+        assert_eq!(shell_word(""), "''");
+    }
 
     /// The modes `names` give with `flags` after a compare command line.
     fn modes_with(names: &str, flags: &[&str]) -> Vec<CompareMode> {

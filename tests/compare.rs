@@ -600,6 +600,12 @@ fn variants_are_rows_of_a_mode_with_the_runs_settings_and_their_own_flags() {
     assert!(one.contains("disks ×1, 1 hop(s)"), "{one}");
     assert!(two.contains("disks ×1, 2 hop(s)"), "{two}");
     assert!(wide.contains("disks ×2, 2 hop(s)"), "{wide}");
+    // The report's command runs again as given: each variant one word for a shell.
+    let command = report["command"].as_str().expect("command");
+    assert!(
+        command.contains(" --variant 'gates-2hops=gates --gate-hops 2' --variant"),
+        "{command}"
+    );
     // Badly written variants are refused, saying how to write one.
     for (variant, says) in [
         ("gates --gate-hops 2", "LABEL=MODE"),
