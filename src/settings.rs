@@ -249,15 +249,16 @@ pub struct MethodArgs {
     /// Gates, interleaved: a pixel whose blur block holds fewer pixels than this that agree
     /// with it (a door jamb, a strip along a wall) walks, in a second pass, the VPL subsets of
     /// the pixels that do not agree, so that every VPL counts once there (a pair of pixel and
-    /// subset a GPU thread); 0: off (default), at most --interleave². Costs 2-7x the frame
-    /// on lavapipe at 48-64; `render` prints how many pixels starved. See the README.
+    /// subset a GPU thread), with the walks' roulette of --walk-roulette; 0: off (default), at
+    /// most --interleave². Costs 2-7x the frame on lavapipe at 48-64; `render` prints how many
+    /// pixels starved. See the README.
     #[arg(long, default_value_t = 0)]
     pub starved_taps: u32,
-    /// Gates with portals or voxels: Russian roulette on the walks. A VPL that brings a pixel
-    /// less than this share of its VPL subset's unshadowed light is walked by chance, with
-    /// probability its share / this, and counts as much more where visible: the same light on
-    /// average in at most 2 / this walks a pixel on average (0.05: 40, where 16,384 VPLs in 8
-    /// x 8 blocks walk 256), with noise the blur evens out. 0: every VPL walked. auto: 0.05
+    /// Gates with portals or voxels: Russian roulette on the walks (the starved pixels' too).
+    /// A VPL that brings a pixel less than this share of its VPL subset's unshadowed light is
+    /// walked by chance, with probability its share / this, and counts as much more where
+    /// visible: the same light on average in at most 2 / this walks a subset on average (0.05:
+    /// 40, where 16,384 VPLs in 8 x 8 blocks walk 256), with noise the blur evens out. 0: every VPL walked. auto: 0.05
     /// where the frame is interleaved in blocks of 8 x 8 or more and a pixel's subset holds 128
     /// VPLs or more (8,192 VPLs in 8 x 8 blocks: there it halves the frame on a GPU and moves
     /// the indirect error by a few per cent, at most +27 % measured; in 4 x 4 blocks it leaves

@@ -985,6 +985,74 @@ fn the_walks_roulette_gives_every_walks_light_on_average_over_its_seeds() {
 }
 
 #[test]
+fn the_starved_pixels_walks_take_the_roulette_and_keep_every_walks_light_on_average() {
+    use visgate_runtime::gpu::InterleaveParams;
+    use visgate_runtime::gpu::{GatesParams, GpuMode, GpuParams, WalkRoulette};
+    use visgate_runtime::metrics::errors;
+    let (ctx, mut gpu, vpls, view) = four_rooms_on_the_gpu([96, 72]);
+    // Blocks of 4 × 4 where no tap but the pixel itself agrees: every pixel starved, its 15
+    // other subsets walked by the starved pass, so that its roulette is most of the noise.
+    let mut render_in = |starved_taps: u32, walk_roulette: f32, walk_seed: u32| {
+        let p = GatesParams {
+            interleave: InterleaveParams {
+                block: 4,
+                blur_distance: 0.0,
+                starved_taps,
+                ..InterleaveParams::default()
+            },
+            walk_roulette: WalkRoulette::Share(walk_roulette),
+            walk_seed,
+            ..GatesParams::default()
+        };
+        let params = GpuParams::with_mode(GpuMode::Gates(p));
+        gpu.render(&ctx, &view, &vpls, &params).expect("render").0
+    };
+    // Not starved, each pixel its own subset × 16 (no blur): one subset's roulette noise,
+    // × 16² in variance. Starved, 16 subsets' noise, each × 1: about a sixteenth of that
+    // (without the roulette in the starved pass, one subset's: a 256th).
+    let own = errors(&render_in(0, 0.2, 0), &render_in(0, 0.0, 0))
+        .expect("size")
+        .rel_mse;
+    let mut render = |walk_roulette: f32, walk_seed: u32| render_in(16, walk_roulette, walk_seed);
+    let full = render(0.0, 0);
+    let seeds = 16;
+    let one = render(0.2, 0);
+    let mut mean = one.clone();
+    for seed in 1..seeds {
+        for (m, p) in mean.pixels.iter_mut().zip(&render(0.2, seed).pixels) {
+            *m += *p;
+        }
+    }
+    for m in &mut mean.pixels {
+        *m /= seeds as f32;
+    }
+    let sum = |img: &visgate_runtime::hdr::HdrImage| -> f64 {
+        img.pixels.iter().map(|p| f64::from(p.element_sum())).sum()
+    };
+    let (e_one, e_mean) = (
+        errors(&one, &full).expect("size"),
+        errors(&mean, &full).expect("size"),
+    );
+    let energy = sum(&mean) / sum(&full);
+    eprintln!(
+        "starved walks, roulette 0.2: rel. MSE to every walk's {:.3e} (one seed), {:.3e} \
+         ({seeds} seeds' mean); energy {energy:.4}; one subset's × 16 {own:.3e}",
+        e_one.rel_mse, e_mean.rel_mse
+    );
+    assert!(e_one.rel_mse > own / 50.0, "{} vs {own}", e_one.rel_mse);
+    // The walked weighted up (no bias): 16 seeds' mean is nearer by about 16× and keeps the
+    // light.
+    assert!(e_one.rel_mse > 1e-6, "{}", e_one.rel_mse);
+    assert!(
+        e_mean.rel_mse < 0.25 * e_one.rel_mse,
+        "{} vs {}",
+        e_mean.rel_mse,
+        e_one.rel_mse
+    );
+    assert!((energy - 1.0).abs() < 0.01, "{energy}");
+}
+
+#[test]
 fn the_light_list_pool_grows_to_what_a_frame_needs() {
     // Disks keep lists; portals keep none (their pool stays at one entry).
     use visgate_runtime::gpu::{GatesParams, GpuContext, GpuMode, GpuParams, GpuRenderer};

@@ -75,8 +75,9 @@ pub fn method_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
                     ui.add(egui::Slider::new(&mut il.starved_taps, 0..=most).text("starved taps"))
                         .on_hover_text(
                             "a pixel whose blur block holds fewer pixels than this that agree \
-                             with it walks the VPLs of the rest itself: fewer black strips along \
-                             walls and jambs, 2-7x the frame on lavapipe; 0: off",
+                             with it walks the VPLs of the rest itself (by the walk roulette): \
+                             fewer black strips along walls and jambs, 2-7x the frame on \
+                             lavapipe; 0: off",
                         );
                 }
                 if g.shape != GateShape::Disk {

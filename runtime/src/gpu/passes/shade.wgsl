@@ -615,8 +615,11 @@ fn cs_starved_walks(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_w
         first = j + walk_batch_index.x * wb * subsets;
         end = min(end, first + wb * subsets);
     }
-    // Every VPL walked here (no roulette): these pixels are where light is scarce.
-    let lit = walk_range(px, pos.xyz, n, decode_cluster(pos.w), walk_end_at(px, pos.xyz), first, end, subsets, 0.0);
+    // The frame's walk roulette, as in the first gather: a VPL under its share of the subset's
+    // unshadowed light walked by chance and weighted up (the share's total made again in each
+    // of lavapipe's batches; once on a GPU, which runs one).
+    let cut = globals.walk_roulette * roulette_total(pos.xyz, n, j, subsets);
+    let lit = walk_range(px, pos.xyz, n, decode_cluster(pos.w), walk_end_at(px, pos.xyz), first, end, subsets, cut);
     let sum = bitcast<vec3<f32>>(pair.xyz) + lit;
     starved_pairs[k] = vec4<u32>(bitcast<vec3<u32>>(sum), pair.w);
 }
