@@ -36,9 +36,10 @@ OUT/report.html hold a table per camera (pass times, MSE, relative MSE, FLIP, in
 ratio, black-where-lit share, speed-up over per-VPL shadow maps), the Pareto plot (frame time
 against --metric, log-log) and a panel per render (reference | method | FLIP map | where the
 method is black and the reference lit, in red); OUT/report.json holds every figure. With
---spp above 1, black where lit leaves out the pixels whose reference samples see several
-surfaces (silhouettes, creases: the reference averages them, a method shades one point a
-pixel), dark yellow in the panels; the share over every pixel follows in brackets. Renders
+--spp above 1, black where lit leaves out the pixels whose reference samples and centre see
+several surfaces or albedos tenfold apart (silhouettes, creases, sharp texels: the reference
+averages them, a method shades one point a pixel), dark yellow in the panels; the share over
+every pixel follows in brackets. Renders
 are kept in OUT/renders: run the same command again after a stop and it resumes, redoing only
 what changed.
 

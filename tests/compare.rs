@@ -225,7 +225,10 @@ fn with_several_samples_a_pixel_the_mixed_pixels_are_left_out_of_black_where_lit
         .expect("share");
     assert!(share > 0.01 && share < 0.3, "{share}");
     let md = std::fs::read_to_string(out.join("report.md")).expect("md");
-    assert!(md.contains("of its pixels see several surfaces"), "{md}");
+    assert!(
+        md.contains("of its pixels mixed, seeing several surfaces"),
+        "{md}"
+    );
     for r in json["rows"].as_array().expect("rows") {
         let (b, all) = (
             r["black_where_lit"].as_f64().expect("share"),

@@ -112,7 +112,8 @@ pub const MIXED_BLACK: [u8; 3] = [150, 120, 0];
 
 impl IndirectMap {
     /// Leaves the pixels where `mixed` is true out of the black-where-lit share: a pixel whose
-    /// reference samples saw several surfaces (a silhouette, a crease) averages their light,
+    /// reference samples saw several surfaces (a silhouette, a crease) or albedos tenfold apart
+    /// ([`crate::cpu::reference::mixed_pixels`]) averages their light,
     /// where a method that shades one point a pixel sees one of them, and the darker one's
     /// indirect light may be under a tenth of the average with no visibility error at all.
     pub fn leave_out_mixed(mut self, mixed: Vec<bool>) -> Result<IndirectMap, RenderError> {

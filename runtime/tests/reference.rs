@@ -462,16 +462,27 @@ fn a_cancelled_reference_stops_with_an_error_and_an_uncancelled_one_is_render_wi
 fn pixels_whose_samples_see_a_panel_and_what_lies_behind_it_are_mixed() {
     // A panel standing on a 20 m floor, seen square on from 5 m at eye height 1.03 m: 64 × 48
     // pixels of 60°, 11.09 pixels a metre at the panel. Its edges fall between the samples of
-    // a pixel (at 1/8–3/4 across, 1/9–2/3 down): left at column 18.37, right 41.64, top at
-    // row 15.4, foot 35.42; the floor ends 10 m behind it, where the void begins.
-    let (x0, x1, top) = (-1.23, 0.87, 1.806);
-    let panel = [
-        Vec3::new(x0, 0.0, 0.0),
-        Vec3::new(x1, 0.0, 0.0),
-        Vec3::new(x1, top, 0.0),
-        Vec3::new(x0, top, 0.0),
-    ];
-    let s = quads(&[floor(10.0), panel], 0.5, Vec::new());
+    // a pixel (at 1/8–3/4 across, 1/9–2/3 down) and its centre: left at column 18.37, right
+    // 41.64, top at row 15.4, foot 35.42; the floor ends 10 m behind it, where the void
+    // begins. Its right part, from column 30.4, is 25 times darker.
+    let (x0, x1, split, top) = (-1.23, 0.87, -0.1443, 1.806);
+    let quad = |a: f32, b: f32| {
+        [
+            Vec3::new(a, 0.0, 0.0),
+            Vec3::new(b, 0.0, 0.0),
+            Vec3::new(b, top, 0.0),
+            Vec3::new(a, top, 0.0),
+        ]
+    };
+    let mut s = quads(
+        &[floor(10.0), quad(x0, split), quad(split, x1)],
+        0.5,
+        Vec::new(),
+    );
+    let mut dark = s.materials[0].clone();
+    dark.albedo = Vec3::splat(0.02);
+    s.materials.push(dark);
+    s.meshes[0].material[4..].fill(1);
     let camera = Camera {
         name: "front".into(),
         eye: Vec3::new(0.0, 1.03, 5.0),
@@ -484,16 +495,18 @@ fn pixels_whose_samples_see_a_panel_and_what_lies_behind_it_are_mixed() {
     let mixed = mixed_pixels(&tracer, &view, 4);
     let at = |x: usize, y: usize| mixed[y * 64 + x];
     // Its sides against the floor and the void behind, its top against the void, its foot
-    // against the floor it stands on (a crease).
+    // against the floor it stands on (a crease), and where its two albedos meet.
     assert!((16..35).all(|y| at(18, y) && at(41, y)), "sides");
     assert!((19..41).all(|x| at(x, 15)), "top");
     assert!((19..41).all(|x| at(x, 35)), "foot");
-    // Inside the panel and on the near floor: one surface a pixel.
-    assert!((20..40).all(|x| (17..34).all(|y| !at(x, y))), "panel");
+    assert!((17..34).all(|y| at(30, y)), "albedos");
+    // Inside the panel's two parts and on the near floor: one surface a pixel.
+    let inside = |x: usize| x == 30 || (17..34).all(|y| !at(x, y));
+    assert!((20..40).all(inside), "panel");
     assert!((0..64).all(|x| (38..48).all(|y| !at(x, y))), "near floor");
-    // Outlines only: 85 pixels of 3,072 (the far edge of the floor falls after the samples).
+    // Outlines only: 105 pixels of 3,072 (the far edge of the floor falls after the samples).
     let n = mixed.iter().filter(|&&m| m).count();
-    assert!((80..120).contains(&n), "{n} mixed pixels");
+    assert!((100..140).contains(&n), "{n} mixed pixels");
     // One sample a pixel sees one surface.
     assert!(mixed_pixels(&tracer, &view, 1).iter().all(|&m| !m));
 }

@@ -78,7 +78,8 @@ fn reference_text(rf: &ReferenceRow) -> String {
     }
     if rf.mixed_share > 0.0 {
         t += &format!(
-            "; {:.1} % of its pixels see several surfaces (left out of black where lit)",
+            "; {:.1} % of its pixels mixed, seeing several surfaces or albedos (left out of black \
+             where lit)",
             rf.mixed_share * 100.0
         );
     }
@@ -143,8 +144,9 @@ the total is the frame. Indirect energy: the method's mean indirect light over t
 replaced by the reference's, the error of the indirect light alone (GPU shadow maps and CPU \
 shadow rays differ at shadow edges alike for every method). Black where lit: of the pixels the reference lights \
 indirectly at ≥ 0.1 of its mean, the share where the method gives < 0.1 of the reference, \
-leaving out the pixels whose reference samples see several surfaces (silhouettes, creases: \
-the reference averages them where a method shades one point a pixel; in brackets the share \
+leaving out the pixels whose reference samples and centre see several surfaces or albedos \
+tenfold apart (silhouettes, creases, sharp texels: the reference averages them where a method \
+shades one point a pixel; in brackets the share \
 over every pixel where they change it; dark yellow in the panels' black map). \
 ◆ front: no other setting is both faster and more accurate (means over the cameras). \
 × per-VPL maps: per-VPL shadow maps' frame time over this one's.";

@@ -15,7 +15,7 @@ use visgate_formats::Light;
 use crate::RenderError;
 use crate::camera::View;
 use crate::cpu::gates::{End, GateLevel, GateParams};
-use crate::cpu::tracer::Tracer;
+use crate::cpu::tracer::{Surface, Tracer};
 use crate::hdr::HdrImage;
 use crate::lights::direct_radiance;
 use crate::vpl::{GatherParams, Vpl, gather_one, halton2};
@@ -248,25 +248,31 @@ const SAME_SURFACE_COS: f32 = 0.9;
 /// from its tangent plane: a pillar's edge before a wall is metres off it. [Units: ratio]
 const SAME_SURFACE_DEPTH: f32 = 0.01;
 
+/// Albedos (summed over the channels) within this ratio cannot make a pixel black where lit
+/// by themselves: the method's point under a tenth of the reference's mean takes a wider one.
+const SAME_ALBEDO_RATIO: f32 = 10.0;
+
 /// The pixels of `view` whose `spp` reference samples (the pattern [`render_reference`]
-/// takes) see more than one surface: some hit and some miss, or their geometric normals or
-/// planes differ — silhouettes and creases, where the reference averages the light of two
-/// surfaces and a method that shades one point a pixel shows one of them. All false for one
-/// sample a pixel. Rows from the top.
+/// takes) and centre (the point a method shades) see more than one surface: some hit and
+/// some miss, or their geometric normals or planes differ — silhouettes and creases —, or
+/// their albedos differ more than tenfold (a dark texel under a bright one's neighbours):
+/// there the reference averages what a method that shades one point a pixel shows one of.
+/// All false for one sample a pixel (it is the centre). Rows from the top.
 pub fn mixed_pixels(tracer: &Tracer, view: &View, spp: u32) -> Vec<bool> {
     let [w, h] = view.size;
     let pixel = |x: u32, y: u32| {
-        let hit = |s: u32| {
-            let at = Vec2::new(x as f32, y as f32) + sample(s, spp);
-            tracer.trace(view.eye, view.ray_dir(at))
-        };
-        let first = hit(0);
-        (1..spp).any(|s| match (first, hit(s)) {
+        let hit =
+            |at: Vec2| tracer.trace(view.eye, view.ray_dir(Vec2::new(x as f32, y as f32) + at));
+        let centre = hit(Vec2::splat(0.5));
+        let albedo = |s: &Surface| s.albedo.element_sum();
+        (0..spp).any(|s| match (centre, hit(sample(s, spp))) {
             (None, None) => false,
             (Some(a), Some(b)) => {
+                let (lo, hi) = (albedo(&a).min(albedo(&b)), albedo(&a).max(albedo(&b)));
                 a.geometric_normal.dot(b.geometric_normal) < SAME_SURFACE_COS
                     || a.geometric_normal.dot(b.position - a.position).abs()
                         > SAME_SURFACE_DEPTH * a.t
+                    || hi > SAME_ALBEDO_RATIO * lo
             }
             _ => true,
         })
