@@ -38,8 +38,8 @@ against --metric, log-log) and a panel per render (reference | method | FLIP map
 method is black and the reference lit, in red); OUT/report.json holds every figure. With
 --spp above 1, black where lit leaves out the pixels whose reference samples and centre see
 several surfaces or albedos tenfold apart (silhouettes, creases, sharp texels: the reference
-averages them, a method shades one point a pixel), dark yellow in the panels; the share over
-every pixel follows in brackets. Renders
+averages them, a method shades one point a pixel), dark yellow in the panels and white in
+OUT/renders/CAMERA/mixed.png; the share over every pixel follows in brackets. Renders
 are kept in OUT/renders: run the same command again after a stop and it resumes, redoing only
 what changed.
 

@@ -82,6 +82,7 @@ fn the_report_holds_every_table_plot_and_panel_with_the_figures_of_render_and_di
     let rows = json["rows"].as_array().expect("rows");
     assert_eq!(rows.len(), 4, "2 modes × 2 VPL counts × 1 camera");
     assert_eq!(json["references"][0]["mixed_share"].as_f64(), Some(0.0));
+    assert!(json["references"][0]["mixed_map"].is_null());
     let md = std::fs::read_to_string(out.join("report.md")).expect("md");
     let html = std::fs::read_to_string(out.join("report.html")).expect("html");
     assert!(md.contains("## Camera main") && md.contains("| mode | settings | VPLs |"));
@@ -224,11 +225,17 @@ fn with_several_samples_a_pixel_the_mixed_pixels_are_left_out_of_black_where_lit
         .as_f64()
         .expect("share");
     assert!(share > 0.01 && share < 0.3, "{share}");
+    // Those pixels white in a map of their own, named in the report.
+    let map = json["references"][0]["mixed_map"].as_str().expect("map");
+    let white = image::open(out.join(map)).expect("map png").to_luma8();
+    let n = white.pixels().filter(|p| p.0[0] == 255).count();
+    assert_eq!(n, (share * 48.0 * 36.0).round() as usize);
     let md = std::fs::read_to_string(out.join("report.md")).expect("md");
     assert!(
         md.contains("of its pixels mixed, seeing several surfaces"),
         "{md}"
     );
+    assert!(md.contains(map), "{md}");
     for r in json["rows"].as_array().expect("rows") {
         let (b, all) = (
             r["black_where_lit"].as_f64().expect("share"),

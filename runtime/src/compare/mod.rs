@@ -214,6 +214,8 @@ pub struct ReferenceRow {
     pub ground_truth_rel_mse: Option<f64>,
     /// Share of the pixels whose samples see several surfaces (left out of black-where-lit).
     pub mixed_share: f64,
+    /// Those pixels, white, relative to the report (none with one sample a pixel).
+    pub mixed_map: Option<String>,
     /// The image, relative to the report.
     pub image: String,
 }
@@ -597,6 +599,7 @@ fn camera_rows(
         |name: &str, renderer| (store.render(camera, name, &job(renderer, 0))).map(|r| one(r.0));
     let direct_cpu = direct("direct-cpu", Renderer::CpuTwin(GpuMode::DirectOnly))?;
     let direct_gpu = direct("direct-gpu", Renderer::Gpu(GpuMode::DirectOnly))?;
+    let mixed_map = mixed_map(store, camera, mixed, [direct_cpu.width, direct_cpu.height])?;
     // A method with other direct shadows than the run's: its own direct light, to take out of
     // its image (once a camera, whatever the VPL count).
     let mut own_direct = Vec::new();
@@ -628,6 +631,7 @@ fn camera_rows(
             shadow_rays: kept.shadow_rays,
             ground_truth_rel_mse: gt.map(|e| e.rel_mse),
             mixed_share: mixed.iter().filter(|&&m| m).count() as f64 / mixed.len().max(1) as f64,
+            mixed_map: mixed_map.clone(),
             image: path_string(&rel.with_extension("png")),
         });
         for (k, (m, own)) in spec.modes.iter().zip(&own_direct).enumerate() {
@@ -665,6 +669,29 @@ fn camera_rows(
         }
     }
     Ok(())
+}
+
+/// Writes `camera`'s mixed pixels (white; `size` pixels) as `renders/CAMERA/mixed.png`, and
+/// returns its path relative to the report; none where no pixel was judged.
+fn mixed_map(
+    store: &Store,
+    camera: &Camera,
+    mixed: &[bool],
+    [w, h]: [u32; 2],
+) -> Result<Option<String>, RenderError> {
+    if mixed.len() != (w * h) as usize {
+        return Ok(None);
+    }
+    let rel = Path::new("renders")
+        .join(file_name(&camera.name))
+        .join("mixed.png");
+    let path = store.dir.join(&rel);
+    image::GrayImage::from_fn(w, h, |x, y| {
+        image::Luma([255 * u8::from(mixed[(y * w + x) as usize])])
+    })
+    .save(&path)
+    .map_err(|e| RenderError::io(&path, e))?;
+    Ok(Some(path_string(&rel)))
 }
 
 /// The row of `m` where an earlier mode of the run (`before`) rendered the same frame for

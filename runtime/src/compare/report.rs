@@ -76,10 +76,10 @@ fn reference_text(rf: &ReferenceRow) -> String {
     if let Some(g) = rf.ground_truth_rel_mse {
         t += &format!("; its rel. MSE against the ground truth {}", sci(g));
     }
-    if rf.mixed_share > 0.0 {
+    if let Some(map) = rf.mixed_map.as_ref().filter(|_| rf.mixed_share > 0.0) {
         t += &format!(
             "; {:.1} % of its pixels mixed, seeing several surfaces or albedos (left out of black \
-             where lit)",
+             where lit; white in {map})",
             rf.mixed_share * 100.0
         );
     }
