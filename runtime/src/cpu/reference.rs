@@ -244,8 +244,8 @@ fn sample(s: u32, spp: u32) -> Vec2 {
 /// Normals of one surface agree to this cosine (25°): a column's facets within a pixel do, a
 /// wall and the floor it stands on do not.
 const SAME_SURFACE_COS: f32 = 0.9;
-/// A sample lies on the first sample's surface when within this share of the first's distance
-/// from its tangent plane: a pillar's edge before a wall is metres off it. [Units: ratio]
+/// A sample lies on the centre's surface when within this share of the centre's distance from
+/// its tangent plane: a pillar's edge before a wall is metres off it. [Units: ratio]
 const SAME_SURFACE_DEPTH: f32 = 0.01;
 
 /// Albedos (summed over the channels) within this ratio cannot make a pixel black where lit
