@@ -302,3 +302,105 @@ pub fn nearest_node(dims: [u32; 3], empty: &[bool], skeleton: &[u32]) -> Vec<u32
         })
         .collect()
 }
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::cmp::Reverse;
+    use std::collections::BinaryHeap;
+
+    /// The nearest-node grid by Dijkstra's heap, one voxel at a time in the order of its
+    /// final state (distance, solid depth, node), with the same steps and rules.
+    fn one_at_a_time(dims: [u32; 3], empty: &[bool], skeleton: &[u32]) -> Vec<u32> {
+        let pack = |dist: u32, depth: u8, node: u32| -> u64 {
+            ((dist as u64) << 34) | ((depth as u64) << 32) | node as u64
+        };
+        let mut state = vec![u64::MAX; empty.len()];
+        let mut heap = BinaryHeap::new();
+        for (id, &v) in skeleton.iter().enumerate() {
+            state[v as usize] = pack(0, 0, id as u32);
+            heap.push(Reverse((state[v as usize], v)));
+        }
+        let d = dims.map(i64::from);
+        while let Some(Reverse((s, v))) = heap.pop() {
+            if s != state[v as usize] {
+                continue;
+            }
+            let c = coords(v, dims);
+            let from_solid = !empty[v as usize];
+            for k in (0..27).filter(|&k| k != 13) {
+                let o = [k % 3 - 1, (k / 3) % 3 - 1, k / 9 - 1];
+                let p: [i64; 3] = std::array::from_fn(|a| c[a] + o[a]);
+                if (0..3).any(|a| p[a] < 0 || p[a] >= d[a]) {
+                    continue;
+                }
+                let j = (p[0] + d[0] * (p[1] + d[1] * p[2])) as usize;
+                let depth = if empty[j] {
+                    if from_solid {
+                        continue;
+                    }
+                    0
+                } else {
+                    let depth = if from_solid {
+                        ((s >> 32) & 3) as u8 + 1
+                    } else {
+                        1
+                    };
+                    if depth > SOLID_SHELL_VOXELS {
+                        continue;
+                    }
+                    depth
+                };
+                let w = W[o.iter().map(|x| x.unsigned_abs() as usize).sum::<usize>()];
+                let new = pack((s >> 34) as u32 + w, depth, s as u32);
+                if new < state[j] {
+                    state[j] = new;
+                    heap.push(Reverse((new, j as u32)));
+                }
+            }
+        }
+        state
+            .into_iter()
+            .map(|s| if s == u64::MAX { u32::MAX } else { s as u32 })
+            .collect()
+    }
+
+    #[test]
+    fn the_nearest_node_grid_is_dijkstras_voxel_by_voxel_on_random_levels() {
+        // Grids big enough that buckets relax in parallel (512 voxels or more), with solid
+        // boxes and few or many nodes.
+        let mut next = crate::xorshift32(0x2545_f491);
+        for (dims, blocks, nodes) in [
+            ([40, 36, 44], 60, 6),
+            ([52, 30, 41], 150, 40),
+            ([17, 23, 9], 10, 3),
+        ] {
+            let n = dims.iter().product::<u32>();
+            let mut empty = vec![true; n as usize];
+            for _ in 0..blocks {
+                let lo: [u32; 3] = std::array::from_fn(|a| next() % dims[a]);
+                let size: [u32; 3] = std::array::from_fn(|_| 1 + next() % 8);
+                for z in lo[2]..(lo[2] + size[2]).min(dims[2]) {
+                    for y in lo[1]..(lo[1] + size[1]).min(dims[1]) {
+                        for x in lo[0]..(lo[0] + size[0]).min(dims[0]) {
+                            empty[(x + dims[0] * (y + dims[1] * z)) as usize] = false;
+                        }
+                    }
+                }
+            }
+            let mut skeleton: Vec<u32> = (0..nodes)
+                .map(|_| next() % n)
+                .filter(|&v| empty[v as usize])
+                .collect();
+            skeleton.sort_unstable();
+            skeleton.dedup();
+            let got = nearest_node(dims, &empty, &skeleton);
+            assert_eq!(got, one_at_a_time(dims, &empty, &skeleton), "{dims:?}");
+            // Most empty voxels reached from some node, and solid ones too (the shell).
+            let reached = got.iter().filter(|&&v| v != u32::MAX).count();
+            assert!(
+                reached > empty.iter().filter(|&&e| e).count() / 2,
+                "{dims:?}"
+            );
+        }
+    }
+}
