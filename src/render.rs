@@ -365,6 +365,12 @@ pub struct DiffArgs {
     /// there, grey where the reference's indirect light counts, dark grey where it does not.
     #[arg(long, requires = "direct")]
     pub black_map: Option<PathBuf>,
+    /// The pixels to leave out of black where lit, white in a PNG of the images' size: `visgate
+    /// compare`'s `renders/CAMERA/mixed.png` (those whose reference samples see several
+    /// surfaces or albedos), so that the figure is compare's; the share over every pixel is
+    /// printed too.
+    #[arg(long, requires = "direct")]
+    pub mixed: Option<PathBuf>,
 }
 
 pub fn diff(args: DiffArgs) -> Result<()> {
@@ -392,7 +398,23 @@ pub fn diff(args: DiffArgs) -> Result<()> {
             Some(p) => rebase_direct(&a, &HdrImage::read(p)?, &direct)?,
             None => a.clone(),
         };
-        let map = indirect_map(&own, &r, &direct)?;
+        let mut map = indirect_map(&own, &r, &direct)?;
+        if let Some(p) = &args.mixed {
+            let mask = image::open(p)
+                .with_context(|| format!("cannot read the mixed pixels {}", p.display()))?
+                .to_luma8();
+            if mask.dimensions() != (a.width, a.height) {
+                bail!(
+                    "{} is {}x{}, the images {}x{}",
+                    p.display(),
+                    mask.width(),
+                    mask.height(),
+                    a.width,
+                    a.height
+                );
+            }
+            map = map.leave_out_mixed(mask.pixels().map(|q| q.0[0] > 127).collect())?;
+        }
         let i = map.errors();
         if let Some(out) = &args.black_map {
             map.to_image(a.width, a.height)
@@ -410,12 +432,21 @@ pub fn diff(args: DiffArgs) -> Result<()> {
             "indirect energy  {:.6}  (mean indirect light over the reference's)",
             i.energy_ratio
         );
-        println!(
-            "black where lit  {:.6} %  (of the pixels the reference lights indirectly, every \
-             pixel counted: compare leaves out those whose reference samples see several \
-             surfaces)",
-            i.black_where_lit * 100.0
-        );
+        match &args.mixed {
+            Some(p) => println!(
+                "black where lit  {:.6} %  (of the pixels the reference lights indirectly, those \
+                 white in {} left out; {:.6} % over every pixel)",
+                i.black_where_lit * 100.0,
+                p.display(),
+                i.black_where_lit_all * 100.0
+            ),
+            None => println!(
+                "black where lit  {:.6} %  (of the pixels the reference lights indirectly, every \
+                 pixel counted: compare leaves out those whose reference samples see several \
+                 surfaces or albedos, --mixed)",
+                i.black_where_lit * 100.0
+            ),
+        }
     }
     if let Some(out) = &args.out {
         false_colour(&map, a.width, a.height, 1.0)

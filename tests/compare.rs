@@ -245,6 +245,33 @@ fn with_several_samples_a_pixel_the_mixed_pixels_are_left_out_of_black_where_lit
             (0.0..=1.0).contains(&b) && (0.0..=1.0).contains(&all),
             "{r}"
         );
+        // `diff` on the same renders with the map gives both figures.
+        let at = |f: &str| {
+            let p = out.join("renders").join("main").join(f);
+            p.to_str().expect("utf-8").to_string()
+        };
+        let image = format!("{}-16.exr", r["mode"].as_str().expect("mode"));
+        let printed = stdout(&visgate(&[
+            "diff",
+            &at(&image),
+            &at("reference-16.exr"),
+            "--direct",
+            &at("direct-cpu.exr"),
+            "--image-direct",
+            &at("direct-gpu.exr"),
+            "--mixed",
+            &at("mixed.png"),
+        ]));
+        close(
+            b * 100.0,
+            figure(&printed, "black where lit"),
+            "black where lit",
+        );
+        let every = printed
+            .split("left out; ")
+            .nth(1)
+            .expect("every pixel's share");
+        close(all * 100.0, figure(every, ""), "over every pixel");
     }
 }
 
