@@ -268,7 +268,8 @@ pub fn mixed_pixels(tracer: &Tracer, view: &View, spp: u32) -> Vec<bool> {
         (0..spp).any(|s| match (centre, hit(sample(s, spp))) {
             (None, None) => false,
             (Some(a), Some(b)) => {
-                let (lo, hi) = (albedo(&a).min(albedo(&b)), albedo(&a).max(albedo(&b)));
+                let (pa, pb) = (albedo(&a), albedo(&b));
+                let (lo, hi) = (pa.min(pb), pa.max(pb));
                 a.geometric_normal.dot(b.geometric_normal) < SAME_SURFACE_COS
                     || a.geometric_normal.dot(b.position - a.position).abs()
                         > SAME_SURFACE_DEPTH * a.t
