@@ -503,6 +503,11 @@ pub fn run_compare(args: CompareArgs) -> Result<()> {
             f.mode, f.vpls, f.camera, f.error
         );
     }
+    for r in &report.references {
+        if let Some(w) = &r.warning {
+            eprintln!("warning: camera {} at {} VPLs: {w}", r.camera, r.vpls);
+        }
+    }
     for a in &report.answers {
         println!("{}: {}", a.kind, a.text);
     }

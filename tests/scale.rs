@@ -6,7 +6,9 @@
 #[path = "../runtime/tests/common/mod.rs"]
 mod common;
 
+use glam::Vec3;
 use visgate_formats::vgate::BakeParams;
+use visgate_formats::{Camera, Light, Scene};
 use visgate_preprocess::bake::{BakeOptions, bake};
 use visgate_runtime::cpu::gates::GateLevel;
 use visgate_runtime::gpu::{METHODS, MethodSettings};
@@ -16,7 +18,31 @@ use visgate_runtime::metrics::errors;
 
 /// Every method's image of the four rooms scaled by `s`, the reference's last.
 fn images_at(s: f32, source: VplSource) -> Vec<(String, HdrImage)> {
-    let (scene, cam) = common::scaled_four_rooms(s);
+    images_placed(s, Vec3::ZERO, source)
+}
+
+/// The four rooms scaled by `s` and then moved by `offset` (metres).
+fn placed_four_rooms(s: f32, offset: Vec3) -> (Scene, Camera) {
+    let (mut scene, _) = common::scaled_four_rooms(s);
+    for m in &mut scene.meshes {
+        m.positions.iter_mut().for_each(|p| *p += offset);
+    }
+    for l in &mut scene.lights {
+        let (Light::Point { position, .. } | Light::Spot { position, .. }) = l;
+        *position += offset;
+    }
+    for c in &mut scene.cameras {
+        c.eye += offset;
+        c.target += offset;
+    }
+    let cam = scene.cameras.first().cloned().expect("a camera");
+    (scene, cam)
+}
+
+/// Every method's image of the four rooms scaled by `s` and moved by `offset`, the
+/// reference's last.
+fn images_placed(s: f32, offset: Vec3, source: VplSource) -> Vec<(String, HdrImage)> {
+    let (scene, cam) = placed_four_rooms(s, offset);
     let level = bake(
         &scene,
         &BakeParams::default(),
@@ -92,6 +118,29 @@ fn assert_same_at_every_scale(source: VplSource, scales: &[f32]) {
 #[test]
 fn every_method_gives_the_same_image_at_scales_1e_3_to_1e4_with_light_paths() {
     assert_same_at_every_scale(VplSource::Paths, &[1e-3, 1e-2, 0.1, 10.0, 100.0, 1e3, 1e4]);
+}
+
+#[test]
+fn every_method_gives_the_same_image_kilometres_from_the_origin() {
+    let one = images_at(1.0, VplSource::Paths);
+    for offset in [
+        Vec3::new(2500.0, 10.0, -800.0),
+        Vec3::new(-9000.0, 300.0, 7000.0),
+    ] {
+        for ((name, img), (_, want)) in images_placed(1.0, offset, VplSource::Paths)
+            .iter()
+            .zip(&one)
+        {
+            let e = errors(img, want).expect("same size");
+            eprintln!(
+                "{name} at {offset}: rel. MSE {:.3e}, mean {}",
+                e.rel_mse,
+                img.mean()
+            );
+            assert!(want.mean().x > 0.0, "{name}: a black image proves nothing");
+            assert!(e.rel_mse < 1e-3, "{name} at {offset}: {e:?}");
+        }
+    }
 }
 
 #[test]

@@ -22,6 +22,7 @@ pub mod geom;
 pub mod import;
 pub mod load;
 pub mod mitsuba;
+pub mod placement;
 pub mod scene;
 pub mod vgate;
 

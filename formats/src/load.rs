@@ -451,6 +451,10 @@ impl Scene {
                 file: file.to_path_buf(),
             });
         }
+        for w in crate::placement::far_placements(&scene, desc) {
+            tracing::warn!("{}: {w}", file.display());
+            scene.report.warnings.push(w);
+        }
         Ok(scene)
     }
 }

@@ -74,6 +74,7 @@ pub(super) fn camera_rows(
             mixed_share: mixed.iter().filter(|&&m| m).count() as f64 / mixed.len().max(1) as f64,
             mixed_map: mixed_map.clone(),
             image: path_string(&rel.with_extension("png")),
+            warning: super::report::reference_warning(vpls, kept.vpl_count, &reference),
         });
         for (k, (m, own)) in spec.modes.iter().zip(&own_direct).enumerate() {
             if let Some(row) = same_frame(&report.rows, &spec.modes[..k], m, &camera.name, vpls) {

@@ -218,6 +218,9 @@ pub struct ReferenceRow {
     pub mixed_map: Option<String>,
     /// The image, relative to the report.
     pub image: String,
+    /// Why the comparison proves nothing, where it does not: no light path met the geometry,
+    /// or the reference is black.
+    pub warning: Option<String>,
 }
 
 /// A render that failed (the run goes on).

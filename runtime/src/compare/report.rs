@@ -6,6 +6,7 @@ use std::path::Path;
 
 use super::{CompareReport, ReferenceRow, Row};
 use crate::RenderError;
+use crate::hdr::HdrImage;
 
 /// The Pareto plot's file in the folder.
 pub const PLOT: &str = "pareto.png";
@@ -83,7 +84,29 @@ fn reference_text(rf: &ReferenceRow) -> String {
             rf.mixed_share * 100.0
         );
     }
+    if let Some(w) = &rf.warning {
+        t += &format!(". **Warning**: {w}");
+    }
     t
+}
+
+/// What a user must read about a reference of `vpls` light paths that made `vpl_count` VPLs:
+/// with none, or with a black image, every method matches it to the digit and the figures
+/// prove nothing (a scene whose lights or camera were written in the wrong units).
+pub(super) fn reference_warning(vpls: u32, vpl_count: usize, image: &HdrImage) -> Option<String> {
+    if vpls > 0 && vpl_count == 0 {
+        return Some(format!(
+            "no light path from the scene's lights met the geometry (0 VPLs of {vpls} asked): \
+             there is no indirect light to compare, and every method matches this reference to \
+             the digit. Is each light inside the level? (A scene file's positions are in its \
+             units, `metres_per_unit`.)"
+        ));
+    }
+    (image.mean().max_element() <= 0.0).then(|| {
+        "the reference is black: nothing lit is in view, so every error is 0 and proves \
+         nothing. Is the camera inside the level, facing lit geometry?"
+            .to_string()
+    })
 }
 
 /// The cells of a row's line, in [`HEADER`]'s order (the last only with ground truth).
@@ -387,4 +410,24 @@ fn html(r: &CompareReport) -> String {
         h += "</ul>";
     }
     h + "</body></html>\n"
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_reference_without_light_paths_or_light_is_said_to_prove_nothing() {
+        let mut lit = HdrImage::new(4, 3);
+        lit.pixels
+            .iter_mut()
+            .for_each(|p| *p = glam::Vec3::splat(0.2));
+        assert_eq!(reference_warning(256, 250, &lit), None);
+        // Direct light alone (no VPLs asked) is a fair reference.
+        assert_eq!(reference_warning(0, 0, &lit), None);
+        let w = reference_warning(256, 0, &lit).expect("no path met the geometry");
+        assert!(w.contains("0 VPLs of 256 asked"), "{w}");
+        let w = reference_warning(256, 250, &HdrImage::new(4, 3)).expect("black");
+        assert!(w.starts_with("the reference is black"), "{w}");
+    }
 }

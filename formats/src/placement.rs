@@ -1,0 +1,170 @@
+//! Lights and cameras far from the level. A scene TOML's positions are in its own units
+//! (`metres_per_unit`), so a level modelled in centimetres with its lights written in metres
+//! puts every light a hundredth of the way to the origin: the renders are black, no light
+//! path meets the geometry, and every method agrees with the black reference to the digit.
+//! Nothing fails; the scene says so when it is read instead.
+
+use glam::{DVec3, Vec3};
+
+use crate::desc::{LightDesc, SceneDesc};
+use crate::scene::{Scene, SceneSpace};
+
+/// How far outside the static geometry's box a light or a camera may stand before it is
+/// named, in the box's diagonals: a lamp outside a window or a camera looking at a building
+/// from across the street stand within one. [Units: ratio]
+pub const FAR_DIAGONALS: f32 = 1.0;
+
+/// Distance from `p` to the box `lo..hi` (0 inside).
+fn outside_by(p: Vec3, (lo, hi): (Vec3, Vec3)) -> f32 {
+    (lo - p).max(p - hi).max(Vec3::ZERO).length()
+}
+
+/// A warning for each light and camera of `scene` (as assembled from `desc`) that lies more
+/// than [`FAR_DIAGONALS`] of the static geometry's box outside it, with its position in metres
+/// and in the file's units, and what it would be read as had it been written in metres.
+pub fn far_placements(scene: &Scene, desc: &SceneDesc) -> Vec<String> {
+    let Some(bounds) = scene.static_bounds().or_else(|| scene.bounds()) else {
+        return Vec::new();
+    };
+    let diagonal = (bounds.1 - bounds.0).length();
+    let space = SceneSpace::new(desc.up, desc.metres_per_unit);
+    let lights = desc.lights.iter().enumerate().map(|(i, l)| {
+        let (kind, at) = match l {
+            LightDesc::Point(p) => ("point", p.position),
+            LightDesc::Spot(s) => ("spot", s.position),
+        };
+        (format!("{kind} light {i}"), at)
+    });
+    let cameras = desc
+        .cameras
+        .iter()
+        .map(|c| (format!("camera '{}'", c.name), c.eye));
+    lights
+        .chain(cameras)
+        .filter_map(|(what, units)| {
+            let p = space.point(units);
+            let off = outside_by(p, bounds);
+            (off > FAR_DIAGONALS * diagonal).then(|| far_warning(scene, desc, &what, units, off))
+        })
+        .collect()
+}
+
+/// The warning for `what`, written at `units`, `off` metres outside the level.
+fn far_warning(scene: &Scene, desc: &SceneDesc, what: &str, units: [f64; 3], off: f32) -> String {
+    let space = SceneSpace::new(desc.up, desc.metres_per_unit);
+    let (lo, hi) = scene
+        .static_bounds()
+        .or_else(|| scene.bounds())
+        .unwrap_or_default();
+    let p = space.point(units);
+    let mut out = format!(
+        "{what} at ({:.2}, {:.2}, {:.2}) m stands {off:.1} m outside the level (its geometry spans \
+         ({:.2}, {:.2}, {:.2}) .. ({:.2}, {:.2}, {:.2}) m)",
+        p.x, p.y, p.z, lo.x, lo.y, lo.z, hi.x, hi.y, hi.z
+    );
+    let mpu = desc.metres_per_unit;
+    if mpu != 1.0 {
+        // Had the numbers been written in metres, they would be these units.
+        let as_units = DVec3::from(units) / mpu;
+        let inside = outside_by(space.point(as_units.to_array()), (lo, hi)) == 0.0;
+        out += &format!("; a scene file's positions are in its units (metres_per_unit = {mpu})");
+        if inside {
+            out += &format!(
+                ", so if ({}) are metres, write ({}) to put it inside",
+                fmt3(DVec3::from(units)),
+                fmt3(as_units)
+            );
+        }
+    }
+    out
+}
+
+/// A point's coordinates, trimmed.
+fn fmt3(p: DVec3) -> String {
+    p.to_array()
+        .map(|c| format!("{}", (c * 1e4).round() / 1e4))
+        .join(", ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::import::{ImportedModel, RawMesh};
+    use std::path::Path;
+
+    /// A 8 × 3 × 4 m room 2.5 km from the origin, modelled in centimetres, with a light and a
+    /// camera written at `light` and `eye` (file units).
+    fn scene(light: [f64; 3], eye: [f64; 3]) -> (Scene, SceneDesc) {
+        let o = DVec3::new(250_000.0, 1_000.0, -80_000.0);
+        let corners: Vec<Vec3> = (0..8)
+            .map(|i| {
+                let c = DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, (i >> 2) as f64);
+                (o + c * DVec3::new(800.0, 300.0, 400.0)).as_vec3()
+            })
+            .collect();
+        let model = ImportedModel {
+            meshes: vec![RawMesh {
+                name: "room".into(),
+                positions: corners,
+                normals: vec![],
+                uvs: vec![],
+                triangles: vec![[0, 1, 3], [0, 3, 2], [4, 6, 7], [4, 7, 5]],
+                material: 0,
+            }],
+            materials: vec![crate::Material {
+                name: "wall".into(),
+                albedo: Vec3::splat(0.5),
+                texture: None,
+            }],
+            ..ImportedModel::default()
+        };
+        let text = format!(
+            "metres_per_unit = 0.01\n[[mesh]]\npath = \"room.obj\"\n\
+             [[light]]\ntype = \"point\"\nposition = {light:?}\nintensity = [1, 1, 1]\n\
+             [[camera]]\nname = \"door\"\neye = {eye:?}\ntarget = [250400.0, 1100.0, -79800.0]\nfov_deg = 75\n"
+        );
+        let desc = SceneDesc::from_toml(&text, Path::new("room.toml")).expect("desc");
+        let scene = Scene::assemble(&desc, vec![model], Path::new("room.toml")).expect("scene");
+        (scene, desc)
+    }
+
+    #[test]
+    fn positions_written_in_metres_in_a_centimetre_scene_are_named_with_the_fix() {
+        // Written in metres: both a hundredth of the way to the origin.
+        let (s, d) = scene([2506.5, 12.2, -798.8], [2500.6, 11.6, -799.6]);
+        let w = far_placements(&s, &d);
+        assert_eq!(w.len(), 2, "{w:?}");
+        assert!(
+            w[0].starts_with("point light 0 at (25.07, 0.12, -7.99) m"),
+            "{}",
+            w[0]
+        );
+        assert!(
+            w[0].contains("if (2506.5, 12.2, -798.8) are metres, write (250650, 1220, -79880)"),
+            "{}",
+            w[0]
+        );
+        assert!(w[1].starts_with("camera 'door'"), "{}", w[1]);
+        // Written in centimetres: nothing to say.
+        let (s, d) = scene(
+            [250_650.0, 1_220.0, -79_880.0],
+            [250_060.0, 1_160.0, -79_960.0],
+        );
+        assert!(far_placements(&s, &d).is_empty());
+        // A lamp outside a window, within a diagonal of the room: nothing to say either.
+        let (s, d) = scene(
+            [250_650.0, 1_220.0, -79_000.0],
+            [250_060.0, 1_160.0, -79_960.0],
+        );
+        assert!(far_placements(&s, &d).is_empty());
+        // Far, but not a units slip: named without the fix.
+        let (s, d) = scene([0.0, 0.0, 0.0], [250_060.0, 1_160.0, -79_960.0]);
+        let w = far_placements(&s, &d);
+        assert_eq!(w.len(), 1, "{w:?}");
+        assert!(
+            w[0].contains("(metres_per_unit = 0.01)") && !w[0].contains("write"),
+            "{}",
+            w[0]
+        );
+    }
+}

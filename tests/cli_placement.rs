@@ -1,0 +1,99 @@
+//! A scene whose lights and cameras were written in metres while its level is modelled in
+//! centimetres: every render was black and every method matched the black reference to the
+//! digit, with nothing said. The command line says so now, with the fix.
+
+mod support;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use support::stderr;
+
+/// `visgate ARGS` with warnings shown, as a user sees them.
+fn visgate_warn(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_visgate"))
+        .args(args)
+        .env("RUST_LOG", "warn")
+        .output()
+        .expect("runs visgate")
+}
+
+/// A closed 4 × 3 × 4 m room modelled in centimetres 1 km along x from the origin, with a
+/// lamp and a camera at its middle written as `light` and `eye` (in the file's units).
+fn room_in_centimetres(dir: &Path, light: [f64; 3], eye: [f64; 3]) -> PathBuf {
+    let c = |x: f64, y: f64, z: f64| [100_000.0 + 400.0 * x, 300.0 * y, 400.0 * z];
+    let corners: Vec<[f64; 3]> = (0..8)
+        .map(|i| c((i & 1) as f64, ((i >> 1) & 1) as f64, (i >> 2) as f64))
+        .collect();
+    let mut obj: String = corners
+        .iter()
+        .map(|p| format!("v {} {} {}\n", p[0], p[1], p[2]))
+        .collect();
+    // Its six faces (corner index bits: x, y, z; 1-based).
+    obj += "f 1 5 7 3\nf 2 4 8 6\nf 1 2 6 5\nf 3 7 8 4\nf 1 3 4 2\nf 5 6 8 7\n";
+    std::fs::write(dir.join("room.obj"), obj).expect("obj");
+    let toml = format!(
+        "name = \"room-cm\"\nmetres_per_unit = 0.01\n[[mesh]]\npath = \"room.obj\"\n\
+         [[light]]\ntype = \"point\"\nposition = {light:?}\nintensity = [5, 5, 5]\n\
+         [[camera]]\nname = \"middle\"\neye = {eye:?}\ntarget = [100200.0, 150.0, 0.0]\n\
+         fov_deg = 70\n"
+    );
+    let path = dir.join("room.toml");
+    std::fs::write(&path, toml).expect("toml");
+    path
+}
+
+#[test]
+fn lights_and_cameras_written_in_the_wrong_units_are_named_with_the_fix() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    // Written in metres: a hundredth of the way to the origin, 1 km from the room.
+    let scene = room_in_centimetres(dir.path(), [1002.0, 1.0, 2.0], [1002.0, 1.5, 3.0]);
+    let scene = scene.to_str().expect("utf-8");
+    let o = visgate_warn(&["inspect", scene]);
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains("point light 0 at (10.02, 0.01, 0.02) m stands")
+            && err.contains("if (1002, 1, 2) are metres, write (100200, 100, 200)")
+            && err.contains("camera 'middle' at"),
+        "{err}"
+    );
+    // The render: no light path meets the room.
+    let out = dir.path().join("x.png");
+    let args = ["render", scene, "--mode", "none", "--cpu", "--vpls", "64"];
+    let o = visgate_warn(
+        &[
+            &args[..],
+            &["--size", "16x12", "-o", out.to_str().expect("utf-8")],
+        ]
+        .concat(),
+    );
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains("no light path from the scene's lights met the geometry (0 VPLs of 64"),
+        "{err}"
+    );
+    // Written in centimetres: nothing to say, and the lamp lights the room.
+    let scene = room_in_centimetres(
+        dir.path(),
+        [100_200.0, 150.0, 200.0],
+        [100_200.0, 150.0, 300.0],
+    );
+    let scene = scene.to_str().expect("utf-8");
+    let o = visgate_warn(
+        &[
+            &args[..1],
+            &[scene],
+            &args[2..],
+            &["--size", "16x12", "-o", out.to_str().expect("utf-8")],
+        ]
+        .concat(),
+    );
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        !err.contains("outside the level") && !err.contains("no light path"),
+        "{err}"
+    );
+}
