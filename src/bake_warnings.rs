@@ -22,6 +22,7 @@ const SUGGESTED_RADIUS_VX: f64 = 6.0;
 pub fn warnings(report: &BakeReport) -> Vec<String> {
     let es = &report.empty_space;
     let mut out = inside_warnings(es);
+    out.extend(turned_faces(es));
     out.extend(most_dropped(es, &report.grid));
     out.extend(cut_off_cameras(es, &report.grid));
     let radius = report
@@ -33,6 +34,19 @@ pub fn warnings(report: &BakeReport) -> Vec<String> {
         out.extend(too_coarse(r, report.summary.clusters, &report.grid));
     }
     out
+}
+
+/// A warning where the bake read the level's faces turned, wound inside out
+/// (`visgate_preprocess::winding`).
+fn turned_faces(empty_space: &Value) -> Option<String> {
+    (empty_space["faces_turned"] == true).then(|| {
+        "the level's faces are wound inside out: its rooms see the backs of their walls (the \
+         cameras' and lights' space, or a bare mesh's enclosed inside), so the bake read every \
+         face turned to keep and drop empty space; the renders light both sides and read no \
+         winding. To have the file say what it means, reverse the faces' winding (flip the \
+         normals) in the modelling tool or the exporter"
+            .to_string()
+    })
 }
 
 /// What to say of a bare mesh's inside (kept as the level's, no camera or light named) that
@@ -308,5 +322,13 @@ mod tests {
         let unsearched = json!({ "openings": [], "inside_leaks_not_looked_for": true });
         let w = inside_warnings(&unsearched);
         assert!(w.len() == 1 && w[0].contains("up to 32 M voxels"), "{w:?}");
+    }
+
+    #[test]
+    fn faces_read_turned_are_said_with_what_to_do() {
+        assert!(turned_faces(&json!({ "faces_turned": false })).is_none());
+        assert!(turned_faces(&json!({})).is_none());
+        let w = turned_faces(&json!({ "faces_turned": true })).expect("a warning");
+        assert!(w.contains("wound inside out") && w.contains("reverse the faces' winding"));
     }
 }

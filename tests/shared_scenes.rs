@@ -148,3 +148,36 @@ fn dabrovic_sponzas_80_arcade_lights_cluster_into_fewer_as_the_minimum_distance_
         assert_eq!(counts.last().map(|c| c.1), Some(1));
     }
 }
+
+#[test]
+fn levels_wound_inside_out_bake_as_written() {
+    use visgate_formats::vgate::{BakeParams, Resolution};
+    use visgate_preprocess::bake::{BakeOptions, Baked, bake};
+    let Some(dir) = shared_scenes() else { return };
+    let params = BakeParams {
+        resolution: Resolution::LongestAxisVoxels(128),
+        ..BakeParams::default()
+    };
+    let bake_it = |s: &Scene| bake(s, &params, &BakeOptions::default(), &|_| {}).expect("bake");
+    let said = |b: &Baked| b.report.empty_space["faces_turned"] == true;
+    // The bare OBJs, as `visgate bake FILE` reads them (no camera, no light): e2m3's void
+    // wraps its rooms; Crytek Sponza's rooms are open to the sky.
+    for file in ["librequake_e2m3/e2m3.obj", "crytek_sponza/sponza.obj"] {
+        let written = load(&dir.join(file));
+        let mut turned = written.clone();
+        for m in &mut turned.meshes {
+            m.triangles.iter_mut().for_each(|t| t.swap(1, 2));
+        }
+        let (w, t) = (bake_it(&written), bake_it(&turned));
+        println!(
+            "{file} at 128: {} / {} clusters, faces turned {} / {}",
+            w.level.topology.clusters.len(),
+            t.level.topology.clusters.len(),
+            said(&w),
+            said(&t)
+        );
+        // Read as written, e2m3's void was kept and its rooms dropped.
+        assert!(!said(&w) && said(&t), "{file}");
+        assert!(w.level.voxel_cluster == t.level.voxel_cluster, "{file}");
+    }
+}

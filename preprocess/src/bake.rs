@@ -341,6 +341,7 @@ pub fn bake(
             "inside_leaks_not_looked_for": inside_unlocated,
             "hung_objects": es.threads,
             "seeds_outside_grid": es.seeds_outside,
+            "faces_turned": es.faces_turned,
         }),
         gate_placements: placements,
     };
@@ -625,6 +626,7 @@ mod tests {
             inside_at_bounds: at_bounds,
             threads: Vec::new(),
             seeds_outside: Vec::new(),
+            faces_turned: false,
         };
         let point = |r: (Option<Inside>, Vec<crate::leak::LeakPath>, bool)| {
             (r.0.map(|s| s.position_m), r.2)

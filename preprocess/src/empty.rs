@@ -18,6 +18,7 @@
 //! skeleton then bends around the object. Each thread is listed (object size, length).
 
 use glam::Vec3;
+use rayon::prelude::*;
 use serde::Serialize;
 use visgate_formats::vgate::GridMeta;
 
@@ -123,6 +124,9 @@ pub struct EmptySpace {
     pub threads: Vec<Thread>,
     /// Seeds that fell outside the grid or in solid with no empty voxel next to them.
     pub seeds_outside: Vec<String>,
+    /// Whether the faces were read turned, wound inside out (winding.rs); the components'
+    /// `faced_by` are then the turned faces'.
+    pub faces_turned: bool,
 }
 
 /// Finds the kept empty space of a solid grid (see the module notes).
@@ -193,12 +197,39 @@ pub fn empty_space(
         }
     }
     let bare = seeds.is_empty() && !params.closed;
-    let (faced, fronts) = facing(meta, solid, &comps, triangles, bare);
+    let Facing {
+        mut faced,
+        mut fronts,
+        backs,
+    } = facing(meta, solid, &comps, triangles);
     // A scene that names no camera and no light (a bare mesh): the level's inside keeps its
-    // component, as a camera would (inside.rs).
-    let inside_component = bare
-        .then(|| crate::inside::inside_component(&fronts, &voxels))
-        .flatten();
+    // component, as a camera would (inside.rs). Faces wound inside out are read turned
+    // (winding.rs).
+    let (inside_component, faces_turned) = if bare {
+        let is_empty = |i: usize| empty[i];
+        let votes = crate::winding::Votes {
+            faced: &faced,
+            fronts: &fronts,
+            backs: &backs,
+            at_bounds: &at_bounds,
+        };
+        crate::winding::bare_inside(meta, &comps, &votes, &voxels, &is_empty)
+    } else {
+        let seeded: Vec<bool> = seeds_in.iter().map(|s| !s.is_empty()).collect();
+        let votes = crate::winding::Votes {
+            faced: &faced,
+            fronts: &fronts,
+            backs: &backs,
+            at_bounds: &at_bounds,
+        };
+        (None, crate::winding::rooms_turned(&votes, &seeded))
+    };
+    if faces_turned {
+        faced.iter_mut().for_each(|f| f.swap(0, 1));
+        if bare {
+            fronts = backs;
+        }
+    }
     // Only where the inside reaches the bounds (a sealed level's inside needs no point), one
     // distance field for its point and its leaks (the border ring open: a voxel by a window to
     // the void is wide, but its rays escape).
@@ -233,9 +264,14 @@ pub fn empty_space(
                 (
                     true,
                     format!(
-                        "{INSIDE}: the most triangles face it ({} of them; no camera or light \
-                         named){point}",
-                        fronts[c]
+                        "{INSIDE}: the most triangles face it ({} of them{}; no camera or \
+                         light named){point}",
+                        fronts[c],
+                        if faces_turned {
+                            ", their faces turned"
+                        } else {
+                            ""
+                        }
                     ),
                 )
             } else if params.closed && at_bounds[c] {
@@ -346,6 +382,7 @@ pub fn empty_space(
         inside_at_bounds,
         threads,
         seeds_outside,
+        faces_turned,
     })
 }
 
@@ -398,46 +435,72 @@ fn leaks_by_side(meta: &GridMeta, empty: &[bool]) -> Vec<Leak> {
 
 /// Which side of each triangle each of `comps`' components lies on (`[front, back]`
 /// counts), sampled 0.75 voxel off the triangle's centroid along its normal and against it;
-/// and, for a bare mesh (`bare`), the triangles that face each component seen from the first
-/// voxel off the centroid that is not solid (0.75, 1.5 or 2.25 voxels along the normal): a
-/// wall that lies on a voxel boundary is voxelized into the layers on both sides of it, so
-/// 0.75 voxel off it is its own solid and the first count gives it to no side.
+/// and the triangles whose front and whose back face each component
+/// seen from the first voxel off the centroid that is not solid (0.75, 1.5 or 2.25 voxels along
+/// the normal or against it): a wall that lies on a voxel boundary is voxelized into the layers
+/// on both sides of it, so 0.75 voxel off it is its own solid and the first count gives it to
+/// no side.
 fn facing(
     meta: &GridMeta,
     solid: &[bool],
     comps: &crate::neighbourhood::Components,
     triangles: &[[Vec3; 3]],
-    bare: bool,
-) -> (Vec<[u64; 2]>, Vec<u64>) {
+) -> Facing {
     let n = comps.count as usize;
-    let mut faced = vec![[0u64; 2]; n];
-    let mut fronts = vec![0u64; if bare { n } else { 0 }];
     let vs = meta.voxel_size_m;
     let label_at = |p: Vec3| {
         let i = meta.index(meta.world_to_voxel(p.to_array())?);
         Some((solid[i], comps.label(i)))
     };
-    for t in triangles {
+    // Per component: [faced front, faced back, first open front, first open back], summed
+    // over chunks of triangles in parallel (integer sums: the same in any order).
+    let count = |mut acc: Vec<[u64; 4]>, t: &[Vec3; 3]| {
         let nrm = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
         if nrm == Vec3::ZERO {
-            continue;
+            return acc;
         }
         let c = (t[0] + t[1] + t[2]) / 3.0;
         for (side, dir) in [(0, nrm), (1, -nrm)] {
-            if let Some((_, Some(l))) = label_at(c + dir * (0.75 * vs)) {
-                faced[l as usize][side] += 1;
+            let near = label_at(c + dir * (0.75 * vs));
+            if let Some((_, Some(l))) = near {
+                acc[l as usize][side] += 1;
             }
-        }
-        if bare {
-            let first_open = [0.75, 1.5, 2.25]
-                .into_iter()
-                .find_map(|k| label_at(c + nrm * (k * vs)).filter(|&(s, _)| !s));
+            let first_open = std::iter::once(near)
+                .chain([1.5, 2.25].map(|k| label_at(c + dir * (k * vs))))
+                .find_map(|x| x.filter(|&(s, _)| !s));
             if let Some((_, Some(l))) = first_open {
-                fronts[l as usize] += 1;
+                acc[l as usize][2 + side] += 1;
             }
         }
+        acc
+    };
+    let sums = triangles
+        .par_chunks(8192)
+        .map(|chunk| chunk.iter().fold(vec![[0u64; 4]; n], count))
+        .reduce(
+            || vec![[0u64; 4]; n],
+            |mut a, b| {
+                for (x, y) in a.iter_mut().zip(&b) {
+                    *x = std::array::from_fn(|k| x[k] + y[k]);
+                }
+                a
+            },
+        );
+    Facing {
+        faced: sums.iter().map(|s| [s[0], s[1]]).collect(),
+        fronts: sums.iter().map(|s| s[2]).collect(),
+        backs: sums.iter().map(|s| s[3]).collect(),
     }
-    (faced, fronts)
+}
+
+/// What [`facing`] counts.
+struct Facing {
+    /// Per component, the triangles whose front and whose back lie on its side.
+    faced: Vec<[u64; 2]>,
+    /// Per component, the triangles whose front faces it from their first open voxel.
+    fronts: Vec<u64>,
+    /// Per component, the triangles whose back faces it from their first open voxel.
+    backs: Vec<u64>,
 }
 
 /// Hangs every solid 6-component that does not reach the grid border (see module notes).

@@ -42,6 +42,7 @@ pub mod stages;
 pub mod thin;
 mod thin_next;
 pub mod voxelize;
+pub mod winding;
 
 /// Everything that can stop a bake.
 #[derive(Debug, thiserror::Error)]
