@@ -99,19 +99,29 @@ fn images_placed(s: f32, offset: Vec3, source: VplSource) -> Vec<(String, HdrIma
         .collect()
 }
 
+/// Each method's image in `got` within a relative MSE of 1e-3 of its image in `want` (which
+/// must not be black); `at` says where `got` was rendered.
+fn assert_same(got: &[(String, HdrImage)], want: &[(String, HdrImage)], at: &str) {
+    for ((name, img), (_, want)) in got.iter().zip(want) {
+        let e = errors(img, want).expect("same size");
+        eprintln!(
+            "{name} {at}: rel. MSE {:.3e}, mean {}",
+            e.rel_mse,
+            img.mean()
+        );
+        assert!(want.mean().x > 0.0, "{name}: a black image proves nothing");
+        assert!(e.rel_mse < 1e-3, "{name} {at}: {e:?}");
+    }
+}
+
 fn assert_same_at_every_scale(source: VplSource, scales: &[f32]) {
     let one = images_at(1.0, source);
     for &s in scales {
-        for ((name, img), (_, want)) in images_at(s, source).iter().zip(&one) {
-            let e = errors(img, want).expect("same size");
-            eprintln!(
-                "{source:?} {name} at scale {s}: rel. MSE {:.3e}, mean {}",
-                e.rel_mse,
-                img.mean()
-            );
-            assert!(want.mean().x > 0.0, "{name}: a black image proves nothing");
-            assert!(e.rel_mse < 1e-3, "{source:?} {name} at scale {s}: {e:?}");
-        }
+        assert_same(
+            &images_at(s, source),
+            &one,
+            &format!("{source:?} at scale {s}"),
+        );
     }
 }
 
@@ -127,19 +137,8 @@ fn every_method_gives_the_same_image_kilometres_from_the_origin() {
         Vec3::new(2500.0, 10.0, -800.0),
         Vec3::new(-9000.0, 300.0, 7000.0),
     ] {
-        for ((name, img), (_, want)) in images_placed(1.0, offset, VplSource::Paths)
-            .iter()
-            .zip(&one)
-        {
-            let e = errors(img, want).expect("same size");
-            eprintln!(
-                "{name} at {offset}: rel. MSE {:.3e}, mean {}",
-                e.rel_mse,
-                img.mean()
-            );
-            assert!(want.mean().x > 0.0, "{name}: a black image proves nothing");
-            assert!(e.rel_mse < 1e-3, "{name} at {offset}: {e:?}");
-        }
+        let got = images_placed(1.0, offset, VplSource::Paths);
+        assert_same(&got, &one, &format!("at {offset}"));
     }
 }
 
