@@ -214,6 +214,15 @@ fn ajar_door_and_pillared_hall_keep_their_loops_and_side_rooms() {
 }
 
 #[test]
+fn the_sun_window_keeps_the_ajar_door_s_answers_with_its_lamp_outside() {
+    // Its only lamp stands outside the grid: the rooms are kept by the faces' votes, and the
+    // window, open onto the grid's border, adds no loop.
+    for res in [64, 128] {
+        check_known_answers(Builtin::SunWindow, res, true);
+    }
+}
+
+#[test]
 fn rebaking_is_byte_identical_for_any_thread_count() {
     let scene = Builtin::FourRooms.scene().expect("scene");
     let bytes = |threads: usize| {

@@ -98,11 +98,14 @@ pub enum Builtin {
     /// The pillared hall lit by 51 lamps: a row of 24 on each side of the columns, one in each
     /// side room (LightCluster's many lights).
     LampHall,
+    /// The ajar door's two rooms with a window to the void, lit by a lamp outside it: most light
+    /// paths leave the level, the rest come in through the window.
+    SunWindow,
 }
 
 impl Builtin {
     /// Every built-in scene.
-    pub const ALL: [Builtin; 9] = [
+    pub const ALL: [Builtin; 10] = [
         Builtin::EmptyBox,
         Builtin::TwoRooms,
         Builtin::RingCorridor,
@@ -112,6 +115,7 @@ impl Builtin {
         Builtin::AjarDoor,
         Builtin::PillaredHall,
         Builtin::LampHall,
+        Builtin::SunWindow,
     ];
 
     /// The name used on the command line (`builtin:NAME`).
@@ -126,6 +130,7 @@ impl Builtin {
             Builtin::AjarDoor => "ajar-door",
             Builtin::PillaredHall => "pillared-hall",
             Builtin::LampHall => "lamp-hall",
+            Builtin::SunWindow => "sun-window",
         }
     }
 
@@ -147,6 +152,9 @@ impl Builtin {
                 "a 16 x 4 x 5 m hall with six 0.6 m columns and three 4 x 4 m side rooms"
             }
             Builtin::LampHall => "the pillared hall lit by 51 lamps (two rows of 24, one a room)",
+            Builtin::SunWindow => {
+                "the ajar door's rooms with a window to the void, lit from outside"
+            }
         }
     }
 
@@ -185,7 +193,7 @@ impl Builtin {
                 cbox(57, 67, 0, 21, 40, 42),
             ],
             Builtin::PillaredHall | Builtin::LampHall => pillared_hall(),
-            Builtin::CornellBox | Builtin::AjarDoor => return None,
+            Builtin::CornellBox | Builtin::AjarDoor | Builtin::SunWindow => return None,
         };
         Some(BoxLevel {
             cell_m: CELL_M,
@@ -205,7 +213,7 @@ impl Builtin {
                     max_m: b.max.map(|c| c as f32 * CELL_M),
                 })
                 .collect(),
-            None if self == Builtin::AjarDoor => vec![
+            None if matches!(self, Builtin::AjarDoor | Builtin::SunWindow) => vec![
                 Opening {
                     min_m: [0.0, 0.0, 0.0],
                     max_m: [4.0, 3.0, 4.0],
@@ -295,7 +303,8 @@ impl Builtin {
                 rooms: vec![],
                 note: "one room, made only quasi-convex by the two boxes resting on the floor; no loop (the boxes touch the floor)",
             },
-            Builtin::AjarDoor => KnownAnswers {
+            // The window opens onto the grid's border: no loop, no component more.
+            Builtin::AjarDoor | Builtin::SunWindow => KnownAnswers {
                 components: 1,
                 cycles: 3,
                 clusters: [3, 12],
@@ -411,6 +420,23 @@ impl Builtin {
                     },
                 ],
             ),
+            // A lamp 1.2 m outside the window and above it, lighting room B's floor through it
+            // (the window: quads::SUN_WINDOW); the cameras in room A looking at the door wall,
+            // and in room B looking at the lit floor.
+            Builtin::SunWindow => (
+                false,
+                vec![point([6.0, 2.8, 5.2], 40.0)],
+                vec![
+                    CameraDesc {
+                        name: "door".into(),
+                        ..camera([0.4, 1.6, 0.5], [4.0, 1.0, 2.2], 75.0)
+                    },
+                    CameraDesc {
+                        name: "window".into(),
+                        ..camera([4.6, 1.7, 0.4], [6.2, 0.2, 3.2], 75.0)
+                    },
+                ],
+            ),
             // One lamp in each side room (the rows are light lines); the cameras of the
             // pillared hall, and one along the south row.
             Builtin::LampHall => (
@@ -519,6 +545,9 @@ impl Builtin {
         match (self, self.level()) {
             (_, Some(level)) => Ok(generated(level.meshes(), &MATERIALS)),
             (Builtin::AjarDoor, None) => Ok(generated(quads::ajar_door(), &quads::QUAD_MATERIALS)),
+            (Builtin::SunWindow, None) => {
+                Ok(generated(quads::sun_window(), &quads::QUAD_MATERIALS))
+            }
             _ => import_obj_str(Path::new("CornellBox-Original.obj"), CORNELL_OBJ, |lib| {
                 (lib == Path::new("CornellBox-Original.mtl")).then(|| CORNELL_MTL.to_string())
             }),

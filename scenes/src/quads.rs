@@ -135,6 +135,20 @@ impl QuadBuilder {
 /// A has a table (1.2 × 0.8 m top, 4 cm thick, at 0.76 m, on four 5 cm legs) and a red wall at
 /// z = 4 m.
 pub fn ajar_door() -> Vec<RawMesh> {
+    two_rooms(false)
+}
+
+/// The window of [`sun_window`] in room B's z = 4 m wall: x from / to, y from / to. [Units: m]
+pub const SUN_WINDOW: [f32; 4] = [5.5, 6.5, 1.0, 2.2];
+
+/// The sun-window level: [`ajar_door`]'s two rooms with a 1 × 1.2 m window to the void in room
+/// B's z = 4 m wall ([`SUN_WINDOW`]), for a light standing outside it.
+pub fn sun_window() -> Vec<RawMesh> {
+    two_rooms(true)
+}
+
+/// The ajar door's two rooms, with the sun window or without.
+fn two_rooms(window: bool) -> Vec<RawMesh> {
     let mut b = QuadBuilder::default();
     let (w, h, d) = (8.0f32, 3.0f32, 4.0f32);
     b.rect(Mat::Floor, 1, 0.0, [0.0, 0.0], [d, w], true);
@@ -144,7 +158,15 @@ pub fn ajar_door() -> Vec<RawMesh> {
     b.rect(Mat::Wall, 0, w, [0.0, 0.0], [h, d], false);
     b.rect(Mat::Wall, 2, 0.0, [0.0, 0.0], [w, h], true);
     b.rect(Mat::Red, 2, d, [0.0, 0.0], [4.0, h], false);
-    b.rect(Mat::Wall, 2, d, [4.0, 0.0], [w, h], false);
+    if window {
+        let [x0, x1, y0, y1] = SUN_WINDOW;
+        b.rect(Mat::Wall, 2, d, [4.0, 0.0], [x0, h], false);
+        b.rect(Mat::Wall, 2, d, [x1, 0.0], [w, h], false);
+        b.rect(Mat::Wall, 2, d, [x0, 0.0], [x1, y0], false);
+        b.rect(Mat::Wall, 2, d, [x0, y1], [x1, h], false);
+    } else {
+        b.rect(Mat::Wall, 2, d, [4.0, 0.0], [w, h], false);
+    }
     // The dividing wall at x = 4, facing room A (−x): beside and above the doorway.
     let (z0, z1, top) = (1.5f32, 2.5f32, 2.1f32);
     b.rect(Mat::Wall, 0, 4.0, [0.0, 0.0], [h, z0], false);

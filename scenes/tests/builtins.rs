@@ -22,7 +22,8 @@ fn every_builtin_loads_with_a_camera_and_a_light_inside_its_empty_space() {
             b.name()
         );
         let boxes = b.empty_boxes_m();
-        for l in &scene.lights {
+        // An open scene may be lit from outside, through a window (sun-window).
+        for l in scene.lights.iter().filter(|_| b != Builtin::SunWindow) {
             let (Light::Point { position, .. } | Light::Spot { position, .. }) = *l;
             assert!(
                 inside(position, &boxes),
@@ -58,7 +59,10 @@ fn vector_area(scene: &Scene) -> DVec3 {
 fn generated_levels_are_closed_surfaces_with_the_stated_floor_area() {
     for b in Builtin::ALL {
         // Single-sided walls: neither closed nor two-faced (by design).
-        if matches!(b, Builtin::CornellBox | Builtin::AjarDoor) {
+        if matches!(
+            b,
+            Builtin::CornellBox | Builtin::AjarDoor | Builtin::SunWindow
+        ) {
             continue;
         }
         let scene = b.scene().expect("loads");
@@ -223,4 +227,27 @@ fn the_ajar_door_level_has_zero_thickness_walls_and_a_door_twenty_degrees_open()
         .0;
     let angle = door_normal.z.atan2(door_normal.x).to_degrees().abs();
     assert!((angle - 20.0).abs() < 0.01, "{angle}°");
+}
+
+#[test]
+fn the_sun_window_is_lit_from_outside_through_its_window() {
+    let b = Builtin::SunWindow;
+    let scene = b.scene().expect("loads");
+    assert!(!scene.closed);
+    let [Light::Point { position, .. }] = scene.lights[..] else {
+        panic!("one point light: {:?}", scene.lights);
+    };
+    // Outside the rooms, beyond the window's wall, above the window's sill.
+    assert!(!inside(position, &b.empty_boxes_m()), "{position}");
+    let [x0, x1, y0, _] = visgate_scenes::quads::SUN_WINDOW;
+    assert!(position.z > 4.0 && (x0..=x1).contains(&position.x) && position.y > y0);
+    // The window is open: a ray from the light to room B's floor through it meets nothing
+    // in the wall's plane (no triangle of the z = 4 m wall covers the window's middle).
+    let mid = Vec3::new(0.5 * (x0 + x1), 1.6, 4.0);
+    let covered = scene.static_triangles().any(|[a, b2, c]| {
+        let z = |p: Vec3| (p.z - 4.0).abs() < 1e-6;
+        let (lo, hi) = (a.min(b2).min(c), a.max(b2).max(c));
+        z(a) && z(b2) && z(c) && (lo.x..=hi.x).contains(&mid.x) && (lo.y..=hi.y).contains(&mid.y)
+    });
+    assert!(!covered);
 }
