@@ -25,6 +25,7 @@ pub fn warnings(report: &BakeReport) -> Vec<String> {
     out.extend(turned_faces(es));
     out.extend(mixed_winding(es));
     out.extend(most_dropped(es, &report.grid));
+    out.extend(enclosed_lights(es));
     out.extend(cut_off_cameras(es, &report.grid));
     let radius = report
         .stages
@@ -150,6 +151,45 @@ fn too_coarse(radius_vx: f64, clusters: u64, grid: &GridMeta) -> Option<String> 
     })
 }
 
+/// Whether a kept part of the empty space holds lights and no camera and the triangles around
+/// it turn their backs to it: the inside of a closed mesh, such as a lamp's bulb or shade.
+fn enclosed_light_part(c: &Value) -> bool {
+    let seeds = c["seeds"].as_array().into_iter().flatten();
+    let mut seeds = seeds.filter_map(Value::as_str).peekable();
+    let lights_only = seeds.peek().is_some() && seeds.all(|s| !is_camera_seed(s));
+    let v = |k: usize| c["faced_by"][k].as_u64().unwrap_or(0);
+    c["kept"] == true && lights_only && v(1) > v(0)
+}
+
+/// A warning for each part that holds lights inside closed geometry ([`enclosed_light_part`]):
+/// they light the inside of that mesh alone (the built-in ajar door with a 20 cm box around its
+/// lamp: 8 voxels, every render black).
+fn enclosed_lights(empty_space: &Value) -> Vec<String> {
+    let comps = empty_space["components"].as_array().into_iter().flatten();
+    comps
+        .filter(|c| enclosed_light_part(c))
+        .map(|c| {
+            let lights: Vec<String> = c["seeds"]
+                .as_array()
+                .into_iter()
+                .flatten()
+                .filter_map(|s| s.as_str().map(str::to_string))
+                .collect();
+            format!(
+                "{} inside closed geometry: the {} triangles around its pocket of {} empty \
+                 voxels ({} .. {} m) turn their backs to it, so it lights that mesh's inside \
+                 alone (a lamp's bulb or shade?) and no light leaves it. Move the light out of \
+                 the mesh, or leave the mesh out of the scene's static geometry",
+                join_and(&lights),
+                c["faced_by"][1].as_u64().unwrap_or(0),
+                c["voxels"].as_u64().unwrap_or(0),
+                metres(&c["bounds_min_m"]),
+                metres(&c["bounds_max_m"])
+            )
+        })
+        .collect()
+}
+
 /// A warning for each kept part of the empty space that holds a camera and no light while
 /// another kept part holds one: sealed off from the lights at this resolution (a doorway
 /// closed by the voxels), it gets no indirect light from them under gates or the VPL modes,
@@ -171,6 +211,13 @@ fn cut_off_cameras(empty_space: &Value, grid: &GridMeta) -> Vec<String> {
         .collect();
     if !kept.iter().any(|s| s.iter().any(|x| !is_camera(x))) {
         return Vec::new(); // no light in any kept part: nothing is cut off from one
+    }
+    let lit_parts = comps.iter().filter(|c| {
+        let s = seeds(c);
+        c["kept"] == true && s.iter().any(|x| !is_camera(x))
+    });
+    if lit_parts.clone().count() > 0 && lit_parts.clone().all(enclosed_light_part) {
+        return Vec::new(); // every light is enclosed: enclosed_lights says so, not a resolution
     }
     // Twice this resolution: a doorway a voxel wide is then two.
     let res = resolution_for(grid, 1.0, 2.0);
@@ -396,5 +443,36 @@ mod tests {
         // Too few votes: nothing.
         let few = json!({ "components": [comp(&["camera 'a'"], "holds", [40, 45], true)] });
         assert!(mixed_winding(&few).is_none());
+    }
+
+    #[test]
+    fn a_light_inside_closed_geometry_is_said_and_not_taken_for_a_closed_doorway() {
+        let g = GridMeta {
+            origin_m: [0.0; 3],
+            voxel_size_m: 0.0625,
+            dims: [130, 50, 66],
+        };
+        let part = |seeds: &[&str], faced: [u64; 2], voxels: u64| {
+            json!({ "seeds": seeds, "faced_by": faced, "kept": true, "voxels": voxels,
+                    "bounds_min_m": [6.5, 2.4, 3.2], "bounds_max_m": [6.7, 2.6, 3.4] })
+        };
+        // The ajar door with a closed box around its lamp.
+        let es = json!({ "components": [
+            part(&["camera 'main'", "camera 'door'"], [49, 0], 352_888),
+            part(&["point light 0"], [0, 8], 8),
+        ]});
+        let w = enclosed_lights(&es);
+        assert!(
+            w.len() == 1 && w[0].starts_with("point light 0 is inside closed geometry: the 8"),
+            "{w:?}"
+        );
+        assert!(cut_off_cameras(&es, &g).is_empty());
+        // A light in a room the doorway closes at this resolution: that warning, not this one.
+        let sealed = json!({ "components": [
+            part(&["camera 'main'"], [49, 0], 352_888),
+            part(&["point light 0"], [30, 0], 40_000),
+        ]});
+        assert!(enclosed_lights(&sealed).is_empty());
+        assert_eq!(cut_off_cameras(&sealed, &g).len(), 1);
     }
 }

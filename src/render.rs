@@ -329,6 +329,14 @@ fn print_frame(
     }
     let m = f.image.mean();
     println!("mean radiance {:.5} {:.5} {:.5}", m.x, m.y, m.z);
+    if m.max_element() <= 0.0 {
+        eprintln!(
+            "warning: the image is black: no light reaches what the camera sees (a light inside \
+             closed geometry such as a lamp's shade, a light or camera outside the level, or a \
+             camera facing away from every lit surface). `visgate bake` names lights inside \
+             closed geometry"
+        );
+    }
 }
 
 /// The output of frame `frame` of `frames`: OUT itself for one frame, else OUT's stem with a

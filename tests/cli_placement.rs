@@ -1,6 +1,7 @@
-//! A scene whose lights and cameras were written in metres while its level is modelled in
-//! centimetres: every render was black and every method matched the black reference to the
-//! digit, with nothing said. The command line says so now, with the fix.
+//! Scenes that rendered black with nothing said: lights and cameras written in metres while the
+//! level is modelled in centimetres (every method matched the black reference to the digit),
+//! and a lamp inside a closed shade (which the bake took for a doorway closed by the voxels).
+//! The command line says so now, with the fix.
 
 mod support;
 
@@ -96,4 +97,53 @@ fn lights_and_cameras_written_in_the_wrong_units_are_named_with_the_fix() {
         !err.contains("outside the level") && !err.contains("no light path"),
         "{err}"
     );
+}
+
+#[test]
+fn a_lamp_inside_a_closed_shade_is_named_by_the_bake_and_its_render_says_black() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    let o = visgate_warn(&["scenes", "export", "ajar-door", d.to_str().expect("utf-8")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // A closed 20 cm box around the lamp at (6.6, 2.5, 3.3).
+    let mut obj = std::fs::read_to_string(d.join("ajar-door.obj")).expect("obj");
+    obj += "o shade\n";
+    for i in 0..8 {
+        let s = |b: usize| if i >> b & 1 == 1 { 0.1 } else { -0.1 };
+        obj += &format!("v {} {} {}\n", 6.6 + s(0), 2.5 + s(1), 3.3 + s(2));
+    }
+    obj += "f -8 -6 -5 -7\nf -4 -3 -1 -2\nf -8 -7 -3 -4\nf -6 -2 -1 -5\nf -8 -4 -2 -6\nf -7 -5 -1 -3\n";
+    std::fs::write(d.join("ajar-door.obj"), obj).expect("obj");
+    let scene = d.join("ajar-door.toml");
+    let scene = scene.to_str().expect("utf-8");
+    let level = d.join("l.vgate");
+    let level = level.to_str().expect("utf-8");
+    // At 128 (voxels of 6.25 cm) the shade holds empty voxels; at 64 it is solid through.
+    let o = visgate_warn(&["bake", scene, "--resolution", "128", "-o", level]);
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains("point light 0 is inside closed geometry"),
+        "{err}"
+    );
+    // Not taken for a doorway the voxels close.
+    assert!(!err.contains("bake at --resolution"), "{err}");
+    let out = d.join("x.png");
+    let o = visgate_warn(&[
+        "render",
+        scene,
+        "--camera",
+        "light-room",
+        "--mode",
+        "reference",
+        "--vpls",
+        "64",
+        "--size",
+        "16x12",
+        "-o",
+        out.to_str().expect("utf-8"),
+    ]);
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(err.contains("the image is black"), "{err}");
 }

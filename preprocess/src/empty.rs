@@ -222,7 +222,9 @@ pub fn empty_space(
             backs: &backs,
             at_bounds: &at_bounds,
         };
-        (None, crate::winding::rooms_turned(&votes, &seeded))
+        let turned = crate::winding::rooms_turned(&votes, &seeded)
+            && !crate::winding::turning_drops_more(&votes, &seeded, &voxels);
+        (None, turned)
     };
     if faces_turned {
         faced.iter_mut().for_each(|f| f.swap(0, 1));

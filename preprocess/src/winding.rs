@@ -95,6 +95,22 @@ pub fn rooms_turned(v: &Votes, rooms: &[bool]) -> bool {
     by_votes && (sealed || first[1] as f64 > OPEN_RATIO * first[0] as f64)
 }
 
+/// Whether reading the faces turned would drop a sealed part (not reaching the bounds) larger
+/// than all the `rooms` together that the faces as written keep (more fronts than backs face
+/// it): then the rooms' backs are not turned faces but a closed mesh around them — a lamp
+/// inside its bulb or shade, whose 8 voxels see the backs of the shade's faces while the room
+/// around sees 49 fronts.
+pub fn turning_drops_more(v: &Votes, rooms: &[bool], voxels: &[u64]) -> bool {
+    let rooms_voxels: u64 = (0..rooms.len())
+        .filter(|&c| rooms[c])
+        .map(|c| voxels[c])
+        .sum();
+    (0..rooms.len()).any(|c| {
+        let [f, b] = v.faced[c];
+        !rooms[c] && !v.at_bounds[c] && f > b && voxels[c] > rooms_voxels
+    })
+}
+
 /// The share of component `c`'s voxels (up to [`SAMPLES`] of its `voxels`, evenly spread in
 /// voxel order) that are enclosed.
 pub fn enclosed_share(
