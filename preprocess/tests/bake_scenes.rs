@@ -713,6 +713,30 @@ fn no_empty_space_no_triangles_and_too_much_memory_are_clear_errors() {
     assert!(matches!(e, BakeError::NoEmptySpace(_)), "{e}");
     assert!(e.to_string().contains("--resolution"), "{e}");
 
+    // The ajar door on a 400 m ground: at 128 voxels on its longest axis (3.1 m) its rooms
+    // are one voxel high. The error says so and what voxel size would do, with its cost.
+    let mut s = Builtin::AjarDoor.scene().expect("scene");
+    let mut ground = s.meshes[0].clone();
+    ground.positions = [
+        (-200.0, -200.0),
+        (200.0, -200.0),
+        (200.0, 200.0),
+        (-200.0, 200.0),
+    ]
+    .map(|(x, z)| Vec3::new(x, -0.01, z))
+    .to_vec();
+    ground.normals = vec![Vec3::Y; 4];
+    ground.uvs = vec![Vec2::ZERO; 4];
+    ground.triangles = vec![[0, 2, 1], [0, 3, 2]];
+    ground.material = vec![0; 2];
+    s.meshes.push(ground);
+    let e = bake_scene(&s, &params(128)).expect_err("no empty space");
+    let text = e.to_string();
+    assert!(
+        text.contains("400.0 x 3.1 x 400.0 m") && text.contains("--voxel-size 0.130 puts 24"),
+        "{text}"
+    );
+
     let mut s = Builtin::EmptyBox.scene().expect("scene");
     s.meshes.iter_mut().for_each(|m| m.is_static = false);
     let e = bake_scene(&s, &params(32)).expect_err("no static triangles");
