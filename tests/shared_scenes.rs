@@ -161,9 +161,17 @@ fn levels_wound_inside_out_bake_as_written() {
     let bake_it = |s: &Scene| bake(s, &params, &BakeOptions::default(), &|_| {}).expect("bake");
     let said = |b: &Baked| b.report.empty_space["faces_turned"] == true;
     // The bare OBJs, as `visgate bake FILE` reads them (no camera, no light): e2m3's void
-    // wraps its rooms; Crytek Sponza's rooms are open to the sky.
-    for file in ["librequake_e2m3/e2m3.obj", "crytek_sponza/sponza.obj"] {
-        let written = load(&dir.join(file));
+    // wraps its rooms; Crytek Sponza's rooms are open to the sky. And their scene files, whose
+    // cameras and lights are in the rooms.
+    let tomls = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/shared");
+    for file in [
+        dir.join("librequake_e2m3/e2m3.obj"),
+        dir.join("crytek_sponza/sponza.obj"),
+        tomls.join("librequake-e2m3.toml"),
+        tomls.join("crytek-sponza.toml"),
+    ] {
+        let file = file.display().to_string();
+        let written = load(std::path::Path::new(&file));
         let mut turned = written.clone();
         for m in &mut turned.meshes {
             m.triangles.iter_mut().for_each(|t| t.swap(1, 2));

@@ -95,19 +95,22 @@ pub fn rooms_turned(v: &Votes, rooms: &[bool]) -> bool {
     by_votes && (sealed || first[1] as f64 > OPEN_RATIO * first[0] as f64)
 }
 
-/// Whether reading the faces turned would drop a sealed part (not reaching the bounds) larger
-/// than all the `rooms` together that the faces as written keep (more fronts than backs face
-/// it): then the rooms' backs are not turned faces but a closed mesh around them — a lamp
-/// inside its bulb or shade, whose 8 voxels see the backs of the shade's faces while the room
-/// around sees 49 fronts.
+/// Whether reading the faces turned would drop a sealed part (not reaching the bounds) that the
+/// faces as written keep (more fronts than backs face it) and that is both larger than all the
+/// `rooms` together and faced by more triangles than turn their backs to them: then the rooms'
+/// backs are not turned faces but a closed mesh around them — a lamp inside its bulb or shade,
+/// whose 8 voxels see the backs of 8 of the shade's faces while the room around, 352,888
+/// voxels, sees 49 fronts. (Crytek Sponza turned, with its scene file: the space around its
+/// rooms is larger, 275,913 voxels against 121,436 at 128, but 2,495 fronts face it and
+/// 85,417 backs its rooms.)
 pub fn turning_drops_more(v: &Votes, rooms: &[bool], voxels: &[u64]) -> bool {
-    let rooms_voxels: u64 = (0..rooms.len())
-        .filter(|&c| rooms[c])
-        .map(|c| voxels[c])
-        .sum();
+    let in_rooms = || (0..rooms.len()).filter(|&c| rooms[c]);
+    let rooms_voxels: u64 = in_rooms().map(|c| voxels[c]).sum();
+    let rooms_backs: u64 = in_rooms().map(|c| v.faced[c][1]).sum();
     (0..rooms.len()).any(|c| {
         let [f, b] = v.faced[c];
-        !rooms[c] && !v.at_bounds[c] && f > b && voxels[c] > rooms_voxels
+        let kept_as_written = !rooms[c] && !v.at_bounds[c] && f > b;
+        kept_as_written && voxels[c] > rooms_voxels && f > rooms_backs
     })
 }
 
