@@ -253,4 +253,26 @@ mod tests {
         assert!(!sealed(10, 20, true));
         assert!(!sealed(0, 400, false));
     }
+
+    #[test]
+    fn a_turn_that_would_drop_a_larger_and_more_faced_part_is_refused() {
+        // The ajar door with a shade around its lamp: the lamp's pocket (a room) sees 8 backs,
+        // the room around it 49 fronts and 352,888 voxels.
+        let v = Votes {
+            faced: &[[49, 0], [0, 8]],
+            fronts: &[0, 0],
+            backs: &[0, 0],
+            at_bounds: &[false, false],
+        };
+        assert!(turning_drops_more(&v, &[false, true], &[352_888, 8]));
+        // Crytek Sponza turned, at 128: the space around its rooms is larger but faced by
+        // fewer triangles than turn their backs to the rooms.
+        let v = Votes {
+            faced: &[[2_495, 1_206], [35_427, 85_417]],
+            fronts: &[0, 0],
+            backs: &[0, 0],
+            at_bounds: &[false, true],
+        };
+        assert!(!turning_drops_more(&v, &[false, true], &[275_913, 121_436]));
+    }
 }
