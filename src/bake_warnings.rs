@@ -23,9 +23,9 @@ pub fn warnings(report: &BakeReport) -> Vec<String> {
     let es = &report.empty_space;
     let mut out = inside_warnings(es);
     out.extend(turned_faces(es));
-    out.extend(mixed_winding(es));
+    out.extend(mixed_winding(es, &report.grid));
     out.extend(most_dropped(es, &report.grid));
-    out.extend(enclosed_lights(es));
+    out.extend(enclosed_seeds(es, &report.grid));
     out.extend(cut_off_cameras(es, &report.grid));
     let radius = report
         .stages
@@ -64,11 +64,13 @@ const MIXED_RATIO: f64 = 1.5;
 /// light, or a bare mesh's inside) face them about as often as they turn their backs: some
 /// objects wound one way, some the other, so the votes that keep and drop the empty space
 /// say little (e2m3 so mixed kept the void around its rooms too: 159 clusters instead of 104).
-fn mixed_winding(empty_space: &Value) -> Option<String> {
+fn mixed_winding(empty_space: &Value, grid: &GridMeta) -> Option<String> {
     let comps = empty_space["components"].as_array()?;
+    // A camera or light inside closed geometry is no room (enclosed_seeds says so).
     let room = |c: &&Value| {
         let seeded = c["seeds"].as_array().is_some_and(|s| !s.is_empty());
-        seeded || c["reason"].as_str().is_some_and(|r| r.starts_with(INSIDE))
+        let inside = c["reason"].as_str().is_some_and(|r| r.starts_with(INSIDE));
+        (seeded || inside) && !enclosed_seed_part(c, grid)
     };
     let (f, b) = comps.iter().filter(room).fold((0, 0), |(f, b), c| {
         let v = |k: usize| c["faced_by"][k].as_u64().unwrap_or(0);
@@ -151,36 +153,53 @@ fn too_coarse(radius_vx: f64, clusters: u64, grid: &GridMeta) -> Option<String> 
     })
 }
 
-/// Whether a kept part of the empty space holds lights and no camera and the triangles around
-/// it turn their backs to it: the inside of a closed mesh, such as a lamp's bulb or shade.
-fn enclosed_light_part(c: &Value) -> bool {
-    let seeds = c["seeds"].as_array().into_iter().flatten();
-    let mut seeds = seeds.filter_map(Value::as_str).peekable();
-    let lights_only = seeds.peek().is_some() && seeds.all(|s| !is_camera_seed(s));
-    let v = |k: usize| c["faced_by"][k].as_u64().unwrap_or(0);
-    c["kept"] == true && lights_only && v(1) > v(0)
+/// Whether part `c` of the report reaches the grid's bounds: its box within a voxel and a half
+/// of the grid's faces, next to its solid border (the outside).
+fn reaches_bounds(c: &Value, grid: &GridMeta) -> bool {
+    let at = |key: &str, a: usize| c[key][a].as_f64().unwrap_or(0.0);
+    let (o, vs) = (grid.origin_m, grid.voxel_size_m as f64);
+    (0..3).any(|a| {
+        at("bounds_min_m", a) <= o[a] as f64 + 1.5 * vs
+            || at("bounds_max_m", a) >= o[a] as f64 + (grid.dims[a] as f64 - 1.5) * vs
+    })
 }
 
-/// A warning for each part that holds lights inside closed geometry ([`enclosed_light_part`]):
-/// they light the inside of that mesh alone (the built-in ajar door with a 20 cm box around its
-/// lamp: 8 voxels, every render black).
-fn enclosed_lights(empty_space: &Value) -> Vec<String> {
+/// Whether a kept part of the empty space holds cameras or lights, does not reach the bounds,
+/// and the triangles around it turn their backs to it: the inside of a closed mesh — a lamp's
+/// bulb or shade, a hollow wall or column a camera was put in. (A room joined to the void by a
+/// window may see its walls' backs too, but it reaches the bounds.)
+fn enclosed_seed_part(c: &Value, grid: &GridMeta) -> bool {
+    let seeded = c["seeds"].as_array().is_some_and(|s| !s.is_empty());
+    let v = |k: usize| c["faced_by"][k].as_u64().unwrap_or(0);
+    c["kept"] == true && seeded && v(1) > v(0) && !reaches_bounds(c, grid)
+}
+
+/// A warning for each part that holds cameras or lights inside closed geometry
+/// ([`enclosed_seed_part`]): a light lights that mesh's inside alone (the built-in ajar door
+/// with a 20 cm box around its lamp: 8 voxels, every render black), a camera sees its inside.
+fn enclosed_seeds(empty_space: &Value, grid: &GridMeta) -> Vec<String> {
     let comps = empty_space["components"].as_array().into_iter().flatten();
     comps
-        .filter(|c| enclosed_light_part(c))
+        .filter(|c| enclosed_seed_part(c, grid))
         .map(|c| {
-            let lights: Vec<String> = c["seeds"]
+            let seeds: Vec<String> = c["seeds"]
                 .as_array()
                 .into_iter()
                 .flatten()
                 .filter_map(|s| s.as_str().map(str::to_string))
                 .collect();
+            let what = if seeds.iter().all(|s| is_camera_seed(s)) {
+                "it sees that mesh's inside alone (a hollow wall, column or object?). Move the \
+                 camera out of the mesh"
+            } else {
+                "it lights that mesh's inside alone (a lamp's bulb or shade?) and no light \
+                 leaves it. Move the light out of the mesh, or leave the mesh out of the \
+                 scene's static geometry"
+            };
             format!(
                 "{} inside closed geometry: the {} triangles around its pocket of {} empty \
-                 voxels ({} .. {} m) turn their backs to it, so it lights that mesh's inside \
-                 alone (a lamp's bulb or shade?) and no light leaves it. Move the light out of \
-                 the mesh, or leave the mesh out of the scene's static geometry",
-                join_and(&lights),
+                 voxels ({} .. {} m) turn their backs to it, so {what}",
+                join_and(&seeds),
                 c["faced_by"][1].as_u64().unwrap_or(0),
                 c["voxels"].as_u64().unwrap_or(0),
                 metres(&c["bounds_min_m"]),
@@ -204,20 +223,11 @@ fn cut_off_cameras(empty_space: &Value, grid: &GridMeta) -> Vec<String> {
             .collect()
     };
     let is_camera = |s: &String| is_camera_seed(s);
-    let kept: Vec<Vec<String>> = comps
-        .iter()
-        .filter(|c| c["kept"] == true)
-        .map(seeds)
-        .collect();
+    // Parts inside closed geometry are said by enclosed_seeds: no resolution opens them.
+    let open = |c: &&Value| c["kept"] == true && !enclosed_seed_part(c, grid);
+    let kept: Vec<Vec<String>> = comps.iter().filter(open).map(seeds).collect();
     if !kept.iter().any(|s| s.iter().any(|x| !is_camera(x))) {
-        return Vec::new(); // no light in any kept part: nothing is cut off from one
-    }
-    let lit_parts = comps.iter().filter(|c| {
-        let s = seeds(c);
-        c["kept"] == true && s.iter().any(|x| !is_camera(x))
-    });
-    if lit_parts.clone().count() > 0 && lit_parts.clone().all(enclosed_light_part) {
-        return Vec::new(); // every light is enclosed: enclosed_lights says so, not a resolution
+        return Vec::new(); // no light in any open kept part: nothing is cut off from one
     }
     // Twice this resolution: a doorway a voxel wide is then two.
     let res = resolution_for(grid, 1.0, 2.0);
@@ -422,6 +432,11 @@ mod tests {
 
     #[test]
     fn faces_wound_both_ways_are_said() {
+        let g = GridMeta {
+            origin_m: [0.0; 3],
+            voxel_size_m: 0.1,
+            dims: [100, 40, 100],
+        };
         let comp = |seeds: &[&str], reason: &str, faced: [u64; 2], kept: bool| json!({ "seeds": seeds, "reason": reason, "faced_by": faced, "kept": kept });
         let inside = format!("{INSIDE}: the most triangles face it");
         // e2m3 with every other material reversed: its inside and the void both kept.
@@ -429,20 +444,20 @@ mod tests {
             comp(&[], "large and faced by the geometry", [4145, 4092], true),
             comp(&[], &inside, [4648, 4908], true),
         ]});
-        let w = mixed_winding(&mixed).expect("a warning");
+        let w = mixed_winding(&mixed, &g).expect("a warning");
         assert!(
             w.contains("4648 face them and 4908 turn") && w.contains("kept 1 part"),
             "{w}"
         );
         // As written, and Crytek Sponza's rooms: nothing.
         let e2m3 = json!({ "components": [comp(&[], &inside, [8924, 482], true)] });
-        assert!(mixed_winding(&e2m3).is_none());
+        assert!(mixed_winding(&e2m3, &g).is_none());
         let sponza =
             json!({ "components": [comp(&["camera 'a'"], "holds", [85417, 35427], true)] });
-        assert!(mixed_winding(&sponza).is_none());
+        assert!(mixed_winding(&sponza, &g).is_none());
         // Too few votes: nothing.
         let few = json!({ "components": [comp(&["camera 'a'"], "holds", [40, 45], true)] });
-        assert!(mixed_winding(&few).is_none());
+        assert!(mixed_winding(&few, &g).is_none());
     }
 
     #[test]
@@ -461,7 +476,7 @@ mod tests {
             part(&["camera 'main'", "camera 'door'"], [49, 0], 352_888),
             part(&["point light 0"], [0, 8], 8),
         ]});
-        let w = enclosed_lights(&es);
+        let w = enclosed_seeds(&es, &g);
         assert!(
             w.len() == 1 && w[0].starts_with("point light 0 is inside closed geometry: the 8"),
             "{w:?}"
@@ -472,7 +487,25 @@ mod tests {
             part(&["camera 'main'"], [49, 0], 352_888),
             part(&["point light 0"], [30, 0], 40_000),
         ]});
-        assert!(enclosed_lights(&sealed).is_empty());
+        assert!(enclosed_seeds(&sealed, &g).is_empty());
         assert_eq!(cut_off_cameras(&sealed, &g).len(), 1);
+        // The four rooms with a camera put inside a hollow wall: said as such, not taken for
+        // a room behind a closed doorway, nor its backs for faces wound both ways.
+        let in_wall = json!({ "components": [
+            part(&["camera 'main'", "point light 0"], [88, 0], 605_452),
+            part(&["camera 'inwall'"], [0, 92], 104_048),
+        ]});
+        let w = enclosed_seeds(&in_wall, &g);
+        assert!(
+            w.len() == 1 && w[0].starts_with("camera 'inwall' is inside closed geometry"),
+            "{w:?}"
+        );
+        assert!(w[0].contains("Move the camera out"), "{w:?}");
+        assert!(cut_off_cameras(&in_wall, &g).is_empty());
+        assert!(mixed_winding(&in_wall, &g).is_none());
+        // A room joined to the void by a window reaches the bounds: its backs say nothing.
+        let mut window = part(&["point light 0"], [0, 288], 40_000);
+        window["bounds_min_m"] = json!([0.0, 0.0, 0.0]);
+        assert!(enclosed_seeds(&json!({ "components": [window] }), &g).is_empty());
     }
 }
