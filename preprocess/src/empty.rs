@@ -144,7 +144,7 @@ pub fn empty_space(
     let comps = grid_components(dims, |i| empty[i], Conn::C26);
     let count = comps.count;
     if count == 0 {
-        return Err(BakeError::NoEmptySpace(all_solid(meta)));
+        return Err(BakeError::NoEmptySpace(crate::voxelize::all_solid(meta)));
     }
     let n = count as usize;
     let mut voxels = vec![0u64; n];
@@ -384,41 +384,6 @@ pub fn empty_space(
         seeds_outside,
         faces_turned,
     })
-}
-
-/// Voxels across the level's shortest side that [`all_solid`] suggests. [Units: voxels]
-const SUGGESTED_ACROSS: f64 = 24.0;
-
-/// Why a grid with no empty voxel is useless and what voxel size would do, with the grid and
-/// the memory that takes: a ground or a sky far wider than the rooms sets the voxel (the ajar
-/// door on a 400 m ground: 3.1 m voxels at 128, its 3 m rooms one voxel high).
-fn all_solid(meta: &GridMeta) -> String {
-    let [nx, ny, nz] = meta.dims;
-    let vs = f64::from(meta.voxel_size_m);
-    // The inner extent (the grid less its border ring).
-    let extent = meta
-        .dims
-        .map(|d| f64::from(d.saturating_sub(2).max(1)) * vs);
-    let shortest = extent.iter().copied().fold(f64::INFINITY, f64::min);
-    let size = shortest / SUGGESTED_ACROSS;
-    let dims = extent.map(|e| (e / size).ceil() + 2.0);
-    let bytes = dims.iter().product::<f64>() * crate::voxelize::BAKE_BYTES_PER_VOXEL as f64;
-    format!(
-        "every voxel of the {nx} x {ny} x {nz} grid is solid: the level is {:.1} x {:.1} x {:.1} m \
-         and its voxels {vs:.3} m, so its shortest side is {:.0} voxel(s) across. Raise \
-         --resolution so the geometry's gaps are wider than a voxel; where a ground or a sky far \
-         wider than the rooms sets the grid, crop it in the modelling tool, or give a voxel size: \
-         --voxel-size {size:.3} puts {SUGGESTED_ACROSS:.0} voxels across the shortest side \
-         ({:.0} x {:.0} x {:.0} voxels, {:.1} GiB to bake)",
-        extent[0],
-        extent[1],
-        extent[2],
-        shortest / vs,
-        dims[0],
-        dims[1],
-        dims[2],
-        bytes / f64::from(1u32 << 30)
-    )
 }
 
 /// A corner of voxel `v`'s cube in metres: its low corner at `corner` 0, its high one at 1 (a
