@@ -101,9 +101,9 @@ pub fn grid_for(
 const SUGGESTED_ACROSS: f64 = 24.0;
 
 /// Why a grid with no empty voxel (the empty-space stage finds none) is useless and what voxel
-/// size would do, with the grid and
-/// the memory that takes: a ground or a sky far wider than the rooms sets the voxel (the ajar
-/// door on a 400 m ground: 3.1 m voxels at 128, its 3 m rooms one voxel high).
+/// size would do, with the grid and the memory that takes: a ground or a sky far wider than
+/// the rooms sets the voxel (the ajar door on a 400 m ground: 3.1 m voxels at 128, its 3 m
+/// rooms one voxel high).
 pub fn all_solid(meta: &GridMeta) -> String {
     let [nx, ny, nz] = meta.dims;
     let vs = f64::from(meta.voxel_size_m);
