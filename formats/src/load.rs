@@ -161,10 +161,11 @@ fn metres_note(path: &Path, longest: f64) -> String {
     format!(
         "{}: a bare mesh states no units; read in metres, its longest side makes a {longest:.0} m \
          level, longer than most indoor levels. If it is modelled in centimetres (a {:.1} m \
-         level), pass --metres-per-unit 0.01, or name the mesh in a scene TOML with \
-         `metres_per_unit` (README, Scenes)",
+         level) or inches ({:.1} m), pass --metres-per-unit 0.01 or 0.0254, or name the mesh in \
+         a scene TOML with `metres_per_unit` (README, Scenes)",
         path.display(),
         longest * 0.01,
+        longest * 0.0254,
     )
 }
 

@@ -59,7 +59,10 @@ fn a_bare_mesh_in_centimetres_is_read_as_such_and_says_so() {
     assert!((longest_m(&long) - 800.0).abs() < 1e-3);
     let w = long.report.warnings.join("\n");
     assert!(
-        w.contains("long.obj") && w.contains("makes a 800 m level") && w.contains("a 8.0 m level"),
+        w.contains("long.obj")
+            && w.contains("makes a 800 m level")
+            && w.contains("a 8.0 m level")
+            && w.contains("inches (20.3 m)"),
         "{w}"
     );
     assert!(w.contains("--metres-per-unit 0.01"), "{w}");
