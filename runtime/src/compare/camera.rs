@@ -247,6 +247,8 @@ fn measure(
         energy_ratio: i.energy_ratio,
         black_where_lit: i.black_where_lit,
         black_where_lit_all: i.black_where_lit_all,
+        lit_pixels: i.lit_pixels,
+        pixels: (image.width * image.height) as u64,
         speedup: None,
         ground_truth_rel_mse: ground_truth
             .map(|g| errors(image, g))

@@ -183,6 +183,10 @@ pub struct Row {
     pub black_where_lit: f64,
     /// The same share over every pixel, the mixed ones too.
     pub black_where_lit_all: f64,
+    /// The lit pixels (mixed ones left out) [`Row::black_where_lit`] is a share of.
+    pub lit_pixels: u64,
+    /// The image's pixels.
+    pub pixels: u64,
     /// Per-VPL shadow maps' frame time over this one's (same camera and VPLs).
     pub speedup: Option<f64>,
     /// Relative MSE against the camera's ground truth.

@@ -58,14 +58,21 @@ fn marks(r: &Row) -> String {
     m.join(", ")
 }
 
-/// Black where lit, and in brackets over every pixel where the mixed ones change it.
+/// Lit pixels under this share of the frame are counted beside black where lit. [Units: share]
+const FEW_LIT: f64 = 0.05;
+
+/// Black where lit, and in brackets over every pixel where the mixed ones change it; where the
+/// reference lights few pixels, how many the share is of.
 fn black_cell(r: &Row) -> String {
     let (b, all) = (r.black_where_lit * 100.0, r.black_where_lit_all * 100.0);
-    if format!("{b:.1}") == format!("{all:.1}") {
-        format!("{b:.1} %")
-    } else {
-        format!("{b:.1} % ({all:.1} %)")
+    let mut cell = format!("{b:.1} %");
+    if (r.lit_pixels as f64) < FEW_LIT * r.pixels as f64 {
+        cell += &format!(" of {} px", r.lit_pixels);
     }
+    if format!("{b:.1}") != format!("{all:.1}") {
+        cell += &format!(" ({all:.1} %)");
+    }
+    cell
 }
 
 /// A reference's line: its VPLs, time, rays, error against the ground truth and mixed pixels.
@@ -170,7 +177,9 @@ indirectly at ≥ 0.1 of its mean, the share where the method gives < 0.1 of the
 leaving out the pixels whose reference samples and centre see several surfaces or albedos \
 tenfold apart (silhouettes, creases, sharp texels: the reference averages them where a method \
 shades one point a pixel; in brackets the share \
-over every pixel where they change it; dark yellow in the panels' black map). \
+over every pixel where they change it; dark yellow in the panels' black map; where those lit \
+pixels are under 5 % of the frame, how many follows the share: in a dark view a line of pixels \
+moves it by whole percents). \
 ◆ front: no other setting is both faster and more accurate (means over the cameras). \
 × per-VPL maps: per-VPL shadow maps' frame time over this one's.";
 
@@ -429,5 +438,39 @@ mod tests {
         assert!(w.contains("0 VPLs of 256 asked"), "{w}");
         let w = reference_warning(256, 250, &HdrImage::new(4, 3)).expect("black");
         assert!(w.starts_with("the reference is black"), "{w}");
+    }
+
+    #[test]
+    fn black_where_lit_says_how_many_pixels_it_is_of_where_few_are_lit() {
+        let row = |lit_pixels: u64, all: f64| Row {
+            camera: "door".into(),
+            mode: "gates".into(),
+            settings: String::new(),
+            vpls: 1024,
+            vpl_count: 189,
+            passes: vec![],
+            total_ms: 1.0,
+            gpu_timed: false,
+            mse: 0.0,
+            indirect_mse: 0.0,
+            rel_mse: 0.0,
+            flip: 0.0,
+            energy_ratio: 1.0,
+            black_where_lit: 0.336,
+            black_where_lit_all: all,
+            lit_pixels,
+            pixels: 76_800,
+            speedup: None,
+            ground_truth_rel_mse: None,
+            pareto: false,
+            answers: vec![],
+            image: String::new(),
+            panel: String::new(),
+        };
+        // sun-window's dark room A: a third of 1,200 pixels.
+        assert_eq!(black_cell(&row(1_200, 0.387)), "33.6 % of 1200 px (38.7 %)");
+        assert_eq!(black_cell(&row(1_200, 0.336)), "33.6 % of 1200 px");
+        // A lit view: the share alone.
+        assert_eq!(black_cell(&row(50_000, 0.387)), "33.6 % (38.7 %)");
     }
 }
