@@ -450,17 +450,19 @@ pub fn diff(args: DiffArgs) -> Result<()> {
         );
         match &args.mixed {
             Some(p) => println!(
-                "black where lit  {:.6} %  (of the pixels the reference lights indirectly, those \
-                 white in {} left out; {:.6} % over every pixel)",
+                "black where lit  {:.6} %  (of the {} pixels the reference lights indirectly, \
+                 those white in {} left out; {:.6} % over every pixel)",
                 i.black_where_lit * 100.0,
+                i.lit_pixels,
                 p.display(),
                 i.black_where_lit_all * 100.0
             ),
             None => println!(
-                "black where lit  {:.6} %  (of the pixels the reference lights indirectly, every \
-                 pixel counted: compare leaves out those whose reference samples see several \
-                 surfaces or albedos, --mixed)",
-                i.black_where_lit * 100.0
+                "black where lit  {:.6} %  (of the {} pixels the reference lights indirectly, \
+                 every pixel counted: compare leaves out those whose reference samples see \
+                 several surfaces or albedos, --mixed)",
+                i.black_where_lit * 100.0,
+                i.lit_pixels
             ),
         }
     }
