@@ -421,19 +421,19 @@ impl Builtin {
                 ],
             ),
             // A lamp 1.2 m outside the window and above it, lighting room B's floor through it
-            // (the window: quads::SUN_WINDOW); the cameras in room A looking at the door wall,
-            // and in room B looking at the lit floor.
+            // (the window: quads::SUN_WINDOW); the cameras in room B looking at the lit floor
+            // (first: what `view` and `render` open on), and in room A looking at the door wall.
             Builtin::SunWindow => (
                 false,
                 vec![point([6.0, 2.8, 5.2], 40.0)],
                 vec![
                     CameraDesc {
-                        name: "door".into(),
-                        ..camera([0.4, 1.6, 0.5], [4.0, 1.0, 2.2], 75.0)
-                    },
-                    CameraDesc {
                         name: "window".into(),
                         ..camera([4.6, 1.7, 0.4], [6.2, 0.2, 3.2], 75.0)
+                    },
+                    CameraDesc {
+                        name: "door".into(),
+                        ..camera([0.4, 1.6, 0.5], [4.0, 1.0, 2.2], 75.0)
                     },
                 ],
             ),
