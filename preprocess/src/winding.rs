@@ -7,23 +7,23 @@
 //! as its inside and dropped the 125 k voxels of its rooms, with nothing said. The renders are
 //! two-sided, so only the bake reads the winding; here it is judged from what it must mean:
 //!
-//! - with cameras or lights, their components are the level's rooms: if the sealed ones (not
-//!   reaching the bounds: a room joined to the void by a window sees the backs of its walls
-//!   from outside too) see the backs of more than [`TURNED_RATIO`] times as many triangles as
-//!   they see fronts, the faces are turned;
+//! - with cameras or lights, their components are the level's rooms: if they see the backs of
+//!   more than [`TURNED_RATIO`] times as many triangles as fronts — and, where one of them
+//!   reaches the bounds (a room joined to the void by a window sees the backs of its walls from
+//!   outside too), more than [`OPEN_RATIO`] times as many from each face's first open voxel —
+//!   the faces are turned ([`rooms_turned`]), unless the turn would drop a sealed part larger
+//!   and more faced than the rooms (a lamp inside its shade: [`turning_drops_more`]);
 //! - a bare mesh's inside as written (the most fronts) and as turned (the most backs), where
-//!   they differ and about as many triangles face each ([`FACED_RATIO`]): the turned one where
-//!   the written one reaches all six sides of the grid (the void around a level) and the
-//!   turned one's voxels are more often **enclosed** (at most [`crate::inside::MAX_ESCAPES`]
-//!   of the 26 rays from a voxel reach the grid's border) by [`ENCLOSED_MARGIN`], or where
-//!   both are enclosed alike and the turned one is [`LARGER_RATIO`] times as large (not the
-//!   inside of a hollow wall); and turned where the inside so found is sealed and sees mostly
-//!   backs, as a camera's room would (one joined to the void by a window sees the backs of
-//!   its walls from outside too, and more backs than fronts with its faces as written). A
-//!   level's rooms open to the sky or a Cornell box's open front reach
-//!   one side, not six; hollow brushes (closed boxes, their backs inward) are enclosed but
-//!   small. Not caught: the Cornell box turned (its open room is not enclosed; the bake keeps
-//!   its blocks' insides, which its turned faces face).
+//!   they differ and about as many triangles face each ([`FACED_RATIO`]), is the turned one
+//!   where the written one reaches all six sides of the grid (the void around a level) and the
+//!   turned one's voxels are more often **enclosed** (at most [`crate::inside::MAX_ESCAPES`] of
+//!   the 26 rays from a voxel reach the grid's border) by [`ENCLOSED_MARGIN`], or where both
+//!   are enclosed alike and the turned one is [`LARGER_RATIO`] times as large (not the inside
+//!   of a hollow wall); the inside so found is then judged as a camera's room. A level's rooms
+//!   open to the sky or a Cornell box's open front reach one side, not six; hollow brushes
+//!   (closed boxes, their backs inward) are enclosed but small. Not caught: the Cornell box
+//!   turned (its open room is not enclosed; the bake keeps its blocks' insides, which its
+//!   turned faces face).
 //!
 //! Turned faces are then read as turned (each component's votes swapped) and the bake says so.
 
@@ -114,7 +114,7 @@ pub fn turning_drops_more(v: &Votes, rooms: &[bool], voxels: &[u64]) -> bool {
     })
 }
 
-/// The share of component `c`'s voxels (up to [`SAMPLES`] of its `voxels`, evenly spread in
+/// The share of component `c`'s voxels (up to 256 of its `voxels`, `SAMPLES`, evenly spread in
 /// voxel order) that are enclosed.
 pub fn enclosed_share(
     meta: &GridMeta,
