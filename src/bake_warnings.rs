@@ -78,10 +78,12 @@ fn mixed_winding(empty_space: &Value, grid: &GridMeta) -> Option<String> {
     });
     let (lo, hi) = (f.min(b) as f64, f.max(b) as f64);
     (f + b >= MIXED_MIN_VOTES && hi < MIXED_RATIO * lo).then(|| {
-        let kept = comps
-            .iter()
-            .filter(|c| c["kept"] == true && !room(c))
-            .count();
+        // Kept by the votes: no camera or light holds them, and they are not the inside.
+        let by_votes = |c: &&Value| {
+            let seeded = c["seeds"].as_array().is_some_and(|s| !s.is_empty());
+            c["kept"] == true && !seeded && !room(c)
+        };
+        let kept = comps.iter().filter(by_votes).count();
         format!(
             "the level's faces are wound both ways: of the triangles beside its rooms {f} face \
              them and {b} turn their backs (objects mirrored or exported inside out?). The bake \
