@@ -10,9 +10,15 @@ use crate::desc::{LightDesc, SceneDesc};
 use crate::scene::{Scene, SceneSpace};
 
 /// How far outside the static geometry's box a light or a camera may stand before it is
-/// named, in the box's diagonals: a lamp outside a window or a camera looking at a building
-/// from across the street stand within one. [Units: ratio]
-pub const FAR_DIAGONALS: f32 = 1.0;
+/// named when its numbers, read as metres in a scene of other units, would put it inside: a
+/// lamp outside a window stands within one. [Units: ratio, the box's diagonals]
+pub const NEAR_DIAGONALS: f32 = 1.0;
+
+/// How far outside it one is named whatever its numbers: a slip of units in a scene of metres
+/// (centimetres: 100 times as far from the origin, inches 39) puts a light that far; a camera
+/// looking at a building from across the street, an aerial view, stand within. [Units: ratio,
+/// the box's diagonals]
+pub const FAR_DIAGONALS: f32 = 10.0;
 
 /// Distance from `p` to the box `lo..hi` (0 inside).
 fn outside_by(p: Vec3, (lo, hi): (Vec3, Vec3)) -> f32 {
@@ -20,14 +26,20 @@ fn outside_by(p: Vec3, (lo, hi): (Vec3, Vec3)) -> f32 {
 }
 
 /// A warning for each light and camera of `scene` (as assembled from `desc`) that lies more
-/// than [`FAR_DIAGONALS`] of the static geometry's box outside it, with its position in metres
-/// and in the file's units, and what it would be read as had it been written in metres.
+/// than [`NEAR_DIAGONALS`] of the static geometry's box outside it where its numbers, read as
+/// metres, would put it inside (with the numbers to write), or more than [`FAR_DIAGONALS`]
+/// whatever they are.
 pub fn far_placements(scene: &Scene, desc: &SceneDesc) -> Vec<String> {
     let Some(bounds) = scene.static_bounds().or_else(|| scene.bounds()) else {
         return Vec::new();
     };
     let diagonal = (bounds.1 - bounds.0).length();
     let space = SceneSpace::new(desc.up, desc.metres_per_unit);
+    let mpu = desc.metres_per_unit;
+    // Had the numbers been written in metres, they would be these units.
+    let as_units = |units: [f64; 3]| (DVec3::from(units) / mpu).to_array();
+    let slip =
+        |units: [f64; 3]| mpu != 1.0 && outside_by(space.point(as_units(units)), bounds) == 0.0;
     let lights = desc.lights.iter().enumerate().map(|(i, l)| {
         let (kind, at) = match l {
             LightDesc::Point(p) => ("point", p.position),
@@ -42,15 +54,25 @@ pub fn far_placements(scene: &Scene, desc: &SceneDesc) -> Vec<String> {
     lights
         .chain(cameras)
         .filter_map(|(what, units)| {
-            let p = space.point(units);
-            let off = outside_by(p, bounds);
-            (off > FAR_DIAGONALS * diagonal).then(|| far_warning(scene, desc, &what, units, off))
+            let off = outside_by(space.point(units), bounds);
+            let fix = slip(units).then(|| as_units(units));
+            let named = match fix {
+                Some(_) => off > NEAR_DIAGONALS * diagonal,
+                None => off > FAR_DIAGONALS * diagonal,
+            };
+            named.then(|| far_warning(scene, desc, (&what, units, fix), off))
         })
         .collect()
 }
 
-/// The warning for `what`, written at `units`, `off` metres outside the level.
-fn far_warning(scene: &Scene, desc: &SceneDesc, what: &str, units: [f64; 3], off: f32) -> String {
+/// The warning for `what`, written at `units`, `off` metres outside the level; `fix`: the
+/// numbers to write where those were metres.
+fn far_warning(
+    scene: &Scene,
+    desc: &SceneDesc,
+    (what, units, fix): (&str, [f64; 3], Option<[f64; 3]>),
+    off: f32,
+) -> String {
     let space = SceneSpace::new(desc.up, desc.metres_per_unit);
     let (lo, hi) = scene
         .static_bounds()
@@ -64,16 +86,18 @@ fn far_warning(scene: &Scene, desc: &SceneDesc, what: &str, units: [f64; 3], off
     );
     let mpu = desc.metres_per_unit;
     if mpu != 1.0 {
-        // Had the numbers been written in metres, they would be these units.
-        let as_units = DVec3::from(units) / mpu;
-        let inside = outside_by(space.point(as_units.to_array()), (lo, hi)) == 0.0;
         out += &format!("; a scene file's positions are in its units (metres_per_unit = {mpu})");
-        if inside {
+    }
+    match fix {
+        Some(f) => {
             out += &format!(
                 ", so if ({}) are metres, write ({}) to put it inside",
                 fmt3(DVec3::from(units)),
-                fmt3(as_units)
+                fmt3(DVec3::from(f))
             );
+        }
+        None => {
+            out += ". If it stands there on purpose (a distant sun, an aerial view), ignore this"
         }
     }
     out
@@ -157,6 +181,16 @@ mod tests {
             [250_060.0, 1_160.0, -79_960.0],
         );
         assert!(far_placements(&s, &d).is_empty());
+        // Three diagonals away, not a slip (an aerial view): nothing to say.
+        let (s, d) = scene(
+            [250_650.0, 1_220.0, -79_880.0],
+            [250_400.0, 4_000.0, -79_800.0],
+        );
+        assert!(
+            far_placements(&s, &d).is_empty(),
+            "{:?}",
+            far_placements(&s, &d)
+        );
         // Far, but not a units slip: named without the fix.
         let (s, d) = scene([0.0, 0.0, 0.0], [250_060.0, 1_160.0, -79_960.0]);
         let w = far_placements(&s, &d);
