@@ -66,12 +66,10 @@ const MIXED_RATIO: f64 = 1.5;
 /// say little (e2m3 so mixed kept the void around its rooms too: 159 clusters instead of 104).
 fn mixed_winding(empty_space: &Value, grid: &GridMeta) -> Option<String> {
     let comps = empty_space["components"].as_array()?;
+    let seeded = |c: &Value| !seeds_of(c).is_empty();
+    let inside = |c: &Value| c["reason"].as_str().is_some_and(|r| r.starts_with(INSIDE));
     // A camera or light inside closed geometry is no room (enclosed_seeds says so).
-    let room = |c: &&Value| {
-        let seeded = c["seeds"].as_array().is_some_and(|s| !s.is_empty());
-        let inside = c["reason"].as_str().is_some_and(|r| r.starts_with(INSIDE));
-        (seeded || inside) && !enclosed_seed_part(c, grid)
-    };
+    let room = |c: &&Value| (seeded(c) || inside(c)) && !enclosed_seed_part(c, grid);
     let (f, b) = comps.iter().filter(room).fold((0, 0), |(f, b), c| {
         let v = |k: usize| c["faced_by"][k].as_u64().unwrap_or(0);
         (f + v(0), b + v(1))
@@ -79,10 +77,7 @@ fn mixed_winding(empty_space: &Value, grid: &GridMeta) -> Option<String> {
     let (lo, hi) = (f.min(b) as f64, f.max(b) as f64);
     (f + b >= MIXED_MIN_VOTES && hi < MIXED_RATIO * lo).then(|| {
         // Kept by the votes: no camera or light holds them, and they are not the inside.
-        let by_votes = |c: &&Value| {
-            let seeded = c["seeds"].as_array().is_some_and(|s| !s.is_empty());
-            c["kept"] == true && !seeded && !room(c)
-        };
+        let by_votes = |c: &&Value| c["kept"] == true && !seeded(c) && !inside(c);
         let kept = comps.iter().filter(by_votes).count();
         format!(
             "the level's faces are wound both ways: of the triangles beside its rooms {f} face \
@@ -155,6 +150,13 @@ fn too_coarse(radius_vx: f64, clusters: u64, grid: &GridMeta) -> Option<String> 
     })
 }
 
+/// The cameras and lights a part of the report holds.
+fn seeds_of(c: &Value) -> Vec<String> {
+    let list = c["seeds"].as_array().into_iter().flatten();
+    list.filter_map(|s| s.as_str().map(str::to_string))
+        .collect()
+}
+
 /// Whether part `c` of the report reaches the grid's bounds: its box within a voxel and a half
 /// of the grid's faces, next to its solid border (the outside).
 fn reaches_bounds(c: &Value, grid: &GridMeta) -> bool {
@@ -171,7 +173,7 @@ fn reaches_bounds(c: &Value, grid: &GridMeta) -> bool {
 /// bulb or shade, a hollow wall or column a camera was put in. (A room joined to the void by a
 /// window may see its walls' backs too, but it reaches the bounds.)
 fn enclosed_seed_part(c: &Value, grid: &GridMeta) -> bool {
-    let seeded = c["seeds"].as_array().is_some_and(|s| !s.is_empty());
+    let seeded = !seeds_of(c).is_empty();
     let v = |k: usize| c["faced_by"][k].as_u64().unwrap_or(0);
     c["kept"] == true && seeded && v(1) > v(0) && !reaches_bounds(c, grid)
 }
@@ -184,12 +186,7 @@ fn enclosed_seeds(empty_space: &Value, grid: &GridMeta) -> Vec<String> {
     comps
         .filter(|c| enclosed_seed_part(c, grid))
         .map(|c| {
-            let seeds: Vec<String> = c["seeds"]
-                .as_array()
-                .into_iter()
-                .flatten()
-                .filter_map(|s| s.as_str().map(str::to_string))
-                .collect();
+            let seeds = seeds_of(c);
             let what = if seeds.iter().all(|s| is_camera_seed(s)) {
                 "it sees that mesh's inside alone (a hollow wall, column or object?). Move the \
                  camera out of the mesh"
@@ -219,15 +216,10 @@ fn cut_off_cameras(empty_space: &Value, grid: &GridMeta) -> Vec<String> {
     let Some(comps) = empty_space["components"].as_array() else {
         return Vec::new();
     };
-    let seeds = |c: &Value| -> Vec<String> {
-        let list = c["seeds"].as_array().into_iter().flatten();
-        list.filter_map(|s| s.as_str().map(str::to_string))
-            .collect()
-    };
     let is_camera = |s: &String| is_camera_seed(s);
     // Parts inside closed geometry are said by enclosed_seeds: no resolution opens them.
     let open = |c: &&Value| c["kept"] == true && !enclosed_seed_part(c, grid);
-    let kept: Vec<Vec<String>> = comps.iter().filter(open).map(seeds).collect();
+    let kept: Vec<Vec<String>> = comps.iter().filter(open).map(seeds_of).collect();
     if !kept.iter().any(|s| s.iter().any(|x| !is_camera(x))) {
         return Vec::new(); // no light in any open kept part: nothing is cut off from one
     }
@@ -272,15 +264,6 @@ fn join_and(items: &[String]) -> String {
 fn most_dropped(empty_space: &Value, grid: &GridMeta) -> Option<String> {
     let comps = empty_space["components"].as_array()?;
     let voxels = |c: &Value| c["voxels"].as_u64().unwrap_or(0);
-    let at = |c: &Value, key: &str, a: usize| c[key][a].as_f64().unwrap_or(0.0);
-    let (o, vs) = (grid.origin_m, grid.voxel_size_m as f64);
-    // Within a voxel and a half of the grid's faces: next to its solid border, the outside.
-    let outside = |c: &Value| {
-        (0..3).any(|a| {
-            at(c, "bounds_min_m", a) <= o[a] as f64 + 1.5 * vs
-                || at(c, "bounds_max_m", a) >= o[a] as f64 + (grid.dims[a] as f64 - 1.5) * vs
-        })
-    };
     let inside = |c: &Value| c["reason"].as_str().is_some_and(|r| r.starts_with(INSIDE));
     if comps.iter().any(inside) {
         return None;
@@ -288,7 +271,7 @@ fn most_dropped(empty_space: &Value, grid: &GridMeta) -> Option<String> {
     let kept: u64 = comps.iter().filter(|c| c["kept"] == true).map(voxels).sum();
     let largest = comps
         .iter()
-        .filter(|c| c["kept"] != true && !outside(c))
+        .filter(|c| c["kept"] != true && !reaches_bounds(c, grid))
         .max_by_key(|c| voxels(c))?;
     (voxels(largest) > kept).then(|| {
         format!(

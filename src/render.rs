@@ -305,12 +305,9 @@ fn print_frame(
         args.light.bounces
     );
     if args.vpls > 0 && f.vpl_count == 0 && args.mode != "direct-only" {
-        eprintln!(
-            "warning: no light path from the scene's lights met the geometry (0 VPLs of {} \
-             asked): the image has no indirect light. Is each light inside the level? (A scene \
-             file's positions are in its units, `metres_per_unit`.)",
-            args.vpls
-        );
+        let what =
+            visgate_runtime::vpl::no_light_paths(args.vpls, "the image has no indirect light");
+        eprintln!("warning: {what}");
     }
     println!("times: load {load_s:.3} s, BVH {bvh_s:.3} s, VPLs {vpl_s:.3} s {setup}");
     match &f.stats {

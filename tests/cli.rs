@@ -421,12 +421,8 @@ fn bake_says_each_import_warning_once() {
     std::fs::write(&mesh, obj).expect("obj");
     let out = dir.path().join("l.vgate");
     // Warnings shown, as a user sees them (the other tests run with RUST_LOG=error).
-    let o = std::process::Command::new(env!("CARGO_BIN_EXE_visgate"))
-        .args(["bake", mesh.to_str().expect("utf-8"), "--resolution", "16"])
-        .args(["-o", out.to_str().expect("utf-8")])
-        .env("RUST_LOG", "warn")
-        .output()
-        .expect("runs visgate");
+    let (mesh, out) = (mesh.to_str().expect("utf-8"), out.to_str().expect("utf-8"));
+    let o = support::visgate_warn(&["bake", mesh, "--resolution", "16", "-o", out]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(
         stderr(&o).matches("degenerate").count(),

@@ -6,18 +6,8 @@
 mod support;
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-use support::stderr;
-
-/// `visgate ARGS` with warnings shown, as a user sees them.
-fn visgate_warn(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_visgate"))
-        .args(args)
-        .env("RUST_LOG", "warn")
-        .output()
-        .expect("runs visgate")
-}
+use support::{stderr, visgate_warn};
 
 /// A closed 4 × 3 × 4 m room modelled in centimetres 1 km along x from the origin, with a
 /// lamp and a camera at its middle written as `light` and `eye` (in the file's units).

@@ -924,6 +924,23 @@ fn the_blur_filled_from_the_next_blocks_is_nearer_every_vpls_gather_and_leaves_a
     }
 }
 
+/// Gates (the default voxel walk) interleaved as `interleave`, the walks' roulette at share
+/// `walk_roulette` with seed `walk_seed`.
+fn with_roulette(
+    interleave: visgate_runtime::gpu::InterleaveParams,
+    walk_roulette: f32,
+    walk_seed: u32,
+) -> visgate_runtime::gpu::GpuParams {
+    use visgate_runtime::gpu::{GatesParams, GpuMode, GpuParams, WalkRoulette};
+    let p = GatesParams {
+        interleave,
+        walk_roulette: WalkRoulette::Share(walk_roulette),
+        walk_seed,
+        ..GatesParams::default()
+    };
+    GpuParams::with_mode(GpuMode::Gates(p))
+}
+
 /// The relative MSE to `full` of seed 0's render (`render(seed)`) and of `seeds` seeds'
 /// mean, and the mean's energy over `full`'s: a roulette's noise and its bias.
 fn over_seeds(
@@ -955,20 +972,14 @@ fn over_seeds(
 #[test]
 fn the_walks_roulette_gives_every_walks_light_on_average_over_its_seeds() {
     use visgate_runtime::gpu::InterleaveParams;
-    use visgate_runtime::gpu::{GatesParams, GpuMode, GpuParams, WalkRoulette};
     let (ctx, mut gpu, vpls, view) = four_rooms_on_the_gpu([96, 72]);
     // Every VPL at every pixel (no blur to hide a bias): the roulette's noise is all there is.
     let mut render = |walk_roulette: f32, walk_seed: u32| {
-        let p = GatesParams {
-            interleave: InterleaveParams {
-                block: 1,
-                ..InterleaveParams::default()
-            },
-            walk_roulette: WalkRoulette::Share(walk_roulette),
-            walk_seed,
-            ..GatesParams::default()
+        let interleave = InterleaveParams {
+            block: 1,
+            ..InterleaveParams::default()
         };
-        let params = GpuParams::with_mode(GpuMode::Gates(p));
+        let params = with_roulette(interleave, walk_roulette, walk_seed);
         gpu.render(&ctx, &view, &vpls, &params).expect("render").0
     };
     let full = render(0.0, 0);
@@ -991,24 +1002,18 @@ fn the_walks_roulette_gives_every_walks_light_on_average_over_its_seeds() {
 #[test]
 fn the_starved_pixels_walks_take_the_roulette_and_keep_every_walks_light_on_average() {
     use visgate_runtime::gpu::InterleaveParams;
-    use visgate_runtime::gpu::{GatesParams, GpuMode, GpuParams, WalkRoulette};
     use visgate_runtime::metrics::errors;
     let (ctx, mut gpu, vpls, view) = four_rooms_on_the_gpu([96, 72]);
     // Blocks of 4 × 4 where no tap but the pixel itself agrees: every pixel starved, its 15
     // other subsets walked by the starved pass, so that its roulette is most of the noise.
     let mut render_in = |starved_taps: u32, walk_roulette: f32, walk_seed: u32| {
-        let p = GatesParams {
-            interleave: InterleaveParams {
-                block: 4,
-                blur_distance: 0.0,
-                starved_taps,
-                ..InterleaveParams::default()
-            },
-            walk_roulette: WalkRoulette::Share(walk_roulette),
-            walk_seed,
-            ..GatesParams::default()
+        let interleave = InterleaveParams {
+            block: 4,
+            blur_distance: 0.0,
+            starved_taps,
+            ..InterleaveParams::default()
         };
-        let params = GpuParams::with_mode(GpuMode::Gates(p));
+        let params = with_roulette(interleave, walk_roulette, walk_seed);
         gpu.render(&ctx, &view, &vpls, &params).expect("render").0
     };
     // Not starved, each pixel its own subset × 16 (no blur): one subset's roulette noise,

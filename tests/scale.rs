@@ -8,7 +8,6 @@ mod common;
 
 use glam::Vec3;
 use visgate_formats::vgate::BakeParams;
-use visgate_formats::{Camera, Light, Scene};
 use visgate_preprocess::bake::{BakeOptions, bake};
 use visgate_runtime::cpu::gates::GateLevel;
 use visgate_runtime::gpu::{METHODS, MethodSettings};
@@ -21,28 +20,10 @@ fn images_at(s: f32, source: VplSource) -> Vec<(String, HdrImage)> {
     images_placed(s, Vec3::ZERO, source)
 }
 
-/// The four rooms scaled by `s` and then moved by `offset` (metres).
-fn placed_four_rooms(s: f32, offset: Vec3) -> (Scene, Camera) {
-    let (mut scene, _) = common::scaled_four_rooms(s);
-    for m in &mut scene.meshes {
-        m.positions.iter_mut().for_each(|p| *p += offset);
-    }
-    for l in &mut scene.lights {
-        let (Light::Point { position, .. } | Light::Spot { position, .. }) = l;
-        *position += offset;
-    }
-    for c in &mut scene.cameras {
-        c.eye += offset;
-        c.target += offset;
-    }
-    let cam = scene.cameras.first().cloned().expect("a camera");
-    (scene, cam)
-}
-
 /// Every method's image of the four rooms scaled by `s` and moved by `offset`, the
 /// reference's last.
 fn images_placed(s: f32, offset: Vec3, source: VplSource) -> Vec<(String, HdrImage)> {
-    let (scene, cam) = placed_four_rooms(s, offset);
+    let (scene, cam) = common::placed_four_rooms(s, offset);
     let level = bake(
         &scene,
         &BakeParams::default(),

@@ -54,37 +54,53 @@ pub fn far_placements(scene: &Scene, desc: &SceneDesc) -> Vec<String> {
     lights
         .chain(cameras)
         .filter_map(|(what, units)| {
-            let off = outside_by(space.point(units), bounds);
+            let p = space.point(units);
+            let off = outside_by(p, bounds);
             let fix = slip(units).then(|| as_units(units));
             let named = match fix {
                 Some(_) => off > NEAR_DIAGONALS * diagonal,
                 None => off > FAR_DIAGONALS * diagonal,
             };
-            named.then(|| far_warning(scene, desc, (&what, units, fix), off))
+            let placed = Placed {
+                what,
+                units,
+                p,
+                off,
+                fix,
+            };
+            named.then(|| far_warning(&placed, bounds, mpu))
         })
         .collect()
 }
 
-/// The warning for `what`, written at `units`, `off` metres outside the level; `fix`: the
-/// numbers to write where those were metres.
-fn far_warning(
-    scene: &Scene,
-    desc: &SceneDesc,
-    (what, units, fix): (&str, [f64; 3], Option<[f64; 3]>),
+/// A light or a camera as [`far_placements`] found it.
+struct Placed {
+    /// What it is (`point light 0`, `camera 'door'`).
+    what: String,
+    /// Its position as written. [Units: the file's]
+    units: [f64; 3],
+    /// Its position. [Units: m]
+    p: Vec3,
+    /// How far outside the level's box it stands. [Units: m]
     off: f32,
-) -> String {
-    let space = SceneSpace::new(desc.up, desc.metres_per_unit);
-    let (lo, hi) = scene
-        .static_bounds()
-        .or_else(|| scene.bounds())
-        .unwrap_or_default();
-    let p = space.point(units);
+    /// The numbers to write where those written were metres.
+    fix: Option<[f64; 3]>,
+}
+
+/// The warning for `placed`, outside the box `(lo, hi)` of a level of `mpu` metres per unit.
+fn far_warning(placed: &Placed, (lo, hi): (Vec3, Vec3), mpu: f64) -> String {
+    let Placed {
+        what,
+        units,
+        p,
+        off,
+        fix,
+    } = placed;
     let mut out = format!(
         "{what} at ({:.2}, {:.2}, {:.2}) m stands {off:.1} m outside the level (its geometry spans \
          ({:.2}, {:.2}, {:.2}) .. ({:.2}, {:.2}, {:.2}) m)",
         p.x, p.y, p.z, lo.x, lo.y, lo.z, hi.x, hi.y, hi.z
     );
-    let mpu = desc.metres_per_unit;
     if mpu != 1.0 {
         out += &format!("; a scene file's positions are in its units (metres_per_unit = {mpu})");
     }
@@ -92,8 +108,8 @@ fn far_warning(
         Some(f) => {
             out += &format!(
                 ", so if ({}) are metres, write ({}) to put it inside",
-                fmt3(DVec3::from(units)),
-                fmt3(DVec3::from(f))
+                fmt3(DVec3::from(*units)),
+                fmt3(DVec3::from(*f))
             );
         }
         None => {

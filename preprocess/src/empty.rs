@@ -203,23 +203,17 @@ pub fn empty_space(
     // A scene that names no camera and no light (a bare mesh): the level's inside keeps its
     // component, as a camera would (inside.rs). Faces wound inside out are read turned
     // (winding.rs).
+    let votes = crate::winding::Votes {
+        faced: &faced,
+        fronts: &fronts,
+        backs: &backs,
+        at_bounds: &at_bounds,
+    };
     let (inside_component, faces_turned) = if bare {
         let is_empty = |i: usize| empty[i];
-        let votes = crate::winding::Votes {
-            faced: &faced,
-            fronts: &fronts,
-            backs: &backs,
-            at_bounds: &at_bounds,
-        };
         crate::winding::bare_inside(meta, &comps, &votes, &voxels, &is_empty)
     } else {
         let seeded: Vec<bool> = seeds_in.iter().map(|s| !s.is_empty()).collect();
-        let votes = crate::winding::Votes {
-            faced: &faced,
-            fronts: &fronts,
-            backs: &backs,
-            at_bounds: &at_bounds,
-        };
         let turned = crate::winding::rooms_turned(&votes, &seeded)
             && !crate::winding::turning_drops_more(&votes, &seeded, &voxels);
         (None, turned)

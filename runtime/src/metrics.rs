@@ -138,29 +138,26 @@ impl IndirectMap {
 
     /// The energy ratio and the black-where-lit shares.
     pub fn errors(&self) -> IndirectErrors {
-        let count = |keep: &dyn Fn(usize) -> bool| {
-            let (mut lit, mut black) = (0usize, 0usize);
-            for (i, c) in self.class.iter().enumerate() {
-                if *c != Lit::Not && keep(i) {
-                    lit += 1;
-                    black += usize::from(*c == Lit::Black);
+        // Lit and black pixels: [left in, every one].
+        let (mut lit, mut black) = ([0usize; 2], [0usize; 2]);
+        for (i, c) in self.class.iter().enumerate() {
+            if *c != Lit::Not {
+                for (k, counted) in [!self.is_mixed(i), true].into_iter().enumerate() {
+                    lit[k] += usize::from(counted);
+                    black[k] += usize::from(counted && *c == Lit::Black);
                 }
             }
-            (lit, black)
-        };
-        let share = |keep: &dyn Fn(usize) -> bool| {
-            let (lit, black) = count(keep);
-            black as f64 / lit.max(1) as f64
-        };
+        }
+        let share = |k: usize| black[k] as f64 / lit[k].max(1) as f64;
         IndirectErrors {
             energy_ratio: if self.mean_r > 0.0 {
                 self.mean_a / self.mean_r
             } else {
                 1.0
             },
-            black_where_lit: share(&|i| !self.is_mixed(i)),
-            black_where_lit_all: share(&|_| true),
-            lit_pixels: count(&|i| !self.is_mixed(i)).0 as u64,
+            black_where_lit: share(0),
+            black_where_lit_all: share(1),
+            lit_pixels: lit[0] as u64,
         }
     }
 

@@ -333,3 +333,13 @@ pub fn clamp_loss(vpls: &[Vpl], x: Vec3, n: Vec3, params: &GatherParams) -> f32 
     }
     if b > 0.0 { (1.0 - a / b) as f32 } else { 0.0 }
 }
+
+/// What a user reads when `asked` light paths made no VPL (every light outside the level, or
+/// its positions written in the wrong units), `then` saying what follows for them.
+pub fn no_light_paths(asked: u32, then: &str) -> String {
+    format!(
+        "no light path from the scene's lights met the geometry (0 VPLs of {asked} asked): \
+         {then}. Is each light inside the level? (A scene file's positions are in its units, \
+         `metres_per_unit`.)"
+    )
+}

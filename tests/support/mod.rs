@@ -15,6 +15,15 @@ pub fn visgate(args: &[&str]) -> Output {
         .expect("runs visgate")
 }
 
+/// `visgate ARGS` with warnings shown, as a user sees them.
+pub fn visgate_warn(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_visgate"))
+        .args(args)
+        .env("RUST_LOG", "warn")
+        .output()
+        .expect("runs visgate")
+}
+
 /// Its standard output.
 pub fn stdout(o: &Output) -> String {
     String::from_utf8_lossy(&o.stdout).into_owned()

@@ -102,11 +102,10 @@ fn reference_text(rf: &ReferenceRow) -> String {
 /// prove nothing (a scene whose lights or camera were written in the wrong units).
 pub(super) fn reference_warning(vpls: u32, vpl_count: usize, image: &HdrImage) -> Option<String> {
     if vpls > 0 && vpl_count == 0 {
-        return Some(format!(
-            "no light path from the scene's lights met the geometry (0 VPLs of {vpls} asked): \
-             there is no indirect light to compare, and every method matches this reference to \
-             the digit. Is each light inside the level? (A scene file's positions are in its \
-             units, `metres_per_unit`.)"
+        return Some(crate::vpl::no_light_paths(
+            vpls,
+            "there is no indirect light to compare, and every method matches this reference to \
+             the digit",
         ));
     }
     (image.mean().max_element() <= 0.0).then(|| {

@@ -106,9 +106,17 @@ pub fn closed_box(r: f32) -> Vec<[Vec3; 4]> {
 /// empty space that holds them) × `scale` and the lights' intensities × `scale²`, so that the
 /// image is the same at any scale.
 pub fn scaled_four_rooms(scale: f32) -> (Scene, Camera) {
+    placed_four_rooms(scale, Vec3::ZERO)
+}
+
+/// The four rooms scaled by `scale` (as [`scaled_four_rooms`]), then moved by `offset`
+/// (metres), and its first camera.
+pub fn placed_four_rooms(scale: f32, offset: Vec3) -> (Scene, Camera) {
     let mut s = Builtin::FourRooms.scene().expect("scene");
     for m in &mut s.meshes {
-        m.positions.iter_mut().for_each(|p| *p *= scale);
+        m.positions
+            .iter_mut()
+            .for_each(|p| *p = *p * scale + offset);
     }
     for l in &mut s.lights {
         let (Light::Point {
@@ -120,12 +128,12 @@ pub fn scaled_four_rooms(scale: f32) -> (Scene, Camera) {
             intensity,
             ..
         }) = l;
-        *position *= scale;
+        *position = *position * scale + offset;
         *intensity *= scale * scale;
     }
     for c in &mut s.cameras {
-        c.eye *= scale;
-        c.target *= scale;
+        c.eye = c.eye * scale + offset;
+        c.target = c.target * scale + offset;
     }
     let cam = s.cameras.first().cloned().expect("a camera");
     (s, cam)
