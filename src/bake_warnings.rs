@@ -35,7 +35,35 @@ pub fn warnings(report: &BakeReport) -> Vec<String> {
     if let Some(r) = radius {
         out.extend(too_coarse(r, report.summary.clusters, &report.grid));
     }
+    let sight_bytes = report
+        .stages
+        .iter()
+        .find(|s| s.name == "sight grid")
+        .and_then(|s| s.counts["bytes"].as_u64());
+    out.extend(sight_bytes.and_then(sight_grid_too_large));
     out
+}
+
+/// The storage binding limit over which [`sight_grid_too_large`] warns: wgpu's default and
+/// lavapipe's (discrete GPUs allow 1–4 GiB). [Units: bytes]
+const GPU_BINDING_DEFAULT: u64 = 128 << 20;
+
+/// A warning where the sight grid, on the GPU (its bits and as many bytes again of bricks), is
+/// larger than [`GPU_BINDING_DEFAULT`]: an adapter that allows no more refuses to walk it (the
+/// ajar door with `--sight-voxel 0.005`: 194 MB, refused on lavapipe).
+fn sight_grid_too_large(bits_bytes: u64) -> Option<String> {
+    let gpu = 2 * bits_bytes;
+    (gpu > GPU_BINDING_DEFAULT).then(|| {
+        format!(
+            "the sight grid takes about {} MiB on the GPU (its bits and bricks), over the {} MiB \
+             that wgpu allows by default and lavapipe at most: adapters that allow no more \
+             refuse the voxel walk (--gate-shape voxels) on this level; most discrete GPUs \
+             allow 1-4 GiB. A coarser --sight-voxel fits it (the grid shrinks with the cube of \
+             the voxel)",
+            gpu >> 20,
+            GPU_BINDING_DEFAULT >> 20
+        )
+    })
 }
 
 /// A warning where the bake read the level's faces turned, wound inside out
@@ -291,6 +319,18 @@ fn most_dropped(empty_space: &Value, grid: &GridMeta) -> Option<String> {
 mod tests {
     use super::*;
     use serde_json::json;
+
+    #[test]
+    fn a_sight_grid_over_wgpus_default_binding_is_told_with_its_size() {
+        // The sun window's at 5 mm: 97 MB of bits, 185 MiB with its bricks.
+        let said = sight_grid_too_large(97_127_222).expect("over 128 MiB");
+        assert!(
+            said.contains("185 MiB") && said.contains("--sight-voxel"),
+            "{said}"
+        );
+        // Crytek Sponza's at 1/1024 of the level: 35 MB of bits, 67 MiB.
+        assert_eq!(sight_grid_too_large(35 << 20), None);
+    }
 
     #[test]
     fn an_enclosed_part_dropped_and_larger_than_all_kept_is_named_and_the_outside_is_not() {

@@ -7,12 +7,18 @@ use clap::{Args, Subcommand};
 use visgate_formats::mitsuba::{MitsubaOptions, write};
 
 pub const EXPORT_HELP: &str = "\
+glTF writes the scene as visgate sees it — +Y up, metres, its meshes, albedos, point and spot
+lights (KHR_lights_punctual, W/sr as candela: x 683) and cameras — one file with its buffer
+beside it, to open in Blender or another engine. Given bare to any visgate command it reads
+back as the same scene (textures are not written).
+
 Mitsuba 3 renders the exported scene as visgate's CPU reference converges to it (direct light
 and one bounce, box filter, horizontal field of view, two-sided Lambertian, the same albedos and
 textures, point and spot lights in W/sr): an independent ground truth for `visgate compare
 --ground-truth`. bench/mitsuba.sh sets Mitsuba up in a virtual environment and renders it.
 
 Examples:
+  visgate export gltf builtin:ajar-door ajar-door.gltf
   visgate export mitsuba builtin:cornell-box cornell-mi --size 256x256 --spp 4096
   bench/mitsuba.sh cornell-mi/scene.xml cornell-mi/out";
 
@@ -21,6 +27,19 @@ pub enum ExportAction {
     /// Mitsuba 3: DIR/scene.xml (a sensor per camera, in order), DIR/meshes/*.obj,
     /// DIR/textures/*.exr.
     Mitsuba(MitsubaArgs),
+    /// glTF 2.0: OUT.gltf and OUT.bin beside it — meshes, albedos, lights, cameras.
+    Gltf(GltfArgs),
+}
+
+#[derive(Debug, Args)]
+pub struct GltfArgs {
+    /// The scene: a .toml, .obj, .gltf/.glb file or builtin:NAME.
+    pub scene: String,
+    /// The glTF file to write (its buffer goes beside it, with the extension .bin).
+    pub out: PathBuf,
+    /// Time the scene's dynamic meshes and lights are posed at, seconds.
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub time: f64,
 }
 
 #[derive(Debug, Args)]
@@ -45,7 +64,50 @@ pub struct MitsubaArgs {
 }
 
 pub fn run(action: ExportAction) -> Result<()> {
-    let ExportAction::Mitsuba(args) = action;
+    match action {
+        ExportAction::Mitsuba(args) => mitsuba(args),
+        ExportAction::Gltf(args) => gltf(args),
+    }
+}
+
+fn gltf(args: GltfArgs) -> Result<()> {
+    if args.out.extension().and_then(|e| e.to_str()) != Some("gltf") {
+        bail!(
+            "{}: the output must end in .gltf (its buffer is written beside it as .bin)",
+            args.out.display()
+        );
+    }
+    let scene = crate::load_scene(&args.scene, false)?.at(args.time);
+    let bin = args.out.with_extension("bin");
+    let bin_name = bin
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let (json, bytes) = visgate_formats::gltf_export::to_gltf(&scene, &bin_name);
+    if let Some(dir) = args.out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    }
+    std::fs::write(&bin, bytes).with_context(|| format!("cannot write {}", bin.display()))?;
+    std::fs::write(&args.out, json)
+        .with_context(|| format!("cannot write {}", args.out.display()))?;
+    println!(
+        "wrote {} and {} ({} meshes, {} materials, {} lights, {} cameras{})",
+        args.out.display(),
+        bin.display(),
+        scene.meshes.len(),
+        scene.materials.len(),
+        scene.lights.len(),
+        scene.cameras.len(),
+        if scene.textures.is_empty() {
+            ""
+        } else {
+            "; textures not written"
+        }
+    );
+    Ok(())
+}
+
+fn mitsuba(args: MitsubaArgs) -> Result<()> {
     if args.spp == 0 || args.max_depth < 2 {
         bail!("--spp must be ≥ 1 and --max-depth ≥ 2 (2: direct light, 3: one bounce)");
     }

@@ -101,7 +101,8 @@ enum Command {
     /// report (Markdown, HTML, JSON) and the answer to a time budget or an error bound.
     #[command(after_help = compare::COMPARE_HELP)]
     Compare(compare::CompareArgs),
-    /// Write a scene for another renderer (Mitsuba 3: an independent ground truth).
+    /// Write a scene for another renderer or tool: Mitsuba 3 (an independent ground truth) or
+    /// glTF (Blender, engines; reads back bare as the same scene).
     #[command(after_help = export::EXPORT_HELP)]
     Export {
         #[command(subcommand)]

@@ -70,6 +70,11 @@ pub struct ImportedModel {
     pub textures_failed: u64,
     /// Warnings, in order.
     pub warnings: Vec<String>,
+    /// Point and spot lights the file places (glTF's `KHR_lights_punctual`), in its units and
+    /// axes ([`crate::gltf_nodes`]); none from an OBJ.
+    pub lights: Vec<crate::desc::LightDesc>,
+    /// Perspective cameras the file places (glTF), in its units and axes.
+    pub cameras: Vec<crate::desc::CameraDesc>,
 }
 
 /// Imports an OBJ, glTF or GLB file, chosen by its extension.
@@ -325,6 +330,9 @@ pub fn import_gltf(path: &Path, options: &ImportOptions) -> Result<ImportedModel
     let scene = document
         .default_scene()
         .or_else(|| document.scenes().next());
+    if let Some(s) = &scene {
+        crate::gltf_nodes::read_nodes(path, s, &mut out);
+    }
     let mut stack: Vec<(gltf::Node, Mat4)> = match &scene {
         Some(s) => s.nodes().map(|n| (n, Mat4::IDENTITY)).collect(),
         None => vec![],

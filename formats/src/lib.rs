@@ -19,6 +19,8 @@ pub mod desc;
 pub mod error;
 pub mod export;
 pub mod geom;
+pub mod gltf_export;
+pub mod gltf_nodes;
 pub mod import;
 pub mod load;
 pub mod mitsuba;

@@ -216,6 +216,37 @@ fn read_bare(
     notes
 }
 
+/// What a scene TOML leaves unread of its mesh files: the lights and cameras a glTF places
+/// where the TOML states none of its own (logged as well).
+fn unread_lights_and_cameras(
+    desc: &SceneDesc,
+    models: &[ImportedModel],
+    path: &Path,
+) -> Vec<String> {
+    let mut notes = Vec::new();
+    let (lights, cameras) = models.iter().fold((0, 0), |(l, c), m| {
+        (l + m.lights.len(), c + m.cameras.len())
+    });
+    if desc.lights.is_empty() && lights > 0 {
+        notes.push(format!(
+            "{}: its mesh files place {lights} light(s), which a scene TOML does not read: state \
+             them as [[light]] (a glTF given bare, without a TOML, brings its own)",
+            path.display()
+        ));
+    }
+    if desc.cameras.is_empty() && cameras > 0 {
+        notes.push(format!(
+            "{}: its mesh files place {cameras} camera(s), which a scene TOML does not read: \
+             state them as [[camera]] (a glTF given bare, without a TOML, brings its own)",
+            path.display()
+        ));
+    }
+    for note in &notes {
+        tracing::warn!("{note}");
+    }
+    notes
+}
+
 impl Scene {
     /// Loads a scene TOML, or a bare OBJ/glTF/GLB file as one static mesh with no lights, in
     /// the units [`bare_mesh_units`] picks from its size.
@@ -246,10 +277,18 @@ impl Scene {
             .iter()
             .map(|m| import::import_file(&base.join(&m.path), options))
             .collect::<Result<Vec<_>, _>>()?;
-        let notes = match kind {
+        let mut notes = match kind {
             Some(k) if bare => read_bare(&mut desc, &models, path, k, options.bare),
             _ => Vec::new(),
         };
+        if bare {
+            // A bare glTF file brings the lights and cameras it places (gltf_nodes.rs).
+            desc.lights = models.iter().flat_map(|m| m.lights.clone()).collect();
+            desc.cameras = models.iter().flat_map(|m| m.cameras.clone()).collect();
+            desc.validate(path)?;
+        } else {
+            notes.extend(unread_lights_and_cameras(&desc, &models, path));
+        }
         let mut scene = Scene::assemble(&desc, models, path)?;
         scene.report.warnings.extend(notes);
         scene.report.load_seconds = start.elapsed().as_secs_f64();

@@ -448,6 +448,10 @@ pub fn default_partition_voxel(longest: f32, voxel_m: f32) -> f32 {
     }
 }
 
+/// Bytes a sight grid's voxel costs at its peak: its closed bits and its open bits as it is
+/// voxelized, the file's copy and the runtime's bricks (an eighth of a byte each, and less).
+const SIGHT_BYTES_PER_VOXEL: f64 = 0.5;
+
 /// The sight grid ([`BakeParams::sight_voxel_m`], filled in: the level's grid, or its bounds at
 /// the finer sight voxel) and its open voxels, voxelized thin ([`crate::separating`]).
 fn sight_grid(
@@ -458,11 +462,18 @@ fn sight_grid(
 ) -> Result<((GridMeta, VoxelBits), SightCounts), BakeError> {
     let size = params.sight_voxel_m.unwrap_or(meta.voxel_size_m);
     let grid = if size < 0.99 * meta.voxel_size_m {
-        grid_for(
-            input.bounds,
-            Resolution::VoxelSizeM(size),
-            options.memory_limit_bytes,
-        )?
+        // A bit a voxel, not the whole bake's bytes: checked against its own cost.
+        let grid = grid_for(input.bounds, Resolution::VoxelSizeM(size), u64::MAX)?;
+        let bytes = grid.dims.map(f64::from).iter().product::<f64>() * SIGHT_BYTES_PER_VOXEL;
+        if bytes > options.memory_limit_bytes as f64 {
+            return Err(BakeError::SightTooLarge {
+                dims: grid.dims.map(f64::from),
+                voxel_m: size,
+                bytes,
+                limit: options.memory_limit_bytes,
+            });
+        }
+        grid
     } else {
         *meta
     };

@@ -80,6 +80,22 @@ pub enum BakeError {
         /// The limit.
         limit: u64,
     },
+    /// The sight grid at `--sight-voxel` would not fit in the memory limit; nothing was
+    /// allocated.
+    #[error(
+        "the sight grid at --sight-voxel {voxel_m} m is {:.0} x {:.0} x {:.0} voxels and needs about {:.1} GiB, over the limit of {:.1} GiB; raise --sight-voxel",
+        dims[0], dims[1], dims[2], *bytes / f64::from(1u32 << 30), *limit as f64 / f64::from(1u32 << 30)
+    )]
+    SightTooLarge {
+        /// The sight grid's dimensions.
+        dims: [f64; 3],
+        /// Its voxel. [Units: m]
+        voxel_m: f32,
+        /// Bytes it would need.
+        bytes: f64,
+        /// The limit.
+        limit: u64,
+    },
 }
 
 /// xorshift32 from `seed` (not 0): the same pseudo-random sequence every run, for tests that

@@ -756,6 +756,23 @@ fn no_empty_space_no_triangles_and_too_much_memory_are_clear_errors() {
         other => panic!("expected TooLarge, got {other}"),
     }
     assert!(e.to_string().contains("GiB"), "{e}");
+
+    // A fine sight grid is a bit a voxel: checked on its own, it bakes where a level grid of
+    // its voxels would not (the room's 4.4 m bounds at 1 cm: 443 x 343 x 443 voxels, 34 MB at
+    // half a byte, 1.5 GiB at a bake's 24 bytes) and is refused past the limit with its own flag.
+    let fine = |m: f32| BakeParams {
+        sight_voxel_m: Some(m),
+        ..params(16)
+    };
+    let opts = BakeOptions {
+        memory_limit_bytes: 64 << 20,
+        ..BakeOptions::default()
+    };
+    let baked = bake(&s, &fine(0.01), &opts, &|_| {}).expect("a 1 cm sight grid fits");
+    assert_eq!(baked.level.info.sight_grid.dims, [443, 343, 443]);
+    let e = bake(&s, &fine(0.004), &opts, &|_| {}).expect_err("too large");
+    assert!(matches!(e, BakeError::SightTooLarge { .. }), "{e}");
+    assert!(e.to_string().contains("raise --sight-voxel"), "{e}");
 }
 
 #[test]
