@@ -17,9 +17,13 @@
 use crate::RenderError;
 
 /// The include files (`gpu/shaders/`).
-const INCLUDES: [(&str, &str); 11] = [
+const INCLUDES: [(&str, &str); 12] = [
     ("globals.wgsl", include_str!("shaders/globals.wgsl")),
     ("lights.wgsl", include_str!("shaders/lights.wgsl")),
+    (
+        "shadow_lookup.wgsl",
+        include_str!("shaders/shadow_lookup.wgsl"),
+    ),
     ("vpl.wgsl", include_str!("shaders/vpl.wgsl")),
     ("grid.wgsl", include_str!("shaders/grid.wgsl")),
     ("gates.wgsl", include_str!("shaders/gates.wgsl")),

@@ -1,5 +1,6 @@
-//! include: globals.wgsl lights.wgsl vpl.wgsl gates.wgsl portals.wgsl sight.wgsl
-// Deferred shading: direct light from point and spot lights with shadow-map PCF (3 × 3), and
+//! include: globals.wgsl lights.wgsl shadow_lookup.wgsl vpl.wgsl gates.wgsl portals.wgsl sight.wgsl
+// Deferred shading: direct light from point and spot lights with shadow-map PCF (3 × 3, a contact
+// test at thin walls' joins: shadow_lookup.wgsl), and
 // the indirect sum over VPLs without visibility (SHADE_ALL), through the gates of a baked
 // level per pixel (SHADE_GATES_PER_PIXEL) or by clustered light lists (SHADE_GATES_CLUSTERED),
 // or none (SHADE_DIRECT: direct light only), into a linear HDR target.
@@ -85,7 +86,7 @@ fn direct_visibility(i: u32, l: Light, p: vec3<f32>, n: vec3<f32>, px: vec2<i32>
         }
         return textureLoad(lc_visibility, px, i32(c / 4u), 0)[c % 4u];
     }
-    return shadow(l, p, n);
+    return shadow(l, p, n, face_normal(px));
 }
 
 // The face's own normal at pixel px (the G-buffer's encode_face_normal).
@@ -158,45 +159,6 @@ fn through_gates(a: vec3<f32>, ca: u32, b: vec3<f32>, cb: u32) -> bool {
         }
     }
     return false;
-}
-
-// Visibility of `p` (normal `n`) from light `l`: 3 × 3 PCF of distance comparisons.
-fn shadow(l: Light, p: vec3<f32>, n: vec3<f32>) -> f32 {
-    let size = f32(globals.shadow_size);
-    let d = p - l.position.xyz;
-    let dist = length(d);
-    var layer = l.layers.x;
-    // Texel footprint at this distance: 90° faces span 2·dist, a spot's layer 2·dist·tan(cutoff).
-    var span = 2.0 * dist;
-    // Six layers: the cube faces of a point light or of a spot too wide for one frustum.
-    if l.layers.y == 6u {
-        let a = abs(d);
-        if a.x >= a.y && a.x >= a.z {
-            layer += select(1u, 0u, d.x > 0.0);
-        } else if a.y >= a.z {
-            layer += select(3u, 2u, d.y > 0.0);
-        } else {
-            layer += select(5u, 4u, d.z > 0.0);
-        }
-    } else {
-        span = 2.0 * dist * tan(l.direction.w);
-    }
-    let texel = span / size;
-    let q = p + n * texel * globals.shadow_normal_offset;
-    let clip = shadow_mats[layer] * vec4<f32>(q, 1.0);
-    let ndc = clip.xyz / clip.w;
-    let uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
-    let c = vec2<i32>(uv * size);
-    let ref_dist = length(q - l.position.xyz) - texel * globals.shadow_bias;
-    var lit = 0.0;
-    for (var dy = -1; dy <= 1; dy++) {
-        for (var dx = -1; dx <= 1; dx++) {
-            let t = clamp(c + vec2<i32>(dx, dy), vec2<i32>(0), vec2<i32>(i32(size) - 1));
-            let stored = textureLoad(shadow_maps, t, i32(layer), 0).x;
-            lit += select(0.0, 1.0, stored >= ref_dist);
-        }
-    }
-    return lit / 9.0;
 }
 
 // The shading pass (a compute pass, as every pass over the frame's pixels: cs_gates_indirect
