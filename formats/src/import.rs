@@ -75,6 +75,9 @@ pub struct ImportedModel {
     pub lights: Vec<crate::desc::LightDesc>,
     /// Perspective cameras the file places (glTF), in its units and axes.
     pub cameras: Vec<crate::desc::CameraDesc>,
+    /// Materials that glow (an OBJ's `Ke`, a glTF's emissive factor above 0): visgate lights
+    /// by point and spot lights alone, so they add no light.
+    pub emissive: Vec<String>,
 }
 
 /// Imports an OBJ, glTF or GLB file, chosen by its extension.
@@ -181,6 +184,9 @@ fn import_obj_reader(
     });
     let mut textures = TextureCache::new(options.load_textures);
     for m in &materials {
+        if m.emissive.is_some_and(|e| e.iter().any(|&c| c > 0.0)) {
+            out.emissive.push(m.name.clone());
+        }
         let texture = m
             .diffuse_texture
             .as_deref()
@@ -300,6 +306,9 @@ pub fn import_gltf(path: &Path, options: &ImportOptions) -> Result<ImportedModel
         }
     }
     for m in document.materials() {
+        if m.emissive_factor().iter().any(|&c| c > 0.0) {
+            out.emissive.push(m.name().unwrap_or("unnamed").to_string());
+        }
         let pbr = m.pbr_metallic_roughness();
         let base_color = pbr.base_color_factor();
         let mut texture = pbr

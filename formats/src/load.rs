@@ -216,6 +216,24 @@ fn read_bare(
     notes
 }
 
+/// What a user reads when a scene with no light has materials that glow (logged as well).
+fn glowing_warning(path: &Path, glowing: &[String]) -> Option<String> {
+    let (first, more) = match glowing {
+        [] => return None,
+        [a] => (a.clone(), String::new()),
+        [a, rest @ ..] => (a.clone(), format!(" and {} more", rest.len())),
+    };
+    let note = format!(
+        "{}: material '{first}'{more} glows, but visgate lights by point and spot lights alone: \
+         an emissive surface adds no light. Place a light at each (a [[light]] in a scene TOML, \
+         or a KHR_lights_punctual light in the glTF); until then render, view and compare add \
+         one of their own and say where",
+        path.display()
+    );
+    tracing::warn!("{note}");
+    Some(note)
+}
+
 /// What a scene TOML leaves unread of its mesh files: the lights and cameras a glTF places
 /// where the TOML states none of its own (logged as well).
 fn unread_lights_and_cameras(
@@ -289,7 +307,11 @@ impl Scene {
         } else {
             notes.extend(unread_lights_and_cameras(&desc, &models, path));
         }
+        let glowing: Vec<String> = models.iter().flat_map(|m| m.emissive.clone()).collect();
         let mut scene = Scene::assemble(&desc, models, path)?;
+        if scene.lights.is_empty() {
+            notes.extend(glowing_warning(path, &glowing));
+        }
         scene.report.warnings.extend(notes);
         scene.report.load_seconds = start.elapsed().as_secs_f64();
         Ok(scene)

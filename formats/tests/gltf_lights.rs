@@ -155,3 +155,37 @@ fn a_scene_toml_says_when_it_leaves_its_gltfs_lights_and_cameras_unread() {
     let said = scene.report.warnings.join("\n");
     assert!(!said.contains("does not read"), "{said}");
 }
+
+#[test]
+fn glowing_materials_in_a_scene_without_lights_are_told_to_need_a_light() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    std::fs::write(
+        d.join("lamp.mtl"),
+        "newmtl bulb\nKd 1 1 1\nKe 10 10 8\nnewmtl wall\nKd 0.5 0.5 0.5\nKe 0 0 0\n",
+    )
+    .expect("mtl");
+    std::fs::write(
+        d.join("lamp.obj"),
+        "mtllib lamp.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nusemtl bulb\nf 1 2 3\n\
+         usemtl wall\nf 1 2 4\n",
+    )
+    .expect("obj");
+    let said = |p: &Path| {
+        Scene::load(p, &ImportOptions::default())
+            .expect("loads")
+            .report
+            .warnings
+            .join("\n")
+    };
+    let obj = said(&d.join("lamp.obj"));
+    assert!(obj.contains("material 'bulb' glows"), "{obj}");
+    assert!(!obj.contains("'wall'"), "{obj}");
+    // A glTF's emissive factor glows too; with a light of its own, nothing is said.
+    let nodes = r#"{"extensions":{"KHR_lights_punctual":{"light":0}}}"#;
+    let glow = r#","materials":[{"name":"panel","emissiveFactor":[1,1,1]}]"#;
+    let p = gltf(d, r#"{"name":"empty"}"#, glow, "[0]");
+    assert!(said(&p).contains("material 'panel' glows"), "{}", said(&p));
+    let p = gltf(d, nodes, &format!("{LIGHTS}{glow}"), "[0,1]");
+    assert!(!said(&p).contains("glows"), "{}", said(&p));
+}
