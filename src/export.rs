@@ -10,7 +10,7 @@ pub const EXPORT_HELP: &str = "\
 glTF writes the scene as visgate sees it — +Y up, metres, its meshes, albedos, point and spot
 lights (KHR_lights_punctual, W/sr as candela: x 683) and cameras — one file with its buffer
 beside it, to open in Blender or another engine. Given bare to any visgate command it reads
-back as the same scene (textures are not written).
+back as the same scene (textures are not written). OUT.glb writes it as one binary file.
 
 Mitsuba 3 renders the exported scene as visgate's CPU reference converges to it (direct light
 and one bounce, box filter, horizontal field of view, two-sided Lambertian, the same albedos and
@@ -27,7 +27,8 @@ pub enum ExportAction {
     /// Mitsuba 3: DIR/scene.xml (a sensor per camera, in order), DIR/meshes/*.obj,
     /// DIR/textures/*.exr.
     Mitsuba(MitsubaArgs),
-    /// glTF 2.0: OUT.gltf and OUT.bin beside it — meshes, albedos, lights, cameras.
+    /// glTF 2.0: OUT.gltf and OUT.bin beside it, or one OUT.glb — meshes, albedos, lights,
+    /// cameras.
     Gltf(GltfArgs),
 }
 
@@ -35,7 +36,7 @@ pub enum ExportAction {
 pub struct GltfArgs {
     /// The scene: a .toml, .obj, .gltf/.glb file or builtin:NAME.
     pub scene: String,
-    /// The glTF file to write (its buffer goes beside it, with the extension .bin).
+    /// The file to write: .gltf (its buffer beside it, with the extension .bin) or .glb.
     pub out: PathBuf,
     /// Time the scene's dynamic meshes and lights are posed at, seconds.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
@@ -71,29 +72,38 @@ pub fn run(action: ExportAction) -> Result<()> {
 }
 
 fn gltf(args: GltfArgs) -> Result<()> {
-    if args.out.extension().and_then(|e| e.to_str()) != Some("gltf") {
-        bail!(
-            "{}: the output must end in .gltf (its buffer is written beside it as .bin)",
+    let glb = match args.out.extension().and_then(|e| e.to_str()) {
+        Some("gltf") => false,
+        Some("glb") => true,
+        _ => bail!(
+            "{}: the output must end in .gltf (its buffer written beside it as .bin) or .glb \
+             (one file)",
             args.out.display()
-        );
-    }
+        ),
+    };
     let scene = crate::load_scene(&args.scene, false)?.at(args.time);
-    let bin = args.out.with_extension("bin");
-    let bin_name = bin
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let (json, bytes) = visgate_formats::gltf_export::to_gltf(&scene, &bin_name);
     if let Some(dir) = args.out.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     }
-    std::fs::write(&bin, bytes).with_context(|| format!("cannot write {}", bin.display()))?;
-    std::fs::write(&args.out, json)
-        .with_context(|| format!("cannot write {}", args.out.display()))?;
+    let write = |path: &std::path::Path, bytes: &[u8]| {
+        std::fs::write(path, bytes).with_context(|| format!("cannot write {}", path.display()))
+    };
+    let wrote = if glb {
+        write(&args.out, &visgate_formats::gltf_export::to_glb(&scene))?;
+        args.out.display().to_string()
+    } else {
+        let bin = args.out.with_extension("bin");
+        let bin_name = bin
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        let (json, bytes) = visgate_formats::gltf_export::to_gltf(&scene, Some(&bin_name));
+        write(&bin, &bytes)?;
+        write(&args.out, json.as_bytes())?;
+        format!("{} and {}", args.out.display(), bin.display())
+    };
     println!(
-        "wrote {} and {} ({} meshes, {} materials, {} lights, {} cameras{})",
-        args.out.display(),
-        bin.display(),
+        "wrote {wrote} ({} meshes, {} materials, {} lights, {} cameras{})",
         scene.meshes.len(),
         scene.materials.len(),
         scene.lights.len(),

@@ -1,5 +1,5 @@
 //! A level exported from another tool as a bare glTF file comes with its lights and cameras:
-//! `visgate export gltf` writes a scene that way, and given bare it reads back as the same
+//! `visgate export gltf` writes a scene that way (as .gltf + .bin, or one .glb), and given bare it reads back as the same
 //! scene — the same lights, cameras and image.
 
 mod support;
@@ -61,14 +61,37 @@ fn a_scene_exported_as_gltf_reads_back_bare_with_its_lights_and_cameras() {
 }
 
 #[test]
-fn export_gltf_refuses_an_output_that_is_not_gltf() {
+fn a_scene_exported_as_one_glb_file_reads_back_the_same() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let glb = dir.path().join("sun-window.glb");
+    let o = visgate(&["export", "gltf", "builtin:sun-window", s(&glb)]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(!glb.with_extension("bin").exists());
+    let a = render("builtin:sun-window", "window", &dir.path().join("a.exr"));
+    let b = render(s(&glb), "window", &dir.path().join("b.exr"));
+    let mean = a.iter().sum::<f32>() / a.len() as f32;
+    let mse = a.iter().zip(&b).map(|(x, y)| (x - y).powi(2)).sum::<f32>() / a.len() as f32;
+    assert!(mean > 1e-3, "mean {mean}");
+    assert!(
+        mse / (mean * mean) < 1e-6,
+        "relative MSE {}",
+        mse / (mean * mean)
+    );
+}
+
+#[test]
+fn export_gltf_refuses_an_output_that_is_not_gltf_or_glb() {
     let dir = tempfile::tempdir().expect("tempdir");
     let o = visgate_warn(&[
         "export",
         "gltf",
         "builtin:four-rooms",
-        s(&dir.path().join("x.glb")),
+        s(&dir.path().join("x.fbx")),
     ]);
     assert!(!o.status.success());
-    assert!(stderr(&o).contains("must end in .gltf"), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("must end in .gltf") && stderr(&o).contains(".glb"),
+        "{}",
+        stderr(&o)
+    );
 }

@@ -19,8 +19,8 @@ const FLOAT: u32 = 5126;
 const UNSIGNED_INT: u32 = 5125;
 
 /// The glTF JSON of `scene` and its binary buffer; the JSON refers to the buffer as
-/// `bin_file_name` (beside it).
-pub fn to_gltf(scene: &Scene, bin_file_name: &str) -> (String, Vec<u8>) {
+/// `bin_file_name` (beside it), or, with `None`, as a GLB's own binary chunk ([`to_glb`]).
+pub fn to_gltf(scene: &Scene, bin_file_name: Option<&str>) -> (String, Vec<u8>) {
     let mut out = Writer::default();
     for mesh in &scene.meshes {
         out.mesh(mesh);
@@ -51,7 +51,10 @@ pub fn to_gltf(scene: &Scene, bin_file_name: &str) -> (String, Vec<u8>) {
         "scene": 0,
         "scenes": [{"nodes": (0..out.nodes.len()).collect::<Vec<_>>()}],
         "nodes": out.nodes, "meshes": out.meshes, "materials": materials,
-        "buffers": [{"uri": bin_file_name, "byteLength": out.bin.len()}],
+        "buffers": [match bin_file_name {
+            Some(uri) => json!({"uri": uri, "byteLength": out.bin.len()}),
+            None => json!({"byteLength": out.bin.len()}),
+        }],
         "bufferViews": out.views, "accessors": out.accessors,
     });
     if !cameras.is_empty() {
@@ -63,6 +66,29 @@ pub fn to_gltf(scene: &Scene, bin_file_name: &str) -> (String, Vec<u8>) {
     }
     let text = serde_json::to_string_pretty(&doc).expect("a JSON value always serializes");
     (text, out.bin)
+}
+
+/// `scene` as one GLB file: the 12-byte header, the JSON chunk (padded with spaces) and the
+/// binary chunk (padded with zeros), each 4-byte aligned.
+pub fn to_glb(scene: &Scene) -> Vec<u8> {
+    let (json, bin) = to_gltf(scene, None);
+    let mut json = json.into_bytes();
+    json.resize(json.len().next_multiple_of(4), b' ');
+    let mut bin = bin;
+    bin.resize(bin.len().next_multiple_of(4), 0);
+    let total = 12 + 8 + json.len() + 8 + bin.len();
+    let mut out = Vec::with_capacity(total);
+    let word = |out: &mut Vec<u8>, w: u32| out.extend_from_slice(&w.to_le_bytes());
+    out.extend_from_slice(b"glTF");
+    word(&mut out, 2);
+    word(&mut out, total as u32);
+    word(&mut out, json.len() as u32);
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&json);
+    word(&mut out, bin.len() as u32);
+    out.extend_from_slice(b"BIN\0");
+    out.extend_from_slice(&bin);
+    out
 }
 
 /// The document's arrays as they fill.
