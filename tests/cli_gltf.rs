@@ -30,6 +30,20 @@ fn render(scene: &str, camera: &str, out: &Path) -> Vec<f32> {
     image::open(out).expect("exr").to_rgb32f().into_raw()
 }
 
+/// `scene` and `file` (its export) give `camera` the same lit image (relative MSE < 1e-6).
+fn same_image(scene: &str, file: &str, camera: &str, dir: &Path) {
+    let a = render(scene, camera, &dir.join("a.exr"));
+    let b = render(file, camera, &dir.join("b.exr"));
+    let mean = a.iter().sum::<f32>() / a.len() as f32;
+    let mse = a.iter().zip(&b).map(|(x, y)| (x - y).powi(2)).sum::<f32>() / a.len() as f32;
+    assert!(mean > 1e-3, "mean {mean}");
+    assert!(
+        mse / (mean * mean) < 1e-6,
+        "relative MSE {}",
+        mse / (mean * mean)
+    );
+}
+
 #[test]
 fn a_scene_exported_as_gltf_reads_back_bare_with_its_lights_and_cameras() {
     let dir = tempfile::tempdir().expect("tempdir");
@@ -48,16 +62,7 @@ fn a_scene_exported_as_gltf_reads_back_bare_with_its_lights_and_cameras() {
     );
     // The same image from the built-in and from its glTF given bare: the point light and the
     // spot in W/sr through candela, the camera through glTF's vertical field of view.
-    let a = render("builtin:four-rooms", "main", &dir.path().join("a.exr"));
-    let b = render(s(&gltf), "main", &dir.path().join("b.exr"));
-    let mean = a.iter().sum::<f32>() / a.len() as f32;
-    let mse = a.iter().zip(&b).map(|(x, y)| (x - y).powi(2)).sum::<f32>() / a.len() as f32;
-    assert!(mean > 1e-3, "mean {mean}");
-    assert!(
-        mse / (mean * mean) < 1e-6,
-        "relative MSE {}",
-        mse / (mean * mean)
-    );
+    same_image("builtin:four-rooms", s(&gltf), "main", dir.path());
 }
 
 #[test]
@@ -67,16 +72,7 @@ fn a_scene_exported_as_one_glb_file_reads_back_the_same() {
     let o = visgate(&["export", "gltf", "builtin:sun-window", s(&glb)]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(!glb.with_extension("bin").exists());
-    let a = render("builtin:sun-window", "window", &dir.path().join("a.exr"));
-    let b = render(s(&glb), "window", &dir.path().join("b.exr"));
-    let mean = a.iter().sum::<f32>() / a.len() as f32;
-    let mse = a.iter().zip(&b).map(|(x, y)| (x - y).powi(2)).sum::<f32>() / a.len() as f32;
-    assert!(mean > 1e-3, "mean {mean}");
-    assert!(
-        mse / (mean * mean) < 1e-6,
-        "relative MSE {}",
-        mse / (mean * mean)
-    );
+    same_image("builtin:sun-window", s(&glb), "window", dir.path());
 }
 
 #[test]
