@@ -84,8 +84,8 @@ fn export_then_inspect_the_files_and_a_bare_mesh() {
     assert_eq!(v["triangles"], 36);
     assert_eq!(v["point_lights"], 0);
     assert_eq!(v["static_triangles"], 36);
-    // Rendering it: it gets a light and a camera in the open space inside the box (not in
-    // its blocks), and says so; the image is lit.
+    // Rendering it: it gets a light under its glowing ceiling lamp and a camera in the open
+    // space inside the box (not in its blocks), and says so; the image is lit.
     let png = dir.path().join("bare.exr");
     let o = visgate(&[
         "render",
@@ -105,9 +105,16 @@ fn export_then_inspect_the_files_and_a_bare_mesh() {
         "{}",
         stdout(&o)
     );
+    // Its ceiling lamp is a glowing material: the light goes there.
+    assert!(
+        stdout(&o).contains("at its glowing surfaces (material 'light'"),
+        "{}",
+        stdout(&o)
+    );
     let img = image::open(&png).expect("exr").to_rgb32f();
     let mean = img.pixels().map(|p| p.0.iter().sum::<f32>()).sum::<f32>() / (3.0 * 768.0);
-    assert!(mean > 0.05, "mean radiance {mean}");
+    // Lit: 0.032 with the light under the lamp (over 0.05 with it at the camera before).
+    assert!(mean > 0.01, "mean radiance {mean}");
     // Compare too: the same light and camera, one row against the reference.
     let cmp = dir.path().join("cmp");
     let o = visgate(&[

@@ -75,9 +75,9 @@ pub struct ImportedModel {
     pub lights: Vec<crate::desc::LightDesc>,
     /// Perspective cameras the file places (glTF), in its units and axes.
     pub cameras: Vec<crate::desc::CameraDesc>,
-    /// Materials that glow (an OBJ's `Ke`, a glTF's emissive factor above 0): visgate lights
-    /// by point and spot lights alone, so they add no light.
-    pub emissive: Vec<String>,
+    /// Indices of the materials that glow (an OBJ's `Ke`, a glTF's emissive factor above 0):
+    /// visgate lights by point and spot lights alone, so they add no light of their own.
+    pub emissive: Vec<u32>,
 }
 
 /// Imports an OBJ, glTF or GLB file, chosen by its extension.
@@ -185,7 +185,7 @@ fn import_obj_reader(
     let mut textures = TextureCache::new(options.load_textures);
     for m in &materials {
         if m.emissive.is_some_and(|e| e.iter().any(|&c| c > 0.0)) {
-            out.emissive.push(m.name.clone());
+            out.emissive.push(out.materials.len() as u32);
         }
         let texture = m
             .diffuse_texture
@@ -307,7 +307,7 @@ pub fn import_gltf(path: &Path, options: &ImportOptions) -> Result<ImportedModel
     }
     for m in document.materials() {
         if m.emissive_factor().iter().any(|&c| c > 0.0) {
-            out.emissive.push(m.name().unwrap_or("unnamed").to_string());
+            out.emissive.push(out.materials.len() as u32);
         }
         let pbr = m.pbr_metallic_roughness();
         let base_color = pbr.base_color_factor();

@@ -226,8 +226,8 @@ fn glowing_warning(path: &Path, glowing: &[String]) -> Option<String> {
     let note = format!(
         "{}: material '{first}'{more} glows, but visgate lights by point and spot lights alone: \
          an emissive surface adds no light. Place a light at each (a [[light]] in a scene TOML, \
-         or a KHR_lights_punctual light in the glTF); until then render, view and compare add \
-         one of their own and say where",
+         or a KHR_lights_punctual light in the glTF); until then render, view and compare put \
+         one at each glowing surface",
         path.display()
     );
     tracing::warn!("{note}");
@@ -307,9 +307,11 @@ impl Scene {
         } else {
             notes.extend(unread_lights_and_cameras(&desc, &models, path));
         }
-        let glowing: Vec<String> = models.iter().flat_map(|m| m.emissive.clone()).collect();
         let mut scene = Scene::assemble(&desc, models, path)?;
         if scene.lights.is_empty() {
+            let glowing: Vec<String> = (scene.report.glowing_materials.iter())
+                .map(|&m| scene.materials[m as usize].name.clone())
+                .collect();
             notes.extend(glowing_warning(path, &glowing));
         }
         scene.report.warnings.extend(notes);
@@ -391,6 +393,7 @@ impl Scene {
             scene.report.triangles_read += model.triangles_read;
             scene.report.degenerate_dropped += model.degenerate_dropped;
             scene.report.textures_failed += model.textures_failed;
+            (scene.report.glowing_materials).extend(model.emissive.iter().map(|m| m + mat_base));
             scene.report.warnings.extend(model.warnings);
             scene.textures.extend(model.textures);
             scene

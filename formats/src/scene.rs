@@ -117,6 +117,9 @@ pub struct ImportReport {
     pub textures_failed: u64,
     /// Every warning, in order.
     pub warnings: Vec<String>,
+    /// Indices of the materials that glow (an OBJ's `Ke`, a glTF's emissive factor): no light
+    /// in visgate, but where a bare mesh's lamps are (`visgate_scenes::bare`).
+    pub glowing_materials: Vec<u32>,
     /// Wall-clock time of the whole load, seconds.
     pub load_seconds: f64,
 }

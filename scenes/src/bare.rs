@@ -6,7 +6,12 @@
 //! the camera looks level, the way that sees deepest into the level (of 16 horizontal
 //! directions, the one whose rays within 22.5° of it reach farthest on average), so that its
 //! first picture is not a wall a metre away. The light's intensity gives the walls around it
-//! about 2 W/m² (`I = 2 d²` W/sr, `d` the mean distance to them).
+//! about 2 W/m² (`I = 2 d²` W/sr, `d` the mean distance to them). Where the mesh has materials
+//! that glow (a lamp's emissive surface, which lights nothing in visgate), the light goes to
+//! them instead: a point light a hundredth of the level's size in front of each glowing
+//! material's surface (its area-weighted centre, off along its area-weighted normal), giving
+//! the walls around it its share by area of about 2 W/m²; a material whose faces point every
+//! way (a closed bulb) gets none.
 
 use glam::Vec3;
 use visgate_formats::vgate::BakedLevel;
@@ -100,11 +105,38 @@ pub fn light_a_bare_scene(
     let mut said = Vec::new();
     if no_light {
         let intensity = 2.0 * mean * mean;
-        scene.lights.push(Light::Point {
-            position: at,
-            intensity: Vec3::splat(intensity),
+        let lamps = glowing_surfaces(scene, 0.01 * (hi - lo).length());
+        let area: f32 = lamps.iter().map(|l| l.area).sum();
+        let mut total = 0.0;
+        for l in &lamps {
+            // The walls around each lamp get their share of about 2 W/m².
+            let d = probe(l.position).map_or(mean, |(_, m)| m);
+            let i = 2.0 * d * d * l.area / area;
+            total += i;
+            scene.lights.push(Light::Point {
+                position: l.position,
+                intensity: Vec3::splat(i),
+            });
+        }
+        said.push(match lamps.as_slice() {
+            [] => {
+                scene.lights.push(Light::Point {
+                    position: at,
+                    intensity: Vec3::splat(intensity),
+                });
+                format!("a point light of {intensity:.3} W/sr")
+            }
+            [l, ..] => format!(
+                "{} point light(s) of {total:.3} W/sr in all at its glowing surfaces \
+                 (material '{}' at ({:.3}, {:.3}, {:.3}) m{})",
+                lamps.len(),
+                l.material,
+                l.position.x,
+                l.position.y,
+                l.position.z,
+                if lamps.len() > 1 { ", …" } else { "" }
+            ),
         });
-        said.push(format!("a point light of {intensity:.3} W/sr"));
     }
     if no_camera {
         let along = deepest_look(at, reach);
@@ -130,6 +162,46 @@ pub fn light_a_bare_scene(
         at.y,
         at.z
     ))
+}
+
+/// A glowing material's surface, as a lamp.
+struct Lamp {
+    material: String,
+    /// A little in front of the surface's area-weighted centre. [Units: m]
+    position: Vec3,
+    /// The surface's area. [Units: m²]
+    area: f32,
+}
+
+/// The glowing materials' surfaces of `scene` (its static and dynamic meshes), each as a lamp
+/// `offset` metres in front of it; none for a material whose faces' normals cancel to under
+/// half their area (a closed bulb: a light at its centre would light nothing).
+fn glowing_surfaces(scene: &Scene, offset: f32) -> Vec<Lamp> {
+    let mut lamps = Vec::new();
+    for &m in &scene.report.glowing_materials {
+        let (mut area, mut centre, mut normal) = (0.0f32, Vec3::ZERO, Vec3::ZERO);
+        for mesh in &scene.meshes {
+            for (t, &tm) in mesh.triangles.iter().zip(&mesh.material) {
+                if tm != m {
+                    continue;
+                }
+                let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+                let n = 0.5 * (b - a).cross(c - a);
+                let ta = n.length();
+                area += ta;
+                centre += ta * (a + b + c) / 3.0;
+                normal += n;
+            }
+        }
+        if area > 0.0 && normal.length() > 0.5 * area {
+            lamps.push(Lamp {
+                material: scene.materials[m as usize].name.clone(),
+                position: centre / area + normal.normalize() * offset,
+                area,
+            });
+        }
+    }
+    lamps
 }
 
 #[cfg(test)]
@@ -201,5 +273,79 @@ mod tests {
         let c = (lo + hi) * 0.5;
         assert!((position - c).abs().max_element() < (hi - lo).max_element() / 7.0);
         assert_eq!(scene.cameras[0].eye, position);
+    }
+
+    #[test]
+    fn a_bare_scenes_light_goes_to_its_glowing_surfaces() {
+        use visgate_formats::{Material, Mesh};
+        let mut scene = crate::Builtin::EmptyBox.scene().expect("builtin");
+        let (lo, hi) = scene.bounds().expect("bounds");
+        let probe = |p: Vec3| {
+            let near = (p - lo).min(hi - p).min_element();
+            (near > 0.0).then_some((near, 2.0 * near))
+        };
+        let reach = to_the_box(lo, hi);
+        scene.lights.clear();
+        let glowing = |scene: &mut Scene, name: &str, positions: Vec<Vec3>, tris: Vec<[u32; 3]>| {
+            let m = scene.materials.len() as u32;
+            scene.materials.push(Material {
+                name: name.into(),
+                albedo: Vec3::ONE,
+                texture: None,
+            });
+            scene.meshes.push(Mesh {
+                name: name.into(),
+                entry: 0,
+                is_static: true,
+                normals: vec![Vec3::Y; positions.len()],
+                uvs: vec![glam::Vec2::ZERO; positions.len()],
+                positions,
+                material: vec![m; tris.len()],
+                triangles: tris,
+            });
+            scene.report.glowing_materials.push(m);
+        };
+        // A closed 20 cm bulb glows all round: no lamp there (a light inside would light
+        // nothing).
+        let corner = Vec3::new(2.0, 1.5, 2.0);
+        let cube = (0..8)
+            .map(|i| {
+                corner + 0.2 * Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, (i >> 2) as f32)
+            })
+            .collect();
+        let faces = vec![
+            [0, 2, 3],
+            [0, 3, 1],
+            [4, 5, 7],
+            [4, 7, 6],
+            [0, 4, 6],
+            [0, 6, 2],
+            [1, 3, 7],
+            [1, 7, 5],
+            [0, 1, 5],
+            [0, 5, 4],
+            [2, 6, 7],
+            [2, 7, 3],
+        ];
+        glowing(&mut scene, "bulb", cube, faces);
+        assert!(glowing_surfaces(&scene, 0.1).is_empty());
+        // A 1 m² panel under the ceiling, wound to face down, glows: the one light goes in
+        // front of it.
+        let y = hi.y - 0.01;
+        let panel = [(1.0, 1.0), (2.0, 1.0), (2.0, 2.0), (1.0, 2.0)]
+            .map(|(x, z)| Vec3::new(x, y, z))
+            .to_vec();
+        glowing(&mut scene, "panel", panel, vec![[0, 1, 2], [0, 2, 3]]);
+        let said = light_a_bare_scene(&mut scene, None, &probe, &reach).expect("a light");
+        assert!(said.contains("material 'panel'"), "{said}");
+        let [Light::Point { position, .. }] = scene.lights[..] else {
+            panic!("one point light: {:?}", scene.lights);
+        };
+        // Its centre, a hundredth of the room's diagonal below it.
+        let below = 0.01 * (hi - lo).length();
+        assert!(
+            (position - Vec3::new(1.5, y - below, 1.5)).length() < 1e-4,
+            "{position}"
+        );
     }
 }
