@@ -102,41 +102,19 @@ pub fn light_a_bare_scene(
     };
     // Walls at the mean distance around it get about 2 W/m².
     let mean = probe(at).map_or(0.1 * (hi - lo).length(), |(_, mean)| mean);
-    let mut said = Vec::new();
+    // What goes at `at`, and the lamps' lights, which go elsewhere.
+    let (mut here, mut lamps_said) = (Vec::new(), None);
     if no_light {
-        let intensity = 2.0 * mean * mean;
         let lamps = glowing_surfaces(scene, 0.01 * (hi - lo).length());
-        let area: f32 = lamps.iter().map(|l| l.area).sum();
-        let mut total = 0.0;
-        for l in &lamps {
-            // The walls around each lamp get their share of about 2 W/m².
-            let d = probe(l.position).map_or(mean, |(_, m)| m);
-            let i = 2.0 * d * d * l.area / area;
-            total += i;
+        lamps_said = light_the_lamps(scene, &lamps, probe, mean);
+        if lamps_said.is_none() {
+            let intensity = 2.0 * mean * mean;
             scene.lights.push(Light::Point {
-                position: l.position,
-                intensity: Vec3::splat(i),
+                position: at,
+                intensity: Vec3::splat(intensity),
             });
+            here.push(format!("a point light of {intensity:.3} W/sr"));
         }
-        said.push(match lamps.as_slice() {
-            [] => {
-                scene.lights.push(Light::Point {
-                    position: at,
-                    intensity: Vec3::splat(intensity),
-                });
-                format!("a point light of {intensity:.3} W/sr")
-            }
-            [l, ..] => format!(
-                "{} point light(s) of {total:.3} W/sr in all at its glowing surfaces \
-                 (material '{}' at ({:.3}, {:.3}, {:.3}) m{})",
-                lamps.len(),
-                l.material,
-                l.position.x,
-                l.position.y,
-                l.position.z,
-                if lamps.len() > 1 { ", …" } else { "" }
-            ),
-        });
     }
     if no_camera {
         let along = deepest_look(at, reach);
@@ -147,20 +125,60 @@ pub fn light_a_bare_scene(
             up: Vec3::Y,
             fov_x_rad: 70f32.to_radians(),
         });
-        said.push(format!("a camera '{INSIDE_CAMERA}'"));
+        here.push(format!("a camera '{INSIDE_CAMERA}'"));
     }
+    let here = (!here.is_empty()).then(|| {
+        format!(
+            "{} at ({:.3}, {:.3}, {:.3}) m, {from}",
+            here.join(" and "),
+            at.x,
+            at.y,
+            at.z
+        )
+    });
+    let said: Vec<String> = lamps_said.into_iter().chain(here).collect();
     Some(format!(
-        "the scene has no {}: {} at ({:.3}, {:.3}, {:.3}) m, {from} (give [[light]]s and \
-         [[camera]]s in a scene TOML that names the mesh to choose your own)",
+        "the scene has no {}: {} (give [[light]]s and [[camera]]s in a scene TOML that names the \
+         mesh to choose your own)",
         match (no_light, no_camera) {
             (true, true) => "light and no camera",
             (true, false) => "light",
             _ => "camera",
         },
-        said.join(" and "),
-        at.x,
-        at.y,
-        at.z
+        said.join(" and ")
+    ))
+}
+
+/// Lights `lamps` (a point light in front of each, the walls around it getting its share by
+/// area of about 2 W/m², at `mean` metres where its rays escape) and says so; `None` where
+/// there are none.
+fn light_the_lamps(
+    scene: &mut Scene,
+    lamps: &[Lamp],
+    probe: &dyn Fn(Vec3) -> Option<(f32, f32)>,
+    mean: f32,
+) -> Option<String> {
+    let first = lamps.first()?;
+    let area: f32 = lamps.iter().map(|l| l.area).sum();
+    let mut total = 0.0;
+    for l in lamps {
+        let d = probe(l.position).map_or(mean, |(_, m)| m);
+        let i = 2.0 * d * d * l.area / area;
+        total += i;
+        scene.lights.push(Light::Point {
+            position: l.position,
+            intensity: Vec3::splat(i),
+        });
+    }
+    Some(format!(
+        "{} point light(s) of {total:.3} W/sr in all at its glowing surfaces (material '{}' at \
+         ({:.3}, {:.3}, {:.3}) m{})",
+        lamps.len(),
+        first.material,
+        first.position.x,
+        first.position.y,
+        first.position.z,
+        if lamps.len() > 1 { ", …" } else { "" }
     ))
 }
 
@@ -337,7 +355,11 @@ mod tests {
             .to_vec();
         glowing(&mut scene, "panel", panel, vec![[0, 1, 2], [0, 2, 3]]);
         let said = light_a_bare_scene(&mut scene, None, &probe, &reach).expect("a light");
-        assert!(said.contains("material 'panel'"), "{said}");
+        // Only the light was missing, and it is not at the enclosed point.
+        assert!(
+            said.contains("material 'panel'") && !said.contains("enclosed point"),
+            "{said}"
+        );
         let [Light::Point { position, .. }] = scene.lights[..] else {
             panic!("one point light: {:?}", scene.lights);
         };
