@@ -227,7 +227,7 @@ fn glowing_warning(path: &Path, glowing: &[String]) -> Option<String> {
         "{}: material '{first}'{more} glows, but visgate lights by point and spot lights alone: \
          an emissive surface adds no light. Place a light at each (a [[light]] in a scene TOML, \
          or a KHR_lights_punctual light in the glTF); until then render, view and compare put \
-         one at each glowing surface",
+         one in front of each glowing surface that faces one way (a closed bulb gets none)",
         path.display()
     );
     tracing::warn!("{note}");
