@@ -6,8 +6,8 @@
 // That bias lit every receiver within about a texel behind a zero-thickness wall, and the taps
 // past a thin wall's edge see the surface that runs on past it (a floor under a wall, an outer
 // wall that a dividing wall meets) lit on the far side at the receiver's own distance: a
-// dotted line of light along every such join, on the dark side. So the receiver's own texel is
-// tested first against the receiver's plane along that texel's ray (receiver-plane depth: the
+// dotted line of light along every such join, on the dark side. So where the taps disagree,
+// the receiver's own texel is tested against the receiver's plane along that texel's ray (receiver-plane depth: the
 // plane through q with the face's normal, its distance per texel solved from two tangent
 // steps), with no bias but the plane's own change over half a texel: shadowed there by a
 // surface within CONTACT_TEXELS of the receiver, it is in a contact shadow, whole.
@@ -110,10 +110,11 @@ fn shadow(l: Light, p: vec3<f32>, n: vec3<f32>, nf: vec3<f32>) -> f32 {
             lit += select(0.0, 1.0, stored >= ref_dist);
         }
     }
-    if lit == 9.0 {
-        return 1.0;
+    if lit == 9.0 || lit == 0.0 {
+        return lit / 9.0;
     }
-    // Some tap shadowed: the receiver's own texel, against its plane, may be a contact shadow.
+    // Some taps lit and some shadowed: the receiver's own texel, against its plane, may be a
+    // contact shadow.
     let r = receiver_plane(layer, light, q, f, nf, texel, size);
     let at = vec2<f32>(c) + 0.5 - f;
     let own = shadow_stored(layer, c, last);
