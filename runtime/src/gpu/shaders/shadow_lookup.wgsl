@@ -7,10 +7,11 @@
 // past a thin wall's edge see the surface that runs on past it (a floor under a wall, an outer
 // wall that a dividing wall meets) lit on the far side at the receiver's own distance: a
 // dotted line of light along every such join, on the dark side. So where the taps disagree,
-// the receiver's own texel is tested against the receiver's plane along that texel's ray (receiver-plane depth: the
-// plane through q with the face's normal, its distance per texel solved from two tangent
-// steps), with no bias but the plane's own change over half a texel: shadowed there by a
-// surface within CONTACT_TEXELS of the receiver, it is in a contact shadow, whole.
+// the receiver's own texel is tested against the receiver's plane along that texel's ray
+// (receiver-plane depth: the plane through q with the face's normal, its distance per texel
+// solved from two tangent steps), with no bias but the plane's own change over half a texel:
+// shadowed there by a surface within CONTACT_TEXELS of the receiver, and behind that surface's
+// plane (from its texel and a neighbour along each axis), it is in a contact shadow, whole.
 
 // Occluder-to-receiver distance within which a shadowed own texel shadows the receiver whole
 // (2 and 8 gave the same images within 1 %). [Units: texels]
