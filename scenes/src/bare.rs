@@ -237,6 +237,15 @@ mod tests {
         }
     }
 
+    /// Inside the box `lo..hi` every ray hits a wall: the nearest is the distance to the
+    /// nearest face, the mean a stand-in.
+    fn in_the_box(lo: Vec3, hi: Vec3) -> impl Fn(Vec3) -> Option<(f32, f32)> {
+        move |p: Vec3| {
+            let near = (p - lo).min(hi - p).min_element();
+            (near > 0.0).then_some((near, 2.0 * near))
+        }
+    }
+
     #[test]
     fn the_camera_looks_level_the_way_that_sees_deepest() {
         // A corridor-like room 8 m long in x, 2 m wide in z; from its centre the deepest view
@@ -263,12 +272,7 @@ mod tests {
     fn a_scene_gets_only_what_it_lacks_at_the_enclosed_point_farthest_from_its_walls() {
         let mut scene = crate::Builtin::EmptyBox.scene().expect("builtin");
         let (lo, hi) = scene.bounds().expect("bounds");
-        // Inside the room's box every ray hits a wall: the nearest is the distance to the
-        // nearest face, the mean a stand-in.
-        let probe = |p: Vec3| {
-            let near = (p - lo).min(hi - p).min_element();
-            (near > 0.0).then_some((near, 2.0 * near))
-        };
+        let probe = in_the_box(lo, hi);
         let reach = to_the_box(lo, hi);
         assert!(light_a_bare_scene(&mut scene, None, &probe, &reach).is_none());
         let lights = scene.lights.clone();
@@ -298,10 +302,7 @@ mod tests {
         use visgate_formats::{Material, Mesh};
         let mut scene = crate::Builtin::EmptyBox.scene().expect("builtin");
         let (lo, hi) = scene.bounds().expect("bounds");
-        let probe = |p: Vec3| {
-            let near = (p - lo).min(hi - p).min_element();
-            (near > 0.0).then_some((near, 2.0 * near))
-        };
+        let probe = in_the_box(lo, hi);
         let reach = to_the_box(lo, hi);
         scene.lights.clear();
         let glowing = |scene: &mut Scene, name: &str, positions: Vec<Vec3>, tris: Vec<[u32; 3]>| {
