@@ -124,6 +124,37 @@ fn summarise(scene: &Scene) -> SceneSummary {
     }
 }
 
+/// Lights the text summary lists one a line.
+const LIGHTS_LISTED: usize = 8;
+
+/// One light as a line: where it is, how bright, and a spot's aim and cone.
+fn light_line(l: &Light) -> String {
+    match *l {
+        Light::Point {
+            position,
+            intensity,
+        } => format!(
+            "point at {} m, {} W/sr",
+            v3(position.to_array()),
+            v3(intensity.to_array())
+        ),
+        Light::Spot {
+            position,
+            direction,
+            intensity,
+            cutoff_rad,
+            beam_rad,
+        } => format!(
+            "spot  at {} m towards {}, {} W/sr, beam {:.1}°, cutoff {:.1}°",
+            v3(position.to_array()),
+            v3(direction.to_array()),
+            v3(intensity.to_array()),
+            beam_rad.to_degrees(),
+            cutoff_rad.to_degrees()
+        ),
+    }
+}
+
 fn v3(v: [f32; 3]) -> String {
     format!("({:.3}, {:.3}, {:.3})", v[0], v[1], v[2])
 }
@@ -150,6 +181,15 @@ fn print_scene(s: &SceneSummary) {
         "lights      {} point, {} spot",
         s.point_lights, s.spot_lights
     );
+    for l in s.lights.iter().take(LIGHTS_LISTED) {
+        println!("  {}", light_line(l));
+    }
+    if s.lights.len() > LIGHTS_LISTED {
+        println!(
+            "  … and {} more (--json lists them all)",
+            s.lights.len() - LIGHTS_LISTED
+        );
+    }
     println!(
         "cameras     {}",
         if s.cameras.is_empty() {

@@ -43,6 +43,16 @@ fn inspect_a_builtin_as_text_and_json() {
         out.contains("triangles") && out.contains("bounds") && out.contains("closed      yes"),
         "{out}"
     );
+    // Each light a line: the four rooms' lamp and spot, where they are and how bright.
+    let o = visgate(&["inspect", "builtin:four-rooms"]);
+    let out = stdout(&o);
+    assert!(
+        out.contains("point at (2.000, 2.700, 2.000) m, (8.000, 8.000, 8.000) W/sr")
+            && out.contains("beam 30.0°, cutoff 40.0°"),
+        "{out}"
+    );
+    let o = visgate(&["inspect", "builtin:lamp-hall"]);
+    assert!(stdout(&o).contains("… and 43 more"), "{}", stdout(&o));
     let o = visgate(&["inspect", "--json", "builtin:four-rooms"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("valid JSON");
