@@ -339,6 +339,8 @@ pub fn import_gltf(path: &Path, options: &ImportOptions) -> Result<ImportedModel
     let scene = document
         .default_scene()
         .or_else(|| document.scenes().next());
+    // Lights and cameras in the file's node order, on a walk of their own: the mesh walk below
+    // pops a stack, and its order is the one the meshes (and baked levels' hashes) keep.
     if let Some(s) = &scene {
         crate::gltf_nodes::read_nodes(path, s, &mut out);
     }

@@ -464,7 +464,7 @@ fn sight_grid(
     let grid = if size < 0.99 * meta.voxel_size_m {
         // A bit a voxel, not the whole bake's bytes: checked against its own cost.
         let grid = grid_for(input.bounds, Resolution::VoxelSizeM(size), u64::MAX)?;
-        let bytes = grid.dims.map(f64::from).iter().product::<f64>() * SIGHT_BYTES_PER_VOXEL;
+        let bytes = grid.voxel_count().map_or(f64::INFINITY, |n| n as f64) * SIGHT_BYTES_PER_VOXEL;
         if bytes > options.memory_limit_bytes as f64 {
             return Err(BakeError::SightTooLarge {
                 dims: grid.dims.map(f64::from),

@@ -77,8 +77,9 @@ fn gather_vpl_clusters(p: vec3<f32>, n: vec3<f32>, px: vec2<i32>, first: u32, st
     return sum * f32(step);
 }
 
-// Light i's visibility at pixel px (p, normal n): its shadow maps, or its cluster's PCSS.
-fn direct_visibility(i: u32, l: Light, p: vec3<f32>, n: vec3<f32>, px: vec2<i32>) -> f32 {
+// Light i's visibility at pixel px (p, shading normal n, face normal nf): its shadow maps, or
+// its cluster's PCSS.
+fn direct_visibility(i: u32, l: Light, p: vec3<f32>, n: vec3<f32>, nf: vec3<f32>, px: vec2<i32>) -> f32 {
     if globals.direct_mode == DIRECT_LIGHTCLUSTER {
         let c = lc_light_cluster[i];
         if c == NONE {
@@ -86,7 +87,7 @@ fn direct_visibility(i: u32, l: Light, p: vec3<f32>, n: vec3<f32>, px: vec2<i32>
         }
         return textureLoad(lc_visibility, px, i32(c / 4u), 0)[c % 4u];
     }
-    return shadow(l, p, n, face_normal(px));
+    return shadow(l, p, n, nf);
 }
 
 // The face's own normal at pixel px (the G-buffer's encode_face_normal).
@@ -178,6 +179,8 @@ fn shade(px: vec2<i32>) -> vec4<f32> {
     let p = pos.xyz;
     let n = normalize(textureLoad(g_normal, px, 0).xyz);
     let albedo = textureLoad(g_albedo, px, 0).xyz;
+    // The face's normal, for the shadow maps' contact test (decoded once, not per light).
+    let nf = face_normal(px);
     var radiance = vec3<f32>(0.0);
     for (var i = 0u; i < globals.light_count; i++) {
         let l = lights[i];
@@ -199,7 +202,7 @@ fn shade(px: vec2<i32>) -> vec4<f32> {
         if all(intensity == vec3<f32>(0.0)) {
             continue;
         }
-        radiance += albedo / PI * intensity * cos_x / d2 * direct_visibility(i, l, p, n, px);
+        radiance += albedo / PI * intensity * cos_x / d2 * direct_visibility(i, l, p, n, nf, px);
     }
     // One loop per mode: a software rasterizer (lavapipe) runs a loop that carries another
     // mode's branch several times slower.

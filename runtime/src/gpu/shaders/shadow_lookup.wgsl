@@ -28,14 +28,14 @@ fn shadow_texels(layer: u32, x: vec3<f32>, size: f32) -> vec2<f32> {
     return vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5) * size;
 }
 
-// The receiver's plane (through q, normal nf) in layer `layer`'s texels: `steps` the texel
-// offsets of one texel's step along each of its tangents `t1`, `t2` (world, a texel `texel`
-// long), and how its distance from the light changes per texel (`slope`). `ok` is false where
-// the plane is seen edge-on from the light.
+// The receiver's plane (through q, normal nf) in layer `layer`'s texels: `to_tangents` takes a
+// texel offset to steps along its tangents `t1`, `t2` (world, a texel `texel` long), and
+// `slope` is how its distance from the light changes per texel. `ok` is false where the plane
+// is seen edge-on from the light (and the rest unset).
 struct ReceiverPlane {
     t1: vec3<f32>,
     t2: vec3<f32>,
-    steps: mat2x2<f32>,
+    to_tangents: mat2x2<f32>,
     slope: vec2<f32>,
     ok: bool,
 };
@@ -45,36 +45,32 @@ fn receiver_plane(layer: u32, light: vec3<f32>, q: vec3<f32>, f: vec2<f32>, nf: 
     let up = select(vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(1.0, 0.0, 0.0), abs(nf.y) > 0.9);
     r.t1 = normalize(cross(nf, up)) * texel;
     r.t2 = cross(nf, r.t1);
-    r.steps = mat2x2<f32>(shadow_texels(layer, q + r.t1, size) - f, shadow_texels(layer, q + r.t2, size) - f);
-    let d = length(q - light);
-    let e = vec2<f32>(length(q + r.t1 - light), length(q + r.t2 - light)) - d;
-    let det = determinant(r.steps);
+    // The texel offsets of one step along each tangent.
+    let m = mat2x2<f32>(shadow_texels(layer, q + r.t1, size) - f, shadow_texels(layer, q + r.t2, size) - f);
+    let det = determinant(m);
     r.ok = abs(det) > 1e-4;
     if r.ok {
-        // slope · steps[k] = e[k] for each tangent k.
-        let s = e * inverse2(r.steps);
+        r.to_tangents = mat2x2<f32>(vec2<f32>(m[1].y, -m[0].y), vec2<f32>(-m[1].x, m[0].x)) * (1.0 / det);
+        // slope · m[k] = e[k], the distance's change along tangent k.
+        let d = length(q - light);
+        let e = vec2<f32>(length(q + r.t1 - light), length(q + r.t2 - light)) - d;
+        let s = e * r.to_tangents;
         r.slope = clamp(s, vec2<f32>(-MAX_PLANE_SLOPE * texel), vec2<f32>(MAX_PLANE_SLOPE * texel));
     }
     return r;
 }
 
-fn inverse2(m: mat2x2<f32>) -> mat2x2<f32> {
-    return mat2x2<f32>(vec2<f32>(m[1].y, -m[0].y), vec2<f32>(-m[1].x, m[0].x)) * (1.0 / determinant(m));
-}
-
 // The surface stored at texel t (texel centre offset `at` from q's point f): its point, on the
 // texel's ray through the receiver's plane.
 fn stored_point(light: vec3<f32>, q: vec3<f32>, r: ReceiverPlane, at: vec2<f32>, stored: f32) -> vec3<f32> {
-    let ab = inverse2(r.steps) * at;
+    let ab = r.to_tangents * at;
     let on_plane = q + r.t1 * ab.x + r.t2 * ab.y;
     return light + normalize(on_plane - light) * stored;
 }
 
-// Whether q lies behind the plane through the occluder's point o (texel c, offset `at`) and
-// the points stored one texel from it along x and y (the signs `s`), seen from the light.
-fn behind(layer: u32, light: vec3<f32>, q: vec3<f32>, r: ReceiverPlane, at: vec2<f32>, o: vec3<f32>, c: vec2<i32>, s: vec2<i32>, last: vec2<i32>) -> bool {
-    let ox = stored_point(light, q, r, at + vec2<f32>(f32(s.x), 0.0), shadow_stored(layer, c + vec2<i32>(s.x, 0), last));
-    let oy = stored_point(light, q, r, at + vec2<f32>(0.0, f32(s.y)), shadow_stored(layer, c + vec2<i32>(0, s.y), last));
+// Whether q lies behind the plane through the occluder's points o, ox and oy, seen from the
+// light.
+fn behind(light: vec3<f32>, q: vec3<f32>, o: vec3<f32>, ox: vec3<f32>, oy: vec3<f32>) -> bool {
     var n_o = cross(ox - o, oy - o);
     if dot(n_o, light - o) < 0.0 {
         n_o = -n_o;
@@ -139,10 +135,21 @@ fn shadow(l: Light, p: vec3<f32>, n: vec3<f32>, nf: vec3<f32>) -> f32 {
         // along each axis, and from the opposite ones too: a surface meeting the receiver on
         // the lit side of a crease hides the receiver's plane past the crease, not the
         // receiver.
-        let sx = select(-1, 1, abs(shadow_stored(layer, c + vec2<i32>(1, 0), last) - own) < abs(shadow_stored(layer, c - vec2<i32>(1, 0), last) - own));
-        let sy = select(-1, 1, abs(shadow_stored(layer, c + vec2<i32>(0, 1), last) - own) < abs(shadow_stored(layer, c - vec2<i32>(0, 1), last) - own));
+        let zx = vec2<f32>(shadow_stored(layer, c + vec2<i32>(1, 0), last), shadow_stored(layer, c - vec2<i32>(1, 0), last));
+        let zy = vec2<f32>(shadow_stored(layer, c + vec2<i32>(0, 1), last), shadow_stored(layer, c - vec2<i32>(0, 1), last));
+        let sx = select(-1.0, 1.0, abs(zx.x - own) < abs(zx.y - own));
+        let sy = select(-1.0, 1.0, abs(zy.x - own) < abs(zy.y - own));
+        // The stored distance one texel along (k, 0) or (0, k).
+        let zxk = select(zx.y, zx.x, sx > 0.0);
+        let zyk = select(zy.y, zy.x, sy > 0.0);
+        let zx_back = select(zx.x, zx.y, sx > 0.0);
+        let zy_back = select(zy.x, zy.y, sy > 0.0);
         let o = stored_point(light, q, r, at, own);
-        if behind(layer, light, q, r, at, o, c, vec2<i32>(sx, sy), last) && behind(layer, light, q, r, at, o, c, vec2<i32>(-sx, -sy), last) {
+        let ox = stored_point(light, q, r, at + vec2<f32>(sx, 0.0), zxk);
+        let oy = stored_point(light, q, r, at + vec2<f32>(0.0, sy), zyk);
+        let ox_back = stored_point(light, q, r, at - vec2<f32>(sx, 0.0), zx_back);
+        let oy_back = stored_point(light, q, r, at - vec2<f32>(0.0, sy), zy_back);
+        if behind(light, q, o, ox, oy) && behind(light, q, o, ox_back, oy_back) {
             return 0.0;
         }
     }
