@@ -63,6 +63,9 @@ struct BakedSummary {
     voxel_cluster_stored_bytes: u64,
     /// Voxels the voxelization left open (the voxel walk's grid).
     open_voxels: u64,
+    /// How the file stores their bits ("dense" words or "runs") and its bytes there.
+    open_voxels_stored_as: &'static str,
+    open_voxels_stored_bytes: u64,
     read_seconds: f64,
 }
 
@@ -225,20 +228,26 @@ fn inspect_baked(path: &Path, json: bool) -> Result<()> {
         .with_context(|| format!("{}: cannot load the baked level", path.display()))?;
     let read_seconds = start.elapsed().as_secs_f64();
     let t = &level.topology;
-    let (stored_as, stored_bytes) = BakedLevel::read_header(&bytes)?
-        .sections
-        .iter()
-        .find_map(|s| match s.kind {
-            SectionKind::VoxelCluster => Some(("dense", s.len)),
-            SectionKind::VoxelClusterRuns => Some(("runs", s.len)),
-            SectionKind::Topology | SectionKind::OpenVoxels => None,
-        })
-        .unwrap_or(("absent", 0));
+    let sections = BakedLevel::read_header(&bytes)?.sections;
+    let stored = |kinds: [SectionKind; 2]| {
+        sections
+            .iter()
+            .find_map(|s| {
+                let how = if s.kind == kinds[0] { "dense" } else { "runs" };
+                kinds.contains(&s.kind).then_some((how, s.len))
+            })
+            .unwrap_or(("absent", 0))
+    };
+    let (stored_as, stored_bytes) =
+        stored([SectionKind::VoxelCluster, SectionKind::VoxelClusterRuns]);
+    let (open_stored_as, open_stored_bytes) =
+        stored([SectionKind::OpenVoxels, SectionKind::OpenVoxelRuns]);
     let s = BakedSummary {
         kind: "baked level",
         file: path.display().to_string(),
         file_bytes: bytes.len() as u64,
-        format_version: visgate_formats::vgate::FORMAT_VERSION,
+        // The file's own (read past the magic by from_bytes).
+        format_version: u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]),
         tool_version: level.info.tool_version.clone(),
         geometry_hash: level.info.geometry_hash.to_string(),
         grid: level.info.grid,
@@ -260,6 +269,8 @@ fn inspect_baked(path: &Path, json: bool) -> Result<()> {
         voxel_cluster_stored_as: stored_as,
         voxel_cluster_stored_bytes: stored_bytes,
         open_voxels: level.open.count_ones(),
+        open_voxels_stored_as: open_stored_as,
+        open_voxels_stored_bytes: open_stored_bytes,
         read_seconds,
     };
     if json {
@@ -313,8 +324,14 @@ fn inspect_baked(path: &Path, json: bool) -> Result<()> {
     let sg = &level.info.sight_grid;
     println!(
         "sight grid  {} x {} x {} voxels of {} m: {} left open by its thin voxelization \
-         (the voxel walk's grid, a bit each)",
-        sg.dims[0], sg.dims[1], sg.dims[2], sg.voxel_size_m, s.open_voxels
+         (the voxel walk's grid, a bit each), stored {} in {} bytes",
+        sg.dims[0],
+        sg.dims[1],
+        sg.dims[2],
+        sg.voxel_size_m,
+        s.open_voxels,
+        s.open_voxels_stored_as,
+        s.open_voxels_stored_bytes
     );
     println!("read time   {:.3} s", s.read_seconds);
     Ok(())

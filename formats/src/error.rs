@@ -129,12 +129,12 @@ pub enum VgateError {
     },
     /// Written by an older, unsupported visgate.
     #[error(
-        "baked file format version {found} is no longer read ({supported} is); re-bake the level"
+        "baked file format version {found} is no longer read (this visgate reads {supported} and later); re-bake the level"
     )]
     OldVersion {
         /// Version in the file.
         found: u32,
-        /// Version this build reads.
+        /// The oldest version this build reads.
         supported: u32,
     },
     /// The file ends before its declared contents.

@@ -331,11 +331,40 @@ fn wrong_magic_and_other_versions_are_named() {
     assert!(matches!(e, VgateError::NewerVersion { found, .. } if found == FORMAT_VERSION + 1));
     assert!(e.to_string().contains("newer"));
     let mut b = bytes;
-    patch_version(&mut b, 0);
-    assert!(matches!(
-        BakedLevel::from_bytes(&b),
-        Err(VgateError::OldVersion { .. })
-    ));
+    patch_version(&mut b, OLDEST_READ_VERSION - 1);
+    let e = BakedLevel::from_bytes(&b).expect_err("older");
+    assert!(matches!(e, VgateError::OldVersion { .. }), "{e}");
+    assert!(e.to_string().contains("re-bake"), "{e}");
+}
+
+#[test]
+fn the_open_voxels_are_stored_as_runs_where_smaller_and_a_format_6_file_still_reads() {
+    let level = two_room_level(40);
+    let bytes = level.to_bytes().expect("encodes");
+    let header = BakedLevel::read_header(&bytes).expect("header");
+    let open = header.sections[2];
+    assert_eq!(open.kind, SectionKind::OpenVoxelRuns);
+    assert!(open.len < level.open.len().div_ceil(64) * 8, "{open:?}");
+    // Format 6 wrote the words as they are, and nothing else differs: read as before.
+    let [t, c] = [0, 1].map(|k| {
+        let s = header.sections[k];
+        &bytes[s.offset as usize..(s.offset + s.len) as usize]
+    });
+    let words: Vec<u8> = level
+        .open
+        .words()
+        .iter()
+        .flat_map(|w| w.to_le_bytes())
+        .collect();
+    let mut dense = header.clone();
+    dense.sections[2].kind = SectionKind::OpenVoxels;
+    let mut file = file_of(dense, [t, c, &words]);
+    patch_version(&mut file, 6);
+    // The header's checksum covers the version: patched, the file is checked again.
+    let hlen = u32::from_le_bytes(file[12..16].try_into().expect("4 bytes")) as usize;
+    let crc = crc32fast::hash(&file[..16 + hlen]);
+    file[16 + hlen..20 + hlen].copy_from_slice(&crc.to_le_bytes());
+    assert_eq!(BakedLevel::from_bytes(&file).expect("format 6"), level);
 }
 
 /// Each way a writer could get the structure wrong is caught by the reader, with its own

@@ -11,16 +11,15 @@ use serde_json::{Value, json};
 use visgate_formats::Scene;
 use visgate_formats::scene::GeometryHash;
 use visgate_formats::scene::Light;
-use visgate_formats::vgate::{
-    BakeInfo, BakeParams, BakedLevel, GridMeta, Resolution, VoxelBits, VoxelValues,
-};
+use visgate_formats::vgate::{BakeInfo, BakeParams, BakedLevel, GridMeta, Resolution, VoxelValues};
 
 use crate::BakeError;
-use crate::counters::{SightCounts, VoxelizeCounts};
+use crate::counters::VoxelizeCounts;
 use crate::empty::EmptySpace;
 use crate::empty::Seed;
 use crate::memory::StagePeak;
 pub use crate::memory::peak_memory_bytes;
+use crate::sight_grid::{default_sight_voxel, sight_grid};
 use crate::stages;
 use crate::thin::Thinned;
 use crate::voxelize::{SolidGrid, grid_for, voxelize};
@@ -176,11 +175,13 @@ fn check_params(p: &BakeParams) -> Result<(), BakeError> {
             "partition voxel {v} m must be in 0..=10 (0 partitions the level's own grid)"
         )));
     }
+    // No upper bound: one coarser than the level's voxel walks the level's own grid, as 0 does
+    // (a level in the wrong units, kilometres long, asks for metres).
     if let Some(v) = p.sight_voxel_m
-        && !(v.is_finite() && (0.0..=10.0).contains(&v))
+        && !(v.is_finite() && v >= 0.0)
     {
         return Err(BakeError::Param(format!(
-            "sight voxel {v} m must be in 0..=10 (0 walks the level's own grid)"
+            "sight voxel {v} m must be a finite number >= 0 (0 walks the level's own grid)"
         )));
     }
     if let Some(persistence) = p.persistence
@@ -399,18 +400,14 @@ pub const MIN_GAP_PARTS: u32 = 256;
 /// partitioned on its own 256 grid).
 pub const PARTITION_PARTS: u32 = 128;
 
-/// The default sight voxel ([`BakeParams::sight_voxel_m`]) is at most 1/this of the level's
-/// longest extent: a level baked coarser still walks its openings on this many voxels.
-pub const SIGHT_PARTS: u32 = 512;
-
 /// `params` with the minimum gap, the partition voxel and the sight voxel it leaves to the
-/// bake filled in (see [`MIN_GAP_PARTS`], [`PARTITION_PARTS`], [`SIGHT_PARTS`]) for a level of
+/// bake filled in (see [`MIN_GAP_PARTS`], [`PARTITION_PARTS`], [`default_sight_voxel`]) for a level of
 /// `bounds` on voxels of `voxel_m`: the values used, which the file records.
 fn level_scaled(params: &BakeParams, bounds: (glam::Vec3, glam::Vec3), voxel_m: f32) -> BakeParams {
     let longest = (bounds.1 - bounds.0).max_element();
     let scale = longest / MIN_GAP_PARTS as f32;
     let sight = match params.sight_voxel_m {
-        None => voxel_m.min(longest / SIGHT_PARTS as f32),
+        None => default_sight_voxel(bounds, voxel_m),
         Some(v) if v == 0.0 || v > voxel_m => voxel_m,
         Some(v) => v,
     };
@@ -446,45 +443,6 @@ pub fn default_partition_voxel(longest: f32, voxel_m: f32) -> f32 {
     } else {
         PARTITION_VOXEL_M
     }
-}
-
-/// Bytes a sight grid's voxel costs at its peak: its closed bits and its open bits as it is
-/// voxelized, the file's copy and the runtime's bricks (an eighth of a byte each, and less).
-const SIGHT_BYTES_PER_VOXEL: f64 = 0.5;
-
-/// The sight grid ([`BakeParams::sight_voxel_m`], filled in: the level's grid, or its bounds at
-/// the finer sight voxel) and its open voxels, voxelized thin ([`crate::separating`]).
-fn sight_grid(
-    input: &stages::Loaded,
-    meta: &GridMeta,
-    params: &BakeParams,
-    options: &BakeOptions,
-) -> Result<((GridMeta, VoxelBits), SightCounts), BakeError> {
-    let size = params.sight_voxel_m.unwrap_or(meta.voxel_size_m);
-    let grid = if size < 0.99 * meta.voxel_size_m {
-        // A bit a voxel, not the whole bake's bytes: checked against its own cost.
-        let grid = grid_for(input.bounds, Resolution::VoxelSizeM(size), u64::MAX)?;
-        let bytes = grid.voxel_count().map_or(f64::INFINITY, |n| n as f64) * SIGHT_BYTES_PER_VOXEL;
-        if bytes > options.memory_limit_bytes as f64 {
-            return Err(BakeError::SightTooLarge {
-                dims: grid.dims.map(f64::from),
-                voxel_m: size,
-                bytes,
-                limit: options.memory_limit_bytes,
-            });
-        }
-        grid
-    } else {
-        *meta
-    };
-    let bits = crate::separating::open_voxels(grid, &input.triangles);
-    let counts = SightCounts {
-        dims: grid.dims,
-        voxel_size_m: grid.voxel_size_m,
-        open_voxels: bits.count_ones(),
-        bytes: grid.voxel_count().unwrap_or(0).div_ceil(8),
-    };
-    Ok(((grid, bits), counts))
 }
 
 /// The point of a bare mesh's inside and its openings, from the level's grid `es` or, where

@@ -36,6 +36,7 @@ pub mod refine;
 pub mod report;
 pub mod segment;
 pub mod separating;
+pub mod sight_grid;
 pub mod sightline;
 pub mod simplify;
 pub mod stages;

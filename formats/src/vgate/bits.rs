@@ -68,6 +68,83 @@ impl VoxelBits {
         self.words.iter().flat_map(|w| w.to_le_bytes()).collect()
     }
 
+    /// The words as runs (format 7): a u32 LE count `n`, then, where its top bit is clear, one
+    /// u64 LE word repeated `n` times, or, where it is set, `n & 0x7fff_ffff` words as they are.
+    /// A sight grid is open space and solid walls, whole words of ones or zeros, save where a
+    /// surface crosses a word: Crytek Sponza's 210 M voxels of 4 cm fill 26 MB of words and
+    /// far fewer bytes of runs.
+    pub(super) fn to_runs_le_bytes(&self) -> Vec<u8> {
+        const MOST: usize = 0x7fff_ffff;
+        let w = &self.words;
+        let mut out = Vec::new();
+        // Where the literal words since the last repeat begin.
+        let mut literal = 0;
+        let mut i = 0;
+        let flush = |out: &mut Vec<u8>, from: usize, to: usize| {
+            for chunk in w[from..to].chunks(MOST) {
+                out.extend_from_slice(&(chunk.len() as u32 | 1 << 31).to_le_bytes());
+                out.extend(chunk.iter().flat_map(|x| x.to_le_bytes()));
+            }
+        };
+        while i < w.len() {
+            let mut j = i + 1;
+            while j < w.len() && w[j] == w[i] && j - i < MOST {
+                j += 1;
+            }
+            // Two equal words or more make a repeat (12 bytes, not 16).
+            if j - i >= 2 {
+                flush(&mut out, literal, i);
+                out.extend_from_slice(&((j - i) as u32).to_le_bytes());
+                out.extend_from_slice(&w[i].to_le_bytes());
+                literal = j;
+            }
+            i = j;
+        }
+        flush(&mut out, literal, w.len());
+        out
+    }
+
+    /// Decodes `len` bits from [`VoxelBits::to_runs_le_bytes`]'s runs: `Err` says what is
+    /// wrong where a run is cut short or empty, or the runs do not make the grid's words.
+    pub(super) fn from_runs_le_bytes(data: &[u8], len: u64) -> Result<VoxelBits, String> {
+        let words = len.div_ceil(64);
+        let mut out: Vec<u64> = Vec::new();
+        out.try_reserve_exact(words as usize)
+            .map_err(|_| format!("{len} voxels: more than this machine can hold"))?;
+        let word = |b: &[u8]| u64::from_le_bytes(b.try_into().unwrap_or([0; 8]));
+        let mut at = 0;
+        while at < data.len() {
+            let head = data
+                .get(at..at + 4)
+                .ok_or_else(|| format!("a run's count cut short at byte {at}"))?;
+            let head = u32::from_le_bytes([head[0], head[1], head[2], head[3]]);
+            let n = u64::from(head & 0x7fff_ffff);
+            if n == 0 || out.len() as u64 + n > words {
+                return Err(format!(
+                    "a run of {n} words at byte {at}, after {} of the grid's {words}",
+                    out.len()
+                ));
+            }
+            let bytes = if head >> 31 == 1 { 8 * n as usize } else { 8 };
+            let body = data
+                .get(at + 4..at + 4 + bytes)
+                .ok_or_else(|| format!("a run of {n} words cut short at byte {at}"))?;
+            if head >> 31 == 1 {
+                out.extend(body.chunks_exact(8).map(word));
+            } else {
+                out.resize(out.len() + n as usize, word(body));
+            }
+            at += 4 + bytes;
+        }
+        if out.len() as u64 != words {
+            return Err(format!(
+                "runs make {} words, the grid has {words}",
+                out.len()
+            ));
+        }
+        Self::checked(out, len)
+    }
+
     /// Decodes `len` bits from `data` (whole little-endian words, nothing after the last bit).
     pub(super) fn from_le_bytes(data: &[u8], len: u64) -> Result<VoxelBits, String> {
         let words = len.div_ceil(64);
@@ -82,6 +159,11 @@ impl VoxelBits {
             .chunks_exact(8)
             .map(|c| u64::from_le_bytes([c[0], c[1], c[2], c[3], c[4], c[5], c[6], c[7]]))
             .collect();
+        Self::checked(words, len)
+    }
+
+    /// `len` bits from their words, refused where a bit past the last is set.
+    fn checked(words: Vec<u64>, len: u64) -> Result<VoxelBits, String> {
         let tail = len % 64;
         if tail != 0 && words.last().is_some_and(|w| w >> tail != 0) {
             return Err(format!("bits set past the last of {len} voxels"));
@@ -114,6 +196,47 @@ mod tests {
         }
         let b = VoxelBits::from_fn(130, |i| i < 100);
         assert_eq!(b.count_ones(), 100);
+    }
+
+    #[test]
+    fn bits_round_trip_through_runs_and_refuse_runs_that_do_not_make_the_grid() {
+        // Open space, a wall, and surfaces crossing words, at lengths around whole words.
+        for len in [0usize, 1, 64, 65, 640, 6400 + 17] {
+            let b = VoxelBits::from_fn(len, |i| match i / 64 % 10 {
+                0..=4 => true,
+                5 | 6 => false,
+                _ => i % 5 != 0,
+            });
+            let runs = b.to_runs_le_bytes();
+            assert_eq!(
+                VoxelBits::from_runs_le_bytes(&runs, len as u64),
+                Ok(b.clone())
+            );
+            if len >= 640 {
+                assert!(
+                    runs.len() < b.to_le_bytes().len(),
+                    "{len}: {} bytes",
+                    runs.len()
+                );
+            }
+            if len > 0 {
+                assert!(VoxelBits::from_runs_le_bytes(&runs, len as u64 + 64).is_err());
+                assert!(
+                    VoxelBits::from_runs_le_bytes(&runs[..runs.len() - 1], len as u64).is_err()
+                );
+            }
+        }
+        // One word repeated, 12 bytes; an empty run, and runs past the grid, refused.
+        let open = VoxelBits::from_fn(64 * 1000, |_| true);
+        assert_eq!(open.to_runs_le_bytes().len(), 12);
+        let empty_run = [0u8; 12];
+        assert!(VoxelBits::from_runs_le_bytes(&empty_run, 64).is_err());
+        let mut two = 2u32.to_le_bytes().to_vec();
+        two.extend(u64::MAX.to_le_bytes());
+        assert!(VoxelBits::from_runs_le_bytes(&two, 64).is_err());
+        // A stray bit past the last voxel, as in the words.
+        assert!(VoxelBits::from_runs_le_bytes(&two, 127).is_err());
+        assert!(VoxelBits::from_runs_le_bytes(&two, 128).is_ok());
     }
 
     #[test]

@@ -15,7 +15,9 @@
 //!                                     or, where smaller, its runs: (u32 LE length, element)
 //!                       open_voxels   a bit per voxel of the sight grid (x fastest), 1 = open
 //!                                     (no triangle crosses its centre segments), u64 LE
-//!                                     words (format 6)
+//!                                     words (format 6), or, where smaller, their runs
+//!                                     (format 7): a u32 LE count, then one word repeated
+//!                                     or, with the count's top bit set, as many words
 //! ```
 //!
 //! The grid is stored in the smallest unsigned type (u8, u16, u32) that holds its largest
@@ -49,8 +51,11 @@ pub use values::{Elem, VoxelValues};
 
 /// The first eight bytes of every `.vgate` file.
 pub const MAGIC: [u8; 8] = *b"VGATE\r\n\x1a";
-/// The format version this build writes and reads.
-pub const FORMAT_VERSION: u32 = 6;
+/// The format version this build writes.
+pub const FORMAT_VERSION: u32 = 7;
+/// The oldest format version this build reads: format 6 differs from 7 only in that its open
+/// voxels are never stored as runs.
+pub const OLDEST_READ_VERSION: u32 = 6;
 /// "No node / no cluster" in a grid decoded to u32.
 pub const NONE: u32 = u32::MAX;
 
@@ -221,6 +226,9 @@ pub enum SectionKind {
     /// A bit per voxel of the sight grid, set where it is open (no triangle crosses its centre
     /// segments): u64 LE words.
     OpenVoxels,
+    /// The same words as runs (format 7): a u32 LE count, then one u64 LE word repeated that
+    /// many times or, with the count's top bit set, that many words.
+    OpenVoxelRuns,
 }
 
 /// An entry of the section table.
@@ -282,10 +290,16 @@ impl BakedLevel {
         } else {
             (SectionKind::VoxelCluster, self.voxel_cluster.to_le_bytes())
         };
+        let open_runs = self.open.to_runs_le_bytes();
+        let open = if (open_runs.len() as u64) < self.open.len().div_ceil(64) * 8 {
+            (SectionKind::OpenVoxelRuns, open_runs)
+        } else {
+            (SectionKind::OpenVoxels, self.open.to_le_bytes())
+        };
         let blobs = [
             (SectionKind::Topology, Elem::Structure, topo),
             (clusters.0, self.voxel_cluster.elem(), clusters.1),
-            (SectionKind::OpenVoxels, Elem::U8, self.open.to_le_bytes()),
+            (open.0, Elem::U8, open.1),
         ];
         let mut header = Header {
             info: self.info.clone(),
@@ -377,10 +391,10 @@ impl BakedLevel {
                 supported: FORMAT_VERSION,
             });
         }
-        if version < FORMAT_VERSION {
+        if version < OLDEST_READ_VERSION {
             return Err(VgateError::OldVersion {
                 found: version,
-                supported: FORMAT_VERSION,
+                supported: OLDEST_READ_VERSION,
             });
         }
         let hlen = u32::from_le_bytes([bytes[12], bytes[13], bytes[14], bytes[15]]) as u64;
@@ -431,7 +445,7 @@ impl BakedLevel {
             [
                 SectionKind::Topology,
                 SectionKind::VoxelCluster | SectionKind::VoxelClusterRuns,
-                SectionKind::OpenVoxels
+                SectionKind::OpenVoxels | SectionKind::OpenVoxelRuns
             ]
         ) {
             return Err(VgateError::Length(format!(
@@ -531,8 +545,12 @@ impl BakedLevel {
                     "the open voxels' section is not a blob of bytes".into(),
                 ));
             }
-            VoxelBits::from_le_bytes(data, sight_voxels)
-                .map_err(|e| VgateError::Length(format!("open voxels: {e}")))?
+            if s.kind == SectionKind::OpenVoxelRuns {
+                VoxelBits::from_runs_le_bytes(data, sight_voxels)
+            } else {
+                VoxelBits::from_le_bytes(data, sight_voxels)
+            }
+            .map_err(|e| VgateError::Length(format!("open voxels: {e}")))?
         };
         let level = BakedLevel {
             info: header.info,
