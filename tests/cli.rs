@@ -694,6 +694,27 @@ fn a_refined_bake_says_where_its_partition_was_made() {
 }
 
 #[test]
+fn a_bake_says_its_sight_grid_and_inspect_how_the_file_stores_it() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("x.vgate");
+    let out = out.to_str().expect("utf-8");
+    // Two rooms, 8.6 m long: the sight grid at 1/512 of it, 515 voxels with the border.
+    let o = visgate(&["bake", "builtin:two-rooms", "-o", out, "--resolution", "64"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = stdout(&o);
+    let want = "sight grid 515 x 205 x 264, ";
+    assert!(
+        text.contains(want) && text.contains("voxel 0.0168 m (the voxel walk's: --sight-voxel)"),
+        "missing the sight grid in:\n{text}"
+    );
+    let info = stdout(&visgate(&["inspect", out]));
+    assert!(
+        info.contains("format v7") && info.contains("bit each), stored runs in "),
+        "{info}"
+    );
+}
+
+#[test]
 fn bake_refuses_bad_arguments_clearly() {
     let dir = tempfile::tempdir().expect("tempdir");
     let out = dir.path().join("x.vgate");

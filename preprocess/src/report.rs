@@ -126,6 +126,7 @@ impl BakeReport {
             "voxels {}  solid {}  empty (kept) {}\n",
             m.voxels, m.solid_voxels, m.empty_voxels
         );
+        s += &self.sight_line();
         s += &format!(
             "skeleton nodes {}  segmented nodes {} (topology {}, curvature {}, coverage {}, narrowing {})\n",
             m.skeleton_nodes,
@@ -183,5 +184,27 @@ impl BakeReport {
             }
         );
         s
+    }
+}
+
+impl BakeReport {
+    /// The sight grid's line of the summary: its voxels and size, from its stage's counts
+    /// (empty where the stage did not run).
+    fn sight_line(&self) -> String {
+        let Some(c) = self.stages.iter().find(|s| s.name == "sight grid") else {
+            return String::new();
+        };
+        let dims: Vec<u64> = c.counts["dims"]
+            .as_array()
+            .map(|d| d.iter().filter_map(|x| x.as_u64()).collect())
+            .unwrap_or_default();
+        let (Some(v), &[x, y, z]) = (c.counts["voxel_size_m"].as_f64(), &dims[..]) else {
+            return String::new();
+        };
+        format!(
+            "sight grid {x} x {y} x {z}, voxel {v:.4} m (the voxel walk's: --sight-voxel), {:.1} MB \
+             of bits\n",
+            c.counts["bytes"].as_f64().unwrap_or(0.0) / 1e6
+        )
     }
 }
