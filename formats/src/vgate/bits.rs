@@ -105,42 +105,49 @@ impl VoxelBits {
     }
 
     /// Decodes `len` bits from [`VoxelBits::to_runs_le_bytes`]'s runs: `Err` says what is
-    /// wrong where a run is cut short or empty, or the runs do not make the grid's words.
+    /// wrong where a run is cut short or empty, or the runs do not make the grid's words. The
+    /// runs are read through once before anything is allocated, so a file whose runs do not
+    /// add up to its grid is refused without holding the grid.
     pub(super) fn from_runs_le_bytes(data: &[u8], len: u64) -> Result<VoxelBits, String> {
         let words = len.div_ceil(64);
-        let mut out: Vec<u64> = Vec::new();
-        out.try_reserve_exact(words as usize)
-            .map_err(|_| format!("{len} voxels: more than this machine can hold"))?;
-        let word = |b: &[u8]| u64::from_le_bytes(b.try_into().unwrap_or([0; 8]));
-        let mut at = 0;
+        // Each run: (words it makes, whether they follow as they are, where its body starts).
+        let mut runs: Vec<(u64, bool, usize)> = Vec::new();
+        let (mut at, mut total) = (0usize, 0u64);
         while at < data.len() {
             let head = data
                 .get(at..at + 4)
                 .ok_or_else(|| format!("a run's count cut short at byte {at}"))?;
             let head = u32::from_le_bytes([head[0], head[1], head[2], head[3]]);
-            let n = u64::from(head & 0x7fff_ffff);
-            if n == 0 || out.len() as u64 + n > words {
+            let (n, literal) = (u64::from(head & 0x7fff_ffff), head >> 31 == 1);
+            if n == 0 || total + n > words {
                 return Err(format!(
-                    "a run of {n} words at byte {at}, after {} of the grid's {words}",
-                    out.len()
+                    "a run of {n} words at byte {at}, after {total} of the grid's {words}"
                 ));
             }
-            let bytes = if head >> 31 == 1 { 8 * n as usize } else { 8 };
-            let body = data
-                .get(at + 4..at + 4 + bytes)
-                .ok_or_else(|| format!("a run of {n} words cut short at byte {at}"))?;
-            if head >> 31 == 1 {
-                out.extend(body.chunks_exact(8).map(word));
+            let bytes = if literal { 8 * n as usize } else { 8 };
+            if data.len() < at + 4 + bytes {
+                return Err(format!("a run of {n} words cut short at byte {at}"));
+            }
+            runs.push((n, literal, at + 4));
+            total += n;
+            at += 4 + bytes;
+        }
+        if total != words {
+            return Err(format!("runs make {total} words, the grid has {words}"));
+        }
+        let mut out: Vec<u64> = Vec::new();
+        out.try_reserve_exact(words as usize)
+            .map_err(|_| format!("{len} voxels: more than this machine can hold"))?;
+        let word = |at: usize| {
+            let b = &data[at..at + 8];
+            u64::from_le_bytes([b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]])
+        };
+        for (n, literal, body) in runs {
+            if literal {
+                out.extend((0..n as usize).map(|k| word(body + 8 * k)));
             } else {
                 out.resize(out.len() + n as usize, word(body));
             }
-            at += 4 + bytes;
-        }
-        if out.len() as u64 != words {
-            return Err(format!(
-                "runs make {} words, the grid has {words}",
-                out.len()
-            ));
         }
         Self::checked(out, len)
     }
@@ -237,6 +244,10 @@ mod tests {
         // A stray bit past the last voxel, as in the words.
         assert!(VoxelBits::from_runs_le_bytes(&two, 127).is_err());
         assert!(VoxelBits::from_runs_le_bytes(&two, 128).is_ok());
+        // A grid of 2^40 voxels (128 GiB of words) and runs that make two words: refused for
+        // that, before anything is allocated.
+        let e = VoxelBits::from_runs_le_bytes(&two, 1 << 40).expect_err("short");
+        assert!(e.contains("runs make 2 words"), "{e}");
     }
 
     #[test]
