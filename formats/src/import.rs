@@ -75,6 +75,9 @@ pub struct ImportedModel {
     pub lights: Vec<crate::desc::LightDesc>,
     /// Perspective cameras the file places (glTF), in its units and axes.
     pub cameras: Vec<crate::desc::CameraDesc>,
+    /// Directional lights the file places (glTF), in its axes: a bare file's become far spot
+    /// lights ([`crate::gltf_nodes::suns_as_spots`]).
+    pub suns: Vec<crate::gltf_nodes::Sun>,
     /// Indices of the materials that glow (an OBJ's `Ke`, a glTF's emissive factor above 0):
     /// visgate lights by point and spot lights alone, so they add no light of their own.
     pub emissive: Vec<u32>,

@@ -243,7 +243,7 @@ fn unread_lights_and_cameras(
 ) -> Vec<String> {
     let mut notes = Vec::new();
     let (lights, cameras) = models.iter().fold((0, 0), |(l, c), m| {
-        (l + m.lights.len(), c + m.cameras.len())
+        (l + m.lights.len() + m.suns.len(), c + m.cameras.len())
     });
     if desc.lights.is_empty() && lights > 0 {
         notes.push(format!(
@@ -300,8 +300,14 @@ impl Scene {
             _ => Vec::new(),
         };
         if bare {
-            // A bare glTF file brings the lights and cameras it places (gltf_nodes.rs).
+            // A bare glTF file brings the lights and cameras it places (gltf_nodes.rs), its suns
+            // as far spot lights.
             desc.lights = models.iter().flat_map(|m| m.lights.clone()).collect();
+            let (suns, placed) =
+                crate::gltf_nodes::suns_as_spots(&models, desc.metres_per_unit, path);
+            placed.iter().for_each(|n| tracing::warn!("{n}"));
+            desc.lights.extend(suns);
+            notes.extend(placed);
             desc.cameras = models.iter().flat_map(|m| m.cameras.clone()).collect();
             desc.validate(path)?;
         } else {

@@ -47,7 +47,7 @@ fn lights_are_placed_by_their_nodes_and_read_in_watts_per_steradian() {
         {"extensions":{"KHR_lights_punctual":{"light":2}}}"#;
     let p = gltf(dir.path(), nodes, LIGHTS, "[0,1,3,4]");
     let scene = Scene::load(&p, &ImportOptions::default()).expect("loads");
-    assert_eq!(scene.lights.len(), 2, "{:?}", scene.lights);
+    assert_eq!(scene.lights.len(), 3, "{:?}", scene.lights);
     let Light::Point {
         position,
         intensity,
@@ -85,8 +85,78 @@ fn lights_are_placed_by_their_nodes_and_read_in_watts_per_steradian() {
     );
     assert!((cutoff_rad - 0.5).abs() < 1e-6, "{cutoff_rad}");
     assert!(beam_rad > 0.0 && beam_rad < 1e-3, "{beam_rad}");
+    // The sun, unrotated (its light along −Z), as a spot 9.5 diagonals of the wall's box (0,
+    // 0, 0)–(4, 3, 0) from its centre, back along its light: 47.5 m; 3 lux of white light is
+    // 3 / 683 W/m² there, so 3 / 683 · 47.5² W/sr; its full beam covers the box.
+    let Light::Spot {
+        position,
+        direction,
+        intensity,
+        cutoff_rad,
+        beam_rad,
+    } = scene.lights[2]
+    else {
+        panic!("{:?}", scene.lights[2])
+    };
+    assert!(
+        (position - Vec3::new(2.0, 1.5, 47.5)).length() < 1e-4,
+        "{position}"
+    );
+    assert!((direction - Vec3::NEG_Z).length() < 1e-6, "{direction}");
+    let irradiance = intensity / (position - Vec3::new(2.0, 1.5, 0.0)).length_squared();
+    assert!(
+        (irradiance - Vec3::splat(3.0 / 683.0)).abs().max_element() < 1e-7,
+        "{irradiance}"
+    );
+    assert!(
+        beam_rad >= (2.5f32 / 47.5).asin() && cutoff_rad > beam_rad,
+        "{beam_rad}"
+    );
     let said = scene.report.warnings.join("\n");
-    assert!(said.contains("directional light 'sun' skipped"), "{said}");
+    assert!(
+        said.contains("directional light 'sun' (irradiance 0.004 0.004 0.004 W/m²) placed as a spot light 48 units"),
+        "{said}"
+    );
+    // Within the distance at which a light is named as misplaced.
+    assert!(!said.contains("outside"), "{said}");
+}
+
+#[test]
+fn a_sun_is_placed_for_its_irradiance_in_metres_whatever_the_file_s_units() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let nodes = r#"{"rotation":[-0.70710677,0,0,0.70710677],
+        "extensions":{"KHR_lights_punctual":{"light":2}}}"#;
+    let p = gltf(dir.path(), nodes, LIGHTS, "[0,1]");
+    // Read in centimetres, the wall is 5 cm across: the sun, now pointing down, 47.5 cm above
+    // its centre, gives the same 3 / 683 W/m² there.
+    let options = ImportOptions {
+        bare: visgate_formats::load::BareMesh {
+            metres_per_unit: Some(0.01),
+            up: None,
+        },
+        ..ImportOptions::default()
+    };
+    let scene = Scene::load(&p, &options).expect("loads");
+    let Light::Spot {
+        position,
+        direction,
+        intensity,
+        ..
+    } = scene.lights[0]
+    else {
+        panic!("{:?}", scene.lights)
+    };
+    let centre = Vec3::new(0.02, 0.015, 0.0);
+    assert!((direction - Vec3::NEG_Y).length() < 1e-5, "{direction}");
+    assert!(
+        (position - (centre + Vec3::Y * 0.475)).length() < 1e-5,
+        "{position}"
+    );
+    let irradiance = intensity / (position - centre).length_squared();
+    assert!(
+        (irradiance - Vec3::splat(3.0 / 683.0)).abs().max_element() < 1e-7,
+        "{irradiance}"
+    );
 }
 
 #[test]

@@ -633,6 +633,37 @@ fn direct_on_gpu_and_cpu(
 }
 
 #[test]
+fn gpu_a_spot_far_outside_the_level_casts_its_shadows() {
+    // A sun placed as a spot 9.5 diagonals from the sun window's centre (as a glTF's
+    // directional light is: formats/src/gltf_nodes.rs), shining in through the window. The
+    // shadow maps' far plane was 4 diagonals: the walls beyond it cast nothing and the whole
+    // floor was lit (the GPU's mean 4.5 times the reference's); and their near plane, 1e-4 of
+    // a diagonal, left the depth test half a metre of precision at 90 m.
+    use visgate_formats::Light;
+    let ctx = context();
+    let mut scene = Builtin::SunWindow.scene().expect("scene");
+    let (lo, hi) = scene.bounds().expect("bounds");
+    let (centre, diagonal) = ((lo + hi) * 0.5, (hi - lo).length());
+    let dir = Vec3::new(-0.3, -0.5, -0.8).normalize();
+    let distance = 9.5 * diagonal;
+    let beam = (0.5 / 9.5f32).asin() * 1.05;
+    scene.lights = vec![Light::Spot {
+        position: centre - dir * distance,
+        direction: dir,
+        intensity: Vec3::splat(10.0 * distance * distance),
+        cutoff_rad: beam * 1.1,
+        beam_rad: beam,
+    }];
+    let view = View::new(scene.camera("window").expect("camera"), [160, 120]).expect("view");
+    let (gpu, cpu) = direct_on_gpu_and_cpu(&ctx, &scene, &view);
+    let (g, c) = (gpu.mean().x, cpu.mean().x);
+    let e = errors(&gpu, &cpu).expect("same size");
+    eprintln!("GPU mean {g}, reference {c}, rel. MSE {}", e.rel_mse);
+    assert!(c > 0.01, "a lit patch: {c}");
+    assert!((g / c - 1.0).abs() < 0.05, "GPU {g}, reference {c}");
+}
+
+#[test]
 fn gpu_normals_that_lean_far_from_their_faces_light_as_the_cpu_does() {
     // Real meshes carry vertex normals far off their faces (Crytek Sponza's arches: up to 90°).
     // The G-buffer once turned the shading normal itself towards the camera, the CPU tracer

@@ -124,7 +124,8 @@ impl GpuRenderer {
         params: &LightClusterGpuParams,
     ) -> Result<LightClusters, RenderError> {
         params.check()?;
-        let (lights, _) = passes::shadow_maps::light_views(&self.scene.lights, 1.0, 2.0);
+        let (lights, _) =
+            passes::shadow_maps::light_views(&self.scene.lights, 1.0, 2.0, self.scene.bounds);
         let lights_buf = self.pool.upload(
             ctx,
             "lights",

@@ -105,9 +105,11 @@ pub struct SceneGpu {
     pub lights: Vec<SceneLight>,
     /// Near plane (1e-4 of the first scene's diagonal). [Units: m]
     pub near_m: f32,
-    /// Far distance of the lights' shadow and paraboloid maps (4 diagonals; the camera has no
-    /// far plane). [Units: m]
+    /// Far distance of the lights' shadow and paraboloid maps, at least (4 diagonals; the
+    /// camera has no far plane): [`SceneGpu::light_far_m`] reaches farther lights. [Units: m]
     pub far_m: f32,
+    /// The first scene's bounds. [Units: m]
+    pub bounds: (Vec3, Vec3),
     /// The first scene's bounding diagonal (LightCluster's light ranges). [Units: m]
     pub diagonal_m: f32,
     /// Albedo textures as one array.
@@ -215,6 +217,20 @@ pub struct GpuRenderer {
     last_hdr: Option<wgpu::Texture>,
 }
 
+impl SceneGpu {
+    /// Far distance of the lights' shadow and paraboloid maps now: [`SceneGpu::far_m`], or, for
+    /// a light farther out (a sun placed as a far spot stands 9.5 diagonals away), the distance
+    /// from it to the far corner of the scene's bounds and a little more; else the geometry
+    /// beyond the far plane would cast no shadow. [Units: m]
+    pub fn light_far_m(&self) -> f32 {
+        let (lo, hi) = self.bounds;
+        let reach = |p: Vec3| (p - lo).abs().max((p - hi).abs()).length() * 1.01;
+        (self.lights.iter())
+            .map(|l| reach(l.position()))
+            .fold(self.far_m, f32::max)
+    }
+}
+
 impl GpuRenderer {
     /// Uploads every mesh of `scene` (albedo per vertex from its material, textures as layers
     /// of one sRGB array, resized to the largest texture's size up to [`MAX_TEXTURE_SIZE`]) and
@@ -237,6 +253,7 @@ impl GpuRenderer {
                 lights: scene.lights.clone(),
                 near_m: size * 1e-4,
                 far_m: size * 4.0,
+                bounds: scene.bounds().unwrap_or((Vec3::ZERO, Vec3::ZERO)),
                 diagonal_m: size,
                 albedo_maps,
                 albedo_sampler,

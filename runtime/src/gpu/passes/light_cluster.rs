@@ -95,7 +95,7 @@ pub fn lc_frame(
         distance_scale: p.clustering.distance_scale,
         range_scale: light_range_scale(&scene.lights, scene.diagonal_m, p.clustering.cutoff),
         near_m: scene.near_m,
-        far_m: scene.far_m,
+        far_m: scene.light_far_m(),
         normal_offset,
         bias,
         blocker_samples: p.pcss.blocker_samples,

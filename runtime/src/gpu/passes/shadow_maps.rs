@@ -36,11 +36,22 @@ const CUBE_FACES: [(Vec3, Vec3); 6] = [
 
 /// The lights as the GPU sees them and each shadow layer's view. A spot whose cutoff is wider
 /// than one frustum can span ([`MAX_SPOT_FRUSTUM_RAD`]) gets the six cube faces of a point
-/// light (its falloff still applies), so no cutoff a scene file accepts is clamped.
-pub fn light_views(lights: &[SceneLight], near: f32, far: f32) -> (Vec<Light>, Vec<ShadowView>) {
+/// light (its falloff still applies), so no cutoff a scene file accepts is clamped. A light
+/// outside the scene's `bounds` has its near plane moved out to half its distance from them:
+/// the depth test's precision falls with distance over the near plane (a sun's spot 90 m away
+/// on a near plane of 1 mm told surfaces apart only half a metre apart, and a wall's shadow
+/// leaked along its foot).
+pub fn light_views(
+    lights: &[SceneLight],
+    near: f32,
+    far: f32,
+    (lo, hi): (Vec3, Vec3),
+) -> (Vec<Light>, Vec<ShadowView>) {
     let mut gpu = Vec::new();
     let mut views = Vec::new();
+    let near_of = |p: Vec3| near.max(0.5 * (lo - p).max(p - hi).max(Vec3::ZERO).length());
     let cube = |position: Vec3, views: &mut Vec<ShadowView>| {
+        let near = near_of(position);
         for (f, up) in CUBE_FACES {
             let vp = perspective(1.0, 1.0, near, far) * look_to(position, f, up);
             views.push(ShadowView {
@@ -80,7 +91,8 @@ pub fn light_views(lights: &[SceneLight], near: f32, far: f32) -> (Vec<Light>, V
                         Vec3::Y
                     };
                     let t = cutoff_rad.tan();
-                    let vp = perspective(t, t, near, far) * look_to(position, direction, up);
+                    let vp = perspective(t, t, near_of(position), far)
+                        * look_to(position, direction, up);
                     views.push(ShadowView {
                         view_proj: vp.to_cols_array_2d(),
                         light: position.extend(1.0).to_array(),
@@ -195,7 +207,12 @@ impl ShadowMaps {
         draw: bool,
     ) -> Result<ShadowOutput, RenderError> {
         let d = &f.ctx.device;
-        let (lights, mut views) = light_views(&f.scene.lights, f.scene.near_m, f.scene.far_m);
+        let (lights, mut views) = light_views(
+            &f.scene.lights,
+            f.scene.near_m,
+            f.scene.light_far_m(),
+            f.scene.bounds,
+        );
         if !draw {
             views.clear();
         }
