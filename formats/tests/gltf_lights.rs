@@ -29,6 +29,20 @@ fn gltf(dir: &Path, nodes: &str, extra: &str, roots: &str) -> PathBuf {
     p
 }
 
+/// A spot light's position, direction, intensity, cutoff and beam (panics on a point light).
+fn spot(light: &Light) -> (Vec3, Vec3, Vec3, f32, f32) {
+    match *light {
+        Light::Spot {
+            position,
+            direction,
+            intensity,
+            cutoff_rad,
+            beam_rad,
+        } => (position, direction, intensity, cutoff_rad, beam_rad),
+        Light::Point { .. } => panic!("not a spot: {light:?}"),
+    }
+}
+
 const LIGHTS: &str = r#","extensionsUsed":["KHR_lights_punctual"],
     "extensions":{"KHR_lights_punctual":{"lights":[
       {"name":"lamp","type":"point","color":[1.0,0.5,0.25],"intensity":683.0},
@@ -64,16 +78,7 @@ fn lights_are_placed_by_their_nodes_and_read_in_watts_per_steradian() {
         (intensity - Vec3::new(1.0, 0.5, 0.25)).length() < 1e-6,
         "{intensity}"
     );
-    let Light::Spot {
-        position,
-        direction,
-        intensity,
-        cutoff_rad,
-        beam_rad,
-    } = scene.lights[1]
-    else {
-        panic!("{:?}", scene.lights[1])
-    };
+    let (position, direction, intensity, cutoff_rad, beam_rad) = spot(&scene.lights[1]);
     assert!(
         (position - Vec3::new(1.0, 2.0, 1.0)).length() < 1e-6,
         "{position}"
@@ -88,16 +93,7 @@ fn lights_are_placed_by_their_nodes_and_read_in_watts_per_steradian() {
     // The sun, unrotated (its light along −Z), as a spot 9.5 diagonals of the wall's box (0,
     // 0, 0)–(4, 3, 0) from its centre, back along its light: 47.5 m; 3 lux of white light is
     // 3 / 683 W/m² there, so 3 / 683 · 47.5² W/sr; its full beam covers the box.
-    let Light::Spot {
-        position,
-        direction,
-        intensity,
-        cutoff_rad,
-        beam_rad,
-    } = scene.lights[2]
-    else {
-        panic!("{:?}", scene.lights[2])
-    };
+    let (position, direction, intensity, cutoff_rad, beam_rad) = spot(&scene.lights[2]);
     assert!(
         (position - Vec3::new(2.0, 1.5, 47.5)).length() < 1e-4,
         "{position}"
@@ -137,15 +133,7 @@ fn a_sun_is_placed_for_its_irradiance_in_metres_whatever_the_file_s_units() {
         ..ImportOptions::default()
     };
     let scene = Scene::load(&p, &options).expect("loads");
-    let Light::Spot {
-        position,
-        direction,
-        intensity,
-        ..
-    } = scene.lights[0]
-    else {
-        panic!("{:?}", scene.lights)
-    };
+    let (position, direction, intensity, _, _) = spot(&scene.lights[0]);
     let centre = Vec3::new(0.02, 0.015, 0.0);
     assert!((direction - Vec3::NEG_Y).length() < 1e-5, "{direction}");
     assert!(
