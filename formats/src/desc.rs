@@ -134,6 +134,9 @@ pub struct SceneDesc {
     /// Named cameras.
     #[serde(default, rename = "camera")]
     pub cameras: Vec<CameraDesc>,
+    /// Suns: directional lights, each placed as a far spot light (`crate::sun`).
+    #[serde(default, rename = "sun", skip_serializing_if = "Vec::is_empty")]
+    pub suns: Vec<crate::sun::SunDesc>,
 }
 
 /// One mesh file placed in the scene.
@@ -361,6 +364,7 @@ impl SceneDesc {
             lights: vec![],
             light_lines: vec![],
             cameras: vec![],
+            suns: vec![],
         }
     }
 
@@ -554,6 +558,18 @@ impl SceneDesc {
                 return Err(bad(format!(
                     "camera '{}': fov_deg = {} must be in (0, 180) (full horizontal angle)",
                     c.name, c.fov_deg
+                )));
+            }
+        }
+        for (i, sun) in self.suns.iter().enumerate() {
+            let ok = finite3(&sun.direction)
+                && sun.direction != [0.0; 3]
+                && sun.irradiance.iter().all(|x| x.is_finite() && *x >= 0.0);
+            if !ok {
+                return Err(bad(format!(
+                    "sun {}: direction must be finite and non-zero, irradiance (W/m²) finite and \
+                     not negative",
+                    i + 1
                 )));
             }
         }

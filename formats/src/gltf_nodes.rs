@@ -9,14 +9,8 @@
 //!   intensity reaches 0 and its `innerConeAngle` the edge of full intensity; between them glTF
 //!   leaves the falloff to the engine and visgate's is linear in angle. `range` is not read (the
 //!   light falls off with the inverse square everywhere).
-//! - **Suns** (directional lights): visgate has no light at infinity, so a bare file's sun is
-//!   placed as a spot light far along its direction ([`suns_as_spots`]): on the line through
-//!   the level's centre, [`SUN_DISTANCE_DIAGONALS`] of its box's diagonals away (within the
-//!   distance at which a light is named as misplaced), its full beam just covering the box,
-//!   intensity set so that the irradiance at the centre is the sun's, `E [W/m²] = colour ×
-//!   illuminance [lux] / 683`. Its rays are then parallel within 3° and its irradiance within
-//!   about ±11 % across the level (the inverse square from the near side to the far one); the
-//!   load says where it went.
+//! - **Suns** (directional lights): irradiance `E [W/m²] = colour × illuminance [lux] / 683`,
+//!   along the node's −Z; the scene places each as a far spot light ([`crate::sun`]).
 //! - **Cameras**: perspective cameras at their node's world position, looking along its −Z with
 //!   its +Y up; glTF gives the vertical field of view and visgate the horizontal one, so
 //!   `fov_x = 2 atan(tan(yfov / 2) · aspect)` with the camera's aspect ratio, or 16:9 where it
@@ -27,7 +21,7 @@
 
 use std::path::Path;
 
-use glam::{DVec3, Mat4, Vec3};
+use glam::{Mat4, Vec3};
 
 use crate::desc::{CameraDesc, LightDesc, PointLightDesc, SpotLightDesc};
 use crate::import::ImportedModel;
@@ -109,8 +103,8 @@ fn read_node(path: &Path, node: &gltf::Node, world: Mat4, out: &mut ImportedMode
                     path.display()
                 ));
             }
-            gltf::khr_lights_punctual::Kind::Directional => out.suns.push(Sun {
-                name,
+            gltf::khr_lights_punctual::Kind::Directional => out.suns.push(crate::sun::SunDesc {
+                name: Some(name),
                 direction: along(Vec3::NEG_Z).as_dvec3().to_array(),
                 irradiance: intensity,
             }),
@@ -152,81 +146,6 @@ fn read_node(path: &Path, node: &gltf::Node, world: Mat4, out: &mut ImportedMode
             }
         }
     }
-}
-
-/// A directional light as the file states it: where its light goes and how strong it is.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Sun {
-    /// The light's name (or its node's).
-    pub name: String,
-    /// Unit direction its light travels, in the file's axes.
-    pub direction: [f64; 3],
-    /// Irradiance on a surface facing it, W/m² per RGB channel (colour × lux / 683).
-    pub irradiance: [f32; 3],
-}
-
-/// How far from the level's centre a sun's spot stands, in diagonals of the level's box: under
-/// [`crate::placement::FAR_DIAGONALS`], at which a light is named as misplaced.
-pub const SUN_DISTANCE_DIAGONALS: f64 = 9.5;
-
-/// The suns of `models` as spot lights (see the module notes), in the files' units and axes,
-/// and a line for each saying where it went; none without geometry. `metres_per_unit` makes
-/// the spot's intensity give the sun's irradiance in metres.
-pub fn suns_as_spots(
-    models: &[ImportedModel],
-    metres_per_unit: f64,
-    path: &Path,
-) -> (Vec<LightDesc>, Vec<String>) {
-    let points = models
-        .iter()
-        .flat_map(|m| &m.meshes)
-        .flat_map(|m| &m.positions)
-        .map(|p| p.as_dvec3());
-    let Some((lo, hi)) = points.fold(None, |b: Option<(DVec3, DVec3)>, p| {
-        Some(b.map_or((p, p), |(lo, hi)| (lo.min(p), hi.max(p))))
-    }) else {
-        return (Vec::new(), Vec::new());
-    };
-    let (centre, diagonal) = (0.5 * (lo + hi), (hi - lo).length().max(1e-9));
-    let distance = SUN_DISTANCE_DIAGONALS * diagonal;
-    // The box's bounding sphere seen from the spot, and a little more.
-    let beam_deg = (0.5 * diagonal / distance).asin().to_degrees() as f32 * 1.05;
-    let metres = distance * metres_per_unit;
-    let mut notes = Vec::new();
-    let spots = (models.iter().flat_map(|m| &m.suns))
-        .map(|sun| {
-            let dir = DVec3::from(sun.direction).normalize();
-            let position = centre - dir * distance;
-            let intensity = Vec3::from(sun.irradiance) * (metres * metres) as f32;
-            notes.push(format!(
-                "{}: directional light '{}' (irradiance {:.3} {:.3} {:.3} W/m²) placed as a \
-                 spot light {:.0} units from the level's centre, at ({:.1}, {:.1}, {:.1}) in \
-                 the file's units and axes, aimed along its direction: visgate has no light at \
-                 infinity; its rays are parallel within 3° and its irradiance within about \
-                 ±11 % across the level",
-                path.display(),
-                sun.name,
-                sun.irradiance[0],
-                sun.irradiance[1],
-                sun.irradiance[2],
-                distance,
-                position.x,
-                position.y,
-                position.z
-            ));
-            LightDesc::Spot(SpotLightDesc {
-                position: position.to_array(),
-                target: None,
-                direction: Some(dir.to_array()),
-                intensity: intensity.to_array(),
-                cutoff_deg: beam_deg * 1.1,
-                beam_deg,
-                animate: vec![],
-                orbit: None,
-            })
-        })
-        .collect();
-    (spots, notes)
 }
 
 /// Gives cameras that share a name a suffix (`name 2`, `name 3`, …): `--camera` picks by name.

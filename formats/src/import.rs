@@ -76,8 +76,8 @@ pub struct ImportedModel {
     /// Perspective cameras the file places (glTF), in its units and axes.
     pub cameras: Vec<crate::desc::CameraDesc>,
     /// Directional lights the file places (glTF), in its axes: a bare file's become far spot
-    /// lights ([`crate::gltf_nodes::suns_as_spots`]).
-    pub suns: Vec<crate::gltf_nodes::Sun>,
+    /// lights ([`crate::sun`]).
+    pub suns: Vec<crate::sun::SunDesc>,
     /// Indices of the materials that glow (an OBJ's `Ke`, a glTF's emissive factor above 0):
     /// visgate lights by point and spot lights alone, so they add no light of their own.
     pub emissive: Vec<u32>,

@@ -26,6 +26,7 @@ pub mod load;
 pub mod mitsuba;
 pub mod placement;
 pub mod scene;
+pub mod sun;
 pub mod vgate;
 
 pub use desc::SceneDesc;

@@ -301,13 +301,9 @@ impl Scene {
         };
         if bare {
             // A bare glTF file brings the lights and cameras it places (gltf_nodes.rs), its suns
-            // as far spot lights.
+            // placed as far spot lights when the scene is assembled (sun.rs).
             desc.lights = models.iter().flat_map(|m| m.lights.clone()).collect();
-            let (suns, placed) =
-                crate::gltf_nodes::suns_as_spots(&models, desc.metres_per_unit, path);
-            placed.iter().for_each(|n| tracing::warn!("{n}"));
-            desc.lights.extend(suns);
-            notes.extend(placed);
+            desc.suns = models.iter().flat_map(|m| m.suns.clone()).collect();
             desc.cameras = models.iter().flat_map(|m| m.cameras.clone()).collect();
             desc.validate(path)?;
         } else {
@@ -525,6 +521,19 @@ impl Scene {
         for w in crate::placement::far_placements(&scene, desc) {
             tracing::warn!("{}: {w}", file.display());
             scene.report.warnings.push(w);
+        }
+        // Suns last, as far spots over the static geometry (crate::sun): their lights' indices
+        // follow the stated lights', which the animation tracks name.
+        let bounds = scene.static_bounds().or_else(|| scene.bounds());
+        for (i, sun) in desc.suns.iter().enumerate().filter(|_| bounds.is_some()) {
+            let dir = to_world.direction(DVec3::from(sun.direction));
+            let light =
+                crate::sun::sun_spot(bounds.unwrap_or_default(), dir, Vec3::from(sun.irradiance));
+            let name = (sun.name.clone()).unwrap_or_else(|| format!("sun {}", i + 1));
+            let note = crate::sun::placed_note(file, &name, sun.irradiance, &light);
+            tracing::warn!("{note}");
+            scene.report.warnings.push(note);
+            scene.lights.push(light);
         }
         Ok(scene)
     }

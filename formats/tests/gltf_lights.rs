@@ -110,7 +110,7 @@ fn lights_are_placed_by_their_nodes_and_read_in_watts_per_steradian() {
     );
     let said = scene.report.warnings.join("\n");
     assert!(
-        said.contains("directional light 'sun' (irradiance 0.004 0.004 0.004 W/m²) placed as a spot light 48 units"),
+        said.contains("sun 'sun' (irradiance 0.004 0.004 0.004 W/m²) placed as a spot light at (2.0, 1.5, 47.5) m"),
         "{said}"
     );
     // Within the distance at which a light is named as misplaced.

@@ -232,6 +232,66 @@ fn z_up_centimetre_scene_is_converted_once_to_y_up_metres() {
 }
 
 #[test]
+fn a_sun_in_a_scene_file_is_placed_as_a_far_spot_in_metres_and_world_axes() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    // A 100 × 100 × 100 cm corner, z up; a sun shining down (−z) at 2 W/m², and a moved mesh.
+    write_obj(
+        dir.path(),
+        "rooms.obj",
+        "v 0 0 0\nv 100 0 0\nv 0 100 0\nv 0 0 100\nf 1 2 3\nf 1 2 4\n",
+    );
+    let toml = "up = \"z\"\nmetres_per_unit = 0.01\n[[mesh]]\npath = \"rooms.obj\"\n\
+                translate = [100, 0, 0]\n[[sun]]\ndirection = [0, 0, -3]\nirradiance = [2, 2, 2]\n";
+    let path = dir.path().join("sun.toml");
+    std::fs::write(&path, toml).expect("write toml");
+    let scene = Scene::load(&path, &Default::default()).expect("loads");
+    let (lo, hi) = scene.static_bounds().expect("bounds");
+    let centre = 0.5 * (lo + hi);
+    let Light::Spot {
+        position,
+        direction,
+        intensity,
+        ..
+    } = scene.lights[0]
+    else {
+        panic!("{:?}", scene.lights)
+    };
+    // Down is −y in the world; the spot 9.5 diagonals above the moved mesh's centre.
+    assert!(
+        (direction - glam::Vec3::NEG_Y).length() < 1e-6,
+        "{direction}"
+    );
+    let up = position - centre;
+    assert!(
+        (up.normalize() - glam::Vec3::Y).length() < 1e-5
+            && (up.length() - 9.5 * (hi - lo).length()).abs() < 1e-4,
+        "{position} over {centre}"
+    );
+    assert!((centre.x - 1.5).abs() < 1e-5, "{centre}");
+    let e = intensity / up.length_squared();
+    assert!(
+        (e - glam::Vec3::splat(2.0)).abs().max_element() < 1e-5,
+        "{e}"
+    );
+    let said = scene.report.warnings.join("\n");
+    assert!(said.contains("sun 'sun 1' (irradiance 2.000"), "{said}");
+    // A sun with no direction, or an unknown key, is refused by name.
+    for (bad, what) in [
+        (
+            "[[sun]]\ndirection = [0, 0, 0]\nirradiance = [1, 1, 1]\n",
+            "sun 1",
+        ),
+        (
+            "[[sun]]\ndirection = [0, -1, 0]\nirradiance = [1, 1, 1]\nlux = 3\n",
+            "lux",
+        ),
+    ] {
+        let e = err(&format!("[[mesh]]\npath = \"a.obj\"\n{bad}"));
+        assert!(e.contains(what), "{bad:?}: {e}");
+    }
+}
+
+#[test]
 fn mesh_transform_applies_scale_then_rotation_then_translation() {
     let dir = tempfile::tempdir().expect("tempdir");
     write_obj(dir.path(), "t.obj", TRI_OBJ);

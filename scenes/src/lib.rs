@@ -513,6 +513,7 @@ impl Builtin {
                 _ => vec![],
             },
             cameras,
+            suns: vec![],
         }
     }
 
