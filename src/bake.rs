@@ -76,7 +76,7 @@ pub struct BakeArgs {
     /// light through. Default: the level's voxel, or 1/512 of the level's longest extent if
     /// smaller, and on a level over 20 m long finer, down to 4 cm while the grid holds at most
     /// 2^27 voxels (16 MiB of bits, 32 MiB on the GPU): Crytek Sponza 4.7 cm, Dabrovic Sponza
-    /// 4.1 cm, the Quake level 16 cm (on 2 cores 0.06–0.12 s, 7–10 MB of the file).
+    /// 4.1 cm, the Quake level 16 cm (on 2 cores 0.05–0.12 s, 7–10 MB of the file).
     #[arg(long)]
     pub sight_voxel: Option<f32>,
     /// Smallest room, metres: a cluster whose largest ball (radius, 0–10) is smaller is merged

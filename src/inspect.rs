@@ -246,8 +246,8 @@ fn inspect_baked(path: &Path, json: bool) -> Result<()> {
         kind: "baked level",
         file: path.display().to_string(),
         file_bytes: bytes.len() as u64,
-        // The file's own (read past the magic by from_bytes).
-        format_version: u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]),
+        // The file's own, not the build's (from_bytes read it).
+        format_version: visgate_formats::vgate::stated_version(&bytes).unwrap_or(0),
         tool_version: level.info.tool_version.clone(),
         geometry_hash: level.info.geometry_hash.to_string(),
         grid: level.info.grid,

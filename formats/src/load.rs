@@ -523,12 +523,12 @@ impl Scene {
             scene.report.warnings.push(w);
         }
         // Suns last, as far spots over the static geometry (crate::sun): their lights' indices
-        // follow the stated lights', which the animation tracks name.
-        let bounds = scene.static_bounds().or_else(|| scene.bounds());
-        for (i, sun) in desc.suns.iter().enumerate().filter(|_| bounds.is_some()) {
+        // follow the stated lights', which the animation tracks name. The scene has triangles
+        // (above), so it has bounds.
+        let bounds = (scene.static_bounds().or_else(|| scene.bounds())).unwrap_or_default();
+        for (i, sun) in desc.suns.iter().enumerate() {
             let dir = to_world.direction(DVec3::from(sun.direction));
-            let light =
-                crate::sun::sun_spot(bounds.unwrap_or_default(), dir, Vec3::from(sun.irradiance));
+            let light = crate::sun::sun_spot(bounds, dir, Vec3::from(sun.irradiance));
             let name = (sun.name.clone()).unwrap_or_else(|| format!("sun {}", i + 1));
             let note = crate::sun::placed_note(file, &name, sun.irradiance, &light);
             tracing::warn!("{note}");

@@ -21,7 +21,7 @@ pub const NEAR_DIAGONALS: f32 = 1.0;
 pub const FAR_DIAGONALS: f32 = 10.0;
 
 /// Distance from `p` to the box `lo..hi` (0 inside).
-fn outside_by(p: Vec3, (lo, hi): (Vec3, Vec3)) -> f32 {
+pub fn outside_by(p: Vec3, (lo, hi): (Vec3, Vec3)) -> f32 {
     (lo - p).max(p - hi).max(Vec3::ZERO).length()
 }
 

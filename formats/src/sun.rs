@@ -91,6 +91,12 @@ mod tests {
         assert!((to_centre.normalize() - dir.normalize()).length() < 1e-5);
         assert!((to_centre.length() - 9.5 * (hi - lo).length()).abs() < 1e-3);
         assert!((direction - dir.normalize()).length() < 1e-6);
+        // Nearer the box than the distance at which a light is named as misplaced.
+        let off = crate::placement::outside_by(position, (lo, hi));
+        assert!(
+            off < crate::placement::FAR_DIAGONALS * (hi - lo).length(),
+            "{off}"
+        );
         let e = intensity / to_centre.length_squared();
         assert!(
             (e - Vec3::new(1.0, 2.0, 3.0)).abs().max_element() < 1e-5,

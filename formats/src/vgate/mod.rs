@@ -56,6 +56,13 @@ pub const FORMAT_VERSION: u32 = 7;
 /// The oldest format version this build reads: format 6 differs from 7 only in that its open
 /// voxels are never stored as runs.
 pub const OLDEST_READ_VERSION: u32 = 6;
+/// The format version a `.vgate` file states (the u32 after its magic); `None` where the bytes
+/// do not begin with [`MAGIC`] and a version.
+pub fn stated_version(bytes: &[u8]) -> Option<u32> {
+    let v = bytes.get(8..12).filter(|_| bytes[..8] == MAGIC)?;
+    Some(u32::from_le_bytes([v[0], v[1], v[2], v[3]]))
+}
+
 /// "No node / no cluster" in a grid decoded to u32.
 pub const NONE: u32 = u32::MAX;
 
@@ -381,10 +388,9 @@ impl BakedLevel {
                 available: avail,
             });
         }
-        if bytes[..8] != MAGIC {
+        let Some(version) = stated_version(bytes) else {
             return Err(VgateError::BadMagic);
-        }
-        let version = u32::from_le_bytes([bytes[8], bytes[9], bytes[10], bytes[11]]);
+        };
         if version > FORMAT_VERSION {
             return Err(VgateError::NewerVersion {
                 found: version,

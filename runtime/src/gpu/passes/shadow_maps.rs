@@ -49,7 +49,7 @@ pub fn light_views(
 ) -> (Vec<Light>, Vec<ShadowView>) {
     let mut gpu = Vec::new();
     let mut views = Vec::new();
-    let near_of = |p: Vec3| near.max(0.5 * (lo - p).max(p - hi).max(Vec3::ZERO).length());
+    let near_of = |p: Vec3| near.max(0.5 * visgate_formats::placement::outside_by(p, (lo, hi)));
     let cube = |position: Vec3, views: &mut Vec<ShadowView>| {
         let near = near_of(position);
         for (f, up) in CUBE_FACES {
