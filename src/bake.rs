@@ -75,8 +75,8 @@ pub struct BakeArgs {
     /// segment passing within a voxel of a surface is blocked, so a finer grid lets more of the
     /// light through. Default: the level's voxel, or 1/512 of the level's longest extent if
     /// smaller, and on a level over 20 m long finer, down to 4 cm while the grid holds at most
-    /// 2^27 voxels (16 MiB of bits, 32 MiB on the GPU): Crytek Sponza 4.7 cm, Dabrovic Sponza
-    /// 4.1 cm, the Quake level 16 cm (on 2 cores 0.05–0.12 s, 7–10 MB of the file).
+    /// 2^28 voxels (32 MiB of bits, 64 MiB on the GPU): Crytek and Dabrovic Sponza 4 cm, the
+    /// Quake level 12.8 cm (on 2 cores 0.1–0.4 s, 9–19 MB of the file).
     #[arg(long)]
     pub sight_voxel: Option<f32>,
     /// Smallest room, metres: a cluster whose largest ball (radius, 0–10) is smaller is merged
