@@ -6,7 +6,7 @@ mod support;
 
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use support::dynamic_scene;
 use visgate_runtime::hdr::HdrImage;
@@ -37,50 +37,56 @@ struct Xvfb(Child, String);
 
 impl Xvfb {
     fn start() -> Xvfb {
-        // A server that exits at once (its display taken after all) is tried on the next one.
+        // A server that exits or hangs before it is ready is stopped and another started.
         for _ in 0..5 {
             if let Some(x) = Xvfb::try_start() {
                 return x;
             }
         }
-        panic!("Xvfb did not start on 5 displays");
+        panic!("Xvfb did not start 5 times");
     }
 
-    /// Xvfb on a display no other server (or test of this run) holds, once its socket is
-    /// there; `None` if it exited first.
+    /// Xvfb on a display it picks itself (`-displayfd`: the first free one, its lock taken
+    /// atomically, so the tests' servers started at once do not collide), once it says it
+    /// accepts connections; `None` if it exited or said nothing in 60 s (a loaded 2-core
+    /// machine starting several servers at once can take a while; on a fresh machine one
+    /// was seen never to make its socket's file when the display was guessed from the lock
+    /// files).
     fn try_start() -> Option<Xvfb> {
-        static NEXT: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
-        let n = (0..)
-            .map(|_| {
-                let k = NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                40 + (std::process::id() * 7 + k) % 900
-            })
-            .find(|n| {
-                !Path::new(&format!("/tmp/.X{n}-lock")).exists()
-                    && !Path::new(&format!("/tmp/.X11-unix/X{n}")).exists()
-            })
-            .expect("a free display");
-        let display = format!(":{n}");
         let mut child = Command::new("Xvfb")
-            .args([&display, "-screen", "0", "1280x800x24", "-nolisten", "tcp"])
-            .stdout(Stdio::null())
+            .args([
+                "-displayfd",
+                "1",
+                "-screen",
+                "0",
+                "1280x800x24",
+                "-nolisten",
+                "tcp",
+            ])
+            .stdout(Stdio::piped())
             .stderr(Stdio::null())
             .spawn()
             .unwrap_or_else(|e| panic!("the viewer test needs Xvfb (apt-get install xvfb): {e}"));
-        let socket = PathBuf::from(format!("/tmp/.X11-unix/X{n}"));
-        let t = Instant::now();
-        while !socket.exists() {
-            if child.try_wait().ok().flatten().is_some() {
-                return None;
+        let out = child.stdout.take().expect("a piped stdout");
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let mut line = String::new();
+            let _ = std::io::BufRead::read_line(&mut std::io::BufReader::new(out), &mut line);
+            let _ = tx.send(line);
+        });
+        let said = rx.recv_timeout(Duration::from_secs(60)).ok();
+        match said
+            .as_deref()
+            .map(str::trim)
+            .and_then(|n| n.parse::<u32>().ok())
+        {
+            Some(n) => Some(Xvfb(child, format!(":{n}"))),
+            None => {
+                let _ = child.kill();
+                let _ = child.wait();
+                None
             }
-            // A loaded 2-core machine starting several servers at once can take a while.
-            assert!(
-                t.elapsed() < Duration::from_secs(60),
-                "Xvfb did not start on {display} in 60 s"
-            );
-            std::thread::sleep(Duration::from_millis(50));
         }
-        Some(Xvfb(child, display))
     }
 }
 
