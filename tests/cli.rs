@@ -660,22 +660,20 @@ fn a_bake_too_coarse_for_its_level_says_so_and_what_resolution_to_use() {
     assert_eq!(stderr(&o), "", "stderr of a bake fine enough");
 }
 
+/// `visgate bake builtin:two-rooms -o OUT --resolution 64` and `extra`.
+fn two_rooms_at_64(out: &str, extra: &[&str]) -> std::process::Output {
+    let mut args = vec!["bake", "builtin:two-rooms", "-o", out, "--resolution", "64"];
+    args.extend(extra);
+    visgate(&args)
+}
+
 #[test]
 fn a_refined_bake_says_where_its_partition_was_made() {
     let dir = tempfile::tempdir().expect("tempdir");
     let out = dir.path().join("x.vgate");
     let out = out.to_str().expect("utf-8");
     // Two rooms at 64 voxels of 0.134 m, partitioned on 0.27 m voxels.
-    let o = visgate(&[
-        "bake",
-        "builtin:two-rooms",
-        "-o",
-        out,
-        "--resolution",
-        "64",
-        "--partition-voxel",
-        "0.27",
-    ]);
+    let o = two_rooms_at_64(out, &["--partition-voxel", "0.27"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let text = stdout(&o);
     for want in ["refine", "partition: made on a 0.270 m grid", "clusters 2"] {
@@ -698,9 +696,22 @@ fn a_bake_says_its_sight_grid_and_inspect_how_the_file_stores_it() {
     let dir = tempfile::tempdir().expect("tempdir");
     let out = dir.path().join("x.vgate");
     let out = out.to_str().expect("utf-8");
+    let report = dir.path().join("r.json");
+    let report = report.to_str().expect("utf-8");
     // Two rooms, 8.6 m long: the sight grid at 1/512 of it, 515 voxels with the border.
-    let o = visgate(&["bake", "builtin:two-rooms", "-o", out, "--resolution", "64"]);
+    let o = two_rooms_at_64(out, &["--report", report]);
     assert!(o.status.success(), "{}", stderr(&o));
+    // Each stage's CPU time, where the OS tells it (Linux).
+    let r: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(report).expect("report")).expect("JSON");
+    let stages = r["stages"].as_array().expect("stages");
+    assert!(stages.len() > 8, "{r}");
+    for st in stages {
+        let cpu = st["cpu_seconds"].as_f64();
+        if cfg!(target_os = "linux") {
+            assert!(cpu.is_some_and(|c| c >= 0.0), "{st}");
+        }
+    }
     let text = stdout(&o);
     let want = "sight grid 515 x 205 x 264, ";
     assert!(

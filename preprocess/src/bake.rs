@@ -17,8 +17,8 @@ use crate::BakeError;
 use crate::counters::VoxelizeCounts;
 use crate::empty::EmptySpace;
 use crate::empty::Seed;
-use crate::memory::StagePeak;
 pub use crate::memory::peak_memory_bytes;
+use crate::memory::{StagePeak, process_cpu_seconds};
 use crate::sight_grid::{default_sight_voxel, sight_grid};
 use crate::stages;
 use crate::thin::Thinned;
@@ -117,6 +117,7 @@ impl<'a> BakeContext<'a> {
     ) -> Result<T, BakeError> {
         (self.progress)(Progress::Start { stage: name, total });
         let peak = StagePeak::start();
+        let cpu = process_cpu_seconds();
         let t = Instant::now();
         let (out, counts) = f(self)?;
         (self.progress)(Progress::Finish);
@@ -124,6 +125,7 @@ impl<'a> BakeContext<'a> {
             name,
             seconds: t.elapsed().as_secs_f64(),
             peak_memory_bytes: peak.finish(),
+            cpu_seconds: cpu.zip(process_cpu_seconds()).map(|(a, b)| b - a),
             counts: serde_json::to_value(counts).unwrap_or(Value::Null),
         });
         Ok(out)

@@ -1,4 +1,5 @@
-//! How much memory a bake holds: the process's peak, and each stage's own peak, sampled.
+//! How much memory a bake holds: the process's peak, and each stage's own peak, sampled; and
+//! how much CPU time the process has used (each stage's share of the cores).
 //!
 //! A stage's peak is the largest resident set seen while it ran, read from the OS every few
 //! milliseconds by a thread of its own (Linux: `/proc/self/status`); elsewhere there is none.
@@ -24,6 +25,27 @@ fn status_bytes(field: &str) -> Option<u64> {
 /// Peak resident set size of this process (Linux `VmHWM`), bytes.
 pub fn peak_memory_bytes() -> Option<u64> {
     status_bytes("VmHWM:")
+}
+
+/// Clock ticks a second of `/proc/self/stat`'s CPU times: Linux's USER_HZ, 100 on every
+/// architecture visgate builds for.
+const USER_HZ: f64 = 100.0;
+
+/// CPU time this process has used, every thread's, user and system (Linux
+/// `/proc/self/stat`; to 10 ms). [Units: s]
+pub fn process_cpu_seconds() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    Some(stat_cpu_ticks(&stat)? as f64 / USER_HZ)
+}
+
+/// User plus system ticks of a `/proc/PID/stat` line: its 14th and 15th fields, counted after
+/// the command's name in parentheses (which may hold spaces and parentheses itself).
+fn stat_cpu_ticks(stat: &str) -> Option<u64> {
+    let after_name = &stat[stat.rfind(')')? + 1..];
+    let mut fields = after_name.split_whitespace().skip(11);
+    let user: u64 = fields.next()?.parse().ok()?;
+    let system: u64 = fields.next()?.parse().ok()?;
+    Some(user + system)
 }
 
 /// Samples the resident set while a stage runs.
@@ -71,6 +93,17 @@ impl StagePeak {
 #[cfg(all(test, target_os = "linux"))]
 mod tests {
     use super::*;
+
+    #[test]
+    fn cpu_ticks_are_read_after_a_name_with_spaces_and_parentheses() {
+        // pid (comm) state ppid pgrp session tty tpgid flags minflt cminflt majflt cmajflt
+        // utime stime ...
+        let line = "4242 (vis gate) (x)) R 1 4242 4242 0 -1 4194304 950 0 0 0 377 23 0 0 20 0";
+        assert_eq!(stat_cpu_ticks(line), Some(400));
+        assert_eq!(stat_cpu_ticks("4242 (visgate) R 1 2"), None);
+        // This process's own line reads.
+        assert!(process_cpu_seconds().is_some_and(|s| s >= 0.0));
+    }
 
     #[test]
     fn a_stage_that_holds_64_mib_has_a_peak_of_64_mib_at_least() {

@@ -17,6 +17,10 @@ pub struct StageReport {
     /// The process's largest resident memory seen while the stage ran (sampled every few
     /// milliseconds: see [`crate::memory`]), where the OS tells. [Units: bytes]
     pub peak_memory_bytes: Option<u64>,
+    /// The process's CPU time while the stage ran, every thread's (where the OS tells: see
+    /// [`crate::memory::process_cpu_seconds`]); over [`StageReport::seconds`], the cores it kept
+    /// busy. [Units: s]
+    pub cpu_seconds: Option<f64>,
     /// What it produced.
     pub counts: Value,
 }
@@ -105,13 +109,21 @@ impl BakeReport {
             } else {
                 "├─"
             };
-            s += &format!(
-                "{branch} {:<18} {:>8.3} s {:>5.1} %  {:>9}\n",
+            // The cores it kept busy, where the stage is long enough for the OS's 10 ms ticks.
+            let cores = st
+                .cpu_seconds
+                .filter(|_| st.seconds >= 0.05)
+                .map(|c| format!("{:.1} cores", c / st.seconds))
+                .unwrap_or_default();
+            let line = format!(
+                "{branch} {:<18} {:>8.3} s {:>5.1} %  {:>9}  {cores}",
                 st.name,
                 st.seconds,
                 100.0 * st.seconds / self.total_seconds.max(1e-9),
                 st.peak_memory_bytes.map(mib).unwrap_or_default()
             );
+            s += line.trim_end();
+            s += "\n";
         }
         let m = &self.summary;
         let res = match self.params.resolution {
