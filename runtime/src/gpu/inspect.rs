@@ -124,8 +124,7 @@ impl GpuRenderer {
         params: &LightClusterGpuParams,
     ) -> Result<LightClusters, RenderError> {
         params.check()?;
-        let (lights, _) =
-            passes::shadow_maps::light_views(&self.scene.lights, 1.0, 2.0, self.scene.bounds);
+        let (lights, _) = passes::shadow_maps::light_views(&self.scene);
         let lights_buf = self.pool.upload(
             ctx,
             "lights",

@@ -126,12 +126,7 @@ impl RsmVpls {
     ) -> Result<(wgpu::Buffer, u32), RenderError> {
         p.check()?;
         let d = &ctx.device;
-        let (gpu_lights, views) = light_views(
-            &scene.lights,
-            scene.near_m,
-            scene.light_far_m(),
-            scene.bounds,
-        );
+        let (gpu_lights, views) = light_views(scene);
         let samples = if views.is_empty() {
             Vec::new()
         } else {

@@ -13,7 +13,7 @@ use crate::gpu::geometry::{VERTEX_STRIDE, positions};
 use crate::gpu::layout::{Light, ShadowView, UNIFORM_STRIDE, strided};
 use crate::gpu::shaders::ShaderSources;
 use crate::gpu::timing::Recorder;
-use crate::gpu::{Frame, shaders};
+use crate::gpu::{Frame, SceneGpu, shaders};
 
 /// The widest spot cutoff one shadow layer's frustum spans; wider spots get a cube of six.
 /// [Units: rad]
@@ -34,22 +34,21 @@ const CUBE_FACES: [(Vec3, Vec3); 6] = [
     (Vec3::NEG_Z, Vec3::NEG_Y),
 ];
 
-/// The lights as the GPU sees them and each shadow layer's view. A spot whose cutoff is wider
-/// than one frustum can span ([`MAX_SPOT_FRUSTUM_RAD`]) gets the six cube faces of a point
-/// light (its falloff still applies), so no cutoff a scene file accepts is clamped. A light
-/// outside the scene's `bounds` has its near plane moved out to half its distance from them:
-/// the depth test's precision falls with distance over the near plane (a sun's spot 90 m away
-/// on a near plane of 1 mm told surfaces apart only half a metre apart, and a wall's shadow
-/// leaked along its foot).
-pub fn light_views(
-    lights: &[SceneLight],
-    near: f32,
-    far: f32,
-    (lo, hi): (Vec3, Vec3),
-) -> (Vec<Light>, Vec<ShadowView>) {
+/// The scene's lights as the GPU sees them and each shadow layer's view, from the scene's near
+/// plane to [`SceneGpu::light_far_m`]. A spot whose cutoff is wider than one frustum can span
+/// ([`MAX_SPOT_FRUSTUM_RAD`]) gets the six cube faces of a point light (its falloff still
+/// applies), so no cutoff a scene file accepts is clamped. A light outside the scene's bounds
+/// has its near plane moved out to half its distance from them: the depth test's precision
+/// falls with distance over the near plane (a sun's spot 90 m away on a near plane of 1 mm told
+/// surfaces apart only half a metre apart, and a wall's shadow leaked along its foot).
+pub fn light_views(scene: &SceneGpu) -> (Vec<Light>, Vec<ShadowView>) {
     let mut gpu = Vec::new();
     let mut views = Vec::new();
-    let near_of = |p: Vec3| near.max(0.5 * visgate_formats::placement::outside_by(p, (lo, hi)));
+    let far = scene.light_far_m();
+    let near_of = |p: Vec3| {
+        let outside = visgate_formats::placement::outside_by(p, scene.bounds);
+        scene.near_m.max(0.5 * outside)
+    };
     let cube = |position: Vec3, views: &mut Vec<ShadowView>| {
         let near = near_of(position);
         for (f, up) in CUBE_FACES {
@@ -60,7 +59,7 @@ pub fn light_views(
             });
         }
     };
-    for l in lights {
+    for l in &scene.lights {
         let first = views.len() as u32;
         match *l {
             SceneLight::Point {
@@ -207,12 +206,7 @@ impl ShadowMaps {
         draw: bool,
     ) -> Result<ShadowOutput, RenderError> {
         let d = &f.ctx.device;
-        let (lights, mut views) = light_views(
-            &f.scene.lights,
-            f.scene.near_m,
-            f.scene.light_far_m(),
-            f.scene.bounds,
-        );
+        let (lights, mut views) = light_views(f.scene);
         if !draw {
             views.clear();
         }
