@@ -17,8 +17,6 @@ use visgate_formats::vgate::MaxBall;
 
 /// "Infinitely far": larger than any squared distance in a grid of up to 2^20 voxels a side.
 const INF: i64 = 1 << 42;
-/// Lines transformed between two write-backs of the y and z passes (bounds the copy).
-const LINES_PER_BATCH: usize = 1 << 13;
 
 /// Squared Euclidean distance (voxel units) to the nearest solid voxel's centre, per voxel.
 pub fn squared_distance(dims: [u32; 3], solid: &[bool]) -> Vec<u64> {
@@ -36,72 +34,117 @@ pub fn radius_vx(d: u64, rule: MaxBall) -> f64 {
 /// Per voxel, the squared distance to the nearest solid voxel under `rule` (see the module
 /// notes for the units); 0 for solid voxels, ordered as the radii.
 pub fn transform(dims: [u32; 3], solid: &[bool], rule: MaxBall) -> Vec<u64> {
-    let envelope = |f: &[i64]| match rule {
-        MaxBall::SolidCentre => envelope(f),
-        MaxBall::Contained => envelope_to_cubes(f),
-    };
-    let [nx, ny, nz] = dims.map(|d| d as usize);
-    let mut d: Vec<i64> = solid.iter().map(|&s| if s { 0 } else { INF }).collect();
-    // Along x: contiguous rows.
-    d.par_chunks_mut(nx).for_each(|row| {
-        let out = envelope(row);
-        row.copy_from_slice(&out);
-    });
-    // Along y and z: gather each line, transform, scatter.
-    for (len, stride, lines) in [
-        (
-            ny,
-            nx,
-            (0..nz)
-                .flat_map(|z| (0..nx).map(move |x| x + nx * ny * z))
-                .collect::<Vec<_>>(),
-        ),
-        (nz, nx * ny, (0..nx * ny).collect::<Vec<_>>()),
-    ] {
-        // A batch of lines at a time: all of them at once held a second copy of the grid.
-        for batch in lines.chunks(LINES_PER_BATCH) {
-            let results: Vec<Vec<i64>> = batch
-                .par_iter()
-                .map(|&start| {
-                    let line: Vec<i64> = (0..len).map(|k| d[start + k * stride]).collect();
-                    envelope(&line)
-                })
-                .collect();
-            for (&start, r) in batch.iter().zip(&results) {
-                for (k, v) in r.iter().enumerate() {
-                    d[start + k * stride] = *v;
-                }
+    let [nx, ny, _] = dims.map(|d| d as usize);
+    let mut d: Vec<i64> = solid.par_iter().map(|&s| if s { 0 } else { INF }).collect();
+    if nx == 0 || ny == 0 {
+        return Vec::new();
+    }
+    // Along x: each row alone.
+    d.par_chunks_mut(nx)
+        .for_each_init(Lines::default, |lines, row| {
+            lines.along(row, rule);
+        });
+    // Along y: each z-slice's rows, a line through element x of every row.
+    d.par_chunks_mut(nx * ny)
+        .for_each_init(Lines::default, |lines, slice| {
+            let mut rows: Vec<&mut [i64]> = slice.chunks_mut(nx).collect();
+            lines.across(&mut rows, rule);
+        });
+    // Along z: the rows of one y from every slice (about nz × nx values: they stay in cache
+    // while the lines are read and written back, where a line at a time read the grid with a
+    // stride of a slice).
+    let mut by_y: Vec<Vec<&mut [i64]>> = (0..ny).map(|_| Vec::new()).collect();
+    for (r, row) in d.chunks_mut(nx).enumerate() {
+        by_y[r % ny].push(row);
+    }
+    by_y.par_iter_mut()
+        .for_each_init(Lines::default, |lines, rows| lines.across(rows, rule));
+    // Every value is at most INF already; collected in place (no second grid).
+    d.into_iter().map(|v| v as u64).collect()
+}
+
+/// One thread's buffers for the 1D transforms.
+#[derive(Default)]
+struct Lines {
+    f: Vec<i64>,
+    out: Vec<i64>,
+    v: Vec<usize>,
+    z: Vec<f64>,
+}
+
+impl Lines {
+    /// Transforms `row` in place, a line of its own.
+    fn along(&mut self, row: &mut [i64], rule: MaxBall) {
+        self.f.clear();
+        self.f.extend_from_slice(row);
+        self.transform(rule);
+        row.copy_from_slice(&self.out);
+    }
+
+    /// Transforms, for each `x`, the line through element `x` of every row, in place.
+    fn across(&mut self, rows: &mut [&mut [i64]], rule: MaxBall) {
+        for x in 0..rows.first().map_or(0, |r| r.len()) {
+            self.f.clear();
+            self.f.extend(rows.iter().map(|r| r[x]));
+            self.transform(rule);
+            for (r, &o) in rows.iter_mut().zip(&self.out) {
+                r[x] = o;
             }
         }
     }
-    d.into_iter().map(|v| v.min(INF) as u64).collect()
+
+    /// `f`'s transform into `out`.
+    fn transform(&mut self, rule: MaxBall) {
+        let len = self.f.len();
+        self.out.resize(len, 0);
+        self.v.resize(len, 0);
+        self.z.resize(len + 1, 0.0);
+        let (f, out, v, z) = (&self.f, &mut self.out, &mut self.v, &mut self.z);
+        match rule {
+            MaxBall::SolidCentre => envelope(f, out, v, z),
+            MaxBall::Contained => envelope_to_cubes(f, out, v, z),
+        }
+    }
 }
 
-/// 1D squared distance transform of sampled function `f` (lower envelope of parabolas).
-fn envelope(f: &[i64]) -> Vec<i64> {
-    lower_envelope(f, 1, &|q, eval| eval(q as i64))
+/// 1D squared distance transform of sampled function `f` (lower envelope of parabolas) into
+/// `out`; `v` and `z` are scratch of `f`'s length and one more.
+fn envelope(f: &[i64], out: &mut [i64], v: &mut [usize], z: &mut [f64]) {
+    lower_envelope(f, 1, &|q, eval| eval(q as i64), out, v, z)
 }
 
 /// 1D transform to the nearest cube, ×4: `min_p f[p] + g(q − p)` with `g(0) = 0` and
-/// `g(k) = (2|k| − 1)²`.
-fn envelope_to_cubes(f: &[i64]) -> Vec<i64> {
-    lower_envelope(f, 2, &|q, eval| {
-        let q2 = 2 * q as i64;
-        f[q].min(eval(q2 - 1)).min(eval(q2 + 1))
-    })
+/// `g(k) = (2|k| − 1)²` (buffers as [`envelope`]'s).
+fn envelope_to_cubes(f: &[i64], out: &mut [i64], v: &mut [usize], z: &mut [f64]) {
+    lower_envelope(
+        f,
+        2,
+        &|q, eval| {
+            let q2 = 2 * q as i64;
+            f[q].min(eval(q2 - 1)).min(eval(q2 + 1))
+        },
+        out,
+        v,
+        z,
+    )
 }
 
 /// How [`lower_envelope`] reads line position `q` from the envelope's value at any `x`.
 type Read<'a> = dyn Fn(usize, &mut dyn FnMut(i64) -> i64) -> i64 + 'a;
 
 /// The lower envelope of the parabolas `f[p] + (x − c·p)²` (`f[p] ≥ INF`: none), and for each
-/// `q`, `read(q, eval)` with `eval(x)` its value at `x`. The `x` read must not decrease with
-/// `q`.
-fn lower_envelope(f: &[i64], c: i64, read: &Read<'_>) -> Vec<i64> {
+/// `q`, `out[q] = read(q, eval)` with `eval(x)` its value at `x`. The `x` read must not
+/// decrease with `q`. `v` (the envelope's parabolas) and `z` (their bounds) are scratch.
+fn lower_envelope(
+    f: &[i64],
+    c: i64,
+    read: &Read<'_>,
+    out: &mut [i64],
+    v: &mut [usize],
+    z: &mut [f64],
+) {
     let n = f.len();
-    let mut out = vec![INF; n];
-    let mut v = vec![0usize; n];
-    let mut z = vec![0f64; n + 1];
+    out.fill(INF);
     let mut k = 0usize;
     let mut first = None;
     for q in 0..n {
@@ -135,7 +178,7 @@ fn lower_envelope(f: &[i64], c: i64, read: &Read<'_>) -> Vec<i64> {
         }
     }
     if first.is_none() {
-        return out;
+        return;
     }
     let mut k = 0;
     for (q, o) in out.iter_mut().enumerate() {
@@ -148,7 +191,6 @@ fn lower_envelope(f: &[i64], c: i64, read: &Read<'_>) -> Vec<i64> {
         };
         *o = read(q, &mut eval).min(INF);
     }
-    out
 }
 
 #[cfg(test)]
@@ -180,6 +222,30 @@ mod tests {
             }
         }
         out
+    }
+
+    #[test]
+    fn grids_one_voxel_thin_along_any_axis_transform_as_brute_force() {
+        for dims in [
+            [5, 1, 4],
+            [1, 6, 1],
+            [4, 3, 1],
+            [1, 1, 7],
+            [1, 1, 1],
+            [6, 5, 2],
+        ] {
+            let n = dims.iter().product::<u32>() as u64;
+            let solid: Vec<bool> = (0..n)
+                .map(|i| (i.wrapping_mul(2_654_435_761) >> 5) % 5 == 0)
+                .collect();
+            for rule in [MaxBall::SolidCentre, MaxBall::Contained] {
+                assert_eq!(
+                    transform(dims, &solid, rule),
+                    brute(dims, &solid, rule),
+                    "{dims:?} {rule:?}"
+                );
+            }
+        }
     }
 
     #[test]

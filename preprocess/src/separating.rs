@@ -33,11 +33,19 @@ pub fn open_voxels(meta: GridMeta, triangles: &[[Vec3; 3]]) -> VoxelBits {
     };
     // One grid of bits, set from every thread (an OR in any order gives the same bits): a
     // grid a thread would cost as many copies of the grid as rayon splits the triangles.
-    let closed: Vec<AtomicU64> = (0..n.div_ceil(64)).map(|_| AtomicU64::new(0)).collect();
+    let closed: Vec<AtomicU64> = (0..n.div_ceil(64))
+        .into_par_iter()
+        .map(|_| AtomicU64::new(0))
+        .collect();
     triangles.par_iter().for_each(|tri| {
         grid.mark(tri.map(|p| p.as_dvec3()), &mut |[x, y, z]| {
             let i = x + nx * (y + ny * z);
-            closed[i / 64].fetch_or(1 << (i % 64), Ordering::Relaxed);
+            let word = &closed[i / 64];
+            // A voxel is met on up to three of its centre segments, and by the triangles
+            // around it: a read first spares the atomic write where its bit is set.
+            if word.load(Ordering::Relaxed) & (1 << (i % 64)) == 0 {
+                word.fetch_or(1 << (i % 64), Ordering::Relaxed);
+            }
         });
     });
     let mut open: Vec<u64> = closed.into_par_iter().map(|w| !w.into_inner()).collect();
@@ -55,6 +63,14 @@ pub fn open_voxels(meta: GridMeta, triangles: &[[Vec3; 3]]) -> VoxelBits {
         close(nx - 1, y, z);
     }
     VoxelBits::from_words(n, open)
+}
+
+/// `x` rounded down, as a whole number: `f64::floor` is a call into the C library on the
+/// x86-64 baseline (no SSE4.1), and the sight grid reads one a line it meets. Exact for
+/// `|x| < 2^63`.
+fn floor(x: f64) -> i64 {
+    let i = x as i64;
+    i.saturating_sub(i64::from((i as f64) > x))
 }
 
 /// The grid's voxel-centre lines.
@@ -87,13 +103,17 @@ impl Lines {
                 let last = (hi - 0.5).floor().min(self.dims[k] as f64 - 1.0);
                 first..(last + 1.0).max(0.0) as usize
             };
+            // Each edge's start, direction and tolerance, read the same way for every centre.
+            let edges: [(DVec2, DVec2, f64); 3] = std::array::from_fn(|k| {
+                let (e0, e1) = (p[k], p[(k + 1) % 3]);
+                (e0, e1 - e0, -1e-10 * (e1 - e0).length())
+            });
             for iw in cells(w, lo.y, hi.y) {
                 for iu in cells(u, lo.x, hi.x) {
                     let c = DVec2::new(iu as f64 + 0.5, iw as f64 + 0.5);
-                    let inside = (0..3).all(|k| {
-                        let (e0, e1) = (p[k], p[(k + 1) % 3]);
-                        s * (e1 - e0).perp_dot(c - e0) >= -1e-10 * (e1 - e0).length()
-                    });
+                    let inside = edges
+                        .iter()
+                        .all(|&(e0, e, tol)| s * e.perp_dot(c - e0) >= tol);
                     if !inside {
                         continue;
                     }
@@ -101,8 +121,10 @@ impl Lines {
                     let t = q[0][a] - (n[u] * (c.x - q[0][u]) + n[w] * (c.y - q[0][w])) / n[a];
                     let mut at = [0usize; 3];
                     (at[u], at[w]) = (iu, iw);
-                    for ia in [t - 1e-10, t + 1e-10].map(|t| t.floor()) {
-                        if ia < 0.0 || ia >= self.dims[a] as f64 {
+                    // The voxels either side of a boundary the line meets the plane on, else
+                    // the one it meets it in (once).
+                    for ia in floor(t - 1e-10)..=floor(t + 1e-10) {
+                        if ia < 0 || ia >= self.dims[a] as i64 {
                             continue;
                         }
                         at[a] = ia as usize;
@@ -119,7 +141,7 @@ mod tests {
     use glam::{Quat, Vec3};
     use visgate_formats::vgate::{GridMeta, Resolution, VoxelBits};
 
-    use super::open_voxels;
+    use super::{floor, open_voxels};
     use crate::voxelize::{grid_for, voxelize};
 
     /// The 12 triangles of the cube of half-size `h` about `c`, turned by `q`.
@@ -168,6 +190,17 @@ mod tests {
             }
         }
         seen
+    }
+
+    #[test]
+    fn floor_rounds_down_as_the_library_does() {
+        for x in [
+            0.0, -0.0, 0.5, -0.5, 1.0, -1.0, 2.999_999, -2.000_001, 1e-10, -1e-10, 511.5, 1e15,
+            -1e15,
+        ] {
+            assert_eq!(floor(x), x.floor() as i64, "{x}");
+        }
+        assert_eq!(floor(f64::NEG_INFINITY), i64::MIN);
     }
 
     #[test]
