@@ -6,6 +6,13 @@ use std::path::Path;
 
 use support::{stderr, stdout, visgate};
 
+/// `visgate bake builtin:two-rooms -o OUT --resolution 64` and `extra`.
+fn two_rooms_at_64(out: &str, extra: &[&str]) -> std::process::Output {
+    let mut args = vec!["bake", "builtin:two-rooms", "-o", out, "--resolution", "64"];
+    args.extend(extra);
+    visgate(&args)
+}
+
 #[test]
 fn help_lists_the_subcommands_that_exist() {
     let o = visgate(&["--help"]);
@@ -331,20 +338,17 @@ fn bake_writes_the_level_report_and_debug_exports() {
     let out = dir.path().join("two.vgate");
     let report = dir.path().join("bake.json");
     let debug = dir.path().join("debug");
-    let o = visgate(&[
-        "bake",
-        "builtin:two-rooms",
-        "-o",
+    let o = two_rooms_at_64(
         out.to_str().expect("utf-8"),
-        "--resolution",
-        "64",
-        "--threads",
-        "2",
-        "--report",
-        report.to_str().expect("utf-8"),
-        "--debug-dir",
-        debug.to_str().expect("utf-8"),
-    ]);
+        &[
+            "--threads",
+            "2",
+            "--report",
+            report.to_str().expect("utf-8"),
+            "--debug-dir",
+            debug.to_str().expect("utf-8"),
+        ],
+    );
     assert!(o.status.success(), "{}", stderr(&o));
     let text = stdout(&o);
     for want in [
@@ -605,14 +609,7 @@ fn a_clean_bake_writes_nothing_on_stderr() {
     // empty (a stage's leftover timing print once went there on every bake).
     let dir = tempfile::tempdir().expect("tempdir");
     let out = dir.path().join("x.vgate");
-    let o = visgate(&[
-        "bake",
-        "builtin:two-rooms",
-        "-o",
-        out.to_str().expect("utf-8"),
-        "--resolution",
-        "64",
-    ]);
+    let o = two_rooms_at_64(out.to_str().expect("utf-8"), &[]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(stderr(&o), "", "stderr of a clean bake");
 }
@@ -660,13 +657,6 @@ fn a_bake_too_coarse_for_its_level_says_so_and_what_resolution_to_use() {
     assert_eq!(stderr(&o), "", "stderr of a bake fine enough");
 }
 
-/// `visgate bake builtin:two-rooms -o OUT --resolution 64` and `extra`.
-fn two_rooms_at_64(out: &str, extra: &[&str]) -> std::process::Output {
-    let mut args = vec!["bake", "builtin:two-rooms", "-o", out, "--resolution", "64"];
-    args.extend(extra);
-    visgate(&args)
-}
-
 #[test]
 fn a_refined_bake_says_where_its_partition_was_made() {
     let dir = tempfile::tempdir().expect("tempdir");
@@ -685,7 +675,7 @@ fn a_refined_bake_says_where_its_partition_was_made() {
         "{info}"
     );
     // On its own grid it says so.
-    let o = visgate(&["bake", "builtin:two-rooms", "-o", out, "--resolution", "64"]);
+    let o = two_rooms_at_64(out, &[]);
     assert!(stdout(&o).contains("partition: made on the level's grid"));
     let info = stdout(&visgate(&["inspect", out]));
     assert!(info.contains("made on this grid"), "{info}");
@@ -946,15 +936,7 @@ fn render_and_diff_refuse_bad_arguments_clearly() {
 fn render_gates_uses_a_baked_level_and_refuses_a_missing_or_stale_one() {
     let dir = tempfile::tempdir().expect("tempdir");
     let p = |n: &str| dir.path().join(n).to_str().expect("utf-8").to_string();
-    let o = visgate(&[
-        "bake",
-        "builtin:two-rooms",
-        "-o",
-        &p("two.vgate"),
-        "--resolution",
-        "64",
-        "-q",
-    ]);
+    let o = two_rooms_at_64(&p("two.vgate"), &["-q"]);
     assert!(o.status.success(), "{}", stderr(&o));
     let base = [
         "render", "--mode", "gates", "--vpls", "64", "--size", "16x12", "--spp", "1",

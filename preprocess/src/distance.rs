@@ -35,10 +35,10 @@ pub fn radius_vx(d: u64, rule: MaxBall) -> f64 {
 /// notes for the units); 0 for solid voxels, ordered as the radii.
 pub fn transform(dims: [u32; 3], solid: &[bool], rule: MaxBall) -> Vec<u64> {
     let [nx, ny, _] = dims.map(|d| d as usize);
-    let mut d: Vec<i64> = solid.par_iter().map(|&s| if s { 0 } else { INF }).collect();
     if nx == 0 || ny == 0 {
         return Vec::new();
     }
+    let mut d: Vec<i64> = solid.par_iter().map(|&s| if s { 0 } else { INF }).collect();
     // Along x: each row alone.
     d.par_chunks_mut(nx)
         .for_each_init(Lines::default, |lines, row| {
