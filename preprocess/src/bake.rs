@@ -257,7 +257,7 @@ pub fn bake(
     let pm = partition_grid(input.bounds, &meta, &params, options)?;
     // A bare mesh's openings are looked for on the partition grid where there is one: on the
     // level's finer grid the search costs seconds and hundreds of MiB (empty::INSIDE_LEAK_MAX_VOXELS).
-    let es = cx.stage("empty space", 0, |_| {
+    let mut es = cx.stage("empty space", 0, |_| {
         let locate = pm.is_none();
         stages::empty(
             scene,
@@ -272,7 +272,7 @@ pub fn bake(
     let part = match pm {
         None => partition(&mut cx, &meta, &es, input.hash, &mut params)?,
         Some(pm) => {
-            let fine = (&meta, &es);
+            let fine = (&meta, &mut es);
             refined_partition(&mut cx, scene, &input, fine, &pm, &mut params)?
         }
     };
@@ -492,7 +492,7 @@ fn refined_partition(
     cx: &mut BakeContext,
     scene: &Scene,
     input: &stages::Loaded,
-    fine: (&GridMeta, &EmptySpace),
+    fine: (&GridMeta, &mut EmptySpace),
     pm: &GridMeta,
     params: &mut BakeParams,
 ) -> Result<Partition, BakeError> {
@@ -508,8 +508,9 @@ fn refined_partition(
             empty: &pes.empty,
             voxel_cluster: &part.voxel_cluster,
         };
-        Ok(crate::refine::refine(meta, &es.empty, &c))
+        Ok(crate::refine::refine(meta, &mut es.empty, &c))
     })?;
+    es.empty_voxels = es.empty.iter().filter(|&&e| e).count() as u64;
     crate::refine::carry_level(meta, &es.empty, &voxel_cluster, &mut part.level);
     part.level.voxel_cluster = VoxelValues::pack(&voxel_cluster);
     part.level.info.params = params.clone();

@@ -560,6 +560,57 @@ fn walls_thinner_than_a_voxel_do_not_leak() {
 }
 
 #[test]
+fn a_scene_file_drops_the_space_around_its_rooms_and_keeps_a_room_cut_off_from_its_camera() {
+    // Two sealed 4 × 3 × 4 m rooms of single-sided walls facing in, 2 m apart; the camera in
+    // the first. The second room is faced by its walls; the space around both sees only
+    // their backs.
+    let mut model = sealed_box(Vec3::new(4.0, 3.0, 4.0));
+    let second = sealed_box(Vec3::new(4.0, 3.0, 4.0)).meshes.remove(0);
+    let mesh = &mut model.meshes[0];
+    let base = mesh.positions.len() as u32;
+    let moved = second
+        .positions
+        .iter()
+        .map(|p| *p + Vec3::new(6.0, 0.0, 0.0));
+    mesh.positions.extend(moved);
+    let tris = second.triangles.iter().map(|t| t.map(|i| i + base));
+    mesh.triangles.extend(tris);
+    mesh.normals.resize(mesh.positions.len(), Vec3::Y);
+    mesh.uvs.resize(mesh.positions.len(), Vec2::ZERO);
+    let s = custom("two-boxes", model, false, [2.0, 1.5, 2.0], 1.0);
+    for res in [48, 96] {
+        let b = bake_scene(&s, &params(res)).expect("bake");
+        let comps = b.report.empty_space["components"]
+            .as_array()
+            .expect("components")
+            .clone();
+        let large: Vec<_> = comps
+            .iter()
+            .filter(|c| c["voxels"].as_u64() > Some(500))
+            .collect();
+        assert_eq!(large.len(), 3, "at {res}: {comps:?}");
+        let inside = |c: &serde_json::Value, x: f64| {
+            let (lo, hi) = (&c["bounds_min_m"], &c["bounds_max_m"]);
+            lo[0].as_f64() > Some(x - 0.5) && hi[0].as_f64() < Some(x + 4.5)
+        };
+        let reason = |c: &serde_json::Value| c["reason"].as_str().unwrap_or("").to_string();
+        for c in large {
+            match (inside(c, 0.0), inside(c, 6.0)) {
+                (true, false) => assert!(reason(c).starts_with("holds camera"), "{c}"),
+                (false, true) => assert_eq!(c["kept"], true, "the second room, at {res}: {c}"),
+                _ => {
+                    assert_eq!(c["kept"], false, "the space around, at {res}: {c}");
+                    assert!(
+                        reason(c).starts_with(visgate_preprocess::empty::UNSEEN),
+                        "{c}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
 fn walls_on_the_bounds_never_leak_at_any_resolution_or_scale() {
     // Rounding used to put such a wall in the solid border ring alone, so that the room
     // touched the ring: "leaks on the +x side" at some resolutions (the ajar door at 100).
