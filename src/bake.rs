@@ -150,7 +150,9 @@ segment → clusters → gates → flatten. A timing tree and a summary are prin
 
 What is kept: the empty space around each camera and light (without any, as for a bare mesh,
 the space the most triangles face: the level's inside), and any other the geometry faces more
-than it turns its back to (not a thick wall's inside) of --min-component-voxels or more. A
+than it turns its back to (not a thick wall's inside) of --min-component-voxels or more; with
+cameras or lights, each triangle's sides counted from the first voxel off it that is not
+solid, so the space around and over the rooms, which sees their walls' backs, is dropped. A
 scene declared `closed = true` stops where its space reaches the bounds and names the opening
 (--allow-leaks bakes on); a bare mesh's inside that reaches them is baked, the opening named
 in a warning (and in leak.ply with --debug-dir).
