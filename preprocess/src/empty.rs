@@ -440,6 +440,14 @@ impl Why<'_> {
                 faced[1], faced[0]
             ));
         }
+        if faced == [0, 0] {
+            // Kept, as before, but not said to be faced: a space that no triangle lies beside
+            // (within 0.75 voxel), a slit or a pocket of the voxels.
+            return (
+                true,
+                "large, and no triangle faces it or turns its back to it".to_string(),
+            );
+        }
         (true, "large and faced by the geometry".to_string())
     }
 }
