@@ -434,7 +434,17 @@ impl Why<'_> {
                  {f} face it (the space around the rooms, or inside walls)"
             ));
         }
-        if !self.seeded_any && faced[1] > faced[0] {
+        if self.seeded_any {
+            return (
+                true,
+                format!(
+                    "faced by its walls, though no camera or light is in it: from their first \
+                     open voxel {f} triangles face it, {b} turn their back to it (a room the \
+                     voxels cut off)"
+                ),
+            );
+        }
+        if faced[1] > faced[0] {
             return dropped(format!(
                 "inside closed geometry: {} triangles turn their back to it, {} face it",
                 faced[1], faced[0]
