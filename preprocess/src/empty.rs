@@ -439,8 +439,7 @@ impl Why<'_> {
                 true,
                 format!(
                     "faced by its walls, though no camera or light is in it: from their first \
-                     open voxel {f} triangles face it, {b} turn their back to it (a room the \
-                     voxels cut off)"
+                     open voxel {f} triangles face it, {b} turn their back to it"
                 ),
             );
         }
