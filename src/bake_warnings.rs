@@ -297,7 +297,7 @@ fn most_dropped(empty_space: &Value, grid: &GridMeta) -> Option<String> {
         return None;
     }
     let fronts = |c: &Value| c["faced_by"][0].as_u64().unwrap_or(0);
-    let reason = |c: &Value| c["reason"].as_str().unwrap_or("").to_string();
+    let unseen = |c: &Value| c["reason"].as_str().is_some_and(|r| r.starts_with(UNSEEN));
     let kept_comps = || comps.iter().filter(|c| c["kept"] == true);
     let kept: u64 = kept_comps().map(voxels).sum();
     let kept_fronts: u64 = kept_comps().map(fronts).sum();
@@ -306,9 +306,7 @@ fn most_dropped(empty_space: &Value, grid: &GridMeta) -> Option<String> {
     // space (the cameras and lights outside the rooms): Crytek Sponza's 2.4 M voxels around
     // its rooms, 2,791 fronts (0.75 voxel off) against the rooms' 90,668, are not.
     let suspect = |c: &&Value| {
-        c["kept"] != true
-            && !reaches_bounds(c, grid)
-            && (!reason(c).starts_with(UNSEEN) || fronts(c) > kept_fronts)
+        c["kept"] != true && !reaches_bounds(c, grid) && (!unseen(c) || fronts(c) > kept_fronts)
     };
     let largest = comps.iter().filter(suspect).max_by_key(|c| voxels(c))?;
     (voxels(largest) > kept).then(|| {

@@ -508,9 +508,10 @@ fn refined_partition(
             empty: &pes.empty,
             voxel_cluster: &part.voxel_cluster,
         };
-        Ok(crate::refine::refine(meta, &mut es.empty, &c))
+        let (voxel_cluster, counts) = crate::refine::refine(meta, &mut es.empty, &c);
+        es.empty_voxels -= counts.unreached;
+        Ok((voxel_cluster, counts))
     })?;
-    es.empty_voxels = es.empty.iter().filter(|&&e| e).count() as u64;
     crate::refine::carry_level(meta, &es.empty, &voxel_cluster, &mut part.level);
     part.level.voxel_cluster = VoxelValues::pack(&voxel_cluster);
     part.level.info.params = params.clone();

@@ -206,7 +206,7 @@ pub fn empty_space(
     let bare = seeds.is_empty() && !params.closed;
     let Facing {
         mut faced,
-        mut fronts,
+        fronts,
         backs,
     } = facing(meta, solid, &comps, triangles);
     // A scene that names no camera and no light (a bare mesh): the level's inside keeps its
@@ -235,9 +235,6 @@ pub fn empty_space(
         .collect();
     if faces_turned {
         faced.iter_mut().for_each(|f| f.swap(0, 1));
-        if bare {
-            fronts = backs;
-        }
     }
     // Only where the inside reaches the bounds (a sealed level's inside needs no point), one
     // distance field for its point and its leaks (the border ring open: a voxel by a window to
@@ -267,7 +264,6 @@ pub fn empty_space(
         inside_component,
         inside_point: inside.map(|s| s.position_m),
         faces_turned,
-        inside_fronts: &fronts,
         first_open: &first_open,
         faced: &faced,
         voxels: &voxels,
@@ -369,10 +365,8 @@ struct Why<'a> {
     inside_point: Option<[f32; 3]>,
     /// Whether the faces were read turned.
     faces_turned: bool,
-    /// Per component, the fronts that chose the inside.
-    inside_fronts: &'a [u64],
     /// Per component, the triangles whose front and whose back face it from their first open
-    /// voxel, the faces read turned where they are.
+    /// voxel, the faces read turned where they are (the fronts chose a bare mesh's inside).
     first_open: &'a [[u64; 2]],
     /// Per component, the triangles whose front and whose back lie 0.75 voxel off on its side.
     faced: &'a [[u64; 2]],
@@ -400,7 +394,7 @@ impl Why<'_> {
             } else {
                 ""
             };
-            let fronts = self.inside_fronts[c];
+            let fronts = self.first_open[c][0];
             let why = format!(
                 "{INSIDE}: the most triangles face it ({fronts} of them{turned}; no camera or \
                  light named){point}"
