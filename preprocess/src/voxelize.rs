@@ -10,8 +10,9 @@
 //! ring is truly beyond the geometry: a leak).
 
 use std::ops::RangeInclusive;
+use std::sync::atomic::{AtomicU64, Ordering};
 
-use glam::{DVec3, Vec3};
+use glam::{DVec2, DVec3, Vec3};
 use rayon::prelude::*;
 pub use visgate_formats::geom::tri_box_overlap;
 use visgate_formats::vgate::{GridMeta, Resolution};
@@ -149,50 +150,43 @@ pub fn voxelize(meta: GridMeta, triangles: &[[Vec3; 3]]) -> SolidGrid {
         half,
         dims: [nx, ny, nz],
     };
-    let bits = triangles
-        .par_chunks(4096)
-        .fold(
-            || vec![0u64; words],
-            |mut bits, chunk| {
-                for tri in chunk {
-                    grid.mark(tri.map(|p| p.as_dvec3()), &mut |[x, y, z]| {
-                        // Geometry never falls into the border ring: a wall on the bounds
-                        // (rounding may put it in the ring alone) marks the first voxel
-                        // inside instead.
-                        let (x, y, z) =
-                            (x.clamp(1, nx - 2), y.clamp(1, ny - 2), z.clamp(1, nz - 2));
-                        let i = x + nx * (y + ny * z);
-                        bits[i / 64] |= 1 << (i % 64);
-                    });
-                }
-                bits
-            },
-        )
-        .reduce(
-            || vec![0u64; words],
-            |mut a, b| {
-                a.iter_mut().zip(&b).for_each(|(x, y)| *x |= y);
-                a
-            },
-        );
-    // Unpacked a z slice at a time in parallel, with the border ring.
-    let mut solid = vec![false; n];
-    solid
-        .par_chunks_mut(nx * ny)
-        .enumerate()
-        .for_each(|(z, slice)| {
-            for (j, s) in slice.iter_mut().enumerate() {
-                let (x, y) = (j % nx, j / nx);
-                let i = j + z * nx * ny;
-                *s = x == 0
-                    || y == 0
-                    || z == 0
-                    || x == nx - 1
-                    || y == ny - 1
-                    || z == nz - 1
-                    || bits[i / 64] >> (i % 64) & 1 == 1;
+    // One grid of bits, set from every thread (an OR in any order gives the same bits): a grid
+    // a rayon split cost a page fault every few marks and a pass to merge (Crytek Sponza at
+    // 512, 4.4 MB each).
+    let bits: Vec<AtomicU64> = (0..words)
+        .into_par_iter()
+        .map(|_| AtomicU64::new(0))
+        .collect();
+    triangles.par_iter().for_each(|tri| {
+        grid.mark(tri.map(|p| p.as_dvec3()), &mut |[x, y, z]| {
+            // Geometry never falls into the border ring: a wall on the bounds (rounding may put
+            // it in the ring alone) marks the first voxel inside instead.
+            let (x, y, z) = (x.clamp(1, nx - 2), y.clamp(1, ny - 2), z.clamp(1, nz - 2));
+            let i = x + nx * (y + ny * z);
+            let word = &bits[i / 64];
+            // A voxel is marked by the triangles around it: a read first spares the atomic
+            // write where its bit is set.
+            if word.load(Ordering::Relaxed) & (1 << (i % 64)) == 0 {
+                word.fetch_or(1 << (i % 64), Ordering::Relaxed);
             }
         });
+    });
+    // Unpacked a row at a time in parallel, with the border ring.
+    let mut solid = vec![false; n];
+    solid.par_chunks_mut(nx).enumerate().for_each(|(row, out)| {
+        let (y, z) = (row % ny, row / ny);
+        if y == 0 || z == 0 || y == ny - 1 || z == nz - 1 {
+            out.fill(true);
+            return;
+        }
+        let first = row * nx;
+        for (x, s) in out.iter_mut().enumerate() {
+            let i = first + x;
+            *s = bits[i / 64].load(Ordering::Relaxed) >> (i % 64) & 1 == 1;
+        }
+        out[0] = true;
+        out[nx - 1] = true;
+    });
     SolidGrid { meta, solid }
 }
 
@@ -247,17 +241,19 @@ impl TriGrid {
         let (u, w) = ((a + 1) % 3, (a + 2) % 3);
         let reach = h * (n.x.abs() + n.y.abs() + n.z.abs());
         let (w0, w1) = span(w);
+        let inside = Inside::new(v, u, w, h);
         for iw in w0..=w1 {
             let Some((u_lo, u_hi)) = slab_extent(v, u, w, self.centre(w, iw), h) else {
                 continue;
             };
             for iu in self.centres_in(u, (u_lo - h, u_hi + h), span(u)) {
+                let (cu, cw) = (self.centre(u, iu), self.centre(w, iw));
+                let within = inside.column(cu, cw);
                 let column = if n[a] == 0.0 {
                     span(a).0..=span(a).1
                 } else {
                     // |n · (c − v0)| ≤ reach, solved for the centre's coordinate on axis a.
-                    let s = n[u] * (self.centre(u, iu) - v[0][u])
-                        + n[w] * (self.centre(w, iw) - v[0][w]);
+                    let s = n[u] * (cu - v[0][u]) + n[w] * (cw - v[0][w]);
                     let (t0, t1) = ((-reach - s) / n[a], (reach - s) / n[a]);
                     let along = (t0.min(t1) + v[0][a], t0.max(t1) + v[0][a]);
                     self.centres_in(a, along, span(a))
@@ -266,12 +262,74 @@ impl TriGrid {
                     let mut at = [0usize; 3];
                     (at[a], at[u], at[w]) = (ia, iu, iw);
                     let c = DVec3::from_array(std::array::from_fn(|k| self.centre(k, at[k])));
-                    if tri_box_overlap(c, h, v) {
+                    // A column inside the triangle's outline: the box touches the triangle
+                    // where it touches its plane, so the nine edge axes need no testing.
+                    let plane = within.then(|| plane_verdict(n, v[0], c, reach)).flatten();
+                    if plane.unwrap_or_else(|| tri_box_overlap(c, h, v)) {
                         hit(at);
                     }
                 }
             }
         }
+    }
+}
+
+/// How far clear of a boundary a fast answer must be, relative to the quantities compared: far
+/// more than rounding moves them, so the fast answers are the separating-axis test's.
+const MARGIN: f64 = 1e-9;
+
+/// Whether the plane of triangle `v` (normal `n`, not normalized) passes through the box about
+/// `c` whose reach along `n` is `reach`, where the answer is clear of rounding (`None`: too
+/// near to tell; the full test decides).
+fn plane_verdict(n: DVec3, v0: DVec3, c: DVec3, reach: f64) -> Option<bool> {
+    let d = n.dot(v0 - c).abs();
+    if d < reach * (1.0 - MARGIN) {
+        Some(true)
+    } else if d > reach * (1.0 + MARGIN) {
+        Some(false)
+    } else {
+        None
+    }
+}
+
+/// A triangle's outline projected along its dominant axis, for telling which columns of voxels
+/// lie wholly inside it.
+struct Inside {
+    /// Each edge's start and direction, projected, and how far inside a column's centre must
+    /// lie: its half-width along the edge's normal, with the margin.
+    edges: [(DVec2, DVec2, f64); 3],
+    /// The projection's winding (0: degenerate, no column is inside).
+    sign: f64,
+}
+
+impl Inside {
+    fn new(v: [DVec3; 3], u: usize, w: usize, h: f64) -> Inside {
+        let p = v.map(|q| DVec2::new(q[u], q[w]));
+        let area = (p[1] - p[0]).perp_dot(p[2] - p[0]);
+        let sign = if area > 0.0 {
+            1.0
+        } else if area < 0.0 {
+            -1.0
+        } else {
+            0.0
+        };
+        let edges = std::array::from_fn(|k| {
+            let (e0, e) = (p[k], p[(k + 1) % 3] - p[k]);
+            (e0, e, h * (e.x.abs() + e.y.abs()))
+        });
+        Inside { edges, sign }
+    }
+
+    /// Whether the square of half-width `h` about column centre (`cu`, `cw`) lies inside the
+    /// outline, clear of rounding.
+    fn column(&self, cu: f64, cw: f64) -> bool {
+        let c = DVec2::new(cu, cw);
+        self.sign != 0.0
+            && self.edges.iter().all(|&(e0, e, half)| {
+                let d = c - e0;
+                let slack = MARGIN * (e.x.abs() + e.y.abs()) * (d.x.abs() + d.y.abs() + half);
+                self.sign * e.perp_dot(d) - half > slack
+            })
     }
 }
 
