@@ -295,14 +295,16 @@ fn plane_verdict(n: DVec3, v0: DVec3, c: DVec3, reach: f64) -> Option<bool> {
 /// A triangle's outline projected along its dominant axis, for telling which columns of voxels
 /// lie wholly inside it.
 struct Inside {
-    /// Each edge's start and direction, projected, and how far inside a column's centre must
-    /// lie: its half-width along the edge's normal, with the margin.
+    /// Each edge's start and direction, projected, and the square's reach across the edge (in
+    /// the edge test's units: the direction is not normalized): a column's centre must lie
+    /// that far inside, and a margin more.
     edges: [(DVec2, DVec2, f64); 3],
     /// The projection's winding (0: degenerate, no column is inside).
     sign: f64,
 }
 
 impl Inside {
+    /// Triangle `v` projected onto axes `u` and `w`, for squares of half-width `h`.
     fn new(v: [DVec3; 3], u: usize, w: usize, h: f64) -> Inside {
         let p = v.map(|q| DVec2::new(q[u], q[w]));
         let area = (p[1] - p[0]).perp_dot(p[2] - p[0]);
