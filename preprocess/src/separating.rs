@@ -15,11 +15,11 @@
 //! slack, so a line through an edge shared by two triangles hits one of them) meet its plane at
 //! one point, whose voxel is closed (both voxels when the point lies on their common face).
 
-use std::sync::atomic::{AtomicU64, Ordering};
-
 use glam::{DVec2, DVec3, Vec3};
 use rayon::prelude::*;
 use visgate_formats::vgate::{GridMeta, VoxelBits};
+
+use crate::voxelize::SharedBits;
 
 /// The open voxels of `meta`'s grid: not crossed by a triangle on a centre segment, and not in
 /// the one-voxel border ring (closed, as the level grid's is).
@@ -31,24 +31,14 @@ pub fn open_voxels(meta: GridMeta, triangles: &[[Vec3; 3]]) -> VoxelBits {
         size: f64::from(meta.voxel_size_m),
         dims: [nx, ny, nz],
     };
-    // One grid of bits, set from every thread (an OR in any order gives the same bits): a
-    // grid a thread would cost as many copies of the grid as rayon splits the triangles.
-    let closed: Vec<AtomicU64> = (0..n.div_ceil(64))
-        .into_par_iter()
-        .map(|_| AtomicU64::new(0))
-        .collect();
+    let closed = SharedBits::new(n);
     triangles.par_iter().for_each(|tri| {
         grid.mark(tri.map(|p| p.as_dvec3()), &mut |[x, y, z]| {
-            let i = x + nx * (y + ny * z);
-            let word = &closed[i / 64];
-            // A voxel is met on up to three of its centre segments, and by the triangles
-            // around it: a read first spares the atomic write where its bit is set.
-            if word.load(Ordering::Relaxed) & (1 << (i % 64)) == 0 {
-                word.fetch_or(1 << (i % 64), Ordering::Relaxed);
-            }
+            closed.set(x + nx * (y + ny * z));
         });
     });
-    let mut open: Vec<u64> = closed.into_par_iter().map(|w| !w.into_inner()).collect();
+    let mut open = closed.into_words();
+    open.par_iter_mut().for_each(|w| *w = !*w);
     // The border ring: two voxels a row, and the rows of the four sides.
     let mut close = |x: usize, y: usize, z: usize| {
         let i = x + nx * (y + ny * z);

@@ -138,7 +138,6 @@ pub fn all_solid(meta: &GridMeta) -> String {
 pub fn voxelize(meta: GridMeta, triangles: &[[Vec3; 3]]) -> SolidGrid {
     let [nx, ny, nz] = meta.dims.map(|d| d as usize);
     let n = nx * ny * nz;
-    let words = n.div_ceil(64);
     let origin = Vec3::from(meta.origin_m).as_dvec3();
     let size = f64::from(meta.voxel_size_m);
     // A hair over half a voxel, so that a triangle lying exactly on a voxel face marks both
@@ -150,25 +149,15 @@ pub fn voxelize(meta: GridMeta, triangles: &[[Vec3; 3]]) -> SolidGrid {
         half,
         dims: [nx, ny, nz],
     };
-    // One grid of bits, set from every thread (an OR in any order gives the same bits): a grid
-    // a rayon split cost a page fault every few marks and a pass to merge (Crytek Sponza at
-    // 512, 4.4 MB each).
-    let bits: Vec<AtomicU64> = (0..words)
-        .into_par_iter()
-        .map(|_| AtomicU64::new(0))
-        .collect();
+    // One grid of bits marked from every thread: a grid a rayon split (4.4 MB each at 512) was
+    // allocated, filled and merged.
+    let bits = SharedBits::new(n);
     triangles.par_iter().for_each(|tri| {
         grid.mark(tri.map(|p| p.as_dvec3()), &mut |[x, y, z]| {
             // Geometry never falls into the border ring: a wall on the bounds (rounding may put
             // it in the ring alone) marks the first voxel inside instead.
             let (x, y, z) = (x.clamp(1, nx - 2), y.clamp(1, ny - 2), z.clamp(1, nz - 2));
-            let i = x + nx * (y + ny * z);
-            let word = &bits[i / 64];
-            // A voxel is marked by the triangles around it: a read first spares the atomic
-            // write where its bit is set.
-            if word.load(Ordering::Relaxed) & (1 << (i % 64)) == 0 {
-                word.fetch_or(1 << (i % 64), Ordering::Relaxed);
-            }
+            bits.set(x + nx * (y + ny * z));
         });
     });
     // Unpacked a row at a time in parallel, with the border ring.
@@ -181,13 +170,47 @@ pub fn voxelize(meta: GridMeta, triangles: &[[Vec3; 3]]) -> SolidGrid {
         }
         let first = row * nx;
         for (x, s) in out.iter_mut().enumerate() {
-            let i = first + x;
-            *s = bits[i / 64].load(Ordering::Relaxed) >> (i % 64) & 1 == 1;
+            *s = bits.get(first + x);
         }
         out[0] = true;
         out[nx - 1] = true;
     });
     SolidGrid { meta, solid }
+}
+
+/// A grid of bits that every thread sets (an OR in any order gives the same bits), for the
+/// voxelizers: one grid, where a grid a thread costs as many copies as rayon splits the work.
+pub(crate) struct SharedBits(Vec<AtomicU64>);
+
+impl SharedBits {
+    /// `n` bits, all clear.
+    pub(crate) fn new(n: usize) -> SharedBits {
+        SharedBits(
+            (0..n.div_ceil(64))
+                .into_par_iter()
+                .map(|_| AtomicU64::new(0))
+                .collect(),
+        )
+    }
+
+    /// Sets bit `i`. A voxel is marked by every triangle around it: a read first spares the
+    /// atomic write where its bit is set.
+    pub(crate) fn set(&self, i: usize) {
+        let (word, bit) = (&self.0[i / 64], 1u64 << (i % 64));
+        if word.load(Ordering::Relaxed) & bit == 0 {
+            word.fetch_or(bit, Ordering::Relaxed);
+        }
+    }
+
+    /// Bit `i`.
+    pub(crate) fn get(&self, i: usize) -> bool {
+        self.0[i / 64].load(Ordering::Relaxed) >> (i % 64) & 1 == 1
+    }
+
+    /// The bits as words (bit `i` in word `i / 64`).
+    pub(crate) fn into_words(self) -> Vec<u64> {
+        self.0.into_par_iter().map(AtomicU64::into_inner).collect()
+    }
 }
 
 /// The grid as the voxelizer sees it: voxel `i` on axis `a` spans `origin[a] + [i, i + 1) ·
