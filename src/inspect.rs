@@ -293,11 +293,10 @@ fn inspect_baked(path: &Path, json: bool) -> Result<()> {
         v3(g.origin_m)
     );
     println!("params      {:?}", s.params);
-    let pv = s.params.partition_voxel_m.unwrap_or(0.0);
-    let on = if pv > 1.01 * g.voxel_size_m {
-        format!("on a {pv} m grid, refined onto this one")
-    } else {
-        "on this grid".to_string()
+    let on = match s.params.separate_partition_voxel(g.voxel_size_m) {
+        Some(pv) if pv > g.voxel_size_m => format!("on a {pv} m grid, refined onto this one"),
+        Some(pv) => format!("on a finer {pv} m grid, each voxel here its share's cluster"),
+        None => "on this grid".to_string(),
     };
     println!(
         "partition   skeleton, clusters and gates made {on}; gaps under {} m left out",

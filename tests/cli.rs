@@ -338,9 +338,12 @@ fn bake_writes_the_level_report_and_debug_exports() {
     let out = dir.path().join("two.vgate");
     let report = dir.path().join("bake.json");
     let debug = dir.path().join("debug");
+    // On its own grid, so that the skeleton's nodes are the exported grid's voxels.
     let o = two_rooms_at_64(
         out.to_str().expect("utf-8"),
         &[
+            "--partition-voxel",
+            "0",
             "--threads",
             "2",
             "--report",
@@ -617,26 +620,35 @@ fn a_clean_bake_writes_nothing_on_stderr() {
 #[test]
 fn a_bake_too_coarse_for_its_level_says_so_and_what_resolution_to_use() {
     // `ajar-door` at 16 voxels: 0.5 m voxels close the door, the cameras' room is sealed off
-    // from the light's, two clusters and no gate. At 32 the rooms are wide enough, the door
-    // still closed; at 64 it is open: nothing to say.
+    // from the light's; partitioned on its own grid, two clusters and no gate. At 32 the rooms
+    // are wide enough, the door still closed; at 64 it is open: nothing to say.
     let dir = tempfile::tempdir().expect("tempdir");
     let out = dir.path().join("x.vgate");
-    let bake = |res: &str| {
-        visgate(&[
-            "bake",
-            "builtin:ajar-door",
-            "-o",
-            out.to_str().expect("utf-8"),
-            "--resolution",
-            res,
-        ])
+    let out = out.to_str().expect("utf-8");
+    let bake_with = |res: &str, more: &[&str]| {
+        let mut args = vec!["bake", "builtin:ajar-door", "-o", out, "--resolution", res];
+        args.extend(more);
+        visgate(&args)
     };
+    let bake = |res: &str| bake_with(res, &[]);
+    let sealed = "warning: camera 'main' and camera 'door' are in a part of the empty space that \
+                  no light is in";
+    // By default a bake this coarse is partitioned on the level's 128 grid: its clusters
+    // follow the rooms (6), only the closed door is said.
     let o = bake("16");
     assert!(o.status.success(), "{}", stderr(&o));
     let err = stderr(&o);
     assert!(
-        err.contains("warning: camera 'main' and camera 'door' are in a part of the empty space that no light is in")
-            && err.contains("--resolution 32 or more"),
+        err.contains(sealed) && err.contains("--resolution 32 or more"),
+        "{err}"
+    );
+    assert!(!err.contains("too coarse"), "{err}");
+    assert!(stdout(&o).contains("clusters 6 "), "{}", stdout(&o));
+    let o = bake_with("16", &["--partition-voxel", "0"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(
+        err.contains(sealed) && err.contains("--resolution 32 or more"),
         "{err}"
     );
     assert!(
@@ -675,10 +687,22 @@ fn a_refined_bake_says_where_its_partition_was_made() {
         "{info}"
     );
     // On its own grid it says so.
-    let o = two_rooms_at_64(out, &[]);
+    let o = two_rooms_at_64(out, &["--partition-voxel", "0"]);
     assert!(stdout(&o).contains("partition: made on the level's grid"));
     let info = stdout(&visgate(&["inspect", out]));
     assert!(info.contains("made on this grid"), "{info}");
+    // By default a bake this coarse (its voxels twice 1/128 of the level) is partitioned on
+    // its 128 grid, and says so.
+    let o = two_rooms_at_64(out, &[]);
+    let text = stdout(&o);
+    let want = "partition: made on a finer 0.0672 m grid (its topology below), each 0.134 m \
+                voxel given the cluster most of its share of it has";
+    assert!(text.contains(want), "{text}");
+    let info = stdout(&visgate(&["inspect", out]));
+    assert!(
+        info.contains("made on a finer 0.0671875 m grid, each voxel here its share's cluster"),
+        "{info}"
+    );
 }
 
 #[test]

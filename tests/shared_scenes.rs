@@ -154,8 +154,11 @@ fn levels_wound_inside_out_bake_as_written() {
     use visgate_formats::vgate::{BakeParams, Resolution};
     use visgate_preprocess::bake::{BakeOptions, Baked, bake};
     let Some(dir) = shared_scenes() else { return };
+    // On the level's own grid: the winding is read there (a finer partition grid would only
+    // make this test slower).
     let params = BakeParams {
         resolution: Resolution::LongestAxisVoxels(128),
+        partition_voxel_m: Some(0.0),
         ..BakeParams::default()
     };
     let bake_it = |s: &Scene| bake(s, &params, &BakeOptions::default(), &|_| {}).expect("bake");
@@ -188,4 +191,47 @@ fn levels_wound_inside_out_bake_as_written() {
         assert!(!said(&w) && said(&t), "{file}");
         assert!(w.level.voxel_cluster == t.level.voxel_cluster, "{file}");
     }
+}
+
+#[test]
+fn dabrovic_sponza_at_128_is_partitioned_as_at_256() {
+    use visgate_formats::vgate::{BakeParams, NONE, Resolution};
+    use visgate_preprocess::bake::{BakeOptions, bake};
+    if shared_scenes().is_none() {
+        return;
+    }
+    let toml = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes/shared/dabrovic-sponza-80-lights.toml");
+    let scene = load(&toml);
+    let at = |res: u32, partition_voxel_m: Option<f32>| {
+        let params = BakeParams {
+            resolution: Resolution::LongestAxisVoxels(res),
+            partition_voxel_m,
+            ..BakeParams::default()
+        };
+        bake(&scene, &params, &BakeOptions::default(), &|_| {}).expect("bake")
+    };
+    let (coarse, fine) = (at(128, None), at(256, None));
+    let (c, f) = (&coarse.level, &fine.level);
+    // Its 27 cm voxels close the upper arcades: on its own grid the 128 bake partitions
+    // another level (17 clusters against 160).
+    let own = at(128, Some(0.0)).level.topology.clusters.len();
+    let n = [c, f].map(|l| l.topology.clusters.len());
+    println!(
+        "Dabrovic Sponza clusters: 128 {} (own grid {own}), 256 {}",
+        n[0], n[1]
+    );
+    assert_eq!(
+        c.info.params.partition_voxel_m,
+        Some(f.info.grid.voxel_size_m)
+    );
+    assert!(n[0] <= 2 * n[1] && n[1] <= 2 * n[0], "{n:?}");
+    assert!(
+        2 * own < n[1],
+        "the own grid's partition is no longer another level: {own}"
+    );
+    // Every kept empty voxel of the coarse grid has a cluster.
+    let e = &coarse.grids.empty;
+    let given = (0..e.len()).filter(|&i| e[i] && c.voxel_cluster.get(i).is_some_and(|k| k != NONE));
+    assert_eq!(given.count(), e.iter().filter(|&&x| x).count());
 }

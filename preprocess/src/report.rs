@@ -166,17 +166,19 @@ impl BakeReport {
             self.params.max_ball,
             self.params.curvature_to
         );
-        let pv = self.params.partition_voxel_m.unwrap_or(0.0);
+        let v = self.grid.voxel_size_m;
         s += &format!(
             "partition: {}; gaps under {:.3} m left out of it\n",
-            if pv > 1.01 * self.grid.voxel_size_m {
-                format!(
-                    "made on a {pv:.3} m grid (its topology below), each {:.4} m voxel given the \
-                     cluster of its space",
-                    self.grid.voxel_size_m
-                )
-            } else {
-                "made on the level's grid".to_string()
+            match self.params.separate_partition_voxel(v) {
+                Some(pv) if pv > v => format!(
+                    "made on a {pv:.3} m grid (its topology below), each {v:.4} m voxel given \
+                     the cluster of its space"
+                ),
+                Some(pv) => format!(
+                    "made on a finer {pv:.4} m grid (its topology below), each {v:.3} m voxel \
+                     given the cluster most of its share of it has"
+                ),
+                None => "made on the level's grid".to_string(),
             },
             self.params.min_gap_m.unwrap_or(0.0)
         );

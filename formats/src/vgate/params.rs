@@ -86,13 +86,15 @@ pub struct BakeParams {
     /// 1/256 of the level's longest extent, whichever is smaller; a baked file stores the
     /// value used. [Limit: [0, 10]] [Units: m, contained ball's radius]
     pub min_gap_m: Option<f32>,
-    /// The skeleton, clusters and gates are made on a grid of this voxel size when the
-    /// level's voxels are finer, and each fine voxel then takes the cluster of its space: the
-    /// partition stays that of this scale at any finer resolution. 0 partitions the level's
-    /// own grid. `None` asks the bake for the least whole multiple of the level's voxel that
-    /// reaches 0.125 m, or 1/128 of the level's longest extent if that is smaller
+    /// The skeleton, clusters and gates are made on a grid of this voxel size when it differs
+    /// from the level's by more than 1 %, and each voxel of the level then takes the cluster of
+    /// its space: the partition stays that of this scale at any resolution (a level coarser
+    /// than it takes the cluster most of its share of the finer grid has). 0 partitions the
+    /// level's own grid. `None` asks the bake for the least whole multiple of the level's
+    /// voxel that reaches 0.125 m, or 1/128 of the level's longest extent if that is smaller,
+    /// or on a coarser level a whole fraction of its voxel
     /// (`visgate_preprocess::bake::default_partition_voxel`); a baked file stores the value
-    /// used. [Limit: [0, 10]] [Units: m]
+    /// used ([`BakeParams::separate_partition_voxel`] reads it). [Limit: [0, 10]] [Units: m]
     pub partition_voxel_m: Option<f32>,
     /// A cluster whose largest max ball is smaller than this is merged into the neighbour
     /// across its widest gate: a roof slab, a crack or a niche where nobody stands is no room
@@ -106,6 +108,18 @@ pub struct BakeParams {
     /// the level's longest extent, whichever is smaller; a baked file stores the value used.
     /// [Limit: [0, 10]] [Units: m]
     pub sight_voxel_m: Option<f32>,
+}
+
+impl BakeParams {
+    /// The voxel of the grid the partition was made on, when that is not the level's grid of
+    /// `level_voxel_m` voxels: more than 1 % coarser (refined onto it), or finer (a coarse
+    /// bake: each of its voxels given the cluster most of its share of that grid has). `None`:
+    /// the level's own grid (a partition voxel of 0, or within 1 % of the level's).
+    pub fn separate_partition_voxel(&self, level_voxel_m: f32) -> Option<f32> {
+        let pv = self.partition_voxel_m.unwrap_or(0.0);
+        let own = pv <= 1.01 * level_voxel_m && pv >= level_voxel_m / 1.01;
+        (pv > 0.0 && !own).then_some(pv)
+    }
 }
 
 impl Default for BakeParams {
