@@ -68,7 +68,8 @@ pub struct BakeArgs {
     /// at 256 then agrees with shadow rays on 91–98 % of pairs, 79–98 % partitioned on its own
     /// grid). A coarser --resolution is partitioned on a whole fraction of its voxel, each voxel
     /// taking the cluster most of its share has (at most 25 cm voxels: Dabrovic Sponza at 128 on
-    /// its 256 grid, 160 clusters as at 256 and 512, where its own 27 cm voxels made 17).
+    /// its 256 grid, 160 clusters as at 256 and 512, where its own 27 cm voxels made 17; 0 bakes
+    /// it on its own grid, 3–8× faster: Crytek Sponza 0.7 s against 2.2 s on two cores).
     #[arg(long)]
     pub partition_voxel: Option<f32>,
     /// Voxel edge of the open-voxel grid that `--gate-shape voxels` walks, metres (0 or more; 0 =
