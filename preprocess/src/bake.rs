@@ -411,8 +411,8 @@ pub const PARTITION_PARTS: u32 = 128;
 /// 1.08 / 1.13 → 0.62 / 0.49 of the reference's, `--gate-shape portal`). [Units: m]
 pub const COARSE_MAX_M: f32 = 0.25;
 /// A large level's partition grid has at most this many voxels on its longest axis when the
-/// level's grid is coarser ([`default_partition_voxel`]): LibreQuake e2m3 (107.5 m) baked at
-/// 128 is partitioned on its 256 grid, 42 cm, not on 12.5 cm voxels (860 of them).
+/// level's grid is coarser ([`default_partition_voxel`]): a 60 m level baked at 128 is
+/// partitioned on its 256 grid, 23 cm, not on 12.5 cm voxels (480 of them).
 pub const COARSE_PARTS: u32 = 256;
 
 /// `params` with the minimum gap, the partition voxel and the sight voxel it leaves to the
@@ -440,19 +440,18 @@ fn level_scaled(params: &BakeParams, bounds: (glam::Vec3, glam::Vec3), voxel_m: 
 }
 
 /// The default partition voxel of a level `longest` metres long on voxels of `voxel_m`: 1/128
-/// of its length where that is under [`PARTITION_VOXEL_M`] (a small level; its voxel where that
-/// is coarser), else the least
-/// whole multiple of its voxel that reaches [`PARTITION_VOXEL_M`] (to 1 %): its voxel itself
-/// where that reaches it (then the partition is made on the level's own grid:
-/// [`partition_grid`]). A whole multiple keeps the partition's voxels
-/// one size at every resolution: Crytek Sponza is partitioned on 14.6 cm voxels at 256, 512
-/// and 1024 (1, 2 and 4 of its voxels; 73, 84 and 84 clusters), where on 12.5 cm voxels at 512
-/// it made 89 and baked in 3.8–4.5 s instead of 2.9.
+/// of its length where that is under [`PARTITION_VOXEL_M`] (a small level; its voxel where
+/// that is coarser), else the least whole multiple of its voxel that reaches
+/// [`PARTITION_VOXEL_M`] (to 1 %): its voxel itself where that reaches it (then the partition
+/// is made on the level's own grid: [`partition_grid`]). A whole multiple keeps the
+/// partition's voxels one size at every resolution: Crytek Sponza is partitioned on 14.6 cm
+/// voxels at 256, 512 and 1024 (1, 2 and 4 of its voxels; 73, 84 and 84 clusters), where on
+/// 12.5 cm voxels at 512 it made 89 and baked in 3.8–4.5 s instead of 2.9.
 ///
 /// A coarse bake, whose voxels are at least twice that voxel and 1/[`COARSE_PARTS`] of the
-/// level (to 1 %), where the greater of these is at most [`COARSE_MAX_M`], is partitioned on the finest whole fraction of its voxel that is not finer
-/// than both, and each of its voxels takes the cluster most of its share of that grid has
-/// ([`crate::refine`]): Dabrovic Sponza at 128, whose 27 cm voxels close its upper arcades,
+/// level (to 1 %), where the greater of these is at most [`COARSE_MAX_M`], is partitioned on
+/// the finest whole fraction of its voxel that is not finer than both, and each of its voxels
+/// takes the cluster most of its share of that grid has ([`crate::refine`]): Dabrovic Sponza at 128, whose 27 cm voxels close its upper arcades,
 /// is partitioned on its 256 grid (160 clusters, as at 256 and 512, instead of 17); the
 /// pillared hall (16.4 m) at 64 on its 128 grid, at 128 on its own.
 pub fn default_partition_voxel(longest: f32, voxel_m: f32) -> f32 {
