@@ -258,9 +258,8 @@ pub fn bake(
     // A bare mesh's openings are looked for on the partition grid where that is coarser: on
     // the level's finer grid the search costs seconds and hundreds of MiB
     // (empty::INSIDE_LEAK_MAX_VOXELS).
-    let locate_coarse = pm.is_some_and(|p| p.voxel_size_m > meta.voxel_size_m);
+    let locate = !pm.is_some_and(|p| p.voxel_size_m > meta.voxel_size_m);
     let mut es = cx.stage("empty space", 0, |_| {
-        let locate = !locate_coarse;
         stages::empty(
             scene,
             &meta,

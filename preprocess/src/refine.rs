@@ -102,26 +102,28 @@ fn samples_per_axis(meta: &GridMeta, partition: &GridMeta) -> usize {
     k.clamp(1.0, 8.0) as usize
 }
 
-/// For each axis, the partition voxel of each of the [`samples_per_axis`] evenly spaced
-/// samples of each of the level's voxels along it (`u32::MAX`: off the partition grid), the
-/// samples of a voxel adjacent. The mapping is separable: `world_to_voxel` of the sample's
-/// point, one axis at a time.
-fn samples_along(meta: &GridMeta, partition: &GridMeta) -> [Vec<u32>; 3] {
+/// The [`samples_per_axis`] `s`, and for each axis the partition voxel of each of the `s`
+/// evenly spaced samples of each of the level's voxels along it (`u32::MAX`: off the partition
+/// grid), the samples of a voxel adjacent. The mapping is separable: `world_to_voxel` of the
+/// sample's point, one axis at a time.
+fn samples_along(meta: &GridMeta, partition: &GridMeta) -> (usize, [Vec<u32>; 3]) {
     let s = samples_per_axis(meta, partition);
-    std::array::from_fn(|a| {
+    let step = meta.voxel_size_m / s as f32;
+    // A point at the partition grid's first voxel centre, moved along one axis at a time.
+    let base = partition.origin_m.map(|o| o + 0.5 * partition.voxel_size_m);
+    let along = std::array::from_fn(|a| {
         (0..meta.dims[a] as usize * s)
             .map(|i| {
                 let (v, k) = (i / s, i % s);
-                let mut w = partition.origin_m.map(|o| o + 0.5 * partition.voxel_size_m);
                 let mut p = [0u32; 3];
                 p[a] = v as u32;
-                let centre = meta.voxel_to_world(p)[a];
-                let step = meta.voxel_size_m / s as f32;
-                w[a] = centre + (k as f32 + 0.5 - 0.5 * s as f32) * step;
+                let mut w = base;
+                w[a] = meta.voxel_to_world(p)[a] + (k as f32 + 0.5 - 0.5 * s as f32) * step;
                 partition.world_to_voxel(w).map_or(u32::MAX, |c| c[a])
             })
             .collect()
-    })
+    });
+    (s, along)
 }
 
 /// What [`refine`] did.
@@ -143,8 +145,7 @@ pub struct RefineCounts {
 /// are dropped from `empty`.
 pub fn refine(meta: &GridMeta, empty: &mut [bool], coarse: &Coarse) -> (Vec<u32>, RefineCounts) {
     let [nx, ny, _] = meta.dims.map(|d| d as usize);
-    let along = samples_along(meta, coarse.meta);
-    let s = samples_per_axis(meta, coarse.meta);
+    let (s, along) = samples_along(meta, coarse.meta);
     // Every voxel written, and those given a cluster counted, a row at a time on every thread
     // (filled on one thread first, this step took 0.20 s at 512, now 0.11 s).
     let mut cluster: Vec<u32> = vec![0; empty.len()];

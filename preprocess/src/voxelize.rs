@@ -266,11 +266,12 @@ impl TriGrid {
         let (w0, w1) = span(w);
         let inside = Inside::new(v, u, w, h);
         for iw in w0..=w1 {
-            let Some((u_lo, u_hi)) = slab_extent(v, u, w, self.centre(w, iw), h) else {
+            let cw = self.centre(w, iw);
+            let Some((u_lo, u_hi)) = slab_extent(v, u, w, cw, h) else {
                 continue;
             };
             for iu in self.centres_in(u, (u_lo - h, u_hi + h), span(u)) {
-                let (cu, cw) = (self.centre(u, iu), self.centre(w, iw));
+                let cu = self.centre(u, iu);
                 let within = inside.column(cu, cw);
                 let column = if n[a] == 0.0 {
                     span(a).0..=span(a).1
@@ -331,13 +332,8 @@ impl Inside {
     fn new(v: [DVec3; 3], u: usize, w: usize, h: f64) -> Inside {
         let p = v.map(|q| DVec2::new(q[u], q[w]));
         let area = (p[1] - p[0]).perp_dot(p[2] - p[0]);
-        let sign = if area > 0.0 {
-            1.0
-        } else if area < 0.0 {
-            -1.0
-        } else {
-            0.0
-        };
+        // signum() of ±0 is ±1: a degenerate outline keeps 0.
+        let sign = if area == 0.0 { 0.0 } else { area.signum() };
         let edges = std::array::from_fn(|k| {
             let (e0, e) = (p[k], p[(k + 1) % 3] - p[k]);
             (e0, e, h * (e.x.abs() + e.y.abs()))
