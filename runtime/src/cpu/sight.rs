@@ -160,6 +160,17 @@ impl VoxelSight {
         self.triangles.get().is_some()
     }
 
+    /// The grid's voxel edge. [Units: m]
+    pub fn voxel_m(&self) -> f32 {
+        self.voxel_m
+    }
+
+    /// Bytes of [`VoxelSight::words`] without the closed voxels' triangle lists: the header,
+    /// the open bits and the bricks' clearance.
+    pub fn bytes_without_triangles(&self) -> u64 {
+        ((SIGHT_HEADER_WORDS + self.words.len() + self.clear.len().div_ceil(4)) * 4) as u64
+    }
+
     /// Point `p` (m) in voxel coordinates.
     pub fn to_voxels(&self, p: Vec3) -> Vec3 {
         (p - self.origin_m) / self.voxel_m

@@ -302,6 +302,45 @@ pub fn hits(c: [Vec3; 3], a: Vec3, b: Vec3) -> bool {
     u >= 0.0 && w >= 0.0 && u + w <= 1.0 && h > 1e-4 && h < 1.0 - 1e-4
 }
 
+/// Why the open voxels' grid of `bytes` (with the closed voxels' triangle lists where
+/// `without_lists` gives its size without them) does not fit a storage binding of `limit`
+/// bytes, and what fits it: the sight grid's voxel (`voxel_m`) is the level's own, not its
+/// resolution's (Crytek Sponza's is 4 cm baked at 128 or at 512), and the lists are the
+/// walk's `--closed-voxel-triangles`.
+pub fn sight_too_large(bytes: u64, without_lists: Option<u64>, voxel_m: f32, limit: u64) -> String {
+    // The bits shrink with the cube of the voxel and the lists (a list a closed voxel, which
+    // lie on the surfaces) with its square at least; a hair coarser than that, as a hint.
+    let power = if without_lists.is_some() {
+        0.5
+    } else {
+        1.0 / 3.0
+    };
+    let fits = voxel_m * (bytes as f32 / limit as f32).powf(power) * 1.05;
+    let coarser = || {
+        format!(
+            "bake with a coarser --sight-voxel (this level's is {voxel_m:.4} m; about {fits:.4} m fits)"
+        )
+    };
+    match without_lists {
+        Some(plain) if plain <= limit => format!(
+            "the open voxels' grid with the closed voxels' triangles (--closed-voxel-triangles) \
+             needs {bytes} bytes, more than the adapter's storage binding limit {limit}: walk \
+             without --closed-voxel-triangles ({plain} bytes), or {}",
+            coarser()
+        ),
+        Some(_) => format!(
+            "the open voxels' grid with the closed voxels' triangles (--closed-voxel-triangles) \
+             needs {bytes} bytes, more than the adapter's storage binding limit {limit}: {}",
+            coarser()
+        ),
+        None => format!(
+            "the open voxels' grid needs {bytes} bytes, more than the adapter's storage binding \
+             limit {limit}: {}",
+            coarser()
+        ),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -376,5 +415,28 @@ mod tests {
         assert!(!t.pass(0, along(0.8), &mut WalkTests::new(0)));
         // A voxel without a list blocks.
         assert!(!t.pass(1, along(0.8), &mut WalkTests::new(4)));
+    }
+
+    #[test]
+    fn a_sight_grid_too_large_for_the_binding_says_what_fits_it() {
+        let limit = 128 << 20;
+        // Crytek Sponza's on lavapipe: 153 MB with the lists, 52 MB without.
+        let m = super::sight_too_large(153_176_188, Some(52_000_000), 0.04, limit);
+        assert!(
+            m.contains("walk without --closed-voxel-triangles (52000000 bytes)"),
+            "{m}"
+        );
+        assert!(
+            m.contains("this level's is 0.0400 m; about 0.0449 m fits"),
+            "{m}"
+        );
+        assert!(!m.contains("resolution"), "{m}");
+        // Too large even without the lists: only the coarser voxel is offered.
+        let m = super::sight_too_large(300 << 20, Some(200 << 20), 0.01, limit);
+        assert!(!m.contains("walk without"), "{m}");
+        assert!(m.contains("about 0.0161 m fits"), "{m}");
+        let m = super::sight_too_large(256 << 20, None, 0.02, limit);
+        assert!(m.starts_with("the open voxels' grid needs"), "{m}");
+        assert!(m.contains("about 0.0265 m fits"), "{m}");
     }
 }

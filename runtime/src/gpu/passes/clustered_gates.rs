@@ -241,22 +241,25 @@ impl LevelBuffers {
                 MAX_CLUSTERS
             )));
         }
-        for (what, words, fix) in [
-            ("voxel→cluster grid", &t.voxel_words, ""),
-            (
-                "open voxels' grid",
-                &t.sight_words,
-                " or a coarser --sight-voxel",
-            ),
-        ] {
-            let bytes = (words.len() * 4) as u64;
-            if bytes > d.limits().max_storage_buffer_binding_size {
-                return Err(RenderError::Param(format!(
-                    "the {what} needs {bytes} bytes, more than the adapter's storage binding \
-                     limit {}: bake at a lower resolution{fix}",
-                    d.limits().max_storage_buffer_binding_size
-                )));
-            }
+        let limit = d.limits().max_storage_buffer_binding_size;
+        let bytes = |words: &[u32]| (words.len() * 4) as u64;
+        if bytes(&t.voxel_words) > limit {
+            return Err(RenderError::Param(format!(
+                "the voxel→cluster grid needs {} bytes, more than the adapter's storage binding \
+                 limit {limit}: bake at a lower resolution",
+                bytes(&t.voxel_words)
+            )));
+        }
+        if bytes(&t.sight_words) > limit {
+            let s = level.sight();
+            return Err(RenderError::Param(
+                crate::cpu::sight_triangles::sight_too_large(
+                    bytes(&t.sight_words),
+                    s.triangles_listed().then(|| s.bytes_without_triangles()),
+                    s.voxel_m(),
+                    limit,
+                ),
+            ));
         }
         let storage = wgpu::BufferUsages::STORAGE;
         Ok(LevelBuffers {
