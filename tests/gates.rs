@@ -234,6 +234,25 @@ fn gpu_gates_agree_with_the_cpu_twin() {
         gpu.level_for_mode(&ctx, &gates, &with_triangles)
             .expect("level upload");
         assert!(gates.sight().triangles_listed() && gpu.level_has_triangles());
+        // Another render of a run (its own renderer) that walks without them uploads none,
+        // though they are listed now: where they overflow the adapter's storage binding, only
+        // the walk with them fails (`visgate compare` with a variant of
+        // `--closed-voxel-triangles`). `set_level`, the viewer's, carries what is listed.
+        let plain = GpuMode::GatesPerPixel(GateParams {
+            shape: GateShape::Voxels,
+            ..GateParams::default()
+        });
+        let mut other = GpuRenderer::new(&ctx, &scene).expect("upload");
+        other
+            .level_for_mode(&ctx, &gates, &plain)
+            .expect("level upload");
+        assert!(!other.level_has_triangles());
+        other
+            .level_for_mode(&ctx, &gates, &with_triangles)
+            .expect("level upload");
+        assert!(other.level_has_triangles());
+        other.set_level(&ctx, &gates).expect("level upload");
+        assert!(other.level_has_triangles());
         for (clustered, hops, shape, triangles) in [
             (true, 1, GateShape::Disk, false),
             (true, 2, GateShape::Disk, false),

@@ -426,8 +426,9 @@ pub struct GateTables {
 }
 
 impl GateLevel {
-    /// The tables the GPU's gate test reads.
-    pub fn tables(&self) -> GateTables {
+    /// The tables the GPU's gate test reads, the closed voxels' triangle lists among them where
+    /// `lists` asks for them and they are listed ([`GateLevel::list_triangles`]).
+    pub fn tables(&self, lists: bool) -> GateTables {
         use visgate_formats::vgate::VoxelValues;
         let (bytes, words): (u32, Vec<u32>) = match &self.level.voxel_cluster {
             VoxelValues::U8(v) => (
@@ -478,7 +479,7 @@ impl GateLevel {
             gates,
             cluster_gates: starts,
             portal_words: self.portal_words(),
-            sight_words: self.sight.words(),
+            sight_words: self.sight.words_with(lists),
             sight_steps: self.sight.most_steps(),
         }
     }

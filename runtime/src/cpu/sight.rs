@@ -328,10 +328,17 @@ impl VoxelSight {
     /// clearances, four bytes a word (little-endian), then the triangle lists
     /// ([`ClosedTriangles::words`]) if they are listed ([`VoxelSight::list_triangles`]).
     pub fn words(&self) -> Vec<u32> {
+        self.words_with(true)
+    }
+
+    /// [`VoxelSight::words`], with the triangle lists only where `lists` asks for them (and
+    /// they are listed): a walk without them need not carry them.
+    pub fn words_with(&self, lists: bool) -> Vec<u32> {
         let clear_at = SIGHT_HEADER_WORDS + self.words.len();
         let lists_at = clear_at + self.clear.len().div_ceil(4);
         let none = ClosedTriangles::default();
-        let (lists, at) = self.triangles.get().unwrap_or(&none).words(lists_at);
+        let listed = self.triangles.get().filter(|_| lists);
+        let (lists, at) = listed.unwrap_or(&none).words(lists_at);
         let mut w = Vec::with_capacity(lists_at + lists.len());
         w.extend(self.dims.to_array().map(|x| x as u32));
         w.extend(self.bricks.to_array().map(|x| x as u32));

@@ -324,7 +324,7 @@ impl GpuRenderer {
     /// lists go up only if they are listed ([`GateLevel::list_triangles`]), which the voxel
     /// walk with the triangles needs.
     pub fn set_level(&mut self, ctx: &GpuContext, level: &GateLevel) -> Result<(), RenderError> {
-        self.scene.level = Some(LevelBuffers::upload(ctx, level)?);
+        self.scene.level = Some(LevelBuffers::upload(ctx, level, true)?);
         Ok(())
     }
 
@@ -336,7 +336,10 @@ impl GpuRenderer {
 
     /// Makes the uploaded level serve `mode`: uploads `level` if none is up, and again with its
     /// triangle lists (listed now) when `mode` walks with them and they are not up yet — the
-    /// first frame of that mode pays for them, a level never walked with them does not.
+    /// first frame of that mode pays for them, a level never walked with them does not. A mode
+    /// without them uploads none, even where another render listed them: on an adapter whose
+    /// storage binding they overflow (lavapipe's 128 MiB and Crytek Sponza's 4 cm grid), only
+    /// the mode that walks them fails.
     pub fn level_for_mode(
         &mut self,
         ctx: &GpuContext,
@@ -349,7 +352,8 @@ impl GpuRenderer {
         } else if self.scene.level.is_some() {
             return Ok(());
         }
-        self.set_level(ctx, level)
+        self.scene.level = Some(LevelBuffers::upload(ctx, level, lists)?);
+        Ok(())
     }
 
     /// GPU textures, buffers and query sets the renderer's frames have made so far (a frame

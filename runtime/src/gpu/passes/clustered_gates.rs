@@ -226,10 +226,16 @@ impl LevelBuffers {
         })
     }
 
-    /// Uploads `level`'s tables; the voxel grid keeps the smallest integer type that holds the
+    /// Uploads `level`'s tables, with the closed voxels' triangle lists where `lists` asks for
+    /// them and they are listed; the voxel grid keeps the smallest integer type that holds the
     /// level's clusters.
-    pub fn upload(ctx: &GpuContext, level: &GateLevel) -> Result<LevelBuffers, RenderError> {
-        let t = level.tables();
+    pub fn upload(
+        ctx: &GpuContext,
+        level: &GateLevel,
+        lists: bool,
+    ) -> Result<LevelBuffers, RenderError> {
+        let lists = lists && level.sight().triangles_listed();
+        let t = level.tables(lists);
         let d = &ctx.device;
         if t.gates.len() > MAX_GATES || level.cluster_count() > MAX_CLUSTERS {
             return Err(RenderError::Param(format!(
@@ -255,7 +261,7 @@ impl LevelBuffers {
             return Err(RenderError::Param(
                 crate::cpu::sight_triangles::sight_too_large(
                     bytes(&t.sight_words),
-                    s.triangles_listed().then(|| s.bytes_without_triangles()),
+                    lists.then(|| s.bytes_without_triangles()),
                     s.voxel_m(),
                     limit,
                 ),
@@ -286,7 +292,7 @@ impl LevelBuffers {
                 storage,
             ),
             sight_steps: t.sight_steps,
-            triangles: level.sight().triangles_listed(),
+            triangles: lists,
         })
     }
 }
