@@ -38,6 +38,11 @@ fn load(path: &std::path::Path) -> Scene {
     scene
 }
 
+/// The repository's scene file `scenes/shared/NAME.toml` for a shared level.
+fn scene_file(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(format!("scenes/shared/{name}.toml"))
+}
+
 /// Each triangle as its corners quantised to `q` units, rotated so the smallest corner comes
 /// first (winding kept), sorted.
 fn canonical_triangles(scene: &Scene, q: f32) -> Vec<[[i64; 3]; 3]> {
@@ -114,9 +119,7 @@ fn dabrovic_sponzas_80_arcade_lights_cluster_into_fewer_as_the_minimum_distance_
     if shared_scenes().is_none() {
         return;
     }
-    let toml = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("scenes/shared/dabrovic-sponza-80-lights.toml");
-    let scene = load(&toml);
+    let scene = load(&scene_file("dabrovic-sponza-80-lights"));
     assert_eq!(scene.lights.len(), 80);
     let (lo, hi) = scene.static_bounds().expect("bounds");
     let diagonal = (hi - lo).length();
@@ -166,12 +169,11 @@ fn levels_wound_inside_out_bake_as_written() {
     // The bare OBJs, as `visgate bake FILE` reads them (no camera, no light): e2m3's void
     // wraps its rooms; Crytek Sponza's rooms are open to the sky. And their scene files, whose
     // cameras and lights are in the rooms.
-    let tomls = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenes/shared");
     for file in [
         dir.join("librequake_e2m3/e2m3.obj"),
         dir.join("crytek_sponza/sponza.obj"),
-        tomls.join("librequake-e2m3.toml"),
-        tomls.join("crytek-sponza.toml"),
+        scene_file("librequake-e2m3"),
+        scene_file("crytek-sponza"),
     ] {
         let file = file.display().to_string();
         let written = load(std::path::Path::new(&file));
@@ -200,9 +202,7 @@ fn dabrovic_sponza_at_128_is_partitioned_as_at_256() {
     if shared_scenes().is_none() {
         return;
     }
-    let toml = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("scenes/shared/dabrovic-sponza-80-lights.toml");
-    let scene = load(&toml);
+    let scene = load(&scene_file("dabrovic-sponza-80-lights"));
     let at = |res: u32, partition_voxel_m: Option<f32>| {
         let params = BakeParams {
             resolution: Resolution::LongestAxisVoxels(res),

@@ -310,35 +310,25 @@ pub fn hits(c: [Vec3; 3], a: Vec3, b: Vec3) -> bool {
 pub fn sight_too_large(bytes: u64, without_lists: Option<u64>, voxel_m: f32, limit: u64) -> String {
     // The bits shrink with the cube of the voxel and the lists (a list a closed voxel, which
     // lie on the surfaces) with its square at least; a hair coarser than that, as a hint.
-    let power = if without_lists.is_some() {
-        0.5
-    } else {
-        1.0 / 3.0
+    let (what, power) = match without_lists {
+        Some(_) => (
+            "the open voxels' grid with the closed voxels' triangles (--closed-voxel-triangles)",
+            0.5,
+        ),
+        None => ("the open voxels' grid", 1.0 / 3.0),
     };
     let fits = voxel_m * (bytes as f32 / limit as f32).powf(power) * 1.05;
-    let coarser = || {
-        format!(
-            "bake with a coarser --sight-voxel (this level's is {voxel_m:.4} m; about {fits:.4} m fits)"
-        )
+    let without = match without_lists {
+        Some(plain) if plain <= limit => {
+            format!("walk without --closed-voxel-triangles ({plain} bytes), or ")
+        }
+        _ => String::new(),
     };
-    match without_lists {
-        Some(plain) if plain <= limit => format!(
-            "the open voxels' grid with the closed voxels' triangles (--closed-voxel-triangles) \
-             needs {bytes} bytes, more than the adapter's storage binding limit {limit}: walk \
-             without --closed-voxel-triangles ({plain} bytes), or {}",
-            coarser()
-        ),
-        Some(_) => format!(
-            "the open voxels' grid with the closed voxels' triangles (--closed-voxel-triangles) \
-             needs {bytes} bytes, more than the adapter's storage binding limit {limit}: {}",
-            coarser()
-        ),
-        None => format!(
-            "the open voxels' grid needs {bytes} bytes, more than the adapter's storage binding \
-             limit {limit}: {}",
-            coarser()
-        ),
-    }
+    format!(
+        "{what} needs {bytes} bytes, more than the adapter's storage binding limit {limit}: \
+         {without}bake with a coarser --sight-voxel (this level's is {voxel_m:.4} m; about \
+         {fits:.4} m fits)"
+    )
 }
 
 #[cfg(test)]
