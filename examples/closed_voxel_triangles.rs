@@ -1,10 +1,12 @@
 //! What the voxel walk gains by testing the triangles in the closed voxels it crosses
 //! (`runtime::cpu::sight_triangles`): every pixel–VPL pair of a view that could exchange light
-//! (as `portal_agreement`), walked three ways and measured against the shadow ray — between
-//! ends set off the surfaces with closed voxels blocking (the walk before the lists), the same
-//! ends with a closed voxel passed where the segment misses the triangles listed in it, and the
-//! walk of `--closed-voxel-triangles`, along the true segment between the surface points, with
-//! the lists. Then, per pixel, the light of every VPL (cos · cos / d², pixel centres) each way
+//! (as `portal_agreement`), walked four ways and measured against the shadow ray — between
+//! ends set off the surfaces with closed voxels blocking (`--no-closed-voxel-planes`), the
+//! default walk with a closed voxel passed where the segment meets neither of its planes
+//! (`runtime::cpu::sight_planes`, its ends 0.3 voxels off the surfaces where the planes allow),
+//! the blocking walk's ends with a closed voxel passed where the segment misses the triangles
+//! listed in it, and the walk of `--closed-voxel-triangles`, along the true segment between the
+//! surface points, with the lists. Then, per pixel, the light of every VPL (cos · cos / d², pixel centres) each way
 //! lets through against the shadow rays': the share of the lit pixels that a way leaves black
 //! (under a tenth of the rays' light, where that is at least a tenth of its mean), `visgate
 //! compare`'s *black where lit* without the interleaving.
@@ -15,6 +17,7 @@
 mod pairs;
 
 use visgate_runtime::cpu::portal_walk::facing_pairs;
+use visgate_runtime::cpu::sight::Closed;
 
 fn main() -> anyhow::Result<()> {
     let pairs::Pairs {
@@ -34,21 +37,28 @@ fn main() -> anyhow::Result<()> {
         lists.lists(),
         lists.references()
     );
-    const WAYS: [&str; 3] = [
+    let planes = sight.planes();
+    let [one, two] = planes.counts();
+    println!(
+        "closed voxels {}: one plane {one}, two {two}",
+        planes.voxels()
+    );
+    const WAYS: [&str; 4] = [
         "closed voxels block (ends off the surfaces)",
+        "closed voxels' planes (the default)",
         "+ triangles in closed voxels (ends off the surfaces)",
         "the true segment walked with the triangles (--closed-voxel-triangles)",
     ];
     // Per way: [exact][walk] pair counts.
-    let mut n = [[[0u64; 2]; 2]; 3];
+    let mut n = [[[0u64; 2]; 2]; 4];
     // Per pixel with pairs: the light the rays let through, then each way's.
-    let mut light: Vec<[f64; 4]> = Vec::new();
+    let mut light: Vec<[f64; 5]> = Vec::new();
     let mut last_point = None;
     facing_pairs(&tracer, &gates, &view, &vpls, |pair| {
         // The pairs come a pixel at a time.
         if last_point != Some(pair.point) {
             last_point = Some(pair.point);
-            light.push([0.0; 4]);
+            light.push([0.0; 5]);
         }
         let ends = (
             sight.end(pair.vpl, pair.vpl_normal),
@@ -56,11 +66,18 @@ fn main() -> anyhow::Result<()> {
         );
         let ways = match ends {
             (Some(x), Some(y)) => [
-                sight.clear(x, y, false),
-                sight.clear(x, y, true),
+                sight.clear(x, y, Closed::Blocks),
+                sight.visible_off_surfaces(
+                    pair.vpl,
+                    pair.vpl_normal,
+                    pair.point,
+                    pair.point_normal,
+                    true,
+                ),
+                sight.clear(x, y, Closed::Triangles),
                 sight.visible(pair.vpl, pair.vpl_normal, pair.point, pair.point_normal),
             ],
-            _ => [true; 3],
+            _ => [true; 4],
         };
         let d = pair.vpl - pair.point;
         let dir = d.normalize_or_zero();
@@ -94,7 +111,7 @@ fn main() -> anyhow::Result<()> {
     }
     // Pixels without pairs get no light: the mean is over the whole view.
     let mean = light.iter().map(|p| p[0]).sum::<f64>() / f64::from(w * h);
-    let lit: Vec<&[f64; 4]> = light.iter().filter(|p| p[0] >= 0.1 * mean).collect();
+    let lit: Vec<&[f64; 5]> = light.iter().filter(|p| p[0] >= 0.1 * mean).collect();
     for (k, name) in WAYS.iter().enumerate() {
         let black = lit.iter().filter(|p| p[k + 1] < 0.1 * p[0]).count();
         println!(

@@ -2,7 +2,8 @@
 //! that could exchange light (the two surfaces face each other): the pairs an exact ray sees
 //! that the walk finds or blocks, the pairs it occludes that the walk lets through or blocks,
 //! and the blocked ones by how many cluster changes the segment passes (sampled at 101
-//! points); then the voxel walk's agreement on the same pairs, where along the segment it
+//! points); then the voxel walk's agreement on the same pairs (every closed voxel blocking:
+//! `--no-closed-voxel-planes`; `closed_voxel_triangles` measures the default), where along the segment it
 //! blocks the visible ones (voxels from the nearer end), and both walks' CPU time.
 //! `tests/portals.rs` holds `ajar-door` to this on built-ins; this measures real levels.
 //!
@@ -16,7 +17,7 @@ mod pairs;
 use glam::Vec3;
 use visgate_runtime::cpu::gates::{GateLevel, GateParams, Walk};
 use visgate_runtime::cpu::portal_walk::facing_pairs;
-use visgate_runtime::cpu::sight::VoxelSight;
+use visgate_runtime::cpu::sight::{Closed, VoxelSight};
 
 /// Pair counts of one view.
 #[derive(Debug, Default)]
@@ -58,7 +59,7 @@ fn block_from_end(sight: &VoxelSight, x: Vec3, y: Vec3) -> f32 {
     let (mut lo, mut hi) = (0.0f32, 1.0f32);
     for _ in 0..24 {
         let m = 0.5 * (lo + hi);
-        if sight.clear(x, x + (y - x) * m, false) {
+        if sight.clear(x, x + (y - x) * m, Closed::Blocks) {
             lo = m;
         } else {
             hi = m;
@@ -93,8 +94,13 @@ fn main() -> anyhow::Result<()> {
         n.seconds[0] += t.elapsed().as_secs_f64();
         let t = std::time::Instant::now();
         let sight = gates.sight();
-        let through =
-            sight.visible_blocking(pair.vpl, pair.vpl_normal, pair.point, pair.point_normal);
+        let through = sight.visible_off_surfaces(
+            pair.vpl,
+            pair.vpl_normal,
+            pair.point,
+            pair.point_normal,
+            false,
+        );
         n.seconds[1] += t.elapsed().as_secs_f64();
         match (pair.exact, through) {
             (true, true) => n.voxels[0] += 1,

@@ -72,6 +72,10 @@ pub struct GateParams {
     /// cost on lavapipe), instead of blocking at every closed voxel, with the ends set off
     /// their surfaces (the default).
     pub triangles: bool,
+    /// Voxels, without the triangles: pass a closed voxel where the segment meets neither of
+    /// the one or two planes its geometry lies in ([`super::sight_planes`]), and start each end
+    /// 0.3 voxels off its surface where those planes allow; else every closed voxel blocks.
+    pub planes: bool,
 }
 
 impl Default for GateParams {
@@ -82,6 +86,7 @@ impl Default for GateParams {
             oversize: 1.0,
             max_hops: 2,
             triangles: false,
+            planes: true,
         }
     }
 }
@@ -165,6 +170,13 @@ impl GateLevel {
     /// `GpuRenderer::set_level` carry them: the GPU's voxel walk with the triangles needs them.
     pub fn list_triangles(&self) {
         self.sight.list_triangles();
+    }
+
+    /// Fits the closed voxels' planes now (once; listing the triangles first; a walk with the
+    /// planes on the CPU fits them when first needed), so that [`GateLevel::tables`] and
+    /// `GpuRenderer::set_level` carry them.
+    pub fn fit_planes(&self) {
+        self.sight.planes();
     }
 
     /// Voxel edge of the level's grid. [Units: m]
@@ -286,8 +298,13 @@ impl GateLevel {
                 self.sight
                     .visible(a.position, a.normal, b.position, b.normal)
             } else {
-                self.sight
-                    .visible_blocking(a.position, a.normal, b.position, b.normal)
+                self.sight.visible_off_surfaces(
+                    a.position,
+                    a.normal,
+                    b.position,
+                    b.normal,
+                    params.planes,
+                )
             };
         }
         let (Some(ca), Some(cb)) = (vpl.cluster, point.cluster) else {
@@ -427,8 +444,9 @@ pub struct GateTables {
 
 impl GateLevel {
     /// The tables the GPU's gate test reads, the closed voxels' triangle lists among them where
-    /// `lists` asks for them and they are listed ([`GateLevel::list_triangles`]).
-    pub fn tables(&self, lists: bool) -> GateTables {
+    /// `lists` asks for them and they are listed ([`GateLevel::list_triangles`]), and their
+    /// planes where `planes` does and they are fitted ([`GateLevel::fit_planes`]).
+    pub fn tables(&self, lists: bool, planes: bool) -> GateTables {
         use visgate_formats::vgate::VoxelValues;
         let (bytes, words): (u32, Vec<u32>) = match &self.level.voxel_cluster {
             VoxelValues::U8(v) => (
@@ -479,7 +497,7 @@ impl GateLevel {
             gates,
             cluster_gates: starts,
             portal_words: self.portal_words(),
-            sight_words: self.sight.words_with(lists),
+            sight_words: self.sight.words_with(lists, planes),
             sight_steps: self.sight.most_steps(),
         }
     }

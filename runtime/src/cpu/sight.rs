@@ -19,9 +19,10 @@
 //! in the closed voxels ([`super::sight_triangles`], when a walk first needs them), the walk of
 //! [`VoxelSight::visible`] runs along the true segment, between the two surface points, and
 //! passes a closed voxel where the segment hits none of them, so a segment that grazes a wall, a
-//! column or a door's edge within a voxel is not blocked; [`VoxelSight::visible_blocking`] is
-//! the walk without them, between the ends described next (the default: several times
-//! faster).
+//! column or a door's edge within a voxel is not blocked; [`VoxelSight::visible_off_surfaces`]
+//! is the walk without them, between the ends described next (the default: several times
+//! faster), where a closed voxel blocks or, with its planes ([`super::sight_planes`], the
+//! default), passes a segment that meets neither of the one or two planes its geometry lies in.
 //!
 //! Each end starts off its own surface, whose closed voxels it may lie in: at the first of
 //! [`END_OFFSETS_VOXELS`] along its normal that lands in an open voxel (a segment from a plane
@@ -33,9 +34,22 @@
 use glam::{BVec3, IVec3, Vec3};
 use visgate_formats::vgate::{GridMeta, VoxelBits};
 
+use super::sight_planes::{self, ClosedPlanes, END_PLANES_OFFSET_VOXELS};
 use super::sight_triangles::{
     ClosedTriangles, TRIANGLE_TESTS_PER_WALK, TRUE_END_OFFSET_VOXELS, WalkTests,
 };
+
+/// What a walk does at a closed voxel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Closed {
+    /// It blocks.
+    Blocks,
+    /// It passes where the segment meets neither of its planes ([`super::sight_planes`]).
+    Planes,
+    /// It passes where the segment hits none of its listed triangles
+    /// ([`super::sight_triangles`]).
+    Triangles,
+}
 
 /// Voxels along a brick's side (sight.wgsl's `SIGHT_BRICK`). 2³ bricks step near walls in
 /// fewer, shorter steps than 4³ ones and cost as many bytes as the open bits (a byte a
@@ -66,6 +80,8 @@ pub struct VoxelSight {
     /// (0.8 s and 35 MB for Crytek Sponza at 512: a level that never walks with them pays
     /// neither).
     triangles: std::sync::OnceLock<ClosedTriangles>,
+    /// The closed voxels' planes, fitted to the lists when first needed.
+    planes: std::sync::OnceLock<ClosedPlanes>,
 }
 
 /// `a` divided by `b`, rounded up.
@@ -115,6 +131,7 @@ impl VoxelSight {
             clear: chessboard(bricks, &closed),
             source: std::sync::Arc::new([]),
             triangles: std::sync::OnceLock::new(),
+            planes: std::sync::OnceLock::new(),
         }
     }
 
@@ -125,28 +142,72 @@ impl VoxelSight {
         VoxelSight {
             source: triangles.into(),
             triangles: std::sync::OnceLock::new(),
+            planes: std::sync::OnceLock::new(),
             ..self
         }
     }
 
     /// The triangles in the closed voxels, listed now if they were not yet.
     pub fn triangles(&self) -> &ClosedTriangles {
-        self.triangles.get_or_init(|| {
-            let t0 = std::time::Instant::now();
-            let grid = GridMeta {
-                origin_m: self.origin_m.to_array(),
-                voxel_size_m: self.voxel_m,
-                dims: self.dims.to_array().map(|d| d as u32),
+        self.triangles.get_or_init(|| self.list())
+    }
+
+    /// The triangles listed in the closed voxels (timed in the log).
+    fn list(&self) -> ClosedTriangles {
+        let t0 = std::time::Instant::now();
+        let grid = GridMeta {
+            origin_m: self.origin_m.to_array(),
+            voxel_size_m: self.voxel_m,
+            dims: self.dims.to_array().map(|d| d as u32),
+        };
+        let lists = ClosedTriangles::new(&grid, |v| self.open(v), &self.source);
+        tracing::info!(
+            "voxel walk: {} closed voxels list {} triangle references ({:.2} s)",
+            lists.voxels(),
+            lists.references(),
+            t0.elapsed().as_secs_f64()
+        );
+        lists
+    }
+
+    /// The closed voxels' planes, fitted now if they were not yet (to the triangle lists: those
+    /// of [`VoxelSight::triangles`] where they are listed, else lists made for the fit and
+    /// dropped, so that the planes alone do not make the lists count as listed); none without
+    /// triangles.
+    pub fn planes(&self) -> &ClosedPlanes {
+        self.planes.get_or_init(|| {
+            if self.source.is_empty() {
+                return ClosedPlanes::default();
+            }
+            let made;
+            let lists = match self.triangles.get() {
+                Some(l) => l,
+                None => {
+                    made = self.list();
+                    &made
+                }
             };
-            let lists = ClosedTriangles::new(&grid, |v| self.open(v), &self.source);
+            let t0 = std::time::Instant::now();
+            let planes = ClosedPlanes::new(self.dims, &self.words, lists);
+            let [one, two] = planes.counts();
             tracing::info!(
-                "voxel walk: {} closed voxels list {} triangle references ({:.2} s)",
-                lists.voxels(),
-                lists.references(),
+                "voxel walk: of {} closed voxels {one} hold one plane, {two} two ({:.2} s)",
+                planes.voxels(),
                 t0.elapsed().as_secs_f64()
             );
-            lists
+            planes
         })
+    }
+
+    /// Whether the closed voxels' planes are fitted (and [`VoxelSight::words`] carries them).
+    pub fn planes_fitted(&self) -> bool {
+        self.planes.get().is_some()
+    }
+
+    /// The planes of closed voxel `v`, none where it blocks (or is open, or outside the grid).
+    fn planes_of(&self, v: IVec3) -> Option<[Option<sight_planes::Plane>; 2]> {
+        let i = self.index(v)?;
+        self.planes().of(i, &self.words)
     }
 
     /// Lists the triangles in the closed voxels now, so that [`VoxelSight::words`] carries
@@ -165,8 +226,8 @@ impl VoxelSight {
         self.voxel_m
     }
 
-    /// Bytes of [`VoxelSight::words`] without the closed voxels' triangle lists: the header,
-    /// the open bits and the bricks' clearance.
+    /// Bytes of [`VoxelSight::words`] without the closed voxels' triangle lists and planes: the
+    /// header, the open bits and the bricks' clearance.
     pub fn bytes_without_triangles(&self) -> u64 {
         ((SIGHT_HEADER_WORDS + self.words.len() + self.clear.len().div_ceil(4)) * 4) as u64
     }
@@ -203,7 +264,25 @@ impl VoxelSight {
     /// Where the walk from or to surface point `p` (normal `n`) starts, in voxel coordinates
     /// (the grid's minimum corner at 0, a voxel 1 wide); `None` with no open voxel near.
     pub fn end(&self, p: Vec3, n: Vec3) -> Option<Vec3> {
+        self.end_with(p, n, false)
+    }
+
+    /// [`VoxelSight::end`]; with `planes`, first [`END_PLANES_OFFSET_VOXELS`] off the surface
+    /// where that point lies in an open voxel or in a closed one whose planes are farther than
+    /// their fit from it.
+    pub fn end_with(&self, p: Vec3, n: Vec3, planes: bool) -> Option<Vec3> {
         let q = self.to_voxels(p);
+        if planes {
+            let s = q + n * END_PLANES_OFFSET_VOXELS;
+            let v = s.floor().as_ivec3();
+            let clear = || {
+                self.planes_of(v)
+                    .is_some_and(|c| sight_planes::clear_of(c, v, s))
+            };
+            if self.open(v) || clear() {
+                return Some(s);
+            }
+        }
         for k in END_OFFSETS_VOXELS {
             let s = q + n * k;
             if self.open(s.floor().as_ivec3()) {
@@ -239,10 +318,10 @@ impl VoxelSight {
     }
 
     /// Whether the segment from `a` to `b` (voxel coordinates) crosses open voxels alone — the
-    /// brick march described in the module docs — or, with `lists`, also closed voxels where
-    /// it hits none of the triangles listed there, within [`TRIANGLE_TESTS_PER_WALK`] list
-    /// entries ([`super::sight_triangles`]).
-    pub fn clear(&self, a: Vec3, b: Vec3, lists: bool) -> bool {
+    /// brick march described in the module docs — or also closed voxels where it meets
+    /// neither of their planes ([`Closed::Planes`]), or hits none of the triangles listed
+    /// there within [`TRIANGLE_TESTS_PER_WALK`] list entries ([`Closed::Triangles`]).
+    pub fn clear(&self, a: Vec3, b: Vec3, closed: Closed) -> bool {
         let mut tests = WalkTests::new(TRIANGLE_TESTS_PER_WALK);
         let d = b - a;
         let (moves, up) = (d.cmpne(Vec3::ZERO), d.cmpgt(Vec3::ZERO));
@@ -255,7 +334,7 @@ impl VoxelSight {
             let c = self.brick_clear(brick);
             let (lo, hi) = if c > 0 {
                 ((brick - (c - 1)) * BRICK, (brick + c) * BRICK - 1)
-            } else if self.open(v) || (lists && self.passes(v, (a, b), &mut tests)) {
+            } else if self.open(v) || self.passes(v, (a, b), closed, &mut tests) {
                 (v, v)
             } else {
                 return false;
@@ -288,11 +367,25 @@ impl VoxelSight {
         false
     }
 
-    /// Whether a walk passes closed voxel `v` on its triangles (never outside the grid; a voxel
-    /// with the list the walk last read whole passes unread, out of tests or not, as on the GPU).
-    fn passes(&self, v: IVec3, segment: (Vec3, Vec3), tests: &mut WalkTests) -> bool {
-        self.index(v)
-            .is_some_and(|i| self.triangles().pass(i, segment, tests))
+    /// Whether a walk passes closed voxel `v` on its planes or its triangles (never outside the
+    /// grid; a voxel with the list the walk last read whole passes unread, out of tests or
+    /// not, as on the GPU).
+    fn passes(
+        &self,
+        v: IVec3,
+        (a, b): (Vec3, Vec3),
+        closed: Closed,
+        tests: &mut WalkTests,
+    ) -> bool {
+        match closed {
+            Closed::Blocks => false,
+            Closed::Planes => self
+                .planes_of(v)
+                .is_some_and(|p| sight_planes::passes(p, v, a, b - a)),
+            Closed::Triangles => self
+                .index(v)
+                .is_some_and(|i| self.triangles().pass(i, (a, b), tests)),
+        }
     }
 
     /// The true segment's end at surface point `p` (normal `n`), in voxel coordinates.
@@ -308,15 +401,28 @@ impl VoxelSight {
         if self.end(a, na).is_none() || self.end(b, nb).is_none() {
             return true;
         }
-        self.clear(self.true_end(a, na), self.true_end(b, nb), true)
+        self.clear(
+            self.true_end(a, na),
+            self.true_end(b, nb),
+            Closed::Triangles,
+        )
     }
 
-    /// Whether light passes between surface points `a` (normal `na`) and `b` (normal `nb`),
-    /// every closed voxel blocking: the walk between their ends off the surfaces
-    /// ([`VoxelSight::end`]); unoccluded when either has no open voxel near.
-    pub fn visible_blocking(&self, a: Vec3, na: Vec3, b: Vec3, nb: Vec3) -> bool {
-        match (self.end(a, na), self.end(b, nb)) {
-            (Some(x), Some(y)) => self.clear(x, y, false),
+    /// Whether light passes between surface points `a` (normal `na`) and `b` (normal `nb`):
+    /// the walk between their ends off the surfaces ([`VoxelSight::end_with`]), each closed
+    /// voxel blocking or, with `planes`, passed where the segment meets neither of its planes;
+    /// unoccluded when either has no open voxel near.
+    pub fn visible_off_surfaces(&self, a: Vec3, na: Vec3, b: Vec3, nb: Vec3, planes: bool) -> bool {
+        match (self.end_with(a, na, planes), self.end_with(b, nb, planes)) {
+            (Some(x), Some(y)) => self.clear(
+                x,
+                y,
+                if planes {
+                    Closed::Planes
+                } else {
+                    Closed::Blocks
+                },
+            ),
             _ => true,
         }
     }
@@ -324,28 +430,35 @@ impl VoxelSight {
     /// The walk's tables packed into words for sight.wgsl: `[nx, ny, nz, bricks x, y, z, word
     /// offset of the clearances, triangle tests a walk, origin x, y, z (m, f32 bits), voxel
     /// edge (m, f32 bits), word offsets of the closed voxels' marks, lists, triangle indices
-    /// and triangles (0: no lists)]`, the open bits (32 a word), the bricks'
-    /// clearances, four bytes a word (little-endian), then the triangle lists
-    /// ([`ClosedTriangles::words`]) if they are listed ([`VoxelSight::list_triangles`]).
+    /// and triangles (0: no lists), of the planes' counts and planes (0: none)]`, the open bits
+    /// (32 a word), the bricks' clearances, four bytes a word (little-endian), then the
+    /// triangle lists ([`ClosedTriangles::words`]) if they are listed
+    /// ([`VoxelSight::list_triangles`]) and the planes ([`ClosedPlanes::words`]) if they are
+    /// fitted ([`VoxelSight::planes`]).
     pub fn words(&self) -> Vec<u32> {
-        self.words_with(true)
+        self.words_with(true, true)
     }
 
-    /// [`VoxelSight::words`], with the triangle lists only where `lists` asks for them (and
-    /// they are listed): a walk without them need not carry them.
-    pub fn words_with(&self, lists: bool) -> Vec<u32> {
+    /// [`VoxelSight::words`], with the triangle lists only where `lists` asks for them and
+    /// the planes where `planes` does (each where it is made): a walk without them need not
+    /// carry them.
+    pub fn words_with(&self, lists: bool, planes: bool) -> Vec<u32> {
         let clear_at = SIGHT_HEADER_WORDS + self.words.len();
         let lists_at = clear_at + self.clear.len().div_ceil(4);
         let none = ClosedTriangles::default();
         let listed = self.triangles.get().filter(|_| lists);
         let (lists, at) = listed.unwrap_or(&none).words(lists_at);
-        let mut w = Vec::with_capacity(lists_at + lists.len());
+        let no_planes = ClosedPlanes::default();
+        let fitted = self.planes.get().filter(|_| planes);
+        let (planes, planes_at) = fitted.unwrap_or(&no_planes).words(lists_at + lists.len());
+        let mut w = Vec::with_capacity(lists_at + lists.len() + planes.len());
         w.extend(self.dims.to_array().map(|x| x as u32));
         w.extend(self.bricks.to_array().map(|x| x as u32));
         w.extend([clear_at as u32, TRIANGLE_TESTS_PER_WALK]);
         w.extend(self.origin_m.to_array().map(f32::to_bits));
         w.push(self.voxel_m.to_bits());
         w.extend(at);
+        w.extend(planes_at);
         w.extend(&self.words);
         w.extend(self.clear.chunks(4).map(|c| {
             let mut b = [0u8; 4];
@@ -353,15 +466,16 @@ impl VoxelSight {
             u32::from_le_bytes(b)
         }));
         w.extend(lists);
+        w.extend(planes);
         w
     }
 }
 
 /// Words before the open bits in [`VoxelSight::words`].
-pub const SIGHT_HEADER_WORDS: usize = 16;
+pub const SIGHT_HEADER_WORDS: usize = 18;
 
 /// Voxel `i` of a grid of `dims` (x fastest).
-fn voxel_of(i: usize, dims: IVec3) -> IVec3 {
+pub(super) fn voxel_of(i: usize, dims: IVec3) -> IVec3 {
     let (nx, ny) = (dims.x as usize, dims.y as usize);
     IVec3::new(
         (i % nx) as i32,
@@ -526,7 +640,7 @@ mod tests {
                 }
                 pairs += 1;
                 assert_eq!(
-                    s.clear(a, b, false),
+                    s.clear(a, b, Closed::Blocks),
                     dda_clear(&s, a, b),
                     "level {level}: {a} → {b}"
                 );
@@ -611,20 +725,33 @@ mod tests {
         let s = bare.clone().with_triangles(&wall);
         let (a, b) = (Vec3::new(8.5, 6.5, 5.0), Vec3::new(11.5, 5.4, 5.0));
         // The walk that blocks at every closed voxel never lists the triangles.
-        assert!(!s.clear(a, b, false));
-        s.visible_blocking(a, Vec3::X, b, -Vec3::X);
-        assert!(!s.triangles_listed());
+        assert!(!s.clear(a, b, Closed::Blocks));
+        s.visible_off_surfaces(a, Vec3::X, b, -Vec3::X, false);
+        assert!(!s.triangles_listed() && !s.planes_fitted());
         // Every closed voxel touched by the same one or two triangles: a few shared lists.
         let lists = s.triangles();
         assert!(lists.voxels() >= 60 && lists.lists() <= 3 && lists.references() <= 4);
         assert!(!bare.open(IVec3::new(10, 5, 5)));
-        assert!(!bare.clear(a, b, true), "no lists: closed voxels block");
-        assert!(!s.clear(a, b, false), "lists not read: closed voxels block");
-        assert!(s.clear(a, b, true));
+        assert!(
+            !bare.clear(a, b, Closed::Triangles),
+            "no lists: closed voxels block"
+        );
+        assert!(!bare.clear(a, b, Closed::Planes), "no triangles: no planes");
+        assert!(
+            !s.clear(a, b, Closed::Blocks),
+            "lists not read: closed voxels block"
+        );
+        assert!(s.clear(a, b, Closed::Triangles));
         assert!(s.visible(a, Vec3::X, b, -Vec3::X));
+        // The planes hold the wall's plane, not its top edge: the voxels above 5.2 block a
+        // segment that crosses the plane there, and pass one beside the wall.
+        assert!(!s.clear(a, b, Closed::Planes));
+        assert!(s.planes_fitted() && s.planes().counts() == [60, 0]);
+        let (e, f) = (Vec3::new(10.3, 2.5, 1.5), Vec3::new(10.3, 2.5, 8.5));
+        assert!(!s.clear(e, f, Closed::Blocks) && s.clear(e, f, Closed::Planes));
         // Through the wall.
         let (c, d) = (Vec3::new(8.5, 3.5, 5.0), Vec3::new(11.5, 3.5, 5.0));
-        assert!(!s.clear(c, d, true));
+        assert!(!s.clear(c, d, Closed::Triangles) && !s.clear(c, d, Closed::Planes));
         // From a point on the wall, whose walk starts in the wall's closed voxels: its own side
         // sees the room and not past the wall, the other side the reverse.
         let on = Vec3::new(10.1, 2.0, 5.0);
@@ -633,12 +760,16 @@ mod tests {
         assert!(!s.visible(on, -Vec3::X, beyond, -Vec3::X));
         assert!(s.visible(on, Vec3::X, beyond, -Vec3::X));
         assert!(!s.visible(on, Vec3::X, room, Vec3::X));
-        // The packed words carry the lists after the clearances.
+        // The packed words carry the lists after the clearances, then the planes: a count per
+        // block of 256 voxels, a word per closed voxel (each of these one plane).
         let w = s.words();
         assert_eq!(w[7], TRIANGLE_TESTS_PER_WALK);
         assert_eq!(w[12] as usize, w[6] as usize + bare.clear.len().div_ceil(4));
-        assert_eq!(w[15] as usize + TRIANGLE_WORDS * wall.len(), w.len());
-        assert_eq!(&bare.words()[12..16], &[0; 4]);
+        assert_eq!(w[16] as usize, w[15] as usize + TRIANGLE_WORDS * wall.len());
+        assert_eq!(w[17] as usize, w[16] as usize + 2000usize.div_ceil(256));
+        assert_eq!(w[17] as usize + 60, w.len());
+        assert_eq!(s.words_with(true, false).len(), w[16] as usize);
+        assert_eq!(&bare.words()[12..18], &[0; 6]);
     }
 
     #[test]

@@ -199,6 +199,32 @@ impl ClosedTriangles {
         Some((id, &self.refs[first..first + len]))
     }
 
+    /// The id of voxel `i`'s list (voxels with the same triangles share it); none without a
+    /// list or with one too long to pack.
+    pub fn list_id(&self, i: usize) -> Option<u32> {
+        let (id, list) = self.list(i)?;
+        (list.len() <= LIST_MAX).then_some(id)
+    }
+
+    /// The lists' ids, once each.
+    pub fn list_ids(&self) -> Vec<u32> {
+        let mut ids = self.ids.clone();
+        ids.par_sort_unstable();
+        ids.dedup();
+        ids
+    }
+
+    /// The corners (voxel coordinates) of the triangles of list `id`
+    /// ([`ClosedTriangles::list_id`]).
+    pub fn corners_in(&self, id: u32) -> Vec<[Vec3; 3]> {
+        let first = (id >> (32 - LIST_START_BITS)) as usize;
+        let len = (id & LIST_LENGTH_MASK) as usize + 1;
+        self.refs[first..first + len]
+            .iter()
+            .map(|&t| self.corners[t as usize])
+            .collect()
+    }
+
     /// Whether a walk passes closed voxel `i`: it holds triangles, and segment `a`–`b` (voxel
     /// coordinates) hits none of them, within the walk's `tests` (spent here; a walk out of
     /// tests is blocked).
@@ -302,25 +328,45 @@ pub fn hits(c: [Vec3; 3], a: Vec3, b: Vec3) -> bool {
     u >= 0.0 && w >= 0.0 && u + w <= 1.0 && h > 1e-4 && h < 1.0 - 1e-4
 }
 
-/// Why the open voxels' grid of `bytes` (with the closed voxels' triangle lists where
-/// `without_lists` gives its size without them) does not fit a storage binding of `limit`
-/// bytes, and what fits it: the sight grid's voxel (`voxel_m`) is the level's own, not its
-/// resolution's (Crytek Sponza's is 4 cm baked at 128 or at 512), and the lists are the
-/// walk's `--closed-voxel-triangles`.
-pub fn sight_too_large(bytes: u64, without_lists: Option<u64>, voxel_m: f32, limit: u64) -> String {
-    // The bits shrink with the cube of the voxel and the lists (a list a closed voxel, which
-    // lie on the surfaces) with its square at least; a hair coarser than that, as a hint.
-    let (what, power) = match without_lists {
-        Some(_) => (
+/// What the open voxels' grid carries beyond its bits, for [`sight_too_large`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SightExtra {
+    /// The closed voxels' triangle lists (`--closed-voxel-triangles`).
+    Lists,
+    /// The closed voxels' planes (the default walk; `--no-closed-voxel-planes` walks without).
+    Planes,
+}
+
+/// Why the open voxels' grid of `bytes` (with the closed voxels' triangle lists or planes where
+/// `without` names them and gives the grid's size without them) does not fit a storage binding
+/// of `limit` bytes, and what fits it: the sight grid's voxel (`voxel_m`) is the level's own,
+/// not its resolution's (Crytek Sponza's is 4 cm baked at 128 or at 512), and the lists and
+/// planes are the walk's.
+pub fn sight_too_large(
+    bytes: u64,
+    without: Option<(SightExtra, u64)>,
+    voxel_m: f32,
+    limit: u64,
+) -> String {
+    // The bits shrink with the cube of the voxel and the lists and planes (one a closed voxel,
+    // which lie on the surfaces) with its square at least; a hair coarser than that, as a hint.
+    let (what, power) = match without {
+        Some((SightExtra::Lists, _)) => (
             "the open voxels' grid with the closed voxels' triangles (--closed-voxel-triangles)",
             0.5,
         ),
+        Some((SightExtra::Planes, _)) => {
+            ("the open voxels' grid with the closed voxels' planes", 0.5)
+        }
         None => ("the open voxels' grid", 1.0 / 3.0),
     };
     let fits = voxel_m * (bytes as f32 / limit as f32).powf(power) * 1.05;
-    let without = match without_lists {
-        Some(plain) if plain <= limit => {
+    let without = match without {
+        Some((SightExtra::Lists, plain)) if plain <= limit => {
             format!("walk without --closed-voxel-triangles ({plain} bytes), or ")
+        }
+        Some((SightExtra::Planes, plain)) if plain <= limit => {
+            format!("walk with --no-closed-voxel-planes ({plain} bytes), or ")
         }
         _ => String::new(),
     };
@@ -411,7 +457,12 @@ mod tests {
     fn a_sight_grid_too_large_for_the_binding_says_what_fits_it() {
         let limit = 128 << 20;
         // Crytek Sponza's on lavapipe: 153 MB with the lists, 52 MB without.
-        let m = super::sight_too_large(153_176_188, Some(52_000_000), 0.04, limit);
+        let m = super::sight_too_large(
+            153_176_188,
+            Some((SightExtra::Lists, 52_000_000)),
+            0.04,
+            limit,
+        );
         assert!(
             m.contains("walk without --closed-voxel-triangles (52000000 bytes)"),
             "{m}"
@@ -422,9 +473,25 @@ mod tests {
         );
         assert!(!m.contains("resolution"), "{m}");
         // Too large even without the lists: only the coarser voxel is offered.
-        let m = super::sight_too_large(300 << 20, Some(200 << 20), 0.01, limit);
+        let m =
+            super::sight_too_large(300 << 20, Some((SightExtra::Lists, 200 << 20)), 0.01, limit);
         assert!(!m.contains("walk without"), "{m}");
         assert!(m.contains("about 0.0161 m fits"), "{m}");
+        // The planes: walk without them.
+        let m = super::sight_too_large(
+            140_000_000,
+            Some((SightExtra::Planes, 60_000_000)),
+            0.04,
+            limit,
+        );
+        assert!(
+            m.starts_with("the open voxels' grid with the closed voxels' planes"),
+            "{m}"
+        );
+        assert!(
+            m.contains("walk with --no-closed-voxel-planes (60000000 bytes)"),
+            "{m}"
+        );
         let m = super::sight_too_large(256 << 20, None, 0.02, limit);
         assert!(m.starts_with("the open voxels' grid needs"), "{m}");
         assert!(m.contains("about 0.0265 m fits"), "{m}");

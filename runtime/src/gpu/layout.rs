@@ -167,10 +167,11 @@ gpu_struct! {
         /// Portals a walk may pass before it is given up.
         pub max_walk: u32,
         /// The voxel walk: 1 along the true segment with the closed voxels' triangles, 0
-        /// between ends off the surfaces, every closed voxel blocking.
+        /// between ends off the surfaces.
         pub triangles: u32,
-        /// Padding.
-        pub _pad0: u32,
+        /// The voxel walk between ends off the surfaces: 1 passing a closed voxel where the
+        /// segment meets neither of its planes, 0 blocking at every closed voxel.
+        pub planes: u32,
         /// Padding.
         pub _pad1: u32,
         /// Padding.

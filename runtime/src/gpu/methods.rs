@@ -238,6 +238,7 @@ impl GpuMode {
             GateShape::Portal => format!("portals, walk ≤ {}", g.max_walk),
             GateShape::Disk => format!("disks ×{}, {} hop(s)", g.oversize, g.max_hops),
             GateShape::Voxels if g.triangles => "voxel walk + triangles".to_string(),
+            GateShape::Voxels if !g.planes => "voxel walk, closed voxels block".to_string(),
             GateShape::Voxels => "voxel walk".to_string(),
         };
         // The VAL clustering's settings where they are not the paper's (Dong et al.'s).

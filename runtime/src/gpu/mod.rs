@@ -320,11 +320,16 @@ impl GpuRenderer {
     }
 
     /// Uploads a baked level's gate tables for the gate modes; the voxel→cluster grid keeps
-    /// the smallest integer type that holds the level's clusters. The closed voxels' triangle
-    /// lists go up only if they are listed ([`GateLevel::list_triangles`]), which the voxel
-    /// walk with the triangles needs.
+    /// the smallest integer type that holds the level's clusters. The closed voxels' planes,
+    /// which the default voxel walk reads, are fitted now if they were not
+    /// ([`GateLevel::fit_planes`]); their triangle lists go up if they are listed
+    /// ([`GateLevel::list_triangles`]), which the voxel walk with the triangles needs — where
+    /// they overflow the adapter's storage binding, the planes alone, or neither (a mode that
+    /// needs them then says so: [`GpuRenderer::level_for_mode`]).
     pub fn set_level(&mut self, ctx: &GpuContext, level: &GateLevel) -> Result<(), RenderError> {
-        self.scene.level = Some(LevelBuffers::upload(ctx, level, true)?);
+        level.fit_planes();
+        let tries = [[true; 2], [false, true], [false; 2]];
+        self.scene.level = Some(upload_level(ctx, level, &tries)?);
         Ok(())
     }
 
@@ -334,25 +339,42 @@ impl GpuRenderer {
         self.scene.level.as_ref().is_some_and(|l| l.triangles)
     }
 
-    /// Makes the uploaded level serve `mode`: uploads `level` if none is up, and again with its
-    /// triangle lists (listed now) when `mode` walks with them and they are not up yet — the
-    /// first frame of that mode pays for them, a level never walked with them does not. A mode
-    /// without them uploads none, even where another render listed them: on an adapter whose
-    /// storage binding they overflow (lavapipe's 128 MiB and Crytek Sponza's 4 cm grid), only
-    /// the mode that walks them fails.
+    /// Whether the uploaded level carries the closed voxels' planes (the default voxel walk
+    /// needs them; [`GpuRenderer::set_level`]).
+    pub fn level_has_planes(&self) -> bool {
+        self.scene.level.as_ref().is_some_and(|l| l.planes)
+    }
+
+    /// Makes the uploaded level serve `mode`: uploads `level` if none is up, and again with the
+    /// closed voxels' triangle lists (listed now) when `mode` walks with them and they are not
+    /// up yet, or with their planes (fitted now) likewise — the first frame of that mode pays
+    /// for them, a level never walked with them does not. An upload keeps what was up with
+    /// what `mode` needs where both fit the adapter's storage binding, else it takes what
+    /// `mode` needs alone: on an adapter whose binding the lists overflow (lavapipe's 128 MiB
+    /// and Crytek Sponza's 4 cm grid), only the mode that walks them fails.
     pub fn level_for_mode(
         &mut self,
         ctx: &GpuContext,
         level: &GateLevel,
         mode: &GpuMode,
     ) -> Result<(), RenderError> {
-        let lists = mode.gates().is_some_and(|g| g.triangles);
-        if lists && !self.level_has_triangles() {
-            level.list_triangles();
-        } else if self.scene.level.is_some() {
+        let voxels = mode.gates().filter(|g| g.shape == GateShape::Voxels);
+        let need = [
+            voxels.is_some_and(|g| g.triangles),
+            voxels.is_some_and(|g| g.planes && !g.triangles),
+        ];
+        let has = [self.level_has_triangles(), self.level_has_planes()];
+        if self.scene.level.is_some() && (0..2).all(|k| !need[k] || has[k]) {
             return Ok(());
         }
-        self.scene.level = Some(LevelBuffers::upload(ctx, level, lists)?);
+        if need[0] {
+            level.list_triangles();
+        }
+        if need[1] {
+            level.fit_planes();
+        }
+        let want = [need[0] || has[0], need[1] || has[1]];
+        self.scene.level = Some(upload_level(ctx, level, &[want, need])?);
         Ok(())
     }
 
@@ -466,7 +488,7 @@ impl GpuRenderer {
             shape: gates.shape.shader_id(),
             max_walk: gates.max_walk,
             triangles: u32::from(gates.triangles),
-            _pad0: 0,
+            planes: u32::from(gates.planes),
             _pad1: 0,
             _pad2: 0,
         };
@@ -614,6 +636,19 @@ impl GpuRenderer {
                     .into(),
             ));
         }
+        if let (Some(g), Some(l)) = (params.mode.gates(), &self.scene.level)
+            && g.shape == GateShape::Voxels
+            && g.planes
+            && !g.triangles
+            && !l.planes
+        {
+            return Err(RenderError::Param(
+                "the voxel walk with the closed voxels' planes needs them on the GPU: \
+                 GpuRenderer::level_for_mode uploads them (and says where they overflow the \
+                 adapter's storage binding; --no-closed-voxel-planes walks without them)"
+                    .into(),
+            ));
+        }
         let vals = params.mode.vals();
         let val_count = vals.map(|v| v.count);
         let warm = vals.is_some_and(|p| p.warm_start && self.val_warm == Some(p.count));
@@ -705,4 +740,21 @@ impl GpuRenderer {
         times.frame_s = t0.elapsed().as_secs_f64();
         Ok((img, times))
     }
+}
+
+/// Uploads `level` with the first of `tries` (closed voxels' triangle lists and planes,
+/// `[lists, planes]`) that fits the adapter's bindings; the last one's error where none does.
+fn upload_level(
+    ctx: &GpuContext,
+    level: &GateLevel,
+    tries: &[[bool; 2]],
+) -> Result<LevelBuffers, RenderError> {
+    let mut result = Err(RenderError::Param("no upload tried".into()));
+    for &[lists, planes] in tries {
+        result = LevelBuffers::upload(ctx, level, lists, planes);
+        if result.is_ok() {
+            break;
+        }
+    }
+    result
 }

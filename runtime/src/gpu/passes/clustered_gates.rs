@@ -216,6 +216,8 @@ pub struct LevelBuffers {
     pub sight_steps: u32,
     /// Whether `sight_words` holds the closed voxels' triangle lists.
     pub triangles: bool,
+    /// Whether `sight_words` holds the closed voxels' planes.
+    pub planes: bool,
 }
 
 impl LevelBuffers {
@@ -227,15 +229,17 @@ impl LevelBuffers {
     }
 
     /// Uploads `level`'s tables, with the closed voxels' triangle lists where `lists` asks for
-    /// them and they are listed; the voxel grid keeps the smallest integer type that holds the
-    /// level's clusters.
+    /// them and they are listed, and their planes where `planes` asks for them and they are
+    /// fitted; the voxel grid keeps the smallest integer type that holds the level's clusters.
     pub fn upload(
         ctx: &GpuContext,
         level: &GateLevel,
         lists: bool,
+        planes: bool,
     ) -> Result<LevelBuffers, RenderError> {
         let lists = lists && level.sight().triangles_listed();
-        let t = level.tables(lists);
+        let planes = planes && level.sight().planes_fitted();
+        let t = level.tables(lists, planes);
         let d = &ctx.device;
         if t.gates.len() > MAX_GATES || level.cluster_count() > MAX_CLUSTERS {
             return Err(RenderError::Param(format!(
@@ -257,15 +261,20 @@ impl LevelBuffers {
             )));
         }
         if bytes(&t.sight_words) > limit {
+            use crate::cpu::sight_triangles::{SightExtra, sight_too_large};
             let s = level.sight();
-            return Err(RenderError::Param(
-                crate::cpu::sight_triangles::sight_too_large(
-                    bytes(&t.sight_words),
-                    lists.then(|| s.bytes_without_triangles()),
-                    s.voxel_m(),
-                    limit,
-                ),
-            ));
+            let extra = match (lists, planes) {
+                (true, _) => Some(SightExtra::Lists),
+                (false, true) => Some(SightExtra::Planes),
+                (false, false) => None,
+            };
+            let plain = s.bytes_without_triangles();
+            return Err(RenderError::Param(sight_too_large(
+                bytes(&t.sight_words),
+                extra.map(|x| (x, plain)),
+                s.voxel_m(),
+                limit,
+            )));
         }
         let storage = wgpu::BufferUsages::STORAGE;
         Ok(LevelBuffers {
@@ -293,6 +302,7 @@ impl LevelBuffers {
             ),
             sight_steps: t.sight_steps,
             triangles: lists,
+            planes,
         })
     }
 }

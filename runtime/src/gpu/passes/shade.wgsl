@@ -117,6 +117,12 @@ fn sight_triangles() -> bool {
     return grid.triangles != 0u;
 }
 
+// The voxel walk between ends off the surfaces passes closed voxels on their planes (the frame's
+// grid.planes; the renderer uploads them for it).
+fn sight_planes() -> bool {
+    return grid.planes != 0u && !sight_triangles();
+}
+
 fn gate_shape() -> u32 {
     if GATE_SHAPE != GATE_SHAPE_AT_RUNTIME {
         return GATE_SHAPE;
@@ -128,7 +134,7 @@ fn gate_shape() -> u32 {
 // the voxels (GateLevel::visible; the voxel walk starts off p's face).
 fn lit_through(v: Vpl, px: vec2<i32>, p: vec3<f32>, here: u32) -> bool {
     if gate_shape() == GATE_VOXELS {
-        return voxel_sight(v.position, v.normal, p, face_normal(px), sight_triangles());
+        return voxel_sight(v.position, v.normal, p, face_normal(px), sight_triangles(), sight_planes());
     }
     return through_gates(v.position, cluster_at(v.position, v.normal), p, here);
 }
@@ -333,7 +339,7 @@ fn walk_end_at(px: vec2<i32>, p: vec3<f32>) -> vec4<f32> {
     var at_p = vec4<f32>(0.0);
     if gate_shape() == GATE_VOXELS {
         let n_face = face_normal(px);
-        at_p = sight_end(p, n_face);
+        at_p = sight_end(p, n_face, sight_planes());
         if sight_triangles() {
             at_p = vec4<f32>(sight_true_end(p, n_face), at_p.w);
         }
@@ -348,6 +354,7 @@ fn walk_end_at(px: vec2<i32>, p: vec3<f32>) -> vec4<f32> {
 fn walk_range(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, at_p: vec4<f32>, first: u32, end: u32, step: u32, cut: f32) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
     let triangles = sight_triangles();
+    let planes = sight_planes();
     let h = roulette_hash(px);
     for (var k = first; k < end; k += step) {
         let v = vpls[k];
@@ -371,7 +378,7 @@ fn walk_range(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, at_p: vec4<f
                 && !sight_clear_lists(sight_true_end(v.position, v.normal), at_p.xyz) {
                 continue;
             }
-            if known && !triangles && !sight_clear(at_v.xyz, at_p.xyz) {
+            if known && !triangles && !sight_clear(at_v.xyz, at_p.xyz, planes) {
                 continue;
             }
         } else {

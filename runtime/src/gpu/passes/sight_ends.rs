@@ -5,25 +5,31 @@
 
 use crate::RenderError;
 use crate::gpu::Frame;
-use crate::gpu::context::{Pool, bind_group, compute_pipelines};
+use crate::gpu::context::{Pool, bind_group, compute_pipeline_with};
 use crate::gpu::shaders::{self, ShaderSources, WG_LINEAR};
 use crate::gpu::timing::Recorder;
 
-/// The pass's pipeline.
+/// The pass's pipelines: the ends without the closed voxels' planes, and with them.
 pub struct SightEnds {
-    pipeline: wgpu::ComputePipeline,
+    pipelines: [wgpu::ComputePipeline; 2],
 }
 
 impl SightEnds {
-    /// Builds the pipeline.
+    /// Builds the pipelines.
     pub fn new(d: &wgpu::Device, s: &ShaderSources) -> Result<SightEnds, RenderError> {
         let module = shaders::module(d, s, "sight_ends.wgsl")?;
-        let [pipeline] = compute_pipelines(d, &module, ["main"]);
-        Ok(SightEnds { pipeline })
+        let with = |planes: u8| {
+            let constants = [("SIGHT_END_PLANES", f64::from(planes))];
+            compute_pipeline_with(d, "vpl sight ends", &module, "main", &constants)
+        };
+        Ok(SightEnds {
+            pipelines: [with(0), with(1)],
+        })
     }
 
-    /// Records the pass over the frame's VPLs and `sight_words` (the level's open voxels):
-    /// the buffer of their ends, a `vec4<f32>` each (kept in `pool`).
+    /// Records the pass over the frame's VPLs and `sight_words` (the level's open voxels), the
+    /// ends off the closed voxels' planes where the frame's walk passes them (which the words
+    /// then carry): the buffer of their ends, a `vec4<f32>` each (kept in `pool`).
     pub fn record(
         &self,
         f: &Frame,
@@ -40,11 +46,17 @@ impl SightEnds {
                 f.vpl_count
             )));
         }
+        let planes = f
+            .params
+            .mode
+            .gates()
+            .is_some_and(|g| g.planes && !g.triangles);
+        let pipeline = &self.pipelines[usize::from(planes)];
         let usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
         let ends = pool.buffer(d, "vpl sight ends", u64::from(f.vpl_count) * 16, usage);
         let bg = bind_group(
             d,
-            &self.pipeline.get_bind_group_layout(0),
+            &pipeline.get_bind_group_layout(0),
             "vpl sight ends",
             vec![
                 (0, f.vpls.as_entire_binding()),
@@ -58,7 +70,7 @@ impl SightEnds {
                 label: Some("vpl sight ends"),
                 timestamp_writes: span.compute(),
             });
-            pass.set_pipeline(&self.pipeline);
+            pass.set_pipeline(pipeline);
             pass.set_bind_group(0, &bg, &[]);
             if groups > 0 {
                 pass.dispatch_workgroups(groups, 1, 1);

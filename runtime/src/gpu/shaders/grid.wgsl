@@ -20,9 +20,11 @@ struct Grid {
     // Portals a walk may pass before it is given up.
     max_walk: u32,
     // The voxel walk: 1 along the true segment with the closed voxels' triangles, 0 between
-    // ends off the surfaces, every closed voxel blocking.
+    // ends off the surfaces.
     triangles: u32,
-    pad0: u32,
+    // The walk between ends off the surfaces: 1 passing a closed voxel where the segment meets
+    // neither of its planes (runtime::cpu::sight_planes), 0 blocking at every closed voxel.
+    planes: u32,
     pad1: u32,
     pad2: u32,
 };

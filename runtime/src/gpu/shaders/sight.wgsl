@@ -2,12 +2,15 @@
 // a VPL and a surface point crosses open voxels alone. It reads the including pass's
 // `sight_words: array<u32>` (VoxelSight::words: [nx, ny, nz, bricks x, y, z, offset of the
 // clearances, triangle tests a walk, origin xyz (m), voxel edge (m), offsets of the closed
-// voxels' marks, list offsets, triangle indices and corners (0: no lists)], the open bits 32 a
-// word, each brick's chessboard distance in bricks to the nearest brick holding a closed voxel,
-// a byte each, then the triangle lists (runtime::cpu::sight_triangles::ClosedTriangles). A
-// step crosses the cube of bricks that a brick's clearance proves open, one open voxel, or a
-// closed voxel where the segment hits no listed triangle. The segment runs between the surface
-// points themselves, each a hair off its surface (runtime::cpu::sight_triangles).
+// voxels' marks, list offsets, triangle indices and corners (0: no lists), of the planes'
+// counts and planes (0: none)], the open bits 32 a word, each brick's chessboard distance in
+// bricks to the nearest brick holding a closed voxel, a byte each, then the triangle lists
+// (runtime::cpu::sight_triangles::ClosedTriangles) and the planes
+// (runtime::cpu::sight_planes::ClosedPlanes). A step crosses the cube of bricks that a brick's
+// clearance proves open, one open voxel, or a closed voxel whose planes the segment meets
+// neither of, or (with the lists) where it hits no listed triangle; with the lists the segment
+// runs between the surface points themselves, each a hair off its surface
+// (runtime::cpu::sight_triangles).
 
 // SIGHT_BRICK (voxels along a brick's side) and SIGHT_BITS (VoxelSight's header words) are
 // injected from runtime::cpu::sight.
@@ -96,10 +99,131 @@ fn sight_list(i: u32) -> vec3<u32> {
     return vec3<u32>(id, id >> 8u, (id >> 8u) + len);
 }
 
+// The closed voxels' planes (runtime::cpu::sight_planes::ClosedPlanes), where the words carry
+// them: header words 16 and 17 hold the offsets of the closed voxels counted before each block
+// of 256 voxels and of the planes: a word per closed voxel in voxel order (kind 0: it blocks;
+// 1: a plane; 2: the place of its two plane words, from word 17's offset), then the pairs.
+fn sight_has_planes() -> bool {
+    return sight_words[17] != 0u;
+}
+
+// The plane words of closed voxel i (its index in the grid; kind 0 in the second: one plane),
+// found by its rank among the closed voxels: its block's count and the open bits' words before
+// it in the block.
+fn sight_plane_words(i: u32) -> vec2<u32> {
+    let block = i / 256u;
+    var rank = sight_words[sight_words[16] + block];
+    for (var w = block * 8u; w < i / 32u; w++) {
+        rank += countOneBits(~sight_words[SIGHT_BITS + w]);
+    }
+    rank += countOneBits(~sight_words[SIGHT_BITS + i / 32u] & ((1u << (i % 32u)) - 1u));
+    let planes_at = sight_words[17];
+    let own = sight_words[planes_at + rank];
+    if (own & 3u) == 2u {
+        let at = planes_at + (own >> 2u);
+        return vec2<u32>(sight_words[at], sight_words[at + 1u]);
+    }
+    return vec2<u32>(own, 0u);
+}
+
+// Plane word w decoded (sight_planes::decode): the unit normal (octahedral, 8 + 8 bits) and
+// the offset from the voxel's centre (14 bits in ±1 voxel); its kind is w's low two bits.
+fn sight_plane(w: u32) -> vec4<f32> {
+    let f = vec3<f32>(vec3<u32>((w >> 2u) & 0xffu, (w >> 10u) & 0xffu, w >> 18u))
+        / vec3<f32>(255.0, 255.0, 16383.0) * 2.0 - 1.0;
+    let z = 1.0 - abs(f.x) - abs(f.y);
+    let t = max(-z, 0.0);
+    let n = normalize(vec3<f32>(f.x - t * sign(f.x), f.y - t * sign(f.y), z));
+    return vec4<f32>(n, f.z);
+}
+
+// How near a segment may come to a plane before it meets it (sight_planes::PLANE_FIT + 1e-3).
+const SIGHT_PLANE_TOL: f32 = 0.051;
+
+// Whether segment a + t d, t in [0, 1], passes closed voxel v (index i) on its planes: inside
+// the voxel it comes within the fit of neither plane's patch (sight_planes::passes).
+fn sight_planes_pass(i: u32, v: vec3<i32>, a: vec3<f32>, d: vec3<f32>) -> bool {
+    let words = sight_plane_words(i);
+    if (words.x & 3u) == 0u {
+        return false;
+    }
+    let c = vec3<f32>(v) + 0.5;
+    let moves = d != vec3<f32>(0.0);
+    let inv = select(vec3<f32>(0.0), 1.0 / select(vec3<f32>(1.0), d, moves), moves);
+    let t0 = (c - 0.5 - a) * inv;
+    let t1 = (c + 0.5 - a) * inv;
+    let tn = select(vec3<f32>(-3.4e38), min(t0, t1), moves);
+    let tf = select(vec3<f32>(3.4e38), max(t0, t1), moves);
+    let lo = max(max(tn.x, max(tn.y, tn.z)), 0.0);
+    let hi = min(min(tf.x, min(tf.y, tf.z)), 1.0);
+    let p0 = a + d * lo - c;
+    let p1 = a + d * max(hi, lo) - c;
+    return sight_plane_passed(words.x, words.y, p0, p1)
+        && ((words.y & 3u) == 0u || sight_plane_passed(words.y, words.x, p0, p1));
+}
+
+// Whether segment p0 → p1 (relative to the voxel's centre) stays clear of the patch of plane
+// word w, whose voxel's other plane word is o (kind 0: none).
+fn sight_plane_passed(w: u32, o: u32, p0: vec3<f32>, p1: vec3<f32>) -> bool {
+    let p = sight_plane(w);
+    let s0 = dot(p.xyz, p0) - p.w;
+    let s1 = dot(p.xyz, p1) - p.w;
+    if (s0 > SIGHT_PLANE_TOL && s1 > SIGHT_PLANE_TOL)
+        || (s0 < -SIGHT_PLANE_TOL && s1 < -SIGHT_PLANE_TOL) {
+        return true;
+    }
+    let kind = w & 3u;
+    if kind < 2u || (o & 3u) == 0u {
+        return false;
+    }
+    // The part of the segment within the fit of the plane, and whether it reaches the patch's
+    // side of the other plane there.
+    var ta = 0.0;
+    var tb = 1.0;
+    if abs(s0 - s1) >= 1e-6 {
+        let x = (s0 - SIGHT_PLANE_TOL) / (s0 - s1);
+        let y = (s0 + SIGHT_PLANE_TOL) / (s0 - s1);
+        ta = clamp(min(x, y), 0.0, 1.0);
+        tb = clamp(max(x, y), 0.0, 1.0);
+    }
+    let side = select(-1.0, 1.0, kind == 2u);
+    let q = sight_plane(o);
+    let oa = dot(q.xyz, p0 + (p1 - p0) * ta) - q.w;
+    let ob = dot(q.xyz, p0 + (p1 - p0) * tb) - q.w;
+    return max(side * oa, side * ob) < -SIGHT_PLANE_TOL;
+}
+
+// Whether point x (voxel coordinates) in closed voxel v lies farther than the fit from both
+// its planes, where it has planes (sight_planes::clear_of).
+fn sight_clear_of_planes(v: vec3<i32>, x: vec3<f32>) -> bool {
+    let dims = sight_dims();
+    if any(v < vec3<i32>(0)) || any(v >= dims) {
+        return false;
+    }
+    let words = sight_plane_words(u32(v.x + dims.x * (v.y + dims.y * v.z)));
+    if (words.x & 3u) == 0u {
+        return false;
+    }
+    let y = x - (vec3<f32>(v) + 0.5);
+    let p = sight_plane(words.x);
+    let q = sight_plane(words.y);
+    return abs(dot(p.xyz, y) - p.w) > SIGHT_PLANE_TOL
+        && ((words.y & 3u) == 0u || abs(dot(q.xyz, y) - q.w) > SIGHT_PLANE_TOL);
+}
+
 // An open voxel's point off surface point p (normal n), in voxel coordinates; w = 0: no open
-// voxel near, where the bake knows nothing (VoxelSight::end).
-fn sight_end(p: vec3<f32>, n: vec3<f32>) -> vec4<f32> {
+// voxel near, where the bake knows nothing (VoxelSight::end). With `planes` (the words must
+// carry them), first 0.3 voxels off the surface where that point is open or clear of its
+// closed voxel's planes (VoxelSight::end_with; sight_planes::END_PLANES_OFFSET_VOXELS).
+fn sight_end(p: vec3<f32>, n: vec3<f32>, planes: bool) -> vec4<f32> {
     let q = sight_voxels(p);
+    if planes {
+        let s = q + n * 0.3;
+        let v = vec3<i32>(floor(s));
+        if sight_open(v) || sight_clear_of_planes(v, s) {
+            return vec4<f32>(s, 1.0);
+        }
+    }
     // END_OFFSETS_VOXELS: 1.25, 2.25, 3.25.
     for (var k = 0; k < 3; k++) {
         let s = q + n * (1.25 + f32(k));
@@ -127,10 +251,11 @@ fn sight_end(p: vec3<f32>, n: vec3<f32>) -> vec4<f32> {
     return best;
 }
 
-// Whether the segment a → b (voxel coordinates, both in open voxels) crosses open voxels alone
-// (VoxelSight::clear without the lists, step for step; sight_clear_lists is the walk with them,
-// a function of its own so that a pipeline without them runs none of their code).
-fn sight_clear(a: vec3<f32>, b: vec3<f32>) -> bool {
+// Whether the segment a → b (voxel coordinates) crosses open voxels alone, or also closed ones
+// whose planes it meets neither of with `planes` (the words must carry them; VoxelSight::clear
+// with Closed::Blocks or Closed::Planes, step for step; sight_clear_lists is the walk with the
+// triangles, a function of its own so that a pipeline without them runs none of their code).
+fn sight_clear(a: vec3<f32>, b: vec3<f32>, planes: bool) -> bool {
     let d = b - a;
     let moves = d != vec3<f32>(0.0);
     let up = d > vec3<f32>(0.0);
@@ -155,7 +280,8 @@ fn sight_clear(a: vec3<f32>, b: vec3<f32>) -> bool {
             hi = (brick + c) * SIGHT_BRICK - 1;
         } else {
             let i = u32(v.x + dims.x * (v.y + dims.y * v.z));
-            if ((sight_words[SIGHT_BITS + i / 32u] >> (i % 32u)) & 1u) == 0u {
+            if ((sight_words[SIGHT_BITS + i / 32u] >> (i % 32u)) & 1u) == 0u
+                && !(planes && sight_planes_pass(i, v, a, d)) {
                 return false;
             }
         }
@@ -278,16 +404,24 @@ fn sight_clear_lists(a: vec3<f32>, b: vec3<f32>) -> bool {
 // Whether light passes between surface points a (normal na) and b (normal nb): with
 // `triangles`, the walk along the segment between them, each end a hair off its surface,
 // through the closed voxels whose listed triangles it misses (VoxelSight::visible); else the
-// walk between their ends off the surfaces, every closed voxel blocking
-// (VoxelSight::visible_blocking). Unoccluded when either has no open voxel near.
-fn voxel_sight(a: vec3<f32>, na: vec3<f32>, b: vec3<f32>, nb: vec3<f32>, triangles: bool) -> bool {
-    let x = sight_end(a, na);
-    let y = sight_end(b, nb);
+// walk between their ends off the surfaces, every closed voxel blocking or passed on its planes
+// with `planes` (VoxelSight::visible_off_surfaces). Unoccluded when either has no open voxel
+// near.
+fn voxel_sight(
+    a: vec3<f32>,
+    na: vec3<f32>,
+    b: vec3<f32>,
+    nb: vec3<f32>,
+    triangles: bool,
+    planes: bool,
+) -> bool {
+    let x = sight_end(a, na, planes && !triangles);
+    let y = sight_end(b, nb, planes && !triangles);
     if x.w == 0.0 || y.w == 0.0 {
         return true;
     }
     if triangles {
         return sight_clear_lists(sight_true_end(a, na), sight_true_end(b, nb));
     }
-    return sight_clear(x.xyz, y.xyz);
+    return sight_clear(x.xyz, y.xyz, planes);
 }

@@ -1,0 +1,622 @@
+//! The closed voxels' planes: where a closed voxel's geometry is one or two planes, the voxel
+//! walk passes it when the segment crosses neither inside it ([`super::sight`]).
+//!
+//! A closed voxel is where geometry may be, not where it is, so the walk that blocks at every
+//! closed voxel blocks a segment that passes a door's jamb, a column's corner or a wall's face
+//! within a voxel though a shadow ray passes (the pillared hall's side room, seen through its
+//! doorway: black strips on the walls where the light through the doorway grazes the jamb).
+//! Most closed voxels hold one plane (a wall, a floor) or two (a corner, an edge), so each is
+//! stored as at most two planes, 32 bits each, fitted to the triangles that touch the voxel
+//! (its triangle list, [`super::sight_triangles`]) so that every part of them inside the voxel
+//! lies within [`PLANE_FIT`] of a plane. The walk blocks at the voxel when the segment, inside
+//! the voxel, comes within the fit of a plane's patch: of the whole plane, or, where the two
+//! planes meet at an edge inside the voxel, of the side of the other plane that the patch lies
+//! on (a jamb's face ends at the wall's face, a column's face at its neighbour). So it never
+//! passes a segment that hits a triangle inside the voxel (tested on random triangles and
+//! segments), and passes what the planes prove clear. A voxel with three planes or more (an
+//! ornament, a plant) still blocks.
+//!
+//! Each end of the walk may then start 0.3 voxels off its surface, inside its own closed voxel
+//! where that voxel's planes are farther than the fit from it ([`END_PLANES_OFFSET_VOXELS`]),
+//! rather than 1.25 voxels or more out, past the geometry within a voxel of it.
+//!
+//! On the GPU (`sight.wgsl`) the planes follow the triangle lists' place in the walk's words: a
+//! count of the closed voxels before each block of 256 voxels, then a word per closed voxel in
+//! voxel order — a plane, or where it has two the place of the pair after them — then the
+//! pairs. Crytek Sponza's 9.4 M closed voxels of 4 cm (2.2 M of them the grid's border, which
+//! blocks) hold 6.3 M single planes and 0.74 M pairs: 44 MB, beside its open voxels' 53 MB.
+
+use glam::{IVec3, Vec2, Vec3};
+use rayon::prelude::*;
+
+use super::sight::voxel_of;
+use super::sight_triangles::ClosedTriangles;
+
+/// How far a closed voxel's triangles may lie from the plane that stands for them, and how near
+/// a segment may come to a plane before it counts as meeting it. [Units: voxels]
+pub const PLANE_FIT: f32 = 0.05;
+
+/// Where a walk's end starts off its surface when its voxel's planes allow it (then at
+/// [`super::sight::END_OFFSETS_VOXELS`]): points of the view with nine tenths of their visible
+/// VPLs blocked (160 × 90, 1,024 paths), 0.1 / 0.3 / 1.25 voxels: the pillared hall's side room
+/// 12 / 8 / 14, Crytek Sponza's gallery 89 / 40 / 87 (the walk without planes 57 and 108).
+/// [Units: voxels]
+pub const END_PLANES_OFFSET_VOXELS: f32 = 0.3;
+
+/// Voxels a block of the closed-voxel count covers (eight words of the open bits).
+pub const PLANES_BLOCK: usize = 256;
+
+/// A plane word's kind (its low two bits): none (the voxel blocks, or has one plane), a whole
+/// plane, or a patch on the positive or the negative side of the voxel's other plane. A closed
+/// voxel's own word is none, whole, or `PAIR`: the place of its two plane words.
+const NONE: u32 = 0;
+const WHOLE: u32 = 1;
+const ABOVE: u32 = 2;
+const BELOW: u32 = 3;
+const PAIR: u32 = 2;
+
+/// Offsets a plane word holds, from the voxel's centre, within ±this. [Units: voxels]
+const OFFSET_RANGE: f32 = 1.0;
+
+/// The closed voxels' planes in the layout the GPU reads.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct ClosedPlanes {
+    /// Per block of [`PLANES_BLOCK`] voxels, the closed voxels before it.
+    before: Vec<u32>,
+    /// Per closed voxel, in voxel order, its word (`NONE`: it blocks; a plane; or `PAIR` and
+    /// the place in this table of its two plane words), then the pairs.
+    words: Vec<u32>,
+    /// Closed voxels.
+    closed: usize,
+}
+
+/// A plane decoded: unit normal, offset from the voxel's centre, kind.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Plane {
+    /// Unit normal.
+    pub normal: Vec3,
+    /// Offset along it from the voxel's centre. [Units: voxels]
+    pub offset: f32,
+    kind: u32,
+}
+
+impl Plane {
+    /// Signed distance of `x` (relative to the voxel's centre).
+    fn at(&self, x: Vec3) -> f32 {
+        self.normal.dot(x) - self.offset
+    }
+}
+
+impl ClosedPlanes {
+    /// Fits the planes of every closed voxel of a grid of `dims` whose open bits are `words`
+    /// (32 voxels a word) to its listed triangles; in parallel over blocks.
+    pub fn new(dims: IVec3, words: &[u32], lists: &ClosedTriangles) -> ClosedPlanes {
+        let voxels = (dims.x as usize) * (dims.y as usize) * (dims.z as usize);
+        let closed_in = |w: usize| {
+            let valid = voxels.saturating_sub(w * 32).min(32);
+            let mask = if valid == 32 {
+                u32::MAX
+            } else {
+                (1u32 << valid) - 1
+            };
+            (!words[w] & mask).count_ones()
+        };
+        let blocks = voxels.div_ceil(PLANES_BLOCK);
+        let words_per_block = PLANES_BLOCK / 32;
+        let mut before = Vec::with_capacity(blocks);
+        let mut n = 0u32;
+        for b in 0..blocks {
+            before.push(n);
+            let w = b * words_per_block;
+            n += (w..(w + words_per_block).min(words.len()))
+                .map(closed_in)
+                .sum::<u32>();
+        }
+        // Lists whose triangles lie in one plane (a wall's, a floor's: most), whose voxels then
+        // take that plane without a fit.
+        let flat: std::collections::HashMap<u32, (Vec3, f32)> = lists
+            .list_ids()
+            .into_par_iter()
+            .filter_map(|id| one_plane(&lists.corners_in(id)).map(|p| (id, p)))
+            .collect();
+        let fitted: Vec<[u32; 2]> = (0..blocks)
+            .into_par_iter()
+            .flat_map_iter(|b| {
+                let end = ((b + 1) * PLANES_BLOCK).min(voxels);
+                (b * PLANES_BLOCK..end)
+                    .filter(|&i| (words[i / 32] >> (i % 32)) & 1 == 0)
+                    .map(|i| {
+                        let v = voxel_of(i, dims);
+                        let Some(id) = lists.list_id(i) else {
+                            return [NONE; 2];
+                        };
+                        match flat.get(&id) {
+                            Some(&(n, d)) => [encode(n, d - n.dot(v.as_vec3() + 0.5), WHOLE), NONE],
+                            None => fit(v, &lists.corners_in(id)),
+                        }
+                    })
+                    .collect::<Vec<_>>()
+            })
+            .collect();
+        debug_assert_eq!(fitted.len(), n as usize);
+        let closed = fitted.len();
+        let mut words: Vec<u32> = Vec::with_capacity(closed);
+        let mut pairs = Vec::new();
+        for [p, q] in fitted {
+            if q == NONE {
+                words.push(p);
+            } else {
+                words.push(PAIR | ((closed + pairs.len()) as u32) << 2);
+                pairs.extend([p, q]);
+            }
+        }
+        words.extend(pairs);
+        ClosedPlanes {
+            before,
+            words,
+            closed,
+        }
+    }
+
+    /// Closed voxels.
+    pub fn voxels(&self) -> usize {
+        self.closed
+    }
+
+    /// Closed voxels that hold one plane, and two (the rest block).
+    pub fn counts(&self) -> [usize; 2] {
+        let own = &self.words[..self.closed];
+        let one = own.iter().filter(|&&w| w & 3 == WHOLE).count();
+        [one, own.iter().filter(|&&w| w & 3 == PAIR).count()]
+    }
+
+    /// The planes of closed voxel `i` (its index in the grid) of open bits `words`; none: it
+    /// blocks (or none are fitted).
+    pub fn of(&self, i: usize, words: &[u32]) -> Option<[Option<Plane>; 2]> {
+        let block = i / PLANES_BLOCK;
+        let first = block * PLANES_BLOCK / 32;
+        let rank = self.before.get(block)?
+            + (first..i / 32)
+                .map(|w| (!words[w]).count_ones())
+                .sum::<u32>()
+            + (!words[i / 32] & ((1u32 << (i % 32)) - 1)).count_ones();
+        let w = self.words[rank as usize];
+        match w & 3 {
+            WHOLE => Some([decode(w), None]),
+            PAIR => {
+                let at = (w >> 2) as usize;
+                Some([decode(self.words[at]), decode(self.words[at + 1])])
+            }
+            _ => None,
+        }
+    }
+
+    /// Packs the tables after `at` words: returns the words and the word offsets of the counts
+    /// and of the planes; both 0 with none.
+    pub fn words(&self, at: usize) -> (Vec<u32>, [u32; 2]) {
+        if self.before.is_empty() {
+            return (Vec::new(), [0; 2]);
+        }
+        let mut w = Vec::with_capacity(self.before.len() + self.words.len());
+        w.extend(&self.before);
+        w.extend(&self.words);
+        (w, [at as u32, (at + self.before.len()) as u32])
+    }
+}
+
+/// Whether segment `a` + t·`d`, t in [0, 1] (voxel coordinates), passes closed voxel `v` whose
+/// planes are `planes`: inside the voxel it comes within [`PLANE_FIT`] of neither plane's
+/// patch (`sight.wgsl`'s `sight_planes_pass`).
+pub fn passes(planes: [Option<Plane>; 2], v: IVec3, a: Vec3, d: Vec3) -> bool {
+    let c = v.as_vec3() + 0.5;
+    // The segment inside the voxel, relative to its centre.
+    let moves = d.cmpne(Vec3::ZERO);
+    let inv = Vec3::select(moves, d.recip(), Vec3::ZERO);
+    let (t0, t1) = ((c - 0.5 - a) * inv, (c + 0.5 - a) * inv);
+    let lo = Vec3::select(moves, t0.min(t1), Vec3::NEG_INFINITY)
+        .max_element()
+        .max(0.0);
+    let hi = Vec3::select(moves, t0.max(t1), Vec3::INFINITY)
+        .min_element()
+        .min(1.0);
+    let (p0, p1) = (a + d * lo - c, a + d * hi.max(lo) - c);
+    let tol = PLANE_FIT + 1e-3;
+    (0..2).all(|k| {
+        let Some(p) = planes[k] else { return true };
+        let (s0, s1) = (p.at(p0), p.at(p1));
+        if (s0 > tol && s1 > tol) || (s0 < -tol && s1 < -tol) {
+            return true;
+        }
+        let (Some(o), ABOVE | BELOW) = (planes[1 - k], p.kind) else {
+            return false;
+        };
+        // The part of the segment within the fit of the plane, and whether it reaches the
+        // patch's side of the other plane there.
+        let (ta, tb) = if (s0 - s1).abs() < 1e-6 {
+            (0.0, 1.0)
+        } else {
+            let (x, y) = ((s0 - tol) / (s0 - s1), (s0 + tol) / (s0 - s1));
+            (x.min(y).clamp(0.0, 1.0), x.max(y).clamp(0.0, 1.0))
+        };
+        let side = if p.kind == ABOVE { 1.0 } else { -1.0 };
+        let (x, y) = (p0 + (p1 - p0) * ta, p0 + (p1 - p0) * tb);
+        (side * o.at(x)).max(side * o.at(y)) < -tol
+    })
+}
+
+/// Whether point `x` (voxel coordinates) in closed voxel `v` lies farther than the fit from
+/// both its planes (an end may start there).
+pub fn clear_of(planes: [Option<Plane>; 2], v: IVec3, x: Vec3) -> bool {
+    let c = v.as_vec3() + 0.5;
+    planes
+        .iter()
+        .flatten()
+        .all(|p| p.at(x - c).abs() > PLANE_FIT + 1e-3)
+}
+
+/// The plane (unit normal, offset from the grid's origin; voxel coordinates) of triangles `tris`
+/// where every corner lies within a thousandth of a voxel of the first whole triangle's plane:
+/// then every voxel they touch holds that plane alone, within the fit whatever the word's
+/// rounding (half a degree of normal over the voxel's half diagonal: under 0.01 voxels).
+fn one_plane(tris: &[[Vec3; 3]]) -> Option<(Vec3, f32)> {
+    let t = tris
+        .iter()
+        .find(|t| (t[1] - t[0]).cross(t[2] - t[0]).length_squared() > 0.0)?;
+    let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize();
+    let d = n.dot(t[0]);
+    let on = |p: &Vec3| (n.dot(*p) - d).abs() < 1e-3;
+    tris.iter().all(|t| t.iter().all(on)).then_some((n, d))
+}
+
+/// The plane words of closed voxel `v` for the triangles `tris` (voxel coordinates) that touch
+/// it: `[NONE, NONE]` where they do not lie within [`PLANE_FIT`] of two planes.
+fn fit(v: IVec3, tris: &[[Vec3; 3]]) -> [u32; 2] {
+    let c = v.as_vec3() + 0.5;
+    // Per plane: the representative (normal, offset from the centre) and its patch's corners.
+    let mut found: Vec<(Vec3, f32, Vec<Vec3>)> = Vec::new();
+    for t in tris {
+        let n = (t[1] - t[0]).cross(t[2] - t[0]);
+        if n.length_squared() == 0.0 {
+            continue;
+        }
+        let patch = clip_to_box(&t.map(|p| p - c));
+        if patch.is_empty() {
+            continue;
+        }
+        let near = |(m, off, _): &&mut (Vec3, f32, Vec<Vec3>)| {
+            patch
+                .iter()
+                .all(|&x| (m.dot(x) - *off).abs() < 0.8 * PLANE_FIT)
+        };
+        match found.iter_mut().find(near) {
+            Some(f) => f.2.extend(patch),
+            None => {
+                let n = n.normalize();
+                let off = n.dot(t[0] - c);
+                found.push((n, off, patch));
+                if found.len() > 2 {
+                    return [NONE; 2];
+                }
+            }
+        }
+    }
+    if found.is_empty() {
+        return [NONE; 2];
+    }
+    let words: Vec<u32> = found.iter().map(|f| encode(f.0, f.1, WHOLE)).collect();
+    let planes: Vec<Plane> = words.iter().map(|&w| decode(w).expect("a plane")).collect();
+    // Every patch within the fit of its decoded plane, else the voxel blocks.
+    for (p, f) in planes.iter().zip(&found) {
+        if f.2.iter().any(|&x| p.at(x).abs() >= PLANE_FIT) {
+            return [NONE; 2];
+        }
+    }
+    if found.len() == 1 {
+        return [words[0], NONE];
+    }
+    let mut out = [NONE; 2];
+    for k in 0..2 {
+        let o = planes[1 - k];
+        let s: Vec<f32> = found[k].2.iter().map(|&x| o.at(x)).collect();
+        let kind = if s.iter().all(|&x| x >= -PLANE_FIT) {
+            ABOVE
+        } else if s.iter().all(|&x| x <= PLANE_FIT) {
+            BELOW
+        } else {
+            WHOLE
+        };
+        out[k] = (words[k] & !3) | kind;
+    }
+    out
+}
+
+/// A plane word: kind (2 bits), the normal octahedral (8 + 8 bits), the offset from the voxel's
+/// centre in ±[`OFFSET_RANGE`] (14 bits).
+fn encode(n: Vec3, offset: f32, kind: u32) -> u32 {
+    let o = octahedral(n);
+    let q = |x: f32, bits: u32| {
+        let m = ((1u32 << bits) - 1) as f32;
+        ((x * 0.5 + 0.5).clamp(0.0, 1.0) * m).round() as u32
+    };
+    let off = q(offset.clamp(-OFFSET_RANGE, OFFSET_RANGE) / OFFSET_RANGE, 14);
+    kind | q(o.x, 8) << 2 | q(o.y, 8) << 10 | off << 18
+}
+
+/// The plane of word `w` (`sight.wgsl`'s `sight_plane`); none for kind `NONE`.
+fn decode(w: u32) -> Option<Plane> {
+    let kind = w & 3;
+    if kind == NONE {
+        return None;
+    }
+    let f = |x: u32, bits: u32| x as f32 / ((1u32 << bits) - 1) as f32 * 2.0 - 1.0;
+    let o = Vec2::new(f((w >> 2) & 0xff, 8), f((w >> 10) & 0xff, 8));
+    Some(Plane {
+        normal: from_octahedral(o),
+        offset: f(w >> 18, 14) * OFFSET_RANGE,
+        kind,
+    })
+}
+
+/// Unit vector `n` on the octahedron, in [-1, 1]².
+fn octahedral(n: Vec3) -> Vec2 {
+    let p = Vec2::new(n.x, n.y) / (n.x.abs() + n.y.abs() + n.z.abs());
+    if n.z >= 0.0 {
+        p
+    } else {
+        (Vec2::ONE - Vec2::new(p.y.abs(), p.x.abs())) * Vec2::new(p.x.signum(), p.y.signum())
+    }
+}
+
+/// The unit vector of octahedral `o`.
+fn from_octahedral(o: Vec2) -> Vec3 {
+    let z = 1.0 - o.x.abs() - o.y.abs();
+    let t = (-z).max(0.0);
+    let x = o.x - t * o.x.signum();
+    let y = o.y - t * o.y.signum();
+    Vec3::new(x, y, z).normalize()
+}
+
+/// Triangle `t` (relative to a voxel's centre) clipped to the voxel grown by a hair
+/// (Sutherland–Hodgman).
+fn clip_to_box(t: &[Vec3; 3]) -> Vec<Vec3> {
+    let mut poly: Vec<Vec3> = t.to_vec();
+    let h = 0.5 + 1e-4;
+    for axis in 0..3 {
+        for side in [1.0f32, -1.0] {
+            let inside = |p: Vec3| side * p[axis] <= h;
+            let mut out = Vec::with_capacity(poly.len() + 1);
+            for k in 0..poly.len() {
+                let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
+                if inside(a) {
+                    out.push(a);
+                }
+                if inside(a) != inside(b) {
+                    let s = (side * h - a[axis]) / (b[axis] - a[axis]);
+                    out.push(a + (b - a) * s);
+                }
+            }
+            poly = out;
+            if poly.is_empty() {
+                return poly;
+            }
+        }
+    }
+    poly
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A small xorshift for the random cases.
+    struct Rng(u64);
+
+    impl Rng {
+        fn f(&mut self) -> f32 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            (self.0 >> 40) as f32 / (1u64 << 24) as f32
+        }
+
+        fn v(&mut self, lo: f32, hi: f32) -> Vec3 {
+            Vec3::new(self.f(), self.f(), self.f()) * (hi - lo) + lo
+        }
+    }
+
+    /// Whether segment `a`–`b` crosses triangle `t` within the closed voxel `v` (sampled finely
+    /// along the segment: a sign change of the triangle's plane between samples inside the
+    /// voxel, at a point inside the triangle).
+    fn hits_in_voxel(t: &[Vec3; 3], v: IVec3, a: Vec3, b: Vec3) -> bool {
+        let n = (t[1] - t[0]).cross(t[2] - t[0]);
+        let inside_box = |p: Vec3| p.cmpge(v.as_vec3()).all() && p.cmple(v.as_vec3() + 1.0).all();
+        let steps = 4000;
+        let s = |p: Vec3| n.dot(p - t[0]);
+        for k in 0..steps {
+            let (p, q) = (
+                a + (b - a) * (k as f32 / steps as f32),
+                a + (b - a) * ((k + 1) as f32 / steps as f32),
+            );
+            if s(p) * s(q) > 0.0 || !inside_box(p) {
+                continue;
+            }
+            let x = p + (q - p) * (s(p) / (s(p) - s(q))).clamp(0.0, 1.0);
+            let edge = |i: usize| (t[(i + 1) % 3] - t[i]).cross(x - t[i]).dot(n) >= 0.0;
+            if edge(0) && edge(1) && edge(2) {
+                return true;
+            }
+        }
+        false
+    }
+
+    fn planes_of(v: IVec3, tris: &[[Vec3; 3]]) -> Option<[Option<Plane>; 2]> {
+        let [p, q] = fit(v, tris);
+        (p != NONE).then(|| [decode(p), decode(q)])
+    }
+
+    #[test]
+    fn a_plane_word_holds_the_normal_and_offset_within_the_fit() {
+        let mut r = Rng(7);
+        for _ in 0..2000 {
+            let n = (r.v(-1.0, 1.0)).normalize_or(Vec3::Y);
+            let off = r.f() * 1.6 - 0.8;
+            let p = decode(encode(n, off, WHOLE)).expect("a plane");
+            // Over the voxel (corners within √3/2 of its centre) the planes part by less than
+            // the fit.
+            for k in 0..8 {
+                let x = Vec3::new((k & 1) as f32, ((k >> 1) & 1) as f32, (k >> 2) as f32) - 0.5;
+                assert!(
+                    (p.at(x) - (n.dot(x) - off)).abs() < 0.5 * PLANE_FIT,
+                    "{n} {off}"
+                );
+            }
+        }
+        assert_eq!(decode(encode(Vec3::Z, 0.0, WHOLE) & !3), None);
+    }
+
+    #[test]
+    fn a_door_jamb_passes_a_segment_beyond_its_edge_and_blocks_one_into_it() {
+        // Voxel (0, 0, 0); a wall's face z = 0.55 for x < 0.7 and the jamb's face x = 0.7 for
+        // z > 0.55 (the wall's material at x < 0.7, 0.55 < z): a convex corner.
+        let v = IVec3::ZERO;
+        let tris = [
+            [
+                Vec3::new(-3.0, -3.0, 0.55),
+                Vec3::new(0.7, -3.0, 0.55),
+                Vec3::new(0.7, 3.0, 0.55),
+            ],
+            [
+                Vec3::new(0.7, -3.0, 0.55),
+                Vec3::new(0.7, 3.0, 0.55),
+                Vec3::new(0.7, -3.0, 3.0),
+            ],
+        ];
+        let p = planes_of(v, &tris).expect("two planes");
+        assert!(p[0].is_some() && p[1].is_some());
+        // Below the wall's face and right of the jamb's: the corner's outside.
+        let (a, b) = (Vec3::new(1.5, 0.5, 0.4), Vec3::new(0.75, 0.5, -0.2));
+        assert!(!hits_in_voxel(&tris[0], v, a, b) && !hits_in_voxel(&tris[1], v, a, b));
+        assert!(passes(p, v, a, b - a));
+        // Through the jamb's face above the wall's.
+        let (a, b) = (Vec3::new(1.5, 0.5, 0.9), Vec3::new(0.2, 0.5, 0.8));
+        assert!(hits_in_voxel(&tris[1], v, a, b));
+        assert!(!passes(p, v, a, b - a));
+        // The whole planes (no patch sides) would block the first: the jamb's plane extends
+        // below the wall's face.
+        let whole = p.map(|q| q.map(|q| Plane { kind: WHOLE, ..q }));
+        let (a, b) = (Vec3::new(1.5, 0.5, 0.4), Vec3::new(0.5, 0.5, -0.1));
+        assert!(passes(p, v, a, b - a) && !passes(whole, v, a, b - a));
+        // Three planes: the voxel blocks.
+        let third = [
+            Vec3::new(-3.0, 0.3, -3.0),
+            Vec3::new(3.0, 0.3, -3.0),
+            Vec3::new(0.0, 0.3, 3.0),
+        ];
+        assert_eq!(planes_of(v, &[tris[0], tris[1], third]), None);
+        // A point clear of both planes may start a walk; one on a plane may not.
+        assert!(clear_of(p, v, Vec3::new(0.9, 0.5, 0.2)));
+        assert!(!clear_of(p, v, Vec3::new(0.72, 0.5, 0.9)));
+    }
+
+    #[test]
+    fn no_segment_that_hits_a_triangle_inside_the_voxel_passes_it() {
+        let mut r = Rng(0x5eed);
+        let v = IVec3::new(3, -2, 5);
+        let c = v.as_vec3() + 0.5;
+        let (mut hit, mut passed) = (0, 0);
+        for case in 0..3000 {
+            // One to three triangles through the voxel: a flat wall cut in two, a fold (a
+            // corner), or a random sheet; some slightly bent (a column's facets).
+            let kind = case % 3;
+            let n = r.v(-1.0, 1.0).normalize_or(Vec3::X);
+            let u = n.any_orthonormal_vector();
+            let w = n.cross(u);
+            let o = c + n * (r.f() - 0.5) * 0.8;
+            let bend = if case % 2 == 0 { 0.0 } else { 0.03 };
+            let mut tris = vec![
+                [o - u * 3.0 - w * 3.0, o + u * 3.0 - w * 3.0, o + w * 3.0],
+                [
+                    o + u * 3.0 - w * 3.0,
+                    o + u * 3.0 + w * 3.0 + n * bend,
+                    o + w * 3.0,
+                ],
+            ];
+            if kind == 1 {
+                // A fold along the line o + t·w at a random angle.
+                let m = (n + u * (r.f() * 4.0 - 2.0)).normalize();
+                tris = vec![
+                    [o - w * 3.0, o + w * 3.0, o - u * 3.0],
+                    [o - w * 3.0, o + w * 3.0, o + m * 3.0],
+                ];
+            } else if kind == 2 {
+                tris.push([c + r.v(-1.5, 1.5), c + r.v(-1.5, 1.5), c + r.v(-1.5, 1.5)]);
+            }
+            let Some(p) = planes_of(v, &tris) else {
+                continue;
+            };
+            for _ in 0..20 {
+                let (a, b) = (c + r.v(-1.5, 1.5), c + r.v(-1.5, 1.5));
+                let hits = tris.iter().any(|t| hits_in_voxel(t, v, a, b));
+                let through = passes(p, v, a, b - a);
+                assert!(!(hits && through), "case {case}: {tris:?} {a} {b}");
+                hit += u32::from(hits);
+                passed += u32::from(through);
+            }
+        }
+        // The cases mean something: many hit, many pass.
+        assert!(hit > 5000 && passed > 5000, "{hit} hit, {passed} passed");
+    }
+
+    #[test]
+    fn the_table_holds_a_word_per_closed_voxel_and_the_pairs_after_them() {
+        use visgate_formats::vgate::GridMeta;
+        // A 4³ grid of 1 m voxels; voxel (1, 1, 1) holds a fold (two planes), voxel (2, 1, 1)
+        // one plane, (0, 0, 0) no triangle; the rest are open.
+        let grid = GridMeta {
+            origin_m: [0.0; 3],
+            voxel_size_m: 1.0,
+            dims: [4, 4, 4],
+        };
+        let tris = [
+            [
+                Vec3::new(1.5, 1.2, 1.0),
+                Vec3::new(1.5, 1.2, 2.0),
+                Vec3::new(1.0, 1.2, 1.5),
+            ],
+            [
+                Vec3::new(1.5, 1.2, 1.0),
+                Vec3::new(1.5, 1.2, 2.0),
+                Vec3::new(1.5, 1.9, 1.5),
+            ],
+            [
+                Vec3::new(2.6, 1.1, 1.1),
+                Vec3::new(2.6, 1.9, 1.1),
+                Vec3::new(2.6, 1.5, 1.9),
+            ],
+        ];
+        let closed = [IVec3::ZERO, IVec3::new(1, 1, 1), IVec3::new(2, 1, 1)];
+        let open = |v: IVec3| !closed.contains(&v);
+        let lists = ClosedTriangles::new(&grid, open, &tris);
+        let mut words = vec![0u32; 2];
+        for i in 0..64 {
+            if open(voxel_of(i, IVec3::splat(4))) {
+                words[i / 32] |= 1 << (i % 32);
+            }
+        }
+        let planes = ClosedPlanes::new(IVec3::splat(4), &words, &lists);
+        assert_eq!(planes.voxels(), 3);
+        assert_eq!(planes.counts(), [1, 1]);
+        let index = |v: IVec3| (v.x + 4 * (v.y + 4 * v.z)) as usize;
+        assert_eq!(planes.of(0, &words), None);
+        let fold = planes.of(index(closed[1]), &words).expect("two planes");
+        assert!(fold.iter().all(Option::is_some));
+        let wall = planes.of(index(closed[2]), &words).expect("a plane");
+        assert!(wall[0].is_some_and(|p| p.normal.x.abs() > 0.99) && wall[1].is_none());
+        // A word per closed voxel, then the pair.
+        let (w, at) = planes.words(100);
+        assert_eq!(at, [100, 101]);
+        assert_eq!(w.len(), 1 + 3 + 2);
+        assert_eq!(w[1 + 1] & 3, PAIR);
+        assert_eq!((w[1 + 1] >> 2) as usize, 3);
+    }
+}
