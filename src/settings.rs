@@ -180,6 +180,12 @@ pub struct MethodArgs {
     /// against 88-99 % without), at several times the walk's cost on a software rasterizer.
     #[arg(long)]
     pub closed_voxel_triangles: bool,
+    /// --gate-shape voxels without the triangles: block at every closed voxel, with each end
+    /// 1.25 voxels or more off its surface, instead of passing a closed voxel where the segment
+    /// meets neither of the one or two planes its geometry lies in (fitted once, when a level
+    /// is loaded for the walk), with each end 0.3 voxels off its surface where they allow.
+    #[arg(long)]
+    pub no_closed_voxel_planes: bool,
     /// Portals one walk may pass before it is given up and counted as occluded (--gate-shape
     /// portal), 1..=1024.
     #[arg(long, default_value_t = 64)]
@@ -436,6 +442,7 @@ impl MethodArgs {
                     },
                     max_walk: self.max_walk,
                     triangles: self.closed_voxel_triangles,
+                    planes: !self.no_closed_voxel_planes,
                 },
                 clusters: ClusterParams {
                     tile_px: self.tile_px,

@@ -10,6 +10,11 @@ use std::path::PathBuf;
 use serde::{Deserialize, Serialize};
 use visgate_runtime::cpu::gates::GateShape;
 
+/// Serde's default for a setting that is on unless a file says otherwise.
+fn on() -> bool {
+    true
+}
+
 /// The viewer's state for one scene.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SavedView {
@@ -30,6 +35,10 @@ pub struct SavedView {
     /// The voxel walk with the closed voxels' triangles (absent in older files: off).
     #[serde(default)]
     pub closed_voxel_triangles: bool,
+    /// The voxel walk passing closed voxels on their planes (absent in older files: on, the
+    /// default).
+    #[serde(default = "on")]
+    pub closed_voxel_planes: bool,
     /// Older files: gates as disks (read, no longer written).
     #[serde(default, skip_serializing)]
     pub disks: bool,
@@ -132,6 +141,7 @@ mod tests {
             settings: [2.0, 1.5, 30.0, 8.0, 4.0, 128.0, 256.0, 32.0],
             gate_shape: (mode == "gates").then(|| SavedView::shape_name(GateShape::Disk)),
             closed_voxel_triangles: mode == "gates",
+            closed_voxel_planes: mode != "gates",
             disks: false,
             voxels: false,
             vals_layer: mode == "val-ism",
@@ -149,8 +159,12 @@ mod tests {
         json.as_object_mut()
             .expect("object")
             .remove("closed_voxel_triangles");
+        json.as_object_mut()
+            .expect("object")
+            .remove("closed_voxel_planes");
         let older: SavedView = serde_json::from_value(json).expect("an older state");
-        assert!(!older.closed_voxel_triangles);
+        assert!(!older.closed_voxel_triangles && older.closed_voxel_planes);
+        assert!(!all["a"].closed_voxel_planes && all["b"].closed_voxel_planes);
         // The roulette as the runtime reads it back; a file from before it: none (the run's).
         use visgate_runtime::gpu::WalkRoulette;
         for r in [

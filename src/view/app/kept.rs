@@ -39,6 +39,7 @@ impl ViewerApp {
             ],
             gate_shape: Some(SavedView::shape_name(g.shape)),
             closed_voxel_triangles: g.triangles,
+            closed_voxel_planes: g.planes,
             disks: false,
             voxels: false,
             vals_layer: l.vals,
@@ -61,6 +62,7 @@ impl ViewerApp {
         g.max_hops = hops as u32;
         g.shape = s.shape();
         g.triangles = s.closed_voxel_triangles;
+        g.planes = s.closed_voxel_planes;
         g.oversize = oversize;
         v.vals.count = vals as u32;
         v.vals.iterations = iterations as u32;
