@@ -10,7 +10,8 @@
 # of the frame, of its indirect pass; wall ms where the adapter's timestamps are not used).
 # LEVEL: e2m3, sponza (default both), pillared (builtin:pillared-hall, camera side-room), ajar
 # (builtin:ajar-door, camera main). Modes: none, direct-only, gates (voxel walk, the walks'
-# roulette auto), gates-rr0, gates-rr05 and gates-rr10 (the roulette off, S = 0.05 and 0.1),
+# roulette auto; closed voxels passed on their planes), gates-blocking (--no-closed-voxel-planes:
+# every closed voxel blocks), gates-rr0, gates-rr05 and gates-rr10 (the roulette off, S = 0.05 and 0.1),
 # gates-triangles, gates-portal, gates-disk, gates-i4, gates-i4-rr0 and val-hard-i4 (4 × 4
 # interleaving; rr0: every VPL walked), gates-starved48, gates-starved64 (--starved-taps 48,
 # 64), gates-filled (--blur-fill), gates-tri-starved64 (the triangles and 64 starved taps),
@@ -37,6 +38,7 @@ log="$out/log.txt" table="$out/table.md"
 args_of() { # LABEL -> render arguments
     case $1 in
     gates-triangles) echo "--mode gates --closed-voxel-triangles" ;;
+    gates-blocking) echo "--mode gates --no-closed-voxel-planes" ;;
     gates-portal) echo "--mode gates --gate-shape portal" ;;
     gates-disk) echo "--mode gates --gate-shape disk" ;;
     gates-i4) echo "--mode gates --interleave 4" ;;
