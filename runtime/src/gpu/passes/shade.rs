@@ -23,11 +23,12 @@ pub const HDR: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 pub struct Shade {
     pipeline: wgpu::ComputePipeline,
     /// The interleaved gates' indirect pass (compute), a pipeline per gate shape (shade.wgsl's
-    /// `GATE_SHAPE`, by [`crate::cpu::gates::GateShape::shader_id`]) and one for the voxel
-    /// walk with the closed voxels' triangles (`SIGHT_TRIANGLES`), each made when first used.
-    gates_indirect: [std::sync::OnceLock<wgpu::ComputePipeline>; 4],
+    /// `GATE_SHAPE`, by [`crate::cpu::gates::GateShape::shader_id`]; the voxel walk's without
+    /// the closed voxels' planes) and one each for the voxel walk with their triangles
+    /// (`SIGHT_TRIANGLES`) and with their planes (`SIGHT_PLANES`), each made when first used.
+    gates_indirect: [std::sync::OnceLock<wgpu::ComputePipeline>; 5],
     /// The starved pixels' walks (`cs_starved_walks`), likewise.
-    gates_starved: [std::sync::OnceLock<wgpu::ComputePipeline>; 4],
+    gates_starved: [std::sync::OnceLock<wgpu::ComputePipeline>; 5],
     /// The starved pixels' other passes (starved.rs).
     pub(super) starved: super::starved::StarvedPipelines,
     module: wgpu::ShaderModule,
@@ -131,9 +132,18 @@ impl Shade {
         shape: GateShape,
     ) -> &wgpu::ComputePipeline {
         let shape = shape.shader_id();
-        let triangles = f.params.mode.gates().is_some_and(|g| g.triangles)
-            && shape == GateShape::Voxels.shader_id();
-        let k = if triangles { 3 } else { shape as usize };
+        let voxels = f
+            .params
+            .mode
+            .gates()
+            .filter(|_| shape == GateShape::Voxels.shader_id());
+        let triangles = voxels.is_some_and(|g| g.triangles);
+        let planes = voxels.is_some_and(|g| g.planes && !g.triangles);
+        let k = match (triangles, planes) {
+            (true, _) => 3,
+            (false, true) => 4,
+            (false, false) => shape as usize,
+        };
         let (cache, entry) = match gather {
             GatesGather::Indirect => (&self.gates_indirect, "cs_gates_indirect"),
             GatesGather::Starved => (&self.gates_starved, "cs_starved_walks"),
@@ -148,6 +158,7 @@ impl Shade {
                 &[
                     ("GATE_SHAPE", f64::from(shape)),
                     ("SIGHT_TRIANGLES", f64::from(u8::from(triangles))),
+                    ("SIGHT_PLANES", f64::from(u8::from(planes))),
                 ],
             )
         })

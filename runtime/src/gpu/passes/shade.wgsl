@@ -117,9 +117,17 @@ fn sight_triangles() -> bool {
     return grid.triangles != 0u;
 }
 
-// The voxel walk between ends off the surfaces passes closed voxels on their planes (the frame's
-// grid.planes; the renderer uploads them for it).
+// The voxel walk between ends off the surfaces passes closed voxels on their planes (1) or not
+// (0): fixed with the interleaved pass's pipeline, so that a walk without them runs none of
+// their code (it cost that walk 10-20 % of its pass on an H200), or SIGHT_PLANES_AT_RUNTIME:
+// the frame's grid.planes. The renderer uploads the planes for it.
+override SIGHT_PLANES: u32 = 2u;
+const SIGHT_PLANES_AT_RUNTIME: u32 = 2u;
+
 fn sight_planes() -> bool {
+    if SIGHT_PLANES != SIGHT_PLANES_AT_RUNTIME {
+        return SIGHT_PLANES == 1u && !sight_triangles();
+    }
     return grid.planes != 0u && !sight_triangles();
 }
 
