@@ -228,7 +228,7 @@ impl VoxelSight {
 
     /// Bytes of [`VoxelSight::words`] without the closed voxels' triangle lists and planes: the
     /// header, the open bits and the bricks' clearance.
-    pub fn bytes_without_triangles(&self) -> u64 {
+    pub fn bytes_without_lists_or_planes(&self) -> u64 {
         ((SIGHT_HEADER_WORDS + self.words.len() + self.clear.len().div_ceil(4)) * 4) as u64
     }
 

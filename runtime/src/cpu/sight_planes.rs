@@ -23,8 +23,9 @@
 //! On the GPU (`sight.wgsl`) the planes follow the triangle lists' place in the walk's words: a
 //! count of the closed voxels before each block of 256 voxels, then a word per closed voxel in
 //! voxel order — a plane, or where it has two the place of the pair after them — then the
-//! pairs. Crytek Sponza's 9.4 M closed voxels of 4 cm (2.2 M of them the grid's border, which
-//! blocks) hold 6.3 M single planes and 0.74 M pairs: 44 MB, beside its open voxels' 53 MB.
+//! pairs. Crytek Sponza's 9.4 M closed voxels of 4 cm (about 2.2 M of them the grid's border,
+//! which blocks) hold 6.3 M single planes and 0.74 M pairs: about 47 MB with the counts, beside
+//! its open voxels' 53 MB.
 
 use glam::{IVec3, Vec2, Vec3};
 use rayon::prelude::*;

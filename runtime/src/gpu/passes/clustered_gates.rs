@@ -268,7 +268,7 @@ impl LevelBuffers {
                 (false, true) => Some(SightExtra::Planes),
                 (false, false) => None,
             };
-            let plain = s.bytes_without_triangles();
+            let plain = s.bytes_without_lists_or_planes();
             return Err(RenderError::Param(sight_too_large(
                 bytes(&t.sight_words),
                 extra.map(|x| (x, plain)),

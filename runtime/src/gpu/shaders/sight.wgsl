@@ -102,13 +102,9 @@ fn sight_list(i: u32) -> vec3<u32> {
 // The closed voxels' planes (runtime::cpu::sight_planes::ClosedPlanes), where the words carry
 // them: header words 16 and 17 hold the offsets of the closed voxels counted before each block
 // of 256 voxels and of the planes: a word per closed voxel in voxel order (kind 0: it blocks;
-// 1: a plane; 2: the place of its two plane words, from word 17's offset), then the pairs.
-fn sight_has_planes() -> bool {
-    return sight_words[17] != 0u;
-}
-
-// The plane words of closed voxel i (its index in the grid; kind 0 in the second: one plane),
-// found by its rank among the closed voxels: its block's count and the open bits' words before
+// 1: a plane; 2: the place of its two plane words, from word 17's offset), then the pairs. The
+// plane words of closed voxel i (its index in the grid; kind 0 in the second: one plane), found
+// by its rank among the closed voxels: its block's count and the open bits' words before
 // it in the block.
 fn sight_plane_words(i: u32) -> vec2<u32> {
     let block = i / 256u;
@@ -141,15 +137,21 @@ fn sight_plane(w: u32) -> vec4<f32> {
 const SIGHT_PLANE_TOL: f32 = 0.051;
 
 // Whether segment a + t d, t in [0, 1], passes closed voxel v (index i) on its planes: inside
-// the voxel it comes within the fit of neither plane's patch (sight_planes::passes).
-fn sight_planes_pass(i: u32, v: vec3<i32>, a: vec3<f32>, d: vec3<f32>) -> bool {
+// the voxel it comes within the fit of neither plane's patch (sight_planes::passes). `moves` and
+// `inv` are the walk's: the axes d moves along and 1 / d on them (0 elsewhere).
+fn sight_planes_pass(
+    i: u32,
+    v: vec3<i32>,
+    a: vec3<f32>,
+    d: vec3<f32>,
+    moves: vec3<bool>,
+    inv: vec3<f32>,
+) -> bool {
     let words = sight_plane_words(i);
     if (words.x & 3u) == 0u {
         return false;
     }
     let c = vec3<f32>(v) + 0.5;
-    let moves = d != vec3<f32>(0.0);
-    let inv = select(vec3<f32>(0.0), 1.0 / select(vec3<f32>(1.0), d, moves), moves);
     let t0 = (c - 0.5 - a) * inv;
     let t1 = (c + 0.5 - a) * inv;
     let tn = select(vec3<f32>(-3.4e38), min(t0, t1), moves);
@@ -281,7 +283,7 @@ fn sight_clear(a: vec3<f32>, b: vec3<f32>, planes: bool) -> bool {
         } else {
             let i = u32(v.x + dims.x * (v.y + dims.y * v.z));
             if ((sight_words[SIGHT_BITS + i / 32u] >> (i % 32u)) & 1u) == 0u
-                && !(planes && sight_planes_pass(i, v, a, d)) {
+                && !(planes && sight_planes_pass(i, v, a, d, moves, inv)) {
                 return false;
             }
         }
