@@ -115,7 +115,7 @@ impl ClosedPlanes {
         }
         // Lists whose triangles lie in one plane (a wall's, a floor's: most), whose voxels then
         // take that plane without a fit.
-        let flat: std::collections::HashMap<u32, (Vec3, f32)> = lists
+        let flat: rustc_hash::FxHashMap<u32, (Vec3, f32)> = lists
             .list_ids()
             .into_par_iter()
             .filter_map(|id| one_plane(&lists.corners_in(id)).map(|p| (id, p)))

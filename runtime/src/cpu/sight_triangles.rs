@@ -19,7 +19,7 @@
 //! same triangles as the last list read whole, which shares its list, is passed unread
 //! ([`WalkTests`]).
 
-use std::collections::HashMap;
+use rustc_hash::FxHashMap;
 
 use glam::{DVec3, IVec3, Vec3};
 use rayon::prelude::*;
@@ -139,20 +139,27 @@ impl ClosedTriangles {
         let mut marks = vec![[0u32; 2]; voxels.div_ceil(32)];
         let mut ids = Vec::new();
         let mut refs = Vec::new();
-        let mut lists: HashMap<Vec<u32>, u32> = HashMap::new();
+        // Voxels with the same triangles share a list: keyed by the triangles' run in the
+        // sorted pairs' low words (no list made per voxel; Crytek Sponza's 9.7 M pairs and
+        // 7.2 M voxels took 0.70 s with a list each and the standard hasher).
+        let triangles: Vec<u32> = pairs.par_iter().map(|&p| p as u32).collect();
+        let mut lists: FxHashMap<&[u32], u32> = FxHashMap::default();
+        let mut start = 0;
         for run in pairs.chunk_by(|p, q| p >> 32 == q >> 32) {
             let v = run[0] >> 32;
             marks[(v / 32) as usize][0] |= 1 << (v % 32);
-            // The triangles alone (the low words), whatever the voxel; a list too long to
-            // pack is cut to its first LIST_MAX + 1 (which the walk reads as blocking).
-            let triangles: Vec<u32> = run.iter().take(LIST_MAX + 1).map(|&p| p as u32).collect();
-            let id = *lists.entry(triangles).or_insert_with_key(|t| {
-                let start = refs.len() as u32;
+            // A list too long to pack is cut to its first LIST_MAX + 1 (which the walk reads
+            // as blocking).
+            let t = &triangles[start..start + run.len().min(LIST_MAX + 1)];
+            start += run.len();
+            let id = *lists.entry(t).or_insert_with(|| {
+                let first = refs.len() as u32;
                 refs.extend_from_slice(t);
-                (start << (32 - LIST_START_BITS)) | (t.len().min(LIST_MAX + 1) as u32 - 1)
+                (first << (32 - LIST_START_BITS)) | (t.len() as u32 - 1)
             });
             ids.push(id);
         }
+        let lists = lists.len();
         let mut before = 0;
         for m in &mut marks {
             m[1] = before;
@@ -165,7 +172,7 @@ impl ClosedTriangles {
         ClosedTriangles {
             marks,
             ids,
-            lists: lists.len(),
+            lists,
             refs,
             corners: corners.iter().map(|c| c.map(|p| p.as_vec3())).collect(),
         }
