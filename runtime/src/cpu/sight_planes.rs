@@ -280,7 +280,10 @@ fn fit(v: IVec3, tris: &[[Vec3; 3]]) -> [u32; 2] {
         if n.length_squared() == 0.0 {
             continue;
         }
-        let patch = clip_to_box(&t.map(|p| p - c));
+        let Some(patch) = clip_to_box(&t.map(|p| p - c)) else {
+            return [NONE; 2];
+        };
+        let patch = patch.corners();
         if patch.is_empty() {
             continue;
         }
@@ -294,7 +297,7 @@ fn fit(v: IVec3, tris: &[[Vec3; 3]]) -> [u32; 2] {
             None => {
                 let n = n.normalize();
                 let off = n.dot(t[0] - c);
-                found.push((n, off, patch));
+                found.push((n, off, patch.to_vec()));
                 if found.len() > 2 {
                     return [NONE; 2];
                 }
@@ -378,31 +381,64 @@ fn from_octahedral(o: Vec2) -> Vec3 {
 }
 
 /// Triangle `t` (relative to a voxel's centre) clipped to the voxel grown by a hair
-/// (Sutherland–Hodgman).
-fn clip_to_box(t: &[Vec3; 3]) -> Vec<Vec3> {
-    let mut poly: Vec<Vec3> = t.to_vec();
+/// (Sutherland–Hodgman) in fixed arrays, not a list made per plane (six a triangle): each of the
+/// six planes adds at most one corner to a convex polygon's, so the three take at most nine;
+/// none where rounding would take it past [`PATCH_MAX`] (the voxel then blocks).
+fn clip_to_box(t: &[Vec3; 3]) -> Option<Patch> {
+    let mut poly = Patch {
+        corners: [Vec3::ZERO; PATCH_MAX],
+        len: 3,
+    };
+    poly.corners[..3].copy_from_slice(t);
     let h = 0.5 + 1e-4;
     for axis in 0..3 {
         for side in [1.0f32, -1.0] {
             let inside = |p: Vec3| side * p[axis] <= h;
-            let mut out = Vec::with_capacity(poly.len() + 1);
-            for k in 0..poly.len() {
-                let (a, b) = (poly[k], poly[(k + 1) % poly.len()]);
+            let mut out = Patch {
+                corners: [Vec3::ZERO; PATCH_MAX],
+                len: 0,
+            };
+            let corners = poly.corners();
+            for (k, &a) in corners.iter().enumerate() {
+                let b = corners[(k + 1) % corners.len()];
                 if inside(a) {
-                    out.push(a);
+                    out.push(a)?;
                 }
                 if inside(a) != inside(b) {
                     let s = (side * h - a[axis]) / (b[axis] - a[axis]);
-                    out.push(a + (b - a) * s);
+                    out.push(a + (b - a) * s)?;
                 }
             }
             poly = out;
-            if poly.is_empty() {
-                return poly;
+            if poly.len == 0 {
+                return Some(poly);
             }
         }
     }
-    poly
+    Some(poly)
+}
+
+/// Corners a triangle clipped to a box has at most: its three, one more per plane of the box
+/// (and room for rounding).
+const PATCH_MAX: usize = 12;
+
+/// A convex polygon of at most [`PATCH_MAX`] corners.
+struct Patch {
+    corners: [Vec3; PATCH_MAX],
+    len: usize,
+}
+
+impl Patch {
+    fn corners(&self) -> &[Vec3] {
+        &self.corners[..self.len]
+    }
+
+    /// Adds corner `p`; none where the polygon is full.
+    fn push(&mut self, p: Vec3) -> Option<()> {
+        *self.corners.get_mut(self.len)? = p;
+        self.len += 1;
+        Some(())
+    }
 }
 
 #[cfg(test)]
