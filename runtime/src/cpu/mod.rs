@@ -10,6 +10,7 @@ pub mod lightcluster;
 pub mod portal_walk;
 pub mod reference;
 pub mod sight;
+mod sight_clearance;
 pub mod sight_planes;
 pub mod sight_triangles;
 pub mod tracer;
