@@ -15,3 +15,15 @@ pub mod sight_planes;
 pub mod sight_triangles;
 pub mod tracer;
 pub mod val;
+
+/// A small xorshift for the tests' random cases: each call steps the state and gives it
+/// modulo `n`.
+#[cfg(test)]
+pub(crate) fn xorshift32(mut seed: u32) -> impl FnMut(u32) -> u32 {
+    move |n| {
+        seed ^= seed << 13;
+        seed ^= seed >> 17;
+        seed ^= seed << 5;
+        seed % n
+    }
+}

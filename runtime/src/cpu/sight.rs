@@ -518,13 +518,7 @@ mod tests {
         // Random boxes of closed voxels in a 40 × 23 × 31 grid (sizes not multiples of a
         // brick), segments between random open voxels, some along axes and diagonals.
         let dims = [40u32, 23, 31];
-        let mut seed = 0x2545_f491u32;
-        let mut rnd = move |n: u32| {
-            seed ^= seed << 13;
-            seed ^= seed >> 17;
-            seed ^= seed << 5;
-            seed % n
-        };
+        let mut rnd = crate::cpu::xorshift32(0x2545_f491u32);
         for level in 0..12 {
             let mut open = vec![true; (dims[0] * dims[1] * dims[2]) as usize];
             for _ in 0..(4 + level * 3) {

@@ -202,13 +202,7 @@ mod tests {
     fn the_separable_chessboard_distance_is_exact_on_random_grids() {
         // Grids with an axis of one cell, sizes not multiples of anything, closed cells from
         // none (the distance to the outside alone) to most, against the brute force.
-        let mut seed = 0x9e37_79b9u32;
-        let mut rnd = move |n: u32| {
-            seed ^= seed << 13;
-            seed ^= seed >> 17;
-            seed ^= seed << 5;
-            seed % n
-        };
+        let mut rnd = crate::cpu::xorshift32(0x9e37_79b9u32);
         for (case, dims) in [
             [23, 1, 17],
             [1, 1, 40],

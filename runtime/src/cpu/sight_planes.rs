@@ -385,19 +385,14 @@ fn from_octahedral(o: Vec2) -> Vec3 {
 /// six planes adds at most one corner to a convex polygon's, so the three take at most nine;
 /// none where rounding would take it past [`PATCH_MAX`] (the voxel then blocks).
 fn clip_to_box(t: &[Vec3; 3]) -> Option<Patch> {
-    let mut poly = Patch {
-        corners: [Vec3::ZERO; PATCH_MAX],
-        len: 3,
-    };
+    let mut poly = Patch::empty();
     poly.corners[..3].copy_from_slice(t);
+    poly.len = 3;
     let h = 0.5 + 1e-4;
     for axis in 0..3 {
         for side in [1.0f32, -1.0] {
             let inside = |p: Vec3| side * p[axis] <= h;
-            let mut out = Patch {
-                corners: [Vec3::ZERO; PATCH_MAX],
-                len: 0,
-            };
+            let mut out = Patch::empty();
             let corners = poly.corners();
             for (k, &a) in corners.iter().enumerate() {
                 let b = corners[(k + 1) % corners.len()];
@@ -429,6 +424,13 @@ struct Patch {
 }
 
 impl Patch {
+    fn empty() -> Patch {
+        Patch {
+            corners: [Vec3::ZERO; PATCH_MAX],
+            len: 0,
+        }
+    }
+
     fn corners(&self) -> &[Vec3] {
         &self.corners[..self.len]
     }
