@@ -17,7 +17,8 @@
 //! - [`cpu`]: the tracer, the exact reference, and the CPU twin of each method.
 //! - [`job`]: what `visgate render` does — CPU or GPU, VPLs, animation frames — as one library
 //!   call the CLI, the viewer and `compare` share.
-//! - [`vpl`] (VPLs, light paths, the gather term), [`lights`], [`camera`], [`hdr`],
+//! - [`vpl`] (VPLs, light paths, the gather term), [`vpl_order`] (their order for interleaved
+//!   sampling), [`lights`], [`camera`], [`hdr`],
 //!   [`metrics`].
 //!
 //! A frame: VPLs (uploaded, or made from the lights' RSMs on the GPU) → shadow maps → G-buffer
@@ -35,6 +36,7 @@ pub mod job;
 pub mod lights;
 pub mod metrics;
 pub mod vpl;
+pub mod vpl_order;
 
 use std::path::Path;
 

@@ -12,7 +12,8 @@
 //! cone, carrying `Φ_path = I(ω) · Ω / N_light` (`Ω` the solid angle sampled). At each hit a VPL
 //! takes `Φ_path · ρ` and the normal facing the path; for `bounces > 1` the path goes on in a
 //! cosine-distributed direction (Halton bases 5, 7, then 11, 13, …) with `Φ_path ← Φ_path · ρ`.
-//! Deterministic for a fixed seed and scene: the VPLs do not flicker.
+//! Deterministic for a fixed seed and scene: the VPLs do not flicker. The list is in
+//! [`crate::vpl_order`]'s order, so that each interleaving subset holds all directions.
 
 use std::f32::consts::PI;
 
@@ -266,7 +267,7 @@ pub fn path_vpls(
     if share.iter().all(|&n| n == 0) {
         return Ok(Vec::new());
     }
-    let mut vpls = Vec::new();
+    let mut by_light = Vec::with_capacity(lights.len());
     for (li, light) in lights.iter().enumerate() {
         let n = share[li];
         if n == 0 {
@@ -315,9 +316,9 @@ pub fn path_vpls(
                 })
                 .collect()
         };
-        vpls.extend(per_light.into_iter().flatten());
+        by_light.push(per_light);
     }
-    Ok(vpls)
+    Ok(crate::vpl_order::interleaving_order(by_light))
 }
 
 /// Fraction of the gathered energy the clamp removes at `x`: `1 − clamped / unclamped` over

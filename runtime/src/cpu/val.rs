@@ -31,6 +31,7 @@ use glam::Vec3;
 
 use crate::RenderError;
 use crate::vpl::{Vpl, basis};
+use crate::vpl_order::dealt_position;
 
 /// Clustering parameters.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -272,7 +273,9 @@ fn centre_at(v: &Vpl) -> Centre {
     (v.position.into(), v.normal.into(), v.flux.into())
 }
 
-/// The initial centres: VAL k starts at VPL ⌊k·N/M⌋ (§5.2), or the next live VPL after it;
+/// The initial centres: VAL k starts at VPL ⌊k·N/M⌋ (§5.2) of the lights' merged sequence
+/// (read through [`dealt_position`]: the list is dealt out for interleaving,
+/// [`crate::vpl_order`]), or the next live VPL after it in the sequence;
 /// with [`ValSeeding::HaltonFlux`] at the first VPL whose cumulative importance exceeds
 /// h₂(k) × the total.
 pub fn initial_centres(vpls: &[Vpl], params: &ValParams) -> Vec<Centre> {
@@ -291,10 +294,8 @@ pub fn initial_centres(vpls: &[Vpl], params: &ValParams) -> Vec<Centre> {
     (0..count as u64)
         .map(|k| {
             let j = (k * n as u64 / count as u64) as usize;
-            let v = (0..n)
-                .map(|s| &vpls[(j + s) % n])
-                .find(|v| is_live(v))
-                .unwrap_or(&vpls[j]);
+            let at = |s: usize| &vpls[dealt_position(((j + s) % n) as u32, n as u32) as usize];
+            let v = (0..n).map(at).find(|v| is_live(v)).unwrap_or(at(0));
             centre_at(v)
         })
         .collect()

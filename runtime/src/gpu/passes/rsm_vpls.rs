@@ -54,7 +54,8 @@ pub struct RsmVpls {
     pipeline: wgpu::ComputePipeline,
 }
 
-/// The Halton samples of the lights' RSM layers: (layer, texel) and power of each.
+/// The Halton samples of the lights' RSM layers: (layer, texel) and power of each, in
+/// [`crate::vpl_order`]'s order.
 fn samples(
     lights: &[SceneLight],
     (gpu_lights, views): (&[Light], &[ShadowView]),
@@ -62,8 +63,9 @@ fn samples(
 ) -> Vec<RsmSample> {
     let share = crate::vpl::share_by_power(lights, p.count);
     let s = p.rsm_size;
-    let mut out = Vec::with_capacity(p.count as usize);
+    let mut by_light = Vec::with_capacity(lights.len());
     for (li, l) in lights.iter().enumerate() {
+        let mut out = Vec::with_capacity(share[li] as usize);
         let m = share[li];
         let first = gpu_lights[li].layers[0];
         let shift = crate::vpl::seed_shift(p.seed ^ li as u64, 0);
@@ -96,13 +98,14 @@ fn samples(
             let power = crate::lights::intensity_towards(l, dir) * solid;
             let tx = (((x / half) * 0.5 + 0.5) * s as f32).clamp(0.0, s as f32 - 1.0) as u32;
             let ty = ((0.5 - (y / half) * 0.5) * s as f32).clamp(0.0, s as f32 - 1.0) as u32;
-            out.push(RsmSample {
+            out.push(vec![RsmSample {
                 texel: [layer, tx, ty, 0],
                 power: power.extend(0.0).to_array(),
-            });
+            }]);
         }
+        by_light.push(out);
     }
-    out
+    crate::vpl_order::interleaving_order(by_light)
 }
 
 impl RsmVpls {

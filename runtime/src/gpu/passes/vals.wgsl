@@ -1,6 +1,7 @@
 //! include: vpl.wgsl val.wgsl
 // Virtual area lights on the GPU (Dong et al. §5–6): k-means of the VPLs into M VALs by
-// d = w_x·Δx/D + w_α·Δα/π, restarted each frame from VAL k = VPL ⌊k·N/M⌋.
+// d = w_x·Δx/D + w_α·Δα/π, restarted each frame from VAL k = VPL ⌊k·N/M⌋ of the lights'
+// merged sequence (the list holds it dealt out for interleaving: vpl.wgsl's dealt_position).
 // runtime::cpu::val is the CPU twin (same order of every sum, so the same VALs).
 //   cumulate (Weinzierl-Heigl's seeds) the VPLs' cumulative importance r + g + b, in one
 //           workgroup: 64 contiguous chunks, as runtime::cpu::val::importance_cdf
@@ -153,16 +154,18 @@ fn init(@builtin(global_invocation_id) id: vec3<u32>) {
         set_centre(k, vpls[min(lo, n - 1u)]);
         return;
     }
-    // ⌊k·N/M⌋ without overflowing 32 bits; a dead VPL there gives way to the next live one.
-    var j = k * (n / m) + (k * (n % m)) / m;
+    // ⌊k·N/M⌋ of the merged sequence without overflowing 32 bits, read through the deal; a
+    // dead VPL there gives way to the next live one of the sequence.
+    let j = k * (n / m) + (k * (n % m)) / m;
+    var at = dealt_position(j, n);
     for (var s = 0u; s < n; s++) {
-        let i = (j + s) % n;
+        let i = dealt_position((j + s) % n, n);
         if live(vpls[i]) {
-            j = i;
+            at = i;
             break;
         }
     }
-    set_centre(k, vpls[j]);
+    set_centre(k, vpls[at]);
 }
 
 fn distance(v: Vpl, k: u32) -> f32 {

@@ -17,6 +17,46 @@ fn interleave_subset(px: vec2<i32>, b: u32) -> u32 {
     return u32(px.x) % b + b * (u32(px.y) % b);
 }
 
+// The list's order (runtime::vpl_order, whose functions these twin): the lights' merged
+// sequence dealt out bit-reversed, so that each subset holds a run of it. dealt_position(s, n)
+// is where the sequence's entry s lies in the list of n.
+fn order_rev(c: u32, bits: u32) -> u32 {
+    return select(0u, reverseBits(c) >> (32u - max(bits, 1u)), bits > 0u);
+}
+
+// The entries dealt before place c: c and the earlier places rev(x) < r that give two.
+fn order_start(c: u32, bits: u32, r: u32) -> u32 {
+    var doubled = 0u;
+    for (var i = 0u; i < bits; i++) {
+        if ((c >> i) & 1u) == 0u {
+            continue;
+        }
+        let f = order_rev((c >> (i + 1u)) << (i + 1u), bits);
+        let p = 1u << (bits - i);
+        if r > f {
+            doubled += min((r - f + p - 1u) / p, 1u << i);
+        }
+    }
+    return c + doubled;
+}
+
+fn dealt_position(s: u32, n: u32) -> u32 {
+    let bits = firstLeadingBit(n);
+    let r = n - (1u << bits);
+    var lo = 0u;
+    var hi = (1u << bits) - 1u;
+    while lo < hi {
+        let mid = lo + (hi - lo + 1u) / 2u;
+        if order_start(mid, bits, r) <= s {
+            lo = mid;
+        } else {
+            hi = mid - 1u;
+        }
+    }
+    let q = order_rev(lo, bits);
+    return select(q + (1u << bits), q, order_start(lo, bits, r) == s);
+}
+
 // The blur's b × b block around px in an image of `size` pixels, moved inside it at its edges
 // (not clipped: a block holds every one of the b² VPL subsets, so that the few VPLs that light
 // a place reach the pixels on the image's border too): lo in xy, hi (past the end) in zw.
