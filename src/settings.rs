@@ -252,6 +252,11 @@ pub struct MethodArgs {
     /// average holds more of the VPLs; every interleaved mode.
     #[arg(long)]
     pub blur_fill: bool,
+    /// Blur: weight the neighbours by a tent over (2·side − 1)² pixels instead of the box of
+    /// side²: every VPL subset still weighs the same, but a bright or dark pixel spreads as a
+    /// soft pyramid instead of a square of the block's size; every interleaved mode.
+    #[arg(long)]
+    pub blur_tent: bool,
     /// Gates, interleaved: a pixel whose blur block holds fewer pixels than this that agree
     /// with it (a door jamb, a strip along a wall) walks, in a second pass, the VPL subsets of
     /// the pixels that do not agree, so that every VPL counts once there (a pair of pixel and
@@ -370,6 +375,7 @@ impl MethodArgs {
             blur_distance: self.blur_distance,
             blur_normal: self.blur_normal,
             fill: self.blur_fill,
+            tent: self.blur_tent,
             starved_taps: self.starved_taps,
         }
     }

@@ -945,6 +945,49 @@ fn the_blur_filled_from_the_next_blocks_is_nearer_every_vpls_gather_and_leaves_a
     }
 }
 
+#[test]
+fn the_tent_blur_keeps_the_light_of_every_vpl_and_is_nearer_every_vpls_gather_than_the_box() {
+    use visgate_runtime::gpu::InterleaveParams;
+    use visgate_runtime::gpu::{GatesParams, GpuMode, GpuParams};
+    use visgate_runtime::metrics::errors;
+    let (ctx, mut gpu, vpls, view) = four_rooms_on_the_gpu([96, 72]);
+    let mut render = |mode: GpuMode| {
+        gpu.render(&ctx, &view, &vpls, &GpuParams::with_mode(mode))
+            .expect("render")
+            .0
+    };
+    let gates = |block: u32, tent: bool| {
+        GpuMode::Gates(GatesParams {
+            interleave: InterleaveParams {
+                block,
+                tent,
+                ..InterleaveParams::default()
+            },
+            ..GatesParams::default()
+        })
+    };
+    let direct = render(GpuMode::DirectOnly).mean().x;
+    let full = render(gates(1, false));
+    for block in [4, 8] {
+        let boxed = render(gates(block, false));
+        let tent = render(gates(block, true));
+        let (b, t) = (
+            errors(&boxed, &full).expect("size"),
+            errors(&tent, &full).expect("size"),
+        );
+        let energy = (tent.mean().x - direct) / (full.mean().x - direct);
+        eprintln!(
+            "block {block}: rel. MSE to every VPL's, box {:.3e}, tent {:.3e}; tent's indirect \
+             energy {energy:.3}",
+            b.rel_mse, t.rel_mse
+        );
+        // Every subset weighs the same under the tent (b² in all): the light of every VPL.
+        assert!((energy - 1.0).abs() < 0.05, "block {block}: {energy}");
+        assert!(t.rel_mse < b.rel_mse, "block {block}: {t:?} vs {b:?}");
+        assert!(tent != boxed, "block {block}: the tent changed nothing");
+    }
+}
+
 /// Gates (the default voxel walk) interleaved as `interleave`, the walks' roulette at share
 /// `walk_roulette` with seed `walk_seed`.
 fn with_roulette(

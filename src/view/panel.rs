@@ -211,7 +211,7 @@ fn ism_controls(ui: &mut egui::Ui, p: &mut IsmParams) {
     ui.add(egui::Slider::new(&mut p.bias, 0.0..=16.0).text("ISM bias (texels)"));
 }
 
-/// The interleaving block's slider and, while it is over 1, the blur's fill.
+/// The interleaving block's slider and, while it is over 1, the blur's fill and tent.
 fn interleave(ui: &mut egui::Ui, il: &mut InterleaveParams) {
     ui.add(egui::Slider::new(&mut il.block, 1..=8).text("interleave block"));
     if il.block > 1 {
@@ -220,6 +220,10 @@ fn interleave(ui: &mut egui::Ui, il: &mut InterleaveParams) {
                 "a neighbour whose surface does not agree with the pixel gives way to the \
                  nearest copy of its VPL subset a block away that does: the average holds more \
                  of the VPLs along edges and jambs, at a few % of the frame",
+            );
+        ui.checkbox(&mut il.tent, "tent blur")
+            .on_hover_text(
+                "the neighbours weighted by a tent twice the block's side instead of the                  block's box: every VPL subset weighs the same, and a bright or dark pixel                  spreads as a soft pyramid instead of a square",
             );
     }
 }

@@ -423,8 +423,9 @@ gpu_struct! {
         pub sharpness: f32,
         /// CSSM normal offset. [Units: texels]
         pub cssm_normal_offset: f32,
-        /// Padding.
-        pub _pad0: f32,
+        /// Blur: 1 where the taps are weighted by a tent over (2b − 1)² pixels (`blur.wgsl`),
+        /// 0 the box of b × b.
+        pub blur_tent: u32,
         /// Interleaving block side (1: none). [Units: px]
         pub block: u32,
         /// Interleaving subsets (block²).

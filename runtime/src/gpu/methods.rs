@@ -231,8 +231,15 @@ impl GpuMode {
         use crate::cpu::gates::GateShape;
         let il = |i: &InterleaveParams| match i.block {
             1 => "every VPL per pixel".to_string(),
-            b if i.fill => format!("{b}×{b} interleaved, blur filled"),
-            b => format!("{b}×{b} interleaved"),
+            b => {
+                let blur = match (i.fill, i.tent) {
+                    (true, true) => ", tent blur filled",
+                    (true, false) => ", blur filled",
+                    (false, true) => ", tent blur",
+                    (false, false) => "",
+                };
+                format!("{b}×{b} interleaved{blur}")
+            }
         };
         let gates = |g: &GateParams| match g.shape {
             GateShape::Portal => format!("portals, walk ≤ {}", g.max_walk),

@@ -1,6 +1,6 @@
 //! include: val.wgsl vpl.wgsl
 // Interleaving's other half: the interleaved indirect irradiance (val_gather.wgsl) blurred over
-// the b × b block where the geometry agrees (Laine et al.: positions closer than a fraction of
+// the b × b block (or, with blur_tent, a tent over (2b − 1)²) where the geometry agrees (Laine et al.: positions closer than a fraction of
 // the scene, normals closer than a cosine), times albedo / π, added onto the image so far
 // (`previous`: ping-pong, 32-bit float targets are not blendable everywhere). A compute pass,
 // as the gathers (shade.wgsl's cs_gates_indirect says why).
@@ -34,7 +34,14 @@ fn compose(px: vec2<i32>) -> vec4<f32> {
     let albedo = textureLoad(g_albedo, px, 0).xyz;
     let b = i32(gather.block);
     let size = vec2<i32>(textureDimensions(indirect));
-    let block = interleave_block_around(px, b, size);
+    // A starved pixel (w 1) walked the subsets of the taps that do not agree itself: each
+    // agreeing tap's subset (its light × B) once, and those; it fills none.
+    let walked = textureLoad(starved_sums, min(px, vec2<i32>(textureDimensions(starved_sums)) - 1), 0);
+    // The tent's window of (2b − 1)², centred on the pixel moved inside the image so that it
+    // holds every subset (as the box's block); the box where the image is too small for it.
+    let tent = gather.blur_tent == 1u && walked.w != 1.0 && all(size >= vec2<i32>(2 * b - 1));
+    let centre = clamp(px, vec2<i32>(b - 1), size - vec2<i32>(b));
+    let block = select(interleave_block_around(px, b, size), vec4<i32>(centre - (b - 1), centre + b), tent);
     let lo = block.xy;
     let hi = block.zw;
     // Where a pixel lies in the deinterleaved target (vpl.wgsl's deinterleave_axis), stepped
@@ -46,9 +53,6 @@ fn compose(px: vec2<i32>) -> vec4<f32> {
     let m = vec2<u32>(size) % bu;
     let deint = gather.deinterleaved == 1u;
     var ry = vec2<u32>(u32(lo.y) % bu, u32(lo.y) / bu);
-    // A starved pixel (w 1) walked the subsets of the taps that do not agree itself: each
-    // agreeing tap's subset (its light × B) once, and those; it fills none.
-    let walked = textureLoad(starved_sums, min(px, vec2<i32>(textureDimensions(starved_sums)) - 1), 0);
     let fill = gather.blur_fill == 1u && walked.w != 1.0;
     var sum = vec3<f32>(0.0);
     var weight = 0.0;
@@ -72,8 +76,10 @@ fn compose(px: vec2<i32>) -> vec4<f32> {
                 // A block's side away, a deinterleaved pixel away (vpl.wgsl's layout).
                 at = select(tap + copy * b, vec2<i32>(ax, ay) + copy, deint);
             }
-            sum += textureLoad(indirect, at, 0).xyz;
-            weight += 1.0;
+            let d = abs(tap - centre);
+            let w = select(1.0, f32((b - d.x) * (b - d.y)), tent);
+            sum += w * textureLoad(indirect, at, 0).xyz;
+            weight += w;
         }
     }
     let e = select(sum / max(weight, 1.0), sum / f32(gather.subsets) + walked.xyz, walked.w == 1.0);

@@ -33,6 +33,11 @@ pub struct InterleaveParams {
     /// VPL subset one block away (a block's side along x or y) that does, so that the average
     /// holds more of the b² subsets; off: it is left out (Laine et al.).
     pub fill: bool,
+    /// Blur: the taps weighted by a tent over (2b − 1)² pixels, (b − |dx|)(b − |dy|), instead
+    /// of the box of b × b: each of the b² subsets still weighs the same (once at weight b² or
+    /// twice summing to it along each axis), but one bright tap spreads as a pyramid instead
+    /// of a b × b square. Off: Laine et al.'s box. A starved pixel keeps the box.
+    pub tent: bool,
 }
 
 impl Default for InterleaveParams {
@@ -43,6 +48,7 @@ impl Default for InterleaveParams {
             blur_normal: 0.8,
             starved_taps: 0,
             fill: false,
+            tent: false,
         }
     }
 }
@@ -123,6 +129,7 @@ impl InterleaveBlur {
             blur_normal: p.blur_normal,
             deinterleaved: u32::from(deinterleaved),
             blur_fill: u32::from(p.fill),
+            blur_tent: u32::from(p.tent),
             ..bytemuck::Zeroable::zeroed()
         };
         pool.upload(

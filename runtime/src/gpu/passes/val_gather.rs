@@ -147,6 +147,7 @@ impl ValGathers {
             blur_distance: il.blur_distance_m(f),
             blur_normal: il.blur_normal,
             blur_fill: u32::from(il.fill),
+            blur_tent: u32::from(il.tent),
             ..bytemuck::Zeroable::zeroed()
         };
         let uniform_buf = pool.upload(

@@ -49,7 +49,8 @@ struct ValGather {
     receiver_offset: f32,
     sharpness: f32,
     cssm_normal_offset: f32,
-    pad0: f32,
+    // 1: the blur weights its taps by a tent over (2b − 1)² pixels, 0: the box of b × b.
+    blur_tent: u32,
     // Interleaving block side b (1: none) and subsets B = b².
     block: u32,
     subsets: u32,
