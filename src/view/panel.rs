@@ -221,10 +221,11 @@ fn interleave(ui: &mut egui::Ui, il: &mut InterleaveParams) {
                  nearest copy of its VPL subset a block away that does: the average holds more \
                  of the VPLs along edges and jambs, at a few % of the frame",
             );
-        ui.checkbox(&mut il.tent, "tent blur")
-            .on_hover_text(
-                "the neighbours weighted by a tent twice the block's side instead of the                  block's box: every VPL subset weighs the same, and a bright or dark pixel                  spreads as a soft pyramid instead of a square",
-            );
+        ui.checkbox(&mut il.tent, "tent blur").on_hover_text(
+            "the neighbours weighted by a tent twice the block's side instead of the \
+                 block's box: every VPL subset weighs the same, and a bright or dark pixel \
+                 spreads as a soft pyramid instead of a square",
+        );
     }
 }
 

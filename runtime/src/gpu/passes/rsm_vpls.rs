@@ -65,8 +65,8 @@ fn samples(
     let s = p.rsm_size;
     let mut by_light = Vec::with_capacity(lights.len());
     for (li, l) in lights.iter().enumerate() {
-        let mut out = Vec::with_capacity(share[li] as usize);
         let m = share[li];
+        let mut out = Vec::with_capacity(m as usize);
         let first = gpu_lights[li].layers[0];
         let shift = crate::vpl::seed_shift(p.seed ^ li as u64, 0);
         // Point lights and wide spots: six cube faces; other spots: their one frustum.
