@@ -437,7 +437,7 @@ pub struct GateTables {
     /// The portals, packed ([`GateLevel::portal_words`]).
     pub portal_words: Vec<u32>,
     /// The open voxels and their bricks' clearance, packed ([`VoxelSight::words`]).
-    pub sight_words: Vec<u32>,
+    pub sight_words: crate::cpu::sight::SightWords,
     /// The most steps a voxel walk takes ([`VoxelSight::most_steps`]).
     pub sight_steps: u32,
 }

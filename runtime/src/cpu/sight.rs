@@ -210,12 +210,6 @@ impl VoxelSight {
         self.voxel_m
     }
 
-    /// Bytes of [`VoxelSight::words`] without the closed voxels' triangle lists and planes: the
-    /// header, the open bits and the bricks' clearance.
-    pub fn bytes_without_lists_or_planes(&self) -> u64 {
-        ((SIGHT_HEADER_WORDS + self.words.len() + self.clear.len().div_ceil(4)) * 4) as u64
-    }
-
     /// Point `p` (m) in voxel coordinates.
     pub fn to_voxels(&self, p: Vec3) -> Vec3 {
         (p - self.origin_m) / self.voxel_m
@@ -411,31 +405,34 @@ impl VoxelSight {
         }
     }
 
-    /// The walk's tables packed into words for sight.wgsl: `[nx, ny, nz, bricks x, y, z, word
-    /// offset of the clearances, triangle tests a walk, origin x, y, z (m, f32 bits), voxel
-    /// edge (m, f32 bits), word offsets of the closed voxels' marks, lists, triangle indices
-    /// and triangles (0: no lists), of the planes' counts and planes (0: none)]`, the open bits
-    /// (32 a word), the bricks' clearances, four bytes a word (little-endian), then the
-    /// triangle lists ([`ClosedTriangles::words`]) if they are listed
+    /// The walk's tables packed into words for sight.wgsl, in two arrays (each a binding of
+    /// its own, so that each fits an adapter's storage binding limit: Crytek Sponza's 4 cm
+    /// grid with its triangle lists is 153 MB, over the 128 MiB of lavapipe and of wgpu's
+    /// default). [`SightWords::base`]: `[nx, ny, nz, bricks x, y, z, word offset of the
+    /// clearances, triangle tests a walk, origin x, y, z (m, f32 bits), voxel edge (m, f32
+    /// bits), word offsets in [`SightWords::extra`] of the closed voxels' marks, lists,
+    /// triangle indices and triangles (0: no lists), of the planes' counts and planes (0:
+    /// none)]`, the open bits (32 a word), the bricks' clearances, four bytes a word
+    /// (little-endian). [`SightWords::extra`]: a word 0 (so that no table starts at 0), then
+    /// the triangle lists ([`ClosedTriangles::words`]) if they are listed
     /// ([`VoxelSight::list_triangles`]) and the planes ([`ClosedPlanes::words`]) if they are
     /// fitted ([`VoxelSight::planes`]).
-    pub fn words(&self) -> Vec<u32> {
+    pub fn words(&self) -> SightWords {
         self.words_with(true, true)
     }
 
     /// [`VoxelSight::words`], with the triangle lists only where `lists` asks for them and
     /// the planes where `planes` does (each where it is made): a walk without them need not
     /// carry them.
-    pub fn words_with(&self, lists: bool, planes: bool) -> Vec<u32> {
+    pub fn words_with(&self, lists: bool, planes: bool) -> SightWords {
         let clear_at = SIGHT_HEADER_WORDS + self.words.len();
-        let lists_at = clear_at + self.clear.len().div_ceil(4);
         let none = ClosedTriangles::default();
         let listed = self.triangles.get().filter(|_| lists);
-        let (lists, at) = listed.unwrap_or(&none).words(lists_at);
+        let (lists, at) = listed.unwrap_or(&none).words(1);
         let no_planes = ClosedPlanes::default();
         let fitted = self.planes.get().filter(|_| planes);
-        let (planes, planes_at) = fitted.unwrap_or(&no_planes).words(lists_at + lists.len());
-        let mut w = Vec::with_capacity(lists_at + lists.len() + planes.len());
+        let (planes, planes_at) = fitted.unwrap_or(&no_planes).words(1 + lists.len());
+        let mut w = Vec::with_capacity(clear_at + self.clear.len().div_ceil(4));
         w.extend(self.dims.to_array().map(|x| x as u32));
         w.extend(self.bricks.to_array().map(|x| x as u32));
         w.extend([clear_at as u32, TRIANGLE_TESTS_PER_WALK]);
@@ -449,10 +446,21 @@ impl VoxelSight {
             b[..c.len()].copy_from_slice(c);
             u32::from_le_bytes(b)
         }));
-        w.extend(lists);
-        w.extend(planes);
-        w
+        let mut extra = Vec::with_capacity(1 + lists.len() + planes.len());
+        extra.push(0);
+        extra.extend(lists);
+        extra.extend(planes);
+        SightWords { base: w, extra }
     }
+}
+
+/// The voxel walk's tables as sight.wgsl reads them ([`VoxelSight::words`]).
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SightWords {
+    /// The header, the open bits and the bricks' clearances (`sight_words`).
+    pub base: Vec<u32>,
+    /// A word 0, then the closed voxels' triangle lists and planes (`sight_extra`).
+    pub extra: Vec<u32>,
 }
 
 /// Words before the open bits in [`VoxelSight::words`].
@@ -676,16 +684,26 @@ mod tests {
         assert!(!s.visible(on, -Vec3::X, beyond, -Vec3::X));
         assert!(s.visible(on, Vec3::X, beyond, -Vec3::X));
         assert!(!s.visible(on, Vec3::X, room, Vec3::X));
-        // The packed words carry the lists after the clearances, then the planes: a count per
-        // block of 256 voxels, a word per closed voxel (each of these one plane).
-        let w = s.words();
+        // The packed words end with the clearances; the extra words carry the lists after a
+        // word 0, then the planes: a count per block of 256 voxels, a word per closed voxel
+        // (each of these one plane).
+        let SightWords { base: w, extra } = s.words();
         assert_eq!(w[7], TRIANGLE_TESTS_PER_WALK);
-        assert_eq!(w[12] as usize, w[6] as usize + bare.clear.len().div_ceil(4));
+        assert_eq!(w.len(), w[6] as usize + bare.clear.len().div_ceil(4));
+        assert_eq!((w[12], extra[0]), (1, 0));
         assert_eq!(w[16] as usize, w[15] as usize + TRIANGLE_WORDS * wall.len());
         assert_eq!(w[17] as usize, w[16] as usize + 2000usize.div_ceil(256));
-        assert_eq!(w[17] as usize + 60, w.len());
-        assert_eq!(s.words_with(true, false).len(), w[16] as usize);
-        assert_eq!(&bare.words()[12..18], &[0; 6]);
+        assert_eq!(w[17] as usize + 60, extra.len());
+        assert_eq!(s.words_with(true, false).extra.len(), w[16] as usize);
+        // The planes alone start after the word 0.
+        let planes = s.words_with(false, true);
+        assert_eq!(&planes.base[12..18], &[0, 0, 0, 0, 1, 1 + w[17] - w[16]]);
+        assert_eq!(planes.extra[1..], extra[w[16] as usize..]);
+        let bare = bare.words();
+        assert_eq!(
+            (&bare.base[12..18], &bare.extra[..]),
+            (&[0; 6][..], &[0][..])
+        );
     }
 
     #[test]
@@ -693,7 +711,7 @@ mod tests {
         let dims = [9u32, 5, 6];
         let open = VoxelBits::from_fn(270, |i| i % 11 != 0);
         let s = VoxelSight::new(&grid(dims), &open);
-        let w = s.words();
+        let w = s.words().base;
         assert_eq!(&w[..6], &[9, 5, 6, 5, 3, 3]);
         assert_eq!(&w[8..12], &[0.0f32, 0.0, 0.0, 1.0].map(f32::to_bits));
         let at = w[6] as usize;

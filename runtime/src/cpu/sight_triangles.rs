@@ -344,44 +344,41 @@ pub enum SightExtra {
     Planes,
 }
 
-/// Why the open voxels' grid of `bytes` (with the closed voxels' triangle lists or planes where
-/// `without` names them and gives the grid's size without them) does not fit a storage binding
-/// of `limit` bytes, and what fits it: the sight grid's voxel (`voxel_m`) is the level's own,
-/// not its resolution's (Crytek Sponza's is 4 cm baked at 128 or at 512), and the lists and
-/// planes are the walk's.
+/// Why the voxel walk's tables do not fit storage bindings of `limit` bytes, and what fits
+/// them: the open voxels' grid of `base` bytes, or the closed voxels' triangle lists or planes
+/// (`extra`: which, and their bytes), each a binding of its own. The sight grid's voxel
+/// (`voxel_m`) is the level's own, not its resolution's (Crytek Sponza's is 4 cm baked at 128
+/// or at 512), and the lists and planes are the walk's. `None` where both fit.
 pub fn sight_too_large(
-    bytes: u64,
-    without: Option<(SightExtra, u64)>,
+    base: u64,
+    extra: Option<(SightExtra, u64)>,
     voxel_m: f32,
     limit: u64,
-) -> String {
+) -> Option<String> {
     // The bits shrink with the cube of the voxel and the lists and planes (one a closed voxel,
     // which lie on the surfaces) with its square at least; a hair coarser than that, as a hint.
-    let (what, power) = match without {
-        Some((SightExtra::Lists, _)) => (
-            "the open voxels' grid with the closed voxels' triangles (--closed-voxel-triangles)",
+    let (what, bytes, power, without) = match extra {
+        _ if base > limit => ("the open voxels' grid needs", base, 1.0 / 3.0, ""),
+        Some((SightExtra::Lists, bytes)) if bytes > limit => (
+            "the closed voxels' triangle lists (--closed-voxel-triangles) need",
+            bytes,
             0.5,
+            "walk without --closed-voxel-triangles, or ",
         ),
-        Some((SightExtra::Planes, _)) => {
-            ("the open voxels' grid with the closed voxels' planes", 0.5)
-        }
-        None => ("the open voxels' grid", 1.0 / 3.0),
+        Some((SightExtra::Planes, bytes)) if bytes > limit => (
+            "the closed voxels' planes need",
+            bytes,
+            0.5,
+            "walk with --no-closed-voxel-planes, or ",
+        ),
+        _ => return None,
     };
     let fits = voxel_m * (bytes as f32 / limit as f32).powf(power) * 1.05;
-    let without = match without {
-        Some((SightExtra::Lists, plain)) if plain <= limit => {
-            format!("walk without --closed-voxel-triangles ({plain} bytes), or ")
-        }
-        Some((SightExtra::Planes, plain)) if plain <= limit => {
-            format!("walk with --no-closed-voxel-planes ({plain} bytes), or ")
-        }
-        _ => String::new(),
-    };
-    format!(
-        "{what} needs {bytes} bytes, more than the adapter's storage binding limit {limit}: \
+    Some(format!(
+        "{what} {bytes} bytes, more than the adapter's storage binding limit {limit}: \
          {without}bake with a coarser --sight-voxel (this level's is {voxel_m:.4} m; about \
          {fits:.4} m fits)"
-    )
+    ))
 }
 
 #[cfg(test)]
@@ -463,44 +460,41 @@ mod tests {
     #[test]
     fn a_sight_grid_too_large_for_the_binding_says_what_fits_it() {
         let limit = 128 << 20;
-        // Crytek Sponza's on lavapipe: 153 MB with the lists, 52 MB without.
-        let m = super::sight_too_large(
-            153_176_188,
-            Some((SightExtra::Lists, 52_000_000)),
-            0.04,
-            limit,
+        let lists = |bytes| Some((SightExtra::Lists, bytes));
+        let refused = |base, extra, voxel_m| {
+            super::sight_too_large(base, extra, voxel_m, limit).expect("refused")
+        };
+        // Crytek Sponza's on lavapipe: 52 MB of grid and 101 MB of lists fit, each a binding.
+        assert_eq!(
+            super::sight_too_large(52_000_000, lists(101_000_000), 0.04, limit),
+            None
         );
+        // Lists past the limit: walk without them, or a coarser voxel.
+        let m = refused(52_000_000, lists(200_000_000), 0.04);
         assert!(
-            m.contains("walk without --closed-voxel-triangles (52000000 bytes)"),
+            m.starts_with("the closed voxels' triangle lists (--closed-voxel-triangles) need"),
             "{m}"
         );
         assert!(
-            m.contains("this level's is 0.0400 m; about 0.0449 m fits"),
+            m.contains("walk without --closed-voxel-triangles, or "),
+            "{m}"
+        );
+        assert!(
+            m.contains("this level's is 0.0400 m; about 0.0513 m fits"),
             "{m}"
         );
         assert!(!m.contains("resolution"), "{m}");
-        // Too large even without the lists: only the coarser voxel is offered.
-        let m =
-            super::sight_too_large(300 << 20, Some((SightExtra::Lists, 200 << 20)), 0.01, limit);
-        assert!(!m.contains("walk without"), "{m}");
-        assert!(m.contains("about 0.0161 m fits"), "{m}");
-        // The planes: walk without them.
-        let m = super::sight_too_large(
-            140_000_000,
-            Some((SightExtra::Planes, 60_000_000)),
-            0.04,
-            limit,
-        );
-        assert!(
-            m.starts_with("the open voxels' grid with the closed voxels' planes"),
-            "{m}"
-        );
-        assert!(
-            m.contains("walk with --no-closed-voxel-planes (60000000 bytes)"),
-            "{m}"
-        );
-        let m = super::sight_too_large(256 << 20, None, 0.02, limit);
+        // The grid itself too large: only the coarser voxel is offered, for the grid.
+        let m = refused(300 << 20, lists(10), 0.01);
         assert!(m.starts_with("the open voxels' grid needs"), "{m}");
+        assert!(!m.contains("walk without"), "{m}");
+        assert!(m.contains("about 0.0139 m fits"), "{m}");
+        // The planes: walk without them.
+        let planes = Some((SightExtra::Planes, 140_000_000));
+        let m = refused(60_000_000, planes, 0.04);
+        assert!(m.starts_with("the closed voxels' planes need"), "{m}");
+        assert!(m.contains("walk with --no-closed-voxel-planes, or "), "{m}");
+        let m = refused(256 << 20, None, 0.02);
         assert!(m.contains("about 0.0265 m fits"), "{m}");
     }
 }

@@ -56,7 +56,9 @@ pub(super) fn record_passes(
     let (lists, vpl_ends) = match &f.params.mode {
         GpuMode::Gates(gp) if gp.gates.shape == GateShape::Voxels => {
             let level = passes::clustered_gates::LevelBuffers::of(f)?;
-            let ends = p.sight_ends.record(f, &level.sight_words, pool, rec)?;
+            let ends =
+                p.sight_ends
+                    .record(f, (&level.sight_words, &level.sight_extra), pool, rec)?;
             (None, Some(ends))
         }
         GpuMode::Gates(gp) => (

@@ -14,6 +14,7 @@ use crate::cpu::clustered::{
     ClusterParams, Clustered, GeometryCluster as CpuGeometryCluster, LightEntry, PixelSurface,
 };
 use crate::cpu::gates::{GateLevel, GateParams, GateShape};
+use crate::cpu::sight_triangles::{SightExtra, sight_too_large};
 use crate::gpu::context::{
     Pool, bind_group, compute_pipelines, init_buffer, read_buffer, read_texture,
 };
@@ -210,13 +211,15 @@ pub struct LevelBuffers {
     pub cluster_gates: wgpu::Buffer,
     /// The portals, packed (`GateLevel::portal_words`).
     pub portal_words: wgpu::Buffer,
-    /// The open voxels, packed (`VoxelSight::words`).
+    /// The open voxels, packed (`VoxelSight::words`' base).
     pub sight_words: wgpu::Buffer,
+    /// The closed voxels' triangle lists and planes (`VoxelSight::words`' extra).
+    pub sight_extra: wgpu::Buffer,
     /// The most steps a voxel walk takes (`VoxelSight::most_steps`).
     pub sight_steps: u32,
-    /// Whether `sight_words` holds the closed voxels' triangle lists.
+    /// Whether `sight_extra` holds the closed voxels' triangle lists.
     pub triangles: bool,
-    /// Whether `sight_words` holds the closed voxels' planes.
+    /// Whether `sight_extra` holds the closed voxels' planes.
     pub planes: bool,
 }
 
@@ -260,21 +263,20 @@ impl LevelBuffers {
                 bytes(&t.voxel_words)
             )));
         }
-        if bytes(&t.sight_words) > limit {
-            use crate::cpu::sight_triangles::{SightExtra, sight_too_large};
-            let s = level.sight();
-            let extra = match (lists, planes) {
-                (true, _) => Some(SightExtra::Lists),
-                (false, true) => Some(SightExtra::Planes),
-                (false, false) => None,
-            };
-            let plain = s.bytes_without_lists_or_planes();
-            return Err(RenderError::Param(sight_too_large(
-                bytes(&t.sight_words),
-                extra.map(|x| (x, plain)),
-                s.voxel_m(),
-                limit,
-            )));
+        let extra = match (lists, planes) {
+            (true, _) => Some(SightExtra::Lists),
+            (false, true) => Some(SightExtra::Planes),
+            (false, false) => None,
+        };
+        let sight = &t.sight_words;
+        let extra_bytes = extra.map(|x| (x, bytes(&sight.extra)));
+        if let Some(why) = sight_too_large(
+            bytes(&sight.base),
+            extra_bytes,
+            level.sight().voxel_m(),
+            limit,
+        ) {
+            return Err(RenderError::Param(why));
         }
         let storage = wgpu::BufferUsages::STORAGE;
         Ok(LevelBuffers {
@@ -297,7 +299,13 @@ impl LevelBuffers {
             sight_words: init_buffer(
                 d,
                 "open voxels",
-                bytemuck::cast_slice(&t.sight_words),
+                bytemuck::cast_slice(&t.sight_words.base),
+                storage,
+            ),
+            sight_extra: init_buffer(
+                d,
+                "closed voxels' triangles and planes",
+                bytemuck::cast_slice(&t.sight_words.extra),
                 storage,
             ),
             sight_steps: t.sight_steps,

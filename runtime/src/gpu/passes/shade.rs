@@ -97,12 +97,13 @@ pub struct Gathers<'a> {
 
 /// The bindings of shade.wgsl's `cs_gates_indirect` (an automatic layout holds only what an
 /// entry point uses) but its batch index (24) and its output (25).
-const GATES_INDIRECT_BINDINGS: [u32; 15] = [0, 2, 5, 6, 7, 8, 10, 12, 13, 14, 15, 16, 21, 22, 23];
+const GATES_INDIRECT_BINDINGS: [u32; 16] =
+    [0, 2, 5, 6, 7, 8, 10, 12, 13, 14, 15, 16, 21, 22, 23, 31];
 /// The bindings of shade.wgsl's `cs_shade` but its output (25): all but the batches' sum, the
 /// batch index, and the VPLs' clusters and walk ends (clustered gates walk apart, in
 /// `cs_gates_indirect`; `cs_shade` gathers their disks and gates per pixel).
-const SHADE_BINDINGS: [u32; 21] = [
-    0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 17, 18, 19, 20, 22,
+const SHADE_BINDINGS: [u32; 22] = [
+    0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 17, 18, 19, 20, 22, 31,
 ];
 /// The bindings of shade.wgsl's `cs_vpl_clusters_indirect` but its output (25).
 const VPL_CLUSTERS_INDIRECT_BINDINGS: [u32; 6] = [0, 2, 5, 6, 19, 20];
@@ -369,7 +370,7 @@ impl Views {
         let level = f.scene.level.as_ref();
         let lists = gathers.lists;
         let none = &f.scene.no_level;
-        let buffers: [(u32, &wgpu::Buffer); 17] = [
+        let buffers: [(u32, &wgpu::Buffer); 18] = [
             (0, &f.globals),
             (1, &shadows.lights),
             (2, &f.vpls),
@@ -387,6 +388,7 @@ impl Views {
             (20, vpl_lc.map_or(none, |o| &o.clusters.light_cluster)),
             (22, level.map_or(none, |l| &l.sight_words)),
             (23, gathers.vpl_ends.unwrap_or(none)),
+            (31, level.map_or(none, |l| &l.sight_extra)),
         ];
         let textures = [
             (4, &self.maps),

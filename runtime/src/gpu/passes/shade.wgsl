@@ -57,6 +57,8 @@ struct GeometryCluster {
 @group(0) @binding(21) var earlier_batches: texture_2d<f32>;
 // The level's open voxels and their bricks' clearance, for the voxel walk (sight.wgsl).
 @group(0) @binding(22) var<storage, read> sight_words: array<u32>;
+// The closed voxels' triangle lists and planes (sight.wgsl).
+@group(0) @binding(31) var<storage, read> sight_extra: array<u32>;
 // Each VPL's end of the voxel walk (sight_ends.wgsl), for cs_gates_indirect.
 @group(0) @binding(23) var<storage, read> vpl_ends: array<vec4<f32>>;
 

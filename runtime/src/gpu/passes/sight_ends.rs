@@ -28,12 +28,12 @@ impl SightEnds {
     }
 
     /// Records the pass over the frame's VPLs and `sight_words` (the level's open voxels), the
-    /// ends off the closed voxels' planes where the frame's walk passes them (which the words
-    /// then carry): the buffer of their ends, a `vec4<f32>` each (kept in `pool`).
+    /// ends off the closed voxels' planes where the frame's walk passes them (which
+    /// `sight_extra` then carries): the buffer of their ends, a `vec4<f32>` each (kept in `pool`).
     pub fn record(
         &self,
         f: &Frame,
-        sight_words: &wgpu::Buffer,
+        (sight_words, sight_extra): (&wgpu::Buffer, &wgpu::Buffer),
         pool: &mut Pool,
         rec: &mut Recorder,
     ) -> Result<wgpu::Buffer, RenderError> {
@@ -62,6 +62,7 @@ impl SightEnds {
                 (0, f.vpls.as_entire_binding()),
                 (1, sight_words.as_entire_binding()),
                 (2, ends.as_entire_binding()),
+                (3, sight_extra.as_entire_binding()),
             ],
         );
         let span = rec.begin("VPL walk ends");

@@ -6,6 +6,8 @@
 
 @group(0) @binding(0) var<storage, read> vpls: array<Vpl>;
 @group(0) @binding(1) var<storage, read> sight_words: array<u32>;
+// The closed voxels' triangle lists and planes (sight.wgsl).
+@group(0) @binding(3) var<storage, read> sight_extra: array<u32>;
 // xyz: the end in the sight grid's voxel coordinates; w: 1, or 0 where no open voxel is near.
 @group(0) @binding(2) var<storage, read_write> vpl_ends: array<vec4<f32>>;
 

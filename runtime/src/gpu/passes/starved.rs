@@ -27,7 +27,7 @@ pub const MAX_STARVED_PIXELS: u64 = 1 << 24;
 const PAIRS_BINDINGS: [u32; 3] = [0, 5, 6];
 /// The bindings of `cs_starved_walks` from the shading's resources (the walks' without the
 /// disks' lists); the batch index (24), count (27) and pairs (28) besides.
-const WALKS_BINDINGS: [u32; 10] = [0, 2, 5, 6, 7, 8, 15, 16, 22, 23];
+const WALKS_BINDINGS: [u32; 11] = [0, 2, 5, 6, 7, 8, 15, 16, 22, 23, 31];
 
 /// What the starved pixels' passes leave: the image the blur reads (xyz the walked subsets'
 /// light, w 1 where starved) and the counters (pairs needed, pixels that did not fit, starved

@@ -1,12 +1,13 @@
 // The voxel walk (runtime::cpu::sight::VoxelSight is its CPU twin): whether the segment between
 // a VPL and a surface point crosses open voxels alone. It reads the including pass's
-// `sight_words: array<u32>` (VoxelSight::words: [nx, ny, nz, bricks x, y, z, offset of the
-// clearances, triangle tests a walk, origin xyz (m), voxel edge (m), offsets of the closed
-// voxels' marks, list offsets, triangle indices and corners (0: no lists), of the planes'
-// counts and planes (0: none)], the open bits 32 a word, each brick's chessboard distance in
-// bricks to the nearest brick holding a closed voxel, a byte each, then the triangle lists
-// (runtime::cpu::sight_triangles::ClosedTriangles) and the planes
-// (runtime::cpu::sight_planes::ClosedPlanes). A step crosses the cube of bricks that a brick's
+// `sight_words: array<u32>` (VoxelSight::words' base: [nx, ny, nz, bricks x, y, z, offset of
+// the clearances, triangle tests a walk, origin xyz (m), voxel edge (m), offsets in
+// sight_extra of the closed voxels' marks, list offsets, triangle indices and corners (0: no
+// lists), of the planes' counts and planes (0: none)], the open bits 32 a word, each brick's
+// chessboard distance in bricks to the nearest brick holding a closed voxel, a byte each) and
+// `sight_extra: array<u32>` (its extra, a binding of its own so that each fits the storage
+// binding limit: a word 0, the triangle lists (runtime::cpu::sight_triangles::ClosedTriangles)
+// and the planes (runtime::cpu::sight_planes::ClosedPlanes)). A step crosses the cube of bricks that a brick's
 // clearance proves open, one open voxel, or a closed voxel whose planes the segment meets
 // neither of, or (with the lists) where it hits no listed triangle; with the lists the segment
 // runs between the surface points themselves, each a hair off its surface
@@ -44,7 +45,7 @@ fn sight_true_end(p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
 // Word w of listed triangle t as a float (runtime::cpu::sight_triangles::TRIANGLE_WORDS a
 // triangle: its plane's normal and offset, its first corner, its two edges).
 fn sight_tri(t: u32, w: u32) -> f32 {
-    return bitcast<f32>(sight_words[sight_words[15] + 13u * t + w]);
+    return bitcast<f32>(sight_extra[sight_words[15] + 13u * t + w]);
 }
 
 fn sight_tri3(t: u32, w: u32) -> vec3<f32> {
@@ -83,15 +84,15 @@ fn sight_list(i: u32) -> vec3<u32> {
     if marks_at == 0u {
         return vec3<u32>(0xffffffffu, 0u, 0u);
     }
-    let mask = sight_words[marks_at + 2u * (i / 32u)];
+    let mask = sight_extra[marks_at + 2u * (i / 32u)];
     let bit = 1u << (i % 32u);
     if (mask & bit) == 0u {
         return vec3<u32>(0xffffffffu, 0u, 0u);
     }
-    let k = sight_words[marks_at + 2u * (i / 32u) + 1u] + countOneBits(mask & (bit - 1u));
+    let k = sight_extra[marks_at + 2u * (i / 32u) + 1u] + countOneBits(mask & (bit - 1u));
     // The list packed: its start in the indices (high 24 bits), its length less one (low 8);
     // a voxel whose list overflowed (255 + 1 entries) blocks (LIST_MAX).
-    let id = sight_words[sight_words[13] + k];
+    let id = sight_extra[sight_words[13] + k];
     let len = (id & 0xffu) + 1u;
     if len > 255u {
         return vec3<u32>(0xffffffffu, 0u, 0u);
@@ -108,16 +109,16 @@ fn sight_list(i: u32) -> vec3<u32> {
 // it in the block.
 fn sight_plane_words(i: u32) -> vec2<u32> {
     let block = i / 256u;
-    var rank = sight_words[sight_words[16] + block];
+    var rank = sight_extra[sight_words[16] + block];
     for (var w = block * 8u; w < i / 32u; w++) {
         rank += countOneBits(~sight_words[SIGHT_BITS + w]);
     }
     rank += countOneBits(~sight_words[SIGHT_BITS + i / 32u] & ((1u << (i % 32u)) - 1u));
     let planes_at = sight_words[17];
-    let own = sight_words[planes_at + rank];
+    let own = sight_extra[planes_at + rank];
     if (own & 3u) == 2u {
         let at = planes_at + (own >> 2u);
-        return vec2<u32>(sight_words[at], sight_words[at + 1u]);
+        return vec2<u32>(sight_extra[at], sight_extra[at + 1u]);
     }
     return vec2<u32>(own, 0u);
 }
@@ -343,7 +344,7 @@ fn sight_clear_lists(a: vec3<f32>, b: vec3<f32>) -> bool {
                 return false;
             }
             left -= 1u;
-            let t = sight_words[refs_at + r];
+            let t = sight_extra[refs_at + r];
             r += 1u;
             if t != last0 && t != last1 {
                 last1 = last0;
