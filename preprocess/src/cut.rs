@@ -83,7 +83,7 @@ fn cut_normal(
 /// The covariance (in voxels²) of the voxels of `runs` (y, z, first and last x), from their
 /// moments summed exactly in whole numbers a run at a time (a run's sums in closed form: the
 /// order the fill finds them in does not show, and a million voxels cost their runs, not a
-/// point each: Crytek Sponza 256's slot searches spent a third of their time on the points);
+/// point each: Crytek Sponza 256's slot searches spent over a quarter of their time on the points);
 /// `None` under 8 voxels.
 fn covariance(runs: &[(i64, i64, i64, i64)]) -> Option<glam::Mat3> {
     let &(y0, z0, x0, _) = runs.first()?;
