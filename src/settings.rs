@@ -178,6 +178,8 @@ pub struct MethodArgs {
     /// a walk first needs them: 0.8 s for Crytek Sponza at 512 on 2 cores): near-exact
     /// visibility (99.3-100 % of pixel-VPL pairs agree with shadow rays on the levels measured,
     /// against 88-99 % without), at several times the walk's cost on a software rasterizer.
+    /// With --blur-tent, the accurate setting: indirect energy within 3 % of the reference and
+    /// under 1 % of the lit pixels black on most cameras measured (README).
     #[arg(long)]
     pub closed_voxel_triangles: bool,
     /// --gate-shape voxels without the triangles: block at every closed voxel, with each end
