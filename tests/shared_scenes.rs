@@ -297,16 +297,15 @@ fn crytek_sponzas_gallery_with_the_triangles_and_the_tent_is_lit_where_every_vpl
     };
     let direct = render(GpuMode::DirectOnly);
     let every = render(mode(1, true, false));
-    let [default, accurate] = [mode(8, false, false), mode(8, true, true)].map(|m| {
+    let [default, accurate] = [
+        ("default walk and box", mode(8, false, false)),
+        ("triangles + tent", mode(8, true, true)),
+    ]
+    .map(|(name, m)| {
         let e = indirect_errors(&render(m), &every, &direct).expect("same size");
         println!(
-            "gallery 320×240, 1,024 paths, {}: energy {:.3}, black where lit {:.2} % of {} \
+            "gallery 320×240, 1,024 paths, {name}: energy {:.3}, black where lit {:.2} % of {} \
              lit pixels",
-            if matches!(m, GpuMode::Gates(g) if g.gates.triangles) {
-                "triangles + tent"
-            } else {
-                "default walk and box"
-            },
             e.energy_ratio,
             100.0 * e.black_where_lit,
             e.lit_pixels

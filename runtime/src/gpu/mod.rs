@@ -350,8 +350,9 @@ impl GpuRenderer {
     /// up yet, or with their planes (fitted now) likewise — the first frame of that mode pays
     /// for them, a level never walked with them does not. An upload keeps what was up with
     /// what `mode` needs where both fit the adapter's storage binding, else it takes what
-    /// `mode` needs alone: on an adapter whose binding the lists overflow (lavapipe's 128 MiB
-    /// and Crytek Sponza's 4 cm grid), only the mode that walks them fails.
+    /// `mode` needs alone: on an adapter whose binding the lists overflow (each part of the
+    /// walk's tables is a binding of its own: `VoxelSight::words`), only the mode that walks
+    /// them fails.
     pub fn level_for_mode(
         &mut self,
         ctx: &GpuContext,
