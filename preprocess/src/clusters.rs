@@ -199,16 +199,7 @@ pub fn gates(
         let path = &e.path;
         let (centre, normal, r, k) = match placement {
             GatePlacement::Midpoint => {
-                // The path node nearest half the path's length splits its voxels.
-                let mut s = vec![0f32; path.len()];
-                for i in 1..path.len() {
-                    s[i] = s[i - 1]
-                        + (position[path[i] as usize] - position[path[i - 1] as usize]).length();
-                }
-                let half = s[path.len() - 1] * 0.5;
-                let k = (0..path.len())
-                    .min_by(|&i, &j| (s[i] - half).abs().total_cmp(&(s[j] - half).abs()))
-                    .unwrap_or(0);
+                let k = path_middle(path, position);
                 (
                     (position[na] + position[nb]) * 0.5,
                     along,
@@ -216,110 +207,7 @@ pub fn gates(
                     k,
                 )
             }
-            GatePlacement::Narrowest => {
-                // The path, extended past each end: when an end is a doorway node of its own
-                // cluster, the narrowest place may lie just beyond.
-                let beyond = |from: u32, avoid: u32| -> Vec<u32> {
-                    let (mut prev, mut cur) = (avoid, from);
-                    let mut out = Vec::new();
-                    for _ in 0..BEYOND_RUN {
-                        if adjacency[cur as usize].len() != 2 {
-                            break;
-                        }
-                        match adjacency[cur as usize].iter().find(|&&n| n != prev) {
-                            Some(&n) => {
-                                out.push(n);
-                                prev = cur;
-                                cur = n;
-                            }
-                            None => break,
-                        }
-                    }
-                    out
-                };
-                let last = path.len() - 1;
-                let pre = if last > 0 {
-                    beyond(path[0], path[1])
-                } else {
-                    Vec::new()
-                };
-                let post = if last > 0 {
-                    beyond(path[last], path[last - 1])
-                } else {
-                    Vec::new()
-                };
-                let ext: Vec<u32> = pre
-                    .iter()
-                    .rev()
-                    .chain(path.iter())
-                    .chain(post.iter())
-                    .copied()
-                    .collect();
-                // Smallest radius on the path or just past its ends (within the end's max
-                // ball, or 3 nodes); among equals the one nearest the middle of the path.
-                let mid = pre.len() as f32 + last as f32 * 0.5;
-                let within = |beyond: &[u32], end: u32| -> usize {
-                    let (p, r) = (position[end as usize], radius[end as usize]);
-                    beyond
-                        .iter()
-                        .take_while(|&&n| (position[n as usize] - p).length() <= r)
-                        .count()
-                        .max(BEYOND_SEARCH.min(beyond.len()))
-                };
-                let window = pre.len() - within(&pre, path[0])
-                    ..pre.len() + path.len() + within(&post, path[last]);
-                let i = window
-                    .min_by(|&i, &j| {
-                        radius[ext[i] as usize]
-                            .total_cmp(&radius[ext[j] as usize])
-                            .then(((i as f32 - mid).abs()).total_cmp(&(j as f32 - mid).abs()))
-                            .then(i.cmp(&j))
-                    })
-                    .unwrap_or(0);
-                // The middle of the run of nodes as narrow as it (within 2 %): the middle
-                // of a doorway's passage rather than one of its faces.
-                let r_min = radius[ext[i] as usize] * 1.02;
-                let narrow = |j: usize| radius[ext[j] as usize] <= r_min;
-                let (mut s, mut e) = (i, i);
-                while s > 0 && narrow(s - 1) {
-                    s -= 1;
-                }
-                while e + 1 < ext.len() && narrow(e + 1) {
-                    e += 1;
-                }
-                let i = (s + e) / 2;
-                let k = i.saturating_sub(pre.len()).min(path.len());
-                // Orthogonal to the line averaged over the disk's own size, so that a line
-                // that dips through a low doorway does not tilt the disk.
-                let (r_i, p_i) = (radius[ext[i] as usize], position[ext[i] as usize]);
-                let reach = |step: isize| -> u32 {
-                    let mut j = i as isize;
-                    loop {
-                        let next = j + step;
-                        if next < 0 || next >= ext.len() as isize {
-                            break;
-                        }
-                        j = next;
-                        let far = (position[ext[j as usize] as usize] - p_i).length() >= r_i;
-                        if far && (j - i as isize).abs() >= 2 {
-                            break;
-                        }
-                    }
-                    ext[j as usize]
-                };
-                // Along the narrow run itself where it is long enough to give a direction
-                // (a doorway's passage), else over about one radius each way.
-                let run = (position[ext[e] as usize] - p_i).length()
-                    + (position[ext[s] as usize] - p_i).length();
-                let (lo, hi) = if run >= 0.5 * r_i {
-                    (ext[s], ext[e])
-                } else {
-                    (reach(-1), reach(1))
-                };
-                let t = (position[hi as usize] - position[lo as usize]).normalize_or_zero();
-                let t = if t == Vec3::ZERO { along } else { t };
-                (position[ext[i] as usize], t, radius[ext[i] as usize], k)
-            }
+            GatePlacement::Narrowest => narrowest(path, adjacency, position, radius, along),
         };
         let normal = if normal == Vec3::ZERO {
             Vec3::X
@@ -336,6 +224,143 @@ pub fn gates(
         });
     }
     out
+}
+
+/// The path node nearest half the path's length (it splits its voxels).
+fn path_middle(path: &[u32], position: &[Vec3]) -> usize {
+    let mut s = vec![0f32; path.len()];
+    for i in 1..path.len() {
+        s[i] = s[i - 1] + (position[path[i] as usize] - position[path[i - 1] as usize]).length();
+    }
+    let half = s[path.len() - 1] * 0.5;
+    (0..path.len())
+        .min_by(|&i, &j| (s[i] - half).abs().total_cmp(&(s[j] - half).abs()))
+        .unwrap_or(0)
+}
+
+/// The nodes past skeleton node `from` away from `avoid`, along a line (nodes of two
+/// neighbours), [`BEYOND_RUN`] at most.
+fn beyond(adjacency: &[Vec<u32>], from: u32, avoid: u32) -> Vec<u32> {
+    let (mut prev, mut cur) = (avoid, from);
+    let mut out = Vec::new();
+    for _ in 0..BEYOND_RUN {
+        if adjacency[cur as usize].len() != 2 {
+            break;
+        }
+        match adjacency[cur as usize].iter().find(|&&n| n != prev) {
+            Some(&n) => {
+                out.push(n);
+                prev = cur;
+                cur = n;
+            }
+            None => break,
+        }
+    }
+    out
+}
+
+/// A gate at the narrowest place of `path` (centre, normal, radius and the path's node):
+/// on the path or just past its ends, the middle of the run as narrow, facing along the run
+/// (or the line over about one radius each way; `along` where that gives no direction).
+fn narrowest(
+    path: &[u32],
+    adjacency: &[Vec<u32>],
+    position: &[Vec3],
+    radius: &[f32],
+    along: Vec3,
+) -> (Vec3, Vec3, f32, usize) {
+    // The path, extended past each end: when an end is a doorway node of its own cluster, the
+    // narrowest place may lie just beyond.
+    let last = path.len() - 1;
+    let (pre, post) = if last > 0 {
+        (
+            beyond(adjacency, path[0], path[1]),
+            beyond(adjacency, path[last], path[last - 1]),
+        )
+    } else {
+        (Vec::new(), Vec::new())
+    };
+    let ext: Vec<u32> = pre
+        .iter()
+        .rev()
+        .chain(path.iter())
+        .chain(post.iter())
+        .copied()
+        .collect();
+    // Smallest radius on the path or just past its ends (within the end's max ball, or 3
+    // nodes); among equals the one nearest the middle of the path.
+    let mid = pre.len() as f32 + last as f32 * 0.5;
+    let within = |beyond: &[u32], end: u32| -> usize {
+        let (p, r) = (position[end as usize], radius[end as usize]);
+        beyond
+            .iter()
+            .take_while(|&&n| (position[n as usize] - p).length() <= r)
+            .count()
+            .max(BEYOND_SEARCH.min(beyond.len()))
+    };
+    let window =
+        pre.len() - within(&pre, path[0])..pre.len() + path.len() + within(&post, path[last]);
+    let i = window
+        .min_by(|&i, &j| {
+            radius[ext[i] as usize]
+                .total_cmp(&radius[ext[j] as usize])
+                .then(((i as f32 - mid).abs()).total_cmp(&(j as f32 - mid).abs()))
+                .then(i.cmp(&j))
+        })
+        .unwrap_or(0);
+    // The middle of the run of nodes as narrow as it (within 2 %): the middle of a doorway's
+    // passage rather than one of its faces.
+    let r_min = radius[ext[i] as usize] * 1.02;
+    let narrow = |j: usize| radius[ext[j] as usize] <= r_min;
+    let (mut s, mut e) = (i, i);
+    while s > 0 && narrow(s - 1) {
+        s -= 1;
+    }
+    while e + 1 < ext.len() && narrow(e + 1) {
+        e += 1;
+    }
+    let i = (s + e) / 2;
+    let k = i.saturating_sub(pre.len()).min(path.len());
+    let t = run_direction(&ext, i, (s, e), position, radius);
+    let t = if t == Vec3::ZERO { along } else { t };
+    (position[ext[i] as usize], t, radius[ext[i] as usize], k)
+}
+
+/// The direction of the line `ext` at its node `i`, averaged over the disk's own size, so
+/// that a line that dips through a low doorway does not tilt the disk: along the narrow run
+/// `s..=e` itself where it is long enough to give a direction (a doorway's passage), else over
+/// about one radius each way.
+fn run_direction(
+    ext: &[u32],
+    i: usize,
+    (s, e): (usize, usize),
+    position: &[Vec3],
+    radius: &[f32],
+) -> Vec3 {
+    let (r_i, p_i) = (radius[ext[i] as usize], position[ext[i] as usize]);
+    let reach = |step: isize| -> u32 {
+        let mut j = i as isize;
+        loop {
+            let next = j + step;
+            if next < 0 || next >= ext.len() as isize {
+                break;
+            }
+            j = next;
+            let far = (position[ext[j as usize] as usize] - p_i).length() >= r_i;
+            if far && (j - i as isize).abs() >= 2 {
+                break;
+            }
+        }
+        ext[j as usize]
+    };
+    let run =
+        (position[ext[e] as usize] - p_i).length() + (position[ext[s] as usize] - p_i).length();
+    let (lo, hi) = if run >= 0.5 * r_i {
+        (ext[s], ext[e])
+    } else {
+        (reach(-1), reach(1))
+    };
+    (position[hi as usize] - position[lo as usize]).normalize_or_zero()
 }
 
 /// Gates of a sliver face each other within this angle's cosine (45°).

@@ -28,7 +28,10 @@ use serde::Serialize;
 use visgate_formats::vgate::GridMeta;
 
 use crate::BakeError;
-use crate::neighbourhood::{Conn, grid_components};
+pub use crate::hang::Thread;
+use crate::hang::hang_floating_objects;
+use crate::neighbourhood::{Components, Conn, grid_components};
+use crate::verdict::Why;
 
 /// What a leak found from the level's inside (a scene without camera or light) starts from.
 pub const INSIDE: &str = "the level's inside";
@@ -98,17 +101,6 @@ pub struct Leak {
     pub bounds_max_m: [f32; 3],
 }
 
-/// A floating solid object hung to other solid (see the module notes).
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Thread {
-    /// Solid voxels of the object.
-    pub object_voxels: u64,
-    /// Where the thread starts (on the object), metres.
-    pub from_m: [f32; 3],
-    /// Empty voxels made solid.
-    pub length_voxels: u64,
-}
-
 /// The result of [`empty_space`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct EmptySpace {
@@ -147,7 +139,7 @@ pub fn empty_space(
     params: &EmptySpaceParams,
 ) -> Result<EmptySpace, BakeError> {
     let dims = meta.dims;
-    let [nx, ny, nz] = dims.map(|d| d as usize);
+    let nx = dims[0] as usize;
     let mut empty: Vec<bool> = solid.iter().map(|&s| !s).collect();
     // Labelled runs along x, not a label a voxel: 4 bytes a voxel would set the bake's peak.
     let comps = grid_components(dims, |i| empty[i], Conn::C26);
@@ -156,108 +148,23 @@ pub fn empty_space(
         return Err(BakeError::NoEmptySpace(crate::voxelize::all_solid(meta)));
     }
     let n = count as usize;
-    let mut voxels = vec![0u64; n];
-    let mut lo = vec![[u32::MAX; 3]; n];
-    let mut hi = vec![[0u32; 3]; n];
-    let mut at_bounds = vec![false; n];
-    for r in 0..ny * nz {
-        let (y, z) = ((r % ny) as u32, (r / ny) as u32);
-        for (a, b, l) in comps.row(r) {
-            let c = l as usize;
-            voxels[c] += u64::from(b - a + 1);
-            for v in [[a, y, z], [b, y, z]] {
-                for ax in 0..3 {
-                    lo[c][ax] = lo[c][ax].min(v[ax]);
-                    hi[c][ax] = hi[c][ax].max(v[ax]);
-                }
-                // A run's ends are its only voxels that can be next to the ring in x; in y
-                // and z all of its voxels are alike.
-                at_bounds[c] |= crate::leak::next_to_ring(v, dims);
-            }
-        }
-    }
-    // Seeds: the voxel of the point, or an empty voxel next to it.
-    let mut seeds_in: Vec<Vec<String>> = vec![Vec::new(); n];
-    let mut seeds_outside = Vec::new();
-    let mut seed_voxels = Vec::new();
-    for s in seeds {
-        let found = meta.world_to_voxel(s.position_m).and_then(|v| {
-            // The voxel itself first, then its 26 neighbours in a fixed order.
-            std::iter::once(13u32)
-                .chain((0..27).filter(|&k| k != 13))
-                .find_map(|k| {
-                    let o = [k % 3, (k / 3) % 3, k / 9].map(|c| c as i64 - 1);
-                    let w: [i64; 3] = std::array::from_fn(|a| v[a] as i64 + o[a]);
-                    if (0..3).any(|a| w[a] < 0 || w[a] >= dims[a] as i64) {
-                        return None;
-                    }
-                    let i = w[0] as usize + nx * (w[1] as usize + ny * w[2] as usize);
-                    comps.label(i).map(|l| (l, i))
-                })
-        });
-        match found {
-            Some((l, i)) => {
-                seeds_in[l as usize].push(s.what.clone());
-                seed_voxels.push((s.what.clone(), s.position_m, i));
-            }
-            None => seeds_outside.push(s.what.clone()),
-        }
-    }
+    let tally = tally(&comps, dims);
+    let Placed {
+        seeds_in,
+        seeds_outside,
+        seed_voxels,
+    } = place_seeds(meta, &comps, seeds);
     let bare = seeds.is_empty() && !params.closed;
-    let Facing {
-        mut faced,
-        fronts,
-        backs,
-    } = facing(meta, solid, &comps, triangles);
-    // A scene that names no camera and no light (a bare mesh): the level's inside keeps its
-    // component, as a camera would (inside.rs). Faces wound inside out are read turned
-    // (winding.rs).
-    let votes = crate::winding::Votes {
-        faced: &faced,
-        fronts: &fronts,
-        backs: &backs,
-        at_bounds: &at_bounds,
-    };
-    let (inside_component, faces_turned) = if bare {
-        let is_empty = |i: usize| empty[i];
-        crate::winding::bare_inside(meta, &comps, &votes, &voxels, &is_empty)
-    } else {
-        let seeded: Vec<bool> = seeds_in.iter().map(|s| !s.is_empty()).collect();
-        let turned = crate::winding::rooms_turned(&votes, &seeded)
-            && !crate::winding::turning_drops_more(&votes, &seeded, &voxels);
-        (None, turned)
-    };
-    // Each component's first-open votes, [fronts, backs], the faces read as the rooms see them.
-    let first_open: Vec<[u64; 2]> = fronts
-        .iter()
-        .zip(&backs)
-        .map(|(&f, &b)| if faces_turned { [b, f] } else { [f, b] })
-        .collect();
-    if faces_turned {
-        faced.iter_mut().for_each(|f| f.swap(0, 1));
-    }
-    // Only where the inside reaches the bounds (a sealed level's inside needs no point), one
-    // distance field for its point and its leaks (the border ring open: a voxel by a window to
-    // the void is wide, but its rays escape).
-    let inside_at_bounds = inside_component.is_some_and(|c| at_bounds[c as usize]);
-    let locate = params.locate_inside_leaks
-        && meta
-            .voxel_count()
-            .is_some_and(|v| v <= INSIDE_LEAK_MAX_VOXELS);
-    let walls = (inside_at_bounds && locate).then(|| crate::leak::clearance_to_walls(meta, &empty));
-    let inside = inside_component.zip(walls.as_ref()).and_then(|(c, d2)| {
-        // The inside's voxels, run by run: a label looked up a voxel cost seconds at 512³.
-        let visit = |f: &mut dyn FnMut(usize)| {
-            for r in 0..ny * nz {
-                for (a, b, l) in comps.row(r) {
-                    if l == c {
-                        (a..=b).for_each(|x| f(r * nx + x as usize));
-                    }
-                }
-            }
-        };
-        crate::inside::find_inside(meta, d2, &visit)
-    });
+    let facing = facing(meta, solid, &comps, triangles);
+    let read = read_faces(meta, &comps, facing, &tally, &seeds_in, bare, &empty);
+    let (inside_component, faces_turned) = (read.inside_component, read.faces_turned);
+    let (faced, first_open) = (read.faced, read.first_open);
+    let located = locate_inside(meta, &comps, &empty, inside_component, &tally, params);
+    let Located {
+        inside_at_bounds,
+        walls,
+        inside,
+    } = located;
     let why = Why {
         seeds_in: &seeds_in,
         seeded_any: seeds_in.iter().any(|s| !s.is_empty()),
@@ -266,17 +173,17 @@ pub fn empty_space(
         faces_turned,
         first_open: &first_open,
         faced: &faced,
-        voxels: &voxels,
-        at_bounds: &at_bounds,
+        voxels: &tally.voxels,
+        at_bounds: &tally.at_bounds,
         params,
     };
     let mut components: Vec<ComponentReport> = (0..n)
         .map(|c| {
             let (kept, reason) = why.verdict(c);
             ComponentReport {
-                voxels: voxels[c],
-                bounds_min_m: box_m(meta, lo[c], 0.0),
-                bounds_max_m: box_m(meta, hi[c], 1.0),
+                voxels: tally.voxels[c],
+                bounds_min_m: box_m(meta, tally.lo[c], 0.0),
+                bounds_max_m: box_m(meta, tally.hi[c], 1.0),
                 seeds: seeds_in[c].clone(),
                 faced_by: faced[c],
                 kept,
@@ -294,36 +201,7 @@ pub fn empty_space(
     }
     drop(comps);
     // Leaks: kept empty voxels next to the border ring, and the openings they pass.
-    let mut leaks = Vec::new();
-    let mut openings = Vec::new();
-    if params.closed {
-        leaks = leaks_by_side(meta, &empty);
-        if !leaks.is_empty() {
-            openings = crate::leak::find_openings(meta, &empty, &seed_voxels);
-        }
-        if !leaks.is_empty() && !params.allow_leaks {
-            let list: Vec<String> = leaks
-                .iter()
-                .map(|l| {
-                    format!(
-                        "{} side: {} voxels in [{:.2}, {:.2}, {:.2}]..[{:.2}, {:.2}, {:.2}] m",
-                        l.side,
-                        l.voxels,
-                        l.bounds_min_m[0],
-                        l.bounds_min_m[1],
-                        l.bounds_min_m[2],
-                        l.bounds_max_m[0],
-                        l.bounds_max_m[1],
-                        l.bounds_max_m[2]
-                    )
-                })
-                .collect();
-            return Err(BakeError::Leak {
-                openings,
-                sides: list.join("; "),
-            });
-        }
-    }
+    let (leaks, mut openings) = closed_leaks(meta, &empty, &seed_voxels, params)?;
     // The inside's space reaching the bounds: where, from the inside, as for a camera.
     if let (Some(s), Some(d2)) = (inside, &walls)
         && s.enclosed
@@ -353,105 +231,235 @@ pub fn empty_space(
     })
 }
 
-/// What keeps or drops a component (see the module notes).
-struct Why<'a> {
-    /// Per component, the cameras and lights in it.
-    seeds_in: &'a [Vec<String>],
-    /// Whether any component holds a camera or a light.
-    seeded_any: bool,
-    /// A bare mesh's inside.
-    inside_component: Option<u32>,
-    /// Its point, where its openings were looked for. [Units: m]
-    inside_point: Option<[f32; 3]>,
-    /// Whether the faces were read turned.
-    faces_turned: bool,
-    /// Per component, the triangles whose front and whose back face it from their first open
-    /// voxel, the faces read turned where they are (the fronts chose a bare mesh's inside).
-    first_open: &'a [[u64; 2]],
-    /// Per component, the triangles whose front and whose back lie 0.75 voxel off on its side.
-    faced: &'a [[u64; 2]],
-    /// Per component, its voxels.
-    voxels: &'a [u64],
-    /// Per component, whether it reaches the bounds.
-    at_bounds: &'a [bool],
-    /// The stage's parameters.
-    params: &'a EmptySpaceParams,
+/// Each empty component's voxels, box (lowest and highest voxel) and whether it is next to
+/// the border ring.
+struct Tally {
+    voxels: Vec<u64>,
+    lo: Vec<[u32; 3]>,
+    hi: Vec<[u32; 3]>,
+    at_bounds: Vec<bool>,
 }
 
-impl Why<'_> {
-    /// Whether component `c` is kept, and why.
-    fn verdict(&self, c: usize) -> (bool, String) {
-        let (params, faced) = (self.params, self.faced[c]);
-        if !self.seeds_in[c].is_empty() {
-            return (true, format!("holds {}", self.seeds_in[c].join(", ")));
+/// [`Tally`] of `comps`, run by run.
+fn tally(comps: &Components, dims: [u32; 3]) -> Tally {
+    let [_, ny, nz] = dims.map(|d| d as usize);
+    let n = comps.count as usize;
+    let mut t = Tally {
+        voxels: vec![0u64; n],
+        lo: vec![[u32::MAX; 3]; n],
+        hi: vec![[0u32; 3]; n],
+        at_bounds: vec![false; n],
+    };
+    for r in 0..ny * nz {
+        let (y, z) = ((r % ny) as u32, (r / ny) as u32);
+        for (a, b, l) in comps.row(r) {
+            let c = l as usize;
+            t.voxels[c] += u64::from(b - a + 1);
+            for v in [[a, y, z], [b, y, z]] {
+                for (ax, &w) in v.iter().enumerate() {
+                    t.lo[c][ax] = t.lo[c][ax].min(w);
+                    t.hi[c][ax] = t.hi[c][ax].max(w);
+                }
+                // A run's ends are its only voxels that can be next to the ring in x; in y
+                // and z all of its voxels are alike.
+                t.at_bounds[c] |= crate::leak::next_to_ring(v, dims);
+            }
         }
-        if self.inside_component == Some(c as u32) {
-            let point = self.inside_point.map_or(String::new(), |p| {
-                format!("; its point ({:.2}, {:.2}, {:.2}) m", p[0], p[1], p[2])
-            });
-            let turned = if self.faces_turned {
-                ", their faces turned"
-            } else {
-                ""
-            };
-            let fronts = self.first_open[c][0];
-            let why = format!(
-                "{INSIDE}: the most triangles face it ({fronts} of them{turned}; no camera or \
-                 light named){point}"
-            );
-            return (true, why);
+    }
+    t
+}
+
+/// The scene's cameras and lights placed in the empty components.
+struct Placed {
+    /// Per component, what is in it.
+    seeds_in: Vec<Vec<String>>,
+    /// What fell outside the grid, or in solid with no empty voxel next to it.
+    seeds_outside: Vec<String>,
+    /// What was placed, where, and its voxel.
+    seed_voxels: Vec<(String, [f32; 3], usize)>,
+}
+
+/// Places each seed in the component of its voxel, or of an empty voxel next to it.
+fn place_seeds(meta: &GridMeta, comps: &Components, seeds: &[Seed]) -> Placed {
+    let dims = meta.dims;
+    let [nx, ny, _] = dims.map(|d| d as usize);
+    let mut placed = Placed {
+        seeds_in: vec![Vec::new(); comps.count as usize],
+        seeds_outside: Vec::new(),
+        seed_voxels: Vec::new(),
+    };
+    for s in seeds {
+        let found = meta.world_to_voxel(s.position_m).and_then(|v| {
+            // The voxel itself first, then its 26 neighbours in a fixed order.
+            std::iter::once(13u32)
+                .chain((0..27).filter(|&k| k != 13))
+                .find_map(|k| {
+                    let o = [k % 3, (k / 3) % 3, k / 9].map(|c| c as i64 - 1);
+                    let w: [i64; 3] = std::array::from_fn(|a| v[a] as i64 + o[a]);
+                    if (0..3).any(|a| w[a] < 0 || w[a] >= dims[a] as i64) {
+                        return None;
+                    }
+                    let i = w[0] as usize + nx * (w[1] as usize + ny * w[2] as usize);
+                    comps.label(i).map(|l| (l, i))
+                })
+        });
+        match found {
+            Some((l, i)) => {
+                placed.seeds_in[l as usize].push(s.what.clone());
+                placed.seed_voxels.push((s.what.clone(), s.position_m, i));
+            }
+            None => placed.seeds_outside.push(s.what.clone()),
         }
-        let dropped = |why: String| (false, why);
-        if params.closed && self.at_bounds[c] {
-            return dropped(
-                "outside the closed level: reaches the bounds and holds no camera or light".into(),
-            );
-        }
-        if self.voxels[c] < params.min_component_voxels {
-            let min = params.min_component_voxels;
-            return dropped(format!("no camera or light and smaller than {min} voxels"));
-        }
-        if params.closed && faced == [0, 0] {
-            return dropped(
-                "inside closed geometry: a closed level's space that no triangle faces or turns \
-                 its back to (a void within a thick wall)"
-                    .into(),
-            );
-        }
-        // Where the scene's cameras and lights are elsewhere: a room the voxels cut off from
-        // theirs (an opening narrower than two voxels) is kept, faced by its walls; the space
-        // around and over the rooms, which sees the backs of their walls, is dropped.
-        let [f, b] = self.first_open[c];
-        if self.seeded_any && b >= f {
-            return dropped(format!(
-                "{UNSEEN}, and from their first open voxel {b} triangles turn their back to it, \
-                 {f} face it (the space around the rooms, or inside walls)"
-            ));
-        }
-        if self.seeded_any {
-            return (
-                true,
-                format!(
-                    "faced by its walls, though no camera or light is in it: from their first \
-                     open voxel {f} triangles face it, {b} turn their back to it"
-                ),
-            );
-        }
-        if faced[1] > faced[0] {
-            return dropped(format!(
-                "inside closed geometry: {} triangles turn their back to it, {} face it",
-                faced[1], faced[0]
-            ));
-        }
-        if faced == [0, 0] {
-            // Kept, as before, but not said to be faced: a space that no triangle lies beside
-            // (within 0.75 voxel), a slit or a pocket of the voxels.
-            return (
-                true,
-                "large, and no triangle faces it or turns its back to it".to_string(),
-            );
-        }
-        (true, "large and faced by the geometry".to_string())
+    }
+    placed
+}
+
+/// A closed scene's leaks (its kept `empty` voxels next to the border ring, by side) and the
+/// openings they pass from `seed_voxels`; an error naming them unless leaks are allowed.
+/// Nothing for a scene not declared closed.
+fn closed_leaks(
+    meta: &GridMeta,
+    empty: &[bool],
+    seed_voxels: &[(String, [f32; 3], usize)],
+    params: &EmptySpaceParams,
+) -> Result<(Vec<Leak>, Vec<crate::leak::LeakPath>), BakeError> {
+    if !params.closed {
+        return Ok((Vec::new(), Vec::new()));
+    }
+    let leaks = leaks_by_side(meta, empty);
+    if leaks.is_empty() {
+        return Ok((leaks, Vec::new()));
+    }
+    let openings = crate::leak::find_openings(meta, empty, seed_voxels);
+    if params.allow_leaks {
+        return Ok((leaks, openings));
+    }
+    let list: Vec<String> = leaks
+        .iter()
+        .map(|l| {
+            let (a, b) = (l.bounds_min_m, l.bounds_max_m);
+            format!(
+                "{} side: {} voxels in [{:.2}, {:.2}, {:.2}]..[{:.2}, {:.2}, {:.2}] m",
+                l.side, l.voxels, a[0], a[1], a[2], b[0], b[1], b[2]
+            )
+        })
+        .collect();
+    Err(BakeError::Leak {
+        openings,
+        sides: list.join("; "),
+    })
+}
+
+/// The faces as the rooms see them, and a bare mesh's inside (winding.rs).
+struct Read {
+    /// A bare mesh's inside: the component the most triangles face.
+    inside_component: Option<u32>,
+    /// Whether the faces were read turned, wound inside out.
+    faces_turned: bool,
+    /// Per component, the triangles whose front and whose back lie 0.75 voxel off on its side.
+    faced: Vec<[u64; 2]>,
+    /// Per component, the triangles whose front and whose back face it from their first open
+    /// voxel.
+    first_open: Vec<[u64; 2]>,
+}
+
+/// Reads the faces' votes: a scene that names no camera and no light (`bare`, a bare mesh)
+/// gets its inside, as a camera would keep its component (inside.rs), and faces wound inside
+/// out are read turned (winding.rs).
+fn read_faces(
+    meta: &GridMeta,
+    comps: &Components,
+    facing: Facing,
+    tally: &Tally,
+    seeds_in: &[Vec<String>],
+    bare: bool,
+    empty: &[bool],
+) -> Read {
+    let Facing {
+        mut faced,
+        fronts,
+        backs,
+    } = facing;
+    let (at_bounds, voxels) = (&tally.at_bounds, &tally.voxels);
+    let votes = crate::winding::Votes {
+        faced: &faced,
+        fronts: &fronts,
+        backs: &backs,
+        at_bounds,
+    };
+    let (inside_component, faces_turned) = if bare {
+        let is_empty = |i: usize| empty[i];
+        crate::winding::bare_inside(meta, comps, &votes, voxels, &is_empty)
+    } else {
+        let seeded: Vec<bool> = seeds_in.iter().map(|s| !s.is_empty()).collect();
+        let turned = crate::winding::rooms_turned(&votes, &seeded)
+            && !crate::winding::turning_drops_more(&votes, &seeded, voxels);
+        (None, turned)
+    };
+    // Each component's first-open votes, [fronts, backs], the faces read as the rooms see them.
+    let first_open: Vec<[u64; 2]> = fronts
+        .iter()
+        .zip(&backs)
+        .map(|(&f, &b)| if faces_turned { [b, f] } else { [f, b] })
+        .collect();
+    if faces_turned {
+        faced.iter_mut().for_each(|f| f.swap(0, 1));
+    }
+    Read {
+        inside_component,
+        faces_turned,
+        faced,
+        first_open,
+    }
+}
+
+/// A bare mesh's inside where it reaches the bounds: its point and the distance field its
+/// openings are looked for on.
+struct Located {
+    /// Whether the inside reaches the bounds (its openings looked for or not).
+    inside_at_bounds: bool,
+    /// The squared clearance to the walls, where the openings are looked for.
+    walls: Option<Vec<u64>>,
+    /// The inside's point.
+    inside: Option<crate::inside::Inside>,
+}
+
+/// Only where the inside reaches the bounds (a sealed level's inside needs no point), one
+/// distance field for its point and its leaks (the border ring open: a voxel by a window to
+/// the void is wide, but its rays escape).
+fn locate_inside(
+    meta: &GridMeta,
+    comps: &Components,
+    empty: &[bool],
+    inside_component: Option<u32>,
+    tally: &Tally,
+    params: &EmptySpaceParams,
+) -> Located {
+    let at_bounds = &tally.at_bounds;
+    let [nx, ny, nz] = meta.dims.map(|d| d as usize);
+    let inside_at_bounds = inside_component.is_some_and(|c| at_bounds[c as usize]);
+    let locate = params.locate_inside_leaks
+        && meta
+            .voxel_count()
+            .is_some_and(|v| v <= INSIDE_LEAK_MAX_VOXELS);
+    let walls = (inside_at_bounds && locate).then(|| crate::leak::clearance_to_walls(meta, empty));
+    let inside = inside_component.zip(walls.as_ref()).and_then(|(c, d2)| {
+        // The inside's voxels, run by run: a label looked up a voxel cost seconds at 512³.
+        let visit = |f: &mut dyn FnMut(usize)| {
+            for r in 0..ny * nz {
+                for (a, b, l) in comps.row(r) {
+                    if l == c {
+                        (a..=b).for_each(|x| f(r * nx + x as usize));
+                    }
+                }
+            }
+        };
+        crate::inside::find_inside(meta, d2, &visit)
+    });
+    Located {
+        inside_at_bounds,
+        walls,
+        inside,
     }
 }
 
@@ -570,91 +578,4 @@ struct Facing {
     fronts: Vec<u64>,
     /// Per component, the triangles whose back faces it from their first open voxel.
     backs: Vec<u64>,
-}
-
-/// Hangs every solid 6-component that does not reach the grid border (see module notes).
-fn hang_floating_objects(meta: &GridMeta, empty: &mut [bool]) -> Vec<Thread> {
-    let dims = meta.dims;
-    let [nx, ny, _] = dims.map(|d| d as usize);
-    let strides = [1isize, nx as isize, (nx * ny) as isize];
-    let mut threads = Vec::new();
-    loop {
-        let solid = grid_components(dims, |i| !empty[i], Conn::C6);
-        let count = solid.count;
-        if count <= 1 {
-            return threads;
-        }
-        // Voxel 0 is on the border ring, which is solid: its label is the grounded one.
-        let ground = solid.label(0).unwrap_or(u32::MAX);
-        let mut sizes = vec![0u64; count as usize];
-        let rows = empty.len() / nx;
-        for r in 0..rows {
-            for (a, b, l) in solid.row(r) {
-                sizes[l as usize] += u64::from(b - a + 1);
-            }
-        }
-        // Shortest march per floating component: (length, start, dir).
-        let mut best: Vec<Option<(usize, usize, usize)>> = vec![None; count as usize];
-        let floating = (0..rows).flat_map(|r| {
-            solid
-                .row(r)
-                .filter(|&(_, _, l)| l != ground)
-                .flat_map(move |(a, b, l)| (a..=b).map(move |x| (r * nx + x as usize, l)))
-        });
-        for (i, l) in floating {
-            for dir in 0..6 {
-                let step = if dir % 2 == 0 {
-                    -strides[dir / 2]
-                } else {
-                    strides[dir / 2]
-                };
-                let mut j = i as isize + step;
-                let mut len = 0usize;
-                // Never out of the grid: the ring is solid and stops every march.
-                while empty[j as usize] {
-                    len += 1;
-                    j += step;
-                }
-                if len == 0 || solid.label(j as usize) == Some(l) {
-                    continue;
-                }
-                let cand = (len, i, dir);
-                let b = &mut best[l as usize];
-                if b.is_none_or(|b| cand < b) {
-                    *b = Some(cand);
-                }
-            }
-        }
-        let mut hung = 0;
-        for (l, b) in best.iter().enumerate() {
-            let Some((len, start, dir)) = *b else {
-                continue;
-            };
-            let step = if dir % 2 == 0 {
-                -strides[dir / 2]
-            } else {
-                strides[dir / 2]
-            };
-            let mut j = start as isize;
-            for _ in 0..len {
-                j += step;
-                empty[j as usize] = false;
-            }
-            let v = [
-                (start % nx) as u32,
-                ((start / nx) % ny) as u32,
-                (start / (nx * ny)) as u32,
-            ];
-            threads.push(Thread {
-                object_voxels: sizes[l],
-                from_m: meta.voxel_to_world(v),
-                length_voxels: len as u64,
-            });
-            hung += 1;
-        }
-        // Relabel: a thread may have reached another floating object, which then still floats.
-        if hung == 0 {
-            return threads;
-        }
-    }
 }

@@ -67,14 +67,32 @@ pub fn segment(
     radius: &[f32],
     params: &SegmentParams,
 ) -> Segmented {
-    let n = adjacency.len();
     let removed = |i: usize| attach.is_some_and(|a| a[i] as usize != i);
     let mut kind: Vec<Option<SegNodeKind>> = adjacency
         .iter()
         .enumerate()
         .map(|(i, a)| (a.len() != 2 && !removed(i)).then_some(SegNodeKind::Topology))
         .collect();
-    // Bare loops: give each an extremity.
+    mark_bare_loops(adjacency, &removed, radius, &mut kind);
+    let lines = topology_lines(adjacency, &kind);
+    // Curvature, then coverage, then narrowing, splitting recursively.
+    let curvature = |line: &[u32]| curvature_split(line, position, radius, params);
+    let coverage = |line: &[u32]| coverage_split(line, position, radius);
+    let narrowing = |line: &[u32]| narrowing_split(line, radius, params.narrowing_ratio);
+    let lines = split_lines(lines, &curvature, SegNodeKind::Curvature, &mut kind);
+    let lines = split_lines(lines, &coverage, SegNodeKind::Coverage, &mut kind);
+    let lines = split_lines(lines, &narrowing, SegNodeKind::Narrowing, &mut kind);
+    assemble(&kind, lines, position, attach)
+}
+
+/// Gives each bare loop (a component without a topology node) one: its widest node.
+fn mark_bare_loops(
+    adjacency: &[Vec<u32>],
+    removed: &dyn Fn(usize) -> bool,
+    radius: &[f32],
+    kind: &mut [Option<SegNodeKind>],
+) {
+    let n = adjacency.len();
     let mut seen = vec![false; n];
     for start in 0..n {
         if seen[start] || removed(start) {
@@ -105,10 +123,13 @@ pub fn segment(
             kind[widest as usize] = Some(SegNodeKind::Topology);
         }
     }
-    // Lines between topology nodes, each walked once (from its lower end, in order).
+}
+
+/// The lines between topology nodes, each walked once (from its lower end, in order).
+fn topology_lines(adjacency: &[Vec<u32>], kind: &[Option<SegNodeKind>]) -> Vec<Vec<u32>> {
     let mut lines: Vec<Vec<u32>> = Vec::new();
     let mut used_first_step = std::collections::BTreeSet::new();
-    for t in 0..n as u32 {
+    for t in 0..adjacency.len() as u32 {
         if kind[t as usize].is_none() {
             continue;
         }
@@ -142,75 +163,99 @@ pub fn segment(
             lines.push(line);
         }
     }
-    // Curvature, then coverage, splitting recursively.
-    let curvature = |line: &[u32]| -> Option<usize> {
-        let (a, b) = (
-            position[line[0] as usize],
-            position[line[line.len() - 1] as usize],
-        );
-        let mut best: Option<(f32, usize)> = None;
-        for (k, &m) in line.iter().enumerate().take(line.len() - 1).skip(1) {
-            let r = radius[m as usize].max(f32::MIN_POSITIVE);
-            let p = position[m as usize];
-            let d = match params.curvature_to {
-                CurvatureTo::Segment => segment_distance(p, a, b),
-                CurvatureTo::Line => line_distance(p, a, b),
-            };
-            let c = d / r;
-            if c > params.curvature_limit && best.is_none_or(|(bc, _)| c > bc) {
-                best = Some((c, k));
-            }
+    lines
+}
+
+/// Where a line bends most beyond the curvature limit: the interior node farthest from the
+/// chord (or its line) in units of its ball's radius.
+fn curvature_split(
+    line: &[u32],
+    position: &[Vec3],
+    radius: &[f32],
+    params: &SegmentParams,
+) -> Option<usize> {
+    let (a, b) = (
+        position[line[0] as usize],
+        position[line[line.len() - 1] as usize],
+    );
+    let mut best: Option<(f32, usize)> = None;
+    for (k, &m) in line.iter().enumerate().take(line.len() - 1).skip(1) {
+        let r = radius[m as usize].max(f32::MIN_POSITIVE);
+        let p = position[m as usize];
+        let d = match params.curvature_to {
+            CurvatureTo::Segment => segment_distance(p, a, b),
+            CurvatureTo::Line => line_distance(p, a, b),
+        };
+        let c = d / r;
+        if c > params.curvature_limit && best.is_none_or(|(bc, _)| c > bc) {
+            best = Some((c, k));
         }
-        best.map(|(_, k)| k)
-    };
-    let coverage = |line: &[u32]| -> Option<usize> {
-        let (f, l) = (line[0] as usize, line[line.len() - 1] as usize);
-        let mut best: Option<(f32, usize)> = None;
-        for (k, &m) in line.iter().enumerate().take(line.len() - 1).skip(1) {
-            let p = position[m as usize];
-            let cf = (p - position[f]).length() / radius[f].max(f32::MIN_POSITIVE);
-            let cl = (p - position[l]).length() / radius[l].max(f32::MIN_POSITIVE);
-            let c = cf.min(cl);
-            if c > 1.0 && best.is_none_or(|(bc, _)| c > bc) {
-                best = Some((c, k));
-            }
+    }
+    best.map(|(_, k)| k)
+}
+
+/// Where a line leaves both its ends' balls farthest: the interior node whose distance to the
+/// nearer end, in units of that end's radius, is largest above 1.
+fn coverage_split(line: &[u32], position: &[Vec3], radius: &[f32]) -> Option<usize> {
+    let (f, l) = (line[0] as usize, line[line.len() - 1] as usize);
+    let mut best: Option<(f32, usize)> = None;
+    for (k, &m) in line.iter().enumerate().take(line.len() - 1).skip(1) {
+        let p = position[m as usize];
+        let cf = (p - position[f]).length() / radius[f].max(f32::MIN_POSITIVE);
+        let cl = (p - position[l]).length() / radius[l].max(f32::MIN_POSITIVE);
+        let c = cf.min(cl);
+        if c > 1.0 && best.is_none_or(|(bc, _)| c > bc) {
+            best = Some((c, k));
         }
-        best.map(|(_, k)| k)
-    };
-    let mut split = |lines: Vec<Vec<u32>>,
-                     pick: &dyn Fn(&[u32]) -> Option<usize>,
-                     label: SegNodeKind|
-     -> Vec<Vec<u32>> {
-        let mut done = Vec::new();
-        let mut stack: Vec<Vec<u32>> = lines.into_iter().rev().collect();
-        while let Some(line) = stack.pop() {
-            match (line.len() > 2).then(|| pick(&line)).flatten() {
-                Some(k) => {
-                    kind[line[k] as usize] = Some(label);
-                    let (a, b) = (line[..=k].to_vec(), line[k..].to_vec());
-                    stack.push(b);
-                    stack.push(a);
-                }
-                None => done.push(line),
+    }
+    best.map(|(_, k)| k)
+}
+
+/// A line's narrowest interior node narrower than `ratio` of its narrower end.
+fn narrowing_split(line: &[u32], radius: &[f32], ratio: f32) -> Option<usize> {
+    let ends = radius[line[0] as usize].min(radius[line[line.len() - 1] as usize]);
+    (1..line.len() - 1)
+        .filter(|&k| radius[line[k] as usize] < ratio * ends)
+        .min_by(|&a, &b| {
+            radius[line[a] as usize]
+                .total_cmp(&radius[line[b] as usize])
+                .then(a.cmp(&b))
+        })
+}
+
+/// Splits `lines` at the nodes `pick` chooses, recursively, marking them `label`.
+fn split_lines(
+    lines: Vec<Vec<u32>>,
+    pick: &dyn Fn(&[u32]) -> Option<usize>,
+    label: SegNodeKind,
+    kind: &mut [Option<SegNodeKind>],
+) -> Vec<Vec<u32>> {
+    let mut done = Vec::new();
+    let mut stack: Vec<Vec<u32>> = lines.into_iter().rev().collect();
+    while let Some(line) = stack.pop() {
+        match (line.len() > 2).then(|| pick(&line)).flatten() {
+            Some(k) => {
+                kind[line[k] as usize] = Some(label);
+                let (a, b) = (line[..=k].to_vec(), line[k..].to_vec());
+                stack.push(b);
+                stack.push(a);
             }
+            None => done.push(line),
         }
-        done
-    };
-    let narrowing = |line: &[u32]| -> Option<usize> {
-        let ends = radius[line[0] as usize].min(radius[line[line.len() - 1] as usize]);
-        (1..line.len() - 1)
-            .filter(|&k| radius[line[k] as usize] < params.narrowing_ratio * ends)
-            .min_by(|&a, &b| {
-                radius[line[a] as usize]
-                    .total_cmp(&radius[line[b] as usize])
-                    .then(a.cmp(&b))
-            })
-    };
-    let lines = split(lines, &curvature, SegNodeKind::Curvature);
-    let lines = split(lines, &coverage, SegNodeKind::Coverage);
-    let lines = split(lines, &narrowing, SegNodeKind::Narrowing);
-    // Segmented nodes in skeleton order.
-    let mut seg_id = vec![u32::MAX; n];
+    }
+    done
+}
+
+/// The segmented skeleton: its nodes in skeleton order, an edge per line, and each skeleton
+/// node's segmented node (an interior node the nearer end by arc length; a removed node its
+/// attachment's).
+fn assemble(
+    kind: &[Option<SegNodeKind>],
+    lines: Vec<Vec<u32>>,
+    position: &[Vec3],
+    attach: Option<&[u32]>,
+) -> Segmented {
+    let mut seg_id = vec![u32::MAX; kind.len()];
     let mut nodes = Vec::new();
     for (i, k) in kind.iter().enumerate() {
         if let Some(k) = k {
