@@ -23,8 +23,9 @@ voxels, walking them along the true segment with the closed voxels' triangles
 --gate-shape says; gates takes --gate-shape, voxels by default), gates-filled (gates as set,
 its blur filled from the next blocks: --blur-fill), gates-starved (gates as set, its
 starved pixels walking what their blur block lacks: --starved-taps, or 3/4 of the block's
-pixels where that is 0) and gates-roulette (gates as set, its walks by Russian roulette:
---walk-roulette, or 0.05 where that is 0 or auto). `all`: every one but direct-only, gates once a
+pixels where that is 0), gates-roulette (gates as set, its walks by Russian roulette:
+--walk-roulette, or 0.05 where that is 0 or auto) and gates-accurate (gates as set, in the
+accurate setting: --accurate). `all`: every one but direct-only and gates-accurate, gates once a
 shape, gates-filled and gates-starved where gates interleave without them, and
 gates-roulette where gates walk (voxels, portals) without it; the gate modes only with a level
 (given, or baked here). A mode that would render another's very frame (gates-roulette where
@@ -247,6 +248,10 @@ const SHAPED: [(&str, GateShape, bool); 4] = [
 /// Mode gates with its starved pixels walking what their blur block lacks, in `visgate
 /// compare`: the gates' own --starved-taps, or 3/4 of the block's pixels where that is 0.
 const STARVED: &str = "gates-starved";
+/// Mode gates in the accurate setting (--accurate: the closed voxels' triangles, the tent
+/// blur, the starved pixels' walks), in `visgate compare`; not in `all` (its frame is several
+/// times the default's).
+const ACCURATE: &str = "gates-accurate";
 /// Mode gates with its blur filled from the next blocks (--blur-fill), in `visgate compare`.
 const FILLED: &str = "gates-filled";
 /// Mode gates with Russian roulette on its walks: the gates' own --walk-roulette, or
@@ -273,10 +278,10 @@ fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMod
     // Gates with one setting changed: the starved pixels' walks, the blur's fill or the walks'
     // roulette.
     let varied = |name: &str| {
-        let mut g = s.gates;
+        let mut g = s.gates.accurate_if(name == ACCURATE);
         let il = &mut g.interleave;
         match name {
-            STARVED if il.starved_taps == 0 => il.starved_taps = 3 * il.block * il.block / 4,
+            STARVED if il.starved_taps == 0 => il.starved_taps = il.three_quarters(),
             FILLED => il.fill = true,
             ROULETTE if !g.walk_roulette.is_fixed() => {
                 g.walk_roulette = WalkRoulette::Share(ROULETTE_SHARE)
@@ -289,10 +294,11 @@ fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMod
         let shape = SHAPED.iter().find(|(n, ..)| *n == name);
         let mode = match (shape, method(name)) {
             (Some(&(_, g, t)), _) => shaped(g, t),
-            _ if [STARVED, FILLED, ROULETTE].contains(&name) => varied(name),
+            _ if [STARVED, FILLED, ROULETTE, ACCURATE].contains(&name) => varied(name),
             (_, Some(m)) => (m.make)(&s),
             (None, None) => bail!(
-                "--modes {name}: give all or some of {}, {}, {FILLED}, {STARVED}, {ROULETTE}",
+                "--modes {name}: give all or some of {}, {}, {FILLED}, {STARVED}, {ROULETTE}, \
+                 {ACCURATE}",
                 METHODS.map(|m| m.name).join(", "),
                 SHAPED.map(|(n, ..)| n).join(", ")
             ),
@@ -584,6 +590,28 @@ mod tests {
         assert_eq!(taps(&[]), 48, "8 x 8 by default");
         assert_eq!(taps(&["--interleave", "4"]), 12);
         assert_eq!(taps(&["--starved-taps", "20"]), 20);
+    }
+
+    #[test]
+    fn gates_accurate_walks_the_triangles_with_the_tent_and_the_starved_pixels() {
+        let g = gates_of(ACCURATE, &[]);
+        assert!(g.gates.triangles && g.interleave.tent);
+        assert_eq!(g.interleave.starved_taps, 48, "3/4 of 8 x 8");
+        assert_eq!(g.gates.shape, GateShape::Voxels);
+        let g = gates_of(ACCURATE, &["--interleave", "4", "--walk-roulette", "0.1"]);
+        assert_eq!(g.interleave.starved_taps, 12);
+        assert_eq!(g.walk_roulette, WalkRoulette::Share(0.1), "the rest as set");
+        let g = gates_of(ACCURATE, &["--starved-taps", "20"]);
+        assert_eq!(g.interleave.starved_taps, 20, "a count given is kept");
+        // The same settings as `render --accurate`; not in `all`, and plain gates unchanged.
+        assert_eq!(
+            g,
+            gates_of("gates", &["--starved-taps", "20", "--accurate"])
+        );
+        assert!(!all_with(&[]).contains(&ACCURATE.to_string()));
+        let plain = gates_of("gates", &[]);
+        assert!(!plain.gates.triangles && !plain.interleave.tent);
+        assert_eq!(plain.interleave.starved_taps, 0);
     }
 
     #[test]

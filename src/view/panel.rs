@@ -7,8 +7,8 @@ use visgate_formats::Scene;
 use visgate_runtime::cpu::gates::GateShape;
 use visgate_runtime::gpu::{
     AUTO_ROULETTE_BLOCK, AUTO_ROULETTE_SHARE, AUTO_ROULETTE_VPLS, DirectLight, DiskLight,
-    InterleaveParams, IsmParams, LcDisk, LightClusterGpuParams, MethodSettings, PassTimes,
-    WalkRoulette,
+    GatesParams, InterleaveParams, IsmParams, LcDisk, LightClusterGpuParams, MethodSettings,
+    PassTimes, WalkRoulette,
 };
 
 use super::camera::FlyCamera;
@@ -143,9 +143,32 @@ pub fn method_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
         }
         _ => {}
     }
+    let voxels = s.gates.gates.shape == GateShape::Voxels;
+    if mode == "gates" && voxels && s.vals.interleave.block > 1 {
+        let button = ui.button("accurate setting").on_hover_text(
+            "the triangles in closed voxels, the tent blur and the starved taps at 3/4 of the \
+             block (render --accurate): the reference's light within a few per cent and under \
+             1 % of the lit pixels black where measured, at several times the frame",
+        );
+        if button.clicked() {
+            set_accurate(s);
+        }
+    }
     let il = &mut s.vals.interleave;
     il.starved_taps = il.starved_taps.min(il.block * il.block);
     s.gates.interleave = *il;
+}
+
+/// The accurate setting ([`GatesParams::accurate`], `render --accurate`) on the viewer's
+/// gates, whose interleaving is the VAL modes' (one block for both, to compare like with like).
+pub fn set_accurate(s: &mut MethodSettings) {
+    let g = GatesParams {
+        interleave: s.vals.interleave,
+        ..s.gates
+    }
+    .accurate();
+    s.gates.gates = g.gates;
+    s.vals.interleave = g.interleave;
 }
 
 /// The direct lights' shadows: each light's maps, or LightCluster with its clustering, disk

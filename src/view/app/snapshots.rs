@@ -111,6 +111,17 @@ fn first_frame(app: ViewerApp) -> Harness<'static, ViewerApp> {
     harness
 }
 
+/// Steps `harness` until it has drawn more than `before` frames (a minute at most).
+fn until_a_frame_after(harness: &mut Harness<'static, ViewerApp>, before: u32) {
+    for _ in 0..3000 {
+        harness.step();
+        if harness.state().frames > before {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+}
+
 // One test per snapshot: kittest keeps one harness's results per test.
 
 #[test]
@@ -181,13 +192,7 @@ fn the_viewer_walks_with_the_closed_voxels_triangles_once_ticked() {
     assert_eq!(listed(harness.state()), (Some(false), false));
     let before = harness.state().frames;
     harness.get_by_label("triangles in closed voxels").click();
-    for _ in 0..600 {
-        harness.step();
-        if harness.state().frames > before {
-            break;
-        }
-        std::thread::sleep(std::time::Duration::from_millis(20));
-    }
+    until_a_frame_after(&mut harness, before);
     let app = harness.state();
     assert!(app.settings.gates.gates.triangles);
     assert_eq!(listed(app), (Some(true), true));
@@ -195,6 +200,26 @@ fn the_viewer_walks_with_the_closed_voxels_triangles_once_ticked() {
     assert!(app.frames > before, "no frame with the triangles");
     let (_, times) = app.last.as_ref().expect("a frame");
     assert!(times.passes.iter().any(|p| p.name == "indirect lighting"));
+}
+
+#[test]
+fn the_viewer_s_accurate_setting_walks_the_triangles_and_the_starved_pixels() {
+    let mut harness = first_frame(viewer(Layers::default(), false));
+    let before = harness.state().frames;
+    harness.get_by_label("accurate setting").click();
+    until_a_frame_after(&mut harness, before);
+    let app = harness.state();
+    let g = app.settings.gates;
+    assert!(g.gates.triangles && g.interleave.tent);
+    assert_eq!(g.interleave.starved_taps, 48, "3/4 of the 8 x 8 block");
+    assert_eq!(app.error, None);
+    assert!(app.frames > before, "no frame in the accurate setting");
+    let (_, times) = app.last.as_ref().expect("a frame");
+    let names: Vec<&str> = times.passes.iter().map(|p| p.name).collect();
+    assert!(
+        names.contains(&"indirect lighting: starved pixels"),
+        "{names:?}"
+    );
 }
 
 #[test]

@@ -160,6 +160,26 @@ pub fn check_gates(g: &GateParams) -> Result<(), RenderError> {
 }
 
 impl GatesParams {
+    /// The accurate setting (`--accurate`): the voxel walk along the true segment with the
+    /// closed voxels' triangles, the tent blur, and the starved pixels walking what their
+    /// block lacks where fewer than three quarters of its taps agree with them (48 of 8 × 8;
+    /// a count already set is kept). On sixteen camera-seeds (README) the indirect energy
+    /// within 1.6 % of the reference's and under 1 % of the lit pixels black, at several
+    /// times the default's frame: for stills and reference-grade walk-throughs.
+    pub fn accurate(mut self) -> GatesParams {
+        self.gates.triangles = true;
+        self.interleave.tent = true;
+        if self.interleave.starved_taps == 0 {
+            self.interleave.starved_taps = self.interleave.three_quarters();
+        }
+        self
+    }
+
+    /// [`GatesParams::accurate`] where `on`, else these.
+    pub fn accurate_if(self, on: bool) -> GatesParams {
+        if on { self.accurate() } else { self }
+    }
+
     /// The roulette's share S for a frame of `vpls` VPLs (0: every VPL walked).
     pub fn roulette_share(&self, vpls: u32) -> f32 {
         let il = self.interleave;

@@ -59,6 +59,12 @@ impl InterleaveParams {
         self.block * self.block
     }
 
+    /// Three quarters of the block's taps: the starved pixels' count of `visgate compare`'s
+    /// gates-starved and of the accurate setting (48 of 8 × 8; 0 for a block of 1).
+    pub fn three_quarters(&self) -> u32 {
+        3 * self.subsets() / 4
+    }
+
     /// Whether starved pixels walk what their block lacks: an interleaved block and a
     /// [`InterleaveParams::starved_taps`] set.
     pub fn walks_starved(&self) -> bool {
