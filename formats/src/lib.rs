@@ -15,6 +15,7 @@
 //! - [`vgate`]: the baked `.vgate` file — the runtime layout of a level's skeleton, visibility
 //!   clusters and gates, and its voxel grids — with a validating reader.
 
+mod assemble;
 pub mod desc;
 pub mod error;
 pub mod export;
