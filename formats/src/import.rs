@@ -10,9 +10,10 @@ use std::collections::HashMap;
 use std::io::BufRead;
 use std::path::{Path, PathBuf};
 
-use glam::{Mat4, Vec2, Vec3};
+use glam::{Vec2, Vec3};
 
 use crate::error::SceneError;
+pub use crate::import_gltf::import_gltf;
 use crate::scene::{FileKind, Material, Texture};
 
 /// Albedo of a triangle with no material: Mitsuba's default diffuse reflectance.
@@ -260,231 +261,6 @@ fn import_obj_reader(
     Ok(out)
 }
 
-/// Imports a glTF 2.0 file (`.gltf` with external or embedded buffers, or `.glb`), walking
-/// the default scene's node hierarchy and applying node transforms.
-pub fn import_gltf(path: &Path, options: &ImportOptions) -> Result<ImportedModel, SceneError> {
-    let gerr = |e: gltf::Error| SceneError::Gltf {
-        file: path.to_path_buf(),
-        message: e.to_string(),
-    };
-    let gltf::Gltf { document, blob } = gltf::Gltf::open(path).map_err(gerr)?;
-    let base = path.parent().unwrap_or(Path::new("."));
-    let buffers = gltf::import_buffers(&document, Some(base), blob).map_err(gerr)?;
-    let mut out = ImportedModel::default();
-
-    // Images → textures (failures fall back to the albedo).
-    let mut image_texture: Vec<Option<u32>> = Vec::new();
-    for image in document.images() {
-        if !options.load_textures {
-            image_texture.push(None);
-            continue;
-        }
-        let name = match image.source() {
-            gltf::image::Source::Uri { uri, .. } => uri.to_string(),
-            gltf::image::Source::View { .. } => {
-                format!("image {} (embedded)", image.index())
-            }
-        };
-        match gltf::image::Data::from_source(image.source(), Some(base), &buffers)
-            .map_err(|e| e.to_string())
-            .and_then(|d| gltf_image_rgba8(&d).map(|px| (d.width, d.height, px)))
-        {
-            Ok((width, height, rgba8)) => {
-                out.textures.push(Texture {
-                    name,
-                    width,
-                    height,
-                    rgba8,
-                });
-                image_texture.push(Some(out.textures.len() as u32 - 1));
-            }
-            Err(e) => {
-                out.textures_failed += 1;
-                out.warnings.push(format!(
-                    "{}: texture '{name}' not loaded ({e}); its materials use their albedo",
-                    path.display()
-                ));
-                image_texture.push(None);
-            }
-        }
-    }
-    for m in document.materials() {
-        if m.emissive_factor().iter().any(|&c| c > 0.0) {
-            out.emissive.push(out.materials.len() as u32);
-        }
-        let pbr = m.pbr_metallic_roughness();
-        let base_color = pbr.base_color_factor();
-        let mut texture = pbr
-            .base_color_texture()
-            .map(|t| t.texture().source().index());
-        let mut albedo = Vec3::new(base_color[0], base_color[1], base_color[2]);
-        if let Some(sg) = m.pbr_specular_glossiness() {
-            let d = sg.diffuse_factor();
-            if base_color == [1.0; 4] {
-                albedo = Vec3::new(d[0], d[1], d[2]);
-            }
-            if texture.is_none() {
-                texture = sg.diffuse_texture().map(|t| t.texture().source().index());
-            }
-        }
-        out.materials.push(Material {
-            name: m
-                .name()
-                .map(str::to_string)
-                .unwrap_or_else(|| format!("material {}", m.index().unwrap_or(0))),
-            albedo,
-            texture: texture.and_then(|i| image_texture.get(i).copied().flatten()),
-        });
-    }
-    let default_material = out.materials.len() as u32;
-    let mut needs_default = false;
-
-    let scene = document
-        .default_scene()
-        .or_else(|| document.scenes().next());
-    // Lights and cameras in the file's node order, on a walk of their own: the mesh walk below
-    // pops a stack, and its order is the one the meshes (and baked levels' hashes) keep.
-    if let Some(s) = &scene {
-        crate::gltf_nodes::read_nodes(path, s, &mut out);
-    }
-    let mut stack: Vec<(gltf::Node, Mat4)> = match &scene {
-        Some(s) => s.nodes().map(|n| (n, Mat4::IDENTITY)).collect(),
-        None => vec![],
-    };
-    while let Some((node, parent)) = stack.pop() {
-        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
-        for child in node.children() {
-            stack.push((child, world));
-        }
-        let Some(mesh) = node.mesh() else { continue };
-        let normal_m = world.inverse().transpose();
-        let flip = world.determinant() < 0.0;
-        for prim in mesh.primitives() {
-            let mname = mesh
-                .name()
-                .or(node.name())
-                .map(str::to_string)
-                .unwrap_or_else(|| format!("mesh {}", mesh.index()));
-            let mode = prim.mode();
-            if !matches!(
-                mode,
-                gltf::mesh::Mode::Triangles
-                    | gltf::mesh::Mode::TriangleStrip
-                    | gltf::mesh::Mode::TriangleFan
-            ) {
-                out.warnings.push(format!(
-                    "{}: mesh '{mname}' has a {mode:?} primitive, which is not triangles; skipped",
-                    path.display()
-                ));
-                continue;
-            }
-            let reader = prim.reader(|b| buffers.get(b.index()).map(|d| d.0.as_slice()));
-            let Some(pos) = reader.read_positions() else {
-                out.warnings.push(format!(
-                    "{}: mesh '{mname}' has a primitive without positions; skipped",
-                    path.display()
-                ));
-                continue;
-            };
-            let positions: Vec<Vec3> = pos.map(|p| world.transform_point3(Vec3::from(p))).collect();
-            let normals = reader.read_normals().map(|it| {
-                it.map(|n| {
-                    normal_m
-                        .transform_vector3(Vec3::from(n))
-                        .normalize_or_zero()
-                })
-                .collect::<Vec<_>>()
-            });
-            let uvs = reader
-                .read_tex_coords(0)
-                .map(|it| it.into_f32().map(Vec2::from).collect::<Vec<_>>());
-            let list: Vec<u64> = match reader.read_indices() {
-                Some(ix) => ix.into_u32().map(u64::from).collect(),
-                None => (0..positions.len() as u64).collect(),
-            };
-            let list = match mode {
-                gltf::mesh::Mode::TriangleStrip => strip_to_list(&list),
-                gltf::mesh::Mode::TriangleFan => fan_to_list(&list),
-                _ => list,
-            };
-            let list = if flip {
-                list.chunks_exact(3)
-                    .flat_map(|t| [t[0], t[2], t[1]])
-                    .collect()
-            } else {
-                list
-            };
-            let material = match prim.material().index() {
-                Some(i) => i as u32,
-                None => {
-                    needs_default = true;
-                    default_material
-                }
-            };
-            let raw = build_mesh(
-                path,
-                mname,
-                positions,
-                normals,
-                uvs,
-                list.into_iter(),
-                material,
-                &mut out,
-            )?;
-            if !raw.triangles.is_empty() {
-                out.meshes.push(raw);
-            }
-        }
-    }
-    if needs_default {
-        out.materials.push(Material {
-            name: "default".into(),
-            albedo: Vec3::splat(DEFAULT_ALBEDO),
-            texture: None,
-        });
-    }
-    finish_warnings(path, &mut out);
-    Ok(out)
-}
-
-fn gltf_image_rgba8(d: &gltf::image::Data) -> Result<Vec<u8>, String> {
-    use gltf::image::Format;
-    let px = &d.pixels;
-    Ok(match d.format {
-        Format::R8G8B8A8 => px.clone(),
-        Format::R8G8B8 => px
-            .chunks_exact(3)
-            .flat_map(|c| [c[0], c[1], c[2], 255])
-            .collect(),
-        Format::R8G8 => px
-            .chunks_exact(2)
-            .flat_map(|c| [c[0], c[0], c[0], c[1]])
-            .collect(),
-        Format::R8 => px.iter().flat_map(|&c| [c, c, c, 255]).collect(),
-        other => return Err(format!("pixel format {other:?} is not supported")),
-    })
-}
-
-fn strip_to_list(ix: &[u64]) -> Vec<u64> {
-    let mut out = Vec::new();
-    for i in 2..ix.len() {
-        if i % 2 == 0 {
-            out.extend([ix[i - 2], ix[i - 1], ix[i]]);
-        } else {
-            out.extend([ix[i - 1], ix[i - 2], ix[i]]);
-        }
-    }
-    out
-}
-
-fn fan_to_list(ix: &[u64]) -> Vec<u64> {
-    let mut out = Vec::new();
-    for i in 2..ix.len() {
-        out.extend([ix[0], ix[i - 1], ix[i]]);
-    }
-    out
-}
-
 /// Whether a triangle has exactly zero area. The cross product is computed in f64, where the
 /// products of f32 coordinate differences are exact, so this is an exact test for collinear
 /// (or repeated) corners rather than a tolerance.
@@ -496,7 +272,7 @@ pub fn is_degenerate(a: Vec3, b: Vec3, c: Vec3) -> bool {
 /// Validates and assembles one mesh: finite vertices, indices in range, degenerate triangles
 /// dropped, face normals where the file has none.
 #[allow(clippy::too_many_arguments)]
-fn build_mesh(
+pub(crate) fn build_mesh(
     path: &Path,
     name: String,
     positions: Vec<Vec3>,
@@ -579,7 +355,7 @@ fn build_mesh(
     }
 }
 
-fn finish_warnings(path: &Path, out: &mut ImportedModel) {
+pub(crate) fn finish_warnings(path: &Path, out: &mut ImportedModel) {
     if out.degenerate_dropped > 0 {
         out.warnings.push(format!(
             "{}: dropped {} degenerate (zero-area) triangles of {}",

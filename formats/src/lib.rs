@@ -23,6 +23,7 @@ pub mod geom;
 pub mod gltf_export;
 pub mod gltf_nodes;
 pub mod import;
+mod import_gltf;
 pub mod load;
 pub mod mitsuba;
 pub mod placement;

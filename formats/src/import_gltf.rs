@@ -1,0 +1,290 @@
+//! glTF 2.0 import (`.gltf` with external or embedded buffers, or `.glb`) through the `gltf`
+//! crate: its images as textures, its materials, and its default scene's node hierarchy
+//! walked with the node transforms applied; the checks are import.rs's.
+
+use std::path::Path;
+
+use glam::{Mat4, Vec2, Vec3};
+
+use crate::error::SceneError;
+use crate::import::{
+    DEFAULT_ALBEDO, ImportOptions, ImportedModel, RawMesh, build_mesh, finish_warnings,
+};
+use crate::scene::{Material, Texture};
+
+/// Imports a glTF 2.0 file (`.gltf` with external or embedded buffers, or `.glb`), walking
+/// the default scene's node hierarchy and applying node transforms.
+pub fn import_gltf(path: &Path, options: &ImportOptions) -> Result<ImportedModel, SceneError> {
+    let gerr = |e: gltf::Error| SceneError::Gltf {
+        file: path.to_path_buf(),
+        message: e.to_string(),
+    };
+    let gltf::Gltf { document, blob } = gltf::Gltf::open(path).map_err(gerr)?;
+    let base = path.parent().unwrap_or(Path::new("."));
+    let buffers = gltf::import_buffers(&document, Some(base), blob).map_err(gerr)?;
+    let mut out = ImportedModel::default();
+    let file = File {
+        path,
+        buffers: &buffers,
+    };
+    let image_texture = textures(&document, &file, base, options, &mut out);
+    materials(&document, &image_texture, &mut out);
+    let default_material = out.materials.len() as u32;
+    let mut needs_default = false;
+
+    let scene = document
+        .default_scene()
+        .or_else(|| document.scenes().next());
+    // Lights and cameras in the file's node order, on a walk of their own: the mesh walk below
+    // pops a stack, and its order is the one the meshes (and baked levels' hashes) keep.
+    if let Some(s) = &scene {
+        crate::gltf_nodes::read_nodes(path, s, &mut out);
+    }
+    let mut stack: Vec<(gltf::Node, Mat4)> = match &scene {
+        Some(s) => s.nodes().map(|n| (n, Mat4::IDENTITY)).collect(),
+        None => vec![],
+    };
+    while let Some((node, parent)) = stack.pop() {
+        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+        for child in node.children() {
+            stack.push((child, world));
+        }
+        let Some(mesh) = node.mesh() else { continue };
+        let mname = mesh
+            .name()
+            .or(node.name())
+            .map(str::to_string)
+            .unwrap_or_else(|| format!("mesh {}", mesh.index()));
+        for prim in mesh.primitives() {
+            let material = prim.material().index().map(|i| i as u32);
+            let placed = Placed {
+                name: &mname,
+                world,
+                material: material.unwrap_or(default_material),
+            };
+            // A primitive read (not skipped) without a material takes the default one.
+            let Some(raw) = primitive(&file, &prim, &placed, &mut out)? else {
+                continue;
+            };
+            needs_default |= material.is_none();
+            if !raw.triangles.is_empty() {
+                out.meshes.push(raw);
+            }
+        }
+    }
+    if needs_default {
+        out.materials.push(Material {
+            name: "default".into(),
+            albedo: Vec3::splat(DEFAULT_ALBEDO),
+            texture: None,
+        });
+    }
+    finish_warnings(path, &mut out);
+    Ok(out)
+}
+
+/// The file being read: its path (for messages) and its buffers.
+struct File<'a> {
+    path: &'a Path,
+    buffers: &'a [gltf::buffer::Data],
+}
+
+/// Where a primitive goes: its mesh's name, its node's world transform, its material.
+struct Placed<'a> {
+    name: &'a str,
+    world: Mat4,
+    material: u32,
+}
+
+/// The file's images as textures, each image's texture index (`None` where textures are not
+/// loaded or it failed: a warning, and its materials use their albedo).
+fn textures(
+    document: &gltf::Document,
+    file: &File,
+    base: &Path,
+    options: &ImportOptions,
+    out: &mut ImportedModel,
+) -> Vec<Option<u32>> {
+    let mut image_texture: Vec<Option<u32>> = Vec::new();
+    for image in document.images() {
+        if !options.load_textures {
+            image_texture.push(None);
+            continue;
+        }
+        let name = match image.source() {
+            gltf::image::Source::Uri { uri, .. } => uri.to_string(),
+            gltf::image::Source::View { .. } => {
+                format!("image {} (embedded)", image.index())
+            }
+        };
+        match gltf::image::Data::from_source(image.source(), Some(base), file.buffers)
+            .map_err(|e| e.to_string())
+            .and_then(|d| gltf_image_rgba8(&d).map(|px| (d.width, d.height, px)))
+        {
+            Ok((width, height, rgba8)) => {
+                out.textures.push(Texture {
+                    name,
+                    width,
+                    height,
+                    rgba8,
+                });
+                image_texture.push(Some(out.textures.len() as u32 - 1));
+            }
+            Err(e) => {
+                out.textures_failed += 1;
+                out.warnings.push(format!(
+                    "{}: texture '{name}' not loaded ({e}); its materials use their albedo",
+                    file.path.display()
+                ));
+                image_texture.push(None);
+            }
+        }
+    }
+    image_texture
+}
+
+/// The file's materials: the base colour (or the specular-glossiness diffuse where the base
+/// colour is left white) and its texture; an emissive one is noted as glowing.
+fn materials(document: &gltf::Document, image_texture: &[Option<u32>], out: &mut ImportedModel) {
+    for m in document.materials() {
+        if m.emissive_factor().iter().any(|&c| c > 0.0) {
+            out.emissive.push(out.materials.len() as u32);
+        }
+        let pbr = m.pbr_metallic_roughness();
+        let base_color = pbr.base_color_factor();
+        let mut texture = pbr
+            .base_color_texture()
+            .map(|t| t.texture().source().index());
+        let mut albedo = Vec3::new(base_color[0], base_color[1], base_color[2]);
+        if let Some(sg) = m.pbr_specular_glossiness() {
+            let d = sg.diffuse_factor();
+            if base_color == [1.0; 4] {
+                albedo = Vec3::new(d[0], d[1], d[2]);
+            }
+            if texture.is_none() {
+                texture = sg.diffuse_texture().map(|t| t.texture().source().index());
+            }
+        }
+        out.materials.push(Material {
+            name: m
+                .name()
+                .map(str::to_string)
+                .unwrap_or_else(|| format!("material {}", m.index().unwrap_or(0))),
+            albedo,
+            texture: texture.and_then(|i| image_texture.get(i).copied().flatten()),
+        });
+    }
+}
+
+/// One primitive as a mesh in the world (strips and fans as lists, turned where the transform
+/// mirrors); `None`, with a warning, where it is not triangles or has no positions.
+fn primitive(
+    file: &File,
+    prim: &gltf::Primitive,
+    placed: &Placed,
+    out: &mut ImportedModel,
+) -> Result<Option<RawMesh>, SceneError> {
+    let (path, mname, world) = (file.path, placed.name, placed.world);
+    let mode = prim.mode();
+    if !matches!(
+        mode,
+        gltf::mesh::Mode::Triangles
+            | gltf::mesh::Mode::TriangleStrip
+            | gltf::mesh::Mode::TriangleFan
+    ) {
+        out.warnings.push(format!(
+            "{}: mesh '{mname}' has a {mode:?} primitive, which is not triangles; skipped",
+            path.display()
+        ));
+        return Ok(None);
+    }
+    let reader = prim.reader(|b| file.buffers.get(b.index()).map(|d| d.0.as_slice()));
+    let Some(pos) = reader.read_positions() else {
+        out.warnings.push(format!(
+            "{}: mesh '{mname}' has a primitive without positions; skipped",
+            path.display()
+        ));
+        return Ok(None);
+    };
+    let normal_m = world.inverse().transpose();
+    let positions: Vec<Vec3> = pos.map(|p| world.transform_point3(Vec3::from(p))).collect();
+    let normals = reader.read_normals().map(|it| {
+        it.map(|n| {
+            normal_m
+                .transform_vector3(Vec3::from(n))
+                .normalize_or_zero()
+        })
+        .collect::<Vec<_>>()
+    });
+    let uvs = reader
+        .read_tex_coords(0)
+        .map(|it| it.into_f32().map(Vec2::from).collect::<Vec<_>>());
+    let list: Vec<u64> = match reader.read_indices() {
+        Some(ix) => ix.into_u32().map(u64::from).collect(),
+        None => (0..positions.len() as u64).collect(),
+    };
+    let list = match mode {
+        gltf::mesh::Mode::TriangleStrip => strip_to_list(&list),
+        gltf::mesh::Mode::TriangleFan => fan_to_list(&list),
+        _ => list,
+    };
+    let list = if world.determinant() < 0.0 {
+        list.chunks_exact(3)
+            .flat_map(|t| [t[0], t[2], t[1]])
+            .collect()
+    } else {
+        list
+    };
+    let raw = build_mesh(
+        path,
+        mname.to_string(),
+        positions,
+        normals,
+        uvs,
+        list.into_iter(),
+        placed.material,
+        out,
+    )?;
+    Ok(Some(raw))
+}
+
+/// An image's pixels as RGBA8 (grey and grey-alpha spread, RGB made opaque).
+fn gltf_image_rgba8(d: &gltf::image::Data) -> Result<Vec<u8>, String> {
+    use gltf::image::Format;
+    let px = &d.pixels;
+    Ok(match d.format {
+        Format::R8G8B8A8 => px.clone(),
+        Format::R8G8B8 => px
+            .chunks_exact(3)
+            .flat_map(|c| [c[0], c[1], c[2], 255])
+            .collect(),
+        Format::R8G8 => px
+            .chunks_exact(2)
+            .flat_map(|c| [c[0], c[0], c[0], c[1]])
+            .collect(),
+        Format::R8 => px.iter().flat_map(|&c| [c, c, c, 255]).collect(),
+        other => return Err(format!("pixel format {other:?} is not supported")),
+    })
+}
+
+/// A triangle strip's indices as a list (every other triangle turned back).
+fn strip_to_list(ix: &[u64]) -> Vec<u64> {
+    let mut out = Vec::new();
+    for i in 2..ix.len() {
+        if i % 2 == 0 {
+            out.extend([ix[i - 2], ix[i - 1], ix[i]]);
+        } else {
+            out.extend([ix[i - 1], ix[i - 2], ix[i]]);
+        }
+    }
+    out
+}
+
+/// A triangle fan's indices as a list.
+fn fan_to_list(ix: &[u64]) -> Vec<u64> {
+    let mut out = Vec::new();
+    for i in 2..ix.len() {
+        out.extend([ix[0], ix[i - 1], ix[i]]);
+    }
+    out
+}
