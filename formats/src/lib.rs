@@ -17,6 +17,7 @@
 
 mod assemble;
 pub mod desc;
+mod desc_checks;
 pub mod error;
 pub mod export;
 pub mod geom;
