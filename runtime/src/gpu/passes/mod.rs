@@ -11,6 +11,7 @@ pub mod ism_params;
 pub mod lc_params;
 pub mod light_cluster;
 pub mod per_vpl_maps;
+pub mod roulette;
 pub mod rsm_vpls;
 pub mod shade;
 pub mod shadow_maps;
