@@ -26,7 +26,8 @@
 //!    [`GpuRenderer::display`] tone-maps it into a texture a window shows as it is
 //!    ([`passes::display`]).
 //!
-//! The methods and their parameters are in [`methods`] (the registry [`METHODS`]); what a
+//! The methods and their parameters are in [`methods`] (the registry [`METHODS`]); a frame's
+//! run — its checks, its passes recorded, its readback — in `run.rs` and `record.rs`; what a
 //! renderer reads back besides a frame (for tests and inspection) in `inspect.rs`; every
 //! struct shared with WGSL in [`layout`]; the WGSL include step and injected constants in
 //! [`shaders`].
@@ -38,10 +39,9 @@ pub mod layout;
 pub mod methods;
 pub mod passes;
 mod record;
+mod run;
 pub mod shaders;
 pub mod timing;
-
-use std::time::Instant;
 
 use glam::Vec3;
 use visgate_formats::{Light as SceneLight, Scene};
@@ -51,7 +51,7 @@ use crate::camera::View;
 use crate::cpu::gates::{GateLevel, GateShape};
 use crate::hdr::HdrImage;
 use crate::vpl::Vpl;
-use context::{Pool, init_buffer, map_read, row_bytes, texels};
+use context::{Pool, init_buffer};
 use geometry::{Geometry, albedo_array};
 use layout::{Globals, Grid};
 use passes::clustered_gates::{ClusteredGates, LevelBuffers};
@@ -602,144 +602,6 @@ impl GpuRenderer {
         context::scoped(ctx, || {
             display.run(ctx, &mut self.pool, &hdr, exposure_stops)
         })
-    }
-
-    /// [`GpuRenderer::render_kept`] without the error scope.
-    fn frame_unscoped(
-        &mut self,
-        ctx: &GpuContext,
-        view: &View,
-        vpls: VplInput,
-        params: &GpuParams,
-        read_hdr: bool,
-    ) -> Result<(Option<HdrImage>, PassTimes), RenderError> {
-        let t0 = Instant::now();
-        params.check()?;
-        if let GpuMode::Gates(g) = params.mode
-            && g.interleave.walks_starved()
-        {
-            passes::starved::check_size(view.size)?;
-        }
-        if params.mode.gates().is_some() && self.scene.level.is_none() {
-            return Err(RenderError::Param(format!(
-                "mode {} needs a baked level (GpuRenderer::set_level, --level)",
-                params.mode.name()
-            )));
-        }
-        if let (Some(g), Some(l)) = (params.mode.gates(), &self.scene.level)
-            && g.shape == GateShape::Voxels
-            && g.triangles
-            && !l.triangles
-        {
-            return Err(RenderError::Param(
-                "the voxel walk with the closed voxels' triangles needs their lists on the GPU: \
-                 GateLevel::list_triangles before GpuRenderer::set_level"
-                    .into(),
-            ));
-        }
-        if let (Some(g), Some(l)) = (params.mode.gates(), &self.scene.level)
-            && g.shape == GateShape::Voxels
-            && g.planes
-            && !g.triangles
-            && !l.planes
-        {
-            return Err(RenderError::Param(
-                "the voxel walk with the closed voxels' planes needs them on the GPU: \
-                 GpuRenderer::level_for_mode uploads them (and says where they overflow the \
-                 adapter's storage binding; --no-closed-voxel-planes walks without them)"
-                    .into(),
-            ));
-        }
-        let vals = params.mode.vals();
-        let val_count = vals.map(|v| v.count);
-        let warm = vals.is_some_and(|p| p.warm_start && self.val_warm == Some(p.count));
-        let mut rec = Recorder::new(ctx, &mut self.pool);
-        let (vpl_buf, count) = self.frame_vpls(ctx, &vpls, &mut rec)?;
-        methods::warn_software_loop_limit(&ctx.adapter_info.name, &params.mode, count);
-        let cpu = match vpls {
-            VplInput::Given(v) => Some(v),
-            VplInput::Rsm(_) => None,
-        };
-        let [w, h] = view.size;
-        let (frame, pipelines, pool) = self.frame(ctx, view, params, (vpl_buf, count, cpu));
-        let out = record::record_passes(pipelines, &frame, pool, &mut rec, warm)?;
-        let read = read_hdr.then(|| {
-            let read = pool.buffer(
-                &ctx.device,
-                "hdr readback",
-                row_bytes(w, 16) * h as u64,
-                wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            );
-            context::copy_texture(&mut rec.enc, &out.hdr, &read);
-            read
-        });
-        let mut read_back = |label, src: &wgpu::Buffer, bytes| {
-            let r = pool.buffer(
-                &ctx.device,
-                label,
-                bytes,
-                wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            );
-            rec.enc.copy_buffer_to_buffer(src, 0, &r, 0, bytes);
-            r
-        };
-        let counter_read =
-            (out.lists.as_ref()).map(|l| read_back("light list counter readback", &l.counter, 32));
-        let state_read =
-            (out.val_state.as_ref()).map(|s| read_back("val convergence readback", s, 16));
-        let lc_read = (out.lc_args.as_ref()).map(|a| read_back("lc args readback", a, 64));
-        let vpl_lc_read =
-            (out.vpl_lc_args.as_ref()).map(|a| read_back("vpl lc args readback", a, 64));
-        let starved_read =
-            (out.starved.as_ref()).map(|s| read_back("starved count readback", &s.count, 16));
-        let mut times = rec.finish(pool)?;
-        let t1 = Instant::now();
-        if let (Some(l), Some(r)) = (&out.lists, &counter_read) {
-            let c: Vec<u32> = bytemuck::cast_slice(&map_read(ctx, r)?).to_vec();
-            times.lists = Some(l.stats(&c)?);
-        }
-        if let (Some(s), Some(r)) = (&out.starved, &starved_read) {
-            let c: Vec<u32> = bytemuck::cast_slice(&map_read(ctx, r)?).to_vec();
-            times.starved = Some(passes::starved::stats(&c, s.capacity)?);
-        }
-        if let (Some(r), Some(v)) = (&state_read, vals) {
-            let c: Vec<u32> = bytemuck::cast_slice(&map_read(ctx, r)?).to_vec();
-            times.vals = Some(ValIterations {
-                iterations: c[2],
-                max: v.iterations,
-                converged: c[1] != 0,
-                live: c[3],
-                count: v.count,
-            });
-        }
-        let counts = |r: &wgpu::Buffer, emitters: u32| -> Result<LcCounts, RenderError> {
-            let args: Vec<u32> = bytemuck::cast_slice(&map_read(ctx, r)?).to_vec();
-            Ok(passes::light_cluster::counts_of(&args, emitters))
-        };
-        if let Some(r) = &lc_read {
-            times.direct_clusters = Some(counts(r, self.scene.lights.len() as u32)?);
-        }
-        if let Some(r) = &vpl_lc_read {
-            times.vpl_clusters = Some(counts(r, count)?);
-        }
-        let img = match &read {
-            Some(read) => {
-                let px = texels(&map_read(ctx, read)?, w, h, false);
-                let mut img = HdrImage::new(w, h);
-                for (o, p) in img.pixels.iter_mut().zip(&px) {
-                    *o = Vec3::new(p[0], p[1], p[2]);
-                }
-                Some(img)
-            }
-            None => None,
-        };
-        self.last_hdr = Some(out.hdr.clone());
-        if val_count.is_some() && count > 0 {
-            self.val_warm = val_count;
-        }
-        times.readback_s += t1.elapsed().as_secs_f64();
-        times.frame_s = t0.elapsed().as_secs_f64();
-        Ok((img, times))
     }
 }
 
