@@ -5,6 +5,7 @@ mod bake;
 mod bake_warnings;
 mod bare;
 mod compare;
+mod compare_modes;
 mod export;
 mod inspect;
 mod render;
