@@ -79,10 +79,10 @@ pub fn check_gates(g: &GateParams) -> Result<(), RenderError> {
 }
 
 impl GatesParams {
-    /// The accurate setting (`--accurate`): the voxel walk along the true segment with the
-    /// closed voxels' triangles, the tent blur, and the starved pixels walking what their
-    /// block lacks where fewer than three quarters of its taps agree with them (48 of 8 × 8;
-    /// a count already set is kept). On sixteen camera-seeds (README) the indirect energy
+    /// The accurate setting (`--accurate`): the voxel walk (the shape as set; the default)
+    /// along the true segment with the closed voxels' triangles, the tent blur, and the
+    /// starved pixels walking what their block lacks where fewer than three quarters of its
+    /// taps agree with them (48 of 8 × 8; a count already set is kept). On sixteen camera-seeds (README) the indirect energy
     /// within 1.6 % of the reference's and under 1 % of the lit pixels black, at several
     /// times the default's frame: for stills and reference-grade walk-throughs.
     pub fn accurate(mut self) -> GatesParams {
