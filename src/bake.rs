@@ -10,7 +10,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use visgate_formats::vgate::{
     AlphaRule, BakeParams, CurvatureTo, GatePlacement, MaxBall, Resolution,
 };
-use visgate_preprocess::bake::{BakeOptions, Progress, bake};
+use visgate_preprocess::bake::{BakeOptions, Baked, Progress, bake};
 
 use crate::bake_warnings::warnings;
 
@@ -171,6 +171,37 @@ Examples:
   visgate inspect sponza.vgate";
 
 pub fn run(args: BakeArgs) -> Result<()> {
+    let (params, options) = params_of(&args)?;
+    let scene = crate::load_scene(&args.scene, false)?;
+    // The importer has logged the scene's warnings (degenerate triangles dropped, …) once.
+    let mut pool = rayon::ThreadPoolBuilder::new();
+    if let Some(t) = args.threads {
+        pool = pool.num_threads(t);
+    }
+    let pool = pool.build().context("cannot start the worker threads")?;
+    let bars = Bars {
+        bar: Mutex::new(None),
+        quiet: args.quiet,
+    };
+    let progress = |p: Progress| bars.show(p);
+    let baked = pool.install(|| bake(&scene, &params, &options, &progress));
+    // A leak stops the bake; its paths still go where the user asked for debug files.
+    if let (Err(visgate_preprocess::BakeError::Leak { openings, .. }), Some(dir)) =
+        (&baked, &args.debug_dir)
+    {
+        write_leak_ply(dir, openings)?;
+    }
+    let baked = baked.with_context(|| format!("cannot bake {}", args.scene))?;
+    baked
+        .level
+        .write(&args.output)
+        .with_context(|| format!("cannot write {}", args.output.display()))?;
+    print_outcome(&args, &baked)
+}
+
+/// The bake's parameters and options from the flags (the limits a flag alone can break
+/// checked here; the rest by the bake).
+fn params_of(args: &BakeArgs) -> Result<(BakeParams, BakeOptions)> {
     let resolution = match args.voxel_size {
         Some(v) => Resolution::VoxelSizeM(v),
         None => Resolution::LongestAxisVoxels(args.resolution),
@@ -219,20 +250,25 @@ pub fn run(args: BakeArgs) -> Result<()> {
         memory_limit_bytes: (args.memory_limit_gib * (1u64 << 30) as f64) as u64,
         keep_solid_grid: args.debug_dir.is_some(),
     };
-    let scene = crate::load_scene(&args.scene, false)?;
-    // The importer has logged the scene's warnings (degenerate triangles dropped, …) once.
-    let mut pool = rayon::ThreadPoolBuilder::new();
-    if let Some(t) = args.threads {
-        pool = pool.num_threads(t);
-    }
-    let pool = pool.build().context("cannot start the worker threads")?;
-    let bar: Mutex<Option<ProgressBar>> = Mutex::new(None);
-    let quiet = args.quiet;
-    let progress = |p: Progress| {
-        if quiet {
+    Ok((params, options))
+}
+
+/// The bake's progress on the terminal: a bar for a stage that counts its work, else a
+/// spinner; nothing with --quiet.
+struct Bars {
+    bar: Mutex<Option<ProgressBar>>,
+    quiet: bool,
+}
+
+impl Bars {
+    /// Shows `p`.
+    fn show(&self, p: Progress) {
+        if self.quiet {
             return;
         }
-        let Ok(mut slot) = bar.lock() else { return };
+        let Ok(mut slot) = self.bar.lock() else {
+            return;
+        };
         match p {
             Progress::Start { stage, total } => {
                 let b = if total > 0 {
@@ -260,19 +296,12 @@ pub fn run(args: BakeArgs) -> Result<()> {
                 }
             }
         }
-    };
-    let baked = pool.install(|| bake(&scene, &params, &options, &progress));
-    // A leak stops the bake; its paths still go where the user asked for debug files.
-    if let (Err(visgate_preprocess::BakeError::Leak { openings, .. }), Some(dir)) =
-        (&baked, &args.debug_dir)
-    {
-        write_leak_ply(dir, openings)?;
     }
-    let baked = baked.with_context(|| format!("cannot bake {}", args.scene))?;
-    baked
-        .level
-        .write(&args.output)
-        .with_context(|| format!("cannot write {}", args.output.display()))?;
+}
+
+/// Prints the bake's report, its leaks and warnings, and writes the JSON report and the
+/// debug files where asked.
+fn print_outcome(args: &BakeArgs, baked: &Baked) -> Result<()> {
     print!("{}", baked.report.text());
     for l in baked.report.empty_space["leaks"]
         .as_array()
