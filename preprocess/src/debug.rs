@@ -15,7 +15,7 @@ use std::io::{self, BufWriter, Write};
 use std::path::Path;
 
 use glam::Vec3;
-use visgate_formats::vgate::{BakedLevel, SegNodeKind};
+use visgate_formats::vgate::{BakedLevel, SegNodeKind, Topology};
 
 use crate::bake::BakeGrids;
 
@@ -47,111 +47,125 @@ pub fn write_all(dir: &Path, level: &BakedLevel, grids: &BakeGrids) -> io::Resul
         solid_surface(w, level, &solid.solid, &grids.empty)
     })?;
     let t = &level.topology;
-    out("skeleton.ply", &|w| {
+    out("skeleton.ply", &|w| skeleton_ply(w, t))?;
+    out("segmented.ply", &|w| segmented_ply(w, t))?;
+    out("clusters.ply", &|w| clusters_ply(w, level, &grids.empty))?;
+    out("gates.ply", &|w| gates_ply(w, t))?;
+    Ok(written)
+}
+
+/// The skeleton as a PLY: its nodes with their max-ball radius (m), its edges.
+fn skeleton_ply(w: &mut dyn Write, t: &Topology) -> io::Result<()> {
+    writeln!(
+        w,
+        "ply\nformat ascii 1.0\ncomment visgate skeleton: nodes with max-ball radius (m), edges\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nproperty float radius\nelement edge {}\nproperty int vertex1\nproperty int vertex2\nend_header",
+        t.skeleton.nodes.len(),
+        t.skeleton.edges.len()
+    )?;
+    for n in &t.skeleton.nodes {
+        let p = n.position_m;
+        writeln!(w, "{} {} {} {}", p[0], p[1], p[2], n.radius_m)?;
+    }
+    for e in &t.skeleton.edges {
+        writeln!(w, "{} {}", e[0], e[1])?;
+    }
+    Ok(())
+}
+
+/// The segmented skeleton as a PLY: its nodes coloured by kind (red topology, green
+/// curvature, blue coverage, yellow narrowing) with their radius, its edges.
+fn segmented_ply(w: &mut dyn Write, t: &Topology) -> io::Result<()> {
+    writeln!(
+        w,
+        "ply\nformat ascii 1.0\ncomment visgate segmented skeleton: red topology, green curvature, blue coverage, yellow narrowing nodes\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nproperty float radius\nelement edge {}\nproperty int vertex1\nproperty int vertex2\nend_header",
+        t.segmented.nodes.len(),
+        t.segmented.edges.len()
+    )?;
+    for n in &t.segmented.nodes {
+        let s = &t.skeleton.nodes[n.skeleton_node as usize];
+        let p = s.position_m;
+        let c = match n.kind {
+            SegNodeKind::Topology => [230, 40, 40],
+            SegNodeKind::Curvature => [40, 200, 40],
+            SegNodeKind::Coverage => [40, 90, 230],
+            SegNodeKind::Narrowing => [230, 200, 40],
+        };
         writeln!(
             w,
-            "ply\nformat ascii 1.0\ncomment visgate skeleton: nodes with max-ball radius (m), edges\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nproperty float radius\nelement edge {}\nproperty int vertex1\nproperty int vertex2\nend_header",
-            t.skeleton.nodes.len(),
-            t.skeleton.edges.len()
+            "{} {} {} {} {} {} {}",
+            p[0], p[1], p[2], c[0], c[1], c[2], s.radius_m
         )?;
-        for n in &t.skeleton.nodes {
-            let p = n.position_m;
-            writeln!(w, "{} {} {} {}", p[0], p[1], p[2], n.radius_m)?;
+    }
+    for e in &t.segmented.edges {
+        writeln!(w, "{} {}", e.nodes[0], e.nodes[1])?;
+    }
+    Ok(())
+}
+
+/// The kept empty voxels (every second per axis) as a binary PLY of points coloured by cluster.
+fn clusters_ply(w: &mut dyn Write, level: &BakedLevel, empty: &[bool]) -> io::Result<()> {
+    let meta = &level.info.grid;
+    let mut pts = Vec::new();
+    for (i, &e) in empty.iter().enumerate() {
+        let v = meta.coords(i as u32);
+        if !e || v.iter().any(|c| c % 2 == 1) {
+            continue;
         }
-        for e in &t.skeleton.edges {
-            writeln!(w, "{} {}", e[0], e[1])?;
+        if let Some(c) = level.voxel_cluster.get(i).filter(|&c| c != u32::MAX) {
+            pts.push((meta.voxel_to_world(v), colour(c)));
         }
-        Ok(())
-    })?;
-    out("segmented.ply", &|w| {
+    }
+    writeln!(
+        w,
+        "ply\nformat binary_little_endian 1.0\ncomment visgate clusters: kept empty voxels (every 2nd per axis) coloured by cluster\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nend_header",
+        pts.len()
+    )?;
+    for (p, c) in pts {
+        for x in p {
+            w.write_all(&x.to_le_bytes())?;
+        }
+        w.write_all(&c)?;
+    }
+    Ok(())
+}
+
+/// The gates as a PLY of disks (32-sided fans) coloured by their first cluster.
+fn gates_ply(w: &mut dyn Write, t: &Topology) -> io::Result<()> {
+    const SIDES: usize = 32;
+    writeln!(
+        w,
+        "ply\nformat ascii 1.0\ncomment visgate gates: disks\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nelement face {}\nproperty list uchar int vertex_indices\nend_header",
+        t.gates.len() * (SIDES + 1),
+        t.gates.len() * SIDES
+    )?;
+    for g in &t.gates {
+        let n = Vec3::from(g.normal);
+        let (u, v) = n.any_orthonormal_pair();
+        let c = Vec3::from(g.centre_m);
+        let col = colour(g.clusters[0]);
         writeln!(
             w,
-            "ply\nformat ascii 1.0\ncomment visgate segmented skeleton: red topology, green curvature, blue coverage, yellow narrowing nodes\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nproperty float radius\nelement edge {}\nproperty int vertex1\nproperty int vertex2\nend_header",
-            t.segmented.nodes.len(),
-            t.segmented.edges.len()
+            "{} {} {} {} {} {}",
+            c.x, c.y, c.z, col[0], col[1], col[2]
         )?;
-        for n in &t.segmented.nodes {
-            let s = &t.skeleton.nodes[n.skeleton_node as usize];
-            let p = s.position_m;
-            let c = match n.kind {
-                SegNodeKind::Topology => [230, 40, 40],
-                SegNodeKind::Curvature => [40, 200, 40],
-                SegNodeKind::Coverage => [40, 90, 230],
-                SegNodeKind::Narrowing => [230, 200, 40],
-            };
-            writeln!(
-                w,
-                "{} {} {} {} {} {} {}",
-                p[0], p[1], p[2], c[0], c[1], c[2], s.radius_m
-            )?;
-        }
-        for e in &t.segmented.edges {
-            writeln!(w, "{} {}", e.nodes[0], e.nodes[1])?;
-        }
-        Ok(())
-    })?;
-    out("clusters.ply", &|w| {
-        let mut pts = Vec::new();
-        for (i, &e) in grids.empty.iter().enumerate() {
-            let v = meta.coords(i as u32);
-            if !e || v.iter().any(|c| c % 2 == 1) {
-                continue;
-            }
-            if let Some(c) = level.voxel_cluster.get(i).filter(|&c| c != u32::MAX) {
-                pts.push((meta.voxel_to_world(v), colour(c)));
-            }
-        }
-        writeln!(
-            w,
-            "ply\nformat binary_little_endian 1.0\ncomment visgate clusters: kept empty voxels (every 2nd per axis) coloured by cluster\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nend_header",
-            pts.len()
-        )?;
-        for (p, c) in pts {
-            for x in p {
-                w.write_all(&x.to_le_bytes())?;
-            }
-            w.write_all(&c)?;
-        }
-        Ok(())
-    })?;
-    out("gates.ply", &|w| {
-        const SIDES: usize = 32;
-        writeln!(
-            w,
-            "ply\nformat ascii 1.0\ncomment visgate gates: disks\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nelement face {}\nproperty list uchar int vertex_indices\nend_header",
-            t.gates.len() * (SIDES + 1),
-            t.gates.len() * SIDES
-        )?;
-        for g in &t.gates {
-            let n = Vec3::from(g.normal);
-            let (u, v) = n.any_orthonormal_pair();
-            let c = Vec3::from(g.centre_m);
-            let col = colour(g.clusters[0]);
+        for k in 0..SIDES {
+            let a = k as f32 / SIDES as f32 * std::f32::consts::TAU;
+            let p = c + (u * a.cos() + v * a.sin()) * g.radius_m;
             writeln!(
                 w,
                 "{} {} {} {} {} {}",
-                c.x, c.y, c.z, col[0], col[1], col[2]
+                p.x, p.y, p.z, col[0], col[1], col[2]
             )?;
-            for k in 0..SIDES {
-                let a = k as f32 / SIDES as f32 * std::f32::consts::TAU;
-                let p = c + (u * a.cos() + v * a.sin()) * g.radius_m;
-                writeln!(
-                    w,
-                    "{} {} {} {} {} {}",
-                    p.x, p.y, p.z, col[0], col[1], col[2]
-                )?;
-            }
         }
-        for gi in 0..t.gates.len() {
-            let base = gi * (SIDES + 1);
-            for k in 0..SIDES {
-                let (a, b) = (base + 1 + k, base + 1 + (k + 1) % SIDES);
-                writeln!(w, "3 {base} {a} {b}")?;
-            }
+    }
+    for gi in 0..t.gates.len() {
+        let base = gi * (SIDES + 1);
+        for k in 0..SIDES {
+            let (a, b) = (base + 1 + k, base + 1 + (k + 1) % SIDES);
+            writeln!(w, "3 {base} {a} {b}")?;
         }
-        Ok(())
-    })?;
-    Ok(written)
+    }
+    Ok(())
 }
 
 /// A distinct colour per cluster (golden-angle hues).
