@@ -74,20 +74,8 @@ pub fn thin(
     });
     let mut flags: Vec<u8> = object.iter().map(|&o| if o { X } else { 0 }).collect();
     let total = object.iter().filter(|&&o| o).count() as u64;
-    let face = [sx, -sx, sy, -sy, sz, -sz];
     // Voxels to examine: at first the whole border, then those whose neighbourhood changed.
-    let mut border: Vec<u32> = (0..flags.len())
-        .into_par_iter()
-        .filter(|&i| {
-            flags[i] & X != 0 && {
-                let (x, y, z) = (i % nx, (i / nx) % ny, i / (nx * ny));
-                debug_assert!(x > 0 && y > 0 && z > 0 && x < nx - 1 && y < ny - 1 && z < nz - 1);
-                face.iter()
-                    .any(|&f| flags[(i as isize + f) as usize] & X == 0)
-            }
-        })
-        .map(|i| i as u32)
-        .collect();
+    let mut border = initial_border(&flags, [nx, ny, nz]);
     let mut birth: Vec<u16> = vec![u16::MAX; flags.len()];
     let mut marks = Marks::new(flags.len());
     let mut deleted_total = 0u64;
@@ -144,15 +132,7 @@ pub fn thin(
         let by_phase = find_cliques(&flags, &off, &candidates, &candidate_xm);
         keep_one_of_each(&mut flags, dist2, &by_phase);
         // 4: delete the candidates not kept.
-        let mut deleted = Vec::new();
-        for &i in &candidates {
-            let f = &mut flags[i as usize];
-            if *f & SEL == 0 {
-                *f &= !X;
-                deleted.push(i);
-            }
-            *f &= !(CAND | SEL);
-        }
+        let deleted = delete_unkept(&mut flags, &candidates);
         if deleted.is_empty() {
             break;
         }
@@ -184,6 +164,46 @@ pub fn thin(
         constrained,
         border_visits,
     }
+}
+
+/// The object's voxels with a face neighbour outside it (`flags`' X bit), in order. The
+/// object never touches the grid's edge (its border ring is solid).
+fn initial_border(flags: &[u8], [nx, ny, nz]: [usize; 3]) -> Vec<u32> {
+    let face = [
+        1,
+        -1,
+        nx as isize,
+        -(nx as isize),
+        (nx * ny) as isize,
+        -((nx * ny) as isize),
+    ];
+    (0..flags.len())
+        .into_par_iter()
+        .filter(|&i| {
+            flags[i] & X != 0 && {
+                let (x, y, z) = (i % nx, (i / nx) % ny, i / (nx * ny));
+                debug_assert!(x > 0 && y > 0 && z > 0 && x < nx - 1 && y < ny - 1 && z < nz - 1);
+                face.iter()
+                    .any(|&f| flags[(i as isize + f) as usize] & X == 0)
+            }
+        })
+        .map(|i| i as u32)
+        .collect()
+}
+
+/// Deletes the `candidates` no clique kept (SEL clear) from the object, clears every
+/// candidate's marks, and returns the deleted, in order.
+fn delete_unkept(flags: &mut [u8], candidates: &[u32]) -> Vec<u32> {
+    let mut deleted = Vec::new();
+    for &i in candidates {
+        let f = &mut flags[i as usize];
+        if *f & SEL == 0 {
+            *f &= !X;
+            deleted.push(i);
+        }
+        *f &= !(CAND | SEL);
+    }
+    deleted
 }
 
 /// The critical cliques through `candidates` (with their object masks `xm`) whose members are
