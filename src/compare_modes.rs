@@ -145,9 +145,10 @@ fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMod
     // Gates with one setting changed: the starved pixels' walks, the blur's fill or the walks'
     // roulette.
     let varied = |name: &str| {
-        let mut g = s.gates.accurate_if(name == ACCURATE);
+        let mut g = s.gates;
         let il = &mut g.interleave;
         match name {
+            ACCURATE => g = g.accurate(),
             STARVED if il.starved_taps == 0 => il.starved_taps = il.three_quarters(),
             FILLED => il.fill = true,
             ROULETTE if !g.walk_roulette.is_fixed() => {

@@ -442,34 +442,40 @@ impl MethodArgs {
 
     /// Every method's settings from the flags.
     pub fn settings(&self) -> MethodSettings {
+        let gates = GatesParams {
+            gates: GateParams {
+                oversize: self.gate_oversize,
+                max_hops: self.gate_hops,
+                shape: match self.gate_shape {
+                    GateShapeArg::Portal => GateShape::Portal,
+                    GateShapeArg::Disk => GateShape::Disk,
+                    GateShapeArg::Voxels => GateShape::Voxels,
+                },
+                max_walk: self.max_walk,
+                triangles: self.closed_voxel_triangles,
+                planes: !self.no_closed_voxel_planes,
+            },
+            clusters: ClusterParams {
+                tile_px: self.tile_px,
+                depth_slices: self.depth_slices,
+            },
+            light_entries: self.light_entries,
+            interleave: self.interleave_params(),
+            walk_roulette: self.walk_roulette,
+            walk_seed: 0,
+        };
+        // --accurate: the gates' accurate setting over what the other flags say.
+        let gates = if self.accurate {
+            gates.accurate()
+        } else {
+            gates
+        };
         MethodSettings {
             per_vpl: PerVplParams {
                 map_size: self.vpl_map_size,
                 batch: self.vpl_batch,
             },
-            gates: GatesParams {
-                gates: GateParams {
-                    oversize: self.gate_oversize,
-                    max_hops: self.gate_hops,
-                    shape: match self.gate_shape {
-                        GateShapeArg::Portal => GateShape::Portal,
-                        GateShapeArg::Disk => GateShape::Disk,
-                        GateShapeArg::Voxels => GateShape::Voxels,
-                    },
-                    max_walk: self.max_walk,
-                    triangles: self.closed_voxel_triangles,
-                    planes: !self.no_closed_voxel_planes,
-                },
-                clusters: ClusterParams {
-                    tile_px: self.tile_px,
-                    depth_slices: self.depth_slices,
-                },
-                light_entries: self.light_entries,
-                interleave: self.interleave_params(),
-                walk_roulette: self.walk_roulette,
-                walk_seed: 0,
-            }
-            .accurate_if(self.accurate),
+            gates,
             vals: ValModeParams {
                 vals: ValParams {
                     count: self.vals,

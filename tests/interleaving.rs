@@ -3,10 +3,11 @@
 //! every VPL lights.
 
 use visgate_runtime::camera::View;
+use visgate_runtime::cpu::gates::GateLevel;
 use visgate_runtime::gpu::InterleaveParams;
 use visgate_runtime::gpu::{GatesParams, GpuContext, GpuMode, GpuParams, GpuRenderer};
 use visgate_runtime::metrics::indirect_errors;
-use visgate_runtime::vpl::{PathParams, path_vpls};
+use visgate_runtime::vpl::{PathParams, Vpl, path_vpls};
 use visgate_scenes::Builtin;
 
 // Shared by the gate tests; this one uses its fixture only.
@@ -14,19 +15,46 @@ use visgate_scenes::Builtin;
 #[path = "support/gates.rs"]
 mod gate_support;
 
-#[test]
-fn an_interleaved_side_room_is_lit_where_every_vpl_lights_it() {
+/// The pillared hall baked at 128 and its side room (lit through its door by the hall's two
+/// lights): a GPU, the level, 1,024 light paths of `seed`, the room's view at `size` and a
+/// renderer of the scene.
+struct SideRoom {
+    ctx: GpuContext,
+    gates: GateLevel,
+    vpls: Vec<Vpl>,
+    view: View,
+    gpu: GpuRenderer,
+}
+
+fn side_room(seed: u64, size: [u32; 2]) -> SideRoom {
     let ctx = GpuContext::new().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"));
     let (scene, gates, tracer, _, _) = gate_support::fixture(Builtin::PillaredHall, 128, 1);
     let paths = PathParams {
         paths: 1024,
         bounces: 1,
-        seed: 0,
+        seed,
     };
     let vpls = path_vpls(&tracer, &scene.lights, &paths).expect("vpls");
-    // The side room, lit through its door by the hall's two lights.
-    let view = View::new(&scene.cameras[1], [320, 180]).expect("view");
-    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    let view = View::new(&scene.cameras[1], size).expect("view");
+    let gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    SideRoom {
+        ctx,
+        gates,
+        vpls,
+        view,
+        gpu,
+    }
+}
+
+#[test]
+fn an_interleaved_side_room_is_lit_where_every_vpl_lights_it() {
+    let SideRoom {
+        ctx,
+        gates,
+        vpls,
+        view,
+        mut gpu,
+    } = side_room(0, [320, 180]);
     gpu.set_level(&ctx, &gates).expect("level");
     let mut render = |mode| {
         gpu.render(&ctx, &view, &vpls, &GpuParams::with_mode(mode))
@@ -68,16 +96,13 @@ fn an_interleaved_side_room_is_lit_where_every_vpl_lights_it() {
 /// black where lit 1.19 % at T = 32, 0.00 % at 48, energy 0.993 and 1.000; 32 s on lavapipe).
 #[test]
 fn the_accurate_setting_lights_the_side_rooms_door_jamb() {
-    let ctx = GpuContext::new().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"));
-    let (scene, gates, tracer, _, _) = gate_support::fixture(Builtin::PillaredHall, 128, 1);
-    let paths = PathParams {
-        paths: 1024,
-        bounces: 1,
-        seed: 2,
-    };
-    let vpls = path_vpls(&tracer, &scene.lights, &paths).expect("vpls");
-    let view = View::new(&scene.cameras[1], [320, 240]).expect("view");
-    let mut gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
+    let SideRoom {
+        ctx,
+        gates,
+        vpls,
+        view,
+        mut gpu,
+    } = side_room(2, [320, 240]);
     let accurate = GatesParams::default().accurate();
     assert_eq!(accurate.interleave.starved_taps, 48);
     let mut render = |mode: GpuMode| {

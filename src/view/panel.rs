@@ -161,7 +161,7 @@ pub fn method_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
 
 /// The accurate setting ([`GatesParams::accurate`], `render --accurate`) on the viewer's
 /// gates, whose interleaving is the VAL modes' (one block for both, to compare like with like).
-pub fn set_accurate(s: &mut MethodSettings) {
+fn set_accurate(s: &mut MethodSettings) {
     let g = GatesParams {
         interleave: s.vals.interleave,
         ..s.gates

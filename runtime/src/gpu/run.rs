@@ -10,11 +10,13 @@ use glam::Vec3;
 use super::context::{self, Pool, map_read, row_bytes, texels};
 use super::record::{self, Recorded};
 use super::timing::Recorder;
-use super::{GpuContext, GpuMode, GpuParams, GpuRenderer, VplInput, methods, passes};
+use super::{
+    GpuContext, GpuMode, GpuParams, GpuRenderer, LcCounts, PassTimes, ValIterations, VplInput,
+    methods, passes,
+};
 use crate::RenderError;
 use crate::camera::View;
 use crate::cpu::gates::GateShape;
-use crate::gpu::{LcCounts, PassTimes, ValIterations};
 use crate::hdr::HdrImage;
 
 /// The buffers a frame's counts are copied into for reading back, where it has them.

@@ -94,11 +94,6 @@ impl GatesParams {
         self
     }
 
-    /// [`GatesParams::accurate`] where `on`, else these.
-    pub fn accurate_if(self, on: bool) -> GatesParams {
-        if on { self.accurate() } else { self }
-    }
-
     /// The roulette's share S for a frame of `vpls` VPLs (0: every VPL walked).
     pub fn roulette_share(&self, vpls: u32) -> f32 {
         let il = self.interleave;
