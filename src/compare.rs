@@ -24,8 +24,9 @@ voxels, walking them along the true segment with the closed voxels' triangles
 its blur filled from the next blocks: --blur-fill), gates-starved (gates as set, its
 starved pixels walking what their blur block lacks: --starved-taps, or 3/4 of the block's
 pixels where that is 0), gates-roulette (gates as set, its walks by Russian roulette:
---walk-roulette, or 0.05 where that is 0 or auto) and gates-accurate (gates as set, in the
-accurate setting: --accurate). `all`: every one but direct-only and gates-accurate, gates once a
+--walk-roulette, or 0.05 where that is 0 or auto), gates-accurate (gates as set, in the
+accurate setting: --accurate) and gates-balanced (gates as set, in the balanced setting:
+--balanced). `all`: every one but direct-only, gates-accurate and gates-balanced, gates once a
 shape, gates-filled and gates-starved where gates interleave without them, and
 gates-roulette where gates walk (voxels, portals) without it; the gate modes only with a level
 (given, or baked here). A mode that would render another's very frame (gates-roulette where

@@ -119,6 +119,9 @@ const STARVED: &str = "gates-starved";
 /// blur, the starved pixels' walks), in `visgate compare`; not in `all` (its frame is several
 /// times the default's).
 const ACCURATE: &str = "gates-accurate";
+/// Mode gates in the balanced setting (--balanced: the closed voxels' triangles, the tent
+/// blur, the dark pixels' walks), in `visgate compare`; not in `all`.
+const BALANCED: &str = "gates-balanced";
 /// Mode gates with its blur filled from the next blocks (--blur-fill), in `visgate compare`.
 const FILLED: &str = "gates-filled";
 /// Mode gates with Russian roulette on its walks: the gates' own --walk-roulette, or
@@ -149,6 +152,7 @@ fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMod
         let il = &mut g.interleave;
         match name {
             ACCURATE => g = g.accurate(),
+            BALANCED => g = g.balanced(),
             STARVED if il.starved_taps == 0 => il.starved_taps = il.three_quarters(),
             FILLED => il.fill = true,
             ROULETTE if !g.walk_roulette.is_fixed() => {
@@ -162,11 +166,11 @@ fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMod
         let shape = SHAPED.iter().find(|(n, ..)| *n == name);
         let mode = match (shape, method(name)) {
             (Some(&(_, g, t)), _) => shaped(g, t),
-            _ if [STARVED, FILLED, ROULETTE, ACCURATE].contains(&name) => varied(name),
+            _ if [STARVED, FILLED, ROULETTE, ACCURATE, BALANCED].contains(&name) => varied(name),
             (_, Some(m)) => (m.make)(&s),
             (None, None) => bail!(
                 "--modes {name}: give all or some of {}, {}, {FILLED}, {STARVED}, {ROULETTE}, \
-                 {ACCURATE}",
+                 {ACCURATE}, {BALANCED}",
                 METHODS.map(|m| m.name).join(", "),
                 SHAPED.map(|(n, ..)| n).join(", ")
             ),
@@ -272,6 +276,32 @@ mod tests {
         let plain = gates_of("gates", &[]);
         assert!(!plain.gates.triangles && !plain.interleave.tent);
         assert_eq!(plain.interleave.starved_taps, 0);
+    }
+
+    #[test]
+    fn gates_balanced_walks_the_triangles_with_the_tent_and_the_dark_pixels() {
+        let g = gates_of(BALANCED, &[]);
+        assert!(g.gates.triangles && g.interleave.tent && g.interleave.starved_dark);
+        assert_eq!(g.interleave.starved_taps, 0, "no count of its own");
+        assert_eq!(g.gates.shape, GateShape::Voxels);
+        let g = gates_of(
+            BALANCED,
+            &["--starved-taps", "20", "--walk-roulette", "0.1"],
+        );
+        assert_eq!(g.interleave.starved_taps, 20, "a count given is kept");
+        assert_eq!(g.walk_roulette, WalkRoulette::Share(0.1), "the rest as set");
+        // The same settings as `render --balanced` and as --starved-dark with the other two
+        // flags; not in `all`; the accurate setting without the dark pixels' walks.
+        let flags = ["--starved-taps", "20", "--walk-roulette", "0.1"];
+        assert_eq!(
+            g,
+            gates_of("gates", &[&flags[..], &["--balanced"]].concat())
+        );
+        let spelled = ["--closed-voxel-triangles", "--blur-tent", "--starved-dark"];
+        assert_eq!(g, gates_of("gates", &[&flags[..], &spelled].concat()));
+        assert!(!all_with(&[]).contains(&BALANCED.to_string()));
+        assert!(!gates_of(ACCURATE, &[]).interleave.starved_dark);
+        assert!(!gates_of("gates", &[]).interleave.starved_dark);
     }
 
     #[test]

@@ -271,6 +271,9 @@ impl GpuMode {
                 if t > 0 && p.interleave.block > 1 {
                     s += &format!(", under {t} agreeing walk the rest");
                 }
+                if p.interleave.starved_dark && p.interleave.block > 1 {
+                    s += ", dark pixels walk the rest";
+                }
                 if p.gates.shape != GateShape::Disk {
                     match p.walk_roulette {
                         WalkRoulette::Share(r) if r > 0.0 => s += &format!(", roulette under {r}"),

@@ -92,7 +92,7 @@ pub(super) fn record_passes(
             let il = &gp.interleave;
             starved = il.walks_starved().then(|| {
                 p.shade
-                    .record_starved(f, pool, rec, inputs, (gp.gates.shape, il))
+                    .record_starved(f, pool, rec, inputs, (gp.gates.shape, il, &indirect))
             });
             let uniform = InterleaveBlur::uniform(f, il, pool, true);
             let targets = (&g, &uniform, &indirect, &hdr);

@@ -223,6 +223,37 @@ fn the_viewer_s_accurate_setting_walks_the_triangles_and_the_starved_pixels() {
 }
 
 #[test]
+fn the_viewer_s_balanced_setting_walks_the_triangles_and_the_dark_pixels() {
+    let mut harness = first_frame(viewer(Layers::default(), false));
+    let before = harness.state().frames;
+    harness.get_by_label("balanced setting").click();
+    until_a_frame_after(&mut harness, before);
+    let app = harness.state();
+    let g = app.settings.gates;
+    assert!(g.gates.triangles && g.interleave.tent && g.interleave.starved_dark);
+    assert_eq!(g.interleave.starved_taps, 0);
+    assert_eq!(app.error, None);
+    assert!(app.frames > before, "no frame in the balanced setting");
+    let (_, times) = app.last.as_ref().expect("a frame");
+    let names: Vec<&str> = times.passes.iter().map(|p| p.name).collect();
+    assert!(
+        names.contains(&"indirect lighting: starved pixels"),
+        "{names:?}"
+    );
+    // Its tick, which the button set, turns the dark pixels' walks off again.
+    let before = app.frames;
+    harness.get_by_label("dark pixels walk the rest").click();
+    until_a_frame_after(&mut harness, before);
+    let app = harness.state();
+    assert!(!app.settings.gates.interleave.starved_dark);
+    let (_, times) = app.last.as_ref().expect("a frame");
+    assert!(
+        !times.passes.iter().any(|p| p.name.contains("starved")),
+        "no starved pass without it"
+    );
+}
+
+#[test]
 fn the_viewer_renders_lightcluster_direct_shadows() {
     use visgate_runtime::gpu::{DirectLight, LightClusterGpuParams};
     let mut app = viewer(Layers::default(), false);

@@ -94,6 +94,21 @@ impl GatesParams {
         self
     }
 
+    /// The balanced setting (`--balanced`): the closed voxels' triangles and the tent blur as
+    /// in [`GatesParams::accurate`], and the pixels whose agreeing taps found no light walking
+    /// what their block lacks ([`InterleaveParams::starved_dark`]) instead of every pixel with
+    /// fewer than three quarters agreeing (a count already set is kept). On the same sixteen
+    /// camera-seeds (README) the indirect energy within 3 % of the reference's and under 1 % of
+    /// the lit pixels black, at 0.2–1× the accurate setting's frame, with a higher MSE.
+    ///
+    /// [`InterleaveParams::starved_dark`]: super::interleave_blur::InterleaveParams::starved_dark
+    pub fn balanced(mut self) -> GatesParams {
+        self.gates.triangles = true;
+        self.interleave.tent = true;
+        self.interleave.starved_dark = true;
+        self
+    }
+
     /// The roulette's share S for a frame of `vpls` VPLs (0: every VPL walked).
     pub fn roulette_share(&self, vpls: u32) -> f32 {
         let il = self.interleave;

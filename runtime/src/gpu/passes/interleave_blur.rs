@@ -29,6 +29,10 @@ pub struct InterleaveParams {
     /// agreeing taps' subsets (a door jamb, a strip along a wall: the few subsets the blur
     /// would average may hold none of the VPLs that light it); 0: none. [Limit: 0..=block²]
     pub starved_taps: u32,
+    /// Gates: a pixel whose agreeing taps found no light at all walks the VPL subsets of the
+    /// taps that do not agree too, however many agree (a lit strip whose few VPLs fell in the
+    /// other taps' subsets); a pixel whose whole block agrees walks nothing more.
+    pub starved_dark: bool,
     /// Blur: a tap that does not agree with the pixel gives way to the nearest copy of its
     /// VPL subset one block away (a block's side along x or y) that does, so that the average
     /// holds more of the b² subsets; off: it is left out (Laine et al.).
@@ -47,6 +51,7 @@ impl Default for InterleaveParams {
             blur_distance: 0.1,
             blur_normal: 0.8,
             starved_taps: 0,
+            starved_dark: false,
             fill: false,
             tent: false,
         }
@@ -66,9 +71,9 @@ impl InterleaveParams {
     }
 
     /// Whether starved pixels walk what their block lacks: an interleaved block and a
-    /// [`InterleaveParams::starved_taps`] set.
+    /// [`InterleaveParams::starved_taps`] or [`InterleaveParams::starved_dark`] set.
     pub fn walks_starved(&self) -> bool {
-        self.block > 1 && self.starved_taps > 0
+        self.block > 1 && (self.starved_taps > 0 || self.starved_dark)
     }
 
     /// The blur's distance threshold in metres for frame `f` (a fraction of the scene's size).

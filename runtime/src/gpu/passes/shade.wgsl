@@ -463,8 +463,10 @@ fn cs_gates_indirect(@builtin(global_invocation_id) id: vec3<u32>) {
 
 // Starved pixels: x the blur's distance (m), y its normals' cosine, z the fewest taps of a
 // pixel's b × b block that must agree with it (blur.wgsl's test) before it walks the subsets of
-// those that do not itself.
+// those that do not itself; w 1: a pixel whose agreeing taps found no light walks them too.
 @group(0) @binding(26) var<uniform> starved_params: vec4<f32>;
+// The first gather's indirect target (deinterleaved), for w's test.
+@group(0) @binding(32) var starved_indirect: texture_2d<f32>;
 // x (pixel, subset) pairs reserved, y pixels whose pairs did not fit (the frame is rendered
 // again with room for x), z starved pixels.
 @group(0) @binding(27) var<storage, read_write> starved_count: array<atomic<u32>, 4>;
@@ -522,12 +524,20 @@ fn cs_starved_pairs(@builtin(global_invocation_id) id: vec3<u32>) {
     var away = array<u32, 8>();
     var agree = 0.0;
     var missing = 0u;
+    // The agreeing taps' light, where w asks for it.
+    let dark_test = starved_params.w == 1.0;
+    var found = 0.0;
     var t = 0u;
     for (var y = block.y; y < block.w; y++) {
         for (var x = block.x; x < block.z; x++) {
             let q = vec2<i32>(x, y);
             if blur_agrees(q, pos.xyz, n) {
                 agree += 1.0;
+                if dark_test {
+                    let at = deinterleaved(q, bu, size);
+                    let l = textureLoad(starved_indirect, at, 0).xyz;
+                    found += l.x + l.y + l.z;
+                }
             } else if interleave_subset(q, bu) < globals.vpl_count {
                 away[t / 32u] |= 1u << (t % 32u);
                 missing += 1u;
@@ -535,7 +545,8 @@ fn cs_starved_pairs(@builtin(global_invocation_id) id: vec3<u32>) {
             t += 1u;
         }
     }
-    if agree >= starved_params.z {
+    let dark = dark_test && found <= 0.0;
+    if agree >= starved_params.z && !(dark && missing > 0u) {
         return;
     }
     let first = atomicAdd(&starved_count[0], missing);

@@ -23,7 +23,8 @@ pub const PAIR_BYTES: u64 = 16;
 pub const MAX_STARVED_PIXELS: u64 = 1 << 24;
 
 /// The bindings of shade.wgsl's `cs_starved_pairs`: globals, the G-buffer's positions and
-/// normals, the starved test's constants (26), the count, pairs and runs (27–29).
+/// normals, the starved test's constants (26), the count, pairs and runs (27–29), the first
+/// gather's indirect target (32).
 const PAIRS_BINDINGS: [u32; 3] = [0, 5, 6];
 /// The bindings of `cs_starved_walks` from the shading's resources (the walks' without the
 /// disks' lists); the batch index (24), count (27) and pairs (28) besides.
@@ -92,7 +93,7 @@ impl Buffers {
             il.blur_distance_m(f),
             il.blur_normal,
             il.starved_taps as f32,
-            0.0,
+            f32::from(u8::from(il.starved_dark)),
         ];
         let uniform = wgpu::BufferUsages::UNIFORM;
         let storage = wgpu::BufferUsages::STORAGE;
@@ -153,7 +154,7 @@ impl Shade {
         pool: &mut Pool,
         rec: &mut Recorder,
         inputs: Inputs,
-        (shape, il): (GateShape, &InterleaveParams),
+        (shape, il, indirect): (GateShape, &InterleaveParams, &wgpu::Texture),
     ) -> StarvedOutput {
         // The renderer refused an image too large for the pairs ([`check_size`]) before the
         // frame made anything.
@@ -163,7 +164,7 @@ impl Shade {
         let b = Buffers::new(f, pool, il, batches);
         let sums = frame_target(f, pool, "starved pixels' irradiance");
         let walks = self.gates_pipeline(f, super::shade::GatesGather::Starved, shape);
-        let g = self.starved_groups(f, inputs, (&b, batches), walks, &sums);
+        let g = self.starved_groups(f, inputs, (&b, batches), walks, (&sums, indirect));
         let p = &self.starved;
         rec.enc.clear_buffer(&b.count, 0, None);
         let span = "indirect lighting: starved pixels";
@@ -204,12 +205,13 @@ impl Shade {
         inputs: Inputs,
         (b, batches): (&Buffers, u32),
         walks: &wgpu::ComputePipeline,
-        sums: &wgpu::Texture,
+        (sums, indirect): (&wgpu::Texture, &wgpu::Texture),
     ) -> Groups {
         let d = &f.ctx.device;
         let p = &self.starved;
         let views = super::shade::Views::new(f, inputs);
         let sums_view = sums.create_view(&Default::default());
+        let indirect_view = indirect.create_view(&Default::default());
         let group = |pipeline: &wgpu::ComputePipeline, used: &[u32], extra: Vec<_>| {
             let mut resources = views.resources(f, inputs, None, Some(used));
             resources.extend(extra);
@@ -224,6 +226,7 @@ impl Shade {
                     (27, whole(&b.count)),
                     (28, whole(&b.pairs)),
                     (29, whole(&b.runs)),
+                    (32, wgpu::BindingResource::TextureView(&indirect_view)),
                 ],
             ),
             args: group(
