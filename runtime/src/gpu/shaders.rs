@@ -36,7 +36,7 @@ const INCLUDES: [(&str, &str); 12] = [
 ];
 
 /// The pass shaders (`gpu/passes/`), before composition.
-pub const SOURCES: [(&str, &str); 17] = [
+pub const SOURCES: [(&str, &str); 18] = [
     ("gbuffer.wgsl", include_str!("passes/gbuffer.wgsl")),
     ("shadow.wgsl", include_str!("passes/shadow.wgsl")),
     ("shade.wgsl", include_str!("passes/shade.wgsl")),
@@ -59,6 +59,7 @@ pub const SOURCES: [(&str, &str); 17] = [
     ("lc_shadows.wgsl", include_str!("passes/lc_shadows.wgsl")),
     ("ism_maps.wgsl", include_str!("passes/ism_maps.wgsl")),
     ("ism_gather.wgsl", include_str!("passes/ism_gather.wgsl")),
+    ("starved.wgsl", include_str!("passes/starved.wgsl")),
     ("display.wgsl", include_str!("passes/display.wgsl")),
 ];
 
@@ -89,6 +90,9 @@ pub const WG_LINEAR: u32 = 64;
 pub const WG_TILE: u32 = 16;
 /// Workgroup size of the tile scan and of the CSSM depth-range reduction.
 pub const WG_WIDE: u32 = 256;
+/// Workgroup size of the starved pixels' walks (shade.wgsl's `cs_starved_walks`: a (pixel,
+/// subset) pair an invocation), which starved.wgsl's `cs_starved_args` dispatches.
+pub const WG_STARVED_WALKS: u32 = 64;
 /// Side of the CSSM basis and mip passes' square workgroups. [Units: texels]
 pub const WG_CSSM: u32 = 8;
 /// Bits of a visibility cluster in a geometry-cluster key (depth slice above them).
@@ -115,6 +119,7 @@ pub fn constants() -> String {
     s += &u("WG_TILE", WG_TILE);
     s += &u("WG_WIDE", WG_WIDE);
     s += &u("WG_CSSM", WG_CSSM);
+    s += &u("STARVED_WALKS_GROUP", WG_STARVED_WALKS);
     s += &u("SHADE_ALL", ShadeIndirect::All as u32);
     s += &u("SHADE_DIRECT", ShadeIndirect::DirectOnly as u32);
     s += &u("SHADE_GATES_PER_PIXEL", ShadeIndirect::GatesPerPixel as u32);

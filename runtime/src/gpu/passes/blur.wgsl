@@ -14,7 +14,7 @@
 @group(0) @binding(12) var indirect: texture_2d<f32>;
 @group(0) @binding(13) var composed: texture_storage_2d<rgba32float, write>;
 // Interleaved gates: at the pixels whose block holds too few taps that agree with them (w 1),
-// the light of the subsets of the taps that do not, which they walked themselves (shade.wgsl's
+// the light of the subsets of the taps that do not, which they walked themselves (starved.wgsl's
 // cs_starved_sums); a 1 × 1 texture of zeros for the other modes.
 @group(0) @binding(14) var starved_sums: texture_2d<f32>;
 

@@ -118,7 +118,7 @@ impl Shade {
             pipeline,
             gates_indirect: Default::default(),
             gates_starved: Default::default(),
-            starved: super::starved::StarvedPipelines::new(d, &module),
+            starved: super::starved::StarvedPipelines::new(d, s)?,
             module,
             vpl_clusters_indirect,
         })

@@ -461,134 +461,18 @@ fn cs_gates_indirect(@builtin(global_invocation_id) id: vec3<u32>) {
     textureStore(out_image, id.xy, sum);
 }
 
-// Starved pixels: x the blur's distance (m), y its normals' cosine, z the fewest taps of a
-// pixel's b × b block that must agree with it (blur.wgsl's test) before it walks the subsets of
-// those that do not itself; w 1: a pixel whose agreeing taps found no light walks them too.
-@group(0) @binding(26) var<uniform> starved_params: vec4<f32>;
-// The first gather's indirect target (deinterleaved), for w's test.
-@group(0) @binding(32) var starved_indirect: texture_2d<f32>;
-// x (pixel, subset) pairs reserved, y pixels whose pairs did not fit (the frame is rendered
-// again with room for x), z starved pixels.
+// Interleaved gates' second gather, the walks (starved.rs; starved.wgsl makes the pairs and
+// sums them): an invocation a (pixel, subset) pair walks its subset's VPLs (in batches on a
+// software rasterizer, each adding to the pair's light).
+// The pairs reserved (x) and those that fit the list (w, from cs_starved_args).
 @group(0) @binding(27) var<storage, read_write> starved_count: array<atomic<u32>, 4>;
 // A pair each: xyz its light so far (f32 bits), w its pixel × 256 + its subset.
 @group(0) @binding(28) var<storage, read_write> starved_pairs: array<vec4<u32>>;
-// A pixel each: x its first pair, y its pairs (NOT_STARVED: not starved).
-@group(0) @binding(29) var<storage, read_write> starved_runs: array<vec2<u32>>;
-// cs_starved_walks' dispatch: workgroups in x, y, z.
-@group(0) @binding(30) var<storage, read_write> starved_args: array<u32, 3>;
 
-const NOT_STARVED: u32 = 0xffffffffu;
-// cs_starved_walks' workgroup: a pair an invocation.
-const STARVED_WALKS_GROUP: u32 = 64u;
-
-// Whether tap q's surface agrees with p (normal n) by the blur's test (vpl.wgsl).
-fn blur_agrees(q: vec2<i32>, p: vec3<f32>, n: vec3<f32>) -> bool {
-    let qp = textureLoad(g_position, q, 0);
-    let qn = normalize(textureLoad(g_normal, q, 0).xyz);
-    return blur_surfaces_agree(qp, qn, p, n, starved_params.x, starved_params.y);
-}
-
-// Interleaved gates' second gather. The blur averages a pixel's block where the geometry
-// agrees, each tap lit by one of the b² VPL subsets; where few taps agree (a door jamb, a strip
-// along a wall) it averages a handful of subsets, and where a few VPLs light the place those
-// may hold none of them. A pixel whose block holds fewer than starved_params.z agreeing taps
-// walks, itself, the subsets of the taps that do not agree, and blur.wgsl adds them to the
-// agreeing taps' subsets: every VPL counted once.
-//
-// Four passes, so that a starved pixel's walks spread over as many invocations as it has
-// subsets to walk: one invocation walking all of them (up to 63 subsets, every VPL of each)
-// held up its whole warp, and the few starved pixels' warps held up the frame (3.7–274× the
-// frame on an NVIDIA H200). cs_starved_pairs: each pixel tests its block; a starved one
-// reserves a run of (pixel, subset) pairs, one per subset of the taps that do not agree, in the
-// block's order. cs_starved_args: the walks' dispatch from the pairs' count. cs_starved_walks:
-// an invocation a pair walks its subset's VPLs (in batches on a software rasterizer, each
-// adding to the pair's light). cs_starved_sums: in pixel order, xyz a starved pixel's pairs'
-// light summed, w 1 there, 0 elsewhere (blur.wgsl reads it).
-@compute @workgroup_size(8, 8)
-fn cs_starved_pairs(@builtin(global_invocation_id) id: vec3<u32>) {
-    let size = textureDimensions(g_position);
-    if any(id.xy >= size) {
-        return;
-    }
-    let pixel = id.x + id.y * size.x;
-    starved_runs[pixel] = vec2<u32>(0u, NOT_STARVED);
-    let px = vec2<i32>(id.xy);
-    let pos = textureLoad(g_position, px, 0);
-    if pos.w == 0.0 {
-        return;
-    }
-    let n = normalize(textureLoad(g_normal, px, 0).xyz);
-    let bu = max(globals.interleave_block, 1u);
-    let block = interleave_block_around(px, i32(bu), vec2<i32>(size));
-    // The taps that do not agree, a bit each in the block's order (b ≤ 16: 256 bits).
-    var away = array<u32, 8>();
-    var agree = 0.0;
-    var missing = 0u;
-    // The agreeing taps' light, where w asks for it.
-    let dark_test = starved_params.w == 1.0;
-    var found = 0.0;
-    var t = 0u;
-    for (var y = block.y; y < block.w; y++) {
-        for (var x = block.x; x < block.z; x++) {
-            let q = vec2<i32>(x, y);
-            if blur_agrees(q, pos.xyz, n) {
-                agree += 1.0;
-                if dark_test {
-                    let at = deinterleaved(q, bu, size);
-                    let l = textureLoad(starved_indirect, at, 0).xyz;
-                    found += l.x + l.y + l.z;
-                }
-            } else if interleave_subset(q, bu) < globals.vpl_count {
-                away[t / 32u] |= 1u << (t % 32u);
-                missing += 1u;
-            }
-            t += 1u;
-        }
-    }
-    let dark = dark_test && found <= 0.0;
-    if agree >= starved_params.z && !(dark && missing > 0u) {
-        return;
-    }
-    let first = atomicAdd(&starved_count[0], missing);
-    if first + missing > arrayLength(&starved_pairs) {
-        atomicAdd(&starved_count[1], 1u);
-        return;
-    }
-    atomicAdd(&starved_count[2], 1u);
-    var k = first;
-    t = 0u;
-    for (var y = block.y; y < block.w; y++) {
-        for (var x = block.x; x < block.z; x++) {
-            if (away[t / 32u] & (1u << (t % 32u))) != 0u {
-                let j = interleave_subset(vec2<i32>(x, y), bu);
-                starved_pairs[k] = vec4<u32>(0u, 0u, 0u, pixel * 256u + j);
-                k += 1u;
-            }
-            t += 1u;
-        }
-    }
-    starved_runs[pixel] = vec2<u32>(first, missing);
-}
-
-// The pairs that fit the list.
-fn starved_pair_count() -> u32 {
-    return min(atomicLoad(&starved_count[0]), arrayLength(&starved_pairs));
-}
-
-@compute @workgroup_size(1)
-fn cs_starved_args() {
-    let groups = (starved_pair_count() + STARVED_WALKS_GROUP - 1u) / STARVED_WALKS_GROUP;
-    // At most 65,535 workgroups along an axis (WebGPU's default limit).
-    let x = min(groups, 65535u);
-    starved_args[0] = x;
-    starved_args[1] = select(1u, (groups + x - 1u) / x, x > 0u);
-    starved_args[2] = 1u;
-}
-
-@compute @workgroup_size(64)
+@compute @workgroup_size(STARVED_WALKS_GROUP)
 fn cs_starved_walks(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let k = id.x + id.y * groups.x * STARVED_WALKS_GROUP;
-    if k >= starved_pair_count() {
+    if k >= atomicLoad(&starved_count[3]) {
         return;
     }
     let pair = starved_pairs[k];
@@ -615,24 +499,6 @@ fn cs_starved_walks(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_w
     let lit = walk_range(px, pos.xyz, n, decode_cluster(pos.w), walk_end_at(px, pos.xyz), first, end, subsets, cut);
     let sum = bitcast<vec3<f32>>(pair.xyz) + lit;
     starved_pairs[k] = vec4<u32>(bitcast<vec3<u32>>(sum), pair.w);
-}
-
-@compute @workgroup_size(8, 8)
-fn cs_starved_sums(@builtin(global_invocation_id) id: vec3<u32>) {
-    let size = textureDimensions(g_position);
-    if any(id.xy >= size) {
-        return;
-    }
-    let run = starved_runs[id.x + id.y * size.x];
-    var out = vec4<f32>(0.0);
-    if run.y != NOT_STARVED {
-        var sum = vec3<f32>(0.0);
-        for (var k = run.x; k < run.x + run.y; k++) {
-            sum += bitcast<vec3<f32>>(starved_pairs[k].xyz);
-        }
-        out = vec4<f32>(sum, 1.0);
-    }
-    textureStore(out_image, id.xy, out);
 }
 
 // The pixel that the invocation at place `frag` of the deinterleaved target shades, and its

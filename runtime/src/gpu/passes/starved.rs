@@ -1,7 +1,9 @@
-//! Interleaved gates' second gather (shade.wgsl's `cs_starved_*`): the pixels whose blur block
-//! holds too few taps that agree with them walk the VPL subsets of the taps that do not, a
+//! Interleaved gates' second gather (starved.wgsl's pairs, dispatch and sums around shade.wgsl's
+//! `cs_starved_walks`): the pixels whose blur block holds too few taps that agree with them
+//! ([`InterleaveParams::starved_taps`]), or whose agreeing taps found no light
+//! ([`InterleaveParams::starved_dark`]), walk the VPL subsets of the taps that do not, a
 //! (pixel, subset) pair an invocation, so that a starved pixel's walks spread over as many
-//! lanes as it has subsets instead of holding up its warp ([`InterleaveParams::starved_taps`]).
+//! lanes as it has subsets instead of holding up its warp.
 
 use super::interleave_blur::InterleaveParams;
 use super::shade::{Inputs, Shade, frame_target};
@@ -9,6 +11,7 @@ use crate::RenderError;
 use crate::cpu::gates::GateShape;
 use crate::gpu::context::{Pool, bind_group, slice};
 use crate::gpu::layout::{UNIFORM_STRIDE, strided};
+use crate::gpu::shaders::{self, ShaderSources};
 use crate::gpu::timing::Recorder;
 use crate::gpu::{Frame, GpuContext};
 
@@ -22,7 +25,7 @@ pub const PAIR_BYTES: u64 = 16;
 /// subset in 32 bits (4,096 × 4,096).
 pub const MAX_STARVED_PIXELS: u64 = 1 << 24;
 
-/// The bindings of shade.wgsl's `cs_starved_pairs`: globals, the G-buffer's positions and
+/// The bindings of starved.wgsl's `cs_starved_pairs`: globals, the G-buffer's positions and
 /// normals, the starved test's constants (26), the count, pairs and runs (27–29), the first
 /// gather's indirect target (32).
 const PAIRS_BINDINGS: [u32; 3] = [0, 5, 6];
@@ -36,7 +39,7 @@ const WALKS_BINDINGS: [u32; 11] = [0, 2, 5, 6, 7, 8, 15, 16, 22, 23, 31];
 pub struct StarvedOutput {
     /// In pixel order.
     pub sums: wgpu::Texture,
-    /// Four words: pairs reserved, pixels whose pairs did not fit, starved pixels.
+    /// Four words: pairs reserved, pixels whose pairs did not fit, starved pixels, pairs walked.
     pub count: wgpu::Buffer,
     /// The pairs' list's capacity.
     pub capacity: u32,
@@ -72,7 +75,7 @@ pub fn check_size([w, h]: [u32; 2]) -> Result<(), RenderError> {
 struct Buffers {
     /// The starved test's constants (26).
     test: wgpu::Buffer,
-    /// Pairs reserved, pixels that did not fit, starved pixels (27).
+    /// Pairs reserved, pixels that did not fit, starved pixels, pairs walked (27).
     count: wgpu::Buffer,
     /// The pairs (28).
     pairs: wgpu::Buffer,
@@ -261,8 +264,8 @@ impl Shade {
     }
 }
 
-/// The pipelines of the starved pixels' passes but the walks' (made per gate shape, as the
-/// gathers', [`Shade`]).
+/// The pipelines of the starved pixels' passes but the walks' (shade.wgsl's, made per gate
+/// shape as the gathers', [`Shade`]).
 pub struct StarvedPipelines {
     pairs: wgpu::ComputePipeline,
     args: wgpu::ComputePipeline,
@@ -270,14 +273,15 @@ pub struct StarvedPipelines {
 }
 
 impl StarvedPipelines {
-    /// Built from shade.wgsl's module.
-    pub fn new(d: &wgpu::Device, module: &wgpu::ShaderModule) -> StarvedPipelines {
+    /// Built from starved.wgsl.
+    pub fn new(d: &wgpu::Device, s: &ShaderSources) -> Result<StarvedPipelines, RenderError> {
+        let module = shaders::module(d, s, "starved.wgsl")?;
         let [pairs, args, sums] = crate::gpu::context::compute_pipelines(
             d,
-            module,
+            &module,
             ["cs_starved_pairs", "cs_starved_args", "cs_starved_sums"],
         );
-        StarvedPipelines { pairs, args, sums }
+        Ok(StarvedPipelines { pairs, args, sums })
     }
 }
 

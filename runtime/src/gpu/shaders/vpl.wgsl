@@ -67,7 +67,7 @@ fn interleave_block_around(px: vec2<i32>, b: i32, size: vec2<i32>) -> vec4<i32> 
 
 // The blur's test (Laine et al.): a tap's surface (position qp, w 0 where there is none;
 // normal qn) agrees with the pixel's (p, n) when nearer than `distance` and its normal within
-// cosine `cosine`. blur.wgsl averages the taps that agree; shade.wgsl's starved pixels count
+// cosine `cosine`. blur.wgsl averages the taps that agree; starved.wgsl's starved pixels count
 // them by the same rule.
 fn blur_surfaces_agree(qp: vec4<f32>, qn: vec3<f32>, p: vec3<f32>, n: vec3<f32>, distance: f32, cosine: f32) -> bool {
     return qp.w != 0.0 && length(qp.xyz - p) <= distance && dot(qn, n) >= cosine;
