@@ -1,0 +1,141 @@
+use super::*;
+
+#[test]
+fn the_default_roulette_is_on_where_an_interleaved_pixel_walks_many_vpls() {
+    use super::super::passes::clustered_gates::AUTO_ROULETTE_SHARE as AUTO;
+    let mut p = GatesParams::default();
+    assert_eq!(p.walk_roulette, WalkRoulette::Auto);
+    assert_eq!(p.interleave.block, 8);
+    assert_eq!(p.roulette_share(4_096), 0.0, "64 VPLs a pixel");
+    assert_eq!(p.roulette_share(8_192), AUTO);
+    assert_eq!(p.roulette_share(16_384), AUTO);
+    assert_eq!(p.roulette_share(8_128), 0.0, "127 VPLs a pixel");
+    // Reports name it as it acts.
+    let described = |p, vpls| GpuMode::Gates(p).describe_for(vpls);
+    assert_eq!(
+        described(p, 8_192),
+        "voxel walk, 8×8 interleaved, roulette under 0.05 (auto)"
+    );
+    assert_eq!(described(p, 4_096), "voxel walk, 8×8 interleaved");
+    assert!(GpuMode::Gates(p).describe().ends_with("roulette auto"));
+    p.interleave.block = 16;
+    assert_eq!(p.roulette_share(32_768), AUTO);
+    // 4 × 4 blocks blur too few subsets to hide it; no blur, none at all.
+    for block in [1, 4] {
+        p.interleave.block = block;
+        assert_eq!(p.roulette_share(16_384), 0.0, "{block}");
+        assert!(!described(p, 16_384).contains("roulette"), "{block}");
+    }
+    p.walk_roulette = WalkRoulette::Share(0.1);
+    assert_eq!(p.roulette_share(16), 0.1);
+    p.walk_roulette = WalkRoulette::Share(0.0);
+    p.interleave.block = 8;
+    assert_eq!(p.roulette_share(16_384), 0.0, "off when asked");
+}
+
+/// Gates with the portal walk.
+fn portals() -> GatesParams {
+    let mut p = GatesParams::default();
+    p.gates.shape = GateShape::Portal;
+    p
+}
+
+#[test]
+fn portals_walk_in_batches_on_a_software_rasterizer_alone() {
+    let portals = portals();
+    let llvmpipe = "llvmpipe (LLVM 19.1.7, 256 bits)";
+    let gates = GpuMode::Gates(portals);
+    assert_eq!(
+        walk_batch(llvmpipe, &gates, Some(1251), 1024),
+        SOFTWARE_WALK_BATCH
+    );
+    assert_eq!(
+        walk_batch("NVIDIA H100 80GB HBM3", &gates, Some(1251), 1024),
+        0
+    );
+    let mut disks = portals;
+    disks.gates.shape = GateShape::Disk;
+    assert_eq!(walk_batch(llvmpipe, &GpuMode::Gates(disks), None, 1024), 0);
+    assert_eq!(
+        walk_batch(llvmpipe, &GpuMode::GatesPerPixel(portals.gates), None, 1024),
+        0
+    );
+    // Voxel walks: as many as fit the loop limit at the sight grid's longest walk, at
+    // least one (tests/gates.rs loses light with a thousand times as many).
+    let mut voxels = portals;
+    voxels.gates.shape = GateShape::Voxels;
+    let voxels = GpuMode::Gates(voxels);
+    assert_eq!(walk_batch(llvmpipe, &voxels, Some(1251), 1024), 52);
+    assert_eq!(walk_batch(llvmpipe, &voxels, Some(99), 1024), 652);
+    // With the triangles, a walk may read 512 list entries too.
+    let mut triangles = portals;
+    triangles.gates.shape = GateShape::Voxels;
+    triangles.gates.triangles = true;
+    let triangles = GpuMode::Gates(triangles);
+    assert_eq!(walk_batch(llvmpipe, &triangles, Some(1251), 1024), 37);
+    assert_eq!(walk_batch(llvmpipe, &triangles, Some(99), 1024), 106);
+    assert_eq!(walk_batch(llvmpipe, &voxels, Some(200_000), 1024), 1);
+    assert_eq!(
+        walk_batch(llvmpipe, &voxels, None, 1024),
+        SOFTWARE_WALK_BATCH
+    );
+    // The roulette's sum over a pixel's subset (16,384 VPLs in 8 × 8: 256) first.
+    let GpuMode::Gates(mut roulette) = voxels else {
+        unreachable!()
+    };
+    roulette.walk_roulette = WalkRoulette::Share(0.05);
+    let roulette = GpuMode::Gates(roulette);
+    assert_eq!(walk_batch(llvmpipe, &roulette, Some(1251), 1024), 52);
+    assert_eq!(
+        walk_batch(llvmpipe, &roulette, Some(99), 16_384),
+        (65_279 - 256) / 100
+    );
+    // The default roulette, on at 256 VPLs a pixel, sums them too.
+    assert_eq!(
+        walk_batch(llvmpipe, &voxels, Some(99), 16_384),
+        (65_279 - 256) / 100
+    );
+    for steps in [3, 100, 1251, 4000] {
+        for (mode, lists) in [(&voxels, 0), (&triangles, TRIANGLE_TESTS_PER_WALK)] {
+            let batch = walk_batch(llvmpipe, mode, Some(steps), 1024);
+            assert!(
+                batch * (steps + 1 + lists) + 256 <= 65_535,
+                "{steps}: {batch}"
+            );
+        }
+    }
+    assert_eq!(
+        walk_batch("NVIDIA H100 80GB HBM3", &voxels, Some(1251), 1024),
+        0
+    );
+}
+
+#[test]
+fn portal_walks_a_pixel_follow_the_shape_and_the_interleaving() {
+    use crate::cpu::gates::GateShape;
+    assert_eq!(GatesParams::default().gates.shape, GateShape::Voxels);
+    let portals = portals();
+    assert_eq!(portals.interleave.subsets(), 64);
+    assert_eq!(GpuMode::Gates(portals).walks_per_pixel(4096), 64);
+    assert_eq!(GpuMode::Gates(portals).walks_per_pixel(4097), 65);
+    assert_eq!(
+        GpuMode::GatesPerPixel(portals.gates).walks_per_pixel(4096),
+        4096
+    );
+    let mut disks = portals;
+    disks.gates.shape = GateShape::Disk;
+    assert_eq!(GpuMode::Gates(disks).walks_per_pixel(4096), 0);
+    assert_eq!(GpuMode::GatesPerPixel(disks.gates).walks_per_pixel(4096), 0);
+    assert_eq!(GpuMode::None.walks_per_pixel(4096), 0);
+}
+
+#[test]
+fn every_registered_method_makes_its_own_mode() {
+    let s = MethodSettings::default();
+    for m in METHODS {
+        let mode = (m.make)(&s);
+        assert_eq!(mode.name(), m.name);
+        assert_eq!(mode.gates().is_some(), m.needs_level, "{}", m.name);
+        assert!(mode.check().is_ok(), "{}", m.name);
+    }
+}
