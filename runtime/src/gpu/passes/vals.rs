@@ -108,90 +108,18 @@ impl ValClustering {
         rec: &mut Recorder,
     ) -> Result<ValBuffers, RenderError> {
         params.check()?;
-        let d = &ctx.device;
-        let (n, m) = (input.count, params.count);
-        let subsets = subsets.max(1);
-        let max = d.limits().max_compute_workgroups_per_dimension;
+        let n = input.count;
+        let max = ctx.device.limits().max_compute_workgroups_per_dimension;
         if n.div_ceil(WG_LINEAR) > max {
             return Err(RenderError::Param(format!(
                 "{n} VPLs need more workgroups than the adapter's {max}"
             )));
         }
-        let frame = ValFrame {
-            vpl_count: n,
-            val_count: m,
-            subsets,
-            seeding: u32::from(params.seeding == ValSeeding::HaltonFlux),
-            w_x: params.w_x,
-            w_alpha: params.w_alpha,
-            w_f: params.w_f,
-            splat: params.splat_or_zero(),
-            reseed: u32::from(warm && params.seeding == ValSeeding::HaltonFlux),
-            ..bytemuck::Zeroable::zeroed()
-        };
-        let uniform = wgpu::BufferUsages::UNIFORM;
-        let frame_buf = pool.upload(ctx, "val frame", bytemuck::bytes_of(&frame), uniform);
-        let rw = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
-        let inv: [f32; 1] = [input.cpu.map_or(1.0, |v| 1.0 / scale_of(v))];
-        let inv_scale = pool.upload(ctx, "val inv scale", bytemuck::cast_slice(&inv), rw);
-        let centres = pool.buffer(d, "val centres", m as u64 * 48, rw);
-        let cdf = pool.buffer(d, "vpl importance cdf", n.max(1) as u64 * 4, rw);
-        let mapping = pool.buffer(d, "vpl → val", n as u64 * 4, rw);
-        let vals = pool.buffer(d, "vals", m as u64 * size_of::<Val>() as u64, rw);
-        let buckets = m as u64 * subsets as u64;
-        let order = pool.buffer(
-            d,
-            "vpls by val",
-            (buckets + 1 + n as u64) * 4,
-            rw | wgpu::BufferUsages::COPY_DST,
-        );
-        let state = pool.buffer(d, "val convergence", 16, rw | wgpu::BufferUsages::COPY_DST);
-        rec.enc.clear_buffer(&order, 0, None);
-        rec.enc.clear_buffer(&state, 0, None);
-        let bind = |pipeline: &wgpu::ComputePipeline, with: &[(u32, &wgpu::Buffer)]| {
-            let resources = with
-                .iter()
-                .map(|&(binding, b)| (binding, b.as_entire_binding()))
-                .collect();
-            bind_group(d, &pipeline.get_bind_group_layout(0), "vals", resources)
-        };
-        let base = [(0, &frame_buf), (1, input.buffer), (2, &centres)];
-        let scale_bg = bind(&self.scale, &[base[0], base[1], (6, &inv_scale)]);
-        let cumulate_bg = bind(&self.cumulate, &[base[0], base[1], (8, &cdf)]);
-        let init_bg = bind(
-            &self.init,
-            &[base[0], base[1], base[2], (4, &vals), (8, &cdf)],
-        );
-        let assign_bg = bind(
-            &self.assign,
-            &[
-                base[0],
-                base[1],
-                base[2],
-                (3, &mapping),
-                (6, &inv_scale),
-                (7, &state),
-            ],
-        );
-        let converge_bg = bind(&self.converge, &[(7, &state)]);
-        let update_bg = bind(
-            &self.update,
-            &[base[0], base[1], base[2], (3, &mapping), (7, &state)],
-        );
-        let finish_bg = bind(
-            &self.finish,
-            &[
-                base[0],
-                base[1],
-                base[2],
-                (3, &mapping),
-                (4, &vals),
-                (7, &state),
-            ],
-        );
-        let counts_bg = bind(&self.bucket_counts, &[base[0], (3, &mapping), (5, &order)]);
-        let offsets_bg = bind(&self.offsets, &[base[0], (5, &order)]);
-        let scatter_bg = bind(&self.scatter, &[base[0], (3, &mapping), (5, &order)]);
+        let frame = frame_constants(input, params, subsets.max(1), warm);
+        let b = Buffers::new(ctx, pool, input, &frame);
+        rec.enc.clear_buffer(&b.out.order, 0, None);
+        rec.enc.clear_buffer(&b.out.state, 0, None);
+        let g = self.groups(&ctx.device, input, &b);
         let span = rec.begin("VAL clustering");
         {
             let mut pass = rec.enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
@@ -199,45 +127,151 @@ impl ValClustering {
                 timestamp_writes: span.compute(),
             });
             if n > 0 {
-                let (gv, gm) = (n.div_ceil(WG_LINEAR), m.div_ceil(WG_LINEAR));
-                let mut run = |p: &wgpu::ComputePipeline, bg: &wgpu::BindGroup, groups: u32| {
-                    pass.set_pipeline(p);
-                    pass.set_bind_group(0, bg, &[]);
-                    pass.dispatch_workgroups(groups, 1, 1);
-                };
-                if input.cpu.is_none() {
-                    run(&self.scale, &scale_bg, 1);
-                }
-                // Cold: every centre from its seed; warm with the paper's seeds: the VALs
-                // that held no VPL last frame.
-                let reseed = warm && params.seeding == ValSeeding::HaltonFlux;
-                if !warm || reseed {
-                    if params.seeding == ValSeeding::HaltonFlux {
-                        run(&self.cumulate, &cumulate_bg, 1);
-                    }
-                    run(&self.init, &init_bg, gm);
-                }
-                // The iterations stop on the GPU once the assignment repeats itself (the
-                // later dispatches return at once): no read-back, no wait.
-                for _ in 0..params.iterations {
-                    run(&self.assign, &assign_bg, gv);
-                    run(&self.converge, &converge_bg, 1);
-                    run(&self.update, &update_bg, m);
-                }
-                run(&self.assign, &assign_bg, gv);
-                run(&self.finish, &finish_bg, m);
-                let gb = (buckets as u32).div_ceil(WG_LINEAR);
-                run(&self.bucket_counts, &counts_bg, gb);
-                run(&self.offsets, &offsets_bg, 1);
-                run(&self.scatter, &scatter_bg, gb);
+                self.dispatch(&mut pass, &g, &frame, params, (warm, input.cpu.is_none()));
             }
         }
         rec.end();
-        Ok(ValBuffers {
-            vals,
-            mapping,
-            order,
-            state,
-        })
+        Ok(b.out)
     }
+
+    /// The clustering's dispatches: the VPLs' scale where the CPU did not give it, the seeds
+    /// (cold, or the emptied VALs of a warm start with the paper's seeds), the k-means
+    /// iterations, the VALs' sums and the VPLs sorted by (VAL, subset).
+    fn dispatch(
+        &self,
+        pass: &mut wgpu::ComputePass,
+        g: &Groups,
+        frame: &ValFrame,
+        params: &ValParams,
+        (warm, scale_here): (bool, bool),
+    ) {
+        let (n, m) = (frame.vpl_count, frame.val_count);
+        let (gv, gm) = (n.div_ceil(WG_LINEAR), m.div_ceil(WG_LINEAR));
+        let mut run = |p: &wgpu::ComputePipeline, bg: &wgpu::BindGroup, groups: u32| {
+            pass.set_pipeline(p);
+            pass.set_bind_group(0, bg, &[]);
+            pass.dispatch_workgroups(groups, 1, 1);
+        };
+        if scale_here {
+            run(&self.scale, &g.scale, 1);
+        }
+        // Cold: every centre from its seed; warm with the paper's seeds: the VALs that held no
+        // VPL last frame.
+        let reseed = warm && params.seeding == ValSeeding::HaltonFlux;
+        if !warm || reseed {
+            if params.seeding == ValSeeding::HaltonFlux {
+                run(&self.cumulate, &g.cumulate, 1);
+            }
+            run(&self.init, &g.init, gm);
+        }
+        // The iterations stop on the GPU once the assignment repeats itself (the later
+        // dispatches return at once): no read-back, no wait.
+        for _ in 0..params.iterations {
+            run(&self.assign, &g.assign, gv);
+            run(&self.converge, &g.converge, 1);
+            run(&self.update, &g.update, m);
+        }
+        run(&self.assign, &g.assign, gv);
+        run(&self.finish, &g.finish, m);
+        let gb = (m * frame.subsets).div_ceil(WG_LINEAR);
+        run(&self.bucket_counts, &g.counts, gb);
+        run(&self.offsets, &g.offsets, 1);
+        run(&self.scatter, &g.scatter, gb);
+    }
+
+    /// The bind groups of the clustering's passes over `b`.
+    fn groups(&self, d: &wgpu::Device, input: &ValInput, b: &Buffers) -> Groups {
+        let bind = |pipeline: &wgpu::ComputePipeline, with: &[(u32, &wgpu::Buffer)]| {
+            let resources = with
+                .iter()
+                .map(|&(binding, b)| (binding, b.as_entire_binding()))
+                .collect();
+            bind_group(d, &pipeline.get_bind_group_layout(0), "vals", resources)
+        };
+        let (frame, vpls, centres) = ((0, &b.frame), (1, input.buffer), (2, &b.centres));
+        let (mapping, vals, order) = ((3, &b.out.mapping), (4, &b.out.vals), (5, &b.out.order));
+        let (inv_scale, state, cdf) = ((6, &b.inv_scale), (7, &b.out.state), (8, &b.cdf));
+        Groups {
+            scale: bind(&self.scale, &[frame, vpls, inv_scale]),
+            cumulate: bind(&self.cumulate, &[frame, vpls, cdf]),
+            init: bind(&self.init, &[frame, vpls, centres, vals, cdf]),
+            assign: bind(
+                &self.assign,
+                &[frame, vpls, centres, mapping, inv_scale, state],
+            ),
+            converge: bind(&self.converge, &[state]),
+            update: bind(&self.update, &[frame, vpls, centres, mapping, state]),
+            finish: bind(&self.finish, &[frame, vpls, centres, mapping, vals, state]),
+            counts: bind(&self.bucket_counts, &[frame, mapping, order]),
+            offsets: bind(&self.offsets, &[frame, order]),
+            scatter: bind(&self.scatter, &[frame, mapping, order]),
+        }
+    }
+}
+
+/// The clustering's constants for `input` into `params.count` VALs with `subsets` subsets.
+fn frame_constants(input: &ValInput, params: &ValParams, subsets: u32, warm: bool) -> ValFrame {
+    ValFrame {
+        vpl_count: input.count,
+        val_count: params.count,
+        subsets,
+        seeding: u32::from(params.seeding == ValSeeding::HaltonFlux),
+        w_x: params.w_x,
+        w_alpha: params.w_alpha,
+        w_f: params.w_f,
+        splat: params.splat_or_zero(),
+        reseed: u32::from(warm && params.seeding == ValSeeding::HaltonFlux),
+        ..bytemuck::Zeroable::zeroed()
+    }
+}
+
+/// The clustering's buffers: what it leaves ([`ValBuffers`]) and its own.
+struct Buffers {
+    out: ValBuffers,
+    /// The constants (0).
+    frame: wgpu::Buffer,
+    /// The centres (2).
+    centres: wgpu::Buffer,
+    /// 1 / D, the VPLs' scale (6).
+    inv_scale: wgpu::Buffer,
+    /// The VPLs' importance CDF for the paper's seeds (8).
+    cdf: wgpu::Buffer,
+}
+
+impl Buffers {
+    fn new(ctx: &GpuContext, pool: &mut Pool, input: &ValInput, frame: &ValFrame) -> Buffers {
+        let d = &ctx.device;
+        let (n, m) = (u64::from(frame.vpl_count), u64::from(frame.val_count));
+        let uniform = wgpu::BufferUsages::UNIFORM;
+        let rw = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC;
+        let inv: [f32; 1] = [input.cpu.map_or(1.0, |v| 1.0 / scale_of(v))];
+        let buckets = m * u64::from(frame.subsets);
+        let cleared = rw | wgpu::BufferUsages::COPY_DST;
+        Buffers {
+            frame: pool.upload(ctx, "val frame", bytemuck::bytes_of(frame), uniform),
+            inv_scale: pool.upload(ctx, "val inv scale", bytemuck::cast_slice(&inv), rw),
+            centres: pool.buffer(d, "val centres", m * 48, rw),
+            cdf: pool.buffer(d, "vpl importance cdf", n.max(1) * 4, rw),
+            out: ValBuffers {
+                mapping: pool.buffer(d, "vpl → val", n * 4, rw),
+                vals: pool.buffer(d, "vals", m * size_of::<Val>() as u64, rw),
+                order: pool.buffer(d, "vpls by val", (buckets + 1 + n) * 4, cleared),
+                state: pool.buffer(d, "val convergence", 16, cleared),
+            },
+        }
+    }
+}
+
+/// The bind groups of the clustering's passes.
+struct Groups {
+    scale: wgpu::BindGroup,
+    cumulate: wgpu::BindGroup,
+    init: wgpu::BindGroup,
+    assign: wgpu::BindGroup,
+    converge: wgpu::BindGroup,
+    update: wgpu::BindGroup,
+    finish: wgpu::BindGroup,
+    counts: wgpu::BindGroup,
+    offsets: wgpu::BindGroup,
+    scatter: wgpu::BindGroup,
 }
