@@ -43,64 +43,68 @@ fn walk_roulette(ui: &mut egui::Ui, r: &mut WalkRoulette) {
     });
 }
 
+/// The gates' settings (mode gates or gates-per-pixel): the shape and its walk or disks,
+/// and for interleaved gates the blur, the starved pixels and the walks' roulette.
+fn gates_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
+    let g = &mut s.gates.gates;
+    ui.horizontal(|ui| {
+        ui.radio_value(&mut g.shape, GateShape::Voxels, "voxels")
+            .on_hover_text("the walk through the level's open voxels");
+        ui.radio_value(&mut g.shape, GateShape::Portal, "portals");
+        ui.radio_value(&mut g.shape, GateShape::Disk, "disks (paper)");
+    });
+    if g.shape == GateShape::Portal {
+        ui.add(egui::Slider::new(&mut g.max_walk, 1..=256).text("portals per walk"));
+    } else if g.shape == GateShape::Disk {
+        ui.add(egui::Slider::new(&mut g.max_hops, 1..=2).text("gate hops"));
+        ui.add(egui::Slider::new(&mut g.oversize, 0.5..=3.0).text("gate oversize"));
+    } else {
+        ui.checkbox(&mut g.triangles, "triangles in closed voxels")
+            .on_hover_text(
+                "the walk along the true segment, tested against the scene's triangles \
+                 in the closed voxels it crosses: near-exact, several times slower",
+            );
+        ui.add_enabled(
+            !g.triangles,
+            egui::Checkbox::new(&mut g.planes, "planes in closed voxels"),
+        )
+        .on_hover_text(
+            "pass a closed voxel where the segment meets neither of the one or two \
+                 planes its geometry lies in (fewer black pixels beside jambs, columns \
+                 and creases; about twice the walk's time); off: every closed voxel \
+                 blocks",
+        );
+    }
+    if mode == "gates" {
+        let il = &mut s.vals.interleave;
+        interleave(ui, il);
+        if il.block > 1 {
+            let most = il.block * il.block;
+            ui.add(egui::Slider::new(&mut il.starved_taps, 0..=most).text("starved taps"))
+                .on_hover_text(
+                    "a pixel whose blur block holds fewer pixels than this that agree \
+                     with it walks the VPLs of the rest itself (by the walk roulette): \
+                     fewer black strips along walls and jambs, 2-7x the frame on \
+                     lavapipe; 0: off",
+                );
+            ui.checkbox(&mut il.starved_dark, "dark pixels walk the rest")
+                .on_hover_text(
+                    "a pixel whose agreeing neighbours found no light walks the VPLs \
+                     of the rest itself: a lit strip whose few VPLs fell in the other \
+                     pixels' subsets is no longer black",
+                );
+        }
+        if g.shape != GateShape::Disk {
+            walk_roulette(ui, &mut s.gates.walk_roulette);
+        }
+    }
+}
+
 /// The settings of method `mode` (by its registry name). Clustered gates and the VAL modes
 /// share one interleaving block, so that their speed compares like with like.
 pub fn method_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
     match mode {
-        "gates" | "gates-per-pixel" => {
-            let g = &mut s.gates.gates;
-            ui.horizontal(|ui| {
-                ui.radio_value(&mut g.shape, GateShape::Voxels, "voxels")
-                    .on_hover_text("the walk through the level's open voxels");
-                ui.radio_value(&mut g.shape, GateShape::Portal, "portals");
-                ui.radio_value(&mut g.shape, GateShape::Disk, "disks (paper)");
-            });
-            if g.shape == GateShape::Portal {
-                ui.add(egui::Slider::new(&mut g.max_walk, 1..=256).text("portals per walk"));
-            } else if g.shape == GateShape::Disk {
-                ui.add(egui::Slider::new(&mut g.max_hops, 1..=2).text("gate hops"));
-                ui.add(egui::Slider::new(&mut g.oversize, 0.5..=3.0).text("gate oversize"));
-            } else {
-                ui.checkbox(&mut g.triangles, "triangles in closed voxels")
-                    .on_hover_text(
-                        "the walk along the true segment, tested against the scene's triangles \
-                         in the closed voxels it crosses: near-exact, several times slower",
-                    );
-                ui.add_enabled(
-                    !g.triangles,
-                    egui::Checkbox::new(&mut g.planes, "planes in closed voxels"),
-                )
-                .on_hover_text(
-                    "pass a closed voxel where the segment meets neither of the one or two \
-                         planes its geometry lies in (fewer black pixels beside jambs, columns \
-                         and creases; about twice the walk's time); off: every closed voxel \
-                         blocks",
-                );
-            }
-            if mode == "gates" {
-                let il = &mut s.vals.interleave;
-                interleave(ui, il);
-                if il.block > 1 {
-                    let most = il.block * il.block;
-                    ui.add(egui::Slider::new(&mut il.starved_taps, 0..=most).text("starved taps"))
-                        .on_hover_text(
-                            "a pixel whose blur block holds fewer pixels than this that agree \
-                             with it walks the VPLs of the rest itself (by the walk roulette): \
-                             fewer black strips along walls and jambs, 2-7x the frame on \
-                             lavapipe; 0: off",
-                        );
-                    ui.checkbox(&mut il.starved_dark, "dark pixels walk the rest")
-                        .on_hover_text(
-                            "a pixel whose agreeing neighbours found no light walks the VPLs \
-                             of the rest itself: a lit strip whose few VPLs fell in the other \
-                             pixels' subsets is no longer black",
-                        );
-                }
-                if g.shape != GateShape::Disk {
-                    walk_roulette(ui, &mut s.gates.walk_roulette);
-                }
-            }
-        }
+        "gates" | "gates-per-pixel" => gates_settings(ui, mode, s),
         "val-hard" | "val-cssm" => {
             let v = &mut s.vals;
             ui.add(egui::Slider::new(&mut v.vals.count, 1..=256).text("VALs"));
