@@ -1,10 +1,9 @@
 //! The built-ins' scene descriptions: whether each is closed, its lights and cameras.
 
-use std::path::PathBuf;
+use std::path::Path;
 
 use visgate_formats::desc::{
-    CameraDesc, LightDesc, LightLineDesc, MeshDesc, PointLightDesc, Scale, SceneDesc,
-    SpotLightDesc, UpAxis,
+    CameraDesc, LightDesc, LightLineDesc, PointLightDesc, SceneDesc, SpotLightDesc,
 };
 
 use crate::Builtin;
@@ -18,20 +17,9 @@ impl Builtin {
         let (closed, lights, cameras) = self.placed();
         SceneDesc {
             name: Some(self.name().into()),
-            up: UpAxis::Y,
-            metres_per_unit: 1.0,
             closed,
-            meshes: vec![MeshDesc {
-                path: PathBuf::from(self.mesh_file_name()),
-                is_static: true,
-                translate: [0.0; 3],
-                rotate_deg: [0.0; 3],
-                scale: Scale::Uniform(1.0),
-                animate: vec![],
-                orbit: None,
-            }],
-            materials: vec![],
             lights,
+            cameras,
             light_lines: match self {
                 // Two rows of 24 lamps 3.2 m up, 1 m either side of the columns.
                 Builtin::LampHall => [1.2, 3.8]
@@ -44,8 +32,7 @@ impl Builtin {
                     .to_vec(),
                 _ => vec![],
             },
-            cameras,
-            suns: vec![],
+            ..SceneDesc::for_mesh_file(Path::new(&self.mesh_file_name()))
         }
     }
 
@@ -59,8 +46,8 @@ impl Builtin {
                 orbit: None,
             })
         };
-        let camera = |eye: [f64; 3], target: [f64; 3], fov: f32| CameraDesc {
-            name: "main".into(),
+        let camera = |name: &str, eye: [f64; 3], target: [f64; 3], fov: f32| CameraDesc {
+            name: name.into(),
             eye,
             target,
             up: None,
@@ -70,28 +57,25 @@ impl Builtin {
             Builtin::EmptyBox => (
                 true,
                 vec![point([2.0, 2.7, 2.0], 8.0)],
-                vec![camera([0.4, 1.6, 0.4], [3.0, 1.0, 3.5], 75.0)],
+                vec![camera("main", [0.4, 1.6, 0.4], [3.0, 1.0, 3.5], 75.0)],
             ),
             Builtin::TwoRooms => (
                 true,
                 vec![point([2.0, 2.7, 2.0], 8.0)],
                 vec![
-                    camera([0.5, 1.6, 2.0], [4.1, 1.0, 2.0], 70.0),
-                    CameraDesc {
-                        name: "room-b".into(),
-                        ..camera([7.7, 1.6, 3.5], [4.2, 1.0, 1.0], 70.0)
-                    },
+                    camera("main", [0.5, 1.6, 2.0], [4.1, 1.0, 2.0], 70.0),
+                    camera("room-b", [7.7, 1.6, 3.5], [4.2, 1.0, 1.0], 70.0),
                 ],
             ),
             Builtin::RingCorridor => (
                 true,
                 vec![point([0.75, 2.2, 0.75], 5.0)],
-                vec![camera([0.75, 1.6, 7.0], [0.75, 1.2, 0.0], 70.0)],
+                vec![camera("main", [0.75, 1.6, 7.0], [0.75, 1.2, 0.0], 70.0)],
             ),
             Builtin::LCorridor => (
                 true,
                 vec![point([0.75, 2.2, 0.75], 5.0)],
-                vec![camera([0.5, 1.6, 0.75], [6.0, 1.0, 0.75], 70.0)],
+                vec![camera("main", [0.5, 1.6, 0.75], [6.0, 1.0, 0.75], 70.0)],
             ),
             Builtin::FourRooms => (
                 true,
@@ -108,7 +92,7 @@ impl Builtin {
                         orbit: None,
                     }),
                 ],
-                vec![camera([0.5, 1.6, 0.5], [4.1, 1.0, 2.0], 75.0)],
+                vec![camera("main", [0.5, 1.6, 0.5], [4.1, 1.0, 2.0], 75.0)],
             ),
             Builtin::CornellBox => (
                 false,
@@ -120,7 +104,7 @@ impl Builtin {
                     animate: vec![],
                     orbit: None,
                 })],
-                vec![camera([0.0, 1.0, 3.5], [0.0, 1.0, 0.0], 45.0)],
+                vec![camera("main", [0.0, 1.0, 3.5], [0.0, 1.0, 0.0], 45.0)],
             ),
             // The light in room B, the cameras in room A looking at the door wall (the light
             // reaches room A only through the door's gap) and one in room B.
@@ -128,15 +112,9 @@ impl Builtin {
                 true,
                 vec![point([6.6, 2.5, 3.3], 10.0)],
                 vec![
-                    camera([0.4, 1.6, 0.5], [4.0, 1.0, 2.2], 75.0),
-                    CameraDesc {
-                        name: "door".into(),
-                        ..camera([1.8, 1.3, 3.6], [4.0, 0.9, 1.8], 70.0)
-                    },
-                    CameraDesc {
-                        name: "light-room".into(),
-                        ..camera([7.6, 1.6, 0.4], [4.0, 1.0, 2.2], 75.0)
-                    },
+                    camera("main", [0.4, 1.6, 0.5], [4.0, 1.0, 2.2], 75.0),
+                    camera("door", [1.8, 1.3, 3.6], [4.0, 0.9, 1.8], 70.0),
+                    camera("light-room", [7.6, 1.6, 0.4], [4.0, 1.0, 2.2], 75.0),
                 ],
             ),
             // A lamp 1.2 m outside the window and above it, lighting room B's floor through it
@@ -146,14 +124,8 @@ impl Builtin {
                 false,
                 vec![point([6.0, 2.8, 5.2], 40.0)],
                 vec![
-                    CameraDesc {
-                        name: "window".into(),
-                        ..camera([4.6, 1.7, 0.4], [6.2, 0.2, 3.2], 75.0)
-                    },
-                    CameraDesc {
-                        name: "door".into(),
-                        ..camera([0.4, 1.6, 0.5], [4.0, 1.0, 2.2], 75.0)
-                    },
+                    camera("window", [4.6, 1.7, 0.4], [6.2, 0.2, 3.2], 75.0),
+                    camera("door", [0.4, 1.6, 0.5], [4.0, 1.0, 2.2], 75.0),
                 ],
             ),
             // One lamp in each side room (the rows are light lines); the cameras of the
@@ -166,15 +138,9 @@ impl Builtin {
                     point([8.0, 2.5, -2.2], 3.0),
                 ],
                 vec![
-                    camera([15.5, 1.7, 1.0], [0.0, 1.2, 4.0], 75.0),
-                    CameraDesc {
-                        name: "side-room".into(),
-                        ..camera([15.5, 1.6, 9.0], [13.5, 1.0, 4.0], 75.0)
-                    },
-                    CameraDesc {
-                        name: "south-row".into(),
-                        ..camera([0.5, 1.5, 0.5], [16.0, 2.0, 1.5], 70.0)
-                    },
+                    camera("main", [15.5, 1.7, 1.0], [0.0, 1.2, 4.0], 75.0),
+                    camera("side-room", [15.5, 1.6, 9.0], [13.5, 1.0, 4.0], 75.0),
+                    camera("south-row", [0.5, 1.5, 0.5], [16.0, 2.0, 1.5], 70.0),
                 ],
             ),
             // A light at the hall's west end, a spot into the south room; one camera down the
@@ -195,11 +161,8 @@ impl Builtin {
                     }),
                 ],
                 vec![
-                    camera([15.5, 1.7, 1.0], [0.0, 1.2, 4.0], 75.0),
-                    CameraDesc {
-                        name: "side-room".into(),
-                        ..camera([15.5, 1.6, 9.0], [13.5, 1.0, 4.0], 75.0)
-                    },
+                    camera("main", [15.5, 1.7, 1.0], [0.0, 1.2, 4.0], 75.0),
+                    camera("side-room", [15.5, 1.6, 9.0], [13.5, 1.0, 4.0], 75.0),
                 ],
             ),
         }
