@@ -182,15 +182,13 @@ impl Isms {
         rec: &mut Recorder,
     ) -> Result<IsmOutput, RenderError> {
         p.check()?;
-        let ctx = f.ctx;
-        let d = &ctx.device;
+        let d = &f.ctx.device;
         let (kind, count, vals) = match emitters {
             Emitters::Vpls => (0, f.vpl_count, None),
             Emitters::Vals(b, m) => (1, m, Some(b)),
         };
         let limit = (d.limits().max_storage_buffer_binding_size).min(d.limits().max_buffer_size);
         let s = p.side_for(count, limit)?;
-        let geo = &f.scene.geometry;
         let points = count as u64 * p.points_per_map as u64;
         if points > u32::MAX as u64 {
             return Err(RenderError::Param(format!(
@@ -199,64 +197,76 @@ impl Isms {
             )));
         }
         let constants = frame_constants(f, p, (kind, count, s), points as u32, gather);
-        let frame = pool.upload(
-            ctx,
-            "ism frame",
-            bytemuck::bytes_of(&constants),
-            wgpu::BufferUsages::UNIFORM,
-        );
-        let rw = wgpu::BufferUsages::STORAGE;
-        let emit_buf = pool.buffer(d, "ism emitters", count.max(1) as u64 * 32, rw);
-        let atlas = pool.buffer(
-            d,
-            "ism atlas",
-            count.max(1) as u64 * (s as u64 * s as u64) * 4,
-            rw | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
-        );
         let levels = p.pull_push.min(s.trailing_zeros());
         let (steps, words) = pull_push_steps(s, levels, count);
-        let pyramid = pool.buffer(d, "ism pyramid", words * 4, rw);
         let keep = points <= MAX_KEPT_POINTS.min(limit / 32);
-        let kept = pool.buffer(d, "ism points", if keep { points * 32 } else { 32 }, rw);
-        let no_vals;
-        let vals = match vals {
-            Some(v) => v,
-            None => {
-                no_vals = pool.buffer(d, "ism no vals", 64, rw);
-                &no_vals
+        let b = MapBuffers::new(f, pool, &constants, (words, keep), vals);
+        let g = self.map_groups(f, pool, &b, (&steps, levels));
+        rec.enc.clear_buffer(&b.atlas, 0, None);
+        timed_pass(rec, "ISM points", |pass| {
+            if count > 0 {
+                dispatch(pass, &self.emit, &g.emit, count as u64);
+                if keep {
+                    dispatch(pass, &self.sample, &g.sample, points);
+                }
             }
-        };
-        let all: [(u32, &wgpu::Buffer); 9] = [
-            (0, &frame),
-            (1, &f.vpls),
-            (2, vals),
-            (3, &emit_buf),
-            (4, &geo.triangles),
-            (5, &geo.area_cdf),
-            (6, &kept),
-            (7, &atlas),
-            (8, &pyramid),
+        });
+        timed_pass(rec, "ISM atlas", |pass| {
+            if count > 0 {
+                dispatch(pass, &self.splat, &g.splat, points);
+            }
+        });
+        timed_pass(rec, "pull-push", |pass| {
+            for (k, step) in steps.iter().enumerate().filter(|_| count > 0) {
+                let (pl, bg) = match k < levels as usize {
+                    true => (&self.pull, &g.pull),
+                    false => (&self.push, &g.push),
+                };
+                pass.set_bind_group(1, &g.levels[k], &[]);
+                dispatch(pass, pl, bg, count as u64 * (step.side as u64).pow(2));
+            }
+        });
+        Ok(IsmOutput {
+            frame: b.frame,
+            emitters: b.emitters,
+            atlas: b.atlas,
+            map_size: s,
+        })
+    }
+
+    /// The maps' passes' bind groups over `b`, and one a pull-push step (`levels` pulls, then
+    /// the pushes).
+    fn map_groups(
+        &self,
+        f: &Frame,
+        pool: &mut Pool,
+        b: &MapBuffers,
+        (steps, levels): (&[IsmLevel], u32),
+    ) -> MapGroups {
+        let d = &f.ctx.device;
+        let geo = &f.scene.geometry;
+        let all: [&wgpu::Buffer; 9] = [
+            &b.frame,
+            &f.vpls,
+            &b.vals,
+            &b.emitters,
+            &geo.triangles,
+            &geo.area_cdf,
+            &b.kept,
+            &b.atlas,
+            &b.pyramid,
         ];
         let bind = |pl: &wgpu::ComputePipeline, which: &[u32]| {
             let r = which
                 .iter()
-                .map(|&b| (b, all[b as usize].1.as_entire_binding()))
+                .map(|&i| (i, all[i as usize].as_entire_binding()))
                 .collect();
             bind_group(d, &pl.get_bind_group_layout(0), "ism", r)
         };
-        let emit_bg = bind(&self.emit, &[0, 1, 2, 3]);
-        let sample_bg = bind(&self.sample, &[0, 4, 5, 6]);
-        let splat_bg = bind(&self.splat, &[0, 3, 4, 5, 6, 7]);
-        let pull_bg = bind(&self.pull, &[0, 7, 8]);
-        let push_bg = bind(&self.push, &[0, 7, 8]);
-        let level_buf = pool.upload(
-            ctx,
-            "ism levels",
-            &strided(&steps),
-            wgpu::BufferUsages::UNIFORM,
-        );
+        let uniform = wgpu::BufferUsages::UNIFORM;
+        let level_buf = pool.upload(f.ctx, "ism levels", &strided(steps), uniform);
         let size = size_of::<IsmLevel>() as u64;
-        let level_bgs: Vec<wgpu::BindGroup> = (0..steps.len())
+        let levels = (0..steps.len())
             .map(|k| {
                 let pl = if k < levels as usize {
                     &self.pull
@@ -272,36 +282,14 @@ impl Isms {
                 )
             })
             .collect();
-        rec.enc.clear_buffer(&atlas, 0, None);
-        timed_pass(rec, "ISM points", |pass| {
-            if count > 0 {
-                dispatch(pass, &self.emit, &emit_bg, count as u64);
-                if keep {
-                    dispatch(pass, &self.sample, &sample_bg, points);
-                }
-            }
-        });
-        timed_pass(rec, "ISM atlas", |pass| {
-            if count > 0 {
-                dispatch(pass, &self.splat, &splat_bg, points);
-            }
-        });
-        timed_pass(rec, "pull-push", |pass| {
-            for (k, step) in steps.iter().enumerate().filter(|_| count > 0) {
-                let (pl, bg) = match k < levels as usize {
-                    true => (&self.pull, &pull_bg),
-                    false => (&self.push, &push_bg),
-                };
-                pass.set_bind_group(1, &level_bgs[k], &[]);
-                dispatch(pass, pl, bg, count as u64 * (step.side as u64).pow(2));
-            }
-        });
-        Ok(IsmOutput {
-            frame,
-            emitters: emit_buf,
-            atlas,
-            map_size: s,
-        })
+        MapGroups {
+            emit: bind(&self.emit, &[0, 1, 2, 3]),
+            sample: bind(&self.sample, &[0, 4, 5, 6]),
+            splat: bind(&self.splat, &[0, 3, 4, 5, 6, 7]),
+            pull: bind(&self.pull, &[0, 7, 8]),
+            push: bind(&self.push, &[0, 7, 8]),
+            levels,
+        }
     }
 
     /// Records the gather through `maps` into an indirect target and the blur composing it
@@ -422,4 +410,61 @@ pub fn read_maps(ctx: &GpuContext, maps: &IsmOutput) -> Result<Vec<f32>, RenderE
             w => f32::from_bits(!w),
         })
         .collect())
+}
+
+/// The maps' buffers for one frame.
+struct MapBuffers {
+    /// The constants (0).
+    frame: wgpu::Buffer,
+    /// The VALs (2; a stand-in for per-VPL maps).
+    vals: wgpu::Buffer,
+    /// Each map's emitter (3).
+    emitters: wgpu::Buffer,
+    /// The points kept between sampling and splatting, where they fit (6).
+    kept: wgpu::Buffer,
+    /// The maps (7).
+    atlas: wgpu::Buffer,
+    /// The pull-push pyramid (8).
+    pyramid: wgpu::Buffer,
+}
+
+impl MapBuffers {
+    /// The buffers for `c` (its maps' count and side), a pyramid of `words`, the points kept
+    /// where `keep`, and `vals` (none: per-VPL maps).
+    fn new(
+        f: &Frame,
+        pool: &mut Pool,
+        c: &IsmFrame,
+        (words, keep): (u64, bool),
+        vals: Option<&wgpu::Buffer>,
+    ) -> MapBuffers {
+        let d = &f.ctx.device;
+        let rw = wgpu::BufferUsages::STORAGE;
+        let uniform = wgpu::BufferUsages::UNIFORM;
+        let (count, side) = (u64::from(c.emitters.max(1)), u64::from(c.map_size));
+        let points = u64::from(c.points);
+        let copies = wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC;
+        MapBuffers {
+            frame: pool.upload(f.ctx, "ism frame", bytemuck::bytes_of(c), uniform),
+            emitters: pool.buffer(d, "ism emitters", count * 32, rw),
+            atlas: pool.buffer(d, "ism atlas", count * side * side * 4, rw | copies),
+            pyramid: pool.buffer(d, "ism pyramid", words * 4, rw),
+            kept: pool.buffer(d, "ism points", if keep { points * 32 } else { 32 }, rw),
+            vals: match vals {
+                Some(v) => v.clone(),
+                None => pool.buffer(d, "ism no vals", 64, rw),
+            },
+        }
+    }
+}
+
+/// The maps' passes' bind groups.
+struct MapGroups {
+    emit: wgpu::BindGroup,
+    sample: wgpu::BindGroup,
+    splat: wgpu::BindGroup,
+    pull: wgpu::BindGroup,
+    push: wgpu::BindGroup,
+    /// A pull-push step's constants each (group 1).
+    levels: Vec<wgpu::BindGroup>,
 }
