@@ -96,17 +96,69 @@ impl ParaboloidMaps {
         rec: &mut Recorder,
         (g, out): (&GBufferOutput, &wgpu::Texture),
     ) {
-        let d = &f.ctx.device;
         let n = f.vpl_count as usize;
         if n == 0 {
             return;
         }
-        let batch = p.batch.min(d.limits().max_texture_array_layers).max(1) as usize;
-        let m = p.map_size;
+        let most = f.ctx.device.limits().max_texture_array_layers;
+        let batch = p.batch.min(most).max(1) as usize;
+        let batches: Vec<Batch> = (0..n.div_ceil(batch))
+            .map(|b| Batch {
+                first: (b * batch) as u32,
+                count: batch.min(n - b * batch) as u32,
+                map_size: p.map_size,
+                g_max: f.params.g_max,
+                normal_offset: f.params.shadows.normal_offset,
+                bias: f.params.shadows.bias,
+                ..bytemuck::Zeroable::zeroed()
+            })
+            .collect();
+        let other = frame_target(f, pool, "hdr (ping-pong)");
+        let t = self.targets(f, pool, (p.map_size, batch as u32), &batches, [out, &other]);
+        let mut current = 0;
+        for (bi, b) in batches.iter().enumerate() {
+            let span = rec.begin("VPL paraboloid maps");
+            for k in 0..b.count {
+                DistancePass {
+                    color: &t.layers[k as usize],
+                    depth: &t.depth,
+                    pipeline: &self.vpl,
+                    bind_group: &t.map_group,
+                    vertices: &f.scene.geometry.vpl_vertices,
+                    count: f.scene.geometry.vpl_vertex_count,
+                    instances: b.first + k..b.first + k + 1,
+                }
+                .record(&mut rec.enc, span.render(k == 0, k + 1 == b.count));
+            }
+            rec.end();
+            self.record_gather(f, rec, (&t, g), bi, current);
+            current = 1 - current;
+            // Each batch goes to the GPU as soon as it is recorded (no wait): with a thousand
+            // render passes in one command buffer the GPU would idle while they are recorded
+            // (H100: 1,024 VPLs at 512², 239 → 178 ms a frame).
+            rec.submit();
+        }
+        if current == 1 {
+            rec.enc
+                .copy_texture_to_texture(other.as_image_copy(), out.as_image_copy(), out.size());
+        }
+    }
+
+    /// The maps (`m`² texels, `batch` layers), their depth, the batches' constants and the
+    /// ping-pong pair's views for one frame.
+    fn targets(
+        &self,
+        f: &Frame,
+        pool: &mut Pool,
+        (m, batch): (u32, u32),
+        batches: &[Batch],
+        pair: [&wgpu::Texture; 2],
+    ) -> Targets {
+        let d = &f.ctx.device;
         let maps = pool.texture(
             d,
             "vpl paraboloid maps",
-            [m, m, batch as u32],
+            [m, m, batch],
             1,
             wgpu::TextureFormat::R32Float,
             wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
@@ -119,7 +171,6 @@ impl ParaboloidMaps {
             wgpu::TextureFormat::Depth32Float,
             wgpu::TextureUsages::RENDER_ATTACHMENT,
         );
-        let other = frame_target(f, pool, "hdr (ping-pong)");
         let uniform = wgpu::BufferUsages::UNIFORM;
         let map_params = MapParams {
             far: f.scene.far_m,
@@ -131,86 +182,62 @@ impl ParaboloidMaps {
             bytemuck::bytes_of(&map_params),
             uniform,
         );
-        let batches: Vec<Batch> = (0..n.div_ceil(batch))
-            .map(|b| Batch {
-                first: (b * batch) as u32,
-                count: batch.min(n - b * batch) as u32,
-                map_size: m,
-                g_max: f.params.g_max,
-                normal_offset: f.params.shadows.normal_offset,
-                bias: f.params.shadows.bias,
-                ..bytemuck::Zeroable::zeroed()
-            })
-            .collect();
-        let batch_buf = pool.upload(f.ctx, "batches", &strided(&batches), uniform);
-        let pair = [out, &other].map(|t| t.create_view(&Default::default()));
-        let layers: Vec<wgpu::TextureView> =
-            (0..batch as u32).map(|l| layer_view(&maps, l)).collect();
-        let maps_view = array_view(&maps);
-        let depth_view = depth.create_view(&Default::default());
-        let map_bg = bind_group(
-            d,
-            &self.vpl.get_bind_group_layout(0),
-            "vpl maps",
+        let batch_buf = pool.upload(f.ctx, "batches", &strided(batches), uniform);
+        Targets {
+            pair: pair.map(|t| t.create_view(&Default::default())),
+            layers: (0..batch).map(|l| layer_view(&maps, l)).collect(),
+            maps: array_view(&maps),
+            depth: depth.create_view(&Default::default()),
+            map_group: bind_group(
+                d,
+                &self.vpl.get_bind_group_layout(0),
+                "vpl maps",
+                vec![
+                    (0, params_buf.as_entire_binding()),
+                    (1, f.vpls.as_entire_binding()),
+                ],
+            ),
+            batches: batch_buf,
+        }
+    }
+
+    /// Records batch `bi`'s gather through its maps, from the pair's `current` target into
+    /// the other.
+    fn record_gather(
+        &self,
+        f: &Frame,
+        rec: &mut Recorder,
+        (t, g): (&Targets, &GBufferOutput),
+        bi: usize,
+        current: usize,
+    ) {
+        let tex = wgpu::BindingResource::TextureView;
+        let size = size_of::<Batch>() as u64;
+        let bg = bind_group(
+            &f.ctx.device,
+            &self.gather.get_bind_group_layout(0),
+            "gather batch",
             vec![
-                (0, params_buf.as_entire_binding()),
+                (0, slice(&t.batches, (bi * UNIFORM_STRIDE) as u64, size)),
                 (1, f.vpls.as_entire_binding()),
+                (2, tex(&t.maps)),
+                (3, tex(&g.views[0])),
+                (4, tex(&g.views[1])),
+                (5, tex(&g.views[2])),
+                (6, tex(&t.pair[current])),
+                (7, tex(&t.pair[1 - current])),
             ],
         );
-        let mut current = 0;
-        for (bi, b) in batches.iter().enumerate() {
-            let span = rec.begin("VPL paraboloid maps");
-            for k in 0..b.count {
-                DistancePass {
-                    color: &layers[k as usize],
-                    depth: &depth_view,
-                    pipeline: &self.vpl,
-                    bind_group: &map_bg,
-                    vertices: &f.scene.geometry.vpl_vertices,
-                    count: f.scene.geometry.vpl_vertex_count,
-                    instances: b.first + k..b.first + k + 1,
-                }
-                .record(&mut rec.enc, span.render(k == 0, k + 1 == b.count));
-            }
-            rec.end();
-            let tex = wgpu::BindingResource::TextureView;
-            let size = size_of::<Batch>() as u64;
-            let bg = bind_group(
-                d,
-                &self.gather.get_bind_group_layout(0),
-                "gather batch",
-                vec![
-                    (0, slice(&batch_buf, (bi * UNIFORM_STRIDE) as u64, size)),
-                    (1, f.vpls.as_entire_binding()),
-                    (2, tex(&maps_view)),
-                    (3, tex(&g.views[0])),
-                    (4, tex(&g.views[1])),
-                    (5, tex(&g.views[2])),
-                    (6, tex(&pair[current])),
-                    (7, tex(&pair[1 - current])),
-                ],
-            );
-            let span = rec.begin("VPL gather");
-            let size = f.view.size;
-            frame_pass(
-                &mut rec.enc,
-                "gather batch",
-                &self.gather,
-                &[&bg],
-                span.compute(),
-                size,
-            );
-            rec.end();
-            current = 1 - current;
-            // Each batch goes to the GPU as soon as it is recorded (no wait): with a thousand
-            // render passes in one command buffer the GPU would idle while they are recorded
-            // (H100: 1,024 VPLs at 512², 239 → 178 ms a frame).
-            rec.submit();
-        }
-        if current == 1 {
-            rec.enc
-                .copy_texture_to_texture(other.as_image_copy(), out.as_image_copy(), out.size());
-        }
+        let span = rec.begin("VPL gather");
+        frame_pass(
+            &mut rec.enc,
+            "gather batch",
+            &self.gather,
+            &[&bg],
+            span.compute(),
+            f.view.size,
+        );
+        rec.end();
     }
 
     /// Records a paraboloid distance map per VAL of `vals` (`m` of them, `s`² each; one render
@@ -279,4 +306,20 @@ impl ParaboloidMaps {
         rec.end();
         maps
     }
+}
+
+/// A frame's per-VPL maps and what their passes read.
+struct Targets {
+    /// The ping-pong pair's views (the output first).
+    pair: [wgpu::TextureView; 2],
+    /// A map layer's view each.
+    layers: Vec<wgpu::TextureView>,
+    /// The maps as an array.
+    maps: wgpu::TextureView,
+    /// The maps' depth buffer.
+    depth: wgpu::TextureView,
+    /// The maps' pass's bind group.
+    map_group: wgpu::BindGroup,
+    /// The batches' constants, strided.
+    batches: wgpu::Buffer,
 }
