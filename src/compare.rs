@@ -7,7 +7,9 @@ use clap::{Args, ValueEnum};
 use indicatif::{ProgressBar, ProgressStyle};
 use visgate_formats::vgate::{BakeParams, Resolution};
 use visgate_formats::{BakedLevel, Scene};
-use visgate_runtime::compare::{CompareMode, CompareSpec, ErrorMetric, Step, report, run};
+use visgate_runtime::compare::{
+    CompareMode, CompareReport, CompareSpec, ErrorMetric, Step, report, run,
+};
 use visgate_runtime::cpu::gates::GateLevel;
 use visgate_runtime::hdr::HdrImage;
 
@@ -212,29 +214,9 @@ pub fn run_compare(args: CompareArgs) -> Result<()> {
         read = args.level.as_deref().map(read_level).transpose()?;
         crate::bare::light_if_bare(&mut scene, read.as_ref(), &args.scene);
     }
-    let cameras = if args.cameras.iter().any(|c| c == "all") {
-        scene.cameras.clone()
-    } else {
-        args.cameras
-            .iter()
-            .map(|c| crate::camera_of(&scene, &args.scene, Some(c)))
-            .collect::<Result<_>>()?
-    };
-    if cameras.is_empty() {
-        crate::camera_of(&scene, &args.scene, None)?;
-    }
-    let mut modes = modes(&args.modes, &args.method, &args.val_counts)?;
-    modes = lightcluster_modes(modes, &args.method, &args.lc_min_distances)?;
+    let cameras = compare_cameras(&scene, &args)?;
     let command_line: Vec<String> = std::env::args().collect();
-    modes.extend(variant_modes(&args.variants, &command_line)?);
-    if let Some(twice) =
-        (modes.iter().enumerate()).find(|(i, m)| modes[..*i].iter().any(|o| o.label == m.label))
-    {
-        bail!(
-            "two rows are labelled {}: give each --variant a label of its own",
-            twice.1.label
-        );
-    }
+    let mut modes = compare_rows(&args, &command_line)?;
     let level = level(&args, read, &scene, &mut modes)?;
     let ground_truth = args
         .ground_truth
@@ -271,6 +253,53 @@ pub fn run_compare(args: CompareArgs) -> Result<()> {
     spec.check(level.is_some())?;
     std::fs::create_dir_all(args.out.join("panels"))
         .with_context(|| format!("cannot create {}", args.out.display()))?;
+    let report = run_with_progress(&spec, &scene, level.as_ref().map(|l| &l.0), &args.out)?;
+    report::write(&report, &args.out)?;
+    print_report(&report, &spec, &args);
+    Ok(())
+}
+
+/// The cameras `--cameras` names (`all`: the scene's), or the scene's first where it names
+/// none the scene has.
+fn compare_cameras(scene: &Scene, args: &CompareArgs) -> Result<Vec<visgate_formats::Camera>> {
+    let cameras = if args.cameras.iter().any(|c| c == "all") {
+        scene.cameras.clone()
+    } else {
+        args.cameras
+            .iter()
+            .map(|c| crate::camera_of(scene, &args.scene, Some(c)))
+            .collect::<Result<_>>()?
+    };
+    if cameras.is_empty() {
+        crate::camera_of(scene, &args.scene, None)?;
+    }
+    Ok(cameras)
+}
+
+/// The rows: `--modes`, the VAL counts', LightCluster's distances and the `--variant`s, each
+/// label once.
+fn compare_rows(args: &CompareArgs, command_line: &[String]) -> Result<Vec<CompareMode>> {
+    let mut modes = modes(&args.modes, &args.method, &args.val_counts)?;
+    modes = lightcluster_modes(modes, &args.method, &args.lc_min_distances)?;
+    modes.extend(variant_modes(&args.variants, command_line)?);
+    if let Some(twice) =
+        (modes.iter().enumerate()).find(|(i, m)| modes[..*i].iter().any(|o| o.label == m.label))
+    {
+        bail!(
+            "two rows are labelled {}: give each --variant a label of its own",
+            twice.1.label
+        );
+    }
+    Ok(modes)
+}
+
+/// `run` with a progress bar of the renders, the one under way and its rows.
+fn run_with_progress(
+    spec: &CompareSpec,
+    scene: &Scene,
+    level: Option<&GateLevel>,
+    out: &std::path::Path,
+) -> Result<CompareReport> {
     let bar = ProgressBar::new(1).with_style(
         ProgressStyle::with_template("compare {bar:30} {pos}/{len} renders {elapsed}<{eta} {msg}")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
@@ -292,15 +321,14 @@ pub fn run_compare(args: CompareArgs) -> Result<()> {
             bar.set_message(format!("{w} (rows {d}/{t})"));
         }
     };
-    let report = run(
-        &spec,
-        &scene,
-        level.as_ref().map(|l| &l.0),
-        &args.out,
-        &progress,
-    )?;
+    let report = run(spec, scene, level, out, &progress)?;
     bar.finish_and_clear();
-    report::write(&report, &args.out)?;
+    Ok(report)
+}
+
+/// What the terminal shows of a report: renders made and failed, the references' warnings,
+/// the answers, the Pareto front and where the report is.
+fn print_report(report: &CompareReport, spec: &CompareSpec, args: &CompareArgs) {
     println!(
         "{}: {} renders made, {} read back; {} failed",
         args.scene,
@@ -332,7 +360,6 @@ pub fn run_compare(args: CompareArgs) -> Result<()> {
         );
     }
     println!("wrote {}", args.out.join("report.md").display());
-    Ok(())
 }
 
 /// `arg` as a POSIX shell reads it back: as it is when it holds only characters no shell
