@@ -233,7 +233,41 @@ pub fn run(args: ViewArgs) -> Result<()> {
         level.as_ref().map(GateLevel::baked),
         &args.scene,
     );
-    let camera = match args.camera.as_deref() {
+    let camera = start_camera(&args, &scene)?;
+    let layers = start_layers(&args, saved.as_ref())?;
+    let g_max = RenderJob::default().for_scene(&scene)?.params.g_max;
+    let start = app::Start {
+        level,
+        mode: info.name,
+        vpls: args.vpls.or(saved.as_ref().map(|s| s.vpls)),
+        rsm: args.rsm || saved.as_ref().is_some_and(|s| s.rsm),
+        size,
+        g_max,
+        camera,
+        screenshot: args.screenshot.clone().map(|p| (p, args.frames)),
+        window_shot: args.window_shot.clone(),
+        layers,
+        compare: args.compare,
+        time: args.time,
+        benchmark: args.benchmark.zip(args.benchmark_out.clone()),
+        benchmark_path,
+        record_path: args.record_path.clone(),
+        // The saved camera only when no --camera was asked for.
+        restore: saved.filter(|_| args.camera.is_none()),
+        persist,
+        shader_dir: args.shader_dir.clone(),
+        scene,
+    };
+    if !args.time.is_finite() {
+        bail!("--time {}: give a finite time in seconds", args.time);
+    }
+    open_window(start)
+}
+
+/// The camera the viewer opens on: --camera's (`level`: none, the level framed), else the
+/// scene's first.
+fn start_camera(args: &ViewArgs, scene: &visgate_formats::Scene) -> Result<Option<usize>> {
+    Ok(match args.camera.as_deref() {
         Some("level") => None,
         Some(name) => Some(
             scene
@@ -243,9 +277,14 @@ pub fn run(args: ViewArgs) -> Result<()> {
                 .with_context(|| format!("--camera {name}: the scene has no such camera"))?,
         ),
         None => (!scene.cameras.is_empty()).then_some(0),
-    };
+    })
+}
+
+/// The debug layers the viewer opens with: --layers, else the saved view's; a level's layers
+/// only with --level.
+fn start_layers(args: &ViewArgs, saved: Option<&SavedView>) -> Result<layers::Layers> {
     let mut layers = layers::Layers::default();
-    if let (true, Some(s)) = (args.layers.is_empty(), &saved) {
+    if let (true, Some(s)) = (args.layers.is_empty(), saved) {
         let [clusters, gates, skeleton, vpls, indirect, geometry, lists] = s.layers;
         let lv = args.level.is_some();
         layers = layers::Layers {
@@ -281,32 +320,11 @@ pub fn run(args: ViewArgs) -> Result<()> {
             "--layers clusters, geometry, lists, gates and skeleton draw a baked level: give --level"
         );
     }
-    let g_max = RenderJob::default().for_scene(&scene)?.params.g_max;
-    let start = app::Start {
-        level,
-        mode: info.name,
-        vpls: args.vpls.or(saved.as_ref().map(|s| s.vpls)),
-        rsm: args.rsm || saved.as_ref().is_some_and(|s| s.rsm),
-        size,
-        g_max,
-        camera,
-        screenshot: args.screenshot.clone().map(|p| (p, args.frames)),
-        window_shot: args.window_shot.clone(),
-        layers,
-        compare: args.compare,
-        time: args.time,
-        benchmark: args.benchmark.zip(args.benchmark_out.clone()),
-        benchmark_path,
-        record_path: args.record_path.clone(),
-        // The saved camera only when no --camera was asked for.
-        restore: saved.filter(|_| args.camera.is_none()),
-        persist,
-        shader_dir: args.shader_dir.clone(),
-        scene,
-    };
-    if !args.time.is_finite() {
-        bail!("--time {}: give a finite time in seconds", args.time);
-    }
+    Ok(layers)
+}
+
+/// Opens the window on `start` and runs it until it closes.
+fn open_window(start: app::Start) -> Result<()> {
     let options = eframe::NativeOptions {
         viewport: eframe::egui::ViewportBuilder::default()
             .with_inner_size([1280.0, 760.0])
