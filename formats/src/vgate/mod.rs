@@ -39,6 +39,7 @@ use crate::scene::GeometryHash;
 mod bits;
 mod params;
 mod portal;
+mod read;
 mod validate;
 mod values;
 
@@ -278,6 +279,7 @@ pub struct BakedLevel {
     pub open: VoxelBits,
 }
 
+/// The fixed header's bytes: the magic, the version and the header's length.
 const PREFIX: usize = 16;
 
 impl BakedLevel {
@@ -364,208 +366,6 @@ impl BakedLevel {
         let tmp = std::path::PathBuf::from(tmp);
         std::fs::write(&tmp, &bytes).map_err(io)?;
         std::fs::rename(&tmp, path).map_err(io)
-    }
-
-    /// Reads and fully validates a file.
-    pub fn read(path: &Path) -> Result<BakedLevel, VgateError> {
-        let bytes = std::fs::read(path).map_err(|source| VgateError::Io {
-            file: path.to_path_buf(),
-            source,
-        })?;
-        Self::from_bytes(&bytes)
-    }
-
-    /// Reads only the header (cheap: no section is decoded), after checking its checksum.
-    pub fn read_header(bytes: &[u8]) -> Result<Header, VgateError> {
-        let avail = bytes.len() as u64;
-        if bytes.len() < PREFIX {
-            if !MAGIC.starts_with(&bytes[..bytes.len().min(8)]) {
-                return Err(VgateError::BadMagic);
-            }
-            return Err(VgateError::Truncated {
-                what: "the fixed header",
-                needed: PREFIX as u64,
-                available: avail,
-            });
-        }
-        let Some(version) = stated_version(bytes) else {
-            return Err(VgateError::BadMagic);
-        };
-        if version > FORMAT_VERSION {
-            return Err(VgateError::NewerVersion {
-                found: version,
-                supported: FORMAT_VERSION,
-            });
-        }
-        if version < OLDEST_READ_VERSION {
-            return Err(VgateError::OldVersion {
-                found: version,
-                supported: OLDEST_READ_VERSION,
-            });
-        }
-        let hlen = u32::from_le_bytes([bytes[12], bytes[13], bytes[14], bytes[15]]) as u64;
-        let hend = PREFIX as u64 + hlen;
-        if hend + 4 > avail {
-            return Err(VgateError::Truncated {
-                what: "the header",
-                needed: hend + 4,
-                available: avail,
-            });
-        }
-        let hend = hend as usize;
-        let expected = u32::from_le_bytes([
-            bytes[hend],
-            bytes[hend + 1],
-            bytes[hend + 2],
-            bytes[hend + 3],
-        ]);
-        let found = crc32fast::hash(&bytes[..hend]);
-        if found != expected {
-            return Err(VgateError::Checksum {
-                section: "header".into(),
-                found,
-                expected,
-            });
-        }
-        let (header, rest): (Header, &[u8]) = postcard::take_from_bytes(&bytes[PREFIX..hend])
-            .map_err(|e| VgateError::Decode {
-                what: "header",
-                message: e.to_string(),
-            })?;
-        if !rest.is_empty() {
-            return Err(VgateError::Length(format!(
-                "header declares {hlen} bytes but its contents end {} bytes earlier",
-                rest.len()
-            )));
-        }
-        Ok(header)
-    }
-
-    /// Decodes and fully validates a file's bytes.
-    pub fn from_bytes(bytes: &[u8]) -> Result<BakedLevel, VgateError> {
-        let header = Self::read_header(bytes)?;
-        let avail = bytes.len() as u64;
-        let kinds: Vec<SectionKind> = header.sections.iter().map(|s| s.kind).collect();
-        if !matches!(
-            kinds[..],
-            [
-                SectionKind::Topology,
-                SectionKind::VoxelCluster | SectionKind::VoxelClusterRuns,
-                SectionKind::OpenVoxels | SectionKind::OpenVoxelRuns
-            ]
-        ) {
-            return Err(VgateError::Length(format!(
-                "section table lists {kinds:?}, expected the topology, the voxel clusters and \
-                 the open voxels"
-            )));
-        }
-        let hlen = u32::from_le_bytes([bytes[12], bytes[13], bytes[14], bytes[15]]) as u64;
-        let mut at = PREFIX as u64 + hlen + 4;
-        let mut slices = Vec::with_capacity(3);
-        for s in &header.sections {
-            if s.offset != at {
-                return Err(VgateError::Length(format!(
-                    "section {:?} starts at byte {}, expected {at}",
-                    s.kind, s.offset
-                )));
-            }
-            let end = s.offset.checked_add(s.len).ok_or_else(|| {
-                VgateError::Length(format!("section {:?} length overflows", s.kind))
-            })?;
-            if end > avail {
-                return Err(VgateError::Truncated {
-                    what: "a section",
-                    needed: end,
-                    available: avail,
-                });
-            }
-            let data = &bytes[s.offset as usize..end as usize];
-            let found = crc32fast::hash(data);
-            if found != s.crc32 {
-                return Err(VgateError::Checksum {
-                    section: format!("{:?}", s.kind),
-                    found,
-                    expected: s.crc32,
-                });
-            }
-            if s.kind != SectionKind::VoxelClusterRuns && s.len % s.elem.size() != 0 {
-                return Err(VgateError::Length(format!(
-                    "section {:?} is {} bytes, not a whole number of {:?} elements",
-                    s.kind, s.len, s.elem
-                )));
-            }
-            slices.push((s, data));
-            at = end;
-        }
-        if at != avail {
-            return Err(VgateError::Length(format!(
-                "the file has {} bytes after its last section",
-                avail - at
-            )));
-        }
-        let topology: Topology = {
-            let (s, data) = slices[0];
-            if s.elem != Elem::Structure {
-                return Err(VgateError::Length(
-                    "topology section is not a structure".into(),
-                ));
-            }
-            let (t, rest) = postcard::take_from_bytes(data).map_err(|e| VgateError::Decode {
-                what: "topology",
-                message: e.to_string(),
-            })?;
-            if !rest.is_empty() {
-                return Err(VgateError::Length(format!(
-                    "topology section has {} bytes after its structure",
-                    rest.len()
-                )));
-            }
-            t
-        };
-        let voxels = header.info.grid.voxel_count().ok_or_else(|| {
-            VgateError::BadValue(format!("grid dims {:?} overflow", header.info.grid.dims))
-        })?;
-        let sight = &header.info.sight_grid;
-        let sight_voxels = sight.voxel_count().ok_or_else(|| {
-            VgateError::BadValue(format!("sight grid dims {:?} overflow", sight.dims))
-        })?;
-        let voxel_cluster = {
-            let (s, data) = slices[1];
-            if s.elem == Elem::Structure {
-                return Err(VgateError::Length(format!(
-                    "section {:?} must be a blob of integers",
-                    s.kind
-                )));
-            }
-            if s.kind == SectionKind::VoxelClusterRuns {
-                VoxelValues::from_runs_le_bytes(s.elem, data, voxels)
-                    .map_err(|e| VgateError::Length(format!("voxel cluster runs: {e}")))?
-            } else {
-                VoxelValues::from_le_bytes(s.elem, data)
-            }
-        };
-        let open = {
-            let (s, data) = slices[2];
-            if s.elem != Elem::U8 {
-                return Err(VgateError::Length(
-                    "the open voxels' section is not a blob of bytes".into(),
-                ));
-            }
-            if s.kind == SectionKind::OpenVoxelRuns {
-                VoxelBits::from_runs_le_bytes(data, sight_voxels)
-            } else {
-                VoxelBits::from_le_bytes(data, sight_voxels)
-            }
-            .map_err(|e| VgateError::Length(format!("open voxels: {e}")))?
-        };
-        let level = BakedLevel {
-            info: header.info,
-            topology,
-            voxel_cluster,
-            open,
-        };
-        level.validate()?;
-        Ok(level)
     }
 
     /// Refuses a level baked from other static geometry than `scene_hash`.
