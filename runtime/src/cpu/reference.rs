@@ -114,18 +114,7 @@ pub fn render_cancellable(
     progress: &(dyn Fn(u32, u32) + Sync),
     cancel: &std::sync::atomic::AtomicBool,
 ) -> Result<(HdrImage, ReferenceStats), RenderError> {
-    if !(1..=4096).contains(&params.samples_per_pixel) {
-        return Err(RenderError::Param(format!(
-            "{} samples per pixel: give 1 to 4096",
-            params.samples_per_pixel
-        )));
-    }
-    if params.gather.g_max.is_nan() || params.gather.g_max <= 0.0 {
-        return Err(RenderError::Param(format!(
-            "geometry-term clamp {} must be > 0",
-            params.gather.g_max
-        )));
-    }
+    check(params)?;
     let t0 = std::time::Instant::now();
     // The visibility cluster of every VPL, for the gate test.
     let vpl_cluster: Vec<Option<u32>> = match vis {
@@ -134,6 +123,13 @@ pub fn render_cancellable(
             .map(|v| level.cluster_at(Vec3::from(v.position), Vec3::from(v.normal)))
             .collect(),
         _ => Vec::new(),
+    };
+    let indirect = Indirect {
+        tracer,
+        vpls,
+        gather: &params.gather,
+        vis,
+        vpl_cluster: &vpl_cluster,
     };
     let [w, h] = view.size;
     let shadow = AtomicU64::new(0);
@@ -159,48 +155,7 @@ pub fn render_cancellable(
                         rays += lights.len() as u64;
                     }
                     if params.indirect {
-                        let from = surf.position + surf.geometric_normal * tracer.epsilon_m;
-                        let here = match vis {
-                            IndirectVisibility::Gates(level, _) => {
-                                level.cluster_at(surf.position, surf.normal)
-                            }
-                            _ => None,
-                        };
-                        for (j, v) in vpls.iter().enumerate() {
-                            let l = gather_one(
-                                v,
-                                surf.position,
-                                surf.normal,
-                                surf.albedo,
-                                &params.gather,
-                            );
-                            if l == Vec3::ZERO {
-                                continue;
-                            }
-                            let lit = match vis {
-                                IndirectVisibility::Unoccluded => true,
-                                IndirectVisibility::Exact => {
-                                    rays += 1;
-                                    let to = Vec3::from(v.position)
-                                        + Vec3::from(v.normal) * tracer.epsilon_m;
-                                    !tracer.occluded(from, to)
-                                }
-                                // Gates, portals or voxels (GateLevel::visible: a point or
-                                // VPL outside every cluster meets no gate, unoccluded).
-                                IndirectVisibility::Gates(level, gp) => {
-                                    let vpl = End::of_vpl(v, vpl_cluster[j]);
-                                    let point = End {
-                                        position: surf.position,
-                                        normal: surf.geometric_normal,
-                                        cluster: here,
-                                    };
-                                    level.visible(&vpl, &point, &gp)
-                                }
-                            };
-                            if lit {
-                                sum += l;
-                            }
-                        }
+                        rays += indirect.add(&surf, &mut sum);
                     }
                 }
                 row.push(sum / spp as f32);
@@ -229,6 +184,76 @@ pub fn render_cancellable(
             seconds: t0.elapsed().as_secs_f64(),
         },
     ))
+}
+
+/// Refuses samples per pixel outside 1..=4096 and a geometry-term clamp that is not > 0.
+fn check(params: &ReferenceParams) -> Result<(), RenderError> {
+    if !(1..=4096).contains(&params.samples_per_pixel) {
+        return Err(RenderError::Param(format!(
+            "{} samples per pixel: give 1 to 4096",
+            params.samples_per_pixel
+        )));
+    }
+    if params.gather.g_max.is_nan() || params.gather.g_max <= 0.0 {
+        return Err(RenderError::Param(format!(
+            "geometry-term clamp {} must be > 0",
+            params.gather.g_max
+        )));
+    }
+    Ok(())
+}
+
+/// The VPLs' light at a surface, each VPL shadowed by the visibility asked for.
+struct Indirect<'a> {
+    tracer: &'a Tracer,
+    vpls: &'a [Vpl],
+    gather: &'a GatherParams,
+    vis: IndirectVisibility<'a>,
+    /// Each VPL's visibility cluster, for the gate test.
+    vpl_cluster: &'a [Option<u32>],
+}
+
+impl Indirect<'_> {
+    /// Adds each VPL's light at `surf` to `sum` where it is visible, VPL after VPL; returns
+    /// the shadow rays cast.
+    fn add(&self, surf: &Surface, sum: &mut Vec3) -> u64 {
+        let tracer = self.tracer;
+        let mut rays = 0;
+        let from = surf.position + surf.geometric_normal * tracer.epsilon_m;
+        let here = match self.vis {
+            IndirectVisibility::Gates(level, _) => level.cluster_at(surf.position, surf.normal),
+            _ => None,
+        };
+        for (j, v) in self.vpls.iter().enumerate() {
+            let l = gather_one(v, surf.position, surf.normal, surf.albedo, self.gather);
+            if l == Vec3::ZERO {
+                continue;
+            }
+            let lit = match self.vis {
+                IndirectVisibility::Unoccluded => true,
+                IndirectVisibility::Exact => {
+                    rays += 1;
+                    let to = Vec3::from(v.position) + Vec3::from(v.normal) * tracer.epsilon_m;
+                    !tracer.occluded(from, to)
+                }
+                // Gates, portals or voxels (GateLevel::visible: a point or VPL outside every
+                // cluster meets no gate, unoccluded).
+                IndirectVisibility::Gates(level, gp) => {
+                    let vpl = End::of_vpl(v, self.vpl_cluster[j]);
+                    let point = End {
+                        position: surf.position,
+                        normal: surf.geometric_normal,
+                        cluster: here,
+                    };
+                    level.visible(&vpl, &point, &gp)
+                }
+            };
+            if lit {
+                *sum += l;
+            }
+        }
+        rays
+    }
 }
 
 /// Where in its pixel the reference's sample `s` of `spp` lies: the centre for one, else a
