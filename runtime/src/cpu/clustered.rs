@@ -190,47 +190,7 @@ pub fn assign(
     let lists = clusters
         .iter()
         .map(|gc| {
-            let (s, r) = gc.sphere();
-            let mut list = Vec::new();
-            for (j, v) in vpls.iter().enumerate() {
-                let a = Vec3::from(v.position);
-                let in_front = (s - a).dot(Vec3::from(v.normal)) >= -r;
-                // An entry with no gates: the walk (if any) runs per point.
-                let walk = |walk_from| LightEntry {
-                    vpl: j as u32,
-                    gates: Vec::new(),
-                    walk_from,
-                };
-                match (vpl_cluster[j], gc.cluster) {
-                    // Voxels: culled only when the cluster lies wholly behind the VPL's
-                    // surface; the voxel walk runs per point, whatever the clusters.
-                    _ if gates.shape == GateShape::Voxels => {
-                        if in_front {
-                            list.push(walk(None));
-                        }
-                    }
-                    // Portals: likewise; the walk runs per point from the VPL's cluster.
-                    (Some(ca), Some(cb)) if ca != cb && gates.shape == GateShape::Portal => {
-                        if in_front {
-                            list.push(walk(Some(ca)));
-                        }
-                    }
-                    (Some(ca), Some(cb)) if ca != cb => {
-                        for chain in level.chains(ca, cb, gates.max_hops) {
-                            let g = level.gate(chain[0]);
-                            if cone_meets_sphere(a, g.0, g.2 * gates.oversize, s, r) {
-                                list.push(LightEntry {
-                                    vpl: j as u32,
-                                    gates: chain,
-                                    walk_from: None,
-                                });
-                            }
-                        }
-                    }
-                    // Same cluster, or outside every cluster: no gate stands between.
-                    _ => list.push(walk(None)),
-                }
-            }
+            let mut list = light_list(gc, (vpls, &vpl_cluster), level, gates);
             list.sort_by_key(|e| (e.vpl % subsets, e.vpl));
             list
         })
@@ -240,6 +200,58 @@ pub fn assign(
         clusters,
         lists,
     }
+}
+
+/// Step 3 for one geometry cluster: the VPLs (with their visibility clusters) that may light
+/// it, each with its chains of gates (disks) or where its walk starts (portals), in VPL order.
+fn light_list(
+    gc: &GeometryCluster,
+    (vpls, vpl_cluster): (&[Vpl], &[Option<u32>]),
+    level: &GateLevel,
+    gates: &GateParams,
+) -> Vec<LightEntry> {
+    let (s, r) = gc.sphere();
+    let mut list = Vec::new();
+    for (j, v) in vpls.iter().enumerate() {
+        let a = Vec3::from(v.position);
+        let in_front = (s - a).dot(Vec3::from(v.normal)) >= -r;
+        // An entry with no gates: the walk (if any) runs per point.
+        let walk = |walk_from| LightEntry {
+            vpl: j as u32,
+            gates: Vec::new(),
+            walk_from,
+        };
+        match (vpl_cluster[j], gc.cluster) {
+            // Voxels: culled only when the cluster lies wholly behind the VPL's surface; the
+            // voxel walk runs per point, whatever the clusters.
+            _ if gates.shape == GateShape::Voxels => {
+                if in_front {
+                    list.push(walk(None));
+                }
+            }
+            // Portals: likewise; the walk runs per point from the VPL's cluster.
+            (Some(ca), Some(cb)) if ca != cb && gates.shape == GateShape::Portal => {
+                if in_front {
+                    list.push(walk(Some(ca)));
+                }
+            }
+            (Some(ca), Some(cb)) if ca != cb => {
+                for chain in level.chains(ca, cb, gates.max_hops) {
+                    let g = level.gate(chain[0]);
+                    if cone_meets_sphere(a, g.0, g.2 * gates.oversize, s, r) {
+                        list.push(LightEntry {
+                            vpl: j as u32,
+                            gates: chain,
+                            walk_from: None,
+                        });
+                    }
+                }
+            }
+            // Same cluster, or outside every cluster: no gate stands between.
+            _ => list.push(walk(None)),
+        }
+    }
+    list
 }
 
 /// Angular slack of the cone test: GPU and CPU compute asin / acos to different last bits
