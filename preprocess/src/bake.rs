@@ -14,7 +14,6 @@ use visgate_formats::scene::Light;
 use visgate_formats::vgate::{BakeInfo, BakeParams, BakedLevel, GridMeta, Resolution, VoxelValues};
 
 use crate::BakeError;
-use crate::counters::VoxelizeCounts;
 use crate::empty::EmptySpace;
 use crate::empty::Seed;
 pub use crate::memory::peak_memory_bytes;
@@ -245,16 +244,8 @@ pub fn bake(
     let mut cx = BakeContext::new(progress);
     let input = cx.stage("load static meshes", 0, |_| stages::load(scene))?;
     let meta = grid_for(input.bounds, params.resolution, options.memory_limit_bytes)?;
-    let (solid, solid_voxels) = cx.stage("voxelize", 0, |_| {
-        let solid = voxelize(meta, &input.triangles);
-        let n = solid.solid_count();
-        let counts = VoxelizeCounts {
-            dims: meta.dims,
-            voxel_size_m: meta.voxel_size_m,
-            solid_voxels: n,
-        };
-        Ok(((solid, n), counts))
-    })?;
+    let (solid, solid_voxels) =
+        cx.stage("voxelize", 0, |_| stages::voxelize(meta, &input.triangles))?;
     let mut params = level_scaled(params, input.bounds, meta.voxel_size_m);
     let (sight_grid, open) = cx.stage("sight grid", 0, |_| {
         sight_grid(&input, &meta, &params, options)

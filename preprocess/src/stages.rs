@@ -17,7 +17,7 @@ use crate::clusters::{ClusterParams, clusters};
 use crate::convex::{SplitInput, split_unseen};
 use crate::counters::{
     ClusterCounts, DistanceCounts, EmptyCounts, FlattenCounts, GateCounts, LoadCounts,
-    PortalCounts, SegmentCounts, SkeletonCounts, ThinCounts, TopologyCounts,
+    PortalCounts, SegmentCounts, SkeletonCounts, ThinCounts, TopologyCounts, VoxelizeCounts,
 };
 use crate::empty::{EmptySpace, EmptySpaceParams, empty_space};
 use crate::gate_step::{GateInput, GateStep, gate_step};
@@ -26,6 +26,7 @@ use crate::portals::Portals;
 use crate::segment::{SegmentParams, Segmented, segment};
 use crate::simplify::simplify;
 use crate::thin::{ThinParams, Thinned, extend_ends, thin};
+use crate::voxelize::SolidGrid;
 use crate::{BakeError, distance};
 
 /// A stage's result and its counts for the report.
@@ -60,6 +61,21 @@ pub fn load(scene: &Scene) -> Result<Counted<Loaded, LoadCounts>, BakeError> {
         },
         counts,
     ))
+}
+
+/// Stage 2: the solid voxels of `triangles` on `meta`, and how many.
+pub fn voxelize(
+    meta: GridMeta,
+    triangles: &[[Vec3; 3]],
+) -> Result<Counted<(SolidGrid, u64), VoxelizeCounts>, BakeError> {
+    let solid = crate::voxelize::voxelize(meta, triangles);
+    let n = solid.solid_count();
+    let counts = VoxelizeCounts {
+        dims: meta.dims,
+        voxel_size_m: meta.voxel_size_m,
+        solid_voxels: n,
+    };
+    Ok(((solid, n), counts))
 }
 
 /// Stage 3: the empty space to keep (see [`crate::empty`]).
