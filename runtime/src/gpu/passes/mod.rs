@@ -4,6 +4,7 @@
 pub mod clustered_gates;
 pub mod cssm;
 pub mod display;
+pub mod gates_params;
 pub mod gbuffer;
 pub mod interleave_blur;
 pub mod ism;
