@@ -422,13 +422,7 @@ pub fn check_cpu_gates(g: &GateParams) -> Result<(), RenderError> {
             g.max_hops
         )));
     }
-    if !(1..=1024).contains(&g.max_walk) {
-        return Err(RenderError::Param(format!(
-            "portal walk limit {} must be 1..=1024 portals",
-            g.max_walk
-        )));
-    }
-    Ok(())
+    crate::gpu::passes::gates_params::check_walk_limit(g)
 }
 
 /// The pass table of a GPU frame: a row per pass that ran (GPU time from timestamp queries,

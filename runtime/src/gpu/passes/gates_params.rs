@@ -46,6 +46,11 @@ pub fn check_gates(g: &GateParams) -> Result<(), RenderError> {
             g.max_hops
         )));
     }
+    check_walk_limit(g)
+}
+
+/// Checks the portal walk's limit (GPU and CPU twin alike).
+pub fn check_walk_limit(g: &GateParams) -> Result<(), RenderError> {
     if !(1..=1024).contains(&g.max_walk) {
         return Err(RenderError::Param(format!(
             "portal walk limit {} must be 1..=1024 portals",
