@@ -193,8 +193,8 @@ pub struct MethodArgs {
     /// Gates: the balanced setting in one word — --closed-voxel-triangles --blur-tent
     /// --starved-dark (a --starved-taps given is kept). On the same sixteen camera-seeds as
     /// --accurate: indirect energy within 3 % of the reference's and under 1 % of the lit
-    /// pixels black on all sixteen, at 1.4-3.1x the default's frame on lavapipe (0.2-1x the
-    /// accurate setting's: as much where many pixels are dark), its indirect MSE between the
+    /// pixels black on all sixteen, at 1.2-2.5x the default's frame on lavapipe (0.2-0.7x the
+    /// accurate setting's), its indirect MSE between the
     /// default's and the accurate setting's (README, The balanced setting).
     #[arg(long, conflicts_with = "accurate")]
     pub balanced: bool,
@@ -284,9 +284,10 @@ pub struct MethodArgs {
     #[arg(long, default_value_t = 0)]
     pub starved_taps: u32,
     /// Gates, interleaved: a pixel whose agreeing neighbours in its blur block found no light
-    /// at all walks the VPL subsets of those that do not agree too, however many agree (a lit
-    /// strip whose few VPLs fell in the other pixels' subsets comes out black without it); a
-    /// pixel whose whole block agrees walks nothing more. Beside --starved-taps or alone.
+    /// at all, where another pixel of the block found some, walks the VPL subsets of those
+    /// that do not agree too, however many agree (a lit strip whose few VPLs fell in the other
+    /// pixels' subsets comes out black without it); a block that found no light anywhere is
+    /// taken for indirect shadow. Beside --starved-taps or alone.
     #[arg(long)]
     pub starved_dark: bool,
     /// Gates with portals or voxels: Russian roulette on the walks (the starved pixels' too).

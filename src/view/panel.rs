@@ -168,7 +168,7 @@ pub fn method_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
             let button = ui.button("balanced setting").on_hover_text(
                 "the triangles in closed voxels, the tent blur and the dark pixels' walks \
                  (render --balanced): the reference's light within a few per cent and under \
-                 1 % of the lit pixels black where measured, at 0.2-1x the accurate \
+                 1 % of the lit pixels black where measured, at 0.2-0.7x the accurate \
                  setting's frame",
             );
             if button.clicked() {

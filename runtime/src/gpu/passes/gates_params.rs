@@ -81,7 +81,7 @@ impl GatesParams {
     /// what their block lacks ([`InterleaveParams::starved_dark`]) instead of every pixel with
     /// fewer than three quarters agreeing (a count already set is kept). On the same sixteen
     /// camera-seeds (README) the indirect energy within 3 % of the reference's and under 1 % of
-    /// the lit pixels black, at 0.2–1× the accurate setting's frame, with a higher MSE.
+    /// the lit pixels black, at 0.2–0.7× the accurate setting's frame, with a higher MSE.
     ///
     /// [`InterleaveParams::starved_dark`]: InterleaveParams::starved_dark
     pub fn balanced(mut self) -> GatesParams {

@@ -29,9 +29,10 @@ pub struct InterleaveParams {
     /// agreeing taps' subsets (a door jamb, a strip along a wall: the few subsets the blur
     /// would average may hold none of the VPLs that light it); 0: none. [Limit: 0..=block²]
     pub starved_taps: u32,
-    /// Gates: a pixel whose agreeing taps found no light at all walks the VPL subsets of the
-    /// taps that do not agree too, however many agree (a lit strip whose few VPLs fell in the
-    /// other taps' subsets); a pixel whose whole block agrees walks nothing more.
+    /// Gates: a pixel whose agreeing taps found no light at all, where some other tap of its
+    /// block did, walks the VPL subsets of the taps that do not agree too, however many agree
+    /// (a lit strip whose few VPLs fell in the other taps' subsets); a pixel whose whole block
+    /// agrees, or whose block found no light anywhere (indirect shadow), walks nothing more.
     pub starved_dark: bool,
     /// Blur: a tap that does not agree with the pixel gives way to the nearest copy of its
     /// VPL subset one block away (a block's side along x or y) that does, so that the average
