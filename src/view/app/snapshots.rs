@@ -205,43 +205,40 @@ fn the_viewer_walks_with_the_closed_voxels_triangles_once_ticked() {
 #[test]
 fn the_viewer_s_accurate_setting_walks_the_triangles_and_the_starved_pixels() {
     let mut harness = first_frame(viewer(Layers::default(), false));
-    let before = harness.state().frames;
-    harness.get_by_label("accurate setting").click();
-    until_a_frame_after(&mut harness, before);
-    let app = harness.state();
-    let g = app.settings.gates;
+    let g = clicked_walks_starved(&mut harness, "accurate setting");
     assert!(g.gates.triangles && g.interleave.tent);
     assert_eq!(g.interleave.starved_taps, 48, "3/4 of the 8 x 8 block");
+}
+
+/// Clicks the setting button `label` and waits for the next frame: it has no error and has
+/// the starved pixels' pass; returns the gates' settings the button made.
+fn clicked_walks_starved(
+    harness: &mut Harness<'static, ViewerApp>,
+    label: &str,
+) -> visgate_runtime::gpu::GatesParams {
+    let before = harness.state().frames;
+    harness.get_by_label(label).click();
+    until_a_frame_after(harness, before);
+    let app = harness.state();
     assert_eq!(app.error, None);
-    assert!(app.frames > before, "no frame in the accurate setting");
+    assert!(app.frames > before, "no frame after {label}");
     let (_, times) = app.last.as_ref().expect("a frame");
     let names: Vec<&str> = times.passes.iter().map(|p| p.name).collect();
     assert!(
         names.contains(&"indirect lighting: starved pixels"),
         "{names:?}"
     );
+    app.settings.gates
 }
 
 #[test]
 fn the_viewer_s_balanced_setting_walks_the_triangles_and_the_dark_pixels() {
     let mut harness = first_frame(viewer(Layers::default(), false));
-    let before = harness.state().frames;
-    harness.get_by_label("balanced setting").click();
-    until_a_frame_after(&mut harness, before);
-    let app = harness.state();
-    let g = app.settings.gates;
+    let g = clicked_walks_starved(&mut harness, "balanced setting");
     assert!(g.gates.triangles && g.interleave.tent && g.interleave.starved_dark);
     assert_eq!(g.interleave.starved_taps, 0);
-    assert_eq!(app.error, None);
-    assert!(app.frames > before, "no frame in the balanced setting");
-    let (_, times) = app.last.as_ref().expect("a frame");
-    let names: Vec<&str> = times.passes.iter().map(|p| p.name).collect();
-    assert!(
-        names.contains(&"indirect lighting: starved pixels"),
-        "{names:?}"
-    );
     // Its tick, which the button set, turns the dark pixels' walks off again.
-    let before = app.frames;
+    let before = harness.state().frames;
     harness.get_by_label("dark pixels walk the rest").click();
     until_a_frame_after(&mut harness, before);
     let app = harness.state();
