@@ -9,12 +9,15 @@
 # OUT/log.txt (every render's report) and OUT/table.md (level, camera, size, VPLs, mode, GPU ms
 # of the frame, of its indirect pass; wall ms where the adapter's timestamps are not used).
 # LEVEL: e2m3, sponza (default both), pillared (builtin:pillared-hall, camera side-room), ajar
-# (builtin:ajar-door, camera main). Modes: none, direct-only, gates (voxel walk, the walks'
-# roulette auto; closed voxels passed on their planes), gates-blocking (--no-closed-voxel-planes:
-# every closed voxel blocks), gates-rr0, gates-rr05 and gates-rr10 (the roulette off, S = 0.05 and 0.1),
-# gates-triangles, gates-portal, gates-disk, gates-i4, gates-i4-rr0 and val-hard-i4 (4 × 4
-# interleaving; rr0: every VPL walked), gates-starved48, gates-starved64 (--starved-taps 48,
-# 64), gates-filled (--blur-fill), gates-tri-starved64 (the triangles and 64 starved taps),
+# (builtin:ajar-door, camera main). Modes: none, direct-only, gates (the default: the balanced
+# setting, the voxel walk with the closed voxels' triangles, the tent blur and the dark pixels'
+# walks; the walks' roulette auto), gates-accurate (--accurate), gates-fast (--fast: closed
+# voxels passed on their planes, the box blur; the default before the balanced setting), and on
+# the fast setting, as they were measured before it: gates-blocking (--no-closed-voxel-planes:
+# every closed voxel blocks), gates-rr0, gates-rr05 and gates-rr10 (the roulette off, S = 0.05
+# and 0.1), gates-triangles, gates-portal, gates-disk, gates-i4, gates-i4-rr0 and val-hard-i4
+# (4 × 4 interleaving; rr0: every VPL walked), gates-starved48, gates-starved64 (--starved-taps
+# 48, 64), gates-filled (--blur-fill), gates-tri-starved64 (the triangles and 64 starved taps);
 # val-hard, val-cssm, per-vpl-shadow-maps. In the
 # environment: RUNS="SIZE:COUNTS ..." (default "512x512:4096,1024,16384 1280x720:4096"), MODES
 # (of those, default all but the 4 × 4 and roulette ones), LIMIT (seconds a render may take,
@@ -29,7 +32,7 @@ bin=$1 out=$2
 shift 2
 levels=${*:-e2m3 sponza}
 runs=${RUNS:-512x512:4096,1024,16384 1280x720:4096}
-modes=${MODES:-none direct-only gates gates-triangles gates-portal gates-disk val-hard val-cssm per-vpl-shadow-maps}
+modes=${MODES:-none direct-only gates gates-fast gates-triangles gates-portal gates-disk val-hard val-cssm per-vpl-shadow-maps}
 limit=${LIMIT:-60}
 mkdir -p "$out"
 log="$out/log.txt" table="$out/table.md"
@@ -37,20 +40,22 @@ log="$out/log.txt" table="$out/table.md"
 
 args_of() { # LABEL -> render arguments
     case $1 in
-    gates-triangles) echo "--mode gates --closed-voxel-triangles" ;;
-    gates-blocking) echo "--mode gates --no-closed-voxel-planes" ;;
-    gates-portal) echo "--mode gates --gate-shape portal" ;;
-    gates-disk) echo "--mode gates --gate-shape disk" ;;
-    gates-i4) echo "--mode gates --interleave 4" ;;
-    gates-i4-rr0) echo "--mode gates --interleave 4 --walk-roulette 0" ;;
-    gates-rr0) echo "--mode gates --walk-roulette 0" ;;
-    gates-rr05) echo "--mode gates --walk-roulette 0.05" ;;
-    gates-rr10) echo "--mode gates --walk-roulette 0.1" ;;
+    gates-fast) echo "--mode gates --fast" ;;
+    gates-accurate) echo "--mode gates --accurate" ;;
+    gates-triangles) echo "--mode gates --fast --closed-voxel-triangles" ;;
+    gates-blocking) echo "--mode gates --fast --no-closed-voxel-planes" ;;
+    gates-portal) echo "--mode gates --fast --gate-shape portal" ;;
+    gates-disk) echo "--mode gates --fast --gate-shape disk" ;;
+    gates-i4) echo "--mode gates --fast --interleave 4" ;;
+    gates-i4-rr0) echo "--mode gates --fast --interleave 4 --walk-roulette 0" ;;
+    gates-rr0) echo "--mode gates --fast --walk-roulette 0" ;;
+    gates-rr05) echo "--mode gates --fast --walk-roulette 0.05" ;;
+    gates-rr10) echo "--mode gates --fast --walk-roulette 0.1" ;;
     val-hard-i4) echo "--mode val-hard --interleave 4" ;;
-    gates-starved48) echo "--mode gates --starved-taps 48" ;;
-    gates-starved64) echo "--mode gates --starved-taps 64" ;;
-    gates-filled) echo "--mode gates --blur-fill" ;;
-    gates-tri-starved64) echo "--mode gates --closed-voxel-triangles --starved-taps 64" ;;
+    gates-starved48) echo "--mode gates --fast --starved-taps 48" ;;
+    gates-starved64) echo "--mode gates --fast --starved-taps 64" ;;
+    gates-filled) echo "--mode gates --fast --blur-fill" ;;
+    gates-tri-starved64) echo "--mode gates --fast --closed-voxel-triangles --starved-taps 64" ;;
     *) echo "--mode $1" ;;
     esac
 }

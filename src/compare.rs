@@ -20,17 +20,19 @@ pub const COMPARE_HELP: &str = "\
 Modes (--modes, comma-separated, or all): every GPU method of `visgate render --mode`
 (none, per-vpl-shadow-maps, gates, gates-per-pixel, val-hard, val-cssm, direct-only) and
 gates-voxels, gates-triangles, gates-portal and gates-disk (mode gates walking the level's open
-voxels, walking them along the true segment with the closed voxels' triangles
+voxels past the closed ones' planes, walking them along the true segment with the closed voxels' triangles
 (--closed-voxel-triangles), walking its portals, or with the paper's disks, whatever
 --gate-shape says; gates takes --gate-shape, voxels by default), gates-filled (gates as set,
 its blur filled from the next blocks: --blur-fill), gates-starved (gates as set, its
 starved pixels walking what their blur block lacks: --starved-taps, or 3/4 of the block's
 pixels where that is 0), gates-roulette (gates as set, its walks by Russian roulette:
---walk-roulette, or 0.05 where that is 0 or auto), gates-accurate (gates as set, in the
-accurate setting: --accurate) and gates-balanced (gates as set, in the balanced setting:
---balanced). `all`: every one but direct-only, gates-accurate and gates-balanced, gates once a
-shape, gates-filled and gates-starved where gates interleave without them, and
-gates-roulette where gates walk (voxels, portals) without it; the gate modes only with a level
+--walk-roulette, or 0.05 where that is 0 or auto), gates-fast (gates as set, in the fast
+setting: --fast, the walk on the closed voxels' planes with the box blur), gates-balanced
+(gates as set, in the balanced setting: --balanced, the default, so gates itself unless
+--fast or --accurate) and gates-accurate (gates as set, in the accurate setting:
+--accurate). `all`: every one but direct-only, gates-accurate and gates-balanced, gates once a
+shape, gates-fast where gates are not fast, gates-filled and gates-starved where gates
+interleave without them, and gates-roulette where gates walk (voxels, portals) without it; the gate modes only with a level
 (given, or baked here). A mode that would render another's very frame (gates-roulette where
 gates' auto roulette takes the same share, 8,192 VPLs or more) takes that mode's row instead.
 

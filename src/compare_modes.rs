@@ -119,9 +119,14 @@ const STARVED: &str = "gates-starved";
 /// blur, the starved pixels' walks), in `visgate compare`; not in `all` (its frame is several
 /// times the default's).
 const ACCURATE: &str = "gates-accurate";
-/// Mode gates in the balanced setting (--balanced: the closed voxels' triangles, the tent
-/// blur, the dark pixels' walks), in `visgate compare`; not in `all`.
+/// Mode gates in the balanced setting (--balanced, the default: the closed voxels' triangles,
+/// the tent blur, the dark pixels' walks), in `visgate compare`: gates itself unless --fast
+/// or --accurate; not in `all`.
 const BALANCED: &str = "gates-balanced";
+/// Mode gates in the fast setting (`render --fast` with the same flags: the walk with the
+/// closed voxels' planes, the box blur, no dark pixels' walks), in `visgate compare`; in `all`
+/// where gates are not that already.
+const FAST: &str = "gates-fast";
 /// Mode gates with its blur filled from the next blocks (--blur-fill), in `visgate compare`.
 const FILLED: &str = "gates-filled";
 /// Mode gates with Russian roulette on its walks: the gates' own --walk-roulette, or
@@ -132,8 +137,8 @@ const ROULETTE: &str = "gates-roulette";
 /// unchanged (README).
 const ROULETTE_SHARE: f32 = 0.05;
 
-/// The modes `names` ask for (`all` expanded: gates with --gate-shape, then each other shape
-/// by its own name, then gates-filled and gates-starved where gates interleave without them,
+/// The modes `names` ask for (`all` expanded: gates with --gate-shape, then gates-fast where
+/// gates are not fast, then each other shape by its own name, then gates-filled and gates-starved where gates interleave without them,
 /// gates-roulette where gates walk without it;
 /// `gates-voxels`, `gates-triangles`, `gates-portal` and `gates-disk` are gates with that
 /// shape).
@@ -147,12 +152,15 @@ fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMod
     };
     // Gates with one setting changed: the starved pixels' walks, the blur's fill or the walks'
     // roulette.
+    // The three settings as `render --fast`, `--balanced`, `--accurate` with the same flags.
+    let flagged = settings.flagged_gates();
     let varied = |name: &str| {
         let mut g = s.gates;
         let il = &mut g.interleave;
         match name {
-            ACCURATE => g = g.accurate(),
-            BALANCED => g = g.balanced(),
+            ACCURATE => g = flagged.accurate(),
+            BALANCED => g = flagged.balanced(),
+            FAST => g = flagged,
             STARVED if il.starved_taps == 0 => il.starved_taps = il.three_quarters(),
             FILLED => il.fill = true,
             ROULETTE if !g.walk_roulette.is_fixed() => {
@@ -166,11 +174,13 @@ fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMod
         let shape = SHAPED.iter().find(|(n, ..)| *n == name);
         let mode = match (shape, method(name)) {
             (Some(&(_, g, t)), _) => shaped(g, t),
-            _ if [STARVED, FILLED, ROULETTE, ACCURATE, BALANCED].contains(&name) => varied(name),
+            _ if [STARVED, FILLED, ROULETTE, ACCURATE, BALANCED, FAST].contains(&name) => {
+                varied(name)
+            }
             (_, Some(m)) => (m.make)(&s),
             (None, None) => bail!(
                 "--modes {name}: give all or some of {}, {}, {FILLED}, {STARVED}, {ROULETTE}, \
-                 {ACCURATE}, {BALANCED}",
+                 {FAST}, {BALANCED}, {ACCURATE}",
                 METHODS.map(|m| m.name).join(", "),
                 SHAPED.map(|(n, ..)| n).join(", ")
             ),
@@ -187,6 +197,9 @@ fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMod
             for m in METHODS.iter().filter(|m| m.name != "direct-only") {
                 out.push(named(m.name)?);
                 if m.name == "gates" {
+                    if flagged != s.gates {
+                        out.push(named(FAST)?);
+                    }
                     let gates = s.gates.gates;
                     let same =
                         |g, t| g == gates.shape && (g != GateShape::Voxels || t == gates.triangles);
@@ -267,15 +280,15 @@ mod tests {
         assert_eq!(g.walk_roulette, WalkRoulette::Share(0.1), "the rest as set");
         let g = gates_of(ACCURATE, &["--starved-taps", "20"]);
         assert_eq!(g.interleave.starved_taps, 20, "a count given is kept");
-        // The same settings as `render --accurate`; not in `all`, and plain gates unchanged.
+        // The same settings as `render --accurate`; not in `all`, and plain gates balanced.
         assert_eq!(
             g,
             gates_of("gates", &["--starved-taps", "20", "--accurate"])
         );
         assert!(!all_with(&[]).contains(&ACCURATE.to_string()));
         let plain = gates_of("gates", &[]);
-        assert!(!plain.gates.triangles && !plain.interleave.tent);
         assert_eq!(plain.interleave.starved_taps, 0);
+        assert_eq!(plain, gates_of(BALANCED, &[]));
     }
 
     #[test]
@@ -290,18 +303,45 @@ mod tests {
         );
         assert_eq!(g.interleave.starved_taps, 20, "a count given is kept");
         assert_eq!(g.walk_roulette, WalkRoulette::Share(0.1), "the rest as set");
-        // The same settings as `render --balanced` and as --starved-dark with the other two
-        // flags; not in `all`; the accurate setting without the dark pixels' walks.
+        // The same settings as `render --balanced`, as plain gates (the default), and as
+        // --starved-dark with the other two flags on the fast setting; not in `all`; the
+        // accurate setting without the dark pixels' walks.
         let flags = ["--starved-taps", "20", "--walk-roulette", "0.1"];
         assert_eq!(
             g,
             gates_of("gates", &[&flags[..], &["--balanced"]].concat())
         );
-        let spelled = ["--closed-voxel-triangles", "--blur-tent", "--starved-dark"];
+        assert_eq!(g, gates_of("gates", &flags));
+        let spelled = [
+            "--fast",
+            "--closed-voxel-triangles",
+            "--blur-tent",
+            "--starved-dark",
+        ];
         assert_eq!(g, gates_of("gates", &[&flags[..], &spelled].concat()));
         assert!(!all_with(&[]).contains(&BALANCED.to_string()));
         assert!(!gates_of(ACCURATE, &[]).interleave.starved_dark);
-        assert!(!gates_of("gates", &[]).interleave.starved_dark);
+        // And back: --fast, or gates-fast, undoes the three and keeps the rest.
+        assert_eq!(
+            g.fast(),
+            gates_of("gates", &[&flags[..], &["--fast"]].concat())
+        );
+        assert_eq!(g.fast(), gates_of(FAST, &flags));
+        assert_eq!(gates_of("gates", &["--fast"]), GatesParams::default());
+    }
+
+    #[test]
+    fn gates_fast_walks_the_planes_with_the_box_and_no_second_walks() {
+        let g = gates_of(FAST, &[]);
+        assert!(g.gates.planes && !g.gates.triangles);
+        assert!(!g.interleave.tent && !g.interleave.starved_dark);
+        assert_eq!(g.gates.shape, GateShape::Voxels);
+        // In `all` beside the default, not beside gates that are fast already.
+        assert!(all_with(&[]).contains(&FAST.to_string()));
+        assert!(!all_with(&["--fast"]).contains(&FAST.to_string()));
+        // Its row is `render --fast` with the same flags: a flag added to it counts there too.
+        assert!(!all_with(&["--fast", "--blur-tent"]).contains(&FAST.to_string()));
+        assert!(gates_of(FAST, &["--blur-tent"]).interleave.tent);
     }
 
     #[test]
@@ -323,8 +363,23 @@ mod tests {
         };
         let plain = all_with(&[]);
         assert!(plain.contains(&"gates".to_string()));
+        // The default walks with the triangles: gates-voxels walks without them, and
+        // gates-fast is the fast setting.
         assert_eq!(
             gates(&plain),
+            [
+                "gates-fast",
+                "gates-voxels",
+                "gates-portal",
+                "gates-disk",
+                "gates-filled",
+                "gates-starved",
+                "gates-roulette"
+            ]
+        );
+        let fast = all_with(&["--fast"]);
+        assert_eq!(
+            gates(&fast),
             [
                 "gates-triangles",
                 "gates-portal",
@@ -334,20 +389,7 @@ mod tests {
                 "gates-roulette"
             ]
         );
-        // Gates walking with the triangles already: gates-voxels walks without them.
-        let with = all_with(&["--closed-voxel-triangles"]);
-        assert_eq!(
-            gates(&with),
-            [
-                "gates-voxels",
-                "gates-portal",
-                "gates-disk",
-                "gates-filled",
-                "gates-starved",
-                "gates-roulette"
-            ]
-        );
-        let portal = all_with(&["--gate-shape", "portal"]);
+        let portal = all_with(&["--fast", "--gate-shape", "portal"]);
         assert_eq!(
             gates(&portal),
             [

@@ -29,13 +29,15 @@ Modes:
                --ism-map-size² paraboloid maps, holes filled by --ism-pull-push levels; one
                hard lookup per VPL (the cheap twin of per-vpl-shadow-maps)
   gates        GPU: a VPL lights a point along the baked --level's open voxels
-               (--gate-shape voxels, the default: blocked by the first voxel the bake's
-               voxelization closed, so what stands inside a cluster blocks too; with
-               --closed-voxel-triangles only where the true segment hits a triangle in
-               one: near-exact, several times slower), or only through its portals when
-               the point lies in another visibility cluster (--gate-shape portal: the
-               segment walks from cluster to cluster through the openings, at most
-               --max-walk of them), or through a chain of at most --gate-hops gate disks
+               (--gate-shape voxels, the default; in the balanced setting, the default,
+               blocked only where the true segment hits a triangle in a closed voxel,
+               near-exact, with a tent blur and the dark pixels walking what their block
+               lacks; --fast passes a closed voxel on its one or two planes with the box
+               blur, 1.2-2.5x faster on lavapipe and darker where columns or curtains
+               graze the light's paths; --accurate walks more pixels), or only through
+               its portals when the point lies in another visibility cluster
+               (--gate-shape portal: the segment walks from cluster to cluster through the
+               openings, at most --max-walk of them), or through a chain of at most --gate-hops gate disks
                (× --gate-oversize; --gate-shape disk, the paper's), by clustered shading
                (the paper's Table I passes: geometry pass, unique clusters of --tile-px
                tiles × --depth-slices slices × visibility cluster, light assignment into a

@@ -177,28 +177,35 @@ pub struct MethodArgs {
     /// closed voxel where it hits none of the scene's triangles listed there (listed once, when
     /// a walk first needs them: 0.8 s for Crytek Sponza at 512 on 2 cores): near-exact
     /// visibility (99.3-100 % of pixel-VPL pairs agree with shadow rays on the levels measured,
-    /// against 88-99 % without), at several times the walk's cost on a software rasterizer.
-    /// Part of the accurate setting (--accurate).
+    /// against 88-99 % without). Part of the balanced setting (the default) and the accurate
+    /// one; with --fast, adds it to the fast setting.
     #[arg(long)]
     pub closed_voxel_triangles: bool,
-    /// Gates: the accurate setting in one word — --closed-voxel-triangles --blur-tent
-    /// --starved-taps of three quarters of the block (48 of 8 x 8; a --starved-taps given is
-    /// kept). On eight cameras of four levels, two seeds each, at 1,024 VPLs: indirect energy
-    /// within 1.6 % of the reference's, under 1 % of the lit pixels black and a lower indirect
-    /// MSE than the default on all sixteen (x0.10-0.78), at 2-23x the default's frame on
-    /// lavapipe: for stills and reference-grade walk-throughs, not the default (README, The
-    /// accurate setting).
-    #[arg(long)]
+    /// Gates: the accurate setting in one word — the balanced setting (the default) and the
+    /// starved taps at three quarters of the block (48 of 8 x 8; a --starved-taps given is
+    /// kept) instead of the dark pixels' walks. On eight cameras of four levels, two seeds each,
+    /// at 1,024 VPLs: indirect energy within 1.6 % of the reference's, under 1 % of the lit
+    /// pixels black and a lower indirect MSE than the fast setting on all sixteen
+    /// (x0.10-0.78), at 2-23x the fast setting's frame on lavapipe: for stills and
+    /// reference-grade walk-throughs (README, The accurate setting).
+    #[arg(long, conflicts_with_all = ["balanced", "fast"])]
     pub accurate: bool,
-    /// Gates: the balanced setting in one word — --closed-voxel-triangles --blur-tent
-    /// --starved-dark (a --starved-taps given is kept). On the same sixteen camera-seeds as
-    /// --accurate: indirect energy within 3 % of the reference's and under 1 % of the lit
-    /// pixels black on all sixteen, at 1.2-2.5x the default's frame on lavapipe (0.2-0.7x the
-    /// accurate setting's), its indirect MSE between the
-    /// default's and the accurate setting's (README, The balanced setting).
-    #[arg(long, conflicts_with = "accurate")]
+    /// Gates: the balanced setting, the default, in one word — --closed-voxel-triangles
+    /// --blur-tent --starved-dark on the fast setting (a --starved-taps given is kept). On the
+    /// same sixteen camera-seeds as --accurate: indirect energy within 3 % of the reference's
+    /// and under 1 % of the lit pixels black on all sixteen, where the fast setting left Crytek
+    /// Sponza's gallery 0.89 of the light and 2.7 % of it black, at 1.2-2.5x the fast
+    /// setting's frame on lavapipe (README, The balanced setting).
+    #[arg(long, conflicts_with = "fast")]
     pub balanced: bool,
-    /// --gate-shape voxels without the triangles: block at every closed voxel, with each end
+    /// Gates: the fast setting — the voxel walk passing closed voxels on their planes, the box
+    /// blur, no second walks: the default until the balanced setting, the fastest voxel walk,
+    /// and the one that loses light where the geometry grazes a light's paths within a sight
+    /// voxel (fluted columns, curtains). --closed-voxel-triangles, --blur-tent, --starved-dark
+    /// and --starved-taps add to it one at a time.
+    #[arg(long)]
+    pub fast: bool,
+    /// --gate-shape voxels without the triangles (--fast): block at every closed voxel, with each end
     /// 1.25 voxels or more off its surface, instead of passing a closed voxel where the segment
     /// meets neither of the one or two planes its geometry lies in (fitted once, when a level
     /// is loaded for the walk), with each end 0.3 voxels off its surface where they allow.
@@ -272,7 +279,8 @@ pub struct MethodArgs {
     pub blur_fill: bool,
     /// Blur: weight the neighbours by a tent over (2·side − 1)² pixels instead of the box of
     /// side²: every VPL subset still weighs the same, but a bright or dark pixel spreads as a
-    /// soft pyramid instead of a square of the block's size; every interleaved mode.
+    /// soft pyramid instead of a square of the block's size; every interleaved mode (gates
+    /// have it in their balanced setting, the default, unless --fast).
     #[arg(long)]
     pub blur_tent: bool,
     /// Gates, interleaved: a pixel whose blur block holds fewer pixels than this that agree
@@ -287,7 +295,8 @@ pub struct MethodArgs {
     /// at all, where another pixel of the block found some, walks the VPL subsets of those
     /// that do not agree too, however many agree (a lit strip whose few VPLs fell in the other
     /// pixels' subsets comes out black without it); a block that found no light anywhere is
-    /// taken for indirect shadow. Beside --starved-taps or alone.
+    /// taken for indirect shadow. Beside --starved-taps or alone; part of the balanced setting
+    /// (the default), so it counts with --fast.
     #[arg(long)]
     pub starved_dark: bool,
     /// Gates with portals or voxels: Russian roulette on the walks (the starved pixels' too).
@@ -456,9 +465,10 @@ impl MethodArgs {
         }
     }
 
-    /// Every method's settings from the flags.
-    pub fn settings(&self) -> MethodSettings {
-        let gates = GatesParams {
+    /// The gates' parameters as the flags spell them, before the setting (--fast, --balanced
+    /// or --accurate) is applied: the fast setting with what the flags add.
+    pub fn flagged_gates(&self) -> GatesParams {
+        GatesParams {
             gates: GateParams {
                 oversize: self.gate_oversize,
                 max_hops: self.gate_hops,
@@ -479,12 +489,17 @@ impl MethodArgs {
             interleave: self.interleave_params(),
             walk_roulette: self.walk_roulette,
             walk_seed: 0,
-        };
-        // --accurate, --balanced: the gates' settings over what the other flags say.
-        let gates = match (self.accurate, self.balanced) {
+        }
+    }
+
+    /// Every method's settings from the flags.
+    pub fn settings(&self) -> MethodSettings {
+        let gates = self.flagged_gates();
+        // The gates' setting over what the other flags say: balanced unless told.
+        let gates = match (self.accurate, self.fast) {
             (true, _) => gates.accurate(),
-            (_, true) => gates.balanced(),
-            _ => gates,
+            (_, true) => gates,
+            _ => gates.balanced(),
         };
         MethodSettings {
             per_vpl: PerVplParams {

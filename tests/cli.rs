@@ -970,17 +970,27 @@ fn render_gates_uses_a_baked_level_and_refuses_a_missing_or_stale_one() {
     let out = p("g.exr");
     let level = p("two.vgate");
     a.extend(["--level", &level, "--out", &out]);
-    // The default: the voxel walk (no clusters or lists, each VPL's end), named in the
-    // frame's first line.
+    // The default: the voxel walk (no clusters or lists, each VPL's end) in the balanced
+    // setting, named in the frame's first line, with the dark pixels' pass.
     let o = visgate(&a);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stdout(&o).contains("VPL walk ends"), "{}", stdout(&o));
+    let balanced = "gates (voxel walk + triangles, 8×8 interleaved, tent blur, dark pixels walk \
+                    the rest) 16x12";
+    assert!(stdout(&o).contains(balanced), "{}", stdout(&o));
+    assert!(stdout(&o).contains("starved pixels"), "{}", stdout(&o));
+    assert!(!stdout(&o).contains("unique clusters"), "{}", stdout(&o));
+    // The fast setting: the walk on the closed voxels' planes, the box blur, no second pass;
+    // the rest below adds to it.
+    a.push("--fast");
+    let o = visgate(&a);
+    assert!(o.status.success(), "{}", stderr(&o));
     assert!(
         stdout(&o).contains("gates (voxel walk, 8×8 interleaved) 16x12"),
         "{}",
         stdout(&o)
     );
-    assert!(!stdout(&o).contains("unique clusters"), "{}", stdout(&o));
+    assert!(!stdout(&o).contains("starved pixels"), "{}", stdout(&o));
     // With the triangles in the closed voxels, named too, and the same room as bright (the
     // two rooms' walls are thick, so the walk sees what it saw).
     // The "mean radiance R G B" line's values.

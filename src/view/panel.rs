@@ -156,23 +156,35 @@ pub fn method_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
     let voxels = s.gates.gates.shape == GateShape::Voxels;
     if mode == "gates" && voxels && s.vals.interleave.block > 1 {
         ui.horizontal(|ui| {
-            let button = ui.button("accurate setting").on_hover_text(
-                "the triangles in closed voxels, the tent blur and the starved taps at 3/4 of \
-                 the block (render --accurate): the reference's light within a few per cent, \
-                 under 1 % of the lit pixels black and the lowest error where measured, at \
-                 several times the frame",
-            );
-            if button.clicked() {
-                set_gates(s, GatesParams::accurate);
-            }
-            let button = ui.button("balanced setting").on_hover_text(
-                "the triangles in closed voxels, the tent blur and the dark pixels' walks \
-                 (render --balanced): the reference's light within a few per cent and under \
-                 1 % of the lit pixels black where measured, at 0.2-0.7x the accurate \
-                 setting's frame",
-            );
-            if button.clicked() {
-                set_gates(s, GatesParams::balanced);
+            let settings: [(&str, &str, GatesSetting); 3] = [
+                (
+                    "fast setting",
+                    "the walk passing closed voxels on their planes, the box blur, no second \
+                     walks (render --fast): the fastest walk, which loses light where columns, \
+                     curtains or plants stand within a sight voxel of the light's paths",
+                    GatesParams::fast,
+                ),
+                (
+                    "balanced setting",
+                    "the default: the triangles in closed voxels, the tent blur and the dark \
+                     pixels' walks (render --balanced): the reference's light within a few per \
+                     cent and under 1 % of the lit pixels black where measured, at 1.2-2.5x the \
+                     fast setting's frame on a software rasterizer",
+                    GatesParams::balanced,
+                ),
+                (
+                    "accurate setting",
+                    "the triangles in closed voxels, the tent blur and the starved taps at 3/4 \
+                     of the block (render --accurate): the reference's light within a few per \
+                     cent, under 1 % of the lit pixels black and the lowest error where \
+                     measured, at several times the frame",
+                    GatesParams::accurate,
+                ),
+            ];
+            for (label, hover, setting) in settings {
+                if ui.button(label).on_hover_text(hover).clicked() {
+                    set_gates(s, setting);
+                }
             }
         });
     }
@@ -181,16 +193,31 @@ pub fn method_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
     s.gates.interleave = *il;
 }
 
-/// A setting of the gates (`render --accurate`: [`GatesParams::accurate`]; `--balanced`) on
-/// the viewer's gates, whose interleaving is the VAL modes' (one block for both, to compare
-/// like with like).
-fn set_gates(s: &mut MethodSettings, setting: fn(GatesParams) -> GatesParams) {
+/// One of the gates' settings ([`GatesParams::fast`], `balanced`, `accurate`).
+type GatesSetting = fn(GatesParams) -> GatesParams;
+
+/// A setting of the gates (`render --fast`: [`GatesParams::fast`]; `--balanced`,
+/// `--accurate`) on the viewer's gates, whose interleaving is the VAL modes' (one block for
+/// both, to compare like with like); the starved taps are the setting's own.
+fn set_gates(s: &mut MethodSettings, setting: GatesSetting) {
     let g = setting(GatesParams {
-        interleave: s.vals.interleave,
+        interleave: InterleaveParams {
+            starved_taps: 0,
+            ..s.vals.interleave
+        },
         ..s.gates
     });
     s.gates.gates = g.gates;
     s.vals.interleave = g.interleave;
+}
+
+/// The viewer's settings at start: every method's defaults, the gates in the balanced setting
+/// (`visgate render`'s default), whose tent blur the VAL modes share.
+pub fn start_settings() -> MethodSettings {
+    let mut s = MethodSettings::default();
+    set_gates(&mut s, GatesParams::balanced);
+    s.gates.interleave = s.vals.interleave;
+    s
 }
 
 /// The direct lights' shadows: each light's maps, or LightCluster with its clustering, disk

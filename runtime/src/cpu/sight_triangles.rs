@@ -360,10 +360,11 @@ pub fn sight_too_large(
     let (what, bytes, power, without) = match extra {
         _ if base > limit => ("the open voxels' grid needs", base, 1.0 / 3.0, ""),
         Some((SightExtra::Lists, bytes)) if bytes > limit => (
-            "the closed voxels' triangle lists (--closed-voxel-triangles) need",
+            "the closed voxels' triangle lists (the balanced and accurate settings, \
+             --closed-voxel-triangles) need",
             bytes,
             0.5,
-            "walk without --closed-voxel-triangles, or ",
+            "walk on the closed voxels' planes (--fast, without --closed-voxel-triangles), or ",
         ),
         Some((SightExtra::Planes, bytes)) if bytes > limit => (
             "the closed voxels' planes need",
@@ -472,11 +473,11 @@ mod tests {
         // Lists past the limit: walk without them, or a coarser voxel.
         let m = refused(52_000_000, lists(200_000_000), 0.04);
         assert!(
-            m.starts_with("the closed voxels' triangle lists (--closed-voxel-triangles) need"),
+            m.starts_with("the closed voxels' triangle lists (the balanced and accurate settings"),
             "{m}"
         );
         assert!(
-            m.contains("walk without --closed-voxel-triangles, or "),
+            m.contains("(--fast, without --closed-voxel-triangles), or "),
             "{m}"
         );
         assert!(

@@ -199,7 +199,7 @@ impl ViewerApp {
             native: None,
             vpls: None,
             camera,
-            settings: MethodSettings::default(),
+            settings: crate::view::panel::start_settings(),
             direct: DirectLight::PerLight,
             moving_scale: if software { 0.25 } else { 0.5 },
             vpl_count,

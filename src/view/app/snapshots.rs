@@ -9,6 +9,7 @@ use egui_kittest::{Harness, SnapshotOptions};
 use visgate_formats::vgate::{BakeParams, Resolution};
 use visgate_preprocess::bake::{BakeOptions, bake};
 use visgate_runtime::cpu::gates::GateLevel;
+use visgate_runtime::gpu::GatesParams;
 use visgate_runtime::job::RenderJob;
 use visgate_scenes::Builtin;
 
@@ -177,10 +178,12 @@ fn the_viewer_beside_the_reference() {
 }
 
 #[test]
-fn the_viewer_walks_with_the_closed_voxels_triangles_once_ticked() {
+fn the_viewer_starts_balanced_and_its_fast_setting_walks_the_planes() {
     let mut harness = first_frame(viewer(Layers::default(), false));
-    assert!(!harness.state().settings.gates.gates.triangles);
-    // The level loads without the lists: the tick lists and uploads them.
+    // The balanced setting, `visgate render`'s default: the triangles listed for the first
+    // frame (the level loads without them), the dark pixels' pass in it.
+    let app = harness.state();
+    assert_eq!(app.settings.gates, GatesParams::default().balanced());
     let listed = |app: &ViewerApp| {
         let cpu = app
             .start
@@ -189,17 +192,33 @@ fn the_viewer_walks_with_the_closed_voxels_triangles_once_ticked() {
             .map(|l| l.sight().triangles_listed());
         (cpu, app.gpu.level_has_triangles())
     };
-    assert_eq!(listed(harness.state()), (Some(false), false));
-    let before = harness.state().frames;
-    harness.get_by_label("triangles in closed voxels").click();
-    until_a_frame_after(&mut harness, before);
-    let app = harness.state();
-    assert!(app.settings.gates.gates.triangles);
     assert_eq!(listed(app), (Some(true), true));
+    assert!(has_pass(app, "indirect lighting: starved pixels"));
+    // The fast setting: no triangles, no tent, no second pass.
+    let app = clicked(&mut harness, "fast setting");
+    assert_eq!(app.settings.gates, GatesParams::default());
+    assert!(!has_pass(app, "indirect lighting: starved pixels"));
+    assert!(has_pass(app, "indirect lighting"));
+    // The triangles' tick alone on it.
+    let app = clicked(&mut harness, "triangles in closed voxels");
+    assert!(app.settings.gates.gates.triangles && !app.settings.gates.interleave.tent);
+}
+
+/// Clicks `label` and waits for the next frame, which has no error.
+fn clicked<'h>(harness: &'h mut Harness<'static, ViewerApp>, label: &str) -> &'h ViewerApp {
+    let before = harness.state().frames;
+    harness.get_by_label(label).click();
+    until_a_frame_after(harness, before);
+    let app = harness.state();
     assert_eq!(app.error, None);
-    assert!(app.frames > before, "no frame with the triangles");
+    assert!(app.frames > before, "no frame after {label}");
+    app
+}
+
+/// Whether `app`'s last frame has the pass `name`.
+fn has_pass(app: &ViewerApp, name: &str) -> bool {
     let (_, times) = app.last.as_ref().expect("a frame");
-    assert!(times.passes.iter().any(|p| p.name == "indirect lighting"));
+    times.passes.iter().any(|p| p.name == name)
 }
 
 #[test]
@@ -212,36 +231,21 @@ fn the_viewer_s_accurate_setting_walks_the_triangles_and_the_starved_pixels() {
 
 /// Clicks the setting button `label` and waits for the next frame: it has no error and has
 /// the starved pixels' pass; returns the gates' settings the button made.
-fn clicked_walks_starved(
-    harness: &mut Harness<'static, ViewerApp>,
-    label: &str,
-) -> visgate_runtime::gpu::GatesParams {
-    let before = harness.state().frames;
-    harness.get_by_label(label).click();
-    until_a_frame_after(harness, before);
-    let app = harness.state();
-    assert_eq!(app.error, None);
-    assert!(app.frames > before, "no frame after {label}");
-    let (_, times) = app.last.as_ref().expect("a frame");
-    let names: Vec<&str> = times.passes.iter().map(|p| p.name).collect();
-    assert!(
-        names.contains(&"indirect lighting: starved pixels"),
-        "{names:?}"
-    );
+fn clicked_walks_starved(harness: &mut Harness<'static, ViewerApp>, label: &str) -> GatesParams {
+    let app = clicked(harness, label);
+    assert!(has_pass(app, "indirect lighting: starved pixels"));
     app.settings.gates
 }
 
 #[test]
 fn the_viewer_s_balanced_setting_walks_the_triangles_and_the_dark_pixels() {
     let mut harness = first_frame(viewer(Layers::default(), false));
+    // From the accurate setting back to the balanced one: its own starved taps (none).
+    clicked_walks_starved(&mut harness, "accurate setting");
     let g = clicked_walks_starved(&mut harness, "balanced setting");
-    assert!(g.gates.triangles && g.interleave.tent && g.interleave.starved_dark);
-    assert_eq!(g.interleave.starved_taps, 0);
-    // Its tick, which the button set, turns the dark pixels' walks off again.
-    let before = harness.state().frames;
-    harness.get_by_label("dark pixels walk the rest").click();
-    until_a_frame_after(&mut harness, before);
-    let app = harness.state();
+    assert_eq!(g, GatesParams::default().balanced());
+    // Its tick turns the dark pixels' walks off again.
+    let app = clicked(&mut harness, "dark pixels walk the rest");
     assert!(!app.settings.gates.interleave.starved_dark);
     let (_, times) = app.last.as_ref().expect("a frame");
     assert!(

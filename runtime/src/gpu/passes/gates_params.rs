@@ -12,7 +12,9 @@ use crate::gpu::shaders::WG_TILE;
 /// The light-list pool's first capacity when it grows on its own. [Units: entries]
 pub const AUTO_LIGHT_ENTRIES: u32 = 1 << 22;
 
-/// Parameters of mode `gates` (clustered shading).
+/// Parameters of mode `gates` (clustered shading). The default is the fast setting
+/// ([`GatesParams::fast`]); `visgate`'s commands and viewer default to the balanced one
+/// ([`GatesParams::balanced`]).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct GatesParams {
     /// How light passes gates (`max_hops` 1 or 2 on the GPU).
@@ -81,13 +83,25 @@ impl GatesParams {
     /// what their block lacks ([`InterleaveParams::starved_dark`]) instead of every pixel with
     /// fewer than three quarters agreeing (a count already set is kept). On the same sixteen
     /// camera-seeds (README) the indirect energy within 3 % of the reference's and under 1 % of
-    /// the lit pixels black, at 0.2–0.7× the accurate setting's frame, with a higher MSE.
+    /// the lit pixels black, at 0.2–0.7× the accurate setting's frame, with a higher MSE: the
+    /// default of `visgate`'s commands and viewer.
     ///
     /// [`InterleaveParams::starved_dark`]: InterleaveParams::starved_dark
     pub fn balanced(mut self) -> GatesParams {
         self.gates.triangles = true;
         self.interleave.tent = true;
         self.interleave.starved_dark = true;
+        self
+    }
+
+    /// The fast setting (`--fast`): the balanced setting's three undone — the voxel walk
+    /// passing closed voxels on their planes, the box blur, no dark pixels' walks (a
+    /// `--starved-taps` count is kept). [`GatesParams::default`] is this setting; `visgate`'s
+    /// commands and viewer start from [`GatesParams::balanced`].
+    pub fn fast(mut self) -> GatesParams {
+        self.gates.triangles = false;
+        self.interleave.tent = false;
+        self.interleave.starved_dark = false;
         self
     }
 

@@ -64,8 +64,9 @@ pub fn check_size([w, h]: [u32; 2]) -> Result<(), RenderError> {
     let pixels = u64::from(w) * u64::from(h);
     if pixels > MAX_STARVED_PIXELS {
         return Err(RenderError::Param(format!(
-            "the starved pixels' walks (--starved-taps) take images of at most {MAX_STARVED_PIXELS} \
-             pixels; this one has {pixels} ({w} x {h}): render it smaller or without them"
+            "the starved pixels' walks (--starved-taps, --starved-dark: in the balanced setting, \
+             the default) take images of at most {MAX_STARVED_PIXELS} pixels; this one has \
+             {pixels} ({w} x {h}): render it smaller, or without them (--fast)"
         )));
     }
     Ok(())
