@@ -187,6 +187,12 @@ pub fn method_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
                 }
             }
         });
+        let now = GatesParams {
+            interleave: s.vals.interleave,
+            ..s.gates
+        };
+        ui.label(format!("gates setting: {}", setting_name(&now)))
+            .on_hover_text("the setting the ticks above make, or your own where they make none");
     }
     let il = &mut s.vals.interleave;
     il.starved_taps = il.starved_taps.min(il.block * il.block);
@@ -198,17 +204,43 @@ type GatesSetting = fn(GatesParams) -> GatesParams;
 
 /// A setting of the gates (`render --fast`: [`GatesParams::fast`]; `--balanced`,
 /// `--accurate`) on the viewer's gates, whose interleaving is the VAL modes' (one block for
-/// both, to compare like with like); the starved taps are the setting's own.
+/// both, to compare like with like): the setting whole, on the fast one, its starved taps its
+/// own (the rest — block, blur thresholds, fill, roulette — as they are).
 fn set_gates(s: &mut MethodSettings, setting: GatesSetting) {
-    let g = setting(GatesParams {
-        interleave: InterleaveParams {
-            starved_taps: 0,
-            ..s.vals.interleave
-        },
-        ..s.gates
-    });
+    let g = setting(
+        GatesParams {
+            interleave: InterleaveParams {
+                starved_taps: 0,
+                ..s.vals.interleave
+            },
+            ..s.gates
+        }
+        .fast(),
+    );
     s.gates.gates = g.gates;
     s.vals.interleave = g.interleave;
+}
+
+/// Which of the three settings gates `g` are in (its starved taps the setting's own), or "your
+/// own".
+fn setting_name(g: &GatesParams) -> &'static str {
+    let base = GatesParams {
+        interleave: InterleaveParams {
+            starved_taps: 0,
+            ..g.interleave
+        },
+        ..*g
+    }
+    .fast();
+    let named: [(&str, GatesSetting); 3] = [
+        ("fast", GatesParams::fast),
+        ("balanced", GatesParams::balanced),
+        ("accurate", GatesParams::accurate),
+    ];
+    named
+        .iter()
+        .find(|(_, setting)| setting(base) == *g)
+        .map_or("your own", |(name, _)| name)
 }
 
 /// The viewer's settings at start: every method's defaults, the gates in the balanced setting

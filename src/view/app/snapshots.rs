@@ -194,14 +194,17 @@ fn the_viewer_starts_balanced_and_its_fast_setting_walks_the_planes() {
     };
     assert_eq!(listed(app), (Some(true), true));
     assert!(has_pass(app, "indirect lighting: starved pixels"));
+    harness.get_by_label("gates setting: balanced");
     // The fast setting: no triangles, no tent, no second pass.
     let app = clicked(&mut harness, "fast setting");
     assert_eq!(app.settings.gates, GatesParams::default());
     assert!(!has_pass(app, "indirect lighting: starved pixels"));
     assert!(has_pass(app, "indirect lighting"));
-    // The triangles' tick alone on it.
+    harness.get_by_label("gates setting: fast");
+    // The triangles' tick alone on it: a setting of the user's own.
     let app = clicked(&mut harness, "triangles in closed voxels");
     assert!(app.settings.gates.gates.triangles && !app.settings.gates.interleave.tent);
+    harness.get_by_label("gates setting: your own");
 }
 
 /// Clicks `label` and waits for the next frame, which has no error.
@@ -227,6 +230,7 @@ fn the_viewer_s_accurate_setting_walks_the_triangles_and_the_starved_pixels() {
     let g = clicked_walks_starved(&mut harness, "accurate setting");
     assert!(g.gates.triangles && g.interleave.tent);
     assert_eq!(g.interleave.starved_taps, 48, "3/4 of the 8 x 8 block");
+    harness.get_by_label("gates setting: accurate");
 }
 
 /// Clicks the setting button `label` and waits for the next frame: it has no error and has
