@@ -138,8 +138,9 @@ const ROULETTE: &str = "gates-roulette";
 const ROULETTE_SHARE: f32 = 0.05;
 
 /// The modes `names` ask for (`all` expanded: gates with --gate-shape, then gates-fast where
-/// gates are not fast, then each other shape by its own name, then gates-filled and gates-starved where gates interleave without them,
-/// gates-roulette where gates walk without it;
+/// gates are not fast, then each other shape by its own name, then gates-filled and
+/// gates-starved where gates interleave without them, gates-roulette where gates walk without
+/// it;
 /// `gates-voxels`, `gates-triangles`, `gates-portal` and `gates-disk` are gates with that
 /// shape).
 fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMode>> {
@@ -150,9 +151,9 @@ fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMod
         g.gates.triangles = triangles;
         GpuMode::Gates(g)
     };
-    // Gates with one setting changed: the starved pixels' walks, the blur's fill or the walks'
-    // roulette.
-    // The three settings as `render --fast`, `--balanced`, `--accurate` with the same flags.
+    // Gates with one setting changed (the starved pixels' walks, the blur's fill or the walks'
+    // roulette), or in one of the three settings as `render --fast`, `--balanced`,
+    // `--accurate` give them with the same flags.
     let flagged = settings.flagged_gates();
     let varied = |name: &str| {
         let mut g = s.gates;

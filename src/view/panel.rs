@@ -156,33 +156,9 @@ pub fn method_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
     let voxels = s.gates.gates.shape == GateShape::Voxels;
     if mode == "gates" && voxels && s.vals.interleave.block > 1 {
         ui.horizontal(|ui| {
-            let settings: [(&str, &str, GatesSetting); 3] = [
-                (
-                    "fast setting",
-                    "the walk passing closed voxels on their planes, the box blur, no second \
-                     walks (render --fast): the fastest walk, which loses light where columns, \
-                     curtains or plants stand within a sight voxel of the light's paths",
-                    GatesParams::fast,
-                ),
-                (
-                    "balanced setting",
-                    "the default: the triangles in closed voxels, the tent blur and the dark \
-                     pixels' walks (render --balanced): the reference's light within a few per \
-                     cent and under 1 % of the lit pixels black where measured, at 1.2-2.5x the \
-                     fast setting's frame on a software rasterizer",
-                    GatesParams::balanced,
-                ),
-                (
-                    "accurate setting",
-                    "the triangles in closed voxels, the tent blur and the starved taps at 3/4 \
-                     of the block (render --accurate): the reference's light within a few per \
-                     cent, under 1 % of the lit pixels black and the lowest error where \
-                     measured, at several times the frame",
-                    GatesParams::accurate,
-                ),
-            ];
-            for (label, hover, setting) in settings {
-                if ui.button(label).on_hover_text(hover).clicked() {
+            for (name, hover, setting) in SETTINGS {
+                let button = ui.button(format!("{name} setting"));
+                if button.on_hover_text(hover).clicked() {
                     set_gates(s, setting);
                 }
             }
@@ -202,45 +178,64 @@ pub fn method_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
 /// One of the gates' settings ([`GatesParams::fast`], `balanced`, `accurate`).
 type GatesSetting = fn(GatesParams) -> GatesParams;
 
-/// A setting of the gates (`render --fast`: [`GatesParams::fast`]; `--balanced`,
-/// `--accurate`) on the viewer's gates, whose interleaving is the VAL modes' (one block for
-/// both, to compare like with like): the setting whole, on the fast one, its starved taps its
-/// own (the rest — block, blur thresholds, fill, roulette — as they are).
-fn set_gates(s: &mut MethodSettings, setting: GatesSetting) {
-    let g = setting(
-        GatesParams {
-            interleave: InterleaveParams {
-                starved_taps: 0,
-                ..s.vals.interleave
-            },
-            ..s.gates
-        }
-        .fast(),
-    );
-    s.gates.gates = g.gates;
-    s.vals.interleave = g.interleave;
-}
+/// The gates' three settings, as the viewer names them (its buttons: "NAME setting") and
+/// describes them.
+const SETTINGS: [(&str, &str, GatesSetting); 3] = [
+    (
+        "fast",
+        "the walk passing closed voxels on their planes, the box blur, no second walks \
+         (render --fast): the fastest walk, which loses light where columns, curtains or \
+         plants stand within a sight voxel of the light's paths",
+        GatesParams::fast,
+    ),
+    (
+        "balanced",
+        "the default: the triangles in closed voxels, the tent blur and the dark pixels' walks \
+         (render --balanced): the reference's light within a few per cent and under 1 % of the \
+         lit pixels black where measured, at 1.2-2.5x the fast setting's frame on a software \
+         rasterizer",
+        GatesParams::balanced,
+    ),
+    (
+        "accurate",
+        "the triangles in closed voxels, the tent blur and the starved taps at 3/4 of the block \
+         (render --accurate): the reference's light within a few per cent, under 1 % of the lit \
+         pixels black and the lowest error where measured, at several times the frame",
+        GatesParams::accurate,
+    ),
+];
 
-/// Which of the three settings gates `g` are in (its starved taps the setting's own), or "your
-/// own".
-fn setting_name(g: &GatesParams) -> &'static str {
-    let base = GatesParams {
+/// What every setting starts from: `g` in the fast setting, without starved taps (each
+/// setting has its own); its block, blur thresholds, fill and roulette as they are.
+fn setting_base(g: GatesParams) -> GatesParams {
+    GatesParams {
         interleave: InterleaveParams {
             starved_taps: 0,
             ..g.interleave
         },
-        ..*g
+        ..g
     }
-    .fast();
-    let named: [(&str, GatesSetting); 3] = [
-        ("fast", GatesParams::fast),
-        ("balanced", GatesParams::balanced),
-        ("accurate", GatesParams::accurate),
-    ];
-    named
+    .fast()
+}
+
+/// A setting of the gates (`render --fast`: [`GatesParams::fast`]; `--balanced`,
+/// `--accurate`), whole, on the viewer's gates, whose interleaving is the VAL modes' (one
+/// block for both, to compare like with like).
+fn set_gates(s: &mut MethodSettings, setting: GatesSetting) {
+    s.gates = setting(setting_base(GatesParams {
+        interleave: s.vals.interleave,
+        ..s.gates
+    }));
+    s.vals.interleave = s.gates.interleave;
+}
+
+/// Which of the three settings gates `g` are in, or "your own".
+fn setting_name(g: &GatesParams) -> &'static str {
+    let base = setting_base(*g);
+    SETTINGS
         .iter()
-        .find(|(_, setting)| setting(base) == *g)
-        .map_or("your own", |(name, _)| name)
+        .find(|(_, _, setting)| setting(base) == *g)
+        .map_or("your own", |(name, ..)| name)
 }
 
 /// The viewer's settings at start: every method's defaults, the gates in the balanced setting
@@ -248,7 +243,6 @@ fn setting_name(g: &GatesParams) -> &'static str {
 pub fn start_settings() -> MethodSettings {
     let mut s = MethodSettings::default();
     set_gates(&mut s, GatesParams::balanced);
-    s.gates.interleave = s.vals.interleave;
     s
 }
 

@@ -35,28 +35,26 @@ impl ViewerApp {
         ui.add(egui::Slider::new(&mut self.moving_scale, 0.125..=1.0).text("resolution moving"));
         ui.separator();
         let has_level = self.start.level.is_some();
+        let l = &mut self.layers;
+        // The layers a baked level draws, then those any frame has.
         ui.add_enabled_ui(has_level, |ui| {
-            ui.checkbox(
-                &mut self.layers.clusters,
-                "visibility cluster of each pixel",
-            );
-            ui.checkbox(&mut self.layers.geometry, "geometry cluster of each pixel");
-            ui.checkbox(
-                &mut self.layers.lists,
-                "light-list length (blue short, red long)",
-            );
-            ui.checkbox(&mut self.layers.gates, "gates");
-            ui.checkbox(
-                &mut self.layers.skeleton,
-                "skeleton (blue narrow, red wide)",
-            );
+            for (on, label) in [
+                (&mut l.clusters, "visibility cluster of each pixel"),
+                (&mut l.geometry, "geometry cluster of each pixel"),
+                (&mut l.lists, "light-list length (blue short, red long)"),
+                (&mut l.gates, "gates"),
+                (&mut l.skeleton, "skeleton (blue narrow, red wide)"),
+            ] {
+                ui.checkbox(on, label);
+            }
         });
-        ui.checkbox(&mut self.layers.vpls, "VPLs (colour: flux)");
-        ui.checkbox(
-            &mut self.layers.vals,
-            "VALs (VAL modes: disks of their area)",
-        );
-        ui.checkbox(&mut self.layers.indirect, "indirect light alone");
+        for (on, label) in [
+            (&mut l.vpls, "VPLs (colour: flux)"),
+            (&mut l.vals, "VALs (VAL modes: disks of their area)"),
+            (&mut l.indirect, "indirect light alone"),
+        ] {
+            ui.checkbox(on, label);
+        }
         ui.separator();
         let image = self.last.as_ref().and_then(|(img, _)| img.as_ref());
         if self.compare.panel(ui, image) {

@@ -42,8 +42,8 @@ fn blur_agrees(q: vec2<i32>, p: vec3<f32>, n: vec3<f32>) -> bool {
 // along a wall) it averages a handful of subsets, and where a few VPLs light the place those
 // may hold none of them. A pixel whose block holds fewer than starved_params.z agreeing taps
 // (or, with starved_params.w, whose agreeing taps found no light at all where the others
-// found some: the strip the blur would leave black) walks, itself, the subsets of the taps that do not agree, and blur.wgsl
-// adds them to the agreeing taps' subsets: every VPL counted once.
+// found some: the strip the blur would leave black) walks, itself, the subsets of the taps that
+// do not agree, and blur.wgsl adds them to the agreeing taps' subsets: every VPL counted once.
 //
 // Four passes, so that a starved pixel's walks spread over as many invocations as it has
 // subsets to walk: one invocation walking all of them (up to 63 subsets, every VPL of each)
