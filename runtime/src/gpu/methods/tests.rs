@@ -61,7 +61,7 @@ fn portals_walk_in_batches_on_a_software_rasterizer_alone() {
         0
     );
     // Voxel walks: as many as fit the loop limit at the sight grid's longest walk, at
-    // least one (tests/gates.rs loses light with a thousand times as many).
+    // least one (tests/gates/blur_roulette.rs loses light with a thousand times as many).
     let mut voxels = portals;
     voxels.gates.shape = GateShape::Voxels;
     let voxels = GpuMode::Gates(voxels);
