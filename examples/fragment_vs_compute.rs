@@ -69,9 +69,37 @@ fn main() -> anyhow::Result<()> {
     {
         anyhow::bail!("{}: no timestamp queries", ctx.adapter_info.name);
     }
-    let period = ctx.queue.get_timestamp_period();
-    let d = &ctx.device;
-    let vpls: Vec<f32> = (0..count)
+    let bench = Bench::new(&ctx, side, count);
+    println!(
+        "{} ({:?}), {side}x{side}, {count} VPLs a pixel",
+        ctx.adapter_info.name, ctx.adapter_info.backend
+    );
+    for rep in 0..4 {
+        let fragment_wall = bench.fragment(&ctx);
+        let compute_wall = bench.compute(&ctx);
+        let [fragment, compute] = bench.gpu_ms(&ctx)?;
+        println!(
+            "rep {rep}: GPU fragment {fragment:.3} ms, compute {compute:.3} ms; wall (submit + \
+             wait) fragment {fragment_wall:.1} ms, compute {compute_wall:.1} ms",
+        );
+    }
+    // Both wrote the same image (else a timing means nothing).
+    let mean = |t: &wgpu::Texture| -> anyhow::Result<f64> {
+        let px = visgate_runtime::gpu::context::read_texture(&ctx, t)?;
+        Ok(px.iter().map(|p| f64::from(p[0])).sum::<f64>() / px.len() as f64)
+    };
+    let (f, c) = (mean(&bench.colour_tex)?, mean(&bench.storage_tex)?);
+    println!("mean red: fragment {f:.6}, compute {c:.6}");
+    anyhow::ensure!(
+        (f - c).abs() <= 1e-3 * f.abs().max(1e-9),
+        "the passes disagree"
+    );
+    Ok(())
+}
+
+/// `count` VPLs above a 10 m floor, facing down: position, normal and flux, 4 floats each.
+fn vpl_data(count: u32) -> Vec<f32> {
+    (0..count)
         .flat_map(|i| {
             let t = i as f32 * 0.618;
             let pos = [
@@ -83,95 +111,127 @@ fn main() -> anyhow::Result<()> {
             [pos, [0.0, -1.0, 0.0, 0.0], [0.01, 0.01, 0.01, 0.0]]
         })
         .flatten()
-        .collect();
-    let usage = wgpu::BufferUsages::STORAGE;
-    let vpl_buf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("vpls"),
-        contents: bytemuck::cast_slice(&vpls),
-        usage,
-    });
-    let size_buf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("size"),
-        contents: bytemuck::cast_slice(&[side, side, count, 0]),
-        usage: wgpu::BufferUsages::UNIFORM,
-    });
-    let target = |usage| {
-        d.create_texture(&wgpu::TextureDescriptor {
-            label: Some("target"),
-            size: wgpu::Extent3d {
-                width: side,
-                height: side,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba16Float,
-            usage,
-            view_formats: &[],
-        })
-    };
-    let copy = wgpu::TextureUsages::COPY_SRC;
-    let colour_tex = target(wgpu::TextureUsages::RENDER_ATTACHMENT | copy);
-    let storage_tex = target(wgpu::TextureUsages::STORAGE_BINDING | copy);
-    let colour = colour_tex.create_view(&Default::default());
-    let storage = storage_tex.create_view(&Default::default());
-    let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("fragment_vs_compute"),
-        source: wgpu::ShaderSource::Wgsl(SHADER.into()),
-    });
-    let fmt = [wgpu::TextureFormat::Rgba16Float];
-    let fragment = visgate_runtime::gpu::context::render_pipeline(
-        d,
-        "fs",
-        &module,
-        ("vs", "fs"),
-        &[],
-        &fmt,
-        None,
-    );
-    let [compute] = visgate_runtime::gpu::context::compute_pipelines(d, &module, ["cs"]);
-    let buffers = |layout: &wgpu::BindGroupLayout, with_storage: bool| {
-        let mut entries = vec![
-            (0, vpl_buf.as_entire_binding()),
-            (1, size_buf.as_entire_binding()),
-        ];
-        if with_storage {
-            entries.push((2, wgpu::BindingResource::TextureView(&storage)));
+        .collect()
+}
+
+/// The two passes over a `side`² target, their bind groups and the timestamp queries.
+struct Bench {
+    side: u32,
+    fragment: wgpu::RenderPipeline,
+    compute: wgpu::ComputePipeline,
+    fragment_group: wgpu::BindGroup,
+    compute_group: wgpu::BindGroup,
+    colour_tex: wgpu::Texture,
+    storage_tex: wgpu::Texture,
+    colour: wgpu::TextureView,
+    queries: wgpu::QuerySet,
+    resolve: wgpu::Buffer,
+    read: wgpu::Buffer,
+}
+
+impl Bench {
+    /// The passes for `count` VPLs on a `side`² target.
+    fn new(ctx: &GpuContext, side: u32, count: u32) -> Bench {
+        let d = &ctx.device;
+        let vpl_buf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("vpls"),
+            contents: bytemuck::cast_slice(&vpl_data(count)),
+            usage: wgpu::BufferUsages::STORAGE,
+        });
+        let size_buf = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("size"),
+            contents: bytemuck::cast_slice(&[side, side, count, 0]),
+            usage: wgpu::BufferUsages::UNIFORM,
+        });
+        let target = |usage| {
+            d.create_texture(&wgpu::TextureDescriptor {
+                label: Some("target"),
+                size: wgpu::Extent3d {
+                    width: side,
+                    height: side,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: wgpu::TextureFormat::Rgba16Float,
+                usage,
+                view_formats: &[],
+            })
+        };
+        let copy = wgpu::TextureUsages::COPY_SRC;
+        let colour_tex = target(wgpu::TextureUsages::RENDER_ATTACHMENT | copy);
+        let storage_tex = target(wgpu::TextureUsages::STORAGE_BINDING | copy);
+        let storage = storage_tex.create_view(&Default::default());
+        let module = d.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("fragment_vs_compute"),
+            source: wgpu::ShaderSource::Wgsl(SHADER.into()),
+        });
+        let fmt = [wgpu::TextureFormat::Rgba16Float];
+        let fragment = visgate_runtime::gpu::context::render_pipeline(
+            d,
+            "fs",
+            &module,
+            ("vs", "fs"),
+            &[],
+            &fmt,
+            None,
+        );
+        let [compute] = visgate_runtime::gpu::context::compute_pipelines(d, &module, ["cs"]);
+        let buffers = |layout: &wgpu::BindGroupLayout, with_storage: bool| {
+            let mut entries = vec![
+                (0, vpl_buf.as_entire_binding()),
+                (1, size_buf.as_entire_binding()),
+            ];
+            if with_storage {
+                entries.push((2, wgpu::BindingResource::TextureView(&storage)));
+            }
+            visgate_runtime::gpu::context::bind_group(d, layout, "fvc", entries)
+        };
+        let fragment_group = buffers(&fragment.get_bind_group_layout(0), false);
+        let compute_group = buffers(&compute.get_bind_group_layout(0), true);
+        let buffer = |label, usage| {
+            d.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: 32,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        Bench {
+            side,
+            colour: colour_tex.create_view(&Default::default()),
+            fragment,
+            compute,
+            fragment_group,
+            compute_group,
+            colour_tex,
+            storage_tex,
+            queries: d.create_query_set(&wgpu::QuerySetDescriptor {
+                label: Some("fvc"),
+                ty: wgpu::QueryType::Timestamp,
+                count: 4,
+            }),
+            resolve: buffer(
+                "resolve",
+                wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+            ),
+            read: buffer(
+                "read",
+                wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            ),
         }
-        visgate_runtime::gpu::context::bind_group(d, layout, "fvc", entries)
-    };
-    let fragment_group = buffers(&fragment.get_bind_group_layout(0), false);
-    let compute_group = buffers(&compute.get_bind_group_layout(0), true);
-    let queries = d.create_query_set(&wgpu::QuerySetDescriptor {
-        label: Some("fvc"),
-        ty: wgpu::QueryType::Timestamp,
-        count: 4,
-    });
-    let resolve = d.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("resolve"),
-        size: 32,
-        usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    let read = d.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("read"),
-        size: 32,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    println!(
-        "{} ({:?}), {side}x{side}, {count} VPLs a pixel",
-        ctx.adapter_info.name, ctx.adapter_info.backend
-    );
-    for rep in 0..4 {
+    }
+
+    /// Runs the fragment pass (timestamps 0 and 1); its wall time, submit and wait, in ms.
+    fn fragment(&self, ctx: &GpuContext) -> f64 {
         let wall = std::time::Instant::now();
-        let mut enc = d.create_command_encoder(&Default::default());
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
         {
             let mut pass = enc.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("fs"),
                 color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &colour,
+                    view: &self.colour,
                     depth_slice: None,
                     resolve_target: None,
                     ops: wgpu::Operations {
@@ -181,62 +241,54 @@ fn main() -> anyhow::Result<()> {
                 })],
                 depth_stencil_attachment: None,
                 timestamp_writes: Some(wgpu::RenderPassTimestampWrites {
-                    query_set: &queries,
+                    query_set: &self.queries,
                     beginning_of_pass_write_index: Some(0),
                     end_of_pass_write_index: Some(1),
                 }),
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_pipeline(&fragment);
-            pass.set_bind_group(0, &fragment_group, &[]);
+            pass.set_pipeline(&self.fragment);
+            pass.set_bind_group(0, &self.fragment_group, &[]);
             pass.draw(0..3, 0..1);
         }
         ctx.queue.submit([enc.finish()]);
         ctx.wait();
-        let fragment_wall = wall.elapsed().as_secs_f64() * 1e3;
+        wall.elapsed().as_secs_f64() * 1e3
+    }
+
+    /// Runs the compute pass (timestamps 2 and 3); its wall time, submit and wait, in ms.
+    fn compute(&self, ctx: &GpuContext) -> f64 {
         let wall = std::time::Instant::now();
-        let mut enc = d.create_command_encoder(&Default::default());
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
         {
             let mut pass = enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("cs"),
                 timestamp_writes: Some(wgpu::ComputePassTimestampWrites {
-                    query_set: &queries,
+                    query_set: &self.queries,
                     beginning_of_pass_write_index: Some(2),
                     end_of_pass_write_index: Some(3),
                 }),
             });
-            pass.set_pipeline(&compute);
-            pass.set_bind_group(0, &compute_group, &[]);
-            pass.dispatch_workgroups(side.div_ceil(8), side.div_ceil(8), 1);
+            pass.set_pipeline(&self.compute);
+            pass.set_bind_group(0, &self.compute_group, &[]);
+            let groups = self.side.div_ceil(8);
+            pass.dispatch_workgroups(groups, groups, 1);
         }
         ctx.queue.submit([enc.finish()]);
         ctx.wait();
-        let compute_wall = wall.elapsed().as_secs_f64() * 1e3;
-        let mut enc = d.create_command_encoder(&Default::default());
-        enc.resolve_query_set(&queries, 0..4, &resolve, 0);
-        enc.copy_buffer_to_buffer(&resolve, 0, &read, 0, 32);
-        ctx.queue.submit([enc.finish()]);
-        let bytes = visgate_runtime::gpu::context::map_read(&ctx, &read)?;
-        let t: &[u64] = bytemuck::cast_slice(&bytes);
-        let ms = |a: usize| (t[a + 1] - t[a]) as f64 * f64::from(period) * 1e-6;
-        println!(
-            "rep {rep}: GPU fragment {:.3} ms, compute {:.3} ms; wall (submit + wait) \
-             fragment {fragment_wall:.1} ms, compute {compute_wall:.1} ms",
-            ms(0),
-            ms(2)
-        );
+        wall.elapsed().as_secs_f64() * 1e3
     }
-    // Both wrote the same image (else a timing means nothing).
-    let mean = |t: &wgpu::Texture| -> anyhow::Result<f64> {
-        let px = visgate_runtime::gpu::context::read_texture(&ctx, t)?;
-        Ok(px.iter().map(|p| f64::from(p[0])).sum::<f64>() / px.len() as f64)
-    };
-    let (f, c) = (mean(&colour_tex)?, mean(&storage_tex)?);
-    println!("mean red: fragment {f:.6}, compute {c:.6}");
-    anyhow::ensure!(
-        (f - c).abs() <= 1e-3 * f.abs().max(1e-9),
-        "the passes disagree"
-    );
-    Ok(())
+
+    /// The GPU ms of the last fragment and compute passes, from their timestamps.
+    fn gpu_ms(&self, ctx: &GpuContext) -> anyhow::Result<[f64; 2]> {
+        let mut enc = ctx.device.create_command_encoder(&Default::default());
+        enc.resolve_query_set(&self.queries, 0..4, &self.resolve, 0);
+        enc.copy_buffer_to_buffer(&self.resolve, 0, &self.read, 0, 32);
+        ctx.queue.submit([enc.finish()]);
+        let bytes = visgate_runtime::gpu::context::map_read(ctx, &self.read)?;
+        let t: &[u64] = bytemuck::cast_slice(&bytes);
+        let period = f64::from(ctx.queue.get_timestamp_period());
+        Ok([0, 2].map(|a| (t[a + 1] - t[a]) as f64 * period * 1e-6))
+    }
 }
