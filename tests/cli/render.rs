@@ -170,20 +170,38 @@ fn render_and_diff_refuse_bad_arguments_clearly() {
     assert!(stderr(&o).contains("missing-a.exr"), "{}", stderr(&o));
 }
 
-#[test]
-fn render_gates_uses_a_baked_level_and_refuses_a_missing_or_stale_one() {
+/// The two rooms baked at 64 in a scratch folder: the folder, the level's path and an image's.
+fn two_rooms_level() -> (tempfile::TempDir, String, String) {
     let dir = tempfile::tempdir().expect("tempdir");
     let p = |n: &str| dir.path().join(n).to_str().expect("utf-8").to_string();
-    let o = two_rooms_at_64(&p("two.vgate"), &["-q"]);
+    let (level, out) = (p("two.vgate"), p("g.exr"));
+    let o = two_rooms_at_64(&level, &["-q"]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let base = [
-        "render", "--mode", "gates", "--vpls", "64", "--size", "16x12", "--spp", "1",
+    (dir, level, out)
+}
+
+/// `visgate render builtin:two-rooms --mode gates` at 64 VPLs and 16×12 with `level`, to `out`.
+fn gates_render<'a>(level: &'a str, out: &'a str) -> Vec<&'a str> {
+    let mut a = vec![
+        "render",
+        "builtin:two-rooms",
+        "--mode",
+        "gates",
+        "--vpls",
+        "64",
+        "--size",
+        "16x12",
+        "--spp",
+        "1",
     ];
-    let mut a: Vec<&str> = base.to_vec();
-    a.insert(1, "builtin:two-rooms");
-    let out = p("g.exr");
-    let level = p("two.vgate");
-    a.extend(["--level", &level, "--out", &out]);
+    a.extend(["--level", level, "--out", out]);
+    a
+}
+
+#[test]
+fn render_gates_names_its_setting_and_each_flag_that_adds_to_the_fast_one() {
+    let (_dir, level, out) = two_rooms_level();
+    let mut a = gates_render(&level, &out);
     // The default: the voxel walk (no clusters or lists, each VPL's end) in the balanced
     // setting, named in the frame's first line, with the dark pixels' pass.
     let o = visgate(&a);
@@ -253,6 +271,13 @@ fn render_gates_uses_a_baked_level_and_refuses_a_missing_or_stale_one() {
         "{}",
         stderr(&ob)
     );
+}
+
+#[test]
+fn render_gates_takes_the_roulette_and_every_gate_shape_and_refuses_a_missing_or_stale_level() {
+    let (_dir, level, out) = two_rooms_level();
+    let mut a = gates_render(&level, &out);
+    a.push("--fast");
     // The roulette on the walks: on by default at 128 VPLs a pixel (8,192 in 8 × 8 blocks),
     // named as it acts; --walk-roulette 0 turns it off.
     let mut r = a.clone();
