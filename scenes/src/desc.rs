@@ -128,6 +128,16 @@ impl Builtin {
                     camera("door", [0.4, 1.6, 0.5], [4.0, 1.0, 2.2], 75.0),
                 ],
             ),
+            // The lamp upstairs; a camera on the ground floor looking up the flight at the hole
+            // (lit through it alone), one upstairs looking down into it.
+            Builtin::Stairwell => (
+                true,
+                vec![point([2.0, 5.5, 3.0], 15.0)],
+                vec![
+                    camera("down", [0.6, 1.6, 5.4], [6.0, 2.6, 1.6], 75.0),
+                    camera("up", [0.5, 4.6, 5.5], [6.0, 3.0, 1.6], 75.0),
+                ],
+            ),
             // One lamp in each side room (the rows are light lines); the cameras of the
             // pillared hall, and one along the south row.
             Builtin::LampHall => (

@@ -98,11 +98,14 @@ pub enum Builtin {
     /// The ajar door's two rooms with a window to the void, lit by a lamp outside it: most light
     /// paths leave the level, the rest come in through the window.
     SunWindow,
+    /// Two storeys of zero-thickness walls joined by a stair hole over a flight of steps, the
+    /// lamp upstairs: the ground floor is lit through a horizontal opening.
+    Stairwell,
 }
 
 impl Builtin {
     /// Every built-in scene.
-    pub const ALL: [Builtin; 10] = [
+    pub const ALL: [Builtin; 11] = [
         Builtin::EmptyBox,
         Builtin::TwoRooms,
         Builtin::RingCorridor,
@@ -113,6 +116,7 @@ impl Builtin {
         Builtin::PillaredHall,
         Builtin::LampHall,
         Builtin::SunWindow,
+        Builtin::Stairwell,
     ];
 
     /// The name used on the command line (`builtin:NAME`).
@@ -128,6 +132,7 @@ impl Builtin {
             Builtin::PillaredHall => "pillared-hall",
             Builtin::LampHall => "lamp-hall",
             Builtin::SunWindow => "sun-window",
+            Builtin::Stairwell => "stairwell",
         }
     }
 
@@ -151,6 +156,9 @@ impl Builtin {
             Builtin::LampHall => "the pillared hall lit by 51 lamps (two rows of 24, one a room)",
             Builtin::SunWindow => {
                 "the ajar door's rooms with a window to the void, lit from outside"
+            }
+            Builtin::Stairwell => {
+                "two 8 x 3 x 6 m storeys, zero-thickness walls, a stair hole, lit from upstairs"
             }
         }
     }
@@ -190,7 +198,9 @@ impl Builtin {
                 cbox(57, 67, 0, 21, 40, 42),
             ],
             Builtin::PillaredHall | Builtin::LampHall => pillared_hall(),
-            Builtin::CornellBox | Builtin::AjarDoor | Builtin::SunWindow => return None,
+            Builtin::CornellBox | Builtin::AjarDoor | Builtin::SunWindow | Builtin::Stairwell => {
+                return None;
+            }
         };
         Some(BoxLevel {
             cell_m: CELL_M,
@@ -218,6 +228,16 @@ impl Builtin {
                 Opening {
                     min_m: [4.0, 0.0, 0.0],
                     max_m: [8.0, 3.0, 4.0],
+                },
+            ],
+            None if self == Builtin::Stairwell => vec![
+                Opening {
+                    min_m: [0.0, 0.0, 0.0],
+                    max_m: [8.0, 3.0, 6.0],
+                },
+                Opening {
+                    min_m: [0.0, 3.0, 0.0],
+                    max_m: [8.0, 6.0, 6.0],
                 },
             ],
             // The inside of the Cornell box (its walls are single planes).
@@ -324,6 +344,17 @@ impl Builtin {
                 ]),
                 note: "each column is a loop (six), but a cluster may wrap a column (a loop inside one cluster); each side room one cluster",
             },
+            // The stairs' top step meets the floor between the storeys beyond the hole: a loop
+            // around the flight's upper end, under that floor.
+            Builtin::Stairwell => KnownAnswers {
+                components: 1,
+                cycles: 4,
+                clusters: [3, 12],
+                gates: [3, 16],
+                doorways: vec![],
+                rooms: vec![],
+                note: "the table's four legs make three loops under it and the flight's top step, meeting the floor above, one more; the storeys meet only at the stair hole",
+            },
         }
     }
 
@@ -359,6 +390,7 @@ impl Builtin {
             (Builtin::SunWindow, None) => {
                 Ok(generated(quads::sun_window(), &quads::QUAD_MATERIALS))
             }
+            (Builtin::Stairwell, None) => Ok(generated(quads::stairwell(), &quads::QUAD_MATERIALS)),
             _ => import_obj_str(Path::new("CornellBox-Original.obj"), CORNELL_OBJ, |lib| {
                 (lib == Path::new("CornellBox-Original.mtl")).then(|| CORNELL_MTL.to_string())
             }),

@@ -204,6 +204,68 @@ fn two_rooms(window: bool) -> Vec<RawMesh> {
     b.finish()
 }
 
+/// The hole of [`stairwell`]'s floor between its storeys: x from / to, z from / to, at y = 3 m.
+/// [Units: m]
+pub const STAIR_HOLE: [f32; 4] = [4.8, 7.2, 1.0, 2.2];
+
+/// The stairwell level: two 8 × 3 × 6 m storeys, one over the other, of zero-thickness walls;
+/// the floor between them a single plane seen from both sides, open over a flight of ten
+/// 0.3 m steps ([`STAIR_HOLE`]) whose top step meets that floor beyond the hole's edge, so that
+/// the ground floor sees the upper one only through a horizontal opening; a table with four
+/// legs on the ground floor.
+pub fn stairwell() -> Vec<RawMesh> {
+    let mut b = QuadBuilder::default();
+    let (w, h, d) = (8.0f32, 3.0f32, 6.0f32);
+    b.rect(Mat::Floor, 1, 0.0, [0.0, 0.0], [d, w], true);
+    b.rect(Mat::Ceiling, 1, 2.0 * h, [0.0, 0.0], [d, w], false);
+    // The floor between the storeys, around the hole (axis y: lo/hi over (z, x)): a plane of
+    // each side's quads, one material (coincident faces of two albedos would leave the pick
+    // between them to rounding: speckles on the CPU, stripes on the GPU).
+    let [x0, x1, z0, z1] = STAIR_HOLE;
+    for (lo, hi) in [
+        ([0.0, 0.0], [d, x0]),
+        ([0.0, x1], [d, w]),
+        ([0.0, x0], [z0, x1]),
+        ([z1, x0], [d, x1]),
+    ] {
+        b.rect(Mat::Floor, 1, h, lo, hi, true);
+        b.rect(Mat::Floor, 1, h, lo, hi, false);
+    }
+    // The outer walls, both storeys' height (axis x: over (y, z); axis z: over (x, y)).
+    b.rect(Mat::Wall, 0, 0.0, [0.0, 0.0], [2.0 * h, d], true);
+    b.rect(Mat::Wall, 0, w, [0.0, 0.0], [2.0 * h, d], false);
+    b.rect(Mat::Wall, 2, 0.0, [0.0, 0.0], [w, 2.0 * h], true);
+    b.rect(Mat::Red, 2, d, [0.0, 0.0], [w, 2.0 * h], false);
+    // The flight: step k rises to 0.3 (k + 1) m, 0.3 m deep, from x1 towards −x.
+    for k in 0..10 {
+        let top = 0.3 * (k + 1) as f32;
+        let x = x1 - 0.3 * (k as f32 + 0.5);
+        b.cuboid(
+            Mat::Wood,
+            Vec3::new(x, 0.5 * top, 0.5 * (z0 + z1)),
+            Vec3::new(0.15, 0.5 * top, 0.5 * (z1 - z0)),
+            0.0,
+        );
+    }
+    // The table on the ground floor.
+    let (tx, tz, top_y) = (2.0f32, 4.0f32, 0.76f32);
+    b.cuboid(
+        Mat::Wood,
+        Vec3::new(tx, top_y - 0.02, tz),
+        Vec3::new(0.6, 0.02, 0.4),
+        0.0,
+    );
+    for (sx, sz) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+        b.cuboid(
+            Mat::Wood,
+            Vec3::new(tx + sx * 0.55, 0.5 * (top_y - 0.04), tz + sz * 0.35),
+            Vec3::new(0.025, 0.5 * (top_y - 0.04), 0.025),
+            0.0,
+        );
+    }
+    b.finish()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -163,6 +163,36 @@ fn ajar_door_and_pillared_hall_keep_their_loops_and_side_rooms() {
 }
 
 #[test]
+fn the_stairwell_s_storeys_meet_at_a_gate_in_its_stair_hole() {
+    // Zero-thickness walls and a floor between the storeys seen from both sides: its four loops
+    // (the table's three, the flight's top step meeting that floor), and the storeys in clusters
+    // of their own joined by a gate in the hole, not through the floor.
+    let [x0, x1, z0, z1] = visgate_scenes::quads::STAIR_HOLE;
+    let hole = Opening {
+        min_m: [x0, 2.5, z0],
+        max_m: [x1, 3.5, z1],
+    };
+    let scene = Builtin::Stairwell.scene().expect("scene");
+    for res in [64, 128] {
+        check_known_answers(Builtin::Stairwell, res, false);
+        let level = bake_scene(&scene, &params(res)).expect("bake").level;
+        let (down, up) = (Vec3::new(1.0, 1.5, 1.5), Vec3::new(1.0, 4.5, 1.5));
+        let (cd, cu) = (cluster_at(&level, down), cluster_at(&level, up));
+        assert!(
+            cd.is_some() && cu.is_some() && cd != cu,
+            "{res}: {cd:?} {cu:?}"
+        );
+        let in_hole = level
+            .topology
+            .gates
+            .iter()
+            .filter(|g| distance_to_box(Vec3::from(g.centre_m), &hole) == 0.0)
+            .count();
+        assert!(in_hole >= 1, "{res}: no gate in the stair hole");
+    }
+}
+
+#[test]
 fn the_sun_window_keeps_the_ajar_door_s_answers_with_its_lamp_outside() {
     // Its only lamp stands outside the grid: the rooms are kept by the faces' votes, and the
     // window, open onto the grid's border, adds no loop.
