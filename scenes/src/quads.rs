@@ -219,8 +219,8 @@ pub fn stairwell() -> Vec<RawMesh> {
     b.rect(Mat::Floor, 1, 0.0, [0.0, 0.0], [d, w], true);
     b.rect(Mat::Ceiling, 1, 2.0 * h, [0.0, 0.0], [d, w], false);
     // The floor between the storeys, around the hole (axis y: lo/hi over (z, x)): a plane of
-    // each side's quads, one material (coincident faces of two albedos would leave the pick
-    // between them to rounding: speckles on the CPU, stripes on the GPU).
+    // each side's quads, the floor's on top and the ceiling's under it, as a level modelled
+    // with zero-thickness floors has them (which one a pixel shows is the face turned to it).
     let [x0, x1, z0, z1] = STAIR_HOLE;
     for (lo, hi) in [
         ([0.0, 0.0], [d, x0]),
@@ -229,7 +229,7 @@ pub fn stairwell() -> Vec<RawMesh> {
         ([z1, x0], [d, x1]),
     ] {
         b.rect(Mat::Floor, 1, h, lo, hi, true);
-        b.rect(Mat::Floor, 1, h, lo, hi, false);
+        b.rect(Mat::Ceiling, 1, h, lo, hi, false);
     }
     // The outer walls, both storeys' height (axis x: over (y, z); axis z: over (x, y)).
     b.rect(Mat::Wall, 0, 0.0, [0.0, 0.0], [2.0 * h, d], true);

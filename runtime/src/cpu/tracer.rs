@@ -24,12 +24,18 @@ const EDGE_SLACK: f32 = 1e-6;
 /// Möller–Trumbore, two-sided, with barycentric slack so that rays through shared edges and
 /// vertices do not slip between triangles (obvhs' own test rejects −0.0). `INFINITY` on a miss.
 fn intersect(tri: &Triangle, ray: &Ray) -> f32 {
+    intersect_facing(tri, ray).0
+}
+
+/// [`intersect`]'s distance, and whether the ray meets the triangle's front (its vertices
+/// counter-clockwise seen from the ray's origin, as the G-buffer's rasterizer counts them).
+fn intersect_facing(tri: &Triangle, ray: &Ray) -> (f32, bool) {
     let e1 = tri.v1 - tri.v0;
     let e2 = tri.v2 - tri.v0;
     let p = ray.direction.cross(e2);
     let det = e1.dot(p);
     if det == 0.0 || !det.is_finite() {
-        return f32::INFINITY;
+        return (f32::INFINITY, false);
     }
     let inv = 1.0 / det;
     let s = ray.origin - tri.v0;
@@ -37,15 +43,23 @@ fn intersect(tri: &Triangle, ray: &Ray) -> f32 {
     let q = s.cross(e1);
     let v = ray.direction.dot(q) * inv;
     if u < -EDGE_SLACK || v < -EDGE_SLACK || u + v > 1.0 + EDGE_SLACK {
-        return f32::INFINITY;
+        return (f32::INFINITY, false);
     }
     let t = e2.dot(q) * inv;
+    // det = −direction · (e1 × e2): positive where the ray meets the front.
     if t >= ray.tmin && t <= ray.tmax {
-        t
+        (t, det > 0.0)
     } else {
-        f32::INFINITY
+        (f32::INFINITY, false)
     }
 }
+
+/// How much nearer than a back face a front face must lie to be hidden by it, relative to the
+/// distance: two faces of one plane turned apart (a floor's top and the ceiling under it,
+/// modelled apart) meet a ray at distances that rounding orders either way, and the pixel
+/// showed either face's albedo at random. The G-buffer draws back faces pushed as far back
+/// (`gbuffer::BACK_FACE_BIAS`). [Units: ratio]
+pub const FRONT_FACE_TIE: f32 = 3e-5;
 
 /// A triangle's shading data.
 #[derive(Debug, Clone, Copy)]
@@ -132,7 +146,15 @@ impl Tracer {
     }
 
     /// The nearest hit along `origin + t·dir`, `t` in `(t_min, t_max)`; `dir` need not be unit.
-    fn hit(&self, origin: Vec3, dir: Vec3, t_min: f32, t_max: f32) -> Option<(usize, f32)> {
+    /// With `front_first`, a front face within [`FRONT_FACE_TIE`] behind a back face is the hit
+    /// (what the eye sees of two faces of one plane); without, whichever is nearer.
+    fn hit(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        (t_min, t_max): (f32, f32),
+        front_first: bool,
+    ) -> Option<(usize, f32)> {
         if self.tris.is_empty() {
             return None;
         }
@@ -147,20 +169,33 @@ impl Tracer {
         }));
         let ray = Ray::new(Vec3A::from(origin), Vec3A::from(dir), t_min, t_max);
         let mut hit = RayHit::none();
+        let tri = |id: u32| &self.tris[self.bvh.primitive_indices[id as usize] as usize];
         let found = self.bvh.ray_traverse(ray, &mut hit, |ray, id| {
-            intersect(&self.tris[self.bvh.primitive_indices[id] as usize], ray)
+            let (t, front) = intersect_facing(tri(id as u32), ray);
+            if front_first && !front && t.is_finite() {
+                t * (1.0 + FRONT_FACE_TIE)
+            } else {
+                t
+            }
         });
         found.then(|| {
+            let t = if front_first {
+                // The hit's own distance, not the one it was ranked by.
+                intersect(tri(hit.primitive_id), &ray)
+            } else {
+                hit.t
+            };
             (
                 self.bvh.primitive_indices[hit.primitive_id as usize] as usize,
-                hit.t,
+                t,
             )
         })
     }
 
-    /// The surface first hit by the ray from `origin` along unit `dir`, beyond `epsilon_m`.
+    /// The surface first hit by the ray from `origin` along unit `dir`, beyond `epsilon_m`; of
+    /// two faces of one plane, the one turned towards `origin` ([`FRONT_FACE_TIE`]).
     pub fn trace(&self, origin: Vec3, dir: Vec3) -> Option<Surface> {
-        let (i, t) = self.hit(origin, dir, self.epsilon_m, f32::INFINITY)?;
+        let (i, t) = self.hit(origin, dir, (self.epsilon_m, f32::INFINITY), true)?;
         Some(self.surface(i, origin + dir * t, dir, t))
     }
 
@@ -172,7 +207,7 @@ impl Tracer {
             return false;
         }
         let dir = d / len;
-        self.hit(a, dir, self.epsilon_m, len - self.epsilon_m)
+        self.hit(a, dir, (self.epsilon_m, len - self.epsilon_m), false)
             .is_some()
     }
 

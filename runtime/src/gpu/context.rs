@@ -177,10 +177,38 @@ pub fn render_pipeline(
     d: &wgpu::Device,
     label: &str,
     module: &wgpu::ShaderModule,
+    entries: (&str, &str),
+    buffers: &[Option<wgpu::VertexBufferLayout>],
+    targets: &[wgpu::TextureFormat],
+    depth: Option<wgpu::CompareFunction>,
+) -> wgpu::RenderPipeline {
+    let raster = Raster::default();
+    render_pipeline_with(d, label, module, entries, buffers, targets, depth, &raster)
+}
+
+/// How a [`render_pipeline_with`] rasterizes: its layout (`None`: derived from the shader), the
+/// faces it culls and its depth bias.
+#[derive(Default)]
+pub struct Raster<'a> {
+    /// An explicit layout, so that one bind group serves several pipelines.
+    pub layout: Option<&'a wgpu::PipelineLayout>,
+    /// The faces not drawn.
+    pub cull: Option<wgpu::Face>,
+    /// Added to each fragment's depth before its test.
+    pub bias: wgpu::DepthBiasState,
+}
+
+/// [`render_pipeline`] rasterized as `raster` says.
+#[allow(clippy::too_many_arguments)]
+pub fn render_pipeline_with(
+    d: &wgpu::Device,
+    label: &str,
+    module: &wgpu::ShaderModule,
     (vertex, fragment): (&str, &str),
     buffers: &[Option<wgpu::VertexBufferLayout>],
     targets: &[wgpu::TextureFormat],
     depth: Option<wgpu::CompareFunction>,
+    raster: &Raster,
 ) -> wgpu::RenderPipeline {
     let targets: Vec<Option<wgpu::ColorTargetState>> = targets
         .iter()
@@ -194,20 +222,23 @@ pub fn render_pipeline(
         .collect();
     d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
-        layout: None,
+        layout: raster.layout,
         vertex: wgpu::VertexState {
             module,
             entry_point: Some(vertex),
             buffers,
             compilation_options: Default::default(),
         },
-        primitive: wgpu::PrimitiveState::default(),
+        primitive: wgpu::PrimitiveState {
+            cull_mode: raster.cull,
+            ..Default::default()
+        },
         depth_stencil: depth.map(|compare| wgpu::DepthStencilState {
             format: wgpu::TextureFormat::Depth32Float,
             depth_write_enabled: Some(true),
             depth_compare: Some(compare),
             stencil: Default::default(),
-            bias: Default::default(),
+            bias: raster.bias,
         }),
         multisample: wgpu::MultisampleState::default(),
         fragment: Some(wgpu::FragmentState {

@@ -3,7 +3,7 @@
 //! reflective shadow maps are G-buffers of this pipeline ([`super::rsm_vpls`]).
 
 use crate::RenderError;
-use crate::gpu::context::{Pool, bind_group, render_pipeline};
+use crate::gpu::context::{Pool, Raster, bind_group, render_pipeline_with};
 use crate::gpu::geometry::VERTEX_STRIDE;
 use crate::gpu::shaders::ShaderSources;
 use crate::gpu::timing::Recorder;
@@ -18,11 +18,21 @@ pub const FORMATS: [wgpu::TextureFormat; 3] = [
 
 /// The G-buffer pipelines: the camera's with reversed depth (an infinite far plane, depth
 /// `near / distance`, compare greater, cleared to 0: no far clipping, precision where it is
-/// needed), the lights' RSM views with their standard depth.
+/// needed), its front faces and its back faces drawn apart, the back pushed back
+/// ([`BACK_FACE_BIAS`]); the lights' RSM views with their standard depth, every face at once.
 pub struct GBuffer {
+    layout: wgpu::BindGroupLayout,
     pipeline: wgpu::RenderPipeline,
+    back: wgpu::RenderPipeline,
     light: wgpu::RenderPipeline,
 }
+
+/// The camera's back faces' depth bias, in units of the depth's last bit (2⁻²³ of its
+/// magnitude): −256, 3e-5 of the distance, so that of two faces of one plane turned apart (a
+/// floor's top and the ceiling under it) the one turned to the eye is seen, as the CPU tracer
+/// sees it (`cpu::tracer::FRONT_FACE_TIE`); drawn together, rounding picked between them in
+/// stripes.
+pub const BACK_FACE_BIAS: i32 = -256;
 
 /// Which depth convention a G-buffer pass uses.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -48,25 +58,45 @@ impl GBuffer {
         let attrs = wgpu::vertex_attr_array![
             0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 3 => Float32x3
         ];
-        let layout = wgpu::VertexBufferLayout {
+        let layout_of_vertices = wgpu::VertexBufferLayout {
             array_stride: VERTEX_STRIDE,
             step_mode: wgpu::VertexStepMode::Vertex,
             attributes: &attrs,
         };
-        let make = |label, compare| {
-            render_pipeline(
+        let layout = bind_group_layout(d);
+        let pipeline_layout = d.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("gbuffer"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let make = |label, compare, cull, bias| {
+            let raster = Raster {
+                layout: Some(&pipeline_layout),
+                cull,
+                bias: wgpu::DepthBiasState {
+                    constant: bias,
+                    ..Default::default()
+                },
+            };
+            let buffers = [Some(layout_of_vertices.clone())];
+            render_pipeline_with(
                 d,
                 label,
                 &module,
                 ("vs", "fs"),
-                &[Some(layout.clone())],
+                &buffers,
                 &FORMATS,
                 Some(compare),
+                &raster,
             )
         };
+        let (front, back) = (Some(wgpu::Face::Back), Some(wgpu::Face::Front));
+        let greater = wgpu::CompareFunction::Greater;
         Ok(GBuffer {
-            pipeline: make("gbuffer", wgpu::CompareFunction::Greater),
-            light: make("rsm gbuffer", wgpu::CompareFunction::Less),
+            pipeline: make("gbuffer", greater, front, 0),
+            back: make("gbuffer back faces", greater, back, BACK_FACE_BIAS),
+            light: make("rsm gbuffer", wgpu::CompareFunction::Less, None, 0),
+            layout,
         })
     }
 
@@ -74,19 +104,14 @@ impl GBuffer {
     /// `offset`), the albedo array and sampler, the level's `grid` and voxel words.
     pub fn bind_group(
         &self,
-        convention: Depth,
         d: &wgpu::Device,
         scene: &SceneGpu,
         globals: wgpu::BindingResource,
         grid: &wgpu::Buffer,
     ) -> wgpu::BindGroup {
-        let pipeline = match convention {
-            Depth::Reversed => &self.pipeline,
-            Depth::Standard => &self.light,
-        };
         bind_group(
             d,
-            &pipeline.get_bind_group_layout(0),
+            &self.layout,
             "gbuffer",
             vec![
                 (0, globals),
@@ -139,13 +164,16 @@ impl GBuffer {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(match convention {
-            Depth::Reversed => &self.pipeline,
-            Depth::Standard => &self.light,
-        });
+        let pipelines = match convention {
+            Depth::Reversed => vec![&self.pipeline, &self.back],
+            Depth::Standard => vec![&self.light],
+        };
         pass.set_bind_group(0, bind_group, &[]);
         pass.set_vertex_buffer(0, scene.geometry.vertices.slice(..));
-        pass.draw(0..scene.geometry.vertex_count, 0..1);
+        for pipeline in pipelines {
+            pass.set_pipeline(pipeline);
+            pass.draw(0..scene.geometry.vertex_count, 0..1);
+        }
     }
 
     /// Records the camera's G-buffer ("geometry pass", as the gates paper's Table I names it).
@@ -168,13 +196,7 @@ impl GBuffer {
         let views = textures
             .each_ref()
             .map(|t| t.create_view(&Default::default()));
-        let bg = self.bind_group(
-            Depth::Reversed,
-            d,
-            f.scene,
-            f.globals.as_entire_binding(),
-            &f.grid,
-        );
+        let bg = self.bind_group(d, f.scene, f.globals.as_entire_binding(), &f.grid);
         let span = rec.begin("geometry pass (G-buffer)");
         self.draw(
             Depth::Reversed,
@@ -188,4 +210,51 @@ impl GBuffer {
         rec.end();
         GBufferOutput { textures, views }
     }
+}
+
+/// The G-buffer's inputs (gbuffer.wgsl): globals, the albedo array and its sampler, the level's
+/// grid and voxel words; one layout for its three pipelines.
+fn bind_group_layout(d: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let entry = |binding, visibility, ty| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty,
+        count: None,
+    };
+    let uniform = wgpu::BindingType::Buffer {
+        ty: wgpu::BufferBindingType::Uniform,
+        has_dynamic_offset: false,
+        min_binding_size: None,
+    };
+    let fragment = wgpu::ShaderStages::FRAGMENT;
+    d.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("gbuffer"),
+        entries: &[
+            entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT, uniform),
+            entry(
+                1,
+                fragment,
+                wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                    view_dimension: wgpu::TextureViewDimension::D2Array,
+                    multisampled: false,
+                },
+            ),
+            entry(
+                2,
+                fragment,
+                wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+            ),
+            entry(8, fragment, uniform),
+            entry(
+                9,
+                fragment,
+                wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only: true },
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+            ),
+        ],
+    })
 }

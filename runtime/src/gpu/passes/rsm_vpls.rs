@@ -191,7 +191,7 @@ impl RsmVpls {
                 (i * UNIFORM_STRIDE) as u64,
                 size_of::<Globals>() as u64,
             );
-            let bg = gbuffer.bind_group(Depth::Standard, d, scene, g, &scene.no_grid);
+            let bg = gbuffer.bind_group(d, scene, g, &scene.no_grid);
             let targets = maps.each_ref().map(|t| layer_view(t, i as u32));
             gbuffer.draw(
                 Depth::Standard,
