@@ -285,4 +285,28 @@ fn of_two_faces_of_one_plane_the_cpu_and_the_gpu_show_the_one_turned_to_the_eye(
         differ * 100 < lit,
         "{differ} of {lit} lit pixels differ by over 5 %"
     );
+    // The lamp's reflective shadow map sees the floor's top: its VPLs there reflect the
+    // floor's albedo (red over blue 1.13), not the ceiling's (1.0); so do the light paths'.
+    let mut renderer = GpuRenderer::new(&ctx, &scene).expect("upload");
+    let rsm = renderer.rsm_vpls(&ctx, 4096, 256, 1).expect("rsm vpls");
+    let params = PathParams {
+        paths: 4096,
+        bounces: 1,
+        seed: 1,
+    };
+    let paths = path_vpls(&tracer, &scene.lights, &params).expect("paths");
+    for (what, vpls) in [("rsm", &rsm), ("paths", &paths)] {
+        let on_floor: Vec<_> = vpls
+            .iter()
+            .filter(|v| (v.position[1] - 3.0).abs() < 1e-3 && v.flux[2] > 0.0)
+            .collect();
+        let n = on_floor.len();
+        let ceiling = on_floor
+            .iter()
+            .filter(|v| v.flux[0] / v.flux[2] < 1.06)
+            .count();
+        eprintln!("{what}: {ceiling} of {n} VPLs on the floor take the ceiling's albedo");
+        assert!(n > 200, "{what}: {n}");
+        assert_eq!(ceiling, 0, "{what}: {ceiling} of {n} VPLs");
+    }
 }

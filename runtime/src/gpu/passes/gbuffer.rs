@@ -18,17 +18,19 @@ pub const FORMATS: [wgpu::TextureFormat; 3] = [
 
 /// The G-buffer pipelines: the camera's with reversed depth (an infinite far plane, depth
 /// `near / distance`, compare greater, cleared to 0: no far clipping, precision where it is
-/// needed), its front faces and its back faces drawn apart, the back pushed back
-/// ([`BACK_FACE_BIAS`]); the lights' RSM views with their standard depth, every face at once.
+/// needed), and the lights' RSM views with their standard depth; each draws its front faces,
+/// then its back faces pushed back ([`BACK_FACE_BIAS`]).
 pub struct GBuffer {
     layout: wgpu::BindGroupLayout,
     pipeline: wgpu::RenderPipeline,
     back: wgpu::RenderPipeline,
     light: wgpu::RenderPipeline,
+    light_back: wgpu::RenderPipeline,
 }
 
-/// The camera's back faces' depth bias, in units of the depth's last bit (2⁻²³ of its
-/// magnitude): −256, 3e-5 of the distance, so that of two faces of one plane turned apart (a
+/// The back faces' depth bias in the camera's reversed depth (negated in the lights' standard
+/// depth), in units of the depth's last bit (2⁻²³ of its magnitude): −256, 3e-5 of the
+/// distance, so that of two faces of one plane turned apart (a
 /// floor's top and the ceiling under it) the one turned to the eye is seen, as the CPU tracer
 /// sees it (`cpu::tracer::FRONT_FACE_TIE`); drawn together, rounding picked between them in
 /// stripes.
@@ -91,11 +93,13 @@ impl GBuffer {
             )
         };
         let (front, back) = (Some(wgpu::Face::Back), Some(wgpu::Face::Front));
-        let greater = wgpu::CompareFunction::Greater;
+        let (greater, less) = (wgpu::CompareFunction::Greater, wgpu::CompareFunction::Less);
         Ok(GBuffer {
             pipeline: make("gbuffer", greater, front, 0),
             back: make("gbuffer back faces", greater, back, BACK_FACE_BIAS),
-            light: make("rsm gbuffer", wgpu::CompareFunction::Less, None, 0),
+            // Standard depth grows away from the light: its back faces' bias is positive.
+            light: make("rsm gbuffer", less, front, 0),
+            light_back: make("rsm gbuffer back faces", less, back, -BACK_FACE_BIAS),
             layout,
         })
     }
@@ -166,7 +170,7 @@ impl GBuffer {
         });
         let pipelines = match convention {
             Depth::Reversed => vec![&self.pipeline, &self.back],
-            Depth::Standard => vec![&self.light],
+            Depth::Standard => vec![&self.light, &self.light_back],
         };
         pass.set_bind_group(0, bind_group, &[]);
         pass.set_vertex_buffer(0, scene.geometry.vertices.slice(..));
