@@ -38,21 +38,6 @@ impl Builtin {
 
     /// Whether the level is closed, and its lights and cameras.
     fn placed(self) -> Placed {
-        let point = |p: [f64; 3], i: f32| {
-            LightDesc::Point(PointLightDesc {
-                position: p,
-                intensity: [i; 3],
-                animate: vec![],
-                orbit: None,
-            })
-        };
-        let camera = |name: &str, eye: [f64; 3], target: [f64; 3], fov: f32| CameraDesc {
-            name: name.into(),
-            eye,
-            target,
-            up: None,
-            fov_deg: fov,
-        };
         match self {
             Builtin::EmptyBox => (
                 true,
@@ -106,38 +91,7 @@ impl Builtin {
                 })],
                 vec![camera("main", [0.0, 1.0, 3.5], [0.0, 1.0, 0.0], 45.0)],
             ),
-            // The light in room B, the cameras in room A looking at the door wall (the light
-            // reaches room A only through the door's gap) and one in room B.
-            Builtin::AjarDoor => (
-                true,
-                vec![point([6.6, 2.5, 3.3], 10.0)],
-                vec![
-                    camera("main", [0.4, 1.6, 0.5], [4.0, 1.0, 2.2], 75.0),
-                    camera("door", [1.8, 1.3, 3.6], [4.0, 0.9, 1.8], 70.0),
-                    camera("light-room", [7.6, 1.6, 0.4], [4.0, 1.0, 2.2], 75.0),
-                ],
-            ),
-            // A lamp 1.2 m outside the window and above it, lighting room B's floor through it
-            // (the window: quads::SUN_WINDOW); the cameras in room B looking at the lit floor
-            // (first: what `view` and `render` open on), and in room A looking at the door wall.
-            Builtin::SunWindow => (
-                false,
-                vec![point([6.0, 2.8, 5.2], 40.0)],
-                vec![
-                    camera("window", [4.6, 1.7, 0.4], [6.2, 0.2, 3.2], 75.0),
-                    camera("door", [0.4, 1.6, 0.5], [4.0, 1.0, 2.2], 75.0),
-                ],
-            ),
-            // The lamp upstairs; a camera on the ground floor looking up the flight at the hole
-            // (lit through it alone), one upstairs looking down into it.
-            Builtin::Stairwell => (
-                true,
-                vec![point([2.0, 5.5, 3.0], 15.0)],
-                vec![
-                    camera("down", [0.6, 1.6, 5.4], [6.0, 2.6, 1.6], 75.0),
-                    camera("up", [0.5, 4.6, 5.5], [6.0, 3.0, 1.6], 75.0),
-                ],
-            ),
+            Builtin::AjarDoor | Builtin::SunWindow | Builtin::Stairwell => self.quad_placed(),
             // One lamp in each side room (the rows are light lines); the cameras of the
             // pillared hall, and one along the south row.
             Builtin::LampHall => (
@@ -176,5 +130,65 @@ impl Builtin {
                 ],
             ),
         }
+    }
+
+    /// [`Builtin::placed`] for the levels of single-sided quads.
+    fn quad_placed(self) -> Placed {
+        match self {
+            // The light in room B, the cameras in room A looking at the door wall (the light
+            // reaches room A only through the door's gap) and one in room B.
+            Builtin::AjarDoor => (
+                true,
+                vec![point([6.6, 2.5, 3.3], 10.0)],
+                vec![
+                    camera("main", [0.4, 1.6, 0.5], [4.0, 1.0, 2.2], 75.0),
+                    camera("door", [1.8, 1.3, 3.6], [4.0, 0.9, 1.8], 70.0),
+                    camera("light-room", [7.6, 1.6, 0.4], [4.0, 1.0, 2.2], 75.0),
+                ],
+            ),
+            // A lamp 1.2 m outside the window and above it, lighting room B's floor through it
+            // (the window: quads::SUN_WINDOW); the cameras in room B looking at the lit floor
+            // (first: what `view` and `render` open on), and in room A looking at the door wall.
+            Builtin::SunWindow => (
+                false,
+                vec![point([6.0, 2.8, 5.2], 40.0)],
+                vec![
+                    camera("window", [4.6, 1.7, 0.4], [6.2, 0.2, 3.2], 75.0),
+                    camera("door", [0.4, 1.6, 0.5], [4.0, 1.0, 2.2], 75.0),
+                ],
+            ),
+            // The lamp upstairs; a camera on the ground floor looking up the flight at the hole
+            // (lit through it alone), one upstairs looking down into it.
+            Builtin::Stairwell => (
+                true,
+                vec![point([2.0, 5.5, 3.0], 15.0)],
+                vec![
+                    camera("down", [0.6, 1.6, 5.4], [6.0, 2.6, 1.6], 75.0),
+                    camera("up", [0.5, 4.6, 5.5], [6.0, 3.0, 1.6], 75.0),
+                ],
+            ),
+            _ => unreachable!("{} is not a level of quads", self.name()),
+        }
+    }
+}
+
+/// A point light at `p` of `i` W/sr on every channel.
+fn point(p: [f64; 3], i: f32) -> LightDesc {
+    LightDesc::Point(PointLightDesc {
+        position: p,
+        intensity: [i; 3],
+        animate: vec![],
+        orbit: None,
+    })
+}
+
+/// A camera `name` at `eye` looking at `target`, `fov` degrees across.
+fn camera(name: &str, eye: [f64; 3], target: [f64; 3], fov: f32) -> CameraDesc {
+    CameraDesc {
+        name: name.into(),
+        eye,
+        target,
+        up: None,
+        fov_deg: fov,
     }
 }
