@@ -22,10 +22,10 @@ pub const FORMATS: [wgpu::TextureFormat; 3] = [
 /// then its back faces pushed back ([`BACK_FACE_BIAS`]).
 pub struct GBuffer {
     layout: wgpu::BindGroupLayout,
-    pipeline: wgpu::RenderPipeline,
-    back: wgpu::RenderPipeline,
-    light: wgpu::RenderPipeline,
-    light_back: wgpu::RenderPipeline,
+    /// The camera's front faces' and back faces' pipelines.
+    camera: [wgpu::RenderPipeline; 2],
+    /// The lights' front faces' and back faces' pipelines.
+    light: [wgpu::RenderPipeline; 2],
 }
 
 /// The back faces' depth bias in the camera's reversed depth (negated in the lights' standard
@@ -95,11 +95,15 @@ impl GBuffer {
         let (front, back) = (Some(wgpu::Face::Back), Some(wgpu::Face::Front));
         let (greater, less) = (wgpu::CompareFunction::Greater, wgpu::CompareFunction::Less);
         Ok(GBuffer {
-            pipeline: make("gbuffer", greater, front, 0),
-            back: make("gbuffer back faces", greater, back, BACK_FACE_BIAS),
+            camera: [
+                make("gbuffer", greater, front, 0),
+                make("gbuffer back faces", greater, back, BACK_FACE_BIAS),
+            ],
             // Standard depth grows away from the light: its back faces' bias is positive.
-            light: make("rsm gbuffer", less, front, 0),
-            light_back: make("rsm gbuffer back faces", less, back, -BACK_FACE_BIAS),
+            light: [
+                make("rsm gbuffer", less, front, 0),
+                make("rsm gbuffer back faces", less, back, -BACK_FACE_BIAS),
+            ],
             layout,
         })
     }
@@ -169,8 +173,8 @@ impl GBuffer {
             multiview_mask: None,
         });
         let pipelines = match convention {
-            Depth::Reversed => vec![&self.pipeline, &self.back],
-            Depth::Standard => vec![&self.light, &self.light_back],
+            Depth::Reversed => &self.camera,
+            Depth::Standard => &self.light,
         };
         pass.set_bind_group(0, bind_group, &[]);
         pass.set_vertex_buffer(0, scene.geometry.vertices.slice(..));
