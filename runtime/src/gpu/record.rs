@@ -97,13 +97,13 @@ pub(super) fn record_passes(
             let uniform = InterleaveBlur::uniform(f, il, pool, true);
             let targets = (&g, &uniform, &indirect, &hdr);
             let sums = starved.as_ref().map(|s| &s.sums);
-            p.blur.record(f, pool, rec, targets, sums);
+            p.blur.record(f, il, pool, rec, targets, sums);
         }
         GpuMode::VplClusters(_, il) if il.block > 1 => {
             let indirect = p.shade.record_indirect(f, pool, rec, inputs, None);
             let uniform = InterleaveBlur::uniform(f, il, pool, true);
             p.blur
-                .record(f, pool, rec, (&g, &uniform, &indirect, &hdr), None);
+                .record(f, il, pool, rec, (&g, &uniform, &indirect, &hdr), None);
         }
         GpuMode::PerVplShadowMaps(pv) => p.maps.record(f, pv, pool, rec, (&g, &hdr)),
         GpuMode::PerVplIsm(pi) => p.isms.record_vpls(f, pi, &p.blur, pool, rec, (&g, &hdr))?,

@@ -18,6 +18,13 @@
 // cs_starved_sums); a 1 × 1 texture of zeros for the other modes.
 @group(0) @binding(14) var starved_sums: texture_2d<f32>;
 
+// Whether a tap that does not agree gives way to a copy of its subset (InterleaveParams::fill,
+// gather.blur_fill): fixed with the pipeline, InterleaveBlur making one each way, so that a blur
+// without it runs none of blur_copy's code. On llvmpipe its mere presence, never taken, made
+// the loop over the taps 3.5× as long (e2m3's hall at 512², 1,024 VPLs, the tent: blur +
+// compose 0.97–0.98 → 0.27–0.28 s; the same image, bit for bit).
+override BLUR_FILL: u32 = 1u;
+
 @compute @workgroup_size(8, 8)
 fn cs_compose(@builtin(global_invocation_id) id: vec3<u32>) {
     if all(id.xy < textureDimensions(previous)) {
@@ -54,7 +61,7 @@ fn compose(px: vec2<i32>) -> vec4<f32> {
     let m = vec2<u32>(size) % bu;
     let deint = gather.deinterleaved == 1u;
     var ry = vec2<u32>(u32(lo.y) % bu, u32(lo.y) / bu);
-    let fill = gather.blur_fill == 1u && walked.w != 1.0;
+    let fill = BLUR_FILL == 1u && gather.blur_fill == 1u && walked.w != 1.0;
     var sum = vec3<f32>(0.0);
     var weight = 0.0;
     for (var y = lo.y; y < hi.y; y++) {

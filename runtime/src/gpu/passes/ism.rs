@@ -339,7 +339,14 @@ impl Isms {
         );
         rec.end();
         let uniform = InterleaveBlur::uniform(f, interleave, pool, false);
-        blur.record(f, pool, rec, (g, &uniform, &indirect, out), None);
+        blur.record(
+            f,
+            interleave,
+            pool,
+            rec,
+            (g, &uniform, &indirect, out),
+            None,
+        );
     }
 
     /// Mode per-vpl-ism onto `out`.

@@ -194,7 +194,7 @@ impl ValGathers {
         rec.end();
         passes
             .blur
-            .record(f, pool, rec, (g, &uniform_buf, &indirect, out), None);
+            .record(f, il, pool, rec, (g, &uniform_buf, &indirect, out), None);
         Ok(Some(b.state))
     }
 }
