@@ -3,11 +3,11 @@
 //! geometry agrees (Laine et al.'s thresholds), times albedo / π, added onto the image (through
 //! a ping-pong target and a copy).
 
+use std::sync::OnceLock;
+
 use super::gbuffer::GBufferOutput;
 use super::shade::{HDR, frame_pass, frame_target};
 use crate::RenderError;
-use std::sync::OnceLock;
-
 use crate::gpu::context::{Pool, bind_group, compute_pipeline_with};
 use crate::gpu::layout::ValGather;
 use crate::gpu::shaders::ShaderSources;
