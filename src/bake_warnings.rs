@@ -4,6 +4,7 @@
 //! sit in the JSON report.
 
 use serde_json::Value;
+use visgate_formats::stray::Stray;
 use visgate_formats::vgate::GridMeta;
 use visgate_preprocess::bake::is_camera_seed;
 use visgate_preprocess::empty::{INSIDE, INSIDE_LEAK_MAX_VOXELS, UNSEEN};
@@ -42,6 +43,31 @@ pub fn warnings(report: &BakeReport) -> Vec<String> {
         .and_then(|s| s.counts["bytes"].as_u64());
     out.extend(sight_bytes.and_then(sight_grid_too_large));
     out
+}
+
+/// The warning for a level's stray triangles ([`visgate_formats::stray::stray_geometry`]),
+/// printed before the bake: they size its grid.
+pub fn stray_warning(s: &Stray) -> String {
+    let p = s.farthest;
+    format!(
+        "{} of the level's {} static triangles {} far from the rest: the farthest corner at \
+         ({:.2}, {:.2}, {:.2}) m, {:.0} m from the rest's bounds. The grid spans them, a {:.1} m \
+         level where the rest is {:.2} m long, so its voxels are {:.0}× as large as the rest \
+         alone needs and its rooms and doorways fall to a few voxels. A helper object left in \
+         the export, a sky box or a vertex in the wrong place? Delete them in the modelling \
+         tool, or give them a mesh of their own and mark it `static = false` in a scene TOML \
+         (lit, not baked)",
+        s.triangles,
+        s.total,
+        if s.triangles == 1 { "lies" } else { "lie" },
+        p.x,
+        p.y,
+        p.z,
+        s.distance_m,
+        s.longest_m(),
+        s.rest_longest_m(),
+        s.longest_m() / s.rest_longest_m().max(1e-9),
+    )
 }
 
 /// The storage binding limit over which [`sight_grid_too_large`] warns: wgpu's default and

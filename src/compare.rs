@@ -175,6 +175,9 @@ fn level(
         (None, n) => {
             let voxels = n.unwrap_or(128);
             println!("baking the level at {voxels} voxels on the longest axis");
+            if let Some(s) = visgate_formats::stray::stray_geometry(scene) {
+                eprintln!("warning: {}", crate::bake_warnings::stray_warning(&s));
+            }
             let params = BakeParams {
                 resolution: Resolution::LongestAxisVoxels(voxels),
                 ..BakeParams::default()

@@ -12,6 +12,8 @@
 //!   into a typed error or a counted warning;
 //! - [`scene`]: the in-memory scene in visgate's space (right-handed, +Y up, metres), and the
 //!   hash of its static geometry;
+//! - [`stray`]: the static triangles far from the rest of a level (a helper left in the
+//!   export, a sky box), which would size the bake's grid;
 //! - [`vgate`]: the baked `.vgate` file — the runtime layout of a level's skeleton, visibility
 //!   clusters and gates, and its voxel grids — with a validating reader.
 
@@ -29,6 +31,7 @@ pub mod load;
 pub mod mitsuba;
 pub mod placement;
 pub mod scene;
+pub mod stray;
 pub mod sun;
 pub mod vgate;
 

@@ -126,6 +126,35 @@ fn bake_says_each_import_warning_once() {
     );
 }
 
+#[test]
+fn a_triangle_far_from_the_level_is_named_before_the_bake() {
+    // The leaky room's mesh (8 m long) with one triangle 500 m away, as an exporter leaves a
+    // helper behind: the grid spans it, so the bake says where it is and by how much it grew
+    // the voxels; the room alone says nothing of it.
+    let dir = tempfile::tempdir().expect("tempdir");
+    leaky_room(dir.path());
+    let mesh = dir.path().join("room.obj");
+    let out = dir.path().join("l.vgate");
+    let (m, o) = (mesh.to_str().expect("utf-8"), out.to_str().expect("utf-8"));
+    let bake = ["bake", m, "--resolution", "32", "-o", o];
+    let clean = visgate(&bake);
+    assert!(clean.status.success(), "{}", stderr(&clean));
+    assert!(
+        !stderr(&clean).contains("far from the rest"),
+        "{}",
+        stderr(&clean)
+    );
+    let mut obj = std::fs::read_to_string(&mesh).expect("obj");
+    obj += "v 500 0 0\nv 501 0 0\nv 500 1 0\nf -3 -2 -1\n";
+    std::fs::write(&mesh, obj).expect("obj");
+    let stray = visgate(&bake);
+    assert!(stray.status.success(), "{}", stderr(&stray));
+    let said = "1 of the level's 21 static triangles lies far from the rest: the farthest corner \
+                at (501.00, 0.00, 0.00) m, 493 m from the rest's bounds. The grid spans them, a \
+                501.0 m level where the rest is 8.00 m long, so its voxels are 63× as large";
+    assert!(stderr(&stray).contains(said), "{}", stderr(&stray));
+}
+
 /// `visgate bake SCENE -o DIR/l.vgate --resolution 64 --debug-dir DIR/debug --report
 /// DIR/bake.json`, and those two paths.
 fn bake_at_64_with_debug(
