@@ -12,7 +12,7 @@ use visgate_formats::vgate::{
 };
 use visgate_preprocess::bake::{BakeOptions, Baked, Progress, bake};
 
-use crate::bake_warnings::{stray_warning, warnings};
+use crate::bake_warnings::{warn_of_strays, warnings};
 
 /// Options of `visgate bake`.
 #[derive(Args)]
@@ -174,9 +174,7 @@ pub fn run(args: BakeArgs) -> Result<()> {
     let (params, options) = params_of(&args)?;
     let scene = crate::load_scene(&args.scene, false)?;
     // The importer has logged the scene's warnings (degenerate triangles dropped, …) once.
-    if let Some(s) = visgate_formats::stray::stray_geometry(&scene) {
-        eprintln!("warning: {}", stray_warning(&s));
-    }
+    warn_of_strays(&scene);
     let mut pool = rayon::ThreadPoolBuilder::new();
     if let Some(t) = args.threads {
         pool = pool.num_threads(t);

@@ -4,7 +4,8 @@
 //! sit in the JSON report.
 
 use serde_json::Value;
-use visgate_formats::stray::Stray;
+use visgate_formats::Scene;
+use visgate_formats::stray::{Stray, stray_geometry};
 use visgate_formats::vgate::GridMeta;
 use visgate_preprocess::bake::is_camera_seed;
 use visgate_preprocess::empty::{INSIDE, INSIDE_LEAK_MAX_VOXELS, UNSEEN};
@@ -45,9 +46,16 @@ pub fn warnings(report: &BakeReport) -> Vec<String> {
     out
 }
 
-/// The warning for a level's stray triangles ([`visgate_formats::stray::stray_geometry`]),
-/// printed before the bake: they size its grid.
-pub fn stray_warning(s: &Stray) -> String {
+/// Prints the warning for `scene`'s stray triangles, where it has any
+/// ([`visgate_formats::stray::stray_geometry`]): before a bake, whose grid they size.
+pub fn warn_of_strays(scene: &Scene) {
+    if let Some(s) = stray_geometry(scene) {
+        eprintln!("warning: {}", stray_warning(&s));
+    }
+}
+
+/// The warning for a level's stray triangles `s`.
+fn stray_warning(s: &Stray) -> String {
     let p = s.farthest;
     format!(
         "{} of the level's {} static triangles {} far from the rest: the farthest corner at \

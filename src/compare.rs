@@ -175,9 +175,7 @@ fn level(
         (None, n) => {
             let voxels = n.unwrap_or(128);
             println!("baking the level at {voxels} voxels on the longest axis");
-            if let Some(s) = visgate_formats::stray::stray_geometry(scene) {
-                eprintln!("warning: {}", crate::bake_warnings::stray_warning(&s));
-            }
+            crate::bake_warnings::warn_of_strays(scene);
             let params = BakeParams {
                 resolution: Resolution::LongestAxisVoxels(voxels),
                 ..BakeParams::default()

@@ -438,7 +438,12 @@ impl Scene {
 }
 
 fn bounds_of<'a>(meshes: impl Iterator<Item = &'a Mesh>) -> Option<(Vec3, Vec3)> {
-    let mut it = meshes.flat_map(|m| m.positions.iter().copied()).peekable();
+    points_bounds(meshes.flat_map(|m| m.positions.iter().copied()))
+}
+
+/// Axis-aligned bounds of `points`; `None` for none.
+pub(crate) fn points_bounds(points: impl Iterator<Item = Vec3>) -> Option<(Vec3, Vec3)> {
+    let mut it = points.peekable();
     let first = *it.peek()?;
     Some(it.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p))))
 }

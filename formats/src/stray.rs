@@ -6,7 +6,7 @@
 
 use glam::Vec3;
 
-use crate::scene::Scene;
+use crate::scene::{Scene, points_bounds};
 
 /// At most this share of the static triangles (and at least one) may be left out of the bulk
 /// of the level along each axis. [Units: ratio]
@@ -61,45 +61,50 @@ pub fn stray_triangles(tris: &[[Vec3; 3]]) -> Option<Stray> {
         return None;
     }
     let k = ((STRAY_SHARE * n as f64) as usize).max(1);
-    let centres: Vec<Vec3> = tris.iter().map(|t| (t[0] + t[1] + t[2]) / 3.0).collect();
     let (mut lo, mut hi) = (Vec3::ZERO, Vec3::ZERO);
     for axis in 0..3 {
-        let mut c: Vec<f32> = centres.iter().map(|p| p[axis]).collect();
-        c.sort_unstable_by(f32::total_cmp);
-        (lo[axis], hi[axis]) = (c[k], c[n - 1 - k]);
+        let mut c: Vec<f32> = tris
+            .iter()
+            .map(|t| (t[0] + t[1] + t[2])[axis] / 3.0)
+            .collect();
+        // The k-th lowest, then the k-th highest among those above it.
+        let (_, &mut low, above) = c.select_nth_unstable_by(k, f32::total_cmp);
+        let (_, &mut high, _) = above.select_nth_unstable_by(n - 2 - 2 * k, f32::total_cmp);
+        (lo[axis], hi[axis]) = (low, high);
     }
     let reach = (hi - lo).max_element();
-    let beyond = |p: Vec3| (lo - p).max(p - hi).max(Vec3::ZERO).length();
-    let far = |t: &[Vec3; 3]| t.iter().any(|&p| beyond(p) > reach);
-    let bounds = corners_bounds(tris.iter())?;
-    let rest = corners_bounds(tris.iter().filter(|t| !far(t)))?;
-    let strays: Vec<&[Vec3; 3]> = tris.iter().filter(|t| far(t)).collect();
-    let rest_longest = (rest.1 - rest.0).max_element();
-    if strays.is_empty()
-        || strays.len() > k
-        || (bounds.1 - bounds.0).max_element() <= STRAY_SPAN_RATIO * rest_longest
+    let (strays, rest): (Vec<&[Vec3; 3]>, Vec<&[Vec3; 3]>) = tris
+        .iter()
+        .partition(|t| t.iter().any(|&p| off_box(p, (lo, hi)) > reach));
+    let corners = |tris: &[&[Vec3; 3]]| points_bounds(tris.iter().flat_map(|t| t.iter().copied()));
+    let (Some(rest), Some(bounds)) = (
+        corners(&rest),
+        points_bounds(tris.iter().flatten().copied()),
+    ) else {
+        return None;
+    };
+    let longest = |b: (Vec3, Vec3)| (b.1 - b.0).max_element();
+    if strays.is_empty() || strays.len() > k || longest(bounds) <= STRAY_SPAN_RATIO * longest(rest)
     {
         return None;
     }
-    let off_rest = |p: Vec3| (rest.0 - p).max(p - rest.1).max(Vec3::ZERO).length();
     let farthest = strays
         .iter()
         .flat_map(|t| t.iter().copied())
-        .max_by(|a, b| off_rest(*a).total_cmp(&off_rest(*b)))?;
+        .max_by(|a, b| off_box(*a, rest).total_cmp(&off_box(*b, rest)))?;
     Some(Stray {
         triangles: strays.len(),
         total: n,
         farthest,
-        distance_m: off_rest(farthest),
+        distance_m: off_box(farthest, rest),
         bounds,
         rest,
     })
 }
 
-fn corners_bounds<'a>(tris: impl Iterator<Item = &'a [Vec3; 3]>) -> Option<(Vec3, Vec3)> {
-    let mut it = tris.flat_map(|t| t.iter().copied()).peekable();
-    let first = *it.peek()?;
-    Some(it.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p))))
+/// How far point `p` lies outside box `b` (0 inside).
+fn off_box(p: Vec3, b: (Vec3, Vec3)) -> f32 {
+    (b.0 - p).max(p - b.1).max(Vec3::ZERO).length()
 }
 
 #[cfg(test)]

@@ -75,15 +75,16 @@ fn cs_starved_pairs(@builtin(global_invocation_id) id: vec3<u32>) {
     // and the block need not be read (the same answer as the loop below, without 64 taps
     // read at every lit pixel); any other pixel reads its taps' surfaces only where they found
     // light (dark_block), and the loop below runs at the dark ones alone.
-    let block = interleave_block_around(px, i32(bu), vec2<i32>(size));
-    if dark_test && starved_params.z <= 1.0 {
+    let dark_only = dark_test && starved_params.z <= 1.0;
+    if dark_only {
         let own = textureLoad(starved_indirect, deinterleaved(px, bu, size), 0).xyz;
         if own.x + own.y + own.z > 0.0 && blur_agrees(px, pos.xyz, n) {
             return;
         }
-        if !dark_block(block, bu, size, pos.xyz, n) {
-            return;
-        }
+    }
+    let block = interleave_block_around(px, i32(bu), vec2<i32>(size));
+    if dark_only && !dark_block(block, bu, size, pos.xyz, n) {
+        return;
     }
     // The taps that do not agree, a bit each in the block's order (b ≤ 16: 256 bits).
     var away = array<u32, 8>();
