@@ -155,12 +155,10 @@ pub struct CompareArgs {
     pub method: MethodArgs,
 }
 
-/// The level for the gate modes: `read` (--level, where the caller read it already) or read,
-/// baked at the asked resolution, or baked at 128 when a gate mode wants one (left out if the
-/// scene does not bake); and its key.
+/// The level for the gate modes: --level read, or baked at the asked resolution, or baked at
+/// 128 when a gate mode wants one (left out if the scene does not bake); and its key.
 fn level(
     args: &CompareArgs,
-    read: Option<BakedLevel>,
     scene: &Scene,
     modes: &mut Vec<CompareMode>,
 ) -> Result<Option<(GateLevel, String)>> {
@@ -168,10 +166,7 @@ fn level(
         return Ok(None);
     }
     let baked = match (&args.level, args.bake_resolution) {
-        (Some(p), _) => match read {
-            Some(b) => b,
-            None => read_level(p)?,
-        },
+        (Some(p), _) => read_level(p)?,
         (None, n) => {
             let voxels = n.unwrap_or(128);
             println!("baking the level at {voxels} voxels on the longest axis");
@@ -210,17 +205,12 @@ fn read_level(p: &std::path::Path) -> Result<BakedLevel> {
 
 pub fn run_compare(args: CompareArgs) -> Result<()> {
     let mut scene = crate::load_scene(&args.scene, true)?;
-    // A bare mesh gets a light and a camera where `visgate render` puts them (the level read
-    // for it is the gate modes' too).
-    let mut read = None;
-    if scene.lights.is_empty() || scene.cameras.is_empty() {
-        read = args.level.as_deref().map(read_level).transpose()?;
-        crate::bare::light_if_bare(&mut scene, read.as_ref(), &args.scene);
-    }
+    // A bare mesh gets a light and a camera where `visgate render` puts them.
+    crate::bare::light_if_bare(&mut scene, &args.scene);
     let cameras = compare_cameras(&scene, &args)?;
     let command_line: Vec<String> = std::env::args().collect();
     let mut modes = compare_rows(&args, &command_line)?;
-    let level = level(&args, read, &scene, &mut modes)?;
+    let level = level(&args, &scene, &mut modes)?;
     let ground_truth = args
         .ground_truth
         .iter()

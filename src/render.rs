@@ -217,7 +217,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
         ),
         None => None,
     };
-    crate::bare::light_if_bare(&mut scene, baked.as_ref(), &args.scene);
+    crate::bare::light_if_bare(&mut scene, &args.scene);
     let camera = crate::camera_of(&scene, &args.scene, args.camera.as_deref())?;
     if scene.lights.is_empty() {
         tracing::warn!(

@@ -16,6 +16,7 @@
 //! [`debug`] writes what each produced in formats Blender and MeshLab open.
 
 pub mod bake;
+pub mod ball;
 pub mod betti;
 pub mod clusters;
 pub mod convex;

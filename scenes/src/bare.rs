@@ -14,7 +14,6 @@
 //! way (a closed bulb) gets none.
 
 use glam::Vec3;
-use visgate_formats::vgate::BakedLevel;
 use visgate_formats::{Camera, Light, Scene};
 
 /// Name of the camera [`light_a_bare_scene`] adds.
@@ -60,12 +59,12 @@ fn deepest_look(eye: Vec3, reach: &dyn Fn(Vec3, Vec3) -> Option<f32>) -> Vec3 {
 /// notes); says what it added, or `None` when it needed nothing (or has no geometry).
 /// `probe(p)` is the nearest and the mean distance to the geometry along
 /// [`probe_directions`] from `p`, `None` where a ray escapes; `reach(p, d)` the distance along
-/// one ray, `None` where it escapes. Without a level, the place is the enclosed point of a 7³
-/// lattice over the bounds farthest from the geometry (a point inside a closed solid is near
-/// its walls), else the farthest of all.
+/// one ray, `None` where it escapes. The place is `ball`, the centre of the level's largest
+/// empty ball, or without one the enclosed point of a 7³ lattice over the bounds farthest from
+/// the geometry (a point inside a closed solid is near its walls).
 pub fn light_a_bare_scene(
     scene: &mut Scene,
-    level: Option<&BakedLevel>,
+    ball: Option<Vec3>,
     probe: &dyn Fn(Vec3) -> Option<(f32, f32)>,
     reach: &dyn Fn(Vec3, Vec3) -> Option<f32>,
 ) -> Option<String> {
@@ -74,15 +73,6 @@ pub fn light_a_bare_scene(
         return None;
     }
     let (lo, hi) = scene.bounds()?;
-    let ball = level.and_then(|l| {
-        l.topology
-            .skeleton
-            .nodes
-            .iter()
-            .max_by(|a, b| a.radius_m.total_cmp(&b.radius_m))
-            .filter(|n| n.radius_m > 0.0)
-            .map(|n| Vec3::from(n.position_m))
-    });
     let (at, from) = match ball {
         Some(p) => (p, "the centre of the level's largest empty ball"),
         None => {

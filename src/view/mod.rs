@@ -228,11 +228,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
         }
         None => None,
     };
-    crate::bare::light_if_bare(
-        &mut scene,
-        level.as_ref().map(GateLevel::baked),
-        &args.scene,
-    );
+    crate::bare::light_if_bare(&mut scene, &args.scene);
     let camera = start_camera(&args, &scene)?;
     let layers = start_layers(&args, saved.as_ref())?;
     let g_max = RenderJob::default().for_scene(&scene)?.params.g_max;

@@ -504,3 +504,47 @@ fn a_reader_that_goes_away_ends_visgate_quietly() {
     assert!(!err.contains("panicked"), "{err}");
     assert_eq!(status.code(), Some(141), "{err}");
 }
+
+/// The line in which a render says where it put a bare mesh's light and camera.
+fn placement(o: &std::process::Output) -> String {
+    let out = stdout(o);
+    let line = out.lines().find(|l| l.contains("camera 'inside' at"));
+    line.unwrap_or_else(|| panic!("no placement in {out}"))
+        .to_string()
+}
+
+#[test]
+fn a_bare_mesh_is_looked_at_from_one_place_with_a_level_or_without() {
+    // The ajar door's rooms as a bare OBJ: no light, no camera. A reference rendered without
+    // a level and a gate render with one must show the same view (they differed: the level's
+    // skeleton placed them, or without it a lattice of probes).
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join("ajar");
+    let o = visgate(&["scenes", "export", "ajar-door", out.to_str().expect("utf8")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let obj = out.join("ajar-door.obj");
+    let (obj, level) = (obj.to_str().expect("utf8"), dir.path().join("a.vgate"));
+    let level = level.to_str().expect("utf8");
+    let o = visgate(&["bake", obj, "-o", level, "--resolution", "64", "-q"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let render = |mode: &str, with_level: bool| {
+        let png = dir.path().join(format!("{mode}-{with_level}.exr"));
+        let mut a = vec![
+            "render", obj, "--mode", mode, "--size", "16x12", "--vpls", "64",
+        ];
+        a.extend(["--spp", "1", "--out", png.to_str().expect("utf8")]);
+        if with_level {
+            a.extend(["--level", level]);
+        }
+        let o = visgate(&a);
+        assert!(o.status.success(), "{}", stderr(&o));
+        (placement(&o), std::fs::read(&png).expect("image"))
+    };
+    let (without, none_without) = render("none", false);
+    let (with, none_with) = render("none", true);
+    assert_eq!(without, with);
+    assert!(without.contains("largest empty ball"), "{without}");
+    // The same camera and light: the same image where the level is not used.
+    assert_eq!(none_without, none_with);
+    assert_eq!(render("gates", true).0, without);
+}
