@@ -344,6 +344,29 @@ impl GpuMode {
         }
     }
 
+    /// The mode a frame runs as: `gates-per-pixel` through portals or voxels is mode `gates`
+    /// with every VPL at every pixel (1 × 1 blocks: nothing blurred, no dark pixels' walks, no
+    /// roulette), whose walks run in batches where a software rasterizer's loop limit needs
+    /// them ([`walk_batch`]). Walked in the shading pass, all in one loop, it lost light on
+    /// llvmpipe (the ajar door's `main` at 4,096 VPLs: 0.01807 of mean radiance against the
+    /// reference's 0.02295) and took twice as long. Disks keep their per-pixel chains.
+    pub fn as_run(&self) -> GpuMode {
+        match *self {
+            GpuMode::GatesPerPixel(gates) if gates.shape != GateShape::Disk => {
+                GpuMode::Gates(GatesParams {
+                    gates,
+                    interleave: InterleaveParams {
+                        block: 1,
+                        ..InterleaveParams::default()
+                    },
+                    walk_roulette: WalkRoulette::Share(0.0),
+                    ..GatesParams::default()
+                })
+            }
+            mode => mode,
+        }
+    }
+
     /// The VAL clustering of the VAL modes.
     pub fn vals(&self) -> Option<ValParams> {
         match self {
@@ -445,8 +468,8 @@ impl GpuParams {
 /// camera, gates per pixel against the CPU twin: 93 % of the light at 512 VPLs, 55 % at
 /// 4,096; Crytek Sponza's gallery, 512 bake, 1,024 VPLs a pixel: 27 %; an H100 matches it to
 /// 0.03 % at every count). Mode `gates` there walks a pixel's VPLs through the portals this
-/// many a draw, through the voxels as many as the loop limit allows ([`walk_batch`]);
-/// `gates-per-pixel` (one pass, no batches) warns above it.
+/// many a draw, through the voxels as many as the loop limit allows ([`walk_batch`]), and so
+/// does `gates-per-pixel` through them ([`GpuMode::as_run`]).
 pub const SOFTWARE_WALK_BATCH: u32 = 16;
 
 /// Whether `adapter` is llvmpipe (lavapipe's rasterizer), with its loop limit.
@@ -489,25 +512,6 @@ pub fn walk_batch(adapter: &str, mode: &GpuMode, sight_steps: Option<u32>, vpls:
             }
         }
         _ => 0,
-    }
-}
-
-/// Warns (once a process) when `adapter` is llvmpipe and `mode` walks more than
-/// [`SOFTWARE_WALK_BATCH`] VPLs a pixel in one draw (`gates-per-pixel`).
-pub fn warn_software_loop_limit(adapter: &str, mode: &GpuMode, vpls: u32) {
-    static WARNED: std::sync::Once = std::sync::Once::new();
-    let walks = match mode {
-        GpuMode::GatesPerPixel(_) => mode.walks_per_pixel(vpls),
-        _ => 0,
-    };
-    if software(adapter) && walks > SOFTWARE_WALK_BATCH {
-        WARNED.call_once(|| {
-            tracing::warn!(
-                "{adapter} ends a shader's loops after 65,535 iterations in all: the portal \
-                 walks of {walks} VPLs a pixel in one pass may stop early and lose light (mode \
-                 gates walks them in batches, or use a hardware GPU)"
-            )
-        });
     }
 }
 

@@ -12,7 +12,7 @@ use super::record::{self, Recorded};
 use super::timing::Recorder;
 use super::{
     GpuContext, GpuMode, GpuParams, GpuRenderer, LcCounts, PassTimes, ValIterations, VplInput,
-    methods, passes,
+    passes,
 };
 use crate::RenderError;
 use crate::camera::View;
@@ -40,12 +40,15 @@ impl GpuRenderer {
     ) -> Result<(Option<HdrImage>, PassTimes), RenderError> {
         let t0 = Instant::now();
         self.check_frame(view, params)?;
+        let params = &GpuParams {
+            mode: params.mode.as_run(),
+            ..*params
+        };
         let vals = params.mode.vals();
         let val_count = vals.map(|v| v.count);
         let warm = vals.is_some_and(|p| p.warm_start && self.val_warm == Some(p.count));
         let mut rec = Recorder::new(ctx, &mut self.pool);
         let (vpl_buf, count) = self.frame_vpls(ctx, &vpls, &mut rec)?;
-        methods::warn_software_loop_limit(&ctx.adapter_info.name, &params.mode, count);
         let cpu = match vpls {
             VplInput::Given(v) => Some(v),
             VplInput::Rsm(_) => None,

@@ -100,10 +100,11 @@ pub struct Gathers<'a> {
 const GATES_INDIRECT_BINDINGS: [u32; 16] =
     [0, 2, 5, 6, 7, 8, 10, 12, 13, 14, 15, 16, 21, 22, 23, 31];
 /// The bindings of shade.wgsl's `cs_shade` but its output (25): all but the batches' sum, the
-/// batch index, and the VPLs' clusters and walk ends (clustered gates walk apart, in
-/// `cs_gates_indirect`; `cs_shade` gathers their disks and gates per pixel).
-const SHADE_BINDINGS: [u32; 22] = [
-    0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 17, 18, 19, 20, 22, 31,
+/// batch index, the VPLs' clusters and walk ends, the portals and the sight grid (portals and
+/// voxels walk apart, in `cs_gates_indirect`; `cs_shade` gathers the disks, per pixel or by
+/// the lists).
+const SHADE_BINDINGS: [u32; 19] = [
+    0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 17, 18, 19, 20,
 ];
 /// The bindings of shade.wgsl's `cs_vpl_clusters_indirect` but its output (25).
 const VPL_CLUSTERS_INDIRECT_BINDINGS: [u32; 6] = [0, 2, 5, 6, 19, 20];

@@ -140,21 +140,12 @@ fn gate_shape() -> u32 {
     return grid.shape;
 }
 
-// Whether VPL v's light reaches p (pixel px, cluster here) through the gates, the portals or
-// the voxels (GateLevel::visible; the voxel walk starts off p's face).
-fn lit_through(v: Vpl, px: vec2<i32>, p: vec3<f32>, here: u32) -> bool {
-    if gate_shape() == GATE_VOXELS {
-        return voxel_sight(v.position, v.normal, p, face_normal(px), sight_triangles(), sight_planes());
-    }
-    return through_gates(v.position, cluster_at(v.position, v.normal), p, here);
-}
-
+// Whether the light of a VPL at a (cluster ca) reaches b (cluster cb) through a chain of at
+// most grid.max_hops gate disks (GateLevel::visible with disks). Portals and voxels walk in
+// cs_gates_indirect, gates-per-pixel too (GpuMode::as_run).
 fn through_gates(a: vec3<f32>, ca: u32, b: vec3<f32>, cb: u32) -> bool {
     if ca == cb || ca == NONE || cb == NONE {
         return true;
-    }
-    if gate_shape() == GATE_PORTALS {
-        return portal_walk(a, ca, b, cb) == WALK_VISIBLE;
     }
     for (var i = cluster_gates[ca]; i < cluster_gates[ca + 1u]; i++) {
         let g = gates[cluster_gates[i]];
@@ -226,7 +217,7 @@ fn shade(px: vec2<i32>) -> vec4<f32> {
     if mode == SHADE_ALL {
         radiance += albedo / PI * gather_all(p, n);
     } else if mode == SHADE_GATES_PER_PIXEL {
-        radiance += albedo / PI * gather_per_pixel(px, p, n, decode_cluster(pos.w));
+        radiance += albedo / PI * gather_per_pixel(p, n, decode_cluster(pos.w));
     } else if mode == SHADE_VPL_CLUSTERS && globals.interleave_block <= 1u {
         radiance += albedo / PI * gather_vpl_clusters(p, n, px, 0u, 1u);
     } else if mode == SHADE_GATES_CLUSTERED && globals.interleave_block <= 1u && gate_shape() == GATE_DISKS {
@@ -543,13 +534,13 @@ fn gather_all(p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
     return sum;
 }
 
-// SHADE_GATES_PER_PIXEL: every VPL through the gates, brute force.
-fn gather_per_pixel(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32) -> vec3<f32> {
+// SHADE_GATES_PER_PIXEL: every VPL through the gate disks, brute force.
+fn gather_per_pixel(p: vec3<f32>, n: vec3<f32>, here: u32) -> vec3<f32> {
     var sum = vec3<f32>(0.0);
     for (var j = 0u; j < globals.vpl_count; j++) {
         let v = vpls[j];
         let l = vpl_light(v, p, n, globals.g_max);
-        if any(l > vec3<f32>(0.0)) && lit_through(v, px, p, here) {
+        if any(l > vec3<f32>(0.0)) && through_gates(v.position, cluster_at(v.position, v.normal), p, here) {
             sum += l;
         }
     }
