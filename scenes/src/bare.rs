@@ -3,9 +3,9 @@
 //! gets a point light and a camera named `inside` at the same place: the centre of the
 //! level's largest empty ball where a baked level is given (inside its largest room, where a
 //! level's light belongs), else the enclosed point farthest from the geometry found by rays;
-//! the camera looks level, the way that sees deepest into the level (of 16 horizontal
-//! directions, the one whose rays within 22.5° of it reach farthest on average), so that its
-//! first picture is not a wall a metre away. The light's intensity gives the walls around it
+//! the camera looks level, the way whose view holds the most of the level (of 64 horizontal
+//! directions, the one whose rays within its 35° half-field reach farthest by the mean of their
+//! cubes), so that its first picture is neither a wall a metre away nor a room's corner. The light's intensity gives the walls around it
 //! about 2 W/m² (`I = 2 d²` W/sr, `d` the mean distance to them). Where the mesh has materials
 //! that glow (a lamp's emissive surface, which lights nothing in visgate), the light goes to
 //! them instead: a point light a hundredth of the level's size in front of each glowing
@@ -35,22 +35,42 @@ pub fn probe_directions() -> Vec<Vec3> {
 }
 
 /// Horizontal directions the camera may look along. [Units: count]
-const LOOK_DIRECTIONS: usize = 16;
+const LOOK_DIRECTIONS: usize = 64;
 
-/// The horizontal direction from `eye` whose rays within one step of it (22.5°) reach farthest
-/// on average; `reach(p, d)` is how far the ray from `p` along `d` goes before it meets the
-/// geometry, `None` where it escapes: through a window to the void, which shows nothing of the
-/// level, so it counts as 0. Ties go to the first, +X.
+/// Of [`LOOK_DIRECTIONS`], those on either side of a view's centre that its rays span: the
+/// camera's 70° across, 35° a side. [Units: count]
+const LOOK_SPAN: usize = 6;
+
+/// The horizontal direction from `eye` whose view holds the most of the level: of 64
+/// directions, the one whose rays within 35° of it (the camera's field) reach farthest, by the
+/// mean of their cubed lengths (the volume of the view's cone) weighted by a tent over the
+/// field; `reach(p, d)` is how far the
+/// ray from `p` along `d` goes before it meets the geometry, `None` where it escapes: through a
+/// window to the void, which shows nothing of the level, so it counts as 0. Cubed, a doorway
+/// onto the next room outweighs the far corner of the camera's own room, which a plain mean
+/// over a narrower window chose (a room's corner is its farthest point from its centre: the
+/// first picture of the ajar door's bare OBJ was two walls meeting). Ties go to the first, +X.
 fn deepest_look(eye: Vec3, reach: &dyn Fn(Vec3, Vec3) -> Option<f32>) -> Vec3 {
-    let dirs: Vec<Vec3> = (0..LOOK_DIRECTIONS)
+    let n = LOOK_DIRECTIONS;
+    let dirs: Vec<Vec3> = (0..n)
         .map(|i| {
-            let a = std::f32::consts::TAU * i as f32 / LOOK_DIRECTIONS as f32;
+            let a = std::f32::consts::TAU * i as f32 / n as f32;
             Vec3::new(a.cos(), 0.0, a.sin())
         })
         .collect();
-    let far: Vec<f32> = dirs.iter().map(|&d| reach(eye, d).unwrap_or(0.0)).collect();
-    let n = LOOK_DIRECTIONS;
-    let score = |i: usize| far[(i + n - 1) % n] + far[i] + far[(i + 1) % n];
+    let volume: Vec<f32> = dirs
+        .iter()
+        .map(|&d| reach(eye, d).map_or(0.0, |t| t * t * t))
+        .collect();
+    // Weighted by a tent over the field, so that what it holds most of sits in its middle.
+    let score = |i: usize| -> f32 {
+        (0..=2 * LOOK_SPAN)
+            .map(|k| {
+                (LOOK_SPAN + 1).abs_diff(k.abs_diff(LOOK_SPAN)) as f32
+                    * volume[(i + n + k - LOOK_SPAN) % n]
+            })
+            .sum()
+    };
     let best = (0..n).fold(0, |b, i| if score(i) > score(b) { i } else { b });
     dirs[best]
 }
@@ -256,6 +276,30 @@ mod tests {
         let open = |p: Vec3, d: Vec3| if d.z < -0.9 { None } else { reach(p, d) };
         let d = deepest_look(Vec3::new(1.0, 1.5, 4.0), &open);
         assert!(d.z > 0.999, "{d}");
+    }
+
+    #[test]
+    fn from_a_rooms_centre_the_camera_looks_through_its_doorway_not_into_a_corner() {
+        // A 4 × 4 m room with a 1 m doorway in its +x wall (z 2.5–3.5) onto a second room as
+        // large: from the first room's centre the farthest walls are its corners, 2.8 m away,
+        // but the view that holds the most looks through the doorway.
+        let (room, both) = (
+            to_the_box(Vec3::ZERO, Vec3::new(4.0, 3.0, 4.0)),
+            to_the_box(Vec3::ZERO, Vec3::new(8.0, 3.0, 4.0)),
+        );
+        let reach = |p: Vec3, d: Vec3| {
+            let t = room(p, d)?;
+            let q = p + d * t;
+            let through = (q.x - 4.0).abs() < 1e-4 && (2.5..3.5).contains(&q.z);
+            if through { both(p, d) } else { Some(t) }
+        };
+        let d = deepest_look(Vec3::new(2.0, 1.5, 2.0), &reach);
+        let angle = d.z.atan2(d.x).to_degrees();
+        // The doorway spans 14°–37° from the centre; the corners lie at ±45° and ±135°.
+        assert!((10.0..=40.0).contains(&angle), "{d} ({angle}°)");
+        // Without the doorway, a corner: the room alone gives nothing better.
+        let d = deepest_look(Vec3::new(2.0, 1.5, 2.0), &room);
+        assert!((d.x.abs() - d.z.abs()).abs() < 1e-3, "{d}");
     }
 
     #[test]
