@@ -140,6 +140,13 @@ fn the_report_holds_every_table_plot_and_panel_with_the_figures_of_render_and_di
     // Stopped or not, a second run reads every render back.
     let again = stdout(&visgate(&args));
     assert!(again.contains("0 renders made, 8 read back"), "{again}");
+    // A render kept by another build of visgate is made again (its key names the build).
+    let kept = out.join("renders").join("main").join("none-16.json");
+    let text = std::fs::read_to_string(&kept).expect("kept render");
+    assert!(text.contains("|visgate "), "{text}");
+    std::fs::write(&kept, text.replace("|visgate ", "|an older visgate ")).expect("write");
+    let rebuilt = stdout(&visgate(&args));
+    assert!(rebuilt.contains("1 renders made, 7 read back"), "{rebuilt}");
     // A changed setting redoes only the renders it touches (the VAL count: val-hard).
     let mut more = args.to_vec();
     more.extend(["--vals", "8"]);

@@ -340,8 +340,10 @@ impl Store<'_> {
             .join(name);
         let path = self.dir.join(&rel);
         let key = format!(
-            "{}|{camera:?}|{job:?}|{}",
-            self.spec.scene, self.spec.level_key
+            "{}|{camera:?}|{job:?}|{}|{}",
+            self.spec.scene,
+            self.spec.level_key,
+            build_id()
         );
         let exr = |i: u32| match job.frames {
             1 => path.with_extension("exr"),
@@ -398,6 +400,29 @@ impl Store<'_> {
             adapter.clone_into(&mut self.adapter);
         }
     }
+}
+
+/// The program that renders: its version and its executable's size and modification time,
+/// so that a kept render is read back only by the build that made it (a rebuilt visgate may
+/// render a mode otherwise: `gates-per-pixel` kept 0.41 of the light on lavapipe before it
+/// walked in batches, and a second run would have read that back).
+fn build_id() -> &'static str {
+    static ID: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    ID.get_or_init(|| {
+        let exe = std::env::current_exe().and_then(std::fs::metadata);
+        let stamp = exe.map_or(String::from("?"), |m| {
+            let modified = m
+                .modified()
+                .ok()
+                .and_then(|t| t.duration_since(std::time::UNIX_EPOCH).ok());
+            format!(
+                "{} bytes, {}",
+                m.len(),
+                modified.map_or(0, |d| d.as_nanos())
+            )
+        });
+        format!("visgate {} ({stamp})", env!("CARGO_PKG_VERSION"))
+    })
 }
 
 /// A kept render's record at `path`, if it has `key`.
