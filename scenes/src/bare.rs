@@ -1,12 +1,14 @@
 //! What a bare mesh file needs to be looked at. An OBJ or glTF on its own carries no light and
 //! no camera, so every render of it is black (or refused for want of a camera). Such a scene
 //! gets a point light and a camera named `inside` at the same place: the centre of the
-//! level's largest empty ball where a baked level is given (inside its largest room, where a
-//! level's light belongs), else the enclosed point farthest from the geometry found by rays;
-//! the camera looks level, the way whose view holds the most of the level (of 64 horizontal
-//! directions, the one whose rays within its 35° half-field reach farthest by the mean of their
-//! cubes), so that its first picture is neither a wall a metre away nor a room's corner. The light's intensity gives the walls around it
-//! about 2 W/m² (`I = 2 d²` W/sr, `d` the mean distance to them). Where the mesh has materials
+//! level's largest empty ball, inside its largest room, where a level's light belongs (the
+//! caller finds it: `visgate_preprocess::ball`, from the scene alone, so that every render of
+//! it looks from one place, with a baked level or without), else the enclosed point farthest
+//! from the geometry found by rays; the camera looks level, the way whose view holds the most
+//! of the level (of 64 horizontal directions, the one whose rays within its 35° half-field
+//! reach farthest by the mean of their cubes), so that its first picture is neither a wall a
+//! metre away nor a room's corner. The light's intensity gives the walls around it about
+//! 2 W/m² (`I = 2 d²` W/sr, `d` the mean distance to them). Where the mesh has materials
 //! that glow (a lamp's emissive surface, which lights nothing in visgate), the light goes to
 //! them instead: a point light a hundredth of the level's size in front of each glowing
 //! material's surface (its area-weighted centre, off along its area-weighted normal), giving
@@ -44,12 +46,12 @@ const LOOK_SPAN: usize = 6;
 /// The horizontal direction from `eye` whose view holds the most of the level: of 64
 /// directions, the one whose rays within 35° of it (the camera's field) reach farthest, by the
 /// mean of their cubed lengths (the volume of the view's cone) weighted by a tent over the
-/// field; `reach(p, d)` is how far the
-/// ray from `p` along `d` goes before it meets the geometry, `None` where it escapes: through a
-/// window to the void, which shows nothing of the level, so it counts as 0. Cubed, a doorway
-/// onto the next room outweighs the far corner of the camera's own room, which a plain mean
-/// over a narrower window chose (a room's corner is its farthest point from its centre: the
-/// first picture of the ajar door's bare OBJ was two walls meeting). Ties go to the first, +X.
+/// field; `reach(p, d)` is how far the ray from `p` along `d` goes before it meets the
+/// geometry, `None` where it escapes: through a window to the void, which shows nothing of the
+/// level, so it counts as 0. Cubed, a doorway onto the next room outweighs the far corner of
+/// the camera's own room, which a plain mean over a narrower window chose (a room's corner is
+/// its farthest point from its centre: the first picture of the ajar door's bare OBJ was two
+/// walls meeting). Ties go to the first, +X.
 fn deepest_look(eye: Vec3, reach: &dyn Fn(Vec3, Vec3) -> Option<f32>) -> Vec3 {
     let n = LOOK_DIRECTIONS;
     let dirs: Vec<Vec3> = (0..n)

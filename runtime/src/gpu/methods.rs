@@ -349,7 +349,8 @@ impl GpuMode {
     /// roulette), whose walks run in batches where a software rasterizer's loop limit needs
     /// them ([`walk_batch`]). Walked in the shading pass, all in one loop, it lost light on
     /// llvmpipe (the ajar door's `main` at 4,096 VPLs: 0.01807 of mean radiance against the
-    /// reference's 0.02295) and took twice as long. Disks keep their per-pixel chains.
+    /// reference's 0.02295) and at 1,024 took twice as long. Disks keep their per-pixel
+    /// chains.
     pub fn as_run(&self) -> GpuMode {
         match *self {
             GpuMode::GatesPerPixel(gates) if gates.shape != GateShape::Disk => {
