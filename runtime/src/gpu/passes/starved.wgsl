@@ -30,10 +30,11 @@
 
 const NOT_STARVED: u32 = 0xffffffffu;
 
-// Whether tap q's surface agrees with p (normal n) by the blur's test (vpl.wgsl).
+// Whether tap q's surface agrees with p (normal n) by the blur's test (vpl.wgsl; the
+// G-buffer's normals are unit already, as blur.wgsl's blur_agrees reads them).
 fn blur_agrees(q: vec2<i32>, p: vec3<f32>, n: vec3<f32>) -> bool {
     let qp = textureLoad(g_position, q, 0);
-    let qn = normalize(textureLoad(g_normal, q, 0).xyz);
+    let qn = textureLoad(g_normal, q, 0).xyz;
     return blur_surfaces_agree(qp, qn, p, n, starved_params.x, starved_params.y);
 }
 
