@@ -25,19 +25,21 @@ const BALL_MEMORY_BYTES: u64 = 1 << 30;
 /// `None` where there is none (no geometry, no empty space, a grid too large); of the voxels
 /// whose ball is as large, the one nearest the centroid of the largest piece they make.
 pub fn largest_empty_ball(scene: &Scene) -> Option<(Vec3, f32)> {
-    let (input, _) = stages::load(scene).ok()?;
+    // The static triangles and their bounds (stages::load would hash them too, for nothing).
+    let triangles: Vec<[Vec3; 3]> = scene.static_triangles().collect();
+    let bounds = scene.static_bounds()?;
     let resolution = Resolution::LongestAxisVoxels(BALL_RESOLUTION);
-    let meta = grid_for(input.bounds, resolution, BALL_MEMORY_BYTES).ok()?;
-    let ((solid, _), _) = stages::voxelize(meta, &input.triangles).ok()?;
+    let meta = grid_for(bounds, resolution, BALL_MEMORY_BYTES).ok()?;
+    let ((solid, _), _) = stages::voxelize(meta, &triangles).ok()?;
     let params = BakeParams::default();
-    let empty = stages::empty(scene, &meta, &solid.solid, &input.triangles, &params, false);
+    let empty = stages::empty(scene, &meta, &solid.solid, &triangles, &params, false);
     let (es, _) = empty.ok()?;
     let (field, _) = stages::distance(&meta, &es, params.max_ball);
     // Of the kept space, the inside's: a bare mesh keeps other large spaces its faces look
     // into too (the outside between the pillared hall's side rooms, within its bounds), and
     // their balls may be larger.
     let comps = grid_components(meta.dims, |i| es.empty[i], Conn::C26);
-    let inside = most_faced(&meta, &comps, &input.triangles)?;
+    let inside = most_faced(&meta, &comps, &triangles)?;
     let ours = |i: usize| es.empty[i] && comps.label(i) == Some(inside);
     let max = (0..es.empty.len())
         .filter(|&i| ours(i))
@@ -48,7 +50,7 @@ pub fn largest_empty_ball(scene: &Scene) -> Option<(Vec3, f32)> {
     // of those as large), the voxel nearest its centroid, so that the ball sits in a room's
     // middle, not on its first voxel in grid order nor between two rooms.
     let top: Vec<usize> = (0..es.empty.len())
-        .filter(|&i| ours(i) && field.dist2[i] == max)
+        .filter(|&i| field.dist2[i] == max && ours(i))
         .collect();
     let piece = largest_piece(&meta, &top);
     let at = |i: usize| Vec3::from(meta.voxel_to_world(meta.coords(i as u32)));
@@ -72,12 +74,15 @@ fn most_faced(meta: &GridMeta, comps: &Components, triangles: &[[Vec3; 3]]) -> O
     let vs = meta.voxel_size_m;
     for t in triangles {
         let n = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
+        if n == Vec3::ZERO {
+            continue;
+        }
         let c = (t[0] + t[1] + t[2]) / 3.0;
         let label = [0.75, 1.5, 2.25].into_iter().find_map(|k| {
             let v = meta.world_to_voxel((c + n * (k * vs)).to_array())?;
             comps.label(meta.index(v))
         });
-        if let (Some(l), true) = (label, n != Vec3::ZERO) {
+        if let Some(l) = label {
             faced[l as usize] += 1;
         }
     }

@@ -61,15 +61,7 @@ fn inspect_a_builtin_as_text_and_json() {
 
 #[test]
 fn export_then_inspect_the_files_and_a_bare_mesh() {
-    let dir = tempfile::tempdir().expect("tempdir");
-    let out = dir.path().join("cb");
-    let o = visgate(&[
-        "scenes",
-        "export",
-        "cornell-box",
-        out.to_str().expect("utf8"),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let (dir, out) = exported("cornell-box");
     let o = visgate(&[
         "inspect",
         "--json",
@@ -155,10 +147,7 @@ fn size_of(v: &serde_json::Value) -> [f64; 3] {
 
 #[test]
 fn a_bare_obj_modelled_z_up_in_millimetres_is_read_as_its_flags_say() {
-    let dir = tempfile::tempdir().expect("tempdir");
-    let out = dir.path().join("tr");
-    let o = visgate(&["scenes", "export", "two-rooms", out.to_str().expect("utf8")]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let (_dir, out) = exported("two-rooms");
     // The two rooms (8.6 × 3.4 × 4.4 m outside, Y up) as a Z-up exporter in millimetres
     // writes them.
     let obj = std::fs::read_to_string(out.join("two-rooms.obj")).expect("obj");

@@ -14,6 +14,16 @@ fn two_rooms_at_64(out: &str, extra: &[&str]) -> std::process::Output {
     visgate(&args)
 }
 
+/// `visgate scenes export NAME` into a scratch folder: the folder (kept while it lives) and
+/// the exported files' folder in it.
+fn exported(name: &str) -> (tempfile::TempDir, std::path::PathBuf) {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let out = dir.path().join(name);
+    let o = visgate(&["scenes", "export", name, out.to_str().expect("utf8")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    (dir, out)
+}
+
 mod bake;
 mod inspect;
 mod render;

@@ -518,10 +518,7 @@ fn a_bare_mesh_is_looked_at_from_one_place_with_a_level_or_without() {
     // The ajar door's rooms as a bare OBJ: no light, no camera. A reference rendered without
     // a level and a gate render with one must show the same view (they differed: the level's
     // skeleton placed them, or without it a lattice of probes).
-    let dir = tempfile::tempdir().expect("tempdir");
-    let out = dir.path().join("ajar");
-    let o = visgate(&["scenes", "export", "ajar-door", out.to_str().expect("utf8")]);
-    assert!(o.status.success(), "{}", stderr(&o));
+    let (dir, out) = exported("ajar-door");
     let obj = out.join("ajar-door.obj");
     let (obj, level) = (obj.to_str().expect("utf8"), dir.path().join("a.vgate"));
     let level = level.to_str().expect("utf8");
