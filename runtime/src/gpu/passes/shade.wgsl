@@ -457,7 +457,8 @@ fn cs_gates_indirect(@builtin(global_invocation_id) id: vec3<u32>) {
 // software rasterizer, each adding to the pair's light).
 // The pairs reserved (x) and those that fit the list (w, from cs_starved_args).
 @group(0) @binding(27) var<storage, read_write> starved_count: array<atomic<u32>, 4>;
-// A pair each: xyz its light so far (f32 bits), w its pixel × 256 + its subset.
+// Two lists of the capacity each (starved.wgsl); the walks read the second, in subset order: a
+// pair each, xyz its light so far (f32 bits), w its pixel × 256 + its subset.
 @group(0) @binding(28) var<storage, read_write> starved_pairs: array<vec4<u32>>;
 
 @compute @workgroup_size(STARVED_WALKS_GROUP)
@@ -466,7 +467,8 @@ fn cs_starved_walks(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_w
     if k >= atomicLoad(&starved_count[3]) {
         return;
     }
-    let pair = starved_pairs[k];
+    let at = arrayLength(&starved_pairs) / 2u + k;
+    let pair = starved_pairs[at];
     let size = textureDimensions(g_position);
     let pixel = pair.w / 256u;
     let j = pair.w % 256u;
@@ -489,7 +491,7 @@ fn cs_starved_walks(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_w
     let cut = globals.walk_roulette * roulette_total(pos.xyz, n, j, subsets);
     let lit = walk_range(px, pos.xyz, n, decode_cluster(pos.w), walk_end_at(px, pos.xyz), first, end, subsets, cut);
     let sum = bitcast<vec3<f32>>(pair.xyz) + lit;
-    starved_pairs[k] = vec4<u32>(bitcast<vec3<u32>>(sum), pair.w);
+    starved_pairs[at] = vec4<u32>(bitcast<vec3<u32>>(sum), pair.w);
 }
 
 // The pixel that the invocation at place `frag` of the deinterleaved target shades, and its

@@ -19,15 +19,17 @@ use crate::gpu::{Frame, GpuContext};
 /// needed 1.7, e2m3's hall 6.8, Crytek Sponza's gallery at T = 64 6.4; a frame that needs more
 /// is rendered again with room, once). [Units: pairs per pixel]
 pub const FIRST_PAIRS_PER_PIXEL: u64 = 4;
-/// A pair's bytes in the list (its light and its pixel × 256 + subset).
-pub const PAIR_BYTES: u64 = 16;
+/// A pair's bytes: in the list in pixel order (its place in the other and its pixel × 256 +
+/// subset) and in the one in subset order, which the walks read (its light and its pixel × 256
+/// + subset), 16 each.
+pub const PAIR_BYTES: u64 = 32;
 /// The most pixels a frame with starved pixels may have: a pair holds its pixel × 256 + its
 /// subset in 32 bits (4,096 × 4,096).
 pub const MAX_STARVED_PIXELS: u64 = 1 << 24;
 
 /// The bindings of starved.wgsl's `cs_starved_pairs`: globals, the G-buffer's positions and
 /// normals, the starved test's constants (26), the count, pairs and runs (27–29), the first
-/// gather's indirect target (32).
+/// gather's indirect target (32), the subsets' counts (33).
 const PAIRS_BINDINGS: [u32; 3] = [0, 5, 6];
 /// The bindings of `cs_starved_walks` from the shading's resources (the walks' without the
 /// disks' lists); the batch index (24), count (27) and pairs (28) besides.
@@ -84,6 +86,8 @@ struct Buffers {
     runs: wgpu::Buffer,
     /// The walks' dispatch (30).
     args: wgpu::Buffer,
+    /// Each subset's pairs, then its first place in the pairs in subset order (33).
+    subsets: wgpu::Buffer,
     /// Each batch's index (24), strided.
     batches: wgpu::Buffer,
 }
@@ -129,15 +133,17 @@ impl Buffers {
                 12,
                 storage | wgpu::BufferUsages::INDIRECT,
             ),
+            subsets: pool.buffer(d, "starved pixels' subsets", 256 * 4, storage | copies),
             batches: pool.upload(f.ctx, "starved walk batches", &strided(&indices), uniform),
         }
     }
 }
 
-/// The bind groups of the four passes, the walks' one a batch.
+/// The bind groups of the five passes, the walks' one a batch.
 struct Groups {
     pairs: wgpu::BindGroup,
     args: wgpu::BindGroup,
+    order: wgpu::BindGroup,
     walks: Vec<wgpu::BindGroup>,
     sums: wgpu::BindGroup,
 }
@@ -171,6 +177,7 @@ impl Shade {
         let g = self.starved_groups(f, inputs, (&b, batches), walks, (&sums, indirect));
         let p = &self.starved;
         rec.enc.clear_buffer(&b.count, 0, None);
+        rec.enc.clear_buffer(&b.subsets, 0, None);
         let span = "indirect lighting: starved pixels";
         let timed = rec.begin(span);
         {
@@ -185,6 +192,9 @@ impl Shade {
             pass.set_pipeline(&p.args);
             pass.set_bind_group(0, &g.args, &[]);
             pass.dispatch_workgroups(1, 1, 1);
+            pass.set_pipeline(&p.order);
+            pass.set_bind_group(0, &g.order, &[]);
+            pass.dispatch_workgroups_indirect(&b.args, 0);
             pass.set_pipeline(walks);
             for group in &g.walks {
                 pass.set_bind_group(0, group, &[]);
@@ -231,6 +241,7 @@ impl Shade {
                     (28, whole(&b.pairs)),
                     (29, whole(&b.runs)),
                     (32, wgpu::BindingResource::TextureView(&indirect_view)),
+                    (33, whole(&b.subsets)),
                 ],
             ),
             args: group(
@@ -238,8 +249,17 @@ impl Shade {
                 &[],
                 vec![
                     (27, whole(&b.count)),
-                    (28, whole(&b.pairs)),
                     (30, whole(&b.args)),
+                    (33, whole(&b.subsets)),
+                ],
+            ),
+            order: group(
+                &p.order,
+                &[],
+                vec![
+                    (27, whole(&b.count)),
+                    (28, whole(&b.pairs)),
+                    (33, whole(&b.subsets)),
                 ],
             ),
             walks: (0..batches as usize)
@@ -270,6 +290,7 @@ impl Shade {
 pub struct StarvedPipelines {
     pairs: wgpu::ComputePipeline,
     args: wgpu::ComputePipeline,
+    order: wgpu::ComputePipeline,
     sums: wgpu::ComputePipeline,
 }
 
@@ -277,12 +298,22 @@ impl StarvedPipelines {
     /// Built from starved.wgsl.
     pub fn new(d: &wgpu::Device, s: &ShaderSources) -> Result<StarvedPipelines, RenderError> {
         let module = shaders::module(d, s, "starved.wgsl")?;
-        let [pairs, args, sums] = crate::gpu::context::compute_pipelines(
+        let [pairs, args, order, sums] = crate::gpu::context::compute_pipelines(
             d,
             &module,
-            ["cs_starved_pairs", "cs_starved_args", "cs_starved_sums"],
+            [
+                "cs_starved_pairs",
+                "cs_starved_args",
+                "cs_starved_order",
+                "cs_starved_sums",
+            ],
         );
-        Ok(StarvedPipelines { pairs, args, sums })
+        Ok(StarvedPipelines {
+            pairs,
+            args,
+            order,
+            sums,
+        })
     }
 }
 

@@ -21,12 +21,24 @@
 // again with room for x), z starved pixels, w the pairs that fit the list (cs_starved_args
 // sets it for the walks).
 @group(0) @binding(27) var<storage, read_write> starved_count: array<atomic<u32>, 4>;
-// A pair each: xyz its light so far (f32 bits), w its pixel × 256 + its subset.
+// Two lists of the list's capacity each. The first, in pixel order (a starved pixel's pairs a
+// run): x the pair's place in the second (before cs_starved_order, its rank among its
+// subset's pairs), w its pixel × 256 + its subset. The second, in subset order (the pairs of
+// subset 0, then of 1, …), which the walks read: xyz the pair's light so far (f32 bits), w as
+// the first's.
 @group(0) @binding(28) var<storage, read_write> starved_pairs: array<vec4<u32>>;
 // A pixel each: x its first pair, y its pairs (NOT_STARVED: not starved).
 @group(0) @binding(29) var<storage, read_write> starved_runs: array<vec2<u32>>;
 // cs_starved_walks' dispatch: workgroups in x, y, z.
 @group(0) @binding(30) var<storage, read_write> starved_args: array<u32, 3>;
+// A subset each: its pairs (cs_starved_pairs counts them), then the first place of its pairs in
+// the second list (cs_starved_args).
+@group(0) @binding(33) var<storage, read_write> starved_subsets: array<atomic<u32>, 256>;
+
+// The pairs a list holds.
+fn starved_capacity() -> u32 {
+    return arrayLength(&starved_pairs) / 2u;
+}
 
 const NOT_STARVED: u32 = 0xffffffffu;
 
@@ -46,7 +58,7 @@ fn blur_agrees(q: vec2<i32>, p: vec3<f32>, n: vec3<f32>) -> bool {
 // found some: the strip the blur would leave black) walks, itself, the subsets of the taps that
 // do not agree, and blur.wgsl adds them to the agreeing taps' subsets: every VPL counted once.
 //
-// Four passes, so that a starved pixel's walks spread over as many invocations as it has
+// Five passes, so that a starved pixel's walks spread over as many invocations as it has
 // subsets to walk: one invocation walking all of them (up to 63 subsets, every VPL of each)
 // held up its whole warp, and the few starved pixels' warps held up the frame (3.7–274× the
 // frame on an NVIDIA H200). cs_starved_pairs: each pixel tests its block; a starved one
@@ -55,6 +67,10 @@ fn blur_agrees(q: vec2<i32>, p: vec3<f32>, n: vec3<f32>) -> bool {
 // an invocation a pair walks its subset's VPLs (in batches on a software rasterizer, each
 // adding to the pair's light). cs_starved_sums: in pixel order, xyz a starved pixel's pairs'
 // light summed, w 1 there, 0 elsewhere (blur.wgsl reads it).
+//
+// Between the dispatch and the walks, cs_starved_order copies the pairs into subset order, so
+// that neighbouring invocations walk the same VPLs to nearby pixels (a pixel's run, in pixel
+// order, puts a different subset on each lane: every lane's walk from another VPL).
 @compute @workgroup_size(8, 8)
 fn cs_starved_pairs(@builtin(global_invocation_id) id: vec3<u32>) {
     let size = textureDimensions(g_position);
@@ -125,7 +141,7 @@ fn cs_starved_pairs(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let first = atomicAdd(&starved_count[0], missing);
-    if first + missing > arrayLength(&starved_pairs) {
+    if first + missing > starved_capacity() {
         atomicAdd(&starved_count[1], 1u);
         return;
     }
@@ -136,7 +152,8 @@ fn cs_starved_pairs(@builtin(global_invocation_id) id: vec3<u32>) {
         for (var x = block.x; x < block.z; x++) {
             if (away[t / 32u] & (1u << (t % 32u))) != 0u {
                 let j = interleave_subset(vec2<i32>(x, y), bu);
-                starved_pairs[k] = vec4<u32>(0u, 0u, 0u, pixel * 256u + j);
+                let rank = atomicAdd(&starved_subsets[j], 1u);
+                starved_pairs[k] = vec4<u32>(rank, 0u, 0u, pixel * 256u + j);
                 k += 1u;
             }
             t += 1u;
@@ -170,10 +187,16 @@ fn dark_block(block: vec4<i32>, bu: u32, size: vec2<u32>, p: vec3<f32>, n: vec3<
     return others;
 }
 
-// The walks' dispatch from the pairs that fit the list, and their count for the walks.
+// The walks' dispatch from the pairs written (those of the pixels whose runs fit the list),
+// their count for the walks, and each subset's first place in the second list.
 @compute @workgroup_size(1)
 fn cs_starved_args() {
-    let pairs = min(atomicLoad(&starved_count[0]), arrayLength(&starved_pairs));
+    var pairs = 0u;
+    for (var j = 0u; j < 256u; j++) {
+        let count = atomicLoad(&starved_subsets[j]);
+        atomicStore(&starved_subsets[j], pairs);
+        pairs += count;
+    }
     atomicStore(&starved_count[3], pairs);
     let groups = (pairs + STARVED_WALKS_GROUP - 1u) / STARVED_WALKS_GROUP;
     // At most 65,535 workgroups along an axis (WebGPU's default limit).
@@ -181,6 +204,20 @@ fn cs_starved_args() {
     starved_args[0] = x;
     starved_args[1] = select(1u, (groups + x - 1u) / x, x > 0u);
     starved_args[2] = 1u;
+}
+
+// The pairs copied into subset order (the second list), each pair of the first told its place
+// there; dispatched as the walks.
+@compute @workgroup_size(STARVED_WALKS_GROUP)
+fn cs_starved_order(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let k = id.x + id.y * groups.x * STARVED_WALKS_GROUP;
+    if k >= atomicLoad(&starved_count[3]) {
+        return;
+    }
+    let pair = starved_pairs[k];
+    let place = atomicLoad(&starved_subsets[pair.w % 256u]) + pair.x;
+    starved_pairs[starved_capacity() + place] = vec4<u32>(0u, 0u, 0u, pair.w);
+    starved_pairs[k].x = place;
 }
 
 @compute @workgroup_size(8, 8)
@@ -193,8 +230,9 @@ fn cs_starved_sums(@builtin(global_invocation_id) id: vec3<u32>) {
     var out = vec4<f32>(0.0);
     if run.y != NOT_STARVED {
         var sum = vec3<f32>(0.0);
+        let second = starved_capacity();
         for (var k = run.x; k < run.x + run.y; k++) {
-            sum += bitcast<vec3<f32>>(starved_pairs[k].xyz);
+            sum += bitcast<vec3<f32>>(starved_pairs[second + starved_pairs[k].x].xyz);
         }
         out = vec4<f32>(sum, 1.0);
     }
