@@ -60,28 +60,28 @@ fn inverse(d: vec3<f32>) -> vec3<f32> {
 }
 
 // Whether a + d·t for some t in [t0, t1] lies in the box [lo, hi], inv = inverse(d)
-// (portal_walk::segment_box).
+// (portal_walk::segment_box), the three slabs at once: on an axis d does not move along, a
+// inside the slab.
 fn segment_box(a: vec3<f32>, inv: vec3<f32>, t0: f32, t1: f32, lo: vec3<f32>, hi: vec3<f32>) -> bool {
-    var near = t0;
-    var far = t1;
-    for (var k = 0; k < 3; k++) {
-        if inv[k] == 0.0 {
-            if a[k] < lo[k] || a[k] > hi[k] {
-                return false;
-            }
-            continue;
-        }
-        let ta = (lo[k] - a[k]) * inv[k];
-        let tb = (hi[k] - a[k]) * inv[k];
-        near = max(near, min(ta, tb));
-        far = min(far, max(ta, tb));
+    let moves = inv != vec3<f32>(0.0);
+    if any(!moves & ((a < lo) | (a > hi))) {
+        return false;
     }
-    return near <= far;
+    let ta = (lo - a) * inv;
+    let tb = (hi - a) * inv;
+    let tn = select(vec3<f32>(t0), min(ta, tb), moves);
+    let tf = select(vec3<f32>(t1), max(ta, tb), moves);
+    return max(t0, max(tn.x, max(tn.y, tn.z))) <= min(t1, min(tf.x, min(tf.y, tf.z)));
 }
 
 // The portal of cluster c that a + d·t leaves it through first for t in [t0, t_end] (plane
 // crossed going out, inside the mask), other than `last`: (bits of t, portal index), index
 // NONE for none (portal_walk::GateLevel::first_exit).
+//
+// Two loops, as sight.wgsl's walks: the inner descends the boxes to the next leaf the segment
+// meets before the nearest portal found so far, the outer tests that leaf's portals. On
+// lavapipe, which runs a loop's every branch under masks, the portals' tests inside the
+// descent cost every node visited.
 fn first_exit(a: vec3<f32>, d: vec3<f32>, inv: vec3<f32>, c: u32, t0: f32, t_end: f32, last: u32) -> vec2<u32> {
     let len = length(d);
     let records = pw(1u);
@@ -94,23 +94,34 @@ fn first_exit(a: vec3<f32>, d: vec3<f32>, inv: vec3<f32>, c: u32, t0: f32, t_end
         stack[0] = root;
         top = 1u;
     }
-    while top > 0u {
-        top--;
-        let node = stack[top];
-        if !segment_box(a, inv, t0, best_t, pv(node), pv(node + 3u)) {
-            continue;
-        }
-        let first = pw(node + 6u);
-        let kind = pw(node + 7u);
-        if kind >= PORTAL_INNER {
+    loop {
+        // The next leaf: its portals' indices [first, end).
+        var leaf = false;
+        var first = 0u;
+        var end = 0u;
+        while top > 0u {
+            top--;
+            let node = stack[top];
+            if !segment_box(a, inv, t0, best_t, pv(node), pv(node + 3u)) {
+                continue;
+            }
+            let kind = pw(node + 7u);
+            first = pw(node + 6u);
+            if kind < PORTAL_INNER {
+                leaf = true;
+                end = first + kind;
+                break;
+            }
             // The nearer child last, so that it is taken first.
             let up = d[kind - PORTAL_INNER] >= 0.0;
             stack[top] = first + select(0u, PORTAL_NODE, up);
             stack[top + 1u] = first + select(PORTAL_NODE, 0u, up);
             top += 2u;
-            continue;
         }
-        for (var k = first; k < first + kind; k++) {
+        if !leaf {
+            break;
+        }
+        for (var k = first; k < end; k++) {
             let pi = pw(k);
             let r = records + pi * PORTAL_RECORD;
             let n = pv(r + 4u) * select(1.0, -1.0, pw(r + 17u) == c);
