@@ -254,88 +254,32 @@ fn sight_end(p: vec3<f32>, n: vec3<f32>, planes: bool) -> vec4<f32> {
     return best;
 }
 
-// Whether the segment a → b (voxel coordinates) crosses open voxels alone, or also closed ones
-// whose planes it meets neither of with `planes` (the words must carry them; VoxelSight::clear
-// with Closed::Blocks or Closed::Planes, step for step; sight_clear_lists is the walk with the
-// triangles, a function of its own so that a pipeline without them runs none of their code).
-//
-// Two loops: the inner marches through clear bricks and open voxels until the end or a closed
-// voxel, the outer tests that voxel's planes and goes on past it. On a CPU's SIMD lanes
-// (lavapipe) a branch runs for every lane under a mask, so a plane test inside the march cost
-// every step its price (e2m3's hall, the fast setting: the walks' pass 3.6× as long as without
-// the planes); here it runs once a closed voxel.
-fn sight_clear(a: vec3<f32>, b: vec3<f32>, planes: bool) -> bool {
+// The segment a → b (voxel coordinates) as the walks step along it: d = b − a, the axes it
+// moves along and up, 1 / d on them (0 elsewhere), the voxel holding b.
+struct SightRay {
+    a: vec3<f32>,
+    d: vec3<f32>,
+    inv: vec3<f32>,
+    end: vec3<i32>,
+    moves: vec3<bool>,
+    up: vec3<bool>,
+};
+
+fn sight_ray(a: vec3<f32>, b: vec3<f32>) -> SightRay {
     let d = b - a;
     let moves = d != vec3<f32>(0.0);
-    let up = d > vec3<f32>(0.0);
     let inv = select(vec3<f32>(0.0), 1.0 / select(vec3<f32>(1.0), d, moves), moves);
-    let end = vec3<i32>(floor(b));
-    var v = vec3<i32>(floor(a));
-    let dims = sight_dims();
-    let bricks = vec3<i32>(i32(sight_words[3]), i32(sight_words[4]), i32(sight_words[5]));
-    let clear_at = sight_words[6];
-    let most = dims.x + dims.y + dims.z + 1;
-    var step = 0;
-    loop {
-        // The march, to the end or a closed voxel (i its index, at v).
-        var closed = false;
-        var i = 0u;
-        for (; step < most; step++) {
-            if any(v < vec3<i32>(0)) || any(v >= dims) {
-                return false;
-            }
-            let brick = v / SIGHT_BRICK;
-            let k = u32(brick.x + bricks.x * (brick.y + bricks.y * brick.z));
-            let c = i32((sight_words[clear_at + k / 4u] >> (8u * (k % 4u))) & 0xffu);
-            var lo = v;
-            var hi = v;
-            if c > 0 {
-                lo = (brick - (c - 1)) * SIGHT_BRICK;
-                hi = (brick + c) * SIGHT_BRICK - 1;
-            } else {
-                i = u32(v.x + dims.x * (v.y + dims.y * v.z));
-                if ((sight_words[SIGHT_BITS + i / 32u] >> (i % 32u)) & 1u) == 0u {
-                    closed = true;
-                    break;
-                }
-            }
-            let next = sight_next(v, lo, hi, end, a, d, up, moves, inv);
-            if next.w != 0 {
-                return true;
-            }
-            v = next.xyz;
-        }
-        if !closed || !(planes && sight_planes_pass(i, v, a, d, moves, inv)) {
-            return false;
-        }
-        let next = sight_next(v, v, v, end, a, d, up, moves, inv);
-        if next.w != 0 {
-            return true;
-        }
-        v = next.xyz;
-        step++;
-    }
-    return false;
+    return SightRay(a, d, inv, vec3<i32>(floor(b)), moves, d > vec3<f32>(0.0));
 }
 
 // The walk's step from the box lo..hi of voxels (v within it) that it crossed: w 1 where the
 // box holds the end voxel or the segment ends in it, else xyz the voxel it enters.
-fn sight_next(
-    v: vec3<i32>,
-    lo: vec3<i32>,
-    hi: vec3<i32>,
-    end: vec3<i32>,
-    a: vec3<f32>,
-    d: vec3<f32>,
-    up: vec3<bool>,
-    moves: vec3<bool>,
-    inv: vec3<f32>,
-) -> vec4<i32> {
-    if all(end >= lo) && all(end <= hi) {
+fn sight_next(v: vec3<i32>, lo: vec3<i32>, hi: vec3<i32>, r: SightRay) -> vec4<i32> {
+    if all(r.end >= lo) && all(r.end <= hi) {
         return vec4<i32>(v, 1);
     }
-    let face = select(vec3<f32>(lo), vec3<f32>(hi + 1), up);
-    let t = select(vec3<f32>(3.4e38), (face - a) * inv, moves);
+    let face = select(vec3<f32>(lo), vec3<f32>(hi + 1), r.up);
+    let t = select(vec3<f32>(3.4e38), (face - r.a) * r.inv, r.moves);
     let te = min(t.x, min(t.y, t.z));
     if te >= 1.0 {
         return vec4<i32>(v, 1);
@@ -346,25 +290,90 @@ fn sight_next(
     } else if t.y <= t.z {
         across = vec3<bool>(false, true, false);
     }
-    let inside = clamp(vec3<i32>(floor(a + d * te)), lo, hi);
-    return vec4<i32>(select(inside, select(lo - 1, hi + 1, up), across), 0);
+    let inside = clamp(vec3<i32>(floor(r.a + r.d * te)), lo, hi);
+    return vec4<i32>(select(inside, select(lo - 1, hi + 1, r.up), across), 0);
+}
+
+// How sight_march ended (x of its result).
+const MARCH_CLEAR: u32 = 0u;
+const MARCH_BLOCKED: u32 = 1u;
+const MARCH_CLOSED: u32 = 2u;
+
+// The walks' march from voxel *v, a step each (*step counts them, up to `most`), through the
+// cubes of bricks that a brick's clearance proves open and through open voxels: x MARCH_CLEAR
+// where it reaches the end, MARCH_BLOCKED where it leaves the grid or runs out of steps,
+// MARCH_CLOSED at a closed voxel (*v, y its index), its step not yet counted.
+//
+// A loop of its own, the closed voxel's test after it (sight_clear, sight_clear_lists): on a
+// CPU's SIMD lanes (lavapipe) a branch runs for every lane under a mask, so a closed voxel's
+// planes or triangles tested inside the march cost every step their price (e2m3's hall, the
+// fast setting: the walks' pass 3.6× as long as with every closed voxel blocking).
+fn sight_march(r: SightRay, v: ptr<function, vec3<i32>>, step: ptr<function, u32>, most: u32) -> vec2<u32> {
+    let dims = sight_dims();
+    let bricks = vec3<i32>(i32(sight_words[3]), i32(sight_words[4]), i32(sight_words[5]));
+    let clear_at = sight_words[6];
+    for (; *step < most; *step += 1u) {
+        let at = *v;
+        if any(at < vec3<i32>(0)) || any(at >= dims) {
+            return vec2<u32>(MARCH_BLOCKED, 0u);
+        }
+        let brick = at / SIGHT_BRICK;
+        let k = u32(brick.x + bricks.x * (brick.y + bricks.y * brick.z));
+        let c = i32((sight_words[clear_at + k / 4u] >> (8u * (k % 4u))) & 0xffu);
+        var lo = at;
+        var hi = at;
+        if c > 0 {
+            lo = (brick - (c - 1)) * SIGHT_BRICK;
+            hi = (brick + c) * SIGHT_BRICK - 1;
+        } else {
+            let i = u32(at.x + dims.x * (at.y + dims.y * at.z));
+            if ((sight_words[SIGHT_BITS + i / 32u] >> (i % 32u)) & 1u) == 0u {
+                return vec2<u32>(MARCH_CLOSED, i);
+            }
+        }
+        let next = sight_next(at, lo, hi, r);
+        if next.w != 0 {
+            return vec2<u32>(MARCH_CLEAR, 0u);
+        }
+        *v = next.xyz;
+    }
+    return vec2<u32>(MARCH_BLOCKED, 0u);
+}
+
+// Whether the segment a → b (voxel coordinates) crosses open voxels alone, or also closed ones
+// whose planes it meets neither of with `planes` (the words must carry them; VoxelSight::clear
+// with Closed::Blocks or Closed::Planes, step for step; sight_clear_lists is the walk with the
+// triangles, a function of its own so that a pipeline without them runs none of their code).
+fn sight_clear(a: vec3<f32>, b: vec3<f32>, planes: bool) -> bool {
+    let r = sight_ray(a, b);
+    let dims = sight_dims();
+    let most = u32(dims.x + dims.y + dims.z + 1);
+    var v = vec3<i32>(floor(a));
+    var step = 0u;
+    loop {
+        let m = sight_march(r, &v, &step, most);
+        if m.x != MARCH_CLOSED {
+            return m.x == MARCH_CLEAR;
+        }
+        if !(planes && sight_planes_pass(m.y, v, a, r.d, r.moves, r.inv)) {
+            return false;
+        }
+        step++;
+        let next = sight_next(v, v, v, r);
+        if next.w != 0 {
+            return true;
+        }
+        v = next.xyz;
+    }
+    return false;
 }
 
 // Whether the segment a → b (voxel coordinates) crosses open voxels, or closed ones whose listed
 // triangles it misses (VoxelSight::clear with the lists, step for step; each list entry read
-// counts a step, as the twin's). As sight_clear, two loops: the inner marches to the end or a
-// closed voxel, the outer looks up that voxel's list and tests its triangles, so that a lane's
-// triangle test does not run (under a mask, on lavapipe) at every other lane's step.
+// counts a step, as the twin's). As sight_clear: the march, then the closed voxel's list.
 fn sight_clear_lists(a: vec3<f32>, b: vec3<f32>) -> bool {
-    let d = b - a;
-    let moves = d != vec3<f32>(0.0);
-    let up = d > vec3<f32>(0.0);
-    let inv = select(vec3<f32>(0.0), 1.0 / select(vec3<f32>(1.0), d, moves), moves);
-    let end = vec3<i32>(floor(b));
-    var v = vec3<i32>(floor(a));
+    let r = sight_ray(a, b);
     let dims = sight_dims();
-    let bricks = vec3<i32>(i32(sight_words[3]), i32(sight_words[4]), i32(sight_words[5]));
-    let clear_at = sight_words[6];
     let refs_at = sight_words[14];
     // List entries the walk may still read, the last list read whole, the last two triangles
     // tested (runtime::cpu::sight_triangles::WalkTests).
@@ -373,53 +382,27 @@ fn sight_clear_lists(a: vec3<f32>, b: vec3<f32>) -> bool {
     var last0 = 0xffffffffu;
     var last1 = 0xffffffffu;
     let most = u32(dims.x + dims.y + dims.z + 1) + left;
+    var v = vec3<i32>(floor(a));
     var step = 0u;
     loop {
-        // The march, to the end or a closed voxel (i its index, at v).
-        var closed = false;
-        var i = 0u;
-        for (; step < most; step++) {
-            if any(v < vec3<i32>(0)) || any(v >= dims) {
-                return false;
-            }
-            let brick = v / SIGHT_BRICK;
-            let k = u32(brick.x + bricks.x * (brick.y + bricks.y * brick.z));
-            let c = i32((sight_words[clear_at + k / 4u] >> (8u * (k % 4u))) & 0xffu);
-            var lo = v;
-            var hi = v;
-            if c > 0 {
-                lo = (brick - (c - 1)) * SIGHT_BRICK;
-                hi = (brick + c) * SIGHT_BRICK - 1;
-            } else {
-                i = u32(v.x + dims.x * (v.y + dims.y * v.z));
-                if ((sight_words[SIGHT_BITS + i / 32u] >> (i % 32u)) & 1u) == 0u {
-                    closed = true;
-                    break;
-                }
-            }
-            let next = sight_next(v, lo, hi, end, a, d, up, moves, inv);
-            if next.w != 0 {
-                return true;
-            }
-            v = next.xyz;
-        }
-        if !closed {
-            return false;
+        let m = sight_march(r, &v, &step, most);
+        if m.x != MARCH_CLOSED {
+            return m.x == MARCH_CLEAR;
         }
         // The closed voxel's lookup is a step, each entry of its list one more.
         step++;
-        let found = sight_list(i);
+        let found = sight_list(m.y);
         if found.x == 0xffffffffu || (found.x != passed && left == 0u) {
             return false;
         }
         if found.x != passed {
-            for (var r = found.y; r < found.z; r++) {
+            for (var e = found.y; e < found.z; e++) {
                 if step >= most || left == 0u {
                     return false;
                 }
                 left -= 1u;
                 step++;
-                let t = sight_extra[refs_at + r];
+                let t = sight_extra[refs_at + e];
                 if t != last0 && t != last1 {
                     last1 = last0;
                     last0 = t;
@@ -430,7 +413,7 @@ fn sight_clear_lists(a: vec3<f32>, b: vec3<f32>) -> bool {
             }
             passed = found.x;
         }
-        let next = sight_next(v, v, v, end, a, d, up, moves, inv);
+        let next = sight_next(v, v, v, r);
         if next.w != 0 {
             return true;
         }
