@@ -491,7 +491,13 @@ const SOFTWARE_LOOP_ITERATIONS: u32 = 65_535 - 256;
 /// the frame, so fewer draws are faster (e2m3's 21 cm grid: 52 walks a draw, 37 with the
 /// triangles; its hall at 512 x 512, 16,384 VPLs: indirect pass 3,466 -> 3,040 ms against 16 a
 /// draw). With the walks' roulette a draw first sums its pixel's whole subset of `vpls` (one
-/// iteration a VPL), which the voxel walks' share of the limit leaves out.
+/// iteration a VPL), which the voxel walks' share of the limit leaves out. The limit counts a
+/// SIMD vector's iterations: since the march runs in a loop of its own (sight.wgsl's
+/// `sight_march`), a closed voxel's step takes the inner loop's last iteration and one of the
+/// outer's, and lanes that reach a closed voxel wait for the others', so a vector's walk may
+/// take more iterations than its longest lane's steps; the bound here assumes every walk
+/// crosses the whole grid, where a walk takes a few dozen steps (e2m3's hall: 31 on average,
+/// the bound 2,057 on its 13 cm sight grid), and the test against the CPU twin at 4,096 VPLs a pixel checks it.
 pub fn walk_batch(adapter: &str, mode: &GpuMode, sight_steps: Option<u32>, vpls: u32) -> u32 {
     match mode {
         GpuMode::Gates(p) if p.gates.shape != GateShape::Disk && software(adapter) => {
