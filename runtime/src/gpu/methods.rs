@@ -497,7 +497,8 @@ const SOFTWARE_LOOP_ITERATIONS: u32 = 65_535 - 256;
 /// outer's, and lanes that reach a closed voxel wait for the others', so a vector's walk may
 /// take more iterations than its longest lane's steps; the bound here assumes every walk
 /// crosses the whole grid, where a walk takes a few dozen steps (e2m3's hall: 31 on average,
-/// the bound 2,057 on its 13 cm sight grid), and the test against the CPU twin at 4,096 VPLs a pixel checks it.
+/// the bound 2,057 on its 13 cm sight grid), and the test against the CPU twin at 4,096 VPLs
+/// a pixel checks it.
 pub fn walk_batch(adapter: &str, mode: &GpuMode, sight_steps: Option<u32>, vpls: u32) -> u32 {
     match mode {
         GpuMode::Gates(p) if p.gates.shape != GateShape::Disk && software(adapter) => {
