@@ -455,7 +455,7 @@ fn cs_gates_indirect(@builtin(global_invocation_id) id: vec3<u32>) {
 // Interleaved gates' second gather, the walks (starved.rs; starved.wgsl makes the pairs and
 // sums them): an invocation a (pixel, subset) pair walks its subset's VPLs (in batches on a
 // software rasterizer, each adding to the pair's light).
-// The pairs reserved (x) and those that fit the list (w, from cs_starved_args).
+// The pairs reserved (x) and those written, which the walks take (w, from cs_starved_args).
 @group(0) @binding(27) var<storage, read_write> starved_count: array<atomic<u32>, 4>;
 // Two lists of the capacity each (starved.wgsl); the walks read the second, in subset order: a
 // pair each, xyz its light so far (f32 bits), w its pixel × 256 + its subset.

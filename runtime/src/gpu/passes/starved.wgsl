@@ -18,8 +18,8 @@
 // The first gather's indirect target (deinterleaved), for w's test.
 @group(0) @binding(32) var starved_indirect: texture_2d<f32>;
 // x (pixel, subset) pairs reserved, y pixels whose pairs did not fit (the frame is rendered
-// again with room for x), z starved pixels, w the pairs that fit the list (cs_starved_args
-// sets it for the walks).
+// again with room for x), z starved pixels, w the pairs written, those of the pixels whose
+// runs fit the list (cs_starved_args sets it for the walks).
 @group(0) @binding(27) var<storage, read_write> starved_count: array<atomic<u32>, 4>;
 // Two lists of the list's capacity each. The first, in pixel order (a starved pixel's pairs a
 // run): x the pair's place in the second (before cs_starved_order, its rank among its
