@@ -137,30 +137,23 @@ fn sight_plane(w: u32) -> vec4<f32> {
 // How near a segment may come to a plane before it meets it (sight_planes::PLANE_FIT + 1e-3).
 const SIGHT_PLANE_TOL: f32 = 0.051;
 
-// Whether segment a + t d, t in [0, 1], passes closed voxel v (index i) on its planes: inside
-// the voxel it comes within the fit of neither plane's patch (sight_planes::passes). `moves` and
-// `inv` are the walk's: the axes d moves along and 1 / d on them (0 elsewhere).
-fn sight_planes_pass(
-    i: u32,
-    v: vec3<i32>,
-    a: vec3<f32>,
-    d: vec3<f32>,
-    moves: vec3<bool>,
-    inv: vec3<f32>,
-) -> bool {
+// Whether the walk's segment r (r.a + t r.d, t in [0, 1]) passes closed voxel v (index i) on
+// its planes: inside the voxel it comes within the fit of neither plane's patch
+// (sight_planes::passes).
+fn sight_planes_pass(i: u32, v: vec3<i32>, r: SightRay) -> bool {
     let words = sight_plane_words(i);
     if (words.x & 3u) == 0u {
         return false;
     }
     let c = vec3<f32>(v) + 0.5;
-    let t0 = (c - 0.5 - a) * inv;
-    let t1 = (c + 0.5 - a) * inv;
-    let tn = select(vec3<f32>(-3.4e38), min(t0, t1), moves);
-    let tf = select(vec3<f32>(3.4e38), max(t0, t1), moves);
+    let t0 = (c - 0.5 - r.a) * r.inv;
+    let t1 = (c + 0.5 - r.a) * r.inv;
+    let tn = select(vec3<f32>(-3.4e38), min(t0, t1), r.moves);
+    let tf = select(vec3<f32>(3.4e38), max(t0, t1), r.moves);
     let lo = max(max(tn.x, max(tn.y, tn.z)), 0.0);
     let hi = min(min(tf.x, min(tf.y, tf.z)), 1.0);
-    let p0 = a + d * lo - c;
-    let p1 = a + d * max(hi, lo) - c;
+    let p0 = r.a + r.d * lo - c;
+    let p1 = r.a + r.d * max(hi, lo) - c;
     return sight_plane_passed(words.x, words.y, p0, p1)
         && ((words.y & 3u) == 0u || sight_plane_passed(words.y, words.x, p0, p1));
 }
@@ -355,7 +348,7 @@ fn sight_clear(a: vec3<f32>, b: vec3<f32>, planes: bool) -> bool {
         if m.x != MARCH_CLOSED {
             return m.x == MARCH_CLEAR;
         }
-        if !(planes && sight_planes_pass(m.y, v, a, r.d, r.moves, r.inv)) {
+        if !(planes && sight_planes_pass(m.y, v, r)) {
             return false;
         }
         step++;
