@@ -58,7 +58,8 @@ def configs(visgate, out, scene):
     os.makedirs(cfg, exist_ok=True)
     if scene in SHARED:
         src = os.path.join(REPO, SHARED[scene])
-        text = open(src).read().replace("../../../shared/", os.path.join(REPO, "..", "shared") + "/")
+        shared = os.path.join(REPO, "..", "shared") + "/"
+        text = open(src).read().replace("../../../shared/", shared)
         level = os.path.join(out, f"{scene}.vgate")
         if not os.path.exists(level):
             run([visgate, "bake", SHARED[scene], "--resolution", "256", "-o", level])
@@ -96,15 +97,20 @@ def parse(report):
 
 
 def tables(rows):
-    head = "| level | light | camera | " + " | ".join(MODES) + " |\n|---|---|---|" + "---|" * len(MODES)
+    """The three Markdown tables of `rows` [(scene, light, camera, {mode: figures})]."""
+    head = ("| level | light | camera | " + " | ".join(MODES) + " |\n|---|---|---|"
+            + "---|" * len(MODES))
     mse, eb, ms = [head], [head], [head]
     for scene, light, cam, r in rows:
         best = min(r[m][1] for m in MODES if m in r and m != "per-vpl-shadow-maps")
+
+        def cells(show):
+            return " | ".join(show(r[m]) if m in r else "–" for m in MODES)
+
         pre = f"| {scene} | {light} | {cam} | "
-        cell = lambda m, f: f(r[m]) if m in r else "–"
-        mse.append(pre + " | ".join(cell(m, lambda v: f"**{v[1]:.2e}**" if v[1] == best else f"{v[1]:.2e}") for m in MODES) + " |")
-        eb.append(pre + " | ".join(cell(m, lambda v: f"{v[2]:.2f} / {v[3]}") for m in MODES) + " |")
-        ms.append(pre + " | ".join(cell(m, lambda v: f"{v[0]:.0f}") for m in MODES) + " |")
+        mse.append(pre + cells(lambda v: f"**{v[1]:.2e}**" if v[1] == best else f"{v[1]:.2e}") + " |")
+        eb.append(pre + cells(lambda v: f"{v[2]:.2f} / {v[3]}") + " |")
+        ms.append(pre + cells(lambda v: f"{v[0]:.0f}") + " |")
     return ("Indirect MSE (bold: the lowest but per-VPL maps')\n\n" + "\n".join(mse)
             + "\n\nIndirect energy / black where lit\n\n" + "\n".join(eb)
             + "\n\nFrame ms\n\n" + "\n".join(ms) + "\n")
@@ -114,12 +120,14 @@ def main():
     if len(sys.argv) < 3:
         sys.exit(__doc__)
     visgate, out = os.path.abspath(sys.argv[1]), os.path.abspath(sys.argv[2])
-    scenes = sys.argv[3:] or ["ajar-door", "pillared-hall", "stairwell", "sun-window", "e2m3", "sponza"]
+    scenes = sys.argv[3:] or ["ajar-door", "pillared-hall", "stairwell", "sun-window", "e2m3",
+                              "sponza"]
     rows = []
     for scene in scenes:
         for light, toml, level, size in configs(visgate, out, scene):
             dest = os.path.join(out, os.path.basename(toml)[:-5])
-            cmd = [visgate, "compare", toml, "--modes", ",".join(MODES), "--vpls", "1024", *size, "--out", dest]
+            cmd = [visgate, "compare", toml, "--modes", ",".join(MODES), "--vpls", "1024", *size,
+                   "--out", dest]
             run(cmd + (["--level", level] if level else []))
             for cam, r in parse(os.path.join(dest, "report.md")).items():
                 rows.append((scene, light, cam, r))
