@@ -114,7 +114,11 @@ mod tests {
         std::hint::black_box(&held);
         let peak = stage.finish().expect("Linux tells the resident set");
         assert!(peak >= 64 << 20, "{peak} bytes");
-        assert!(peak_memory_bytes().is_some_and(|p| p >= peak), "{peak}");
+        // The process's peak holds what is resident now. Not compared with the stage's sampled
+        // peak: the tests beside this one allocate and free too, and the kernel's high-water
+        // mark is kept lazily (a CI rehearsal sampled 87 MB, then read a lower VmHWM).
+        let process = peak_memory_bytes();
+        assert!(process.is_some_and(|p| p >= 64 << 20), "{process:?}");
         drop(held);
     }
 }
