@@ -18,6 +18,7 @@ or the built-in's light and the same light moved to the other room or storey (th
 the stairwell); the sun window has one (its sun). Built-ins at their default bake (128),
 320 x 240, 4 spp; the shared levels baked at 256, 320 x 180, 1 spp (the reference traces Sponza's
 262,000 triangles); 1,024 light paths each."""
+import json
 import os
 import re
 import subprocess
@@ -82,17 +83,18 @@ def configs(visgate, out, scene):
 
 
 def parse(report):
-    """{camera: {mode: (frame ms, indirect MSE, energy, black where lit)}} of a report.md."""
-    out, cam = {}, None
-    for line in open(report):
-        m = re.match(r"## Camera (\S+)", line)
-        if m:
-            cam = m.group(1)
-            out[cam] = {}
-        elif cam and line.startswith("| "):
-            c = [x.strip() for x in line.split("|")[1:-1]]
-            if c[0] in MODES and len(c) >= 12:
-                out[cam][c[0]] = (float(c[4]), float(c[7]), float(c[10]), c[11].split(" (")[0])
+    """{camera: {mode: (frame ms, indirect MSE, energy, black where lit)}} of a compare
+    report.json, black where lit as the report writes it (with the lit pixels where they are
+    under 5 % of the frame)."""
+    data = json.load(open(report))
+    out = {cam: {} for cam in data["cameras"]}
+    for r in data["rows"]:
+        if r["mode"] not in MODES:
+            continue
+        black = f"{100 * r['black_where_lit']:.1f} %"
+        if r["lit_pixels"] < 0.05 * r["pixels"]:
+            black += f" of {r['lit_pixels']} px"
+        out[r["camera"]][r["mode"]] = (r["total_ms"], r["indirect_mse"], r["energy_ratio"], black)
     return out
 
 
@@ -129,7 +131,7 @@ def main():
             cmd = [visgate, "compare", toml, "--modes", ",".join(MODES), "--vpls", "1024", *size,
                    "--out", dest]
             run(cmd + (["--level", level] if level else []))
-            for cam, r in parse(os.path.join(dest, "report.md")).items():
+            for cam, r in parse(os.path.join(dest, "report.json")).items():
                 rows.append((scene, light, cam, r))
     with open(os.path.join(out, "table.md"), "w") as f:
         f.write(tables(rows))
