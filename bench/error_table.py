@@ -27,7 +27,8 @@ import sys
 MODES = ["none", "gates", "gates-fast", "gates-portal", "gates-disk", "val-hard", "val-cssm",
          "per-vpl-shadow-maps"]
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-SHARED = {"e2m3": "scenes/shared/librequake-e2m3.toml", "sponza": "scenes/shared/crytek-sponza.toml"}
+SHARED = {"e2m3": "scenes/shared/librequake-e2m3.toml",
+          "sponza": "scenes/shared/crytek-sponza.toml"}
 # Built-ins whose second configuration moves their one light: (name, position, where).
 MOVED = {"ajar-door": ("1.2, 2.5, 0.8", "the near room"),
          "stairwell": ("6.5, 2.5, 4.5", "downstairs")}
@@ -110,7 +111,8 @@ def tables(rows):
             return " | ".join(show(r[m]) if m in r else "–" for m in MODES)
 
         pre = f"| {scene} | {light} | {cam} | "
-        mse.append(pre + cells(lambda v: f"**{v[1]:.2e}**" if v[1] == best else f"{v[1]:.2e}") + " |")
+        bold = lambda v: f"**{v[1]:.2e}**" if v[1] == best else f"{v[1]:.2e}"  # noqa: E731
+        mse.append(pre + cells(bold) + " |")
         eb.append(pre + cells(lambda v: f"{v[2]:.2f} / {v[3]}") + " |")
         ms.append(pre + cells(lambda v: f"{v[0]:.0f}") + " |")
     return ("Indirect MSE (bold: the lowest but per-VPL maps')\n\n" + "\n".join(mse)
