@@ -120,11 +120,12 @@ const STARVED: &str = "gates-starved";
 /// times the default's).
 const ACCURATE: &str = "gates-accurate";
 /// Mode gates in the balanced setting (--balanced, the default: the closed voxels' triangles,
-/// the tent blur, the dark pixels' walks), in `visgate compare`: gates itself unless --fast
+/// the tent blur, the dark pixels' walks, the near field), in `visgate compare`: gates itself unless --fast
 /// or --accurate; not in `all`.
 const BALANCED: &str = "gates-balanced";
 /// Mode gates in the fast setting (`render --fast` with the same flags: the walk with the
-/// closed voxels' planes, the box blur, no dark pixels' walks), in `visgate compare`; in `all`
+/// closed voxels' planes, the box blur, no dark pixels' walks, no near field unless
+/// --near-field), in `visgate compare`; in `all`
 /// where gates are not that already.
 const FAST: &str = "gates-fast";
 /// Mode gates with its blur filled from the next blocks (--blur-fill), in `visgate compare`.
@@ -159,8 +160,8 @@ fn named_modes(names: &[String], settings: &MethodArgs) -> Result<Vec<CompareMod
         let mut g = s.gates;
         let il = &mut g.interleave;
         match name {
-            ACCURATE => g = flagged.accurate(),
-            BALANCED => g = flagged.balanced(),
+            ACCURATE => g = settings.over_setting(flagged.accurate()),
+            BALANCED => g = settings.over_setting(flagged.balanced()),
             FAST => g = flagged,
             STARVED if il.starved_taps == 0 => il.starved_taps = il.three_quarters(),
             FILLED => il.fill = true,
@@ -318,11 +319,13 @@ mod tests {
             "--closed-voxel-triangles",
             "--blur-tent",
             "--starved-dark",
+            "--near-field",
+            "4",
         ];
         assert_eq!(g, gates_of("gates", &[&flags[..], &spelled].concat()));
         assert!(!all_with(&[]).contains(&BALANCED.to_string()));
         assert!(!gates_of(ACCURATE, &[]).interleave.starved_dark);
-        // And back: --fast, or gates-fast, undoes the three and keeps the rest.
+        // And back: --fast, or gates-fast, undoes the four and keeps the rest.
         assert_eq!(
             g.fast(),
             gates_of("gates", &[&flags[..], &["--fast"]].concat())

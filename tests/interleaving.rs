@@ -2,11 +2,13 @@
 //! b² subsets holds every direction of every light, so that a pixel's 8 × 8 block lights what
 //! every VPL lights.
 
+use visgate_formats::Scene;
 use visgate_runtime::camera::View;
 use visgate_runtime::cpu::gates::GateLevel;
 use visgate_runtime::gpu::InterleaveParams;
 use visgate_runtime::gpu::{GatesParams, GpuContext, GpuMode, GpuParams, GpuRenderer};
-use visgate_runtime::metrics::indirect_errors;
+use visgate_runtime::hdr::HdrImage;
+use visgate_runtime::metrics::{errors, indirect_errors};
 use visgate_runtime::vpl::{PathParams, Vpl, path_vpls};
 use visgate_scenes::Builtin;
 
@@ -15,10 +17,9 @@ use visgate_scenes::Builtin;
 #[path = "support/gates.rs"]
 mod gate_support;
 
-/// The pillared hall baked at 128 and its side room (lit through its door by the hall's two
-/// lights): a GPU, the level, 1,024 light paths of `seed`, the room's view at `size` and a
-/// renderer of the scene.
-struct SideRoom {
+/// A built-in baked, lit and seen: a GPU, the level, the VPLs of its lights' paths, a view and
+/// a renderer of the scene.
+struct LitView {
     ctx: GpuContext,
     gates: GateLevel,
     vpls: Vec<Vpl>,
@@ -26,29 +27,56 @@ struct SideRoom {
     gpu: GpuRenderer,
 }
 
-fn side_room(seed: u64, size: [u32; 2]) -> SideRoom {
+impl LitView {
+    /// A frame of `mode` (its level made for it).
+    fn render(&mut self, mode: GpuMode) -> HdrImage {
+        let (ctx, gpu) = (&self.ctx, &mut self.gpu);
+        gpu.level_for_mode(ctx, &self.gates, &mode).expect("level");
+        let params = GpuParams::with_mode(mode);
+        gpu.render(ctx, &self.view, &self.vpls, &params)
+            .expect("render")
+            .0
+    }
+}
+
+/// Built-in `b` baked at `res` voxels, `paths` one-bounce light paths of `seed`, its camera
+/// `camera` at `size`; and the scene.
+fn lit_view(
+    b: Builtin,
+    res: u32,
+    camera: usize,
+    (paths, seed): (u32, u64),
+    size: [u32; 2],
+) -> (LitView, Scene) {
     let ctx = GpuContext::new().unwrap_or_else(|e| panic!("GPU tests need an adapter: {e}"));
-    let (scene, gates, tracer, _, _) = gate_support::fixture(Builtin::PillaredHall, 128, 1);
+    let (scene, gates, tracer, _, _) = gate_support::fixture(b, res, camera);
     let paths = PathParams {
-        paths: 1024,
+        paths,
         bounces: 1,
         seed,
     };
     let vpls = path_vpls(&tracer, &scene.lights, &paths).expect("vpls");
-    let view = View::new(&scene.cameras[1], size).expect("view");
+    let view = View::new(&scene.cameras[camera], size).expect("view");
     let gpu = GpuRenderer::new(&ctx, &scene).expect("upload");
-    SideRoom {
+    let lit = LitView {
         ctx,
         gates,
         vpls,
         view,
         gpu,
-    }
+    };
+    (lit, scene)
+}
+
+/// The pillared hall baked at 128 and its side room (lit through its door by the hall's two
+/// lights), 1,024 light paths of `seed`, the room's view at `size`.
+fn side_room(seed: u64, size: [u32; 2]) -> LitView {
+    lit_view(Builtin::PillaredHall, 128, 1, (1024, seed), size).0
 }
 
 #[test]
 fn an_interleaved_side_room_is_lit_where_every_vpl_lights_it() {
-    let SideRoom {
+    let LitView {
         ctx,
         gates,
         vpls,
@@ -117,21 +145,10 @@ fn an_interleaved_side_room_is_lit_where_every_vpl_lights_it() {
 /// 1.000 and 1.015; 40 s on lavapipe).
 #[test]
 fn the_accurate_and_balanced_settings_light_the_side_rooms_door_jamb() {
-    let SideRoom {
-        ctx,
-        gates,
-        vpls,
-        view,
-        mut gpu,
-    } = side_room(2, [320, 240]);
+    let mut room = side_room(2, [320, 240]);
     let accurate = GatesParams::default().accurate();
     assert_eq!(accurate.interleave.starved_taps, 48);
-    let mut render = |mode: GpuMode| {
-        gpu.level_for_mode(&ctx, &gates, &mode).expect("level");
-        gpu.render(&ctx, &view, &vpls, &GpuParams::with_mode(mode))
-            .expect("render")
-            .0
-    };
+    let mut render = |mode: GpuMode| room.render(mode);
     let direct = render(GpuMode::DirectOnly);
     let mut every = accurate;
     every.interleave.block = 1;
@@ -163,4 +180,67 @@ fn the_accurate_and_balanced_settings_light_the_side_rooms_door_jamb() {
     assert!(t32.black_where_lit > 0.01, "the jamb at T = 32: {t32:?}");
     assert!(dark.black_where_lit < 0.005, "{dark:?}");
     assert!((dark.energy_ratio - 1.0).abs() < 0.05, "{dark:?}");
+}
+
+/// The near field (`GatesParams::near_field`): in the pillared hall's main view, lit by its two
+/// lights, most of the interleaving's error lies in the far end's creases beside the point
+/// light, spots that single VPLs light; walking the VPLs within the balanced setting's 4
+/// blocks' width at each pixel itself takes most of it away, against every VPL at every pixel
+/// (1,024 paths, 320 × 240; measured 5.07e-4 without, 4.60e-5 with).
+#[test]
+fn the_near_field_takes_the_creases_error_out_of_the_interleaving() {
+    let (mut lit, _) = lit_view(Builtin::PillaredHall, 128, 0, (1024, 0), [320, 240]);
+    let near = GatesParams::default().balanced();
+    assert_eq!(near.near_field, 4.0, "the balanced setting's near field");
+    let mut every = near;
+    every.interleave.block = 1;
+    let every = lit.render(GpuMode::Gates(every));
+    let direct = lit.render(GpuMode::DirectOnly);
+    let mut plain = near;
+    plain.near_field = 0.0;
+    let [plain, near] = [plain, near].map(|g| lit.render(GpuMode::Gates(g)));
+    let [e_plain, e_near] = [&plain, &near].map(|i| errors(i, &every).expect("same size"));
+    let [i_plain, i_near] =
+        [&plain, &near].map(|i| indirect_errors(i, &every, &direct).expect("same size"));
+    eprintln!(
+        "pillared hall, main: indirect MSE against every VPL at every pixel {:.3e} without the \
+         near field, {:.3e} with 4 blocks; energy {:.3} / {:.3}",
+        e_plain.mse, e_near.mse, i_plain.energy_ratio, i_near.energy_ratio
+    );
+    assert!(
+        e_near.mse < 0.25 * e_plain.mse,
+        "{e_near:?} against {e_plain:?}"
+    );
+    assert!((i_near.energy_ratio - 1.0).abs() < 0.05, "{i_near:?}");
+}
+
+/// With a near field wider than the level at every pixel (8 blocks on an 8 × 6 image of the
+/// Cornell box: its whole share reaches over 4 times each point's distance from the eye),
+/// every VPL is near: the interleaved gathers take none and each pixel walks them all itself,
+/// which is the render with every VPL at every pixel.
+#[test]
+fn a_near_field_that_holds_every_vpl_is_every_vpl_at_every_pixel() {
+    let (mut lit, scene) = lit_view(Builtin::CornellBox, 64, 0, (256, 1), [8, 6]);
+    let mut near = GatesParams::default().balanced();
+    near.near_field = 8.0;
+    let (view, vpls) = (lit.view, lit.vpls.len() as u32);
+    let scale = near.near_scale(&view, vpls);
+    let (lo, hi) = scene.bounds().expect("bounds");
+    let nearest = (lo - view.eye)
+        .max(view.eye - hi)
+        .max(glam::Vec3::ZERO)
+        .length();
+    assert!(
+        scale / 2.0 * nearest.max(0.5) > (hi - lo).length(),
+        "the near field {scale} m a metre, the box {:?} from the eye {nearest} m",
+        hi - lo
+    );
+    let mut every = near;
+    every.interleave.block = 1;
+    let every = lit.render(GpuMode::Gates(every));
+    let near = lit.render(GpuMode::Gates(near));
+    let e = errors(&near, &every).expect("same size");
+    eprintln!("near field of every VPL against every VPL at every pixel: {e:?}");
+    assert!(e.reference_mean > 0.0, "{e:?}");
+    assert!(e.rel_mse < 1e-8, "{e:?}");
 }

@@ -96,6 +96,17 @@ fn gates_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
         }
         if g.shape != GateShape::Disk {
             walk_roulette(ui, &mut s.gates.walk_roulette);
+            if il.block > 1 {
+                ui.add(
+                    egui::Slider::new(&mut s.gates.near_field, 0.0..=8.0)
+                        .text("near field (blocks)"),
+                )
+                .on_hover_text(
+                    "each pixel walks the VPLs nearer it than this many blur blocks' width \
+                     itself, unblurred: the spots that single VPLs light in the creases \
+                     beside a light, which interleaving smears; 0: off",
+                );
+            }
         }
     }
 }

@@ -143,6 +143,16 @@ gpu_struct! {
         pub walk_roulette: f32,
         /// The roulette's seed.
         pub walk_seed: u32,
+        /// Interleaved walks: the VPLs nearer a pixel than this times its distance from the
+        /// eye are left out of its subset's gather and walked at the pixel itself, unblurred
+        /// (0: none; [`crate::gpu::passes::gates_params::GatesParams::near_scale`]).
+        pub near_scale: f32,
+        /// Padding.
+        pub _pad0: u32,
+        /// Padding.
+        pub _pad1: u32,
+        /// Padding.
+        pub _pad2: u32,
     }
 }
 

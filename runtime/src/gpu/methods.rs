@@ -213,12 +213,17 @@ impl GpuMode {
     }
 
     /// The mode as it renders a frame of `vpls` VPLs: the gates' automatic roulette resolved
-    /// to the share it takes there (0: every VPL walked), so that two modes that render the
-    /// same frame compare equal (`gates` and `gates-roulette` at 8,192 VPLs or more).
+    /// to the share it takes there (0: every VPL walked), and their near field off where the
+    /// roulette is on, so that two modes that render the same frame compare equal (`gates` and
+    /// `gates-roulette` at 8,192 VPLs or more).
     pub fn resolved_for(&self, vpls: u32) -> GpuMode {
         match *self {
             GpuMode::Gates(mut p) => {
-                p.walk_roulette = WalkRoulette::Share(p.roulette_share(vpls));
+                let share = p.roulette_share(vpls);
+                p.walk_roulette = WalkRoulette::Share(share);
+                if share > 0.0 {
+                    p.near_field = 0.0;
+                }
                 GpuMode::Gates(p)
             }
             m => m,
@@ -273,6 +278,10 @@ impl GpuMode {
                 }
                 if p.interleave.starved_dark && p.interleave.block > 1 {
                     s += ", dark pixels walk the rest";
+                }
+                let walks = p.gates.shape != GateShape::Disk;
+                if p.near_field > 0.0 && p.interleave.block > 1 && walks {
+                    s += &format!(", near field {} blocks", p.near_field);
                 }
                 if p.gates.shape != GateShape::Disk {
                     match p.walk_roulette {
@@ -520,6 +529,37 @@ pub fn walk_batch(adapter: &str, mode: &GpuMode, sight_steps: Option<u32>, vpls:
             }
         }
         _ => 0,
+    }
+}
+
+/// VPLs that the near field (shade.wgsl's `cs_near_field`) tests a draw on `adapter`, a run
+/// of the VPL list (0: all in one) — on a software rasterizer as many as fit its loop limit
+/// when each is walked: a near walk is at most `radius` long (the frame's largest), so it crosses at most
+/// √3 (radius / voxel + 8) + 4 voxels of a sight grid of `voxel_m` (its ends off the surfaces
+/// up to 3.25 voxels each, a voxel's corner), twice that in iterations (a closed voxel's step
+/// takes two loops' iterations), and reads up to [`TRIANGLE_TESTS_PER_WALK`] list entries
+/// with the triangles; the pass's own loops take the margin (64 points, a mark a VPL). Portal
+/// walks take [`SOFTWARE_WALK_BATCH`] a draw.
+pub fn near_batch(adapter: &str, mode: &GpuMode, voxel_m: Option<f32>, radius: f32) -> u32 {
+    let GpuMode::Gates(p) = mode else {
+        return 0;
+    };
+    if !software(adapter) || radius <= 0.0 {
+        return 0;
+    }
+    match (p.gates.shape, voxel_m) {
+        (GateShape::Voxels, Some(edge)) if edge > 0.0 => {
+            let crossed = 3f32.sqrt() * (radius / edge + 8.0) + 4.0;
+            let steps = (2.0 * crossed).ceil().min(u32::MAX as f32 / 2.0) as u32;
+            let lists = if p.gates.triangles {
+                TRIANGLE_TESTS_PER_WALK
+            } else {
+                0
+            };
+            let spare = SOFTWARE_LOOP_ITERATIONS - 64;
+            (spare / (steps + 2 + lists)).max(1)
+        }
+        _ => SOFTWARE_WALK_BATCH,
     }
 }
 

@@ -122,6 +122,11 @@ pub struct Frame<'a> {
     /// VPLs of a pixel's subset mode gates walks a draw ([`methods::walk_batch`]; also
     /// [`Globals::walk_batch`], which the shader reads).
     pub walk_batch: u32,
+    /// The near field's radius per metre of distance from the eye ([`Globals::near_scale`]; 0:
+    /// none).
+    pub near_scale: f32,
+    /// VPLs the near field tests a draw ([`methods::near_batch`]; 0: all in one).
+    pub near_batch: u32,
     /// The starved pixels' list of (pixel, subset) pairs: its capacity.
     pub starved_pairs: u32,
 }
@@ -403,10 +408,19 @@ impl GpuRenderer {
             scene.level.as_ref().map(|l| l.sight_steps),
             vpl_count,
         );
-        let (walk_roulette, walk_seed) = match params.mode {
-            GpuMode::Gates(gp) => (gp.roulette_share(vpl_count), gp.walk_seed),
-            _ => (0.0, 0),
+        let (walk_roulette, walk_seed, near_scale) = match params.mode {
+            GpuMode::Gates(gp) => (
+                gp.roulette_share(vpl_count),
+                gp.walk_seed,
+                gp.near_scale(view, vpl_count),
+            ),
+            _ => (0.0, 0, 0.0),
         };
+        // Off where its marks (a bit a VPL for each 8 × 8 tile) would not fit a storage binding
+        // (7680 × 4320 at 8,128 VPLs): the gathers must leave out only what the pass walks.
+        let marks = passes::shade::near_marks_bytes(view.size, vpl_count);
+        let fits = marks <= ctx.device.limits().max_storage_buffer_binding_size;
+        let near_scale = if fits { near_scale } else { 0.0 };
         let globals = Globals {
             view_proj: view.view_proj(scene.near_m).to_cols_array_2d(),
             eye: view.eye.extend(1.0).to_array(),
@@ -426,6 +440,10 @@ impl GpuRenderer {
             walk_batch,
             walk_roulette,
             walk_seed,
+            near_scale,
+            _pad0: 0,
+            _pad1: 0,
+            _pad2: 0,
         };
         let level = scene.level.as_ref();
         let gates = params.mode.gates().unwrap_or_default();
@@ -456,6 +474,13 @@ impl GpuRenderer {
             vpl_count,
             vpls_cpu,
             walk_batch,
+            near_scale,
+            near_batch: methods::near_batch(
+                &ctx.adapter_info.name,
+                &params.mode,
+                scene.level.as_ref().map(|l| l.sight_voxel_m),
+                near_scale * farthest(view.eye, scene.bounds),
+            ),
             starved_pairs: self
                 .starved_pairs
                 .max(passes::starved::first_capacity(ctx, view.size)),
@@ -570,4 +595,9 @@ fn upload_level(
         }
     }
     result
+}
+
+/// The distance from `eye` to the farthest corner of box `(lo, hi)`. [Units: m]
+fn farthest(eye: glam::Vec3, (lo, hi): (glam::Vec3, glam::Vec3)) -> f32 {
+    (eye - lo).abs().max((eye - hi).abs()).length()
 }

@@ -81,7 +81,7 @@ pub(super) fn record_passes(
         vpl_ends: vpl_ends.as_ref(),
     };
     let inputs = (&shadows, &g, gathers, lc.as_ref(), vpl_lc.as_ref());
-    let hdr = p.shade.record(f, pool, rec, inputs, shading);
+    let mut hdr = p.shade.record(f, pool, rec, inputs, shading);
     let mut val_state = None;
     let mut starved = None;
     match &f.params.mode {
@@ -94,6 +94,11 @@ pub(super) fn record_passes(
                 p.shade
                     .record_starved(f, pool, rec, inputs, (gp.gates.shape, il, &indirect))
             });
+            if f.near_scale > 0.0 {
+                hdr = p
+                    .shade
+                    .record_near(f, pool, rec, inputs, (gp.gates.shape, &hdr));
+            }
             let uniform = InterleaveBlur::uniform(f, il, pool, true);
             let targets = (&g, &uniform, &indirect, &hdr);
             let sums = starved.as_ref().map(|s| &s.sums);

@@ -17,7 +17,7 @@
 use crate::RenderError;
 
 /// The include files (`gpu/shaders/`).
-const INCLUDES: [(&str, &str); 12] = [
+const INCLUDES: [(&str, &str); 13] = [
     ("globals.wgsl", include_str!("shaders/globals.wgsl")),
     ("lights.wgsl", include_str!("shaders/lights.wgsl")),
     (
@@ -29,6 +29,7 @@ const INCLUDES: [(&str, &str); 12] = [
     ("gates.wgsl", include_str!("shaders/gates.wgsl")),
     ("portals.wgsl", include_str!("shaders/portals.wgsl")),
     ("sight.wgsl", include_str!("shaders/sight.wgsl")),
+    ("walk.wgsl", include_str!("shaders/walk.wgsl")),
     ("val.wgsl", include_str!("shaders/val.wgsl")),
     ("lc.wgsl", include_str!("shaders/lc.wgsl")),
     ("pcss.wgsl", include_str!("shaders/pcss.wgsl")),

@@ -33,6 +33,52 @@ fn the_default_roulette_is_on_where_an_interleaved_pixel_walks_many_vpls() {
     assert_eq!(p.roulette_share(16_384), 0.0, "off when asked");
 }
 
+#[test]
+fn the_near_field_is_on_in_the_balanced_setting_where_the_walks_are_not_thinned() {
+    use crate::camera::View;
+    let camera = visgate_formats::scene::Camera {
+        name: "c".into(),
+        eye: glam::Vec3::ZERO,
+        target: glam::Vec3::NEG_Z,
+        up: glam::Vec3::Y,
+        fov_x_rad: 1.2,
+    };
+    let view = View::new(&camera, [320, 240]).expect("view");
+    let balanced = GatesParams::default().balanced();
+    assert_eq!(balanced.near_field, 4.0);
+    assert_eq!(GatesParams::default().near_field, 0.0, "the fast setting");
+    // 4 blocks of 8 pixels, each 2 tan(fov_x / 2) / 320 of the distance.
+    let pixel = 2.0 * (view.fov_x_rad / 2.0).tan() / 320.0;
+    let scale = balanced.near_scale(&view, 1_024);
+    assert!((scale - 32.0 * pixel).abs() < 1e-6, "{scale}");
+    assert_eq!(
+        balanced.near_scale(&view, 8_128),
+        scale,
+        "127 VPLs a subset"
+    );
+    assert_eq!(balanced.near_scale(&view, 8_192), 0.0, "the roulette on");
+    let described = |p, vpls| GpuMode::Gates(p).describe_for(vpls);
+    assert!(described(balanced, 1_024).contains("near field 4 blocks"));
+    assert!(!described(balanced, 16_384).contains("near field"));
+    let mut p = balanced;
+    p.walk_roulette = WalkRoulette::Share(0.0);
+    assert_eq!(p.near_scale(&view, 16_384), scale, "the roulette off");
+    assert_eq!(p.near_scale(&view, 40_000), 0.0, "over the marks' words");
+    p.interleave.block = 1;
+    assert_eq!(p.near_scale(&view, 1_024), 0.0, "not interleaved");
+    let mut p = balanced;
+    p.gates.shape = GateShape::Disk;
+    assert_eq!(
+        p.near_scale(&view, 1_024),
+        0.0,
+        "the paper's disks walk nothing"
+    );
+    assert_eq!(GatesParams::default().fast().near_scale(&view, 1_024), 0.0);
+    p = balanced;
+    p.near_field = 9.0;
+    assert!(p.check().is_err());
+}
+
 /// Gates with the portal walk.
 fn portals() -> GatesParams {
     let mut p = GatesParams::default();

@@ -52,6 +52,8 @@ pub struct LevelBuffers {
     pub sight_extra: wgpu::Buffer,
     /// The most steps a voxel walk takes (`VoxelSight::most_steps`).
     pub sight_steps: u32,
+    /// The sight grid's voxel edge. [Units: m]
+    pub sight_voxel_m: f32,
     /// Whether `sight_extra` holds the closed voxels' triangle lists.
     pub triangles: bool,
     /// Whether `sight_extra` holds the closed voxels' planes.
@@ -144,6 +146,7 @@ impl LevelBuffers {
                 storage,
             ),
             sight_steps: t.sight_steps,
+            sight_voxel_m: level.sight().voxel_m(),
             triangles: lists,
             planes,
         })

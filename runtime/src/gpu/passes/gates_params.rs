@@ -5,6 +5,7 @@
 use super::interleave_blur::InterleaveParams;
 use super::roulette::WalkRoulette;
 use crate::RenderError;
+use crate::camera::View;
 use crate::cpu::clustered::ClusterParams;
 use crate::cpu::gates::{GateParams, GateShape};
 use crate::gpu::shaders::WG_TILE;
@@ -36,7 +37,25 @@ pub struct GatesParams {
     /// seed and the pixel's tile (shade.wgsl's `roulette_hash`; a frame's noise is the same
     /// each time it is rendered, another seed draws other walks).
     pub walk_seed: u32,
+    /// Interleaved walks, the near field: the VPLs nearer a pixel than this many interleaving
+    /// blocks' widths (b pixels on a surface at the pixel's distance, facing the camera) are
+    /// left out of its subset's gather and walked at the pixel itself, unblurred (shade.wgsl's
+    /// `cs_near_field`). A VPL beside a crease lights the other face in a spot about as wide
+    /// as its distance, and its light changes across a block as much as the block's width is
+    /// of that distance: interleaved, one pixel in b² takes it and the blur smears it over the
+    /// block (the light's own room's corners). 0: none. [Limit: 0..=8]
+    pub near_field: f32,
 }
+
+/// The balanced and accurate settings' near field ([`GatesParams::near_field`]), in blocks:
+/// on 24 camera and light configurations (README) the indirect MSE ×0.24–1.0 of the setting's
+/// without it, for a near pass of 33–571 ms on lavapipe at 320 × 240 (the light's own room the
+/// most).
+pub const NEAR_FIELD: f32 = 4.0;
+
+/// The most VPLs the near field takes (shade.wgsl's NEAR_WORDS × 32: a workgroup marks its
+/// tile's near VPLs a bit each); above, it is off.
+pub const NEAR_MAX_VPLS: u32 = 32_768;
 
 /// Checks gate parameters against what the GPU's test does (≤ 2 hops).
 pub fn check_gates(g: &GateParams) -> Result<(), RenderError> {
@@ -66,20 +85,22 @@ impl GatesParams {
     /// The accurate setting (`--accurate`): the voxel walk (the shape as set; the default)
     /// along the true segment with the closed voxels' triangles, the tent blur, and the
     /// starved pixels walking what their block lacks where fewer than three quarters of its
-    /// taps agree with them (48 of 8 × 8; a count already set is kept). On sixteen camera-seeds (README) the indirect energy
+    /// taps agree with them (48 of 8 × 8; a count already set is kept), and the near field of
+    /// [`NEAR_FIELD`] blocks. On sixteen camera-seeds (README, before the near field) the indirect energy
     /// within 1.6 % of the reference's and under 1 % of the lit pixels black, at several
     /// times the default's frame: for stills and reference-grade walk-throughs.
     pub fn accurate(mut self) -> GatesParams {
         self.gates.triangles = true;
         self.interleave.tent = true;
+        self.near_field = NEAR_FIELD;
         if self.interleave.starved_taps == 0 {
             self.interleave.starved_taps = self.interleave.three_quarters();
         }
         self
     }
 
-    /// The balanced setting (`--balanced`): the closed voxels' triangles and the tent blur as
-    /// in [`GatesParams::accurate`], and the pixels whose agreeing taps found no light walking
+    /// The balanced setting (`--balanced`): the closed voxels' triangles, the tent blur and the
+    /// near field as in [`GatesParams::accurate`], and the pixels whose agreeing taps found no light walking
     /// what their block lacks ([`InterleaveParams::starved_dark`]) instead of every pixel with
     /// fewer than three quarters agreeing (a count already set is kept). On the same sixteen
     /// camera-seeds (README) the indirect energy within 3 % of the reference's and under 1 % of
@@ -90,17 +111,19 @@ impl GatesParams {
     pub fn balanced(mut self) -> GatesParams {
         self.gates.triangles = true;
         self.interleave.tent = true;
+        self.near_field = NEAR_FIELD;
         self.interleave.starved_dark = true;
         self
     }
 
-    /// The fast setting (`--fast`): the balanced setting's three undone — the voxel walk
-    /// passing closed voxels on their planes, the box blur, no dark pixels' walks (a
-    /// `--starved-taps` count is kept). [`GatesParams::default`] is this setting; `visgate`'s
+    /// The fast setting (`--fast`): the balanced setting's four undone — the voxel walk
+    /// passing closed voxels on their planes, the box blur, no dark pixels' walks, no near
+    /// field (a `--starved-taps` count is kept). [`GatesParams::default`] is this setting; `visgate`'s
     /// commands and viewer start from [`GatesParams::balanced`].
     pub fn fast(mut self) -> GatesParams {
         self.gates.triangles = false;
         self.interleave.tent = false;
+        self.near_field = 0.0;
         self.interleave.starved_dark = false;
         self
     }
@@ -110,6 +133,23 @@ impl GatesParams {
         let il = self.interleave;
         self.walk_roulette
             .share(vpls.div_ceil(il.subsets()), il.block)
+    }
+
+    /// The near field's radius per metre of a pixel's distance from the eye in `view`, for a
+    /// frame of `vpls` VPLs (0: none — off, no interleaving, the paper's disks, the walks'
+    /// roulette on, or over [`NEAR_MAX_VPLS`]): [`GatesParams::near_field`] blocks of b
+    /// pixels. Where the roulette thins the walks (by default from 128 VPLs a subset: 8,192
+    /// VPLs in 8 × 8 blocks) the near field is off: its walks, every near VPL at every pixel,
+    /// took e2m3's hall at 16,384 VPLs from 3.3 to 8.4 s on lavapipe at 512².
+    pub fn near_scale(&self, view: &View, vpls: u32) -> f32 {
+        let walks = self.gates.shape != GateShape::Disk;
+        let b = self.interleave.block;
+        let thinned = self.roulette_share(vpls) > 0.0;
+        if self.near_field <= 0.0 || b <= 1 || !walks || thinned || vpls > NEAR_MAX_VPLS {
+            return 0.0;
+        }
+        let pixel = 2.0 * (view.fov_x_rad / 2.0).tan() / view.size[0].max(1) as f32;
+        self.near_field * b as f32 * pixel
     }
 
     /// Whether the indirect light is gathered in a pass of its own and composed by the blur
@@ -133,6 +173,12 @@ impl GatesParams {
             )));
         }
         self.walk_roulette.check()?;
+        if !(0.0..=8.0).contains(&self.near_field) {
+            return Err(RenderError::Param(format!(
+                "the near field {} must be 0..=8 interleaving blocks (0: none)",
+                self.near_field
+            )));
+        }
         if self.light_entries == Some(0) {
             return Err(RenderError::Param(
                 "the light-entry pool (--light-entries) must hold at least 1 entry".into(),

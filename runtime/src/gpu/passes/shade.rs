@@ -29,6 +29,11 @@ pub struct Shade {
     gates_indirect: [std::sync::OnceLock<wgpu::ComputePipeline>; 5],
     /// The starved pixels' walks (`cs_starved_walks`), likewise.
     gates_starved: [std::sync::OnceLock<wgpu::ComputePipeline>; 5],
+    /// The near field's walks (`cs_near_field`), marks (`cs_near_marks`) and sums composed
+    /// (`cs_near_compose`), likewise.
+    gates_near: [std::sync::OnceLock<wgpu::ComputePipeline>; 5],
+    near_marks: [std::sync::OnceLock<wgpu::ComputePipeline>; 5],
+    near_compose: [std::sync::OnceLock<wgpu::ComputePipeline>; 5],
     /// The starved pixels' other passes (starved.rs).
     pub(super) starved: super::starved::StarvedPipelines,
     module: wgpu::ShaderModule,
@@ -99,6 +104,9 @@ pub struct Gathers<'a> {
 /// entry point uses) but its batch index (24) and its output (25).
 const GATES_INDIRECT_BINDINGS: [u32; 16] =
     [0, 2, 5, 6, 7, 8, 10, 12, 13, 14, 15, 16, 21, 22, 23, 31];
+/// The bindings of shade.wgsl's `cs_near_field` but its batch (24), marks (34) and sums (35):
+/// `cs_gates_indirect`'s but the gate disks, the light lists and the batches' sum.
+const NEAR_BINDINGS: [u32; 11] = [0, 2, 5, 6, 7, 8, 15, 16, 22, 23, 31];
 /// The bindings of shade.wgsl's `cs_shade` but its output (25): all but the batches' sum, the
 /// batch index, the VPLs' clusters and walk ends, the portals and the sight grid (portals and
 /// voxels walk apart, in `cs_gates_indirect`; `cs_shade` gathers the disks, per pixel or by
@@ -119,6 +127,9 @@ impl Shade {
             pipeline,
             gates_indirect: Default::default(),
             gates_starved: Default::default(),
+            gates_near: Default::default(),
+            near_marks: Default::default(),
+            near_compose: Default::default(),
             starved: super::starved::StarvedPipelines::new(d, s)?,
             module,
             vpl_clusters_indirect,
@@ -149,6 +160,9 @@ impl Shade {
         let (cache, entry) = match gather {
             GatesGather::Indirect => (&self.gates_indirect, "cs_gates_indirect"),
             GatesGather::Starved => (&self.gates_starved, "cs_starved_walks"),
+            GatesGather::Near => (&self.gates_near, "cs_near_field"),
+            GatesGather::NearMarks => (&self.near_marks, "cs_near_marks"),
+            GatesGather::NearCompose => (&self.near_compose, "cs_near_compose"),
         };
         let d = &f.ctx.device;
         cache[k].get_or_init(|| {
@@ -213,6 +227,100 @@ impl Shade {
             extra: None,
         };
         self.walk_batches(f, pool, rec, inputs, batched)
+    }
+
+    /// Records the near field of interleaved walks with gate shape `shape`
+    /// (`globals.near_scale` > 0): each tile's VPLs within its pixels' radius marked, each
+    /// pixel's light from the VPLs within its radius walked there and summed (a run of
+    /// `f.near_batch` VPLs a dispatch on a software rasterizer: `walk_batch_index` the batch,
+    /// its first VPL, its end), then added onto `hdr` (the image so far) into a target of its
+    /// own, which it returns.
+    pub fn record_near(
+        &self,
+        f: &Frame,
+        pool: &mut Pool,
+        rec: &mut Recorder,
+        inputs: Inputs,
+        (shape, hdr): (GateShape, &wgpu::Texture),
+    ) -> wgpu::Texture {
+        let n = f.vpl_count;
+        let [w, h] = f.view.size;
+        let d = &f.ctx.device;
+        let storage = wgpu::BufferUsages::STORAGE;
+        let marks_bytes = near_marks_bytes(f.view.size, n);
+        let marks = pool.buffer(d, "near VPLs' marks", marks_bytes, storage);
+        let sums_bytes = u64::from(w) * u64::from(h) * 16;
+        let sums = pool.buffer(
+            d,
+            "near VPLs' light",
+            sums_bytes,
+            storage | wgpu::BufferUsages::COPY_DST,
+        );
+        rec.enc.clear_buffer(&sums, 0, None);
+        let run = match f.near_batch {
+            0 => n.max(1),
+            b => b,
+        };
+        let indices: Vec<[u32; 4]> = (0..n.div_ceil(run).max(1))
+            .map(|i| [i, i * run, ((i + 1) * run).min(n), 0])
+            .collect();
+        let index_buf = pool.upload(
+            f.ctx,
+            "near batch indices",
+            &strided(&indices),
+            wgpu::BufferUsages::UNIFORM,
+        );
+        let views = Views::new(f, inputs);
+        let before = hdr.create_view(&Default::default());
+        let out = frame_target(f, pool, "hdr (near VPLs)");
+        let target = out.create_view(&Default::default());
+        let group = |gather, used: &[u32], extra: Vec<(u32, wgpu::BindingResource)>| {
+            let pipeline = self.gates_pipeline(f, gather, shape);
+            let earlier = used.contains(&21).then_some(&before);
+            let mut resources = views.resources(f, inputs, earlier, Some(used));
+            resources.extend(extra);
+            let layout = pipeline.get_bind_group_layout(0);
+            (pipeline, bind_group(d, &layout, "near VPLs", resources))
+        };
+        let marks_at = (34, marks.as_entire_binding());
+        let sums_at = || (35, sums.as_entire_binding());
+        let (mark, marking) = group(GatesGather::NearMarks, &[0, 2, 5], vec![marks_at.clone()]);
+        let walking: Vec<wgpu::BindGroup> = (0..indices.len())
+            .map(|i| {
+                let index = (24, slice(&index_buf, (i * UNIFORM_STRIDE) as u64, 16));
+                let extra = vec![index, marks_at.clone(), sums_at()];
+                group(GatesGather::Near, &NEAR_BINDINGS, extra).1
+            })
+            .collect();
+        let walk = self.gates_pipeline(f, GatesGather::Near, shape);
+        let out_at = (25, wgpu::BindingResource::TextureView(&target));
+        let (compose, composing) = group(
+            GatesGather::NearCompose,
+            &[5, 7, 21],
+            vec![out_at, sums_at()],
+        );
+        let name = "indirect lighting: near VPLs";
+        let span = rec.begin(name);
+        {
+            let mut pass = rec.enc.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(name),
+                timestamp_writes: span.compute(),
+            });
+            let tiles = [w.div_ceil(8), h.div_ceil(8)];
+            pass.set_pipeline(mark);
+            pass.set_bind_group(0, &marking, &[]);
+            pass.dispatch_workgroups(tiles[0], tiles[1], 1);
+            pass.set_pipeline(walk);
+            for g in &walking {
+                pass.set_bind_group(0, g, &[]);
+                pass.dispatch_workgroups(tiles[0], tiles[1], 1);
+            }
+            pass.set_pipeline(compose);
+            pass.set_bind_group(0, &composing, &[]);
+            pass.dispatch_workgroups(tiles[0], tiles[1], 1);
+        }
+        rec.end();
+        out
     }
 
     /// A pass of shade.wgsl with `pipeline` (and the bindings it uses but its output, all if
@@ -315,6 +423,19 @@ pub(super) enum GatesGather {
     Indirect,
     /// `cs_starved_walks`: the starved pixels' walks of what their block lacks.
     Starved,
+    /// `cs_near_field`: each pixel's walks of the VPLs near it.
+    Near,
+    /// `cs_near_marks`: each tile's near VPLs marked.
+    NearMarks,
+    /// `cs_near_compose`: the near light added onto the image.
+    NearCompose,
+}
+
+/// The bytes of the near field's marks for a frame of `size` pixels and `vpls` VPLs: a bit a
+/// VPL for each 8 × 8 tile, in words.
+pub fn near_marks_bytes([w, h]: [u32; 2], vpls: u32) -> u64 {
+    let tiles = u64::from(w.div_ceil(8)) * u64::from(h.div_ceil(8));
+    tiles * u64::from(vpls.div_ceil(32)) * 4
 }
 
 /// The dispatches a gather of up to `walks` walks a pixel takes: batches of `f.walk_batch`

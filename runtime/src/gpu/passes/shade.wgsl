@@ -1,4 +1,4 @@
-//! include: globals.wgsl lights.wgsl shadow_lookup.wgsl vpl.wgsl gates.wgsl portals.wgsl sight.wgsl
+//! include: globals.wgsl lights.wgsl shadow_lookup.wgsl vpl.wgsl gates.wgsl portals.wgsl sight.wgsl walk.wgsl
 // Deferred shading: direct light from point and spot lights with shadow-map PCF (3 × 3, a contact
 // test at thin walls' joins: shadow_lookup.wgsl), and
 // the indirect sum over VPLs without visibility (SHADE_ALL), through the gates of a baked
@@ -90,54 +90,6 @@ fn direct_visibility(i: u32, l: Light, p: vec3<f32>, n: vec3<f32>, nf: vec3<f32>
         return textureLoad(lc_visibility, px, i32(c / 4u), 0)[c % 4u];
     }
     return shadow(l, p, n, nf);
-}
-
-// The face's own normal at pixel px (the G-buffer's encode_face_normal).
-fn face_normal(px: vec2<i32>) -> vec3<f32> {
-    let e = vec2<f32>(textureLoad(g_normal, px, 0).w, textureLoad(g_albedo, px, 0).w);
-    return decode_face_normal(e);
-}
-
-// The gate shape: fixed when a pipeline is made (the interleaved indirect pass has one per
-// shape, runtime::gpu::passes::shade), or GATE_SHAPE_AT_RUNTIME: the level's. llvmpipe runs
-// both sides of a branch on a value read at run time, under masks: with the shape read from
-// the level every VPL's voxel walk also ran the portal walk's code (LibreQuake e2m3's hall,
-// 512 x 512, 4,096 VPLs: indirect pass 1,363 -> 818 ms; with no walk at all, 632 -> 167 ms).
-override GATE_SHAPE: u32 = 3u;
-const GATE_SHAPE_AT_RUNTIME: u32 = 3u;
-
-// The voxel walk along the true segment with the closed voxels' triangles (1) or between ends
-// off the surfaces, closed voxels blocking (0): fixed with the interleaved pass's pipeline, or
-// SIGHT_TRIANGLES_AT_RUNTIME: the frame's (grid.triangles).
-override SIGHT_TRIANGLES: u32 = 2u;
-const SIGHT_TRIANGLES_AT_RUNTIME: u32 = 2u;
-
-fn sight_triangles() -> bool {
-    if SIGHT_TRIANGLES != SIGHT_TRIANGLES_AT_RUNTIME {
-        return SIGHT_TRIANGLES == 1u;
-    }
-    return grid.triangles != 0u;
-}
-
-// The voxel walk between ends off the surfaces passes closed voxels on their planes (1) or not
-// (0): fixed with the interleaved pass's pipeline, so that a walk without them runs none of
-// their code (it cost that walk 10-20 % of its pass on an H200), or SIGHT_PLANES_AT_RUNTIME:
-// the frame's grid.planes. The renderer uploads the planes for it.
-override SIGHT_PLANES: u32 = 2u;
-const SIGHT_PLANES_AT_RUNTIME: u32 = 2u;
-
-fn sight_planes() -> bool {
-    if SIGHT_PLANES != SIGHT_PLANES_AT_RUNTIME {
-        return SIGHT_PLANES == 1u && !sight_triangles();
-    }
-    return grid.planes != 0u && !sight_triangles();
-}
-
-fn gate_shape() -> u32 {
-    if GATE_SHAPE != GATE_SHAPE_AT_RUNTIME {
-        return GATE_SHAPE;
-    }
-    return grid.shape;
 }
 
 // Whether the light of a VPL at a (cluster ca) reaches b (cluster cb) through a chain of at
@@ -294,106 +246,6 @@ fn portal_gather(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, j: u32, s
     return vec4<f32>(lit * f32(subsets), total);
 }
 
-// The walks' Russian roulette (globals.walk_roulette = s > 0) at p: the unshadowed light of
-// the whole of subset j (of `subsets`) there, summed over its channels; a VPL under s times
-// it is walked by chance (walk_range). Summed once, in a pixel's first batch, so that the cut
-// does not depend on the batching (summed in every batch, it cost e2m3's hall 1.2 s of 3.7 at
-// 16,384 VPLs on lavapipe). 0 when off.
-fn roulette_total(p: vec3<f32>, n: vec3<f32>, j: u32, subsets: u32) -> f32 {
-    if globals.walk_roulette <= 0.0 {
-        return 0.0;
-    }
-    var total = 0.0;
-    for (var k = j; k < globals.vpl_count; k += subsets) {
-        let l = vpl_light(vpls[k], p, n, globals.g_max);
-        total += l.x + l.y + l.z;
-    }
-    return total;
-}
-
-// The roulette's numbers for pixel px: a hash (PCG, O'Neill) of the seed and the pixel's
-// 8 × 8 tile of the deinterleaved target (8 b × 8 b pixels), which roulette_unit shifts a Weyl
-// sequence by. The tile's lanes (a workgroup) walk or skip a VPL together, for a GPU's warps,
-// where one lane's walk holds up the others (on lavapipe's 8 lanes it changed nothing). The
-// blur averages pixels of 64 tiles.
-fn roulette_hash(px: vec2<i32>) -> u32 {
-    let t = px / i32(8u * max(globals.interleave_block, 1u));
-    var h = (u32(t.x) * 73856093u) ^ (u32(t.y) * 19349663u) ^ globals.walk_seed;
-    for (var r = 0; r < 2; r++) {
-        let state = h * 747796405u + 2891336453u;
-        let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
-        h = (word >> 22u) ^ word;
-    }
-    return h;
-}
-
-// A uniform number in [0, 1) for VPL k at a pixel whose roulette_hash is h: the Weyl sequence
-// k times the golden ratio, mod 1, shifted by h. Each VPL's number is uniform; a pixel's VPLs'
-// numbers spread evenly over [0, 1), so the weak VPLs it walks number about what they should.
-fn roulette_unit(h: u32, k: u32) -> f32 {
-    return f32((k * 2654435769u + h) >> 8u) * (1.0 / 16777216.0);
-}
-
-// The voxel walk's end at p (off its face, or a hair off it along the true segment; w = 0:
-// no open voxel near), the same for every VPL; unused by the portal walk.
-fn walk_end_at(px: vec2<i32>, p: vec3<f32>) -> vec4<f32> {
-    var at_p = vec4<f32>(0.0);
-    if gate_shape() == GATE_VOXELS {
-        let n_face = face_normal(px);
-        at_p = sight_end(p, n_face, sight_planes());
-        if sight_triangles() {
-            at_p = vec4<f32>(sight_true_end(p, n_face), at_p.w);
-        }
-    }
-    return at_p;
-}
-
-// The light at pixel px's p (normal n, cluster `here`, walk end at_p) of VPLs first,
-// first + step, … below end, each that the walk finds visible; a VPL whose light sums under
-// `cut` (the roulette's share of roulette_total; 0: none) is walked with probability (its
-// light / cut) and counts 1 / that probability.
-fn walk_range(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, at_p: vec4<f32>, first: u32, end: u32, step: u32, cut: f32) -> vec3<f32> {
-    var sum = vec3<f32>(0.0);
-    let triangles = sight_triangles();
-    let planes = sight_planes();
-    let h = roulette_hash(px);
-    for (var k = first; k < end; k += step) {
-        let v = vpls[k];
-        var l = vpl_light(v, p, n, globals.g_max);
-        if all(l == vec3<f32>(0.0)) {
-            continue;
-        }
-        let y = l.x + l.y + l.z;
-        if y < cut {
-            let keep = y / cut;
-            if roulette_unit(h, k) >= keep {
-                continue;
-            }
-            l /= keep;
-        }
-        if gate_shape() == GATE_VOXELS {
-            let at_v = vpl_ends[k];
-            // Either end where the bake knows nothing: unoccluded.
-            let known = at_v.w != 0.0 && at_p.w != 0.0;
-            if known && triangles
-                && !sight_clear_lists(sight_true_end(v.position, v.normal), at_p.xyz) {
-                continue;
-            }
-            if known && !triangles && !sight_clear(at_v.xyz, at_p.xyz, planes) {
-                continue;
-            }
-        } else {
-            let ca = vpl_cluster[k];
-            if ca != NONE && here != NONE && ca != here
-                && portal_walk(v.position, ca, p, here) != WALK_VISIBLE {
-                continue;
-            }
-        }
-        sum += l;
-    }
-    return sum;
-}
-
 // The first entry of [first, end) whose VPL is in subset j or later (VPL mod B >= j).
 fn subset_start(first: u32, end: u32, subsets: u32, j: u32) -> u32 {
     var lo = first;
@@ -547,4 +399,137 @@ fn gather_per_pixel(p: vec3<f32>, n: vec3<f32>, here: u32) -> vec3<f32> {
         }
     }
     return sum;
+}
+
+// The near field (globals.near_scale > 0; GatesParams::near_scale): each pixel walks the VPLs
+// nearer it than near_radius itself — every one, not its subset's — and adds their light
+// (× albedo / π, × near_share) onto the image so far, unblurred; walk_range takes the rest of
+// their light in the interleaved gathers. A VPL beside a crease lights the other face in a spot about as wide as
+// its distance: interleaved, one pixel in b² takes it and the blur spreads it over the block
+// (the light's own room's creases held most of the interleaving's error).
+//
+// Three entry points: cs_near_marks, once, a workgroup an 8 × 8 tile of pixels, marks in
+// near_tiles the VPLs within the tile's largest radius of the box of its surface points (a bit
+// each, NEAR_WORDS words: at most 32,768 VPLs); cs_near_field, in pixel order, tests the
+// marked ones in VPL order, walks those within its own radius and adds their light to
+// near_sums; cs_near_compose adds near_sums (× albedo / π) onto the image so far
+// (earlier_batches). A dispatch of cs_near_field takes the VPLs walk_batch_index.y up to .z
+// (all of them but on a software rasterizer: its loop limit), and a pixel whose tile marked
+// none of them returns at once, so that a batch costs what it walks; the marks apart, so that
+// a batch has no barrier (lavapipe runs a workgroup's barriers as coroutine switches).
+const NEAR_WORDS: u32 = 1024u;
+// The marks: each tile's ⌈VPLs / 32⌉ words, tile after tile in rows of ⌈width / 8⌉.
+@group(0) @binding(34) var<storage, read_write> near_tiles: array<u32>;
+// Each pixel's near light so far (xyz), in rows of the frame's width.
+@group(0) @binding(35) var<storage, read_write> near_sums: array<vec4<f32>>;
+var<workgroup> near_lo: array<vec4<f32>, 64>;
+var<workgroup> near_hi: array<vec4<f32>, 64>;
+var<workgroup> near_marks: array<atomic<u32>, NEAR_WORDS>;
+
+@compute @workgroup_size(8, 8)
+fn cs_near_marks(
+    @builtin(global_invocation_id) id: vec3<u32>,
+    @builtin(local_invocation_index) li: u32,
+    @builtin(workgroup_id) tile: vec3<u32>,
+) {
+    let size = textureDimensions(g_position);
+    let inside = all(id.xy < size);
+    let pos = textureLoad(g_position, vec2<i32>(min(id.xy, size - 1u)), 0);
+    // The box's corners (w: the radius), reduced over the tile.
+    let point = inside && pos.w != 0.0;
+    near_lo[li] = select(vec4<f32>(3.4e38, 3.4e38, 3.4e38, 0.0), vec4<f32>(pos.xyz, 0.0), point);
+    near_hi[li] = select(vec4<f32>(-3.4e38, -3.4e38, -3.4e38, 0.0), vec4<f32>(pos.xyz, near_radius(pos.xyz)), point);
+    let words = (globals.vpl_count + 31u) / 32u;
+    for (var w = li; w < words; w += 64u) {
+        atomicStore(&near_marks[w], 0u);
+    }
+    for (var half = 32u; half > 0u; half /= 2u) {
+        workgroupBarrier();
+        if li < half {
+            near_lo[li] = min(near_lo[li], near_lo[li + half]);
+            near_hi[li] = max(near_hi[li], near_hi[li + half]);
+        }
+    }
+    workgroupBarrier();
+    let lo = near_lo[0].xyz;
+    let hi = near_hi[0];
+    // A hair wider than the pixels' own test, so that rounding never drops one of theirs.
+    let r2 = hi.w * hi.w * 1.01;
+    for (var k = li; k < globals.vpl_count; k += 64u) {
+        let v = vpls[k].position;
+        let c = clamp(v, lo, hi.xyz);
+        if dot(v - c, v - c) <= r2 {
+            atomicOr(&near_marks[k / 32u], 1u << (k % 32u));
+        }
+    }
+    workgroupBarrier();
+    let at = (tile.x + tile.y * ((size.x + 7u) / 8u)) * words;
+    for (var w = li; w < words; w += 64u) {
+        near_tiles[at + w] = atomicLoad(&near_marks[w]);
+    }
+}
+
+@compute @workgroup_size(8, 8)
+fn cs_near_field(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = textureDimensions(g_position);
+    if any(id.xy >= size) {
+        return;
+    }
+    let all_words = (globals.vpl_count + 31u) / 32u;
+    let at = (id.x / 8u + (id.y / 8u) * ((size.x + 7u) / 8u)) * all_words;
+    let first = walk_batch_index.y;
+    let end = min(walk_batch_index.z, globals.vpl_count);
+    // This batch's words (a software rasterizer's runs need not start on a word: the bits
+    // outside them skipped below).
+    let words = vec2<u32>(first / 32u, (end + 31u) / 32u);
+    var marked = 0u;
+    for (var w = words.x; w < words.y; w++) {
+        marked |= near_tiles[at + w];
+    }
+    let px = vec2<i32>(id.xy);
+    let pos = textureLoad(g_position, px, 0);
+    if pos.w == 0.0 || marked == 0u {
+        return;
+    }
+    let p = pos.xyz;
+    let n = normalize(textureLoad(g_normal, px, 0).xyz);
+    let here = decode_cluster(pos.w);
+    let at_p = walk_end_at(px, p);
+    let r = near_radius(p);
+    var sum = vec3<f32>(0.0);
+    for (var w = words.x; w < words.y; w++) {
+        var bits = near_tiles[at + w];
+        while bits != 0u {
+            let k = w * 32u + firstTrailingBit(bits);
+            bits &= bits - 1u;
+            if k < first || k >= end {
+                continue;
+            }
+            let v = vpls[k];
+            let to_v = v.position - p;
+            let near = near_share(dot(to_v, to_v), r);
+            if near <= 0.0 {
+                continue;
+            }
+            let l = vpl_light(v, p, n, globals.g_max) * near;
+            if any(l != vec3<f32>(0.0)) && walk_visible(k, v, p, here, at_p) {
+                sum += l;
+            }
+        }
+    }
+    let i = id.x + id.y * size.x;
+    near_sums[i] = vec4<f32>(near_sums[i].xyz + sum, 0.0);
+}
+
+@compute @workgroup_size(8, 8)
+fn cs_near_compose(@builtin(global_invocation_id) id: vec3<u32>) {
+    let size = textureDimensions(g_position);
+    if any(id.xy >= size) {
+        return;
+    }
+    let px = vec2<i32>(id.xy);
+    let before = textureLoad(earlier_batches, px, 0);
+    let albedo = textureLoad(g_albedo, px, 0).xyz;
+    let sum = near_sums[id.x + id.y * size.x].xyz;
+    textureStore(out_image, id.xy, vec4<f32>(before.xyz + albedo / PI * sum, before.w));
 }

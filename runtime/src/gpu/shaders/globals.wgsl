@@ -22,4 +22,10 @@ struct Globals {
     // Portals and voxels: Russian roulette on the walks, a share of a pixel's light (0: off).
     walk_roulette: f32,
     walk_seed: u32,
+    // Interleaved walks: the VPLs nearer a pixel than this times its distance from the eye are
+    // walked at the pixel itself (shade.wgsl's cs_near_field), not in its subset (0: none).
+    near_scale: f32,
+    pad0: u32,
+    pad1: u32,
+    pad2: u32,
 };
