@@ -51,6 +51,9 @@ pub struct SavedView {
     /// The gates' walk roulette, `auto` or a share (absent in older files: the run's own).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub walk_roulette: Option<String>,
+    /// The gates' near field, in blur blocks (absent in older files: the run's own).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub near_field: Option<f32>,
 }
 
 impl SavedView {
@@ -146,6 +149,7 @@ mod tests {
             voxels: false,
             vals_layer: mode == "val-ism",
             walk_roulette: (mode == "gates").then(|| "0.1".into()),
+            near_field: (mode == "gates").then_some(2.0),
         };
         save_to(&p, "a", state("gates"));
         save_to(&p, "b", state("val-cssm"));
@@ -181,6 +185,12 @@ mod tests {
             .remove("walk_roulette");
         let older: SavedView = serde_json::from_value(json).expect("an older state");
         assert_eq!(older.walk_roulette, None);
+        // The near field likewise.
+        assert_eq!(all["a"].near_field, Some(2.0));
+        let mut json: serde_json::Value = serde_json::to_value(state("gates")).expect("json");
+        json.as_object_mut().expect("object").remove("near_field");
+        let older: SavedView = serde_json::from_value(json).expect("an older state");
+        assert_eq!(older.near_field, None);
         // A file from before the shape was named: disks and voxels as chosen, else today's
         // default.
         let old = |disks: bool, voxels: bool| SavedView {

@@ -44,6 +44,7 @@ impl ViewerApp {
             voxels: false,
             vals_layer: l.vals,
             walk_roulette: Some(self.settings.gates.walk_roulette.to_string()),
+            near_field: Some(self.settings.gates.near_field),
         }
     }
 
@@ -74,6 +75,10 @@ impl ViewerApp {
         // A share this build refuses (a file edited by hand) keeps the run's own.
         if let Some(r) = s.walk_roulette.as_deref().and_then(|t| t.parse().ok()) {
             self.settings.gates.walk_roulette = r;
+        }
+        // Likewise a near field out of its limits.
+        if let Some(k) = s.near_field.filter(|k| (0.0..=8.0).contains(k)) {
+            self.settings.gates.near_field = k;
         }
     }
 
