@@ -8,7 +8,7 @@ use visgate_runtime::cpu::gates::GateShape;
 use visgate_runtime::gpu::{
     AUTO_ROULETTE_BLOCK, AUTO_ROULETTE_SHARE, AUTO_ROULETTE_VPLS, DirectLight, DiskLight,
     GatesParams, InterleaveParams, IsmParams, LcDisk, LightClusterGpuParams, MethodSettings,
-    PassTimes, WalkRoulette,
+    NEAR_FIELD_MAX, PassTimes, WalkRoulette,
 };
 
 use super::camera::FlyCamera;
@@ -98,7 +98,7 @@ fn gates_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
             walk_roulette(ui, &mut s.gates.walk_roulette);
             if il.block > 1 {
                 ui.add(
-                    egui::Slider::new(&mut s.gates.near_field, 0.0..=8.0)
+                    egui::Slider::new(&mut s.gates.near_field, 0.0..=NEAR_FIELD_MAX)
                         .text("near field (blocks)"),
                 )
                 .on_hover_text(

@@ -538,8 +538,8 @@ pub fn walk_batch(adapter: &str, mode: &GpuMode, sight_steps: Option<u32>, vpls:
 /// √3 (radius / voxel + 8) + 4 voxels of a sight grid of `voxel_m` (its ends off the surfaces
 /// up to 3.25 voxels each, a voxel's corner), twice that in iterations (a closed voxel's step
 /// takes two loops' iterations), and reads up to [`TRIANGLE_TESTS_PER_WALK`] list entries
-/// with the triangles; the pass's own loops take the margin (64 points, a mark a VPL). Portal
-/// walks take [`SOFTWARE_WALK_BATCH`] a draw.
+/// with the triangles; the pass's own loops (the run's marks read twice, a mark a VPL) take
+/// the rest of the margin. Portal walks take [`SOFTWARE_WALK_BATCH`] a draw.
 pub fn near_batch(adapter: &str, mode: &GpuMode, voxel_m: Option<f32>, radius: f32) -> u32 {
     let GpuMode::Gates(p) = mode else {
         return 0;

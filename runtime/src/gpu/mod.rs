@@ -86,6 +86,7 @@ pub use passes::clustered_gates::{
     WalkRoulette,
 };
 pub use passes::display::{DISPLAY_FORMAT, read_display};
+pub use passes::gates_params::NEAR_FIELD_MAX;
 pub use passes::light_cluster::{MAX_LC_CLUSTERS, MAX_LC_LIGHTS};
 pub use passes::rsm_vpls::RsmParams;
 pub use timing::{LcCounts, LightListStats, PassTime, PassTimes, ValIterations};

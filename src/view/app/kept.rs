@@ -2,6 +2,7 @@
 //! changes.
 
 use glam::Vec3;
+use visgate_runtime::gpu::NEAR_FIELD_MAX;
 
 use super::ViewerApp;
 use crate::view::camera::FlyCamera;
@@ -77,7 +78,7 @@ impl ViewerApp {
             self.settings.gates.walk_roulette = r;
         }
         // Likewise a near field out of its limits.
-        if let Some(k) = s.near_field.filter(|k| (0.0..=8.0).contains(k)) {
+        if let Some(k) = s.near_field.filter(|k| (0.0..=NEAR_FIELD_MAX).contains(k)) {
             self.settings.gates.near_field = k;
         }
     }

@@ -48,10 +48,13 @@ pub struct GatesParams {
 }
 
 /// The balanced and accurate settings' near field ([`GatesParams::near_field`]), in blocks:
-/// on 24 camera and light configurations (README) the indirect MSE ×0.24–1.0 of the setting's
-/// without it, for a near pass of 33–571 ms on lavapipe at 320 × 240 (the light's own room the
-/// most).
+/// on 24 camera and light configurations (README) the indirect MSE ×0.19–1.0 of the setting's
+/// without it, for a near pass of 47–557 ms on lavapipe at 320 × 240, 8–43 % of the frame (the
+/// light's own room the most).
 pub const NEAR_FIELD: f32 = 4.0;
+
+/// The widest near field ([`GatesParams::near_field`]), in blocks.
+pub const NEAR_FIELD_MAX: f32 = 8.0;
 
 /// The most VPLs the near field takes (shade.wgsl's NEAR_WORDS × 32: a workgroup marks its
 /// tile's near VPLs a bit each); above, it is off.
@@ -173,9 +176,9 @@ impl GatesParams {
             )));
         }
         self.walk_roulette.check()?;
-        if !(0.0..=8.0).contains(&self.near_field) {
+        if !(0.0..=NEAR_FIELD_MAX).contains(&self.near_field) {
             return Err(RenderError::Param(format!(
-                "the near field {} must be 0..=8 interleaving blocks (0: none)",
+                "the near field {} must be 0..={NEAR_FIELD_MAX} interleaving blocks (0: none)",
                 self.near_field
             )));
         }
