@@ -318,7 +318,7 @@ pub struct MethodArgs {
     /// interleaving's error in the light's own room. 0: none. At most 8; off where the walks'
     /// roulette is on (by default from 8,192 VPLs in 8 x 8 blocks) and above 32,768 VPLs.
     /// Unset: 4 in the balanced and accurate settings (the indirect MSE x0.19-1.0 on 24 views
-    /// at 1,024 VPLs, its pass 8-43 % of the frame on lavapipe), 0 in the fast one
+    /// at 1,024 VPLs, its pass 3-32 % of the frame on lavapipe), 0 in the fast one
     #[arg(long, value_name = "K")]
     pub near_field: Option<f32>,
     /// Per-VPL paraboloid map size (GPU), texels.

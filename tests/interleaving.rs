@@ -217,7 +217,9 @@ fn the_near_field_takes_the_creases_error_out_of_the_interleaving() {
 /// With a near field wider than the level at every pixel (8 blocks on an 8 × 6 image of the
 /// Cornell box: its whole share reaches over 4 times each point's distance from the eye),
 /// every VPL is near: the interleaved gathers take none and each pixel walks them all itself,
-/// which is the render with every VPL at every pixel.
+/// which is the render with every VPL at every pixel. On lavapipe every tile marks every VPL
+/// and walks them in rounds of 2 (the loop limit; `methods::near_run`): 114 rounds, all but
+/// the first over the tiles that the round before left (relative MSE 0.24 with them left out).
 #[test]
 fn a_near_field_that_holds_every_vpl_is_every_vpl_at_every_pixel() {
     let (mut lit, scene) = lit_view(Builtin::CornellBox, 64, 0, (256, 1), [8, 6]);

@@ -532,15 +532,24 @@ pub fn walk_batch(adapter: &str, mode: &GpuMode, sight_steps: Option<u32>, vpls:
     }
 }
 
-/// VPLs that the near field (shade.wgsl's `cs_near_field`) tests a draw on `adapter`, a run
-/// of the VPL list (0: all in one) — on a software rasterizer as many as fit its loop limit
-/// when each is walked: a near walk is at most `radius` long (the frame's largest), so it crosses at most
-/// √3 (radius / voxel + 8) + 4 voxels of a sight grid of `voxel_m` (its ends off the surfaces
-/// up to 3.25 voxels each, a voxel's corner), twice that in iterations (a closed voxel's step
-/// takes two loops' iterations), and reads up to [`TRIANGLE_TESTS_PER_WALK`] list entries
-/// with the triangles; the pass's own loops (the run's marks read twice, a mark a VPL) take
-/// the rest of the margin. Portal walks take [`SOFTWARE_WALK_BATCH`] a draw.
-pub fn near_batch(adapter: &str, mode: &GpuMode, voxel_m: Option<f32>, radius: f32) -> u32 {
+/// Marked VPLs a tile of the near field (shade.wgsl's `cs_near_field`) walks a round on
+/// `adapter` (0: all in one round) — on a software rasterizer as many as fit its loop limit
+/// when each is walked: a near walk is at most `radius` long (the frame's largest), so it
+/// crosses at most √3 (radius / voxel + 8) + 4 voxels of a sight grid of `voxel_m` (its ends
+/// off the surfaces up to 3.25 voxels each, a voxel's corner), twice that in iterations (a
+/// closed voxel's step takes two loops' iterations), and reads up to
+/// [`TRIANGLE_TESTS_PER_WALK`] list entries with the triangles; the round's own loops (the
+/// tile's marks of `vpls` VPLs read twice, a mark a VPL) take their share of the limit. Portal
+/// walks take [`SOFTWARE_WALK_BATCH`] a round. A round's dispatch costs a pass over the frame
+/// (about 15-20 ms at 512² on lavapipe) and a tile that marks more VPLs than this walks the rest
+/// in the next rounds, which take only the tiles left.
+pub fn near_run(
+    adapter: &str,
+    mode: &GpuMode,
+    voxel_m: Option<f32>,
+    radius: f32,
+    vpls: u32,
+) -> u32 {
     let GpuMode::Gates(p) = mode else {
         return 0;
     };
@@ -556,8 +565,8 @@ pub fn near_batch(adapter: &str, mode: &GpuMode, voxel_m: Option<f32>, radius: f
             } else {
                 0
             };
-            let spare = SOFTWARE_LOOP_ITERATIONS - 64;
-            (spare / (steps + 2 + lists)).max(1)
+            let spare = SOFTWARE_LOOP_ITERATIONS - 64 - 2 * vpls.div_ceil(32);
+            (spare / (steps + 3 + lists)).max(1)
         }
         _ => SOFTWARE_WALK_BATCH,
     }

@@ -126,8 +126,9 @@ pub struct Frame<'a> {
     /// The near field's radius per metre of distance from the eye ([`Globals::near_scale`]; 0:
     /// none).
     pub near_scale: f32,
-    /// VPLs the near field tests a draw ([`methods::near_batch`]; 0: all in one).
-    pub near_batch: u32,
+    /// Marked VPLs a tile of the near field walks a round ([`methods::near_run`]; 0: all in
+    /// one).
+    pub near_run: u32,
     /// The starved pixels' list of (pixel, subset) pairs: its capacity.
     pub starved_pairs: u32,
 }
@@ -476,11 +477,12 @@ impl GpuRenderer {
             vpls_cpu,
             walk_batch,
             near_scale,
-            near_batch: methods::near_batch(
+            near_run: methods::near_run(
                 &ctx.adapter_info.name,
                 &params.mode,
                 scene.level.as_ref().map(|l| l.sight_voxel_m),
                 near_scale * farthest(view.eye, scene.bounds),
+                vpl_count,
             ),
             starved_pairs: self
                 .starved_pairs

@@ -49,7 +49,7 @@ pub struct GatesParams {
 
 /// The balanced and accurate settings' near field ([`GatesParams::near_field`]), in blocks:
 /// on 24 camera and light configurations (README) the indirect MSE ×0.19–1.0 of the setting's
-/// without it, for a near pass of 47–557 ms on lavapipe at 320 × 240, 8–43 % of the frame (the
+/// without it, for a near pass of 18–340 ms on lavapipe at 320 × 240, 3–32 % of the frame (the
 /// light's own room the most).
 pub const NEAR_FIELD: f32 = 4.0;
 

@@ -231,10 +231,10 @@ impl Shade {
 
     /// Records the near field of interleaved walks with gate shape `shape`
     /// (`globals.near_scale` > 0): each tile's VPLs within its pixels' radius marked, each
-    /// pixel's light from the VPLs within its radius walked there and summed (a run of
-    /// `f.near_batch` VPLs a dispatch on a software rasterizer: `walk_batch_index` the batch,
-    /// its first VPL, its end), then added onto `hdr` (the image so far) into a target of its
-    /// own, which it returns.
+    /// pixel's light from the VPLs within its radius walked there and summed (on a software
+    /// rasterizer in rounds of `f.near_run` marked VPLs a tile: the first over every tile, the
+    /// later ones indirect, over the tiles that the round before left unfinished), then added
+    /// onto `hdr` (the image so far) into a target of its own, which it returns.
     pub fn record_near(
         &self,
         f: &Frame,
@@ -245,6 +245,7 @@ impl Shade {
     ) -> wgpu::Texture {
         let n = f.vpl_count;
         let [w, h] = f.view.size;
+        let tiles = [w.div_ceil(8), h.div_ceil(8)];
         let d = &f.ctx.device;
         let storage = wgpu::BufferUsages::STORAGE;
         let marks_bytes = near_marks_bytes(f.view.size, n);
@@ -257,17 +258,15 @@ impl Shade {
             storage | wgpu::BufferUsages::COPY_DST,
         );
         rec.enc.clear_buffer(&sums, 0, None);
-        let run = match f.near_batch {
-            0 => n.max(1),
-            b => b,
+        let (run, rounds) = match f.near_run {
+            0 => (u32::MAX, 1),
+            r => (r, n.div_ceil(r).max(1)),
         };
-        let indices: Vec<[u32; 4]> = (0..n.div_ceil(run).max(1))
-            .map(|i| [i, i * run, ((i + 1) * run).min(n), 0])
-            .collect();
+        let lists = near_lists(f, pool, tiles[0] * tiles[1]);
         let index_buf = pool.upload(
             f.ctx,
-            "near batch indices",
-            &strided(&indices),
+            "near round indices",
+            &strided(&[[0, run, 0, 0], [1, run, 0, 0]]),
             wgpu::BufferUsages::UNIFORM,
         );
         let views = Views::new(f, inputs);
@@ -285,10 +284,16 @@ impl Shade {
         let marks_at = (34, marks.as_entire_binding());
         let sums_at = || (35, sums.as_entire_binding());
         let (mark, marking) = group(GatesGather::NearMarks, &[0, 2, 5], vec![marks_at.clone()]);
-        let walking: Vec<wgpu::BindGroup> = (0..indices.len())
-            .map(|i| {
-                let index = (24, slice(&index_buf, (i * UNIFORM_STRIDE) as u64, 16));
-                let extra = vec![index, marks_at.clone(), sums_at()];
+        // The first round's group, then a later round r's (r mod 3): its list, the next, the
+        // one after.
+        let walking: Vec<wgpu::BindGroup> = [(0, 0), (1, 0), (1, 1), (1, 2)]
+            .into_iter()
+            .map(|(later, r)| {
+                let index = (24, slice(&index_buf, later * UNIFORM_STRIDE as u64, 16));
+                let mut extra = vec![index, marks_at.clone(), sums_at()];
+                for (k, binding) in [36, 37, 38].into_iter().enumerate() {
+                    extra.push((binding, lists[(r + k) % 3].as_entire_binding()));
+                }
                 group(GatesGather::Near, &NEAR_BINDINGS, extra).1
             })
             .collect();
@@ -306,14 +311,15 @@ impl Shade {
                 label: Some(name),
                 timestamp_writes: span.compute(),
             });
-            let tiles = [w.div_ceil(8), h.div_ceil(8)];
             pass.set_pipeline(mark);
             pass.set_bind_group(0, &marking, &[]);
             pass.dispatch_workgroups(tiles[0], tiles[1], 1);
             pass.set_pipeline(walk);
-            for g in &walking {
-                pass.set_bind_group(0, g, &[]);
-                pass.dispatch_workgroups(tiles[0], tiles[1], 1);
+            pass.set_bind_group(0, &walking[0], &[]);
+            pass.dispatch_workgroups(tiles[0], tiles[1], 1);
+            for r in 1..rounds as usize {
+                pass.set_bind_group(0, &walking[1 + r % 3], &[]);
+                pass.dispatch_workgroups_indirect(&lists[r % 3], 0);
             }
             pass.set_pipeline(compose);
             pass.set_bind_group(0, &composing, &[]);
@@ -436,6 +442,27 @@ pub(super) enum GatesGather {
 pub fn near_marks_bytes([w, h]: [u32; 2], vpls: u32) -> u64 {
     let tiles = u64::from(w.div_ceil(8)) * u64::from(h.div_ceil(8));
     tiles * u64::from(vpls.div_ceil(32)) * 4
+}
+
+/// The near field's three lists of tiles (shade.wgsl's `near_in`, `near_out`, `near_spare`,
+/// rotated a round) for a frame of `tiles` tiles, each emptied: its control slot alone, an
+/// indirect dispatch of one workgroup.
+fn near_lists(f: &Frame, pool: &mut Pool, tiles: u32) -> [wgpu::Buffer; 3] {
+    const NAMES: [&str; 3] = [
+        "near rounds' list 0",
+        "near rounds' list 1",
+        "near rounds' list 2",
+    ];
+    let bytes = (4 + 2 * (u64::from(tiles) + 1)) * 4;
+    let usage =
+        wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST;
+    NAMES.map(|name| {
+        let list = pool.buffer(&f.ctx.device, name, bytes, usage);
+        f.ctx
+            .queue
+            .write_buffer(&list, 0, bytemuck::cast_slice(&[1u32, 1, 1, 1]));
+        list
+    })
 }
 
 /// The dispatches a gather of up to `walks` walks a pixel takes: batches of `f.walk_batch`

@@ -413,15 +413,28 @@ fn gather_per_pixel(p: vec3<f32>, n: vec3<f32>, here: u32) -> vec3<f32> {
 // each, NEAR_WORDS words: at most 32,768 VPLs); cs_near_field, in pixel order, tests the
 // marked ones in VPL order, walks those within its own radius and adds their light to
 // near_sums; cs_near_compose adds near_sums (× albedo / π) onto the image so far
-// (earlier_batches). A dispatch of cs_near_field takes the VPLs walk_batch_index.y up to .z
-// (all of them but on a software rasterizer: its loop limit), and a pixel whose tile marked
-// none of them returns at once, so that a batch costs what it walks; the marks apart, so that
-// a batch has no barrier (lavapipe runs a workgroup's barriers as coroutine switches).
+// (earlier_batches). cs_near_field runs in rounds (walk_batch_index.x: 0 the first, 1 a later
+// one): a tile walks at most walk_batch_index.y of its marked VPLs a round (all of them but on
+// a software rasterizer, whose loop limit a pixel would reach), and a tile that has more left
+// puts itself on the next round's list, whose dispatch is indirect: the first round a
+// dispatch over every tile, each later one over the tiles left, so that a round costs what it
+// walks (rounds over every tile, a run of the VPL list each, cost e2m3's hall at 512², 1,024
+// VPLs 14 dispatches and 410 ms where 170 walk). The marks apart, so that a round has no
+// barrier (lavapipe runs a workgroup's barriers as coroutine switches).
 const NEAR_WORDS: u32 = 1024u;
 // The marks: each tile's ⌈VPLs / 32⌉ words, tile after tile in rows of ⌈width / 8⌉.
 @group(0) @binding(34) var<storage, read_write> near_tiles: array<u32>;
 // Each pixel's near light so far (xyz), in rows of the frame's width.
 @group(0) @binding(35) var<storage, read_write> near_sums: array<vec4<f32>>;
+// The rounds' lists of tiles (record_near rotates three): words 0-2 an indirect dispatch's
+// workgroups (x, y, z), word 3 the slots used, then a slot's tile and the VPL it starts from;
+// slot 0 is the round's control workgroup. This round's (near_in), the next round's, which this
+// one appends to (near_out), and the one after (near_spare), which this one empties.
+const NEAR_LIST_HEAD: u32 = 4u;
+const NEAR_ROUND_ROW: u32 = 65535u;
+@group(0) @binding(36) var<storage, read> near_in: array<u32>;
+@group(0) @binding(37) var<storage, read_write> near_out: array<atomic<u32>>;
+@group(0) @binding(38) var<storage, read_write> near_spare: array<u32>;
 var<workgroup> near_lo: array<vec4<f32>, 64>;
 var<workgroup> near_hi: array<vec4<f32>, 64>;
 var<workgroup> near_marks: array<atomic<u32>, NEAR_WORDS>;
@@ -470,25 +483,48 @@ fn cs_near_marks(
 }
 
 @compute @workgroup_size(8, 8)
-fn cs_near_field(@builtin(global_invocation_id) id: vec3<u32>) {
+fn cs_near_field(
+    @builtin(local_invocation_id) lid: vec3<u32>,
+    @builtin(local_invocation_index) li: u32,
+    @builtin(workgroup_id) wg: vec3<u32>,
+) {
     let size = textureDimensions(g_position);
-    if any(id.xy >= size) {
+    let tiles_x = (size.x + 7u) / 8u;
+    var tile = wg.x + wg.y * tiles_x;
+    var first = 0u;
+    if walk_batch_index.x == 0u {
+        if tile == 0u && li == 0u {
+            near_round_reset();
+        }
+    } else {
+        // A later round: workgroup 0 resets the round after next's list, the others each walk
+        // a tile of this round's list from where the round before stopped.
+        let slot = wg.x + NEAR_ROUND_ROW * wg.y;
+        if slot == 0u {
+            if li == 0u {
+                near_round_reset();
+            }
+            return;
+        }
+        if slot >= near_in[3] {
+            return;
+        }
+        tile = near_in[NEAR_LIST_HEAD + 2u * slot];
+        first = near_in[NEAR_LIST_HEAD + 2u * slot + 1u];
+    }
+    let words = (globals.vpl_count + 31u) / 32u;
+    let at = tile * words;
+    let run = near_run(at, first, words, walk_batch_index.y);
+    if li == 0u && run.x < globals.vpl_count {
+        near_round_append(tile, run.x);
+    }
+    let id = vec2<u32>(tile % tiles_x, tile / tiles_x) * 8u + lid.xy;
+    if any(id >= size) || run.y == 0u {
         return;
     }
-    let all_words = (globals.vpl_count + 31u) / 32u;
-    let at = (id.x / 8u + (id.y / 8u) * ((size.x + 7u) / 8u)) * all_words;
-    let first = walk_batch_index.y;
-    let end = min(walk_batch_index.z, globals.vpl_count);
-    // This batch's words (a software rasterizer's runs need not start on a word: the bits
-    // outside them skipped below).
-    let words = vec2<u32>(first / 32u, (end + 31u) / 32u);
-    var marked = 0u;
-    for (var w = words.x; w < words.y; w++) {
-        marked |= near_tiles[at + w];
-    }
-    let px = vec2<i32>(id.xy);
+    let px = vec2<i32>(id);
     let pos = textureLoad(g_position, px, 0);
-    if pos.w == 0.0 || marked == 0u {
+    if pos.w == 0.0 {
         return;
     }
     let p = pos.xyz;
@@ -497,13 +533,16 @@ fn cs_near_field(@builtin(global_invocation_id) id: vec3<u32>) {
     let at_p = walk_end_at(px, p);
     let r = near_radius(p);
     var sum = vec3<f32>(0.0);
-    for (var w = words.x; w < words.y; w++) {
+    for (var w = first / 32u; w < (run.x + 31u) / 32u; w++) {
         var bits = near_tiles[at + w];
+        if w == first / 32u {
+            bits &= ~0u << (first % 32u);
+        }
         while bits != 0u {
             let k = w * 32u + firstTrailingBit(bits);
             bits &= bits - 1u;
-            if k < first || k >= end {
-                continue;
+            if k >= run.x {
+                break;
             }
             let v = vpls[k];
             let to_v = v.position - p;
@@ -519,6 +558,44 @@ fn cs_near_field(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let i = id.x + id.y * size.x;
     near_sums[i] = vec4<f32>(near_sums[i].xyz + sum, 0.0);
+}
+
+// Of the VPLs that tile words `at` marks from VPL `first` on, the run a round walks: at most
+// `budget` marked ones (its end, the next marked VPL or the VPL count; and how many it holds).
+fn near_run(at: u32, first: u32, words: u32, budget: u32) -> vec2<u32> {
+    var left = budget;
+    for (var w = first / 32u; w < words; w++) {
+        var bits = near_tiles[at + w];
+        if w == first / 32u {
+            bits &= ~0u << (first % 32u);
+        }
+        let c = countOneBits(bits);
+        if c > left {
+            for (var i = 0u; i < left; i++) {
+                bits &= bits - 1u;
+            }
+            return vec2<u32>(w * 32u + firstTrailingBit(bits), budget);
+        }
+        left -= c;
+    }
+    return vec2<u32>(globals.vpl_count, budget - left);
+}
+
+// The next round's list (near_out): tile `tile` from VPL `start` on, in the next slot, the
+// indirect dispatch's workgroups grown to hold it (rows of NEAR_ROUND_ROW).
+fn near_round_append(tile: u32, start: u32) {
+    let slot = atomicAdd(&near_out[3], 1u);
+    atomicStore(&near_out[NEAR_LIST_HEAD + 2u * slot], tile);
+    atomicStore(&near_out[NEAR_LIST_HEAD + 2u * slot + 1u], start);
+    atomicMax(&near_out[0], min(slot + 1u, NEAR_ROUND_ROW));
+    atomicMax(&near_out[1], slot / NEAR_ROUND_ROW + 1u);
+}
+
+// The list after the next one emptied: its control slot alone, a workgroup (x 1, y 1, z 1).
+fn near_round_reset() {
+    near_spare[0] = 1u;
+    near_spare[1] = 1u;
+    near_spare[3] = 1u;
 }
 
 @compute @workgroup_size(8, 8)
