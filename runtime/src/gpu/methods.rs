@@ -540,9 +540,9 @@ pub fn walk_batch(adapter: &str, mode: &GpuMode, sight_steps: Option<u32>, vpls:
 /// closed voxel's step takes two loops' iterations), and reads up to
 /// [`TRIANGLE_TESTS_PER_WALK`] list entries with the triangles; the round's own loops (the
 /// tile's marks of `vpls` VPLs read twice, a mark a VPL) take their share of the limit. Portal
-/// walks take [`SOFTWARE_WALK_BATCH`] a round. A round's dispatch costs a pass over the frame
-/// (about 15-20 ms at 512² on lavapipe) and a tile that marks more VPLs than this walks the rest
-/// in the next rounds, which take only the tiles left.
+/// walks take [`SOFTWARE_WALK_BATCH`] a round. A dispatch over every tile costs lavapipe about
+/// 15-20 ms at 512² whatever it walks, so only the first round takes every tile: a tile that
+/// marks more VPLs than this walks the rest in the next rounds, which take the tiles left.
 pub fn near_run(
     adapter: &str,
     mode: &GpuMode,

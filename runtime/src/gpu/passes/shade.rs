@@ -262,7 +262,7 @@ impl Shade {
             0 => (u32::MAX, 1),
             r => (r, n.div_ceil(r).max(1)),
         };
-        let lists = near_lists(f, pool, tiles[0] * tiles[1]);
+        let lists = near_lists(f, pool, rec, tiles[0] * tiles[1]);
         let index_buf = pool.upload(
             f.ctx,
             "near round indices",
@@ -445,22 +445,27 @@ pub fn near_marks_bytes([w, h]: [u32; 2], vpls: u32) -> u64 {
 }
 
 /// The near field's three lists of tiles (shade.wgsl's `near_in`, `near_out`, `near_spare`,
-/// rotated a round) for a frame of `tiles` tiles, each emptied: its control slot alone, an
-/// indirect dispatch of one workgroup.
-fn near_lists(f: &Frame, pool: &mut Pool, tiles: u32) -> [wgpu::Buffer; 3] {
+/// rotated a round) for a frame of `tiles` tiles, each emptied in the frame's commands: its
+/// control slot alone, an indirect dispatch of one workgroup.
+fn near_lists(f: &Frame, pool: &mut Pool, rec: &mut Recorder, tiles: u32) -> [wgpu::Buffer; 3] {
     const NAMES: [&str; 3] = [
         "near rounds' list 0",
         "near rounds' list 1",
         "near rounds' list 2",
     ];
+    let head: [u32; 4] = [1, 1, 1, 1];
+    let empty = pool.upload(
+        f.ctx,
+        "near rounds' empty list",
+        bytemuck::cast_slice(&head),
+        wgpu::BufferUsages::COPY_SRC,
+    );
     let bytes = (4 + 2 * (u64::from(tiles) + 1)) * 4;
     let usage =
         wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST;
     NAMES.map(|name| {
         let list = pool.buffer(&f.ctx.device, name, bytes, usage);
-        f.ctx
-            .queue
-            .write_buffer(&list, 0, bytemuck::cast_slice(&[1u32, 1, 1, 1]));
+        rec.enc.copy_buffer_to_buffer(&empty, 0, &list, 0, 16);
         list
     })
 }
