@@ -410,7 +410,7 @@ fn gather_per_pixel(p: vec3<f32>, n: vec3<f32>, here: u32) -> vec3<f32> {
 //
 // Three entry points: cs_near_marks, once, a workgroup an 8 × 8 tile of pixels, marks in
 // near_tiles the VPLs within the tile's largest radius of the box of its surface points (a bit
-// each, NEAR_WORDS words: at most 32,768 VPLs); cs_near_field, in pixel order, tests the
+// each, NEAR_WORDS words: at most 32,768 VPLs); cs_near_field, a workgroup a tile, tests the
 // marked ones in VPL order, walks those within its own radius and adds their light to
 // near_sums; cs_near_compose adds near_sums (× albedo / π) onto the image so far
 // (earlier_batches). cs_near_field runs in rounds (walk_batch_index.x: 0 the first, 1 a later
@@ -419,7 +419,7 @@ fn gather_per_pixel(p: vec3<f32>, n: vec3<f32>, here: u32) -> vec3<f32> {
 // puts itself on the next round's list, whose dispatch is indirect: the first round a
 // dispatch over every tile, each later one over the tiles left, so that a round costs what it
 // walks (rounds over every tile, a run of the VPL list each, cost e2m3's hall at 512², 1,024
-// VPLs 14 dispatches and 410 ms where 170 walk). The marks apart, so that a round has no
+// VPLs 14 dispatches and 343-413 ms where 170 walk). The marks apart, so that a round has no
 // barrier (lavapipe runs a workgroup's barriers as coroutine switches).
 const NEAR_WORDS: u32 = 1024u;
 // The marks: each tile's ⌈VPLs / 32⌉ words, tile after tile in rows of ⌈width / 8⌉.
@@ -431,6 +431,7 @@ const NEAR_WORDS: u32 = 1024u;
 // slot 0 is the round's control workgroup. This round's (near_in), the next round's, which this
 // one appends to (near_out), and the one after (near_spare), which this one empties.
 const NEAR_LIST_HEAD: u32 = 4u;
+// The workgroups of a row of a later round's dispatch (the most a dimension may hold).
 const NEAR_ROUND_ROW: u32 = 65535u;
 @group(0) @binding(36) var<storage, read> near_in: array<u32>;
 @group(0) @binding(37) var<storage, read_write> near_out: array<atomic<u32>>;
