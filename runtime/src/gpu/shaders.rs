@@ -17,7 +17,7 @@
 use crate::RenderError;
 
 /// The include files (`gpu/shaders/`).
-const INCLUDES: [(&str, &str); 13] = [
+const INCLUDES: [(&str, &str); 14] = [
     ("globals.wgsl", include_str!("shaders/globals.wgsl")),
     ("lights.wgsl", include_str!("shaders/lights.wgsl")),
     (
@@ -30,6 +30,7 @@ const INCLUDES: [(&str, &str); 13] = [
     ("portals.wgsl", include_str!("shaders/portals.wgsl")),
     ("sight.wgsl", include_str!("shaders/sight.wgsl")),
     ("walk.wgsl", include_str!("shaders/walk.wgsl")),
+    ("near.wgsl", include_str!("shaders/near.wgsl")),
     ("val.wgsl", include_str!("shaders/val.wgsl")),
     ("lc.wgsl", include_str!("shaders/lc.wgsl")),
     ("pcss.wgsl", include_str!("shaders/pcss.wgsl")),
