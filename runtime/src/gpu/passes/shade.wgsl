@@ -535,10 +535,7 @@ fn cs_near_field(
     let r = near_radius(p);
     var sum = vec3<f32>(0.0);
     for (var w = first / 32u; w < (run.x + 31u) / 32u; w++) {
-        var bits = near_tiles[at + w];
-        if w == first / 32u {
-            bits &= ~0u << (first % 32u);
-        }
+        var bits = near_word(at, w, first);
         while bits != 0u {
             let k = w * 32u + firstTrailingBit(bits);
             bits &= bits - 1u;

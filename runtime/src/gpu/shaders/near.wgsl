@@ -7,10 +7,7 @@
 fn near_run(at: u32, first: u32, words: u32, budget: u32) -> vec2<u32> {
     var left = budget;
     for (var w = first / 32u; w < words; w++) {
-        var bits = near_tiles[at + w];
-        if w == first / 32u {
-            bits &= ~0u << (first % 32u);
-        }
+        var bits = near_word(at, w, first);
         let c = countOneBits(bits);
         if c > left {
             for (var i = 0u; i < left; i++) {
@@ -21,6 +18,12 @@ fn near_run(at: u32, first: u32, words: u32, budget: u32) -> vec2<u32> {
         left -= c;
     }
     return vec2<u32>(globals.vpl_count, budget - left);
+}
+
+// Word w of the tile marks at `at`, without the VPLs before `first`.
+fn near_word(at: u32, w: u32, first: u32) -> u32 {
+    let bits = near_tiles[at + w];
+    return select(bits, bits & (~0u << (first % 32u)), w == first / 32u);
 }
 
 // The next round's list (near_out): tile `tile` from VPL `start` on, in the next slot, the
