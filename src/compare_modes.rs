@@ -321,11 +321,12 @@ mod tests {
             "--starved-dark",
             "--near-field",
             "4",
+            "--ratio",
         ];
         assert_eq!(g, gates_of("gates", &[&flags[..], &spelled].concat()));
         assert!(!all_with(&[]).contains(&BALANCED.to_string()));
         assert!(!gates_of(ACCURATE, &[]).interleave.starved_dark);
-        // And back: --fast, or gates-fast, undoes the four and keeps the rest.
+        // And back: --fast, or gates-fast, undoes the five and keeps the rest.
         assert_eq!(
             g.fast(),
             gates_of("gates", &[&flags[..], &["--fast"]].concat())

@@ -106,6 +106,13 @@ fn gates_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
                      itself, unblurred: the spots that single VPLs light in the creases \
                      beside a light, which interleaving smears; 0: off",
                 );
+                ui.checkbox(&mut s.gates.ratio, "ratio estimator")
+                    .on_hover_text(
+                        "each pixel sums every far VPL's unshadowed light itself and the blur \
+                         scales it by the share its neighbours' walks found visible: the \
+                         interleaving's error left to where the visibility changes (off where \
+                         the walk roulette is on)",
+                    );
             }
         }
     }

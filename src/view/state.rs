@@ -54,6 +54,9 @@ pub struct SavedView {
     /// The gates' near field, in blur blocks (absent in older files: the run's own).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub near_field: Option<f32>,
+    /// The gates' ratio estimator (absent in older files: the run's own).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ratio: Option<bool>,
 }
 
 impl SavedView {
@@ -150,6 +153,7 @@ mod tests {
             vals_layer: mode == "val-ism",
             walk_roulette: (mode == "gates").then(|| "0.1".into()),
             near_field: (mode == "gates").then_some(2.0),
+            ratio: (mode == "gates").then_some(false),
         };
         save_to(&p, "a", state("gates"));
         save_to(&p, "b", state("val-cssm"));
@@ -191,6 +195,12 @@ mod tests {
         json.as_object_mut().expect("object").remove("near_field");
         let older: SavedView = serde_json::from_value(json).expect("an older state");
         assert_eq!(older.near_field, None);
+        // And the ratio estimator.
+        assert_eq!(all["a"].ratio, Some(false));
+        let mut json: serde_json::Value = serde_json::to_value(state("gates")).expect("json");
+        json.as_object_mut().expect("object").remove("ratio");
+        let older: SavedView = serde_json::from_value(json).expect("an older state");
+        assert_eq!(older.ratio, None);
         // A file from before the shape was named: disks and voxels as chosen, else today's
         // default.
         let old = |disks: bool, voxels: bool| SavedView {

@@ -203,16 +203,31 @@ fn render_gates_names_its_setting_and_each_flag_that_adds_to_the_fast_one() {
     let (_dir, level, out) = two_rooms_level();
     let mut a = gates_render(&level, &out);
     // The default: the voxel walk (no clusters or lists, each VPL's end) in the balanced
-    // setting, named in the frame's first line, with the dark pixels' pass and the near
-    // field's.
+    // setting, named in the frame's first line, with the dark pixels' pass, the near field's
+    // and the ratio estimator's unshadowed light.
     let o = visgate(&a);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stdout(&o).contains("VPL walk ends"), "{}", stdout(&o));
     let balanced = "gates (voxel walk + triangles, 8×8 interleaved, tent blur, dark pixels walk \
-                    the rest, near field 4 blocks) 16x12";
+                    the rest, near field 4 blocks, ratio estimator) 16x12";
     assert!(stdout(&o).contains(balanced), "{}", stdout(&o));
     assert!(stdout(&o).contains("starved pixels"), "{}", stdout(&o));
     assert!(stdout(&o).contains("near VPLs"), "{}", stdout(&o));
+    assert!(stdout(&o).contains("unshadowed"), "{}", stdout(&o));
+    // Without the ratio estimator: named so, and its pass not run.
+    let mut n = a.clone();
+    n.push("--no-ratio");
+    let on = visgate(&n);
+    assert!(on.status.success(), "{}", stderr(&on));
+    assert!(
+        stdout(&on).contains("near field 4 blocks) 16x12"),
+        "{}",
+        stdout(&on)
+    );
+    assert!(!stdout(&on).contains("unshadowed"), "{}", stdout(&on));
+    n.push("--ratio");
+    let both = visgate(&n);
+    assert!(!both.status.success(), "--ratio with --no-ratio is refused");
     assert!(!stdout(&o).contains("unique clusters"), "{}", stdout(&o));
     // The fast setting: the walk on the closed voxels' planes, the box blur, no second pass;
     // the rest below adds to it.
@@ -226,6 +241,7 @@ fn render_gates_names_its_setting_and_each_flag_that_adds_to_the_fast_one() {
     );
     assert!(!stdout(&o).contains("starved pixels"), "{}", stdout(&o));
     assert!(!stdout(&o).contains("near VPLs"), "{}", stdout(&o));
+    assert!(!stdout(&o).contains("unshadowed"), "{}", stdout(&o));
     // With the triangles in the closed voxels, named too, and the same room as bright (the
     // two rooms' walls are thick, so the walk sees what it saw).
     // The "mean radiance R G B" line's values.

@@ -147,8 +147,10 @@ gpu_struct! {
         /// eye are left out of its subset's gather and walked at the pixel itself, unblurred
         /// (0: none; [`crate::gpu::passes::gates_params::GatesParams::near_scale`]).
         pub near_scale: f32,
-        /// Padding.
-        pub _pad0: u32,
+        /// Interleaved walks, the ratio estimator: 1 where the blur scales each pixel's
+        /// unshadowed far light by its taps' visible share, 0 where it averages their light
+        /// ([`crate::gpu::passes::gates_params::GatesParams::ratio`]).
+        pub ratio: u32,
         /// Padding.
         pub _pad1: u32,
         /// Padding.
@@ -450,8 +452,12 @@ gpu_struct! {
         pub blur_distance: f32,
         /// Blur: neighbours whose normals' cosine is below this are left out.
         pub blur_normal: f32,
+        /// Interleaved walks, the ratio estimator: 1 where the blur scales each pixel's
+        /// unshadowed far light by its taps' visible share (`blur.wgsl`), 0 where it averages
+        /// their light.
+        pub ratio: u32,
         /// Padding.
-        pub _pad2: [f32; 2],
+        pub _pad2: f32,
     }
 }
 

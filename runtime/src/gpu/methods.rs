@@ -213,8 +213,8 @@ impl GpuMode {
     }
 
     /// The mode as it renders a frame of `vpls` VPLs: the gates' automatic roulette resolved
-    /// to the share it takes there (0: every VPL walked), and their near field off where the
-    /// roulette is on, so that two modes that render the same frame compare equal (`gates` and
+    /// to the share it takes there (0: every VPL walked), and their near field and ratio
+    /// estimator off where the roulette is on, so that two modes that render the same frame compare equal (`gates` and
     /// `gates-roulette` at 8,192 VPLs or more).
     pub fn resolved_for(&self, vpls: u32) -> GpuMode {
         match *self {
@@ -223,6 +223,7 @@ impl GpuMode {
                 p.walk_roulette = WalkRoulette::Share(share);
                 if share > 0.0 {
                     p.near_field = 0.0;
+                    p.ratio = false;
                 }
                 GpuMode::Gates(p)
             }
@@ -282,6 +283,9 @@ impl GpuMode {
                 let walks = p.gates.shape != GateShape::Disk;
                 if p.near_field > 0.0 && p.interleave.block > 1 && walks {
                     s += &format!(", near field {} blocks", p.near_field);
+                }
+                if p.ratio && p.interleave.block > 1 && walks {
+                    s += ", ratio estimator";
                 }
                 if p.gates.shape != GateShape::Disk {
                     match p.walk_roulette {
@@ -393,6 +397,12 @@ impl GpuMode {
             GpuMode::GatesPerPixel(g) => Some(*g),
             _ => None,
         }
+    }
+
+    /// Whether the mode's blur of a frame of `vpls` VPLs takes the ratio estimator
+    /// ([`GatesParams::ratio_for`]).
+    pub fn ratio_for(&self, vpls: u32) -> bool {
+        matches!(self, GpuMode::Gates(p) if p.ratio_for(vpls))
     }
 }
 

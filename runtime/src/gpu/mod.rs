@@ -443,7 +443,7 @@ impl GpuRenderer {
             walk_roulette,
             walk_seed,
             near_scale,
-            _pad0: 0,
+            ratio: u32::from(params.mode.ratio_for(vpl_count)),
             _pad1: 0,
             _pad2: 0,
         };

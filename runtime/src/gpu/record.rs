@@ -99,16 +99,21 @@ pub(super) fn record_passes(
                     .shade
                     .record_near(f, pool, rec, inputs, (gp.gates.shape, &hdr));
             }
+            let unshadowed = gp.ratio_for(f.vpl_count).then(|| {
+                p.shade
+                    .record_unshadowed(f, pool, rec, inputs, gp.gates.shape)
+            });
             let uniform = InterleaveBlur::uniform(f, il, pool, true);
             let targets = (&g, &uniform, &indirect, &hdr);
             let sums = starved.as_ref().map(|s| &s.sums);
-            p.blur.record(f, il, pool, rec, targets, sums);
+            p.blur
+                .record(f, il, pool, rec, targets, (sums, unshadowed.as_ref()));
         }
         GpuMode::VplClusters(_, il) if il.block > 1 => {
             let indirect = p.shade.record_indirect(f, pool, rec, inputs, None);
             let uniform = InterleaveBlur::uniform(f, il, pool, true);
-            p.blur
-                .record(f, il, pool, rec, (&g, &uniform, &indirect, &hdr), None);
+            let targets = (&g, &uniform, &indirect, &hdr);
+            p.blur.record(f, il, pool, rec, targets, (None, None));
         }
         GpuMode::PerVplShadowMaps(pv) => p.maps.record(f, pv, pool, rec, (&g, &hdr)),
         GpuMode::PerVplIsm(pi) => p.isms.record_vpls(f, pi, &p.blur, pool, rec, (&g, &hdr))?,

@@ -46,6 +46,7 @@ impl ViewerApp {
             vals_layer: l.vals,
             walk_roulette: Some(self.settings.gates.walk_roulette.to_string()),
             near_field: Some(self.settings.gates.near_field),
+            ratio: Some(self.settings.gates.ratio),
         }
     }
 
@@ -80,6 +81,9 @@ impl ViewerApp {
         // Likewise a near field out of its limits.
         if let Some(k) = s.near_field.filter(|k| (0.0..=NEAR_FIELD_MAX).contains(k)) {
             self.settings.gates.near_field = k;
+        }
+        if let Some(r) = s.ratio {
+            self.settings.gates.ratio = r;
         }
     }
 

@@ -60,6 +60,23 @@ fn the_near_field_is_on_in_the_balanced_setting_where_the_walks_are_not_thinned(
     let described = |p, vpls| GpuMode::Gates(p).describe_for(vpls);
     assert!(described(balanced, 1_024).contains("near field 4 blocks"));
     assert!(!described(balanced, 16_384).contains("near field"));
+    // The ratio estimator likewise: in the balanced setting, off where the roulette is on.
+    assert!(described(balanced, 1_024).contains("ratio estimator"));
+    assert!(!described(balanced, 16_384).contains("ratio estimator"));
+    assert!(balanced.ratio_for(8_128) && !balanced.ratio_for(8_192));
+    assert!(
+        GatesParams::default()
+            .balanced()
+            .accurate()
+            .ratio_for(1_024)
+    );
+    assert!(
+        !GatesParams::default().fast().ratio_for(1_024),
+        "the fast setting"
+    );
+    let mut disks = balanced;
+    disks.gates.shape = GateShape::Disk;
+    assert!(!disks.ratio_for(1_024), "the paper's disks walk nothing");
     let mut p = balanced;
     p.walk_roulette = WalkRoulette::Share(0.0);
     assert_eq!(p.near_scale(&view, 16_384), scale, "the roulette off");

@@ -45,6 +45,15 @@ pub struct GatesParams {
     /// of that distance: interleaved, one pixel in b² takes it and the blur smears it over the
     /// block (the light's own room's corners). 0: none. [Limit: 0..=8]
     pub near_field: f32,
+    /// Interleaved walks (portals or voxels), the ratio estimator (Heitz et al. 2018,
+    /// "Combining analytic direct illumination and stochastic shadows"): each pixel sums the
+    /// unshadowed light of every VPL beyond its near field (no visibility: a loop over the VPLs,
+    /// shade.wgsl's `cs_far_unshadowed`), and the blur scales it by the share of their
+    /// unshadowed light that its taps' walks found visible, instead of averaging the taps'
+    /// light: where every VPL is visible the pixel gets its exact light whatever VPL subsets its
+    /// taps held, so that the interleaving's error is left to the visibility's changes across a
+    /// block. Off: Laine et al.'s average.
+    pub ratio: bool,
 }
 
 /// The balanced and accurate settings' near field ([`GatesParams::near_field`]), in blocks:
@@ -88,22 +97,23 @@ impl GatesParams {
     /// The accurate setting (`--accurate`): the voxel walk (the shape as set; the default)
     /// along the true segment with the closed voxels' triangles, the tent blur, and the
     /// starved pixels walking what their block lacks where fewer than three quarters of its
-    /// taps agree with them (48 of 8 × 8; a count already set is kept), and the near field of
-    /// [`NEAR_FIELD`] blocks. On sixteen camera-seeds (README, before the near field) the indirect energy
+    /// taps agree with them (48 of 8 × 8; a count already set is kept), the near field of
+    /// [`NEAR_FIELD`] blocks and the ratio estimator ([`GatesParams::ratio`]). On sixteen camera-seeds (README, before the near field) the indirect energy
     /// within 1.6 % of the reference's and under 1 % of the lit pixels black, at several
     /// times the default's frame: for stills and reference-grade walk-throughs.
     pub fn accurate(mut self) -> GatesParams {
         self.gates.triangles = true;
         self.interleave.tent = true;
         self.near_field = NEAR_FIELD;
+        self.ratio = true;
         if self.interleave.starved_taps == 0 {
             self.interleave.starved_taps = self.interleave.three_quarters();
         }
         self
     }
 
-    /// The balanced setting (`--balanced`): the closed voxels' triangles, the tent blur and the
-    /// near field as in [`GatesParams::accurate`], and the pixels whose agreeing taps found no light walking
+    /// The balanced setting (`--balanced`): the closed voxels' triangles, the tent blur, the
+    /// near field and the ratio estimator as in [`GatesParams::accurate`], and the pixels whose agreeing taps found no light walking
     /// what their block lacks ([`InterleaveParams::starved_dark`]) instead of every pixel with
     /// fewer than three quarters agreeing (a count already set is kept). On the same sixteen
     /// camera-seeds (README) the indirect energy within 3 % of the reference's and under 1 % of
@@ -115,19 +125,21 @@ impl GatesParams {
         self.gates.triangles = true;
         self.interleave.tent = true;
         self.near_field = NEAR_FIELD;
+        self.ratio = true;
         self.interleave.starved_dark = true;
         self
     }
 
-    /// The fast setting (`--fast`): the balanced setting's four undone — the voxel walk
+    /// The fast setting (`--fast`): the balanced setting's five undone — the voxel walk
     /// passing closed voxels on their planes, the box blur, no dark pixels' walks, no near
-    /// field (a `--starved-taps` count is kept). [`GatesParams::default`] is this setting; `visgate`'s
+    /// field, no ratio estimator (a `--starved-taps` count is kept). [`GatesParams::default`] is this setting; `visgate`'s
     /// commands and viewer start from [`GatesParams::balanced`].
     pub fn fast(mut self) -> GatesParams {
         self.gates.triangles = false;
         self.interleave.tent = false;
         self.near_field = 0.0;
         self.interleave.starved_dark = false;
+        self.ratio = false;
         self
     }
 
@@ -153,6 +165,17 @@ impl GatesParams {
         }
         let pixel = 2.0 * (view.fov_x_rad / 2.0).tan() / view.size[0].max(1) as f32;
         self.near_field * b as f32 * pixel
+    }
+
+    /// Whether the blur of a frame of `vpls` VPLs takes the ratio estimator
+    /// ([`GatesParams::ratio`]): asked for, the walks (portals or voxels) interleaved, and the
+    /// roulette off — where it thins the walks (by default from 128 VPLs a subset) the near
+    /// field is off too, and the unshadowed light, every VPL at every pixel, would cost
+    /// a GPU what the none mode does (15 ms at 512² and 16,384 VPLs on an H200) for a
+    /// subset's error that its many VPLs have made small.
+    pub fn ratio_for(&self, vpls: u32) -> bool {
+        let walks = self.gates.shape != GateShape::Disk;
+        self.ratio && self.interleave.block > 1 && walks && self.roulette_share(vpls) == 0.0
     }
 
     /// Whether the indirect light is gathered in a pass of its own and composed by the blur

@@ -171,6 +171,7 @@ impl InterleaveBlur {
             deinterleaved: u32::from(deinterleaved),
             blur_fill: u32::from(p.fill),
             blur_tent: u32::from(p.tent),
+            ratio: u32::from(f.params.mode.ratio_for(f.vpl_count)),
             ..bytemuck::Zeroable::zeroed()
         };
         pool.upload(
@@ -182,8 +183,9 @@ impl InterleaveBlur {
     }
 
     /// Records the blur of `indirect` composed onto `out`, with the gather's constants
-    /// `uniform` (a `ValGather` made from `il`), and the starved pixels' own sums where gates
-    /// have them (`Shade::record_starved`).
+    /// `uniform` (a `ValGather` made from `il`), the starved pixels' own sums where gates
+    /// have them (`Shade::record_starved`) and each pixel's unshadowed far light where they
+    /// take the ratio estimator (`Shade::record_unshadowed`).
     pub fn record(
         &self,
         f: &Frame,
@@ -196,25 +198,28 @@ impl InterleaveBlur {
             &wgpu::Texture,
             &wgpu::Texture,
         ),
-        starved: Option<&wgpu::Texture>,
+        (starved, unshadowed): (Option<&wgpu::Texture>, Option<&wgpu::Texture>),
     ) {
         let d = &f.ctx.device;
         let pipeline = self.pipeline_for(d, il.fill);
         let other = frame_target(f, pool, "hdr (ping-pong)");
         let tex = wgpu::BindingResource::TextureView;
-        // Modes without starved pixels read a texel of zeros (w 0: none starved).
-        let starved = match starved {
-            Some(t) => t.clone(),
-            None => pool.texture(
-                d,
-                "no starved pixels",
-                [1, 1, 1],
-                1,
-                HDR,
-                wgpu::TextureUsages::TEXTURE_BINDING,
-            ),
+        // Modes without them read a texel of zeros (starved: w 0, none starved).
+        let mut or_texel = |t: Option<&wgpu::Texture>, label: &'static str| match t {
+            Some(t) => t.create_view(&Default::default()),
+            None => pool
+                .texture(
+                    d,
+                    label,
+                    [1, 1, 1],
+                    1,
+                    HDR,
+                    wgpu::TextureUsages::TEXTURE_BINDING,
+                )
+                .create_view(&Default::default()),
         };
-        let starved_view = starved.create_view(&Default::default());
+        let starved_view = or_texel(starved, "no starved pixels");
+        let unshadowed_view = or_texel(unshadowed, "no unshadowed light");
         let (out_view, indirect_view, other_view) = (
             out.create_view(&Default::default()),
             indirect.create_view(&Default::default()),
@@ -233,6 +238,7 @@ impl InterleaveBlur {
                 (12, tex(&indirect_view)),
                 (13, tex(&other_view)),
                 (14, tex(&starved_view)),
+                (15, tex(&unshadowed_view)),
             ],
         );
         let span = rec.begin("blur + compose");

@@ -345,7 +345,7 @@ impl Isms {
             pool,
             rec,
             (g, &uniform, &indirect, out),
-            None,
+            (None, None),
         );
     }
 

@@ -34,6 +34,8 @@ pub struct Shade {
     gates_near: [std::sync::OnceLock<wgpu::ComputePipeline>; 5],
     near_marks: [std::sync::OnceLock<wgpu::ComputePipeline>; 5],
     near_compose: [std::sync::OnceLock<wgpu::ComputePipeline>; 5],
+    /// The ratio estimator's unshadowed far light (`cs_far_unshadowed`), likewise.
+    far_unshadowed: [std::sync::OnceLock<wgpu::ComputePipeline>; 5],
     /// The starved pixels' other passes (starved.rs).
     pub(super) starved: super::starved::StarvedPipelines,
     module: wgpu::ShaderModule,
@@ -100,6 +102,9 @@ pub struct Gathers<'a> {
     pub vpl_ends: Option<&'a wgpu::Buffer>,
 }
 
+/// VPLs a dispatch of shade.wgsl's `cs_far_unshadowed` sums (its RATIO_RUN).
+pub const RATIO_RUN: u32 = 16_384;
+
 /// The bindings of shade.wgsl's `cs_gates_indirect` (an automatic layout holds only what an
 /// entry point uses) but its batch index (24) and its output (25).
 const GATES_INDIRECT_BINDINGS: [u32; 16] =
@@ -130,6 +135,7 @@ impl Shade {
             gates_near: Default::default(),
             near_marks: Default::default(),
             near_compose: Default::default(),
+            far_unshadowed: Default::default(),
             starved: super::starved::StarvedPipelines::new(d, s)?,
             module,
             vpl_clusters_indirect,
@@ -163,6 +169,7 @@ impl Shade {
             GatesGather::Near => (&self.gates_near, "cs_near_field"),
             GatesGather::NearMarks => (&self.near_marks, "cs_near_marks"),
             GatesGather::NearCompose => (&self.near_compose, "cs_near_compose"),
+            GatesGather::FarUnshadowed => (&self.far_unshadowed, "cs_far_unshadowed"),
         };
         let d = &f.ctx.device;
         cache[k].get_or_init(|| {
@@ -224,6 +231,29 @@ impl Shade {
             used: &GATES_INDIRECT_BINDINGS,
             names: ["indirect irradiance", "indirect irradiance (batches)"],
             span: "indirect lighting",
+            extra: None,
+        };
+        self.walk_batches(f, pool, rec, inputs, batched)
+    }
+
+    /// Records each pixel's unshadowed light from every VPL beyond its near field, for the
+    /// ratio estimator of interleaved walks with gate shape `shape`
+    /// ([`super::gates_params::GatesParams::ratio`]), into a target of its own (in pixel
+    /// order), in runs of [`RATIO_RUN`] VPLs a dispatch (a software rasterizer's loop limit).
+    pub fn record_unshadowed(
+        &self,
+        f: &Frame,
+        pool: &mut Pool,
+        rec: &mut Recorder,
+        inputs: Inputs,
+        shape: GateShape,
+    ) -> wgpu::Texture {
+        let batched = Batched {
+            pipeline: self.gates_pipeline(f, GatesGather::FarUnshadowed, shape),
+            batches: f.vpl_count.div_ceil(RATIO_RUN).max(1),
+            used: &[0, 2, 5, 6, 21],
+            names: ["unshadowed far light", "unshadowed far light (runs)"],
+            span: "indirect lighting: unshadowed",
             extra: None,
         };
         self.walk_batches(f, pool, rec, inputs, batched)
@@ -435,6 +465,8 @@ pub(super) enum GatesGather {
     NearMarks,
     /// `cs_near_compose`: the near light added onto the image.
     NearCompose,
+    /// `cs_far_unshadowed`: each pixel's unshadowed far light, for the ratio estimator.
+    FarUnshadowed,
 }
 
 /// The bytes of the near field's marks for a frame of `size` pixels and `vpls` VPLs: a bit a

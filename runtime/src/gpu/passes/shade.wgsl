@@ -304,6 +304,39 @@ fn cs_gates_indirect(@builtin(global_invocation_id) id: vec3<u32>) {
     textureStore(out_image, id.xy, sum);
 }
 
+// The ratio estimator's other half (GatesParams::ratio; Heitz et al. 2018): each pixel's
+// unshadowed far light, every VPL's but the near field's share, no visibility, which the blur
+// scales by the visible share of its taps' subsets. In runs of RATIO_RUN VPLs a dispatch
+// (walk_batch_index.x the run), each adding to the runs' before (earlier_batches): llvmpipe's
+// loop limit.
+const RATIO_RUN: u32 = 16384u;
+
+@compute @workgroup_size(8, 8)
+fn cs_far_unshadowed(@builtin(global_invocation_id) id: vec3<u32>) {
+    if any(id.xy >= textureDimensions(g_position)) {
+        return;
+    }
+    let px = vec2<i32>(id.xy);
+    let run = walk_batch_index.x;
+    var sum = vec3<f32>(0.0);
+    if run > 0u {
+        sum = textureLoad(earlier_batches, px, 0).xyz;
+    }
+    let pos = textureLoad(g_position, px, 0);
+    if pos.w != 0.0 {
+        let p = pos.xyz;
+        let n = normalize(textureLoad(g_normal, px, 0).xyz);
+        let r = near_radius(p);
+        let end = min(globals.vpl_count, (run + 1u) * RATIO_RUN);
+        for (var k = run * RATIO_RUN; k < end; k++) {
+            let v = vpls[k];
+            let to_v = v.position - p;
+            sum += vpl_light(v, p, n, globals.g_max) * (1.0 - near_share(dot(to_v, to_v), r));
+        }
+    }
+    textureStore(out_image, id.xy, vec4<f32>(sum, 1.0));
+}
+
 // Interleaved gates' second gather, the walks (starved.rs; starved.wgsl makes the pairs and
 // sums them): an invocation a (pixel, subset) pair walks its subset's VPLs (in batches on a
 // software rasterizer, each adding to the pair's light).

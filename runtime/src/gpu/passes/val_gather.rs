@@ -192,9 +192,14 @@ impl ValGathers {
             f.view.size,
         );
         rec.end();
-        passes
-            .blur
-            .record(f, il, pool, rec, (g, &uniform_buf, &indirect, out), None);
+        passes.blur.record(
+            f,
+            il,
+            pool,
+            rec,
+            (g, &uniform_buf, &indirect, out),
+            (None, None),
+        );
         Ok(Some(b.state))
     }
 }

@@ -25,7 +25,9 @@ struct Globals {
     // Interleaved walks: the VPLs nearer a pixel than this times its distance from the eye are
     // walked at the pixel itself (shade.wgsl's cs_near_field), not in its subset (0: none).
     near_scale: f32,
-    pad0: u32,
+    // Interleaved walks, the ratio estimator: 1 where the blur scales each pixel's unshadowed far
+    // light by its taps' visible share (blur.wgsl's compose), 0 where it averages their light.
+    ratio: u32,
     pad1: u32,
     pad2: u32,
 };

@@ -62,5 +62,8 @@ struct ValGather {
     // Blur thresholds: distance (m) and normal cosine.
     blur_distance: f32,
     blur_normal: f32,
-    pad2: vec2<f32>,
+    // Interleaved walks, the ratio estimator: 1 where the blur scales the pixel's unshadowed
+    // far light by its taps' visible share, 0 where it averages their light.
+    ratio: u32,
+    pad2: f32,
 };

@@ -56,15 +56,22 @@ fn gate_shape() -> u32 {
 // the whole of subset j (of `subsets`) there, summed over its channels; a VPL under s times
 // it is walked by chance (walk_range). Summed once, in a pixel's first batch, so that the cut
 // does not depend on the batching (summed in every batch, it cost e2m3's hall 1.2 s of 3.7 at
-// 16,384 VPLs on lavapipe). 0 when off.
+// 16,384 VPLs on lavapipe). 0 when off. With the ratio estimator (globals.ratio) the near
+// field's share left out: the subset's unshadowed far light, which the blur weighs the walks'
+// light against (blur.wgsl's compose), and the roulette's total too.
 fn roulette_total(p: vec3<f32>, n: vec3<f32>, j: u32, subsets: u32) -> f32 {
-    if globals.walk_roulette <= 0.0 {
+    let ratio = globals.ratio == 1u;
+    if globals.walk_roulette <= 0.0 && !ratio {
         return 0.0;
     }
+    // near_share is 0 at a radius of 0: the whole light, as without the ratio.
+    let r = select(0.0, near_radius(p), ratio);
     var total = 0.0;
     for (var k = j; k < globals.vpl_count; k += subsets) {
-        let l = vpl_light(vpls[k], p, n, globals.g_max);
-        total += l.x + l.y + l.z;
+        let v = vpls[k];
+        let l = vpl_light(v, p, n, globals.g_max);
+        let to_v = v.position - p;
+        total += (l.x + l.y + l.z) * (1.0 - near_share(dot(to_v, to_v), r));
     }
     return total;
 }
