@@ -191,18 +191,21 @@ pub struct MethodArgs {
     #[arg(long, conflicts_with_all = ["balanced", "fast"])]
     pub accurate: bool,
     /// Gates: the balanced setting, the default, in one word — --closed-voxel-triangles
-    /// --blur-tent --starved-dark on the fast setting (a --starved-taps given is kept). On the
-    /// same sixteen camera-seeds as --accurate: indirect energy within 3 % of the reference's
-    /// and under 1 % of the lit pixels black on all sixteen, where the fast setting left Crytek
-    /// Sponza's gallery 0.89 of the light and 2.7 % of it black, at 1.2-2.5x the fast
-    /// setting's frame on lavapipe (README, The balanced setting).
+    /// --blur-tent --starved-dark --near-field 4 --ratio on the fast setting (a --starved-taps
+    /// given is kept). On the same sixteen camera-seeds as --accurate (before the near field
+    /// and the ratio): indirect energy within 3 % of the reference's and under 1 % of the lit
+    /// pixels black on all sixteen, where the fast setting left Crytek Sponza's gallery 0.89 of
+    /// the light and 2.7 % of it black, at 1.2-2.5x the fast setting's frame on lavapipe
+    /// (README, The balanced setting); with them, within 1.5x per-VPL shadow maps' indirect
+    /// MSE on 23 of 24 views (README, the error table).
     #[arg(long, conflicts_with = "fast")]
     pub balanced: bool,
     /// Gates: the fast setting — the voxel walk passing closed voxels on their planes, the box
-    /// blur, no second walks: the default until the balanced setting, the fastest voxel walk,
-    /// and the one that loses light where the geometry grazes a light's paths within a sight
-    /// voxel (fluted columns, curtains). --closed-voxel-triangles, --blur-tent, --starved-dark
-    /// and --starved-taps add to it one at a time.
+    /// blur, no second walks, no near field, no ratio estimator: the default until the
+    /// balanced setting, the fastest voxel walk, and the one that loses light where the
+    /// geometry grazes a light's paths within a sight voxel (fluted columns, curtains).
+    /// --closed-voxel-triangles, --blur-tent, --starved-dark, --starved-taps, --near-field and
+    /// --ratio add to it one at a time.
     #[arg(long)]
     pub fast: bool,
     /// --gate-shape voxels without the triangles (--fast): block at every closed voxel, with each end
@@ -328,9 +331,10 @@ pub struct MethodArgs {
     /// their average light by that share: where every VPL is visible a pixel gets its exact
     /// light, whichever VPL subsets its block held, and the interleaving's error is left to
     /// where the visibility changes across a block. Part of the balanced and accurate settings
-    /// (the indirect MSE x0.18-1.0 on 20 of 24 views at 1,024 VPLs, see the README); this
-    /// turns it on with --fast. Off where the walks' roulette is on (by default from 8,192
-    /// VPLs in 8 x 8 blocks).
+    /// (the indirect MSE x0.18-0.98 on 21 of 24 views at 1,024 VPLs, within 1.5x per-VPL
+    /// shadow maps' on 23; the frame 1.6-2.1x on lavapipe at 512², its pass about 0.8 ms at
+    /// 1,024 VPLs on an H200 by the none mode's loop: see the README); this turns it on with --fast. Off where the
+    /// walks' roulette is on (by default from 8,192 VPLs in 8 x 8 blocks).
     #[arg(long, conflicts_with = "no_ratio")]
     pub ratio: bool,
     /// Leaves the ratio estimator (--ratio) out of the balanced or accurate setting: the blur
