@@ -89,6 +89,7 @@ pub use passes::display::{DISPLAY_FORMAT, read_display};
 pub use passes::gates_params::NEAR_FIELD_MAX;
 pub use passes::light_cluster::{MAX_LC_CLUSTERS, MAX_LC_LIGHTS};
 pub use passes::rsm_vpls::RsmParams;
+pub use passes::shade::RATIO_RUN;
 pub use timing::{LcCounts, LightListStats, PassTime, PassTimes, ValIterations};
 
 /// Where a frame's VPLs come from.
