@@ -324,15 +324,9 @@ fn cs_far_unshadowed(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let pos = textureLoad(g_position, px, 0);
     if pos.w != 0.0 {
-        let p = pos.xyz;
         let n = normalize(textureLoad(g_normal, px, 0).xyz);
-        let r = near_radius(p);
         let end = min(globals.vpl_count, (run + 1u) * RATIO_RUN);
-        for (var k = run * RATIO_RUN; k < end; k++) {
-            let v = vpls[k];
-            let to_v = v.position - p;
-            sum += vpl_light(v, p, n, globals.g_max) * (1.0 - near_share(dot(to_v, to_v), r));
-        }
+        sum += far_unshadowed(pos.xyz, n, run * RATIO_RUN, end);
     }
     textureStore(out_image, id.xy, vec4<f32>(sum, 1.0));
 }

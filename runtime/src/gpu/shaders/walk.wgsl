@@ -76,6 +76,19 @@ fn roulette_total(p: vec3<f32>, n: vec3<f32>, j: u32, subsets: u32) -> f32 {
     return total;
 }
 
+// The ratio estimator's unshadowed far light at p (normal n) from VPLs [first, end): each
+// one's light without visibility, less the near field's share (shade.wgsl's cs_far_unshadowed).
+fn far_unshadowed(p: vec3<f32>, n: vec3<f32>, first: u32, end: u32) -> vec3<f32> {
+    let r = near_radius(p);
+    var sum = vec3<f32>(0.0);
+    for (var k = first; k < end; k++) {
+        let v = vpls[k];
+        let to_v = v.position - p;
+        sum += vpl_light(v, p, n, globals.g_max) * (1.0 - near_share(dot(to_v, to_v), r));
+    }
+    return sum;
+}
+
 // The roulette's numbers for pixel px: a hash (PCG, O'Neill) of the seed and the pixel's
 // 8 × 8 tile of the deinterleaved target (8 b × 8 b pixels), which roulette_unit shifts a Weyl
 // sequence by. The tile's lanes (a workgroup) walk or skip a VPL together, for a GPU's warps,
