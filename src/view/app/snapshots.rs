@@ -194,11 +194,24 @@ fn the_viewer_starts_balanced_and_its_fast_setting_walks_the_planes() {
     };
     assert_eq!(listed(app), (Some(true), true));
     assert!(has_pass(app, "indirect lighting: starved pixels"));
+    assert!(
+        has_pass(app, "indirect lighting: unshadowed"),
+        "the ratio's pass"
+    );
     harness.get_by_label("gates setting: balanced");
-    // The fast setting: no triangles, no tent, no second pass.
+    // The ratio's tick: its pass off on the next frame, a setting of the user's own; on again.
+    let app = clicked(&mut harness, "ratio estimator");
+    assert!(!app.settings.gates.ratio);
+    assert!(!has_pass(app, "indirect lighting: unshadowed"));
+    harness.get_by_label("gates setting: your own");
+    let app = clicked(&mut harness, "ratio estimator");
+    assert!(has_pass(app, "indirect lighting: unshadowed"));
+    harness.get_by_label("gates setting: balanced");
+    // The fast setting: no triangles, no tent, no second pass, no ratio.
     let app = clicked(&mut harness, "fast setting");
     assert_eq!(app.settings.gates, GatesParams::default());
     assert!(!has_pass(app, "indirect lighting: starved pixels"));
+    assert!(!has_pass(app, "indirect lighting: unshadowed"));
     assert!(has_pass(app, "indirect lighting"));
     harness.get_by_label("gates setting: fast");
     // The triangles' tick alone on it: a setting of the user's own.
