@@ -180,6 +180,13 @@ fn two_rooms_level() -> (tempfile::TempDir, String, String) {
     (dir, level, out)
 }
 
+/// `visgate` with `args`, which must succeed (its stderr shown where it does not).
+fn succeeded(args: &[&str]) -> std::process::Output {
+    let o = visgate(args);
+    assert!(o.status.success(), "{}", stderr(&o));
+    o
+}
+
 /// `visgate render builtin:two-rooms --mode gates` at 64 VPLs and 16×12 with `level`, to `out`.
 fn gates_render<'a>(level: &'a str, out: &'a str) -> Vec<&'a str> {
     let mut a = vec![
@@ -214,21 +221,14 @@ fn render_gates_names_its_setting_and_each_flag_that_adds_to_the_fast_one() {
     assert!(stdout(&o).contains("starved pixels"), "{}", stdout(&o));
     assert!(stdout(&o).contains("near VPLs"), "{}", stdout(&o));
     assert!(stdout(&o).contains("unshadowed"), "{}", stdout(&o));
-    // Without the ratio estimator: named so, and its pass not run.
-    let mut n = a.clone();
-    n.push("--no-ratio");
-    let on = visgate(&n);
-    assert!(on.status.success(), "{}", stderr(&on));
-    assert!(
-        stdout(&on).contains("near field 4 blocks) 16x12"),
-        "{}",
-        stdout(&on)
-    );
-    assert!(!stdout(&on).contains("unshadowed"), "{}", stdout(&on));
-    n.push("--ratio");
-    let both = visgate(&n);
-    assert!(!both.status.success(), "--ratio with --no-ratio is refused");
     assert!(!stdout(&o).contains("unique clusters"), "{}", stdout(&o));
+    // Without the ratio estimator: named so, and its pass not run; with both flags, refused.
+    let no_ratio = [&a[..], &["--no-ratio"]].concat();
+    let out = stdout(&succeeded(&no_ratio));
+    assert!(out.contains("near field 4 blocks) 16x12"), "{out}");
+    assert!(!out.contains("unshadowed"), "{out}");
+    let both = visgate(&[&no_ratio[..], &["--ratio"]].concat());
+    assert!(!both.status.success(), "--ratio with --no-ratio is refused");
     // The fast setting: the walk on the closed voxels' planes, the box blur, no second pass;
     // the rest below adds to it.
     a.push("--fast");

@@ -127,6 +127,9 @@ pub struct Frame<'a> {
     /// The near field's radius per metre of distance from the eye ([`Globals::near_scale`]; 0:
     /// none).
     pub near_scale: f32,
+    /// Whether the interleaved walks' blur takes the ratio estimator ([`Globals::ratio`];
+    /// [`GpuMode::ratio_for`] of the frame's VPLs).
+    pub ratio: bool,
     /// Marked VPLs a tile of the near field walks a round ([`methods::near_run`]; 0: all in
     /// one).
     pub near_run: u32,
@@ -424,6 +427,7 @@ impl GpuRenderer {
         let marks = passes::shade::near_marks_bytes(view.size, vpl_count);
         let fits = marks <= ctx.device.limits().max_storage_buffer_binding_size;
         let near_scale = if fits { near_scale } else { 0.0 };
+        let ratio = params.mode.ratio_for(vpl_count);
         let globals = Globals {
             view_proj: view.view_proj(scene.near_m).to_cols_array_2d(),
             eye: view.eye.extend(1.0).to_array(),
@@ -444,7 +448,7 @@ impl GpuRenderer {
             walk_roulette,
             walk_seed,
             near_scale,
-            ratio: u32::from(params.mode.ratio_for(vpl_count)),
+            ratio: u32::from(ratio),
             _pad1: 0,
             _pad2: 0,
         };
@@ -478,6 +482,7 @@ impl GpuRenderer {
             vpls_cpu,
             walk_batch,
             near_scale,
+            ratio,
             near_run: methods::near_run(
                 &ctx.adapter_info.name,
                 &params.mode,

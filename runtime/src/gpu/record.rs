@@ -99,7 +99,7 @@ pub(super) fn record_passes(
                     .shade
                     .record_near(f, pool, rec, inputs, (gp.gates.shape, &hdr));
             }
-            let unshadowed = gp.ratio_for(f.vpl_count).then(|| {
+            let unshadowed = f.ratio.then(|| {
                 p.shade
                     .record_unshadowed(f, pool, rec, inputs, gp.gates.shape)
             });

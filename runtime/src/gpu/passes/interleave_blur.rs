@@ -171,7 +171,7 @@ impl InterleaveBlur {
             deinterleaved: u32::from(deinterleaved),
             blur_fill: u32::from(p.fill),
             blur_tent: u32::from(p.tent),
-            ratio: u32::from(f.params.mode.ratio_for(f.vpl_count)),
+            ratio: u32::from(f.ratio),
             ..bytemuck::Zeroable::zeroed()
         };
         pool.upload(

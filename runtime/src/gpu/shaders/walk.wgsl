@@ -68,25 +68,28 @@ fn roulette_total(p: vec3<f32>, n: vec3<f32>, j: u32, subsets: u32) -> f32 {
     let r = select(0.0, near_radius(p), ratio);
     var total = 0.0;
     for (var k = j; k < globals.vpl_count; k += subsets) {
-        let v = vpls[k];
-        let l = vpl_light(v, p, n, globals.g_max);
-        let to_v = v.position - p;
-        total += (l.x + l.y + l.z) * (1.0 - near_share(dot(to_v, to_v), r));
+        let l = far_light(vpls[k], p, n, r);
+        total += l.x + l.y + l.z;
     }
     return total;
 }
 
-// The ratio estimator's unshadowed far light at p (normal n) from VPLs [first, end): each
-// one's light without visibility, less the near field's share (shade.wgsl's cs_far_unshadowed).
+// The ratio estimator's unshadowed far light at p (normal n) from VPLs [first, end)
+// (shade.wgsl's cs_far_unshadowed).
 fn far_unshadowed(p: vec3<f32>, n: vec3<f32>, first: u32, end: u32) -> vec3<f32> {
     let r = near_radius(p);
     var sum = vec3<f32>(0.0);
     for (var k = first; k < end; k++) {
-        let v = vpls[k];
-        let to_v = v.position - p;
-        sum += vpl_light(v, p, n, globals.g_max) * (1.0 - near_share(dot(to_v, to_v), r));
+        sum += far_light(vpls[k], p, n, r);
     }
     return sum;
+}
+
+// VPL v's light at p (normal n) without visibility, less the near field's share at radius r
+// (all of it at r = 0).
+fn far_light(v: Vpl, p: vec3<f32>, n: vec3<f32>, r: f32) -> vec3<f32> {
+    let to_v = v.position - p;
+    return vpl_light(v, p, n, globals.g_max) * (1.0 - near_share(dot(to_v, to_v), r));
 }
 
 // The roulette's numbers for pixel px: a hash (PCG, O'Neill) of the seed and the pixel's
