@@ -322,6 +322,8 @@ mod tests {
             "--near-field",
             "4",
             "--ratio",
+            "--ratio-stride",
+            "3",
         ];
         assert_eq!(g, gates_of("gates", &[&flags[..], &spelled].concat()));
         assert!(!all_with(&[]).contains(&BALANCED.to_string()));

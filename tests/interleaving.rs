@@ -187,7 +187,9 @@ fn the_accurate_and_balanced_settings_light_the_side_rooms_door_jamb() {
 /// light, spots that single VPLs light; walking the VPLs within the balanced setting's 4
 /// blocks' width at each pixel itself takes most of it away, against every VPL at every pixel
 /// (1,024 paths, 320 × 240; measured 5.07e-4 without, 4.60e-5 with), and the ratio estimator
-/// (the balanced setting's too) most of what is left (1.84e-6).
+/// (the balanced setting's too) most of what is left (2.35e-6 with its unshadowed light on the
+/// setting's 3 px grid; 1.84e-6 summed at every pixel, 4.8e-6 on the grid before the pixels
+/// where its light spreads summed their own).
 #[test]
 fn the_near_field_takes_the_creases_error_out_of_the_interleaving() {
     let (mut lit, _) = lit_view(Builtin::PillaredHall, 128, 0, (1024, 0), [320, 240]);
@@ -278,7 +280,8 @@ fn a_near_field_that_holds_every_vpl_is_every_vpl_at_every_pixel() {
 /// interleaving's average, without the ratio, is off by what the subsets' light changes
 /// across a block (7.8e-4). With the voxel walk 2e-7: a few pixels along the ceiling, whose
 /// walks to VPLs beside them the closed voxels block at some pixels of a block and not at
-/// others.
+/// others. On the unshadowed light's 3 px grid (`GatesParams::ratio_stride`, the balanced
+/// setting's) the pixels between the grid's take it bilinearly: 8.0e-7.
 #[test]
 fn the_ratio_estimator_in_a_room_that_sees_itself_is_every_vpl_at_every_pixel() {
     let (mut lit, _) = lit_view(Builtin::EmptyBox, 32, 0, (1024, 1), [160, 120]);
@@ -290,23 +293,31 @@ fn the_ratio_estimator_in_a_room_that_sees_itself_is_every_vpl_at_every_pixel() 
     let mut ratio = balanced;
     balanced.ratio = false;
     ratio.ratio = true;
-    let [plain, ratio] = [balanced, ratio].map(|g| lit.render(GpuMode::Gates(g)));
-    let [e_plain, e_ratio] = [&plain, &ratio].map(|i| errors(i, &every).expect("same size"));
+    ratio.ratio_stride = 1;
+    let mut grid = ratio;
+    grid.ratio_stride = 3;
+    let [plain, ratio, grid] = [balanced, ratio, grid].map(|g| lit.render(GpuMode::Gates(g)));
+    let [e_plain, e_ratio, e_grid] =
+        [&plain, &ratio, &grid].map(|i| errors(i, &every).expect("same size"));
     eprintln!(
         "empty box against every VPL at every pixel: relative MSE {:.3e} averaged, {:.3e} with \
-         the ratio estimator",
-        e_plain.rel_mse, e_ratio.rel_mse
+         the ratio estimator, {:.3e} on its 3 px grid",
+        e_plain.rel_mse, e_ratio.rel_mse, e_grid.rel_mse
     );
     assert!(e_ratio.reference_mean > 0.0, "{e_ratio:?}");
     assert!(e_ratio.rel_mse < 1e-10, "{e_ratio:?}");
     assert!(e_plain.rel_mse > 100.0 * e_ratio.rel_mse, "{e_plain:?}");
+    // On a grid the pixels between take the light bilinearly, which it is not quite: a small
+    // error, far below the average's.
+    assert!(e_grid.rel_mse < 0.05 * e_plain.rel_mse, "{e_grid:?}");
 }
 
 /// The unshadowed light sums its VPLs in runs of `RATIO_RUN` a dispatch (lavapipe's loop
 /// limit), each adding to the runs' before: past one run (20,000 light paths, the walks'
 /// roulette off so that the ratio stays on) the empty box's known answer holds as it does
 /// within one — every VPL at every pixel (measured: relative MSE 1.2e-12; 9.6e-3 with the
-/// shader's run set to half the renderer's, the last VPLs left out).
+/// shader's run set to half the renderer's, the last VPLs left out) — and on the balanced
+/// setting's grid, within its bilinear error.
 #[test]
 fn the_ratio_estimators_unshadowed_light_holds_every_run_of_vpls() {
     use visgate_runtime::gpu::{RATIO_RUN, WalkRoulette};
@@ -317,16 +328,23 @@ fn the_ratio_estimators_unshadowed_light_holds_every_run_of_vpls() {
     ratio.walk_roulette = WalkRoulette::Share(0.0);
     // No near field: at 16 × 12 pixels its radius would hold the whole box.
     ratio.near_field = 0.0;
+    ratio.ratio_stride = 1;
     assert!(ratio.ratio_for(lit.vpls.len() as u32));
     let mut every = ratio;
     every.interleave.block = 1;
     let every = lit.render(GpuMode::Gates(every));
-    let ratio = lit.render(GpuMode::Gates(ratio));
-    let e = errors(&ratio, &every).expect("same size");
+    let mut grid = ratio;
+    grid.ratio_stride = 3;
+    let [ratio, grid] = [ratio, grid].map(|g| lit.render(GpuMode::Gates(g)));
+    let [e, e_grid] = [&ratio, &grid].map(|i| errors(i, &every).expect("same size"));
     eprintln!(
-        "{} VPLs, ratio against every VPL at every pixel: {e:?}",
+        "{} VPLs, ratio against every VPL at every pixel: {e:?}; on a 3 px grid {e_grid:?}",
         lit.vpls.len()
     );
     assert!(e.reference_mean > 0.0, "{e:?}");
     assert!(e.rel_mse < 1e-10, "{e:?}");
+    // On a 3 px grid the grid's pixels and those beside the box's creases sum both runs too:
+    // 4.6e-4 (16 × 12 pixels, a grid of 6 × 5: the bilinear light's error), 1.2e-2 with the
+    // shader's run set to half the renderer's.
+    assert!(e_grid.rel_mse < 2e-3, "{e_grid:?}");
 }

@@ -498,6 +498,18 @@ pub fn pass_table(t: &PassTimes) -> String {
             st.pairs as f64 / f64::from(st.capacity.max(1)) * 100.0
         );
     }
+    if let Some(r) = t.ratio {
+        s += &format!(
+            "ratio estimator: unshadowed light summed at {} grid pixels (every {} px) and {} \
+             between them ({:.1} % of {} pixels) off their grid pixels' surface, the rest \
+             bilinear\n",
+            r.grid,
+            r.stride,
+            r.own,
+            f64::from(r.own) / f64::from(r.pixels.max(1)) * 100.0,
+            r.pixels
+        );
+    }
     if let Some(l) = t.lists {
         s += &format!(
             "light lists: {} geometry clusters, {} entries ({:.1} per cluster), pool {} entries \

@@ -8,7 +8,7 @@ use visgate_runtime::cpu::gates::GateShape;
 use visgate_runtime::gpu::{
     AUTO_ROULETTE_BLOCK, AUTO_ROULETTE_SHARE, AUTO_ROULETTE_VPLS, DirectLight, DiskLight,
     GatesParams, InterleaveParams, IsmParams, LcDisk, LightClusterGpuParams, MethodSettings,
-    NEAR_FIELD_MAX, PassTimes, WalkRoulette,
+    NEAR_FIELD_MAX, PassTimes, RATIO_STRIDE_MAX, WalkRoulette,
 };
 
 use super::camera::FlyCamera;
@@ -113,6 +113,17 @@ fn gates_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
                          interleaving's error left to where the visibility changes (off where \
                          the walk roulette is on)",
                     );
+                if s.gates.ratio {
+                    ui.add(
+                        egui::Slider::new(&mut s.gates.ratio_stride, 1..=RATIO_STRIDE_MAX)
+                            .text("ratio grid (px)"),
+                    )
+                    .on_hover_text(
+                        "the unshadowed light is summed at every n-th pixel across and down \
+                         and at the pixels beside a crease or an edge; the others take it \
+                         between their four grid pixels: n² times fewer sums on flat walls",
+                    );
+                }
             }
         }
     }

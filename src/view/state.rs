@@ -57,6 +57,9 @@ pub struct SavedView {
     /// The gates' ratio estimator (absent in older files: the run's own).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ratio: Option<bool>,
+    /// The ratio estimator's grid stride (absent in older files: the run's own).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ratio_stride: Option<u32>,
 }
 
 impl SavedView {
@@ -154,6 +157,7 @@ mod tests {
             walk_roulette: (mode == "gates").then(|| "0.1".into()),
             near_field: (mode == "gates").then_some(2.0),
             ratio: (mode == "gates").then_some(false),
+            ratio_stride: (mode == "gates").then_some(3),
         };
         save_to(&p, "a", state("gates"));
         save_to(&p, "b", state("val-cssm"));
@@ -201,6 +205,12 @@ mod tests {
         json.as_object_mut().expect("object").remove("ratio");
         let older: SavedView = serde_json::from_value(json).expect("an older state");
         assert_eq!(older.ratio, None);
+        // And its grid.
+        assert_eq!(all["a"].ratio_stride, Some(3));
+        let mut json: serde_json::Value = serde_json::to_value(state("gates")).expect("json");
+        json.as_object_mut().expect("object").remove("ratio_stride");
+        let older: SavedView = serde_json::from_value(json).expect("an older state");
+        assert_eq!(older.ratio_stride, None);
         // A file from before the shape was named: disks and voxels as chosen, else today's
         // default.
         let old = |disks: bool, voxels: bool| SavedView {

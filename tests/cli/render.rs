@@ -216,8 +216,14 @@ fn render_gates_names_its_setting_and_each_flag_that_adds_to_the_fast_one() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(stdout(&o).contains("VPL walk ends"), "{}", stdout(&o));
     let balanced = "gates (voxel walk + triangles, 8×8 interleaved, tent blur, dark pixels walk \
-                    the rest, near field 4 blocks, ratio estimator) 16x12";
+                    the rest, near field 4 blocks, ratio estimator (grid 3 px)) 16x12";
     assert!(stdout(&o).contains(balanced), "{}", stdout(&o));
+    assert!(
+        stdout(&o)
+            .contains("ratio estimator: unshadowed light summed at 30 grid pixels (every 3 px)"),
+        "{}",
+        stdout(&o)
+    );
     assert!(stdout(&o).contains("starved pixels"), "{}", stdout(&o));
     assert!(stdout(&o).contains("near VPLs"), "{}", stdout(&o));
     assert!(stdout(&o).contains("unshadowed"), "{}", stdout(&o));
@@ -229,6 +235,24 @@ fn render_gates_names_its_setting_and_each_flag_that_adds_to_the_fast_one() {
     assert!(!out.contains("unshadowed"), "{out}");
     let both = visgate(&[&no_ratio[..], &["--ratio"]].concat());
     assert!(!both.status.success(), "--ratio with --no-ratio is refused");
+    let grid = visgate(&[&no_ratio[..], &["--ratio-stride", "3"]].concat());
+    assert!(
+        !grid.status.success(),
+        "--ratio-stride with --no-ratio is refused"
+    );
+    // Its grid: every pixel's own at stride 1 (named without a grid), a wider one named, one
+    // past the limit refused with it.
+    let out = stdout(&succeeded(&[&a[..], &["--ratio-stride", "1"]].concat()));
+    assert!(out.contains("ratio estimator) 16x12"), "{out}");
+    assert!(
+        out.contains("summed at 192 grid pixels (every 1 px) and 0 between"),
+        "{out}"
+    );
+    let out = stdout(&succeeded(&[&a[..], &["--ratio-stride", "8"]].concat()));
+    assert!(out.contains("ratio estimator (grid 8 px)) 16x12"), "{out}");
+    let wide = visgate(&[&a[..], &["--ratio-stride", "9"]].concat());
+    assert!(!wide.status.success(), "stride 9 is refused");
+    assert!(stderr(&wide).contains("0..=8 pixels"), "{}", stderr(&wide));
     // The fast setting: the walk on the closed voxels' planes, the box blur, no second pass;
     // the rest below adds to it.
     a.push("--fast");

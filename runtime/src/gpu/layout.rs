@@ -151,8 +151,10 @@ gpu_struct! {
         /// unshadowed far light by its taps' visible share, 0 where it averages their light
         /// ([`crate::gpu::passes::gates_params::GatesParams::ratio`]).
         pub ratio: u32,
-        /// Padding.
-        pub _pad1: u32,
+        /// The ratio estimator's grid: the unshadowed far light summed at every this many
+        /// pixels across and down (1: every pixel;
+        /// [`crate::gpu::passes::gates_params::GatesParams::ratio_stride`]). [Units: px]
+        pub ratio_stride: u32,
         /// Padding.
         pub _pad2: u32,
     }
@@ -456,8 +458,9 @@ gpu_struct! {
         /// unshadowed far light by its taps' visible share (`blur.wgsl`), 0 where it averages
         /// their light.
         pub ratio: u32,
-        /// Padding.
-        pub _pad2: f32,
+        /// The ratio estimator's grid stride (`ratio.wgsl`; 1: every pixel).
+        /// [Units: px]
+        pub ratio_stride: u32,
     }
 }
 

@@ -286,6 +286,9 @@ impl GpuMode {
                 }
                 if p.ratio && p.interleave.block > 1 && walks {
                     s += ", ratio estimator";
+                    if p.ratio_grid() > 1 {
+                        s += &format!(" (grid {} px)", p.ratio_grid());
+                    }
                 }
                 if p.gates.shape != GateShape::Disk {
                     match p.walk_roulette {
@@ -403,6 +406,15 @@ impl GpuMode {
     /// ([`GatesParams::ratio_for`]).
     pub fn ratio_for(&self, vpls: u32) -> bool {
         matches!(self, GpuMode::Gates(p) if p.ratio_for(vpls))
+    }
+
+    /// The ratio estimator's grid stride in pixels ([`GatesParams::ratio_grid`]; 1 for the
+    /// modes without it).
+    pub fn ratio_stride(&self) -> u32 {
+        match self {
+            GpuMode::Gates(p) => p.ratio_grid(),
+            _ => 1,
+        }
     }
 }
 

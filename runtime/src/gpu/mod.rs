@@ -68,6 +68,7 @@ use passes::rsm_vpls::RsmVpls;
 use passes::shade::Shade;
 use passes::shadow_maps::ShadowMaps;
 use passes::sight_ends::SightEnds;
+use passes::unshadowed::Unshadowed;
 use passes::val_gather::ValGathers;
 use passes::vals::ValClustering;
 use shaders::ShadeIndirect;
@@ -86,10 +87,10 @@ pub use passes::clustered_gates::{
     WalkRoulette,
 };
 pub use passes::display::{DISPLAY_FORMAT, read_display};
-pub use passes::gates_params::NEAR_FIELD_MAX;
+pub use passes::gates_params::{NEAR_FIELD_MAX, RATIO_STRIDE, RATIO_STRIDE_MAX};
 pub use passes::light_cluster::{MAX_LC_CLUSTERS, MAX_LC_LIGHTS};
 pub use passes::rsm_vpls::RsmParams;
-pub use passes::shade::RATIO_RUN;
+pub use passes::unshadowed::RATIO_RUN;
 pub use timing::{LcCounts, LightListStats, PassTime, PassTimes, ValIterations};
 
 /// Where a frame's VPLs come from.
@@ -130,6 +131,8 @@ pub struct Frame<'a> {
     /// Whether the interleaved walks' blur takes the ratio estimator ([`Globals::ratio`];
     /// [`GpuMode::ratio_for`] of the frame's VPLs).
     pub ratio: bool,
+    /// The ratio estimator's grid stride ([`Globals::ratio_stride`]; 1 without it).
+    pub ratio_stride: u32,
     /// Marked VPLs a tile of the near field walks a round ([`methods::near_run`]; 0: all in
     /// one).
     pub near_run: u32,
@@ -153,6 +156,7 @@ pub struct Pipelines {
     isms: Isms,
     display: Display,
     sight_ends: SightEnds,
+    unshadowed: Unshadowed,
 }
 
 impl Pipelines {
@@ -172,6 +176,7 @@ impl Pipelines {
             isms: Isms::new(d, s)?,
             display: Display::new(d, s)?,
             sight_ends: SightEnds::new(d, s)?,
+            unshadowed: Unshadowed::new(d, s)?,
         })
     }
 }
@@ -428,6 +433,7 @@ impl GpuRenderer {
         let fits = marks <= ctx.device.limits().max_storage_buffer_binding_size;
         let near_scale = if fits { near_scale } else { 0.0 };
         let ratio = params.mode.ratio_for(vpl_count);
+        let ratio_stride = if ratio { params.mode.ratio_stride() } else { 1 };
         let globals = Globals {
             view_proj: view.view_proj(scene.near_m).to_cols_array_2d(),
             eye: view.eye.extend(1.0).to_array(),
@@ -449,7 +455,7 @@ impl GpuRenderer {
             walk_seed,
             near_scale,
             ratio: u32::from(ratio),
-            _pad1: 0,
+            ratio_stride,
             _pad2: 0,
         };
         let level = scene.level.as_ref();
@@ -483,6 +489,7 @@ impl GpuRenderer {
             walk_batch,
             near_scale,
             ratio,
+            ratio_stride,
             near_run: methods::near_run(
                 &ctx.adapter_info.name,
                 &params.mode,

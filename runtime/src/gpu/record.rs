@@ -24,6 +24,8 @@ pub(super) struct Recorded {
     pub(super) vpl_lc_args: Option<wgpu::Buffer>,
     /// Interleaved gates' starved pixels, with `--starved-taps`.
     pub(super) starved: Option<passes::starved::StarvedOutput>,
+    /// Interleaved walks' ratio estimator's unshadowed light.
+    pub(super) unshadowed: Option<passes::unshadowed::UnshadowedOutput>,
 }
 
 /// The frame as its passes (after the VPLs): shadow maps, G-buffer, the mode's passes,
@@ -84,6 +86,7 @@ pub(super) fn record_passes(
     let mut hdr = p.shade.record(f, pool, rec, inputs, shading);
     let mut val_state = None;
     let mut starved = None;
+    let mut unshadowed = None;
     match &f.params.mode {
         GpuMode::Gates(gp) if gp.gathers_apart() => {
             let indirect = p
@@ -99,15 +102,18 @@ pub(super) fn record_passes(
                     .shade
                     .record_near(f, pool, rec, inputs, (gp.gates.shape, &hdr));
             }
-            let unshadowed = f.ratio.then(|| {
-                p.shade
-                    .record_unshadowed(f, pool, rec, inputs, gp.gates.shape)
-            });
+            unshadowed = f.ratio.then(|| p.unshadowed.record(f, pool, rec, &g));
             let uniform = InterleaveBlur::uniform(f, il, pool, true);
             let targets = (&g, &uniform, &indirect, &hdr);
             let sums = starved.as_ref().map(|s| &s.sums);
-            p.blur
-                .record(f, il, pool, rec, targets, (sums, unshadowed.as_ref()));
+            p.blur.record(
+                f,
+                il,
+                pool,
+                rec,
+                targets,
+                (sums, unshadowed.as_ref().map(|u| &u.image)),
+            );
         }
         GpuMode::VplClusters(_, il) if il.block > 1 => {
             let indirect = p.shade.record_indirect(f, pool, rec, inputs, None);
@@ -146,5 +152,6 @@ pub(super) fn record_passes(
         lc_args: lc.map(|o| o.clusters.args),
         vpl_lc_args: vpl_lc.map(|o| o.clusters.args),
         starved,
+        unshadowed,
     })
 }

@@ -26,6 +26,7 @@ struct Readbacks {
     lc: Option<wgpu::Buffer>,
     vpl_lc: Option<wgpu::Buffer>,
     starved: Option<wgpu::Buffer>,
+    ratio: Option<wgpu::Buffer>,
 }
 
 impl GpuRenderer {
@@ -154,6 +155,10 @@ impl GpuRenderer {
         if let (Some(s), Some(b)) = (&out.starved, &r.starved) {
             times.starved = Some(passes::starved::stats(&words(b)?, s.capacity)?);
         }
+        if let (Some(u), Some(b)) = (&out.unshadowed, &r.ratio) {
+            let own = words(b)?[0];
+            times.ratio = Some(passes::unshadowed::RatioStats { own, ..u.stats });
+        }
         if let (Some(b), Some(v)) = (&r.val_state, params.mode.vals()) {
             let c = words(b)?;
             times.vals = Some(ValIterations {
@@ -198,5 +203,6 @@ fn copy_counts(ctx: &GpuContext, pool: &mut Pool, rec: &mut Recorder, out: &Reco
         lc: (out.lc_args.as_ref()).map(|a| read_back("lc args readback", a, 64)),
         vpl_lc: (out.vpl_lc_args.as_ref()).map(|a| read_back("vpl lc args readback", a, 64)),
         starved: (out.starved.as_ref()).map(|s| read_back("starved count readback", &s.count, 16)),
+        ratio: (out.unshadowed.as_ref()).map(|u| read_back("ratio own count readback", &u.list, 4)),
     }
 }

@@ -17,7 +17,7 @@
 use crate::RenderError;
 
 /// The include files (`gpu/shaders/`).
-const INCLUDES: [(&str, &str); 14] = [
+const INCLUDES: [(&str, &str); 17] = [
     ("globals.wgsl", include_str!("shaders/globals.wgsl")),
     ("lights.wgsl", include_str!("shaders/lights.wgsl")),
     (
@@ -25,20 +25,23 @@ const INCLUDES: [(&str, &str); 14] = [
         include_str!("shaders/shadow_lookup.wgsl"),
     ),
     ("vpl.wgsl", include_str!("shaders/vpl.wgsl")),
+    ("face.wgsl", include_str!("shaders/face.wgsl")),
     ("grid.wgsl", include_str!("shaders/grid.wgsl")),
     ("gates.wgsl", include_str!("shaders/gates.wgsl")),
     ("portals.wgsl", include_str!("shaders/portals.wgsl")),
     ("sight.wgsl", include_str!("shaders/sight.wgsl")),
+    ("far.wgsl", include_str!("shaders/far.wgsl")),
     ("walk.wgsl", include_str!("shaders/walk.wgsl")),
     ("near.wgsl", include_str!("shaders/near.wgsl")),
     ("val.wgsl", include_str!("shaders/val.wgsl")),
+    ("ratio.wgsl", include_str!("shaders/ratio.wgsl")),
     ("lc.wgsl", include_str!("shaders/lc.wgsl")),
     ("pcss.wgsl", include_str!("shaders/pcss.wgsl")),
     ("ism.wgsl", include_str!("shaders/ism.wgsl")),
 ];
 
 /// The pass shaders (`gpu/passes/`), before composition.
-pub const SOURCES: [(&str, &str); 18] = [
+pub const SOURCES: [(&str, &str); 19] = [
     ("gbuffer.wgsl", include_str!("passes/gbuffer.wgsl")),
     ("shadow.wgsl", include_str!("passes/shadow.wgsl")),
     ("shade.wgsl", include_str!("passes/shade.wgsl")),
@@ -53,6 +56,7 @@ pub const SOURCES: [(&str, &str); 18] = [
     ("vals.wgsl", include_str!("passes/vals.wgsl")),
     ("val_gather.wgsl", include_str!("passes/val_gather.wgsl")),
     ("blur.wgsl", include_str!("passes/blur.wgsl")),
+    ("unshadowed.wgsl", include_str!("passes/unshadowed.wgsl")),
     ("cssm.wgsl", include_str!("passes/cssm.wgsl")),
     (
         "light_cluster.wgsl",

@@ -62,6 +62,8 @@ pub struct PassTimes {
     pub vpl_clusters: Option<LcCounts>,
     /// Interleaved gates with `--starved-taps`: the starved pixels' walks.
     pub starved: Option<crate::gpu::passes::starved::StarvedStats>,
+    /// Interleaved walks with the ratio estimator: where its unshadowed light was summed.
+    pub ratio: Option<crate::gpu::passes::unshadowed::RatioStats>,
 }
 
 /// How LightCluster clustered a frame's lights (or VPLs).
@@ -264,6 +266,7 @@ impl<'c> Recorder<'c> {
             direct_clusters: None,
             vpl_clusters: None,
             starved: None,
+            ratio: None,
         })
     }
 }

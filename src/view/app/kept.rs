@@ -2,7 +2,7 @@
 //! changes.
 
 use glam::Vec3;
-use visgate_runtime::gpu::NEAR_FIELD_MAX;
+use visgate_runtime::gpu::{NEAR_FIELD_MAX, RATIO_STRIDE_MAX};
 
 use super::ViewerApp;
 use crate::view::camera::FlyCamera;
@@ -47,6 +47,7 @@ impl ViewerApp {
             walk_roulette: Some(self.settings.gates.walk_roulette.to_string()),
             near_field: Some(self.settings.gates.near_field),
             ratio: Some(self.settings.gates.ratio),
+            ratio_stride: Some(self.settings.gates.ratio_stride),
         }
     }
 
@@ -84,6 +85,9 @@ impl ViewerApp {
         }
         if let Some(r) = s.ratio {
             self.settings.gates.ratio = r;
+        }
+        if let Some(n) = s.ratio_stride.filter(|n| *n <= RATIO_STRIDE_MAX) {
+            self.settings.gates.ratio_stride = n;
         }
     }
 

@@ -199,10 +199,17 @@ fn the_viewer_starts_balanced_and_its_fast_setting_walks_the_planes() {
         "the ratio's pass"
     );
     harness.get_by_label("gates setting: balanced");
-    // The ratio's tick: its pass off on the next frame, a setting of the user's own; on again.
+    // Its grid's slider beside the tick, at the setting's 3 px.
+    let grid_slider =
+        |h: &Harness<'static, ViewerApp>| h.query_all_by_label("ratio grid (px)").next().is_some();
+    assert!(grid_slider(&harness));
+    assert_eq!(harness.state().settings.gates.ratio_stride, 3);
+    // The ratio's tick: its pass off on the next frame, its grid's slider gone, a setting of
+    // the user's own; on again.
     let app = clicked(&mut harness, "ratio estimator");
     assert!(!app.settings.gates.ratio);
     assert!(!has_pass(app, "indirect lighting: unshadowed"));
+    assert!(!grid_slider(&harness));
     harness.get_by_label("gates setting: your own");
     let app = clicked(&mut harness, "ratio estimator");
     assert!(has_pass(app, "indirect lighting: unshadowed"));

@@ -94,6 +94,32 @@ fn the_near_field_is_on_in_the_balanced_setting_where_the_walks_are_not_thinned(
     p = balanced;
     p.near_field = 9.0;
     assert!(p.check().is_err());
+    // The ratio estimator's grid: the settings', named; 0 and 1 every pixel; 8 the widest.
+    assert_eq!(balanced.ratio_stride, crate::gpu::RATIO_STRIDE);
+    assert!(described(balanced, 1_024).contains("ratio estimator (grid 3 px)"));
+    p = balanced;
+    for (n, grid) in [(0, 1), (1, 1), (8, 8)] {
+        p.ratio_stride = n;
+        assert!(p.check().is_ok(), "stride {n}");
+        assert_eq!(p.ratio_grid(), grid);
+    }
+    assert!(described(p, 1_024).contains("ratio estimator (grid 8 px)"));
+    p.ratio_stride = 1;
+    assert!(!described(p, 1_024).contains("grid"));
+    p.ratio_stride = 9;
+    assert!(p.check().is_err());
+}
+
+/// The ratio estimator's grid holds the pixels 0, s, 2s, … and the last of each axis.
+#[test]
+fn the_ratio_grid_ends_on_the_last_pixel() {
+    use crate::gpu::passes::unshadowed::ratio_grid_size;
+    assert_eq!(ratio_grid_size([16, 12], 2), [9, 7]);
+    assert_eq!(ratio_grid_size([16, 12], 1), [16, 12]);
+    assert_eq!(ratio_grid_size([16, 12], 0), [16, 12]);
+    // 320: 0, 3, …, 318 and 319.
+    assert_eq!(ratio_grid_size([320, 1], 3), [108, 1]);
+    assert_eq!(ratio_grid_size([1, 7], 8), [1, 2]);
 }
 
 /// Gates with the portal walk.

@@ -1,4 +1,4 @@
-//! include: val.wgsl vpl.wgsl
+//! include: val.wgsl vpl.wgsl face.wgsl ratio.wgsl
 // Interleaving's other half: the interleaved indirect irradiance (val_gather.wgsl) blurred over
 // the b × b block (or, with blur_tent, a tent over (2b − 1)²) where the geometry agrees (Laine
 // et al.: positions closer than a fraction of the scene, normals closer than a cosine), times
@@ -17,8 +17,9 @@
 // the light of the subsets of the taps that do not, which they walked themselves (starved.wgsl's
 // cs_starved_sums); a 1 × 1 texture of zeros for the other modes.
 @group(0) @binding(14) var starved_sums: texture_2d<f32>;
-// Interleaved walks with the ratio estimator (gather.ratio): each pixel's unshadowed far light
-// (shade.wgsl's cs_far_unshadowed), in pixel order; a 1 × 1 texture for the other modes.
+// Interleaved walks with the ratio estimator (gather.ratio): the unshadowed far light at the
+// pixels that unshadowed.wgsl sums it at (ratio.wgsl's grid), in pixel order; a 1 × 1 texture
+// for the other modes.
 @group(0) @binding(15) var unshadowed: texture_2d<f32>;
 
 // Whether a tap that does not agree gives way to a copy of its subset (InterleaveParams::fill,
@@ -109,8 +110,10 @@ fn compose(px: vec2<i32>) -> vec4<f32> {
     // pixel (its own walks hold no unshadowed light), nor where the taps' subsets hold no far
     // light.
     if gather.ratio == 1u && walked.w != 1.0 && unshadowed_sum > 0.0 {
+        let stride = i32(max(gather.ratio_stride, 1u));
+        let u = ratio_unshadowed(unshadowed, px, pos.xyz, n, stride, vec2<i32>(textureDimensions(g_position)));
         let s = min((sum.x + sum.y + sum.z) / (unshadowed_sum * f32(gather.subsets)), 1.0);
-        e = mix(e, textureLoad(unshadowed, px, 0).xyz * s, s);
+        e = mix(e, u * s, s);
     }
     return vec4<f32>(before.xyz + albedo / PI * e, 1.0);
 }

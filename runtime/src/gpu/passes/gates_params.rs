@@ -48,13 +48,30 @@ pub struct GatesParams {
     /// Interleaved walks (portals or voxels), the ratio estimator (Heitz et al. 2018,
     /// "Combining analytic direct illumination and stochastic shadows"): each pixel sums the
     /// unshadowed light of every VPL beyond its near field (no visibility: a loop over the VPLs,
-    /// shade.wgsl's `cs_far_unshadowed`), and the blur scales it by the share of their
+    /// unshadowed.wgsl), and the blur scales it by the share of their
     /// unshadowed light that its taps' walks found visible, instead of averaging the taps'
     /// light: where every VPL is visible the pixel gets its exact light whatever VPL subsets its
     /// taps held, so that the interleaving's error is left to the visibility's changes across a
     /// block. Off: Laine et al.'s average.
     pub ratio: bool,
+    /// The ratio estimator's grid: the unshadowed far light summed at every n-th pixel across
+    /// and down (a 1/n² share of the pixels, each every VPL) and at the pixels between whose
+    /// four grid pixels around do not all lie on their surface (creases, edges, steps); the
+    /// others take it bilinearly from those four (ratio.wgsl). 0 or 1: summed at every pixel.
+    /// [Limit: 0..=8]
+    pub ratio_stride: u32,
 }
+
+/// The balanced and accurate settings' ratio estimator's grid stride
+/// ([`GatesParams::ratio_stride`]): on the error table's 24 views the indirect MSE within
+/// 0.9 % of every pixel's own sum on 23 and 3.6 % on one, for an unshadowed pass 3.1–4.8×
+/// shorter on lavapipe at 512² (README; 4 px shortened it no more: more pixels sum their
+/// own). [Units: px]
+pub const RATIO_STRIDE: u32 = 3;
+
+/// The most pixels across between two of the ratio estimator's grid pixels
+/// ([`GatesParams::ratio_stride`]).
+pub const RATIO_STRIDE_MAX: u32 = 8;
 
 /// The balanced and accurate settings' near field ([`GatesParams::near_field`]), in blocks:
 /// on 24 camera and light configurations (README) the indirect MSE ×0.19–1.0 of the setting's
@@ -106,6 +123,7 @@ impl GatesParams {
         self.interleave.tent = true;
         self.near_field = NEAR_FIELD;
         self.ratio = true;
+        self.ratio_stride = RATIO_STRIDE;
         if self.interleave.starved_taps == 0 {
             self.interleave.starved_taps = self.interleave.three_quarters();
         }
@@ -126,13 +144,15 @@ impl GatesParams {
         self.interleave.tent = true;
         self.near_field = NEAR_FIELD;
         self.ratio = true;
+        self.ratio_stride = RATIO_STRIDE;
         self.interleave.starved_dark = true;
         self
     }
 
     /// The fast setting (`--fast`): the balanced setting's five undone — the voxel walk
     /// passing closed voxels on their planes, the box blur, no dark pixels' walks, no near
-    /// field, no ratio estimator (a `--starved-taps` count is kept). [`GatesParams::default`] is this setting; `visgate`'s
+    /// field, no ratio estimator (its grid back to every pixel; a `--starved-taps` count is
+    /// kept). [`GatesParams::default`] is this setting; `visgate`'s
     /// commands and viewer start from [`GatesParams::balanced`].
     pub fn fast(mut self) -> GatesParams {
         self.gates.triangles = false;
@@ -140,6 +160,7 @@ impl GatesParams {
         self.near_field = 0.0;
         self.interleave.starved_dark = false;
         self.ratio = false;
+        self.ratio_stride = 0;
         self
     }
 
@@ -178,6 +199,11 @@ impl GatesParams {
         self.ratio && self.interleave.block > 1 && walks && self.roulette_share(vpls) == 0.0
     }
 
+    /// The ratio estimator's grid stride in pixels ([`GatesParams::ratio_stride`]), at least 1.
+    pub fn ratio_grid(&self) -> u32 {
+        self.ratio_stride.max(1)
+    }
+
     /// Whether the indirect light is gathered in a pass of its own and composed by the blur
     /// (interleaved, or walks — portals or voxels —, which run in batches on a software
     /// rasterizer), not in the shading pass (disks gathering every VPL at every pixel).
@@ -203,6 +229,13 @@ impl GatesParams {
             return Err(RenderError::Param(format!(
                 "the near field {} must be 0..={NEAR_FIELD_MAX} interleaving blocks (0: none)",
                 self.near_field
+            )));
+        }
+        if self.ratio_stride > RATIO_STRIDE_MAX {
+            return Err(RenderError::Param(format!(
+                "the ratio estimator's grid stride {} must be 0..={RATIO_STRIDE_MAX} pixels \
+                 (0 or 1: every pixel)",
+                self.ratio_stride
             )));
         }
         if self.light_entries == Some(0) {

@@ -172,6 +172,7 @@ impl InterleaveBlur {
             blur_fill: u32::from(p.fill),
             blur_tent: u32::from(p.tent),
             ratio: u32::from(f.ratio),
+            ratio_stride: f.ratio_stride,
             ..bytemuck::Zeroable::zeroed()
         };
         pool.upload(
@@ -185,7 +186,7 @@ impl InterleaveBlur {
     /// Records the blur of `indirect` composed onto `out`, with the gather's constants
     /// `uniform` (a `ValGather` made from `il`), the starved pixels' own sums where gates
     /// have them (`Shade::record_starved`) and each pixel's unshadowed far light where they
-    /// take the ratio estimator (`Shade::record_unshadowed`).
+    /// take the ratio estimator (`Unshadowed::record`).
     pub fn record(
         &self,
         f: &Frame,

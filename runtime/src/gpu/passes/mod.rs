@@ -18,5 +18,6 @@ pub mod shade;
 pub mod shadow_maps;
 pub mod sight_ends;
 pub mod starved;
+pub mod unshadowed;
 pub mod val_gather;
 pub mod vals;

@@ -34,8 +34,6 @@ pub struct Shade {
     gates_near: [std::sync::OnceLock<wgpu::ComputePipeline>; 5],
     near_marks: [std::sync::OnceLock<wgpu::ComputePipeline>; 5],
     near_compose: [std::sync::OnceLock<wgpu::ComputePipeline>; 5],
-    /// The ratio estimator's unshadowed far light (`cs_far_unshadowed`), likewise.
-    far_unshadowed: [std::sync::OnceLock<wgpu::ComputePipeline>; 5],
     /// The starved pixels' other passes (starved.rs).
     pub(super) starved: super::starved::StarvedPipelines,
     module: wgpu::ShaderModule,
@@ -82,6 +80,29 @@ pub fn frame_target(f: &Frame, pool: &mut Pool, label: &'static str) -> wgpu::Te
     )
 }
 
+/// The two targets of a gather in `dispatches` dispatches, each writing one and reading the
+/// other as the sum so far (named `names`, kept in `pool`); with one dispatch a 1 × 1 texel
+/// stands in for the second, which it binds but does not read.
+pub(super) fn ping_pong_targets(
+    f: &Frame,
+    pool: &mut Pool,
+    names: [&'static str; 2],
+    dispatches: u32,
+) -> [wgpu::Texture; 2] {
+    let second = match dispatches {
+        1 => pool.texture(
+            &f.ctx.device,
+            "no earlier dispatches",
+            [1, 1, 1],
+            1,
+            HDR,
+            wgpu::TextureUsages::TEXTURE_BINDING,
+        ),
+        _ => frame_target(f, pool, names[1]),
+    };
+    [frame_target(f, pool, names[0]), second]
+}
+
 /// What shading reads: the lights (and their maps), the G-buffer, mode gates' gather inputs,
 /// LightCluster's visibility.
 pub type Inputs<'a> = (
@@ -101,9 +122,6 @@ pub struct Gathers<'a> {
     /// [`super::sight_ends`]'s output.
     pub vpl_ends: Option<&'a wgpu::Buffer>,
 }
-
-/// VPLs a dispatch of shade.wgsl's `cs_far_unshadowed` sums (its RATIO_RUN).
-pub const RATIO_RUN: u32 = 16_384;
 
 /// The bindings of shade.wgsl's `cs_gates_indirect` (an automatic layout holds only what an
 /// entry point uses) but its batch index (24) and its output (25).
@@ -135,7 +153,6 @@ impl Shade {
             gates_near: Default::default(),
             near_marks: Default::default(),
             near_compose: Default::default(),
-            far_unshadowed: Default::default(),
             starved: super::starved::StarvedPipelines::new(d, s)?,
             module,
             vpl_clusters_indirect,
@@ -169,7 +186,6 @@ impl Shade {
             GatesGather::Near => (&self.gates_near, "cs_near_field"),
             GatesGather::NearMarks => (&self.near_marks, "cs_near_marks"),
             GatesGather::NearCompose => (&self.near_compose, "cs_near_compose"),
-            GatesGather::FarUnshadowed => (&self.far_unshadowed, "cs_far_unshadowed"),
         };
         let d = &f.ctx.device;
         cache[k].get_or_init(|| {
@@ -231,29 +247,6 @@ impl Shade {
             used: &GATES_INDIRECT_BINDINGS,
             names: ["indirect irradiance", "indirect irradiance (batches)"],
             span: "indirect lighting",
-            extra: None,
-        };
-        self.walk_batches(f, pool, rec, inputs, batched)
-    }
-
-    /// Records each pixel's unshadowed light from every VPL beyond its near field, for the
-    /// ratio estimator of interleaved walks with gate shape `shape`
-    /// ([`super::gates_params::GatesParams::ratio`]), into a target of its own (in pixel
-    /// order), in runs of [`RATIO_RUN`] VPLs a dispatch (a software rasterizer's loop limit).
-    pub fn record_unshadowed(
-        &self,
-        f: &Frame,
-        pool: &mut Pool,
-        rec: &mut Recorder,
-        inputs: Inputs,
-        shape: GateShape,
-    ) -> wgpu::Texture {
-        let batched = Batched {
-            pipeline: self.gates_pipeline(f, GatesGather::FarUnshadowed, shape),
-            batches: f.vpl_count.div_ceil(RATIO_RUN).max(1),
-            used: &[0, 2, 5, 6, 21],
-            names: ["unshadowed far light", "unshadowed far light (runs)"],
-            span: "indirect lighting: unshadowed",
             extra: None,
         };
         self.walk_batches(f, pool, rec, inputs, batched)
@@ -408,19 +401,7 @@ impl Shade {
             extra,
         } = b;
         let d = &f.ctx.device;
-        let first = frame_target(f, pool, names[0]);
-        let second = match batches {
-            1 => pool.texture(
-                d,
-                "no earlier batches",
-                [1, 1, 1],
-                1,
-                HDR,
-                wgpu::TextureUsages::TEXTURE_BINDING,
-            ),
-            _ => frame_target(f, pool, names[1]),
-        };
-        let targets = [first, second];
+        let targets = ping_pong_targets(f, pool, names, batches);
         let targets_view = targets
             .each_ref()
             .map(|t| t.create_view(&Default::default()));
@@ -465,8 +446,6 @@ pub(super) enum GatesGather {
     NearMarks,
     /// `cs_near_compose`: the near light added onto the image.
     NearCompose,
-    /// `cs_far_unshadowed`: each pixel's unshadowed far light, for the ratio estimator.
-    FarUnshadowed,
 }
 
 /// The bytes of the near field's marks for a frame of `size` pixels and `vpls` VPLs: a bit a

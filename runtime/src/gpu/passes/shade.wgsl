@@ -1,4 +1,4 @@
-//! include: globals.wgsl lights.wgsl shadow_lookup.wgsl vpl.wgsl gates.wgsl portals.wgsl sight.wgsl walk.wgsl near.wgsl
+//! include: globals.wgsl lights.wgsl shadow_lookup.wgsl vpl.wgsl gates.wgsl portals.wgsl sight.wgsl far.wgsl walk.wgsl near.wgsl
 // Deferred shading: direct light from point and spot lights with shadow-map PCF (3 × 3, a contact
 // test at thin walls' joins: shadow_lookup.wgsl), and
 // the indirect sum over VPLs without visibility (SHADE_ALL), through the gates of a baked
@@ -302,33 +302,6 @@ fn cs_gates_indirect(@builtin(global_invocation_id) id: vec3<u32>) {
         }
     }
     textureStore(out_image, id.xy, sum);
-}
-
-// The ratio estimator's other half (GatesParams::ratio; Heitz et al. 2018): each pixel's
-// unshadowed far light, every VPL's but the near field's share, no visibility, which the blur
-// scales by the visible share of its taps' subsets. In runs of RATIO_RUN VPLs a dispatch
-// (walk_batch_index.x the run), each adding to the runs' before (earlier_batches): llvmpipe's
-// loop limit.
-const RATIO_RUN: u32 = 16384u;
-
-@compute @workgroup_size(8, 8)
-fn cs_far_unshadowed(@builtin(global_invocation_id) id: vec3<u32>) {
-    if any(id.xy >= textureDimensions(g_position)) {
-        return;
-    }
-    let px = vec2<i32>(id.xy);
-    let run = walk_batch_index.x;
-    var sum = vec3<f32>(0.0);
-    if run > 0u {
-        sum = textureLoad(earlier_batches, px, 0).xyz;
-    }
-    let pos = textureLoad(g_position, px, 0);
-    if pos.w != 0.0 {
-        let n = normalize(textureLoad(g_normal, px, 0).xyz);
-        let end = min(globals.vpl_count, (run + 1u) * RATIO_RUN);
-        sum += far_unshadowed(pos.xyz, n, run * RATIO_RUN, end);
-    }
-    textureStore(out_image, id.xy, vec4<f32>(sum, 1.0));
 }
 
 // Interleaved gates' second gather, the walks (starved.rs; starved.wgsl makes the pairs and

@@ -28,6 +28,8 @@ struct Globals {
     // Interleaved walks, the ratio estimator: 1 where the blur scales each pixel's unshadowed far
     // light by its taps' visible share (blur.wgsl's compose), 0 where it averages their light.
     ratio: u32,
-    pad1: u32,
+    // The ratio estimator's grid: the unshadowed far light summed at every this many pixels
+    // across and down (1: every pixel; ratio.wgsl).
+    ratio_stride: u32,
     pad2: u32,
 };

@@ -1,3 +1,4 @@
+//! include: face.wgsl
 // The level's voxel→cluster grid and the visibility cluster of a surface point;
 // runtime::cpu::gates::GateLevel::cluster_at is its CPU twin. Its functions read two bindings
 // that the including pass declares: `grid: Grid` (uniform) and `voxel_words: array<u32>`
@@ -98,22 +99,4 @@ fn encode_cluster(c: u32) -> f32 {
 
 fn decode_cluster(w: f32) -> u32 {
     return u32(w - 1.0) - 1u;
-}
-
-// The G-buffer keeps the face's own normal (turned to the camera) octahedral-encoded in
-// normal.w and albedo.w: the voxel walk starts off the face, whatever the shading normal.
-fn encode_face_normal(n: vec3<f32>) -> vec2<f32> {
-    let p = n.xy / (abs(n.x) + abs(n.y) + abs(n.z));
-    if n.z < 0.0 {
-        return (1.0 - abs(p.yx)) * select(vec2<f32>(-1.0), vec2<f32>(1.0), p >= vec2<f32>(0.0));
-    }
-    return p;
-}
-
-fn decode_face_normal(e: vec2<f32>) -> vec3<f32> {
-    var n = vec3<f32>(e.x, e.y, 1.0 - abs(e.x) - abs(e.y));
-    let t = max(-n.z, 0.0);
-    n.x += select(t, -t, n.x >= 0.0);
-    n.y += select(t, -t, n.y >= 0.0);
-    return normalize(n);
 }

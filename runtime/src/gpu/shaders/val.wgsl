@@ -65,5 +65,6 @@ struct ValGather {
     // Interleaved walks, the ratio estimator: 1 where the blur scales the pixel's unshadowed
     // far light by its taps' visible share, 0 where it averages their light.
     ratio: u32,
-    pad2: f32,
+    // Its grid stride (px; 1: every pixel).
+    ratio_stride: u32,
 };
