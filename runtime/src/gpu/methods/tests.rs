@@ -122,6 +122,18 @@ fn the_ratio_grid_ends_on_the_last_pixel() {
     assert_eq!(ratio_grid_size([1, 7], 8), [1, 2]);
 }
 
+/// Where the list of the pixels that sum their own would not fit a storage binding, the grid
+/// falls back to every pixel (no list): 8192 × 4096 against lavapipe's 128 MiB.
+#[test]
+fn the_ratio_grid_falls_back_to_every_pixel_where_its_list_would_not_fit() {
+    use crate::gpu::passes::unshadowed::{own_list_bytes, stride_that_fits};
+    let mib128 = 128 << 20;
+    assert_eq!(own_list_bytes([16, 12]), 193 * 4);
+    assert_eq!(stride_that_fits(3, [3840, 2160], mib128), 3);
+    assert_eq!(stride_that_fits(3, [7680, 4320], mib128), 3);
+    assert_eq!(stride_that_fits(3, [8192, 4096], mib128), 1);
+}
+
 /// Gates with the portal walk.
 fn portals() -> GatesParams {
     let mut p = GatesParams::default();

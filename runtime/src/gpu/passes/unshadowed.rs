@@ -26,6 +26,23 @@ pub fn ratio_grid_size(size: [u32; 2], stride: u32) -> [u32; 2] {
     size.map(|n| n.saturating_sub(1).div_ceil(s) + 1)
 }
 
+/// The bytes of the list of the pixels that sum their own light for a frame of `size` pixels:
+/// a word each and the count.
+pub fn own_list_bytes([w, h]: [u32; 2]) -> u64 {
+    (1 + u64::from(w) * u64::from(h)) * 4
+}
+
+/// The grid stride a frame of `size` pixels takes: `stride`, or every pixel (1, no list) where
+/// the list of the pixels that sum their own would not fit a storage binding of `limit` bytes
+/// (from 8192 × 4096 on lavapipe's 128 MiB): the blur must find every listed pixel's light.
+pub fn stride_that_fits(stride: u32, size: [u32; 2], limit: u64) -> u32 {
+    if own_list_bytes(size) <= limit {
+        stride
+    } else {
+        1
+    }
+}
+
 /// Where a frame's unshadowed far light was summed (`PassTimes::ratio`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct RatioStats {
@@ -171,7 +188,6 @@ impl Unshadowed {
 /// commands.
 fn own_list(f: &Frame, pool: &mut Pool, rec: &mut Recorder) -> (wgpu::Buffer, wgpu::Buffer) {
     let d = &f.ctx.device;
-    let [w, h] = f.view.size;
     let head: [u32; 4] = [0, 1, 1, 0];
     let empty = pool.upload(
         f.ctx,
@@ -180,7 +196,11 @@ fn own_list(f: &Frame, pool: &mut Pool, rec: &mut Recorder) -> (wgpu::Buffer, wg
         wgpu::BufferUsages::COPY_SRC,
     );
     let storage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
-    let bytes = (1 + u64::from(w) * u64::from(h)) * 4;
+    // At stride 1 no pixel is listed: the count alone.
+    let bytes = match f.ratio_stride {
+        1 => 4,
+        _ => own_list_bytes(f.view.size),
+    };
     let list = pool.buffer(
         d,
         "unshadowed own pixels",
