@@ -43,7 +43,8 @@ fn cs_own_list(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let n = normalize(textureLoad(g_normal, px, 0).xyz);
-    if ratio_own(grid_light, px, pos.xyz, n, i32(max(globals.ratio_stride, 1u)), vec2<i32>(size)) {
+    let s = i32(max(globals.ratio_stride, 1u));
+    if ratio_own(grid_light, px, pos.xyz, n, s, vec2<i32>(size), RATIO_SLACK) {
         let slot = atomicAdd(&own_list[0], 1u);
         atomicStore(&own_list[1u + slot], id.x + id.y * size.x);
         let g = slot / OWN_GROUP;

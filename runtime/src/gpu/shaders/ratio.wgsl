@@ -18,6 +18,10 @@ const RATIO_PLANE: f32 = 0.1;
 // of the least of it, the light curves between them more than bilinear follows (beside a
 // light, or across the near field's edge): the pixel sums its own.
 const RATIO_SPREAD: f32 = 0.25;
+// The list's tests are this much looser than the blur's (ratio_own's `slack`): the two passes
+// are compiled apart, and a pixel that the blur takes as its own but the list left out would
+// read a texel nothing wrote. Within the slack a pixel is summed and not read: harmless.
+const RATIO_SLACK: f32 = 1e-3;
 
 // The grid's texels for a frame of `size` pixels with stride s: pixels 0, s, 2s, … and the
 // last (as runtime::gpu::passes::unshadowed::ratio_grid_size).
@@ -54,9 +58,10 @@ fn ratio_corner(cell: vec4<f32>, k: i32) -> RatioCorner {
 }
 
 // Whether pixel px (surface p, normal n; a frame of `size`, stride s) sums its own unshadowed
-// light: not a grid pixel, and of the grid pixels around it that weigh one off its surface, or
-// their light in `light` (each at its pixel) spread by more than RATIO_SPREAD.
-fn ratio_own(light: texture_2d<f32>, px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, s: i32, size: vec2<i32>) -> bool {
+// light: a grid pixel that weighs in its bilinear sum lies off its surface, or their light in
+// `light` (each at its pixel) spreads by more than RATIO_SPREAD; the tests loosened by `slack`
+// (RATIO_SLACK for the list, 0 for the blur). Never a grid pixel: its own texel weighs alone.
+fn ratio_own(light: texture_2d<f32>, px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, s: i32, size: vec2<i32>, slack: f32) -> bool {
     if s <= 1 {
         return false;
     }
@@ -73,21 +78,22 @@ fn ratio_own(light: texture_2d<f32>, px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, 
         let qp = textureLoad(g_position, q, 0);
         let qn = textureLoad(g_normal, q, 0).xyz;
         let d = qp.xyz - p;
-        if qp.w == 0.0 || dot(qn, n) < RATIO_COSINE || abs(dot(d, face)) > RATIO_PLANE * length(d) {
+        let off_plane = abs(dot(d, face)) > (RATIO_PLANE - slack) * length(d);
+        if qp.w == 0.0 || dot(qn, n) < RATIO_COSINE + slack || off_plane {
             return true;
         }
         let u = textureLoad(light, q, 0).xyz;
         lo = min(lo, u.x + u.y + u.z);
         hi = max(hi, u.x + u.y + u.z);
     }
-    return hi > lo * (1.0 + RATIO_SPREAD);
+    return hi > lo * (1.0 + RATIO_SPREAD - slack);
 }
 
 // Pixel px's unshadowed far light (surface p, normal n; a frame of `size`, stride s) from
 // `unshadowed`, where unshadowed.wgsl wrote it: its own (ratio_own, or every pixel's at stride
 // 1), or bilinear between the four grid pixels around it.
 fn ratio_unshadowed(unshadowed: texture_2d<f32>, px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, s: i32, size: vec2<i32>) -> vec3<f32> {
-    if s <= 1 || ratio_own(unshadowed, px, p, n, s, size) {
+    if s <= 1 || ratio_own(unshadowed, px, p, n, s, size, 0.0) {
         return textureLoad(unshadowed, px, 0).xyz;
     }
     let cell = ratio_cell(px, s, size);
