@@ -433,12 +433,13 @@ impl GpuRenderer {
         let fits = marks <= ctx.device.limits().max_storage_buffer_binding_size;
         let near_scale = if fits { near_scale } else { 0.0 };
         let ratio = params.mode.ratio_for(vpl_count);
+        // Its grid: every pixel without it, or where its list would not fit a binding.
         let limit = ctx.device.limits().max_storage_buffer_binding_size;
-        let ratio_stride = match ratio {
-            true => {
-                passes::unshadowed::stride_that_fits(params.mode.ratio_stride(), view.size, limit)
-            }
-            false => 1,
+        let stride = params.mode.ratio_stride();
+        let ratio_stride = if ratio {
+            passes::unshadowed::stride_that_fits(stride, view.size, limit)
+        } else {
+            1
         };
         let globals = Globals {
             view_proj: view.view_proj(scene.near_m).to_cols_array_2d(),
