@@ -435,6 +435,16 @@ pub fn pass_times(ui: &mut egui::Ui, size: [u32; 2], t: &PassTimes, history: &Ve
             l.vpls_outside
         ));
     }
+    if let Some(r) = &t.ratio {
+        ui.label(format!(
+            "ratio estimator: unshadowed light at {} grid pixels (every {} px) and {} of their \
+             own ({:.1} %)",
+            r.grid,
+            r.stride,
+            r.own,
+            100.0 * f64::from(r.own) / f64::from(r.pixels.max(1))
+        ));
+    }
     if let Some(c) = &t.direct_clusters {
         ui.label(format!(
             "LightCluster: {} lights in {} clusters, {} culled",

@@ -204,6 +204,9 @@ fn the_viewer_starts_balanced_and_its_fast_setting_walks_the_planes() {
         |h: &Harness<'static, ViewerApp>| h.query_all_by_label("ratio grid (px)").next().is_some();
     assert!(grid_slider(&harness));
     assert_eq!(harness.state().settings.gates.ratio_stride, 3);
+    // And where it summed, under the passes.
+    let said = harness.query_all_by_label_contains("ratio estimator: unshadowed light at");
+    assert!(said.count() == 1, "the grid's report");
     // The ratio's tick: its pass off on the next frame, its grid's slider gone, a setting of
     // the user's own; on again.
     let app = clicked(&mut harness, "ratio estimator");
