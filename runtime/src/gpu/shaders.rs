@@ -126,6 +126,7 @@ pub fn constants() -> String {
     s += &u("WG_WIDE", WG_WIDE);
     s += &u("WG_CSSM", WG_CSSM);
     s += &u("STARVED_WALKS_GROUP", WG_STARVED_WALKS);
+    s += &u("RATIO_RUN", super::passes::unshadowed::RATIO_RUN);
     s += &u("SHADE_ALL", ShadeIndirect::All as u32);
     s += &u("SHADE_DIRECT", ShadeIndirect::DirectOnly as u32);
     s += &u("SHADE_GATES_PER_PIXEL", ShadeIndirect::GatesPerPixel as u32);

@@ -15,8 +15,8 @@ use crate::gpu::layout::{UNIFORM_STRIDE, strided};
 use crate::gpu::shaders::{self, ShaderSources};
 use crate::gpu::timing::Recorder;
 
-/// VPLs a dispatch of unshadowed.wgsl sums (its RATIO_RUN): a software rasterizer ends a
-/// shader invocation's loops after 65,535 iterations.
+/// VPLs a dispatch of unshadowed.wgsl sums (injected as its RATIO_RUN): a software
+/// rasterizer ends a shader invocation's loops after 65,535 iterations.
 pub const RATIO_RUN: u32 = 16_384;
 
 /// The ratio estimator's grid for a frame of `size` pixels with stride `stride`: the pixels

@@ -4,7 +4,8 @@
 // its grid and those that sum their own (ratio.wgsl), each written at its pixel; blur.wgsl's
 // compose takes it at every pixel and scales it by the visible share of its taps' subsets.
 //
-// Three entry points, the VPLs in runs of RATIO_RUN (run.x; llvmpipe's loop limit), each run
+// Three entry points, the VPLs in runs of RATIO_RUN (injected from runtime::gpu::passes::
+// unshadowed; run.x the run; llvmpipe's loop limit), each run
 // adding to the runs before (earlier_runs): cs_far_grid sums the grid pixels' light (an
 // invocation a grid texel), run after run; cs_own_list, once, lists the pixels between that sum
 // their own (ratio_own: off their grid pixels' surface, or where those's light spreads); then
@@ -27,7 +28,6 @@
 // cs_own_list: the grid pixels' light, all runs summed (each at its pixel).
 @group(0) @binding(10) var grid_light: texture_2d<f32>;
 
-const RATIO_RUN: u32 = 16384u;
 const OWN_GROUP: u32 = 64u;
 const OWN_ROW: u32 = 65535u;
 
