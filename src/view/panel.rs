@@ -6,9 +6,10 @@ use eframe::egui;
 use visgate_formats::Scene;
 use visgate_runtime::cpu::gates::GateShape;
 use visgate_runtime::gpu::{
-    AUTO_ROULETTE_BLOCK, AUTO_ROULETTE_SHARE, AUTO_ROULETTE_VPLS, DirectLight, DiskLight,
-    GatesParams, InterleaveParams, IsmParams, LcDisk, LightClusterGpuParams, MethodSettings,
-    NEAR_FIELD_MAX, PassTimes, RATIO_STRIDE_MAX, WalkRoulette,
+    AUTO_ROULETTE_BLOCK, AUTO_ROULETTE_RATIO_VPLS, AUTO_ROULETTE_SHARE, AUTO_ROULETTE_VPLS,
+    DirectLight, DiskLight, GatesParams, InterleaveParams, IsmParams, LcDisk,
+    LightClusterGpuParams, MethodSettings, NEAR_FIELD_MAX, PassTimes, RATIO_STRIDE_MAX,
+    WalkRoulette,
 };
 
 use super::camera::FlyCamera;
@@ -17,11 +18,17 @@ use super::camera::FlyCamera;
 fn walk_roulette(ui: &mut egui::Ui, r: &mut WalkRoulette) {
     let mut auto = *r == WalkRoulette::Auto;
     ui.horizontal(|ui| {
-        let (b, n) = (AUTO_ROULETTE_BLOCK, AUTO_ROULETTE_VPLS);
+        let (b, n, m) = (
+            AUTO_ROULETTE_BLOCK,
+            AUTO_ROULETTE_VPLS,
+            AUTO_ROULETTE_RATIO_VPLS,
+        );
         let hint = format!(
             "{AUTO_ROULETTE_SHARE} in blocks of {b} × {b} or more where a pixel's subset holds \
-             {n} VPLs or more ({} VPLs in {b} × {b} blocks), else every VPL walked",
-            n * b * b
+             {n} VPLs or more ({} VPLs in {b} × {b} blocks), {m} with the ratio estimator \
+             ({}), else every VPL walked",
+            n * b * b,
+            m * b * b
         );
         if ui.checkbox(&mut auto, "auto").on_hover_text(hint).changed() {
             *r = if auto {

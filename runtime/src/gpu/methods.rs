@@ -214,14 +214,16 @@ impl GpuMode {
 
     /// The mode as it renders a frame of `vpls` VPLs: the gates' automatic roulette resolved
     /// to the share it takes there (0: every VPL walked), and their near field and ratio
-    /// estimator off where the roulette is on, so that two modes that render the same frame compare equal (`gates` and
-    /// `gates-roulette` at 8,192 VPLs or more).
+    /// estimator off where the roulette thins the walks that far
+    /// ([`GatesParams::thinned`](crate::gpu::passes::gates_params::GatesParams::thinned)), so
+    /// that two modes that render the same frame compare equal (`gates` and `gates-roulette` at
+    /// 8,192 VPLs or more).
     pub fn resolved_for(&self, vpls: u32) -> GpuMode {
         match *self {
             GpuMode::Gates(mut p) => {
-                let share = p.roulette_share(vpls);
-                p.walk_roulette = WalkRoulette::Share(share);
-                if share > 0.0 {
+                let thinned = p.thinned(vpls);
+                p.walk_roulette = WalkRoulette::Share(p.roulette_share(vpls));
+                if thinned {
                     p.near_field = 0.0;
                     p.ratio = false;
                 }

@@ -83,8 +83,8 @@ pub use methods::{
     PerVplParams, ShadowParams, ValIsmParams, ValModeParams, VplIsmParams, method,
 };
 pub use passes::clustered_gates::{
-    AUTO_ROULETTE_BLOCK, AUTO_ROULETTE_SHARE, AUTO_ROULETTE_VPLS, MAX_CLUSTERS, MAX_GATES,
-    WalkRoulette,
+    AUTO_ROULETTE_BLOCK, AUTO_ROULETTE_RATIO_VPLS, AUTO_ROULETTE_SHARE, AUTO_ROULETTE_VPLS,
+    MAX_CLUSTERS, MAX_GATES, WalkRoulette,
 };
 pub use passes::display::{DISPLAY_FORMAT, read_display};
 pub use passes::gates_params::{NEAR_FIELD_MAX, RATIO_STRIDE, RATIO_STRIDE_MAX};

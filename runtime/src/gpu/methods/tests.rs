@@ -18,6 +18,18 @@ fn the_default_roulette_is_on_where_an_interleaved_pixel_walks_many_vpls() {
     );
     assert_eq!(described(p, 4_096), "voxel walk, 8×8 interleaved");
     assert!(GpuMode::Gates(p).describe().ends_with("roulette auto"));
+    // With the ratio estimator (the balanced setting) from 8 VPLs a pixel, its near field
+    // and ratio kept until 128.
+    let balanced = GatesParams::default().balanced();
+    assert_eq!(balanced.roulette_share(512), AUTO);
+    assert_eq!(balanced.roulette_share(448), 0.0, "7 VPLs a pixel");
+    let named = described(balanced, 1_024);
+    assert!(
+        named.ends_with("ratio estimator (grid 3 px), roulette under 0.05 (auto)"),
+        "{named}"
+    );
+    assert!(described(balanced, 8_192).ends_with("roulette under 0.05 (auto)"));
+    assert!(!described(balanced, 8_192).contains("ratio"));
     p.interleave.block = 16;
     assert_eq!(p.roulette_share(32_768), AUTO);
     // 4 × 4 blocks blur too few subsets to hide it; no blur, none at all.
@@ -33,9 +45,8 @@ fn the_default_roulette_is_on_where_an_interleaved_pixel_walks_many_vpls() {
     assert_eq!(p.roulette_share(16_384), 0.0, "off when asked");
 }
 
-#[test]
-fn the_near_field_is_on_in_the_balanced_setting_where_the_walks_are_not_thinned() {
-    use crate::camera::View;
+/// A 320 × 240 view with a horizontal field of 1.2 rad.
+fn view_320x240() -> crate::camera::View {
     let camera = visgate_formats::scene::Camera {
         name: "c".into(),
         eye: glam::Vec3::ZERO,
@@ -43,7 +54,49 @@ fn the_near_field_is_on_in_the_balanced_setting_where_the_walks_are_not_thinned(
         up: glam::Vec3::Y,
         fov_x_rad: 1.2,
     };
-    let view = View::new(&camera, [320, 240]).expect("view");
+    crate::camera::View::new(&camera, [320, 240]).expect("view")
+}
+
+#[test]
+fn the_roulette_keeps_the_near_field_and_the_ratio_until_a_subset_holds_128_vpls() {
+    let view = view_320x240();
+    let mut p = GatesParams::default().balanced();
+    p.walk_roulette = WalkRoulette::Share(0.05);
+    for vpls in [1_024, 4_096, 8_128] {
+        assert!(!p.thinned(vpls), "{vpls}");
+        assert!(
+            p.near_scale(&view, vpls) > 0.0 && p.ratio_for(vpls),
+            "{vpls}"
+        );
+        let resolved = GpuMode::Gates(p).resolved_for(vpls);
+        assert!(
+            matches!(resolved, GpuMode::Gates(r) if r.ratio && r.near_field == 4.0),
+            "{vpls}"
+        );
+        let named = GpuMode::Gates(p).describe_for(vpls);
+        assert!(
+            named.contains("near field 4 blocks, ratio estimator"),
+            "{named}"
+        );
+        assert!(named.ends_with("roulette under 0.05"), "{named}");
+    }
+    // 128 a subset: both off, as the resolved mode says.
+    assert!(p.thinned(8_192));
+    assert!(p.near_scale(&view, 8_192) == 0.0 && !p.ratio_for(8_192));
+    let resolved = GpuMode::Gates(p).resolved_for(8_192);
+    assert!(matches!(resolved, GpuMode::Gates(r) if !r.ratio && r.near_field == 0.0));
+    // Without the roulette, never thinned.
+    p.walk_roulette = WalkRoulette::Share(0.0);
+    assert!(!p.thinned(16_384) && p.ratio_for(16_384));
+    // In 4 × 4 blocks a subset holds 128 from 2,048 VPLs.
+    p.walk_roulette = WalkRoulette::Share(0.05);
+    p.interleave.block = 4;
+    assert!(!p.thinned(2_032) && p.thinned(2_048));
+}
+
+#[test]
+fn the_near_field_is_on_in_the_balanced_setting_where_the_walks_are_not_thinned() {
+    let view = view_320x240();
     let balanced = GatesParams::default().balanced();
     assert_eq!(balanced.near_field, 4.0);
     assert_eq!(GatesParams::default().near_field, 0.0, "the fast setting");

@@ -11,7 +11,8 @@ use glam::Vec3;
 pub use super::gates_params::{AUTO_LIGHT_ENTRIES, GatesParams, check_gates};
 use super::gbuffer::GBufferOutput;
 pub use super::roulette::{
-    AUTO_ROULETTE_BLOCK, AUTO_ROULETTE_SHARE, AUTO_ROULETTE_VPLS, WalkRoulette,
+    AUTO_ROULETTE_BLOCK, AUTO_ROULETTE_RATIO_VPLS, AUTO_ROULETTE_SHARE, AUTO_ROULETTE_VPLS,
+    WalkRoulette,
 };
 use crate::cpu::clustered::{
     Clustered, GeometryCluster as CpuGeometryCluster, LightEntry, PixelSurface,

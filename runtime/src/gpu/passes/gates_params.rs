@@ -86,6 +86,13 @@ pub const NEAR_FIELD_MAX: f32 = 8.0;
 /// tile's near VPLs a bit each); above, it is off.
 pub const NEAR_MAX_VPLS: u32 = 32_768;
 
+/// The VPLs a pixel's subset holds from which the walks' roulette, where it is on, turns the
+/// near field and the ratio estimator off (8,192 VPLs in 8 × 8 blocks): both cost a pixel every
+/// near or every VPL, which at 16,384 VPLs took e2m3's hall from 3.3 to 8.4 s on lavapipe at
+/// 512² (the near field), while the subset's many VPLs have made its error small. Below it the
+/// roulette thins the walks alone.
+pub const THIN_SUBSET_VPLS: u32 = 128;
+
 /// Checks gate parameters against what the GPU's test does (≤ 2 hops).
 pub fn check_gates(g: &GateParams) -> Result<(), RenderError> {
     let o = g.oversize;
@@ -168,20 +175,21 @@ impl GatesParams {
     pub fn roulette_share(&self, vpls: u32) -> f32 {
         let il = self.interleave;
         self.walk_roulette
-            .share(vpls.div_ceil(il.subsets()), il.block)
+            .share(vpls.div_ceil(il.subsets()), il.block, self.ratio)
     }
 
     /// The near field's radius per metre of a pixel's distance from the eye in `view`, for a
-    /// frame of `vpls` VPLs (0: none — off, no interleaving, the paper's disks, the walks'
-    /// roulette on, or over [`NEAR_MAX_VPLS`]): [`GatesParams::near_field`] blocks of b
-    /// pixels. Where the roulette thins the walks (by default from 128 VPLs a subset: 8,192
-    /// VPLs in 8 × 8 blocks) the near field is off: its walks, every near VPL at every pixel,
-    /// took e2m3's hall at 16,384 VPLs from 3.3 to 8.4 s on lavapipe at 512².
+    /// frame of `vpls` VPLs (0: none — off, no interleaving, the paper's disks, the walks
+    /// thinned by the roulette ([`Self::thinned`]), or over [`NEAR_MAX_VPLS`]):
+    /// [`GatesParams::near_field`] blocks of b pixels. Where the roulette thins the walks (from
+    /// 128 VPLs a subset: 8,192 VPLs in 8 × 8 blocks) the near field is off: its walks, every
+    /// near VPL at every pixel, took e2m3's hall at 16,384 VPLs from 3.3 to 8.4 s on lavapipe
+    /// at 512².
     pub fn near_scale(&self, view: &View, vpls: u32) -> f32 {
         let walks = self.gates.shape != GateShape::Disk;
         let b = self.interleave.block;
-        let thinned = self.roulette_share(vpls) > 0.0;
-        if self.near_field <= 0.0 || b <= 1 || !walks || thinned || vpls > NEAR_MAX_VPLS {
+        if self.near_field <= 0.0 || b <= 1 || !walks || self.thinned(vpls) || vpls > NEAR_MAX_VPLS
+        {
             return 0.0;
         }
         let pixel = 2.0 * (view.fov_x_rad / 2.0).tan() / view.size[0].max(1) as f32;
@@ -189,14 +197,22 @@ impl GatesParams {
     }
 
     /// Whether the blur of a frame of `vpls` VPLs takes the ratio estimator
-    /// ([`GatesParams::ratio`]): asked for, the walks (portals or voxels) interleaved, and the
-    /// roulette off — where it thins the walks (by default from 128 VPLs a subset) the near
-    /// field is off too, and the unshadowed light, every VPL at every pixel, would cost
+    /// ([`GatesParams::ratio`]): asked for, the walks (portals or voxels) interleaved, and not
+    /// thinned by the roulette ([`Self::thinned`]) — where it thins them (from 128 VPLs a
+    /// subset) the near field is off too, and the unshadowed light, every VPL at every pixel,
+    /// would cost
     /// a GPU what the none mode does (15 ms at 512² and 16,384 VPLs on an H200) for a
     /// subset's error that its many VPLs have made small.
     pub fn ratio_for(&self, vpls: u32) -> bool {
         let walks = self.gates.shape != GateShape::Disk;
-        self.ratio && self.interleave.block > 1 && walks && self.roulette_share(vpls) == 0.0
+        self.ratio && self.interleave.block > 1 && walks && !self.thinned(vpls)
+    }
+
+    /// Whether the roulette thins a frame of `vpls` VPLs so far that the near field and the
+    /// ratio estimator are off: on, with [`THIN_SUBSET_VPLS`] VPLs a pixel's subset or more.
+    pub fn thinned(&self, vpls: u32) -> bool {
+        let subset = vpls.div_ceil(self.interleave.subsets());
+        self.roulette_share(vpls) > 0.0 && subset >= THIN_SUBSET_VPLS
     }
 
     /// The ratio estimator's grid stride in pixels ([`GatesParams::ratio_stride`]), at least 1.

@@ -56,12 +56,12 @@ fn gate_shape() -> u32 {
 // the whole of subset j (of `subsets`) there, summed over its channels; a VPL under s times
 // it is walked by chance (walk_range). Summed once, in a pixel's first batch, so that the cut
 // does not depend on the batching (summed in every batch, it cost e2m3's hall 1.2 s of 3.7 at
-// 16,384 VPLs on lavapipe). 0 when off. With the ratio estimator (globals.ratio) the near
-// field's share left out: the subset's unshadowed far light, which the blur weighs the walks'
-// light against (blur.wgsl's compose), and the roulette's total too.
+// 16,384 VPLs on lavapipe), but for the ratio estimator's (shade.wgsl's portal_gather). 0
+// when off. With the ratio estimator (globals.ratio) the near field's share left out: the
+// subset's unshadowed far light, as the walks weigh it.
 fn roulette_total(p: vec3<f32>, n: vec3<f32>, j: u32, subsets: u32) -> f32 {
     let ratio = globals.ratio == 1u;
-    if globals.walk_roulette <= 0.0 && !ratio {
+    if globals.walk_roulette <= 0.0 {
         return 0.0;
     }
     // near_share is 0 at a radius of 0: the whole light, as without the ratio.
@@ -116,9 +116,12 @@ fn walk_end_at(px: vec2<i32>, p: vec3<f32>) -> vec4<f32> {
 // `cut` (the roulette's share of roulette_total; 0: none) is walked with probability (its
 // light / cut) and counts 1 / that probability. The VPLs nearer p than the near field's
 // radius (near_radius) count by the share near_share leaves them: cs_near_field walks them at
-// the pixel itself for the rest.
-fn walk_range(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, at_p: vec4<f32>, first: u32, end: u32, step: u32, cut: f32) -> vec3<f32> {
+// the pixel itself for the rest. w: the unshadowed light, summed over its channels, of the
+// VPLs walked, each weighed as its light (the ratio estimator's share of visible light: 1
+// where every VPL walked is visible, with the roulette too).
+fn walk_range(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, at_p: vec4<f32>, first: u32, end: u32, step: u32, cut: f32) -> vec4<f32> {
     var sum = vec3<f32>(0.0);
+    var walked = 0.0;
     let h = roulette_hash(px);
     let r = near_radius(p);
     for (var k = first; k < end; k += step) {
@@ -140,11 +143,12 @@ fn walk_range(px: vec2<i32>, p: vec3<f32>, n: vec3<f32>, here: u32, at_p: vec4<f
             }
             l /= keep;
         }
+        walked += l.x + l.y + l.z;
         if walk_visible(k, v, p, here, at_p) {
             sum += l;
         }
     }
-    return sum;
+    return vec4<f32>(sum, walked);
 }
 
 // Whether VPL k (v) lights p (cluster `here`, walk end at_p): the voxel walk or the portal
