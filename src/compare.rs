@@ -34,7 +34,7 @@ setting: --fast, the walk on the closed voxels' planes with the box blur), gates
 shape, gates-fast where gates are not fast, gates-filled and gates-starved where gates
 interleave without them, and gates-roulette where gates walk (voxels, portals) without it; the gate modes only with a level
 (given, or baked here). A mode that would render another's very frame (gates-roulette where
-gates' auto roulette takes the same share: 8,192 VPLs or more, 512 or more in the
+gates' auto roulette takes the same share: 8,192 VPLs or more, 2,048 or more in the
 balanced and accurate settings) takes that mode's row instead.
 
 Every mode renders at every --vpls count from every camera, beside the CPU reference with the

@@ -310,10 +310,10 @@ pub struct MethodArgs {
     /// where the frame is interleaved in blocks of 8 x 8 or more and a pixel's subset holds 128
     /// VPLs or more (8,192 VPLs in 8 x 8 blocks: there it halves the frame on a GPU and moves
     /// the indirect error by a few per cent, at most +27 % measured; in 4 x 4 blocks it leaves
-    /// blotches; see the README), or 8 with the ratio estimator (512 VPLs in the balanced and
-    /// accurate settings, whose estimator keeps each pixel's own unshadowed light: the frame
-    /// 1.0-1.7x faster on lavapipe at 1,024 and 4,096 VPLs, the indirect error -3 ... +23 %
-    /// on 23 of 24 views, +56 % on one), else 0.
+    /// blotches; see the README), or 32 with the ratio estimator (2,048 VPLs in the balanced
+    /// and accurate settings, whose estimator keeps each pixel's own unshadowed light: at
+    /// 4,096 VPLs the frame 1.1-1.7x faster on lavapipe, the indirect error -3 ... +5 % on 22
+    /// of 24 views, +17 % and +23 % on two near black), else 0.
     #[arg(long, value_name = "auto|SHARE", value_parser = walk_roulette, default_value = "auto")]
     pub walk_roulette: WalkRoulette,
     /// Interleaved gates with portals or voxels, the near field: each pixel walks the VPLs

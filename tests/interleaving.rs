@@ -282,7 +282,7 @@ fn a_near_field_that_holds_every_vpl_is_every_vpl_at_every_pixel() {
 /// walks to VPLs beside them the closed voxels block at some pixels of a block and not at
 /// others. On the unshadowed light's 3 px grid (`GatesParams::ratio_stride`, the balanced
 /// setting's) the pixels between the grid's take it bilinearly: 5.8e-7. With the walks'
-/// roulette on (S = 0.05, the balanced setting's auto share from 512 VPLs): the share is of
+/// roulette on (S = 0.05, the balanced setting's auto share from 2,048 VPLs): the share is of
 /// the light of the VPLs walked, each weighed as its light, so still 1 (measured 7.4e-14;
 /// against the subset's whole unshadowed light, as before, 7.9e-7).
 #[test]

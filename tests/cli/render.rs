@@ -335,6 +335,15 @@ fn render_gates_takes_the_roulette_and_every_gate_shape_and_refuses_a_missing_or
     assert!(or.status.success(), "{}", stderr(&or));
     let named = "gates (voxel walk, 8×8 interleaved) 16x12";
     assert!(stdout(&or).contains(named), "{}", stdout(&or));
+    // In the balanced setting, whose blur takes the ratio estimator, from 32 VPLs a pixel
+    // (2,048 in 8 × 8 blocks), the near field and the estimator kept beside it.
+    let mut balanced = gates_render(&level, &out);
+    balanced[vpls] = "2048";
+    let ob = visgate(&balanced);
+    assert!(ob.status.success(), "{}", stderr(&ob));
+    let named = "near field 4 blocks, ratio estimator (grid 3 px), roulette under 0.05 (auto))";
+    assert!(stdout(&ob).contains(named), "{}", stdout(&ob));
+    assert!(stdout(&ob).contains("ratio estimator: unshadowed light summed"));
     a.extend(["--gate-shape", "portal"]);
     let o = visgate(&a);
     assert!(o.status.success(), "{}", stderr(&o));

@@ -18,12 +18,13 @@ fn the_default_roulette_is_on_where_an_interleaved_pixel_walks_many_vpls() {
     );
     assert_eq!(described(p, 4_096), "voxel walk, 8×8 interleaved");
     assert!(GpuMode::Gates(p).describe().ends_with("roulette auto"));
-    // With the ratio estimator (the balanced setting) from 8 VPLs a pixel, its near field
+    // With the ratio estimator (the balanced setting) from 32 VPLs a pixel, its near field
     // and ratio kept until 128.
     let balanced = GatesParams::default().balanced();
-    assert_eq!(balanced.roulette_share(512), AUTO);
-    assert_eq!(balanced.roulette_share(448), 0.0, "7 VPLs a pixel");
-    let named = described(balanced, 1_024);
+    assert_eq!(balanced.roulette_share(2_048), AUTO);
+    assert_eq!(balanced.roulette_share(1_984), 0.0, "31 VPLs a pixel");
+    assert!(!described(balanced, 1_024).contains("roulette"));
+    let named = described(balanced, 4_096);
     assert!(
         named.ends_with("ratio estimator (grid 3 px), roulette under 0.05 (auto)"),
         "{named}"
