@@ -200,9 +200,8 @@ impl GatesParams {
     /// ([`GatesParams::ratio`]): asked for, the walks (portals or voxels) interleaved, and not
     /// thinned by the roulette ([`Self::thinned`]) — where it thins them (from 128 VPLs a
     /// subset) the near field is off too, and the unshadowed light, every VPL at every pixel,
-    /// would cost
-    /// a GPU what the none mode does (15 ms at 512² and 16,384 VPLs on an H200) for a
-    /// subset's error that its many VPLs have made small.
+    /// would cost a GPU what the none mode does (15 ms at 512² and 16,384 VPLs on an H200) for
+    /// a subset's error that its many VPLs have made small.
     pub fn ratio_for(&self, vpls: u32) -> bool {
         let walks = self.gates.shape != GateShape::Disk;
         self.ratio && self.interleave.block > 1 && walks && !self.thinned(vpls)
