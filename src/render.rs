@@ -367,9 +367,13 @@ pub struct DiffArgs {
     /// Exposure both are tone mapped at for FLIP, in stops.
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub exposure: f32,
-    /// The reference's direct light alone (.exr, e.g. `render --mode direct-only --cpu`): also
-    /// print the indirect energy ratio and the share of pixels black where the reference's
-    /// indirect light is.
+    /// The reference's direct light alone (.exr): also print the indirect energy ratio and the
+    /// share of pixels black where the reference's indirect light is. It must come from the
+    /// reference's own renderer: `render --mode direct-only --cpu` (rays) for `render`'s
+    /// reference, `renders/CAMERA/direct-cpu.exr` (the CPU twin's shadow maps) for `visgate
+    /// compare`'s. Another's shadow edges stay in the indirect light: on a level lit mostly
+    /// directly the energy ratio reads far from 1 (LibreQuake e2m3's hall at 4,096 VPLs: 0.05
+    /// instead of 1.00).
     #[arg(long)]
     pub direct: Option<PathBuf>,
     /// The image's own direct light (.exr, e.g. `render --mode direct-only`), taken out of it
