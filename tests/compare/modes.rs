@@ -309,8 +309,10 @@ fn variants_are_rows_of_a_mode_with_the_runs_settings_and_their_own_flags() {
 
 #[test]
 fn a_mode_that_renders_another_s_frame_takes_its_row_instead_of_a_second_render() {
-    // At 16,384 VPLs gates' auto roulette is gates-roulette's share: one frame, two rows; at
-    // 64 it is off, and gates-roulette renders its own.
+    // At 16,384 VPLs gates' auto roulette is gates-roulette's share: one frame, two rows; so
+    // at 2,048, where the balanced setting's blur takes the ratio estimator (the near field
+    // and the estimator kept beside the roulette, in both); at 64 it is off, and
+    // gates-roulette renders its own.
     let dir = tempfile::tempdir().expect("tempdir");
     let out = dir.path().join("same");
     visgate(&[
@@ -321,7 +323,7 @@ fn a_mode_that_renders_another_s_frame_takes_its_row_instead_of_a_second_render(
         "--modes",
         "gates,gates-roulette",
         "--vpls",
-        "64,16384",
+        "64,2048,16384",
         "--size",
         "24x18",
         "--spp",
@@ -338,11 +340,21 @@ fn a_mode_that_renders_another_s_frame_takes_its_row_instead_of_a_second_render(
             .find(|r| r["camera"] == "main" && r["mode"] == mode && r["vpls"] == vpls)
             .unwrap_or_else(|| panic!("no row {mode} at {vpls}: {rows:?}"))
     };
-    let (g, r) = (row("gates", 16384), row("gates-roulette", 16384));
-    let settings = r["settings"].as_str().expect("settings");
-    assert!(settings.contains("the frame of gates"), "{settings}");
-    assert_eq!(g["indirect_mse"], r["indirect_mse"]);
-    assert_eq!(g["image"], r["image"]);
+    for vpls in [2048, 16384] {
+        let (g, r) = (row("gates", vpls), row("gates-roulette", vpls));
+        let settings = r["settings"].as_str().expect("settings");
+        assert!(
+            settings.contains("the frame of gates"),
+            "{vpls}: {settings}"
+        );
+        assert_eq!(g["indirect_mse"], r["indirect_mse"]);
+        assert_eq!(g["image"], r["image"]);
+    }
+    let settings = row("gates", 2048)["settings"].as_str().expect("settings");
+    assert!(
+        settings.contains("ratio estimator (grid 3 px), roulette under 0.05 (auto)"),
+        "{settings}"
+    );
     let (g, r) = (row("gates", 64), row("gates-roulette", 64));
     assert!(
         !r["settings"]
