@@ -173,9 +173,13 @@ impl GatesParams {
 
     /// The roulette's share S for a frame of `vpls` VPLs (0: every VPL walked).
     pub fn roulette_share(&self, vpls: u32) -> f32 {
-        let il = self.interleave;
         self.walk_roulette
-            .share(vpls.div_ceil(il.subsets()), il.block, self.ratio)
+            .share(self.subset_vpls(vpls), self.interleave.block, self.ratio)
+    }
+
+    /// The VPLs a pixel's subset holds in a frame of `vpls` VPLs (the last subsets one fewer).
+    fn subset_vpls(&self, vpls: u32) -> u32 {
+        vpls.div_ceil(self.interleave.subsets())
     }
 
     /// The near field's radius per metre of a pixel's distance from the eye in `view`, for a
@@ -210,8 +214,7 @@ impl GatesParams {
     /// Whether the roulette thins a frame of `vpls` VPLs so far that the near field and the
     /// ratio estimator are off: on, with [`THIN_SUBSET_VPLS`] VPLs a pixel's subset or more.
     pub fn thinned(&self, vpls: u32) -> bool {
-        let subset = vpls.div_ceil(self.interleave.subsets());
-        self.roulette_share(vpls) > 0.0 && subset >= THIN_SUBSET_VPLS
+        self.roulette_share(vpls) > 0.0 && self.subset_vpls(vpls) >= THIN_SUBSET_VPLS
     }
 
     /// The ratio estimator's grid stride in pixels ([`GatesParams::ratio_stride`]), at least 1.
