@@ -233,11 +233,15 @@ fn reaches_bounds(c: &Value, grid: &GridMeta) -> bool {
 /// Whether a kept part of the empty space holds cameras or lights, does not reach the bounds,
 /// and the triangles around it turn their backs to it: the inside of a closed mesh — a lamp's
 /// bulb or shade, a hollow wall or column a camera was put in. (A room joined to the void by a
-/// window may see its walls' backs too, but it reaches the bounds.)
+/// window may see its walls' backs too, but it reaches the bounds.) Their backs must outvote
+/// their fronts by [`MIXED_RATIO`]: under it the faces are wound both ways ([`mixed_winding`]
+/// says so), and a sealed level whose walls were wound at random, 146 backs to 142 fronts
+/// around its rooms, was told that its lamp lit the inside of a bulb.
 fn enclosed_seed_part(c: &Value, grid: &GridMeta) -> bool {
     let seeded = !seeds_of(c).is_empty();
     let v = |k: usize| c["faced_by"][k].as_u64().unwrap_or(0);
-    c["kept"] == true && seeded && v(1) > v(0) && !reaches_bounds(c, grid)
+    let backs = v(1) > v(0) && v(1) as f64 >= MIXED_RATIO * v(0) as f64;
+    c["kept"] == true && seeded && backs && !reaches_bounds(c, grid)
 }
 
 /// A warning for each part that holds cameras or lights inside closed geometry
@@ -582,6 +586,14 @@ mod tests {
         assert!(w[0].contains("Move the camera out"), "{w:?}");
         assert!(cut_off_cameras(&in_wall, &g).is_empty());
         assert!(mixed_winding(&in_wall, &g).is_none());
+        // A sealed level whose walls face their rooms and turn their backs about as often:
+        // wound both ways, not the inside of a closed mesh.
+        let office = json!({ "components": [
+            part(&["camera 'lit'", "camera 'away'", "point light 0"], [142, 146], 294_216),
+        ]});
+        assert!(enclosed_seeds(&office, &g).is_empty());
+        let w = mixed_winding(&office, &g).expect("wound both ways");
+        assert!(w.contains("146 turn their backs"), "{w}");
         // A room joined to the void by a window reaches the bounds: its backs say nothing.
         let mut window = part(&["point light 0"], [0, 288], 40_000);
         window["bounds_min_m"] = json!([0.0, 0.0, 0.0]);
