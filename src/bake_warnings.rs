@@ -143,11 +143,12 @@ fn mixed_winding(empty_space: &Value, grid: &GridMeta) -> Option<String> {
         let kept = comps.iter().filter(by_votes).count();
         format!(
             "the level's faces are wound both ways: of the triangles beside its rooms {f} face \
-             them and {b} turn their backs (objects mirrored or exported inside out?). The bake \
-             keeps and drops empty space by these votes, and kept {kept} part(s) beside the \
-             rooms by them, which may be the void around the level or the insides of walls. \
-             Make the winding consistent, or name the level in a scene file with a camera or a \
-             light inside and `closed = true`, which drops what reaches the bounds"
+             them and {b} turn their backs (objects mirrored or exported inside out, or faces \
+             doubled back to back?). The bake keeps and drops empty space by these votes, and \
+             kept {kept} part(s) beside the rooms by them, which may be the void around the \
+             level or the insides of walls. Make the winding consistent (one face a surface, \
+             facing the rooms), or name the level in a scene file with a camera or a light \
+             inside and `closed = true`, which drops what reaches the bounds"
         )
     })
 }
@@ -594,6 +595,8 @@ mod tests {
         assert!(enclosed_seeds(&office, &g).is_empty());
         let w = mixed_winding(&office, &g).expect("wound both ways");
         assert!(w.contains("146 turn their backs"), "{w}");
+        // Two-sided walls modelled as two faces back to back vote both ways too.
+        assert!(w.contains("doubled back to back"), "{w}");
         // A room joined to the void by a window reaches the bounds: its backs say nothing.
         let mut window = part(&["point light 0"], [0, 288], 40_000);
         window["bounds_min_m"] = json!([0.0, 0.0, 0.0]);
