@@ -20,6 +20,14 @@ pub const NEAR_DIAGONALS: f32 = 1.0;
 /// the box's diagonals]
 pub const FAR_DIAGONALS: f32 = 10.0;
 
+/// How near the origin every light and camera must stand, where each read as metres would
+/// stand inside the level, to be named as a slip of units in a level that holds the origin
+/// (modelled from a room's corner or its middle): a lamp and a camera written in metres in a
+/// level of centimetres that starts at the origin stand a hundredth of the way there, inside
+/// the level's box or at its edge, and the far rule says nothing. [Units: ratio, the box's
+/// diagonals]
+pub const ORIGIN_DIAGONALS: f32 = 0.02;
+
 /// Distance from `p` to the box `lo..hi` (0 inside).
 pub fn outside_by(p: Vec3, (lo, hi): (Vec3, Vec3)) -> f32 {
     (lo - p).max(p - hi).max(Vec3::ZERO).length()
@@ -28,7 +36,9 @@ pub fn outside_by(p: Vec3, (lo, hi): (Vec3, Vec3)) -> f32 {
 /// A warning for each light and camera of `scene` (as assembled from `desc`) that lies more
 /// than [`NEAR_DIAGONALS`] of the static geometry's box outside it where its numbers, read as
 /// metres, would put it inside (with the numbers to write), or more than [`FAR_DIAGONALS`]
-/// whatever they are.
+/// whatever they are; and, where every one stands within [`ORIGIN_DIAGONALS`] of the origin
+/// and each read as metres would stand inside the box, for each of those too (a slip of units
+/// in a level that holds the origin).
 pub fn far_placements(scene: &Scene, desc: &SceneDesc) -> Vec<String> {
     let Some(bounds) = scene.static_bounds().or_else(|| scene.bounds()) else {
         return Vec::new();
@@ -51,24 +61,36 @@ pub fn far_placements(scene: &Scene, desc: &SceneDesc) -> Vec<String> {
         .cameras
         .iter()
         .map(|c| (format!("camera '{}'", c.name), c.eye));
-    lights
+    let placed: Vec<Placed> = lights
         .chain(cameras)
-        .filter_map(|(what, units)| {
+        .map(|(what, units)| {
             let p = space.point(units);
-            let off = outside_by(p, bounds);
-            let fix = slip(units).then(|| as_units(units));
-            let named = match fix {
-                Some(_) => off > NEAR_DIAGONALS * diagonal,
-                None => off > FAR_DIAGONALS * diagonal,
-            };
-            let placed = Placed {
+            Placed {
                 what,
                 units,
                 p,
-                off,
-                fix,
-            };
-            named.then(|| far_warning(&placed, bounds, mpu))
+                off: outside_by(p, bounds),
+                fix: slip(units).then(|| as_units(units)),
+            }
+        })
+        .collect();
+    let far = |x: &Placed| match x.fix {
+        Some(_) => x.off > NEAR_DIAGONALS * diagonal,
+        None => x.off > FAR_DIAGONALS * diagonal,
+    };
+    // Every one a slip near the origin: none stands where the level is.
+    let at_origin = !placed.is_empty()
+        && placed
+            .iter()
+            .all(|x| x.fix.is_some() && x.p.length() <= ORIGIN_DIAGONALS * diagonal);
+    placed
+        .iter()
+        .filter_map(|x| {
+            if far(x) {
+                Some(far_warning(x, bounds, mpu))
+            } else {
+                at_origin.then(|| origin_warning(x, diagonal, mpu))
+            }
         })
         .collect()
 }
@@ -119,6 +141,25 @@ fn far_warning(placed: &Placed, (lo, hi): (Vec3, Vec3), mpu: f64) -> String {
     out
 }
 
+/// The warning for `placed`, one of a scene's lights and cameras that all stand near the
+/// origin of a level `diagonal` m across, of `mpu` metres per unit, where each read as metres
+/// would stand inside it.
+fn origin_warning(placed: &Placed, diagonal: f32, mpu: f64) -> String {
+    let Placed { what, units, p, .. } = placed;
+    let fix = placed.fix.map_or(String::new(), |f| fmt3(DVec3::from(f)));
+    format!(
+        "{what} at ({:.3}, {:.3}, {:.3}) m stands {:.2} m from the origin, as every light and \
+         camera of the scene does, in a level {diagonal:.1} m across; a scene file's positions \
+         are in its units (metres_per_unit = {mpu}), so if ({}) are metres, write ({fix}) to \
+         put it where they say",
+        p.x,
+        p.y,
+        p.z,
+        p.length(),
+        fmt3(DVec3::from(*units)),
+    )
+}
+
 /// A point's coordinates, trimmed.
 fn fmt3(p: DVec3) -> String {
     p.to_array()
@@ -135,7 +176,11 @@ mod tests {
     /// A 8 × 3 × 4 m room 2.5 km from the origin, modelled in centimetres, with a light and a
     /// camera written at `light` and `eye` (file units).
     fn scene(light: [f64; 3], eye: [f64; 3]) -> (Scene, SceneDesc) {
-        let o = DVec3::new(250_000.0, 1_000.0, -80_000.0);
+        room_at(DVec3::new(250_000.0, 1_000.0, -80_000.0), light, eye)
+    }
+
+    /// The room with its first corner at `o` (file units).
+    fn room_at(o: DVec3, light: [f64; 3], eye: [f64; 3]) -> (Scene, SceneDesc) {
         let corners: Vec<Vec3> = (0..8)
             .map(|i| {
                 let c = DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, (i >> 2) as f64);
@@ -216,5 +261,34 @@ mod tests {
             "{}",
             w[0]
         );
+    }
+
+    #[test]
+    fn positions_written_in_metres_in_a_centimetre_level_at_the_origin_are_named_with_the_fix() {
+        // The room from the origin: written in metres, the lamp and the camera stand inside
+        // its box or at its edge, within a few centimetres of its corner.
+        let o = DVec3::ZERO;
+        let (s, d) = room_at(o, [2.5, 2.0, 1.5], [0.5, 1.6, 0.5]);
+        let w = far_placements(&s, &d);
+        assert_eq!(w.len(), 2, "{w:?}");
+        assert!(
+            w[0].starts_with(
+                "point light 0 at (0.025, 0.020, 0.015) m stands 0.04 m from the origin"
+            ) && w[0].contains("if (2.5, 2, 1.5) are metres, write (250, 200, 150)"),
+            "{}",
+            w[0]
+        );
+        assert!(w[1].starts_with("camera 'door'"), "{}", w[1]);
+        // Written in centimetres: nothing to say.
+        let (s, d) = room_at(o, [250.0, 200.0, 150.0], [50.0, 160.0, 50.0]);
+        assert!(far_placements(&s, &d).is_empty());
+        // A lamp in the corner on purpose, the camera across the room: not every one is near
+        // the origin, nothing to say.
+        let (s, d) = room_at(o, [2.5, 2.0, 1.5], [700.0, 160.0, 300.0]);
+        assert!(far_placements(&s, &d).is_empty());
+        // Near the origin but, read as metres, outside the room (3 m up in a 3 m room): not a
+        // slip that puts them inside, nothing to say.
+        let (s, d) = room_at(o, [2.5, 3.5, 1.5], [0.5, 3.5, 0.5]);
+        assert!(far_placements(&s, &d).is_empty());
     }
 }
