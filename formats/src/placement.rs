@@ -6,7 +6,7 @@
 
 use glam::{DVec3, Vec3};
 
-use crate::desc::{LightDesc, SceneDesc};
+use crate::desc::{LightDesc, SceneDesc, UpAxis};
 use crate::scene::{Scene, SceneSpace};
 
 /// How far outside the static geometry's box a light or a camera may stand before it is
@@ -61,6 +61,18 @@ pub fn far_placements(scene: &Scene, desc: &SceneDesc) -> Vec<String> {
         .cameras
         .iter()
         .map(|c| (format!("camera '{}'", c.name), c.eye));
+    // Numbers written as metres with the other axis up (a Y-up engine's positions in a Z-up
+    // file): the file's units that stand where they say, where that is inside the level.
+    let other = match desc.up {
+        UpAxis::Y => UpAxis::Z,
+        UpAxis::Z => UpAxis::Y,
+    };
+    let to_units = space.matrix.inverse();
+    let axes_slip = |units: [f64; 3]| {
+        let world = SceneSpace::new(other, 1.0).point(units);
+        let fix = to_units.transform_point3(world.as_dvec3()).to_array();
+        (mpu != 1.0 && outside_by(world, bounds) == 0.0).then_some((other, fix))
+    };
     let placed: Vec<Placed> = lights
         .chain(cameras)
         .map(|(what, units)| {
@@ -71,6 +83,7 @@ pub fn far_placements(scene: &Scene, desc: &SceneDesc) -> Vec<String> {
                 p,
                 off: outside_by(p, bounds),
                 fix: slip(units).then(|| as_units(units)),
+                axes_fix: axes_slip(units),
             }
         })
         .collect();
@@ -78,11 +91,12 @@ pub fn far_placements(scene: &Scene, desc: &SceneDesc) -> Vec<String> {
         Some(_) => x.off > NEAR_DIAGONALS * diagonal,
         None => x.off > FAR_DIAGONALS * diagonal,
     };
-    // Every one a slip near the origin: none stands where the level is.
+    // Every one a slip near the origin (of units, or of units and axes): none stands where
+    // the level is.
     let at_origin = !placed.is_empty()
-        && placed
-            .iter()
-            .all(|x| x.fix.is_some() && x.p.length() <= ORIGIN_DIAGONALS * diagonal);
+        && placed.iter().all(|x| {
+            (x.fix.is_some() || x.axes_fix.is_some()) && x.p.length() <= ORIGIN_DIAGONALS * diagonal
+        });
     placed
         .iter()
         .filter_map(|x| {
@@ -107,6 +121,8 @@ struct Placed {
     off: f32,
     /// The numbers to write where those written were metres.
     fix: Option<[f64; 3]>,
+    /// Where those written were metres with the other axis up: that axis and the numbers.
+    axes_fix: Option<(UpAxis, [f64; 3])>,
 }
 
 /// The warning for `placed`, outside the box `(lo, hi)` of a level of `mpu` metres per unit.
@@ -117,6 +133,7 @@ fn far_warning(placed: &Placed, (lo, hi): (Vec3, Vec3), mpu: f64) -> String {
         p,
         off,
         fix,
+        ..
     } = placed;
     let mut out = format!(
         "{what} at ({:.2}, {:.2}, {:.2}) m stands {off:.1} m outside the level (its geometry spans \
@@ -146,18 +163,31 @@ fn far_warning(placed: &Placed, (lo, hi): (Vec3, Vec3), mpu: f64) -> String {
 /// would stand inside it.
 fn origin_warning(placed: &Placed, diagonal: f32, mpu: f64) -> String {
     let Placed { what, units, p, .. } = placed;
-    let fix = placed.fix.map_or(String::new(), |f| fmt3(DVec3::from(f)));
+    let (read, fix) = match (placed.fix, placed.axes_fix) {
+        (Some(f), _) => ("metres".to_string(), f),
+        (None, Some((up, f))) => (format!("metres with {} up", axis_name(up)), f),
+        (None, None) => ("metres".to_string(), *units),
+    };
     format!(
         "{what} at ({:.3}, {:.3}, {:.3}) m stands {:.2} m from the origin, as every light and \
          camera of the scene does, in a level {diagonal:.1} m across; a scene file's positions \
-         are in its units (metres_per_unit = {mpu}), so if ({}) are metres, write ({fix}) to \
-         put it where they say",
+         are in its units (metres_per_unit = {mpu}) and axes, so if ({}) are {read}, write \
+         ({}) to put it where they say",
         p.x,
         p.y,
         p.z,
         p.length(),
         fmt3(DVec3::from(*units)),
+        fmt3(DVec3::from(fix)),
     )
+}
+
+/// An up axis as a scene file names it.
+fn axis_name(up: UpAxis) -> &'static str {
+    match up {
+        UpAxis::Y => "Y",
+        UpAxis::Z => "Z",
+    }
 }
 
 /// A point's coordinates, trimmed.
@@ -286,9 +316,19 @@ mod tests {
         // the origin, nothing to say.
         let (s, d) = room_at(o, [2.5, 2.0, 1.5], [700.0, 160.0, 300.0]);
         assert!(far_placements(&s, &d).is_empty());
-        // Near the origin but, read as metres, outside the room (3 m up in a 3 m room): not a
-        // slip that puts them inside, nothing to say.
+        // Near the origin but, read as metres either way up, outside the room (3.5 m up in a
+        // 3 m room; 3.5 m along −z): not a slip that puts them inside, nothing to say.
         let (s, d) = room_at(o, [2.5, 3.5, 1.5], [0.5, 3.5, 0.5]);
         assert!(far_placements(&s, &d).is_empty());
+        // Written in metres with Z up (a Z-up tool's numbers in this Y-up file): read Y up
+        // they stand under the floor, read Z up inside; named with the numbers for Y up.
+        let (s, d) = room_at(o, [2.5, -3.5, 2.0], [0.5, -0.5, 1.6]);
+        let w = far_placements(&s, &d);
+        assert_eq!(w.len(), 2, "{w:?}");
+        assert!(
+            w[0].contains("if (2.5, -3.5, 2) are metres with Z up, write (250, 200, 350)"),
+            "{}",
+            w[0]
+        );
     }
 }
