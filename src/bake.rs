@@ -172,6 +172,10 @@ Examples:
 
 pub fn run(args: BakeArgs) -> Result<()> {
     let (params, options) = params_of(&args)?;
+    crate::writable(&args.output, "-o")?;
+    if let Some(report) = &args.report {
+        crate::writable(report, "--report")?;
+    }
     let scene = crate::load_scene(&args.scene, false)?;
     // The importer has logged the scene's warnings (degenerate triangles dropped, …) once.
     warn_of_strays(&scene);

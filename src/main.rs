@@ -12,10 +12,10 @@ mod render;
 mod settings;
 mod view;
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use anyhow::{Context, Result};
+use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use visgate_formats::desc::UpAxis;
 use visgate_formats::{BareMesh, ImportOptions, Scene};
@@ -225,6 +225,30 @@ pub fn load_scene(arg: &str, load_textures: bool) -> Result<Scene> {
         bare: BARE_MESH.get().copied().unwrap_or_default(),
     };
     Ok(visgate_scenes::load(arg, &options)?)
+}
+
+/// Refuses an output that a command could not write before it works (a bake at 1024 voxels or
+/// a reference render takes minutes, and a mistyped folder failed only then): its folder must
+/// exist and take a file. The probe is `PATH.partial` (the level is written through it),
+/// removed again.
+pub fn writable(path: &Path, flag: &str) -> Result<()> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    if !dir.is_dir() {
+        bail!(
+            "{flag} {}: the folder {} does not exist; create it, or write elsewhere",
+            path.display(),
+            dir.display()
+        );
+    }
+    let mut probe = path.as_os_str().to_owned();
+    probe.push(".partial");
+    std::fs::File::create(&probe)
+        .with_context(|| format!("{flag} {}: cannot write there", path.display()))?;
+    std::fs::remove_file(&probe).ok();
+    Ok(())
 }
 
 /// The camera named `name` of `scene` (loaded from `arg`), or its first.

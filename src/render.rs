@@ -202,6 +202,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
     if args.threads == Some(0) {
         bail!("--threads 0: give at least 1 thread, or leave it out to use all cores");
     }
+    crate::writable(&args.out, "--out")?;
     job.check(args.level.is_some())?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(args.threads.unwrap_or(0))

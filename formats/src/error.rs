@@ -106,13 +106,15 @@ pub enum SceneError {
 /// Everything that can go wrong reading or writing a baked `.vgate` file.
 #[derive(Debug, thiserror::Error)]
 pub enum VgateError {
-    /// The file could not be read or written.
-    #[error("{}: {source}", file.display())]
+    /// The file could not be read or written: the OS's words alone, since every caller names
+    /// the file and what it was doing (`cannot read the level L: …`); as the error's source
+    /// too, a chain printed them twice, the file's name with them.
+    #[error("{error}")]
     Io {
         /// The file.
         file: PathBuf,
         /// The OS error.
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// The first bytes are not the `.vgate` magic.
     #[error("not a visgate baked file (wrong magic bytes)")]

@@ -461,6 +461,43 @@ fn bake_refuses_bad_arguments_clearly() {
     assert!(stderr(&o).contains("GiB"), "{}", stderr(&o));
     let o = visgate(&["bake", "nope.toml", "-o", out]);
     assert!(stderr(&o).contains("no such file"), "{}", stderr(&o));
+    // An output in a folder that is not there is refused before the bake, not after it.
+    let lost = dir.path().join("no-such-folder").join("x.vgate");
+    let lost = lost.to_str().expect("utf-8");
+    for (flag, args) in [
+        ("-o", vec!["-o", lost]),
+        ("--report", vec!["-o", out, "--report", lost]),
+    ] {
+        let o = visgate(&[&["bake", "builtin:two-rooms"], &args[..]].concat());
+        assert!(!o.status.success());
+        let want = format!("{flag} {lost}: the folder");
+        assert!(stderr(&o).contains(&want), "{}", stderr(&o));
+        assert!(!stdout(&o).contains("bake of"), "it baked: {}", stdout(&o));
+    }
+    // A level that cannot be read says so once, the file's name with it.
+    let missing = dir.path().join("missing.vgate");
+    let missing = missing.to_str().expect("utf-8");
+    let o = visgate(&["inspect", missing]);
+    assert!(!o.status.success());
+    let image = dir.path().join("x.png");
+    let image = image.to_str().expect("utf-8");
+    let o = visgate(&[
+        "render",
+        "builtin:two-rooms",
+        "--mode",
+        "gates",
+        "--level",
+        missing,
+        "--out",
+        image,
+    ]);
+    let err = stderr(&o);
+    assert!(
+        err.contains(&format!("cannot read the level {missing}: ")),
+        "{err}"
+    );
+    assert_eq!(err.matches("os error").count(), 1, "{err}");
+    assert_eq!(err.matches(missing).count(), 1, "{err}");
     // The sizes that shape the partition name their limits.
     for (flag, value, says) in [
         ("--min-gap", "-0.1", "minimum gap -0.1 m must be in 0..=10"),

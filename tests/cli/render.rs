@@ -165,6 +165,25 @@ fn render_and_diff_refuse_bad_arguments_clearly() {
     }
     let o = visgate(&["render", "builtin:cornell-box", "--out", "x.jpg"]);
     assert!(stderr(&o).contains(".exr"), "{}", stderr(&o));
+    // An image for a folder that is not there is refused before the render, not after it.
+    let lost = dir.path().join("no-such-folder").join("x.png");
+    let lost = lost.to_str().expect("utf-8");
+    let o = visgate(&[
+        "render",
+        "builtin:cornell-box",
+        "--size",
+        "8x8",
+        "--out",
+        lost,
+    ]);
+    assert!(!o.status.success());
+    let want = format!("--out {lost}: the folder");
+    assert!(stderr(&o).contains(&want), "{}", stderr(&o));
+    assert!(
+        !stdout(&o).contains("mean radiance"),
+        "it rendered: {}",
+        stdout(&o)
+    );
     let o = visgate(&["diff", "missing-a.exr", "missing-b.exr"]);
     assert!(!o.status.success());
     assert!(stderr(&o).contains("missing-a.exr"), "{}", stderr(&o));

@@ -357,9 +357,9 @@ impl BakedLevel {
     /// half a file under the final name).
     pub fn write(&self, path: &Path) -> Result<(), VgateError> {
         let bytes = self.to_bytes()?;
-        let io = |source| VgateError::Io {
+        let io = |error| VgateError::Io {
             file: path.to_path_buf(),
-            source,
+            error,
         };
         let mut tmp = path.as_os_str().to_owned();
         tmp.push(".partial");

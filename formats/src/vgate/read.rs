@@ -12,9 +12,9 @@ use crate::error::VgateError;
 impl BakedLevel {
     /// Reads and fully validates a file.
     pub fn read(path: &Path) -> Result<BakedLevel, VgateError> {
-        let bytes = std::fs::read(path).map_err(|source| VgateError::Io {
+        let bytes = std::fs::read(path).map_err(|error| VgateError::Io {
             file: path.to_path_buf(),
-            source,
+            error,
         })?;
         Self::from_bytes(&bytes)
     }
