@@ -394,9 +394,9 @@ impl SceneDesc {
 
     /// Reads, parses and validates a scene TOML file.
     pub fn read(file: &Path) -> Result<Self, SceneError> {
-        let text = std::fs::read_to_string(file).map_err(|source| SceneError::Io {
+        let text = std::fs::read_to_string(file).map_err(|error| SceneError::Io {
             file: file.to_path_buf(),
-            source,
+            error,
         })?;
         Self::from_toml(&text, file)
     }

@@ -5,13 +5,14 @@ use std::path::PathBuf;
 /// Everything that can go wrong reading a scene description or importing its meshes.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
-    /// The file could not be read.
-    #[error("{}: cannot read: {source}", file.display())]
+    /// The file could not be read (the OS's words in the message alone: as the error's source
+    /// too, a chain printed them twice).
+    #[error("{}: cannot read: {error}", file.display())]
     Io {
         /// The file.
         file: PathBuf,
         /// The OS error.
-        source: std::io::Error,
+        error: std::io::Error,
     },
     /// The scene TOML does not parse, or has an unknown key.
     #[error("{}: {message}", file.display())]

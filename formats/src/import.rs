@@ -87,9 +87,16 @@ pub struct ImportedModel {
 /// Imports an OBJ, glTF or GLB file, chosen by its extension.
 pub fn import_file(path: &Path, options: &ImportOptions) -> Result<ImportedModel, SceneError> {
     if !path.is_file() {
+        let (kind, words) = match path.is_dir() {
+            true => (
+                std::io::ErrorKind::InvalidInput,
+                "a folder, not a mesh file",
+            ),
+            false => (std::io::ErrorKind::NotFound, "no such file"),
+        };
         return Err(SceneError::Io {
             file: path.to_path_buf(),
-            source: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
+            error: std::io::Error::new(kind, words),
         });
     }
     let import = match FileKind::of(path) {
@@ -136,9 +143,9 @@ fn tobj_options() -> tobj::LoadOptions {
 
 /// Imports an OBJ file and its MTL libraries (relative to the OBJ).
 pub fn import_obj(path: &Path, options: &ImportOptions) -> Result<ImportedModel, SceneError> {
-    let file = std::fs::File::open(path).map_err(|source| SceneError::Io {
+    let file = std::fs::File::open(path).map_err(|error| SceneError::Io {
         file: path.to_path_buf(),
-        source,
+        error,
     })?;
     let dir = path.parent().unwrap_or(Path::new(".")).to_path_buf();
     let mut reader = std::io::BufReader::with_capacity(1 << 20, file);

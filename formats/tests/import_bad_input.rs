@@ -27,6 +27,17 @@ fn missing_files_are_io_errors_naming_the_file() {
     let toml = write(dir.path(), "s.toml", b"[[mesh]]\npath = \"gone.obj\"\n");
     let e = load(&toml).expect_err("missing mesh").to_string();
     assert!(e.contains("gone.obj"), "{e}");
+    // The OS's words once, as `error: {e:#}` prints the chain: the error is its own last link.
+    let e = load(&toml).expect_err("missing mesh");
+    assert!(std::error::Error::source(&e).is_none(), "{e}");
+    // A folder named like a mesh is said to be one.
+    std::fs::create_dir(dir.path().join("room.obj")).expect("mkdir");
+    let folder = write(dir.path(), "f.toml", b"[[mesh]]\npath = \"room.obj\"\n");
+    let e = load(&folder).expect_err("a folder").to_string();
+    assert!(
+        e.contains("room.obj: cannot read: a folder, not a mesh file"),
+        "{e}"
+    );
 }
 
 #[test]
