@@ -393,7 +393,31 @@ pub struct DiffArgs {
     pub mixed: Option<PathBuf>,
 }
 
+/// Refuses an image `diff` would misread: it measures linear radiance, which an .exr holds (a
+/// .png holds sRGB-encoded 8-bit values, which it would take for radiance; another file is no
+/// image at all).
+fn linear_exr(what: &str, path: Option<&PathBuf>) -> Result<()> {
+    match path {
+        Some(p) if p.extension().and_then(|e| e.to_str()) != Some("exr") => bail!(
+            "{what} {}: diff reads linear .exr images (render one with --out NAME.exr)",
+            p.display()
+        ),
+        _ => Ok(()),
+    }
+}
+
 pub fn diff(args: DiffArgs) -> Result<()> {
+    let named = [
+        ("IMAGE", Some(&args.image)),
+        ("REFERENCE", Some(&args.reference)),
+    ];
+    let flags = [
+        ("--direct", args.direct.as_ref()),
+        ("--image-direct", args.image_direct.as_ref()),
+    ];
+    for (what, path) in named.into_iter().chain(flags) {
+        linear_exr(what, path)?;
+    }
     let a = HdrImage::read(&args.image)?;
     let r = HdrImage::read(&args.reference)?;
     let e = errors(&a, &r)?;

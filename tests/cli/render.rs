@@ -187,6 +187,21 @@ fn render_and_diff_refuse_bad_arguments_clearly() {
     let o = visgate(&["diff", "missing-a.exr", "missing-b.exr"]);
     assert!(!o.status.success());
     assert!(stderr(&o).contains("missing-a.exr"), "{}", stderr(&o));
+    // A PNG holds sRGB-encoded values, a level no image: diff measures radiance in .exr files.
+    for (args, want) in [
+        (
+            ["image.png", "ref.exr"],
+            "IMAGE image.png: diff reads linear .exr images",
+        ),
+        (
+            ["image.exr", "level.vgate"],
+            "REFERENCE level.vgate: diff reads",
+        ),
+    ] {
+        let o = visgate(&[&["diff"], &args[..]].concat());
+        assert!(!o.status.success());
+        assert!(stderr(&o).contains(want), "{}", stderr(&o));
+    }
 }
 
 /// The two rooms baked at 64 in a scratch folder: the folder, the level's path and an image's.
