@@ -201,6 +201,14 @@ pub fn run(args: ViewArgs) -> Result<()> {
     if args.frames == 0 {
         bail!("--frames 0: render at least 1 frame before the screenshot");
     }
+    for (flag, out) in [
+        ("--or-render", &args.or_render),
+        ("--screenshot", &args.screenshot),
+    ] {
+        if let Some(out) = out {
+            crate::writable(out, flag)?;
+        }
+    }
     if !has_display() {
         let mode = start_mode(&args, None)?.name;
         if let Some(out) = &args.or_render {
