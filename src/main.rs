@@ -15,7 +15,7 @@ mod view;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use visgate_formats::desc::UpAxis;
 use visgate_formats::{BareMesh, ImportOptions, Scene};
@@ -227,22 +227,23 @@ pub fn load_scene(arg: &str, load_textures: bool) -> Result<Scene> {
     Ok(visgate_scenes::load(arg, &options)?)
 }
 
-/// Refuses an output that a command could not write before it works (a bake at 1024 voxels or
-/// a reference render takes minutes, and a mistyped folder failed only then): its folder must
-/// exist and take a file. The probe is `PATH.partial` (the level is written through it),
-/// removed again.
+/// Makes ready an output file before a command works: its folder made where it is not there
+/// (as `visgate export` and `scenes export` make theirs), and a file made and removed there, so
+/// that a place it cannot write is refused first (a bake at 1024 voxels or a reference render
+/// takes minutes, and a folder that was not there failed only then). The probe is
+/// `PATH.partial`, the file the level is written through.
 pub fn writable(path: &Path, flag: &str) -> Result<()> {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    if !dir.is_dir() {
-        bail!(
-            "{flag} {}: the folder {} does not exist; create it, or write elsewhere",
+    std::fs::create_dir_all(dir).with_context(|| {
+        format!(
+            "{flag} {}: cannot make its folder {}",
             path.display(),
             dir.display()
-        );
-    }
+        )
+    })?;
     let mut probe = path.as_os_str().to_owned();
     probe.push(".partial");
     std::fs::File::create(&probe)

@@ -257,12 +257,13 @@ fn without_a_display_the_viewer_says_what_to_do_or_renders_headless() {
     assert!(text(&o).contains("--level"), "{}", text(&o));
     let o = visgate(&["view", "builtin:cornell-box", "--mode", "nope"], None);
     assert!(text(&o).contains("give one of"), "{}", text(&o));
-    let lost = dir.path().join("no-such-folder").join("x.png");
+    std::fs::write(dir.path().join("a-file"), "x").expect("write");
+    let lost = dir.path().join("a-file").join("x.png");
     let lost = lost.to_str().expect("utf-8");
     let o = visgate(&["view", "builtin:cornell-box", "--or-render", lost], None);
     assert!(!o.status.success());
     assert!(!text(&o).contains("headless"), "{}", text(&o));
-    let want = format!("--or-render {lost}: the folder");
+    let want = format!("--or-render {lost}: cannot make its folder");
     assert!(text(&o).contains(&want), "{}", text(&o));
 }
 

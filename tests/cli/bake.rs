@@ -461,8 +461,22 @@ fn bake_refuses_bad_arguments_clearly() {
     assert!(stderr(&o).contains("GiB"), "{}", stderr(&o));
     let o = visgate(&["bake", "nope.toml", "-o", out]);
     assert!(stderr(&o).contains("no such file"), "{}", stderr(&o));
-    // An output in a folder that is not there is refused before the bake, not after it.
-    let lost = dir.path().join("no-such-folder").join("x.vgate");
+    // An output's folder is made where it is not there; one that cannot be made (a file
+    // stands at its name) is refused before the bake, not after it.
+    let made = dir.path().join("new-folder").join("x.vgate");
+    let made = made.to_str().expect("utf-8");
+    let o = visgate(&[
+        "bake",
+        "builtin:two-rooms",
+        "-o",
+        made,
+        "--resolution",
+        "32",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(Path::new(made).is_file());
+    std::fs::write(dir.path().join("a-file"), "x").expect("write");
+    let lost = dir.path().join("a-file").join("x.vgate");
     let lost = lost.to_str().expect("utf-8");
     for (flag, args) in [
         ("-o", vec!["-o", lost]),
@@ -470,7 +484,7 @@ fn bake_refuses_bad_arguments_clearly() {
     ] {
         let o = visgate(&[&["bake", "builtin:two-rooms"], &args[..]].concat());
         assert!(!o.status.success());
-        let want = format!("{flag} {lost}: the folder");
+        let want = format!("{flag} {lost}: cannot make its folder");
         assert!(stderr(&o).contains(&want), "{}", stderr(&o));
         assert!(!stdout(&o).contains("bake of"), "it baked: {}", stdout(&o));
     }

@@ -165,8 +165,10 @@ fn render_and_diff_refuse_bad_arguments_clearly() {
     }
     let o = visgate(&["render", "builtin:cornell-box", "--out", "x.jpg"]);
     assert!(stderr(&o).contains(".exr"), "{}", stderr(&o));
-    // An image for a folder that is not there is refused before the render, not after it.
-    let lost = dir.path().join("no-such-folder").join("x.png");
+    // An image whose folder cannot be made (a file stands at its name) is refused before
+    // the render, not after it.
+    std::fs::write(dir.path().join("a-file"), "x").expect("write");
+    let lost = dir.path().join("a-file").join("x.png");
     let lost = lost.to_str().expect("utf-8");
     let o = visgate(&[
         "render",
@@ -177,7 +179,7 @@ fn render_and_diff_refuse_bad_arguments_clearly() {
         lost,
     ]);
     assert!(!o.status.success());
-    let want = format!("--out {lost}: the folder");
+    let want = format!("--out {lost}: cannot make its folder");
     assert!(stderr(&o).contains(&want), "{}", stderr(&o));
     assert!(
         !stdout(&o).contains("mean radiance"),
