@@ -3,7 +3,8 @@
 //! export), every wall one quad wound whichever way (half face their room, half turn their
 //! backs), doorways that make loops, desks on thin legs; the light in one room, a camera there
 //! and one two doorways away. Baked and compared through the command line: the partition
-//! holds at two resolutions, and gates light both views as the reference does.
+//! holds at two resolutions, and gates light both views as the reference does — also with
+//! every face written twice, back to back, as exporters write two-sided walls.
 
 #[path = "support/mod.rs"]
 mod support;
@@ -18,11 +19,13 @@ const ROOMS: (usize, usize) = (4, 3);
 const ROOM: f32 = 300.0;
 const HEIGHT: f32 = 270.0;
 
-/// The OBJ being written: corners and faces, every quad wound as a coin says.
+/// The OBJ being written: corners and faces, every quad wound as a coin says, or written
+/// twice, back to back (`doubled`: two-sided walls as many exporters write them).
 struct Obj {
     text: String,
     corners: usize,
     coin: u32,
+    doubled: bool,
 }
 
 impl Obj {
@@ -35,6 +38,14 @@ impl Obj {
     }
 
     fn quad(&mut self, mut q: [[f32; 3]; 4]) {
+        if self.doubled {
+            self.doubled = false;
+            self.quad(q);
+            q.reverse();
+            self.quad(q);
+            self.doubled = true;
+            return;
+        }
         if self.flip() {
             q.reverse();
         }
@@ -87,14 +98,15 @@ fn doorway(a: (usize, usize), b: (usize, usize)) -> bool {
     along_middle || off_middle || loops
 }
 
-/// The office floor as OBJ text.
-fn office() -> String {
+/// The office floor as OBJ text, its faces `doubled` back to back or not.
+fn office(doubled: bool) -> String {
     let (nx, ny) = ROOMS;
     let (w, d) = (nx as f32 * ROOM, ny as f32 * ROOM);
     let mut o = Obj {
         text: "# an office floor, centimetres, Z up\n".into(),
         corners: 0,
         coin: 0x9e37_79b9,
+        doubled,
     };
     o.quad([[0.0, 0.0, 0.0], [w, 0.0, 0.0], [w, d, 0.0], [0.0, d, 0.0]]);
     o.quad([
@@ -192,21 +204,31 @@ fn bake(dir: &Path, resolution: &str) -> (f64, f64) {
     (count(&report, "clusters"), count(&report, "gates"))
 }
 
-/// office.obj and office.toml into `dir`.
-fn write_office(dir: &Path) {
-    std::fs::write(dir.join("office.obj"), office()).expect("write office.obj");
+/// office.obj (its faces `doubled` or not) and office.toml into `dir`.
+fn write_office(dir: &Path, doubled: bool) {
+    std::fs::write(dir.join("office.obj"), office(doubled)).expect("write office.obj");
     std::fs::write(dir.join("office.toml"), SCENE).expect("write office.toml");
 }
 
 #[test]
 fn an_office_floor_unlike_the_built_ins_bakes_stably_and_gates_light_it_as_the_reference() {
-    let dir = tempfile::tempdir().expect("tempdir");
-    write_office(dir.path());
     // To look at it (README: a level unlike the built-ins), the files written there too.
     if let Some(keep) = std::env::var_os("VISGATE_OFFICE_DIR") {
         std::fs::create_dir_all(&keep).expect("VISGATE_OFFICE_DIR");
-        write_office(Path::new(&keep));
+        write_office(Path::new(&keep), false);
     }
+    office_bakes_stably_and_gates_light_it(false);
+}
+
+#[test]
+fn the_office_with_two_sided_walls_written_as_faces_back_to_back_is_lit_as_the_reference() {
+    office_bakes_stably_and_gates_light_it(true);
+}
+
+/// The office (its faces `doubled` back to back or not) baked at 64 and 128, and compared.
+fn office_bakes_stably_and_gates_light_it(doubled: bool) {
+    let dir = tempfile::tempdir().expect("tempdir");
+    write_office(dir.path(), doubled);
 
     // The partition is the level's, not the voxel size's: issue 19's 2× on clusters and
     // gates between resolutions (portal pieces follow the grid's detail: README).
