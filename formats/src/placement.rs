@@ -46,10 +46,18 @@ pub fn far_placements(scene: &Scene, desc: &SceneDesc) -> Vec<String> {
     let diagonal = (bounds.1 - bounds.0).length();
     let space = SceneSpace::new(desc.up, desc.metres_per_unit);
     let mpu = desc.metres_per_unit;
-    // Had the numbers been written in metres, they would be these units.
-    let as_units = |units: [f64; 3]| (DVec3::from(units) / mpu).to_array();
-    let slip =
-        |units: [f64; 3]| mpu != 1.0 && outside_by(space.point(as_units(units)), bounds) == 0.0;
+    // The unit the numbers were likely written in where the scene states another: metres in
+    // a scene of other units, centimetres in one of metres (an engine's numbers in a level
+    // that sets no `metres_per_unit`); the file's numbers that stand where they say, where
+    // that is inside the level.
+    let (slip_unit, slip_m) = match mpu == 1.0 {
+        true => ("centimetres", 0.01),
+        false => ("metres", 1.0),
+    };
+    let slip = |units: [f64; 3]| {
+        let fix = (DVec3::from(units) * (slip_m / mpu)).to_array();
+        (outside_by(space.point(fix), bounds) == 0.0).then_some((slip_unit, fix))
+    };
     let lights = desc.lights.iter().enumerate().map(|(i, l)| {
         let (kind, at) = match l {
             LightDesc::Point(p) => ("point", p.position),
@@ -82,7 +90,7 @@ pub fn far_placements(scene: &Scene, desc: &SceneDesc) -> Vec<String> {
                 units,
                 p,
                 off: outside_by(p, bounds),
-                fix: slip(units).then(|| as_units(units)),
+                fix: slip(units),
                 axes_fix: axes_slip(units),
             }
         })
@@ -91,9 +99,10 @@ pub fn far_placements(scene: &Scene, desc: &SceneDesc) -> Vec<String> {
         Some(_) => x.off > NEAR_DIAGONALS * diagonal,
         None => x.off > FAR_DIAGONALS * diagonal,
     };
-    // Every one a slip near the origin (of units, or of units and axes): none stands where
-    // the level is.
-    let at_origin = !placed.is_empty()
+    // Every one a slip near the origin (of units, or of units and axes), numbers in a larger
+    // unit than the file's: none stands where the level is.
+    let at_origin = mpu < 1.0
+        && !placed.is_empty()
         && placed.iter().all(|x| {
             (x.fix.is_some() || x.axes_fix.is_some()) && x.p.length() <= ORIGIN_DIAGONALS * diagonal
         });
@@ -119,8 +128,9 @@ struct Placed {
     p: Vec3,
     /// How far outside the level's box it stands. [Units: m]
     off: f32,
-    /// The numbers to write where those written were metres.
-    fix: Option<[f64; 3]>,
+    /// The unit those written were likely in (metres; centimetres in a scene of metres) and
+    /// the numbers to write then.
+    fix: Option<(&'static str, [f64; 3])>,
     /// Where those written were metres with the other axis up: that axis and the numbers.
     axes_fix: Option<(UpAxis, [f64; 3])>,
 }
@@ -142,11 +152,13 @@ fn far_warning(placed: &Placed, (lo, hi): (Vec3, Vec3), mpu: f64) -> String {
     );
     if mpu != 1.0 {
         out += &format!("; a scene file's positions are in its units (metres_per_unit = {mpu})");
+    } else if fix.is_some() {
+        out += "; a scene file's positions are in metres where it sets no metres_per_unit";
     }
     match fix {
-        Some(f) => {
+        Some((unit, f)) => {
             out += &format!(
-                ", so if ({}) are metres, write ({}) to put it inside",
+                ", so if ({}) are {unit}, write ({}) to put it inside",
                 fmt3(DVec3::from(*units)),
                 fmt3(DVec3::from(*f))
             );
@@ -164,7 +176,7 @@ fn far_warning(placed: &Placed, (lo, hi): (Vec3, Vec3), mpu: f64) -> String {
 fn origin_warning(placed: &Placed, diagonal: f32, mpu: f64) -> String {
     let Placed { what, units, p, .. } = placed;
     let (read, fix) = match (placed.fix, placed.axes_fix) {
-        (Some(f), _) => ("metres".to_string(), f),
+        (Some((unit, f)), _) => (unit.to_string(), f),
         (None, Some((up, f))) => (format!("metres with {} up", axis_name(up)), f),
         (None, None) => ("metres".to_string(), *units),
     };
@@ -209,12 +221,17 @@ mod tests {
         room_at(DVec3::new(250_000.0, 1_000.0, -80_000.0), light, eye)
     }
 
-    /// The room with its first corner at `o` (file units).
+    /// The room in centimetres with its first corner at `o` (file units).
     fn room_at(o: DVec3, light: [f64; 3], eye: [f64; 3]) -> (Scene, SceneDesc) {
+        room_in(0.01, o, light, eye)
+    }
+
+    /// The room in a file of `mpu` metres per unit with its first corner at `o` (file units).
+    fn room_in(mpu: f64, o: DVec3, light: [f64; 3], eye: [f64; 3]) -> (Scene, SceneDesc) {
         let corners: Vec<Vec3> = (0..8)
             .map(|i| {
                 let c = DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, (i >> 2) as f64);
-                (o + c * DVec3::new(800.0, 300.0, 400.0)).as_vec3()
+                (o + c * DVec3::new(8.0, 3.0, 4.0) / mpu).as_vec3()
             })
             .collect();
         let model = ImportedModel {
@@ -234,7 +251,7 @@ mod tests {
             ..ImportedModel::default()
         };
         let text = format!(
-            "metres_per_unit = 0.01\n[[mesh]]\npath = \"room.obj\"\n\
+            "metres_per_unit = {mpu:?}\n[[mesh]]\npath = \"room.obj\"\n\
              [[light]]\ntype = \"point\"\nposition = {light:?}\nintensity = [1, 1, 1]\n\
              [[camera]]\nname = \"door\"\neye = {eye:?}\ntarget = [250400.0, 1100.0, -79800.0]\nfov_deg = 75\n"
         );
@@ -329,6 +346,30 @@ mod tests {
             w[0].contains("if (2.5, -3.5, 2) are metres with Z up, write (250, 200, 350)"),
             "{}",
             w[0]
+        );
+    }
+
+    #[test]
+    fn positions_written_in_centimetres_in_a_scene_of_metres_are_named_with_the_fix() {
+        // A room in metres from the origin, its lamp and camera written in centimetres: 100
+        // times as far, named with the numbers in metres.
+        let (s, d) = room_in(1.0, DVec3::ZERO, [250.0, 200.0, 150.0], [50.0, 160.0, 50.0]);
+        let w = far_placements(&s, &d);
+        assert_eq!(w.len(), 2, "{w:?}");
+        assert!(
+            w[0].contains("if (250, 200, 150) are centimetres, write (2.5, 2, 1.5)"),
+            "{}",
+            w[0]
+        );
+        // Written in metres: nothing to say; near the origin on purpose: nothing either (the
+        // origin rule reads numbers as a larger unit than the file's only).
+        let (s, d) = room_in(1.0, DVec3::ZERO, [2.5, 2.0, 1.5], [0.5, 1.6, 0.5]);
+        assert!(far_placements(&s, &d).is_empty());
+        let (s, d) = room_in(1.0, DVec3::ZERO, [0.05, 0.05, 0.05], [0.1, 0.1, 0.1]);
+        assert!(
+            far_placements(&s, &d).is_empty(),
+            "{:?}",
+            far_placements(&s, &d)
         );
     }
 }
