@@ -257,9 +257,8 @@ fn without_a_display_the_viewer_says_what_to_do_or_renders_headless() {
     assert!(text(&o).contains("--level"), "{}", text(&o));
     let o = visgate(&["view", "builtin:cornell-box", "--mode", "nope"], None);
     assert!(text(&o).contains("give one of"), "{}", text(&o));
-    std::fs::write(dir.path().join("a-file"), "x").expect("write");
-    let lost = dir.path().join("a-file").join("x.png");
-    let lost = lost.to_str().expect("utf-8");
+    let lost = support::under_a_file(dir.path(), "x.png");
+    let lost = lost.as_str();
     let o = visgate(&["view", "builtin:cornell-box", "--or-render", lost], None);
     assert!(!o.status.success());
     assert!(!text(&o).contains("headless"), "{}", text(&o));

@@ -87,12 +87,13 @@ pub struct ImportedModel {
 /// Imports an OBJ, glTF or GLB file, chosen by its extension.
 pub fn import_file(path: &Path, options: &ImportOptions) -> Result<ImportedModel, SceneError> {
     if !path.is_file() {
-        let (kind, words) = match path.is_dir() {
-            true => (
+        let (kind, words) = if path.is_dir() {
+            (
                 std::io::ErrorKind::InvalidInput,
                 "a folder, not a mesh file",
-            ),
-            false => (std::io::ErrorKind::NotFound, "no such file"),
+            )
+        } else {
+            (std::io::ErrorKind::NotFound, "no such file")
         };
         return Err(SceneError::Io {
             file: path.to_path_buf(),

@@ -50,9 +50,10 @@ pub fn far_placements(scene: &Scene, desc: &SceneDesc) -> Vec<String> {
     // a scene of other units, centimetres in one of metres (an engine's numbers in a level
     // that sets no `metres_per_unit`); the file's numbers that stand where they say, where
     // that is inside the level.
-    let (slip_unit, slip_m) = match mpu == 1.0 {
-        true => ("centimetres", 0.01),
-        false => ("metres", 1.0),
+    let (slip_unit, slip_m) = if mpu == 1.0 {
+        ("centimetres", 0.01)
+    } else {
+        ("metres", 1.0)
     };
     let slip = |units: [f64; 3]| {
         let fix = (DVec3::from(units) * (slip_m / mpu)).to_array();
@@ -103,16 +104,17 @@ pub fn far_placements(scene: &Scene, desc: &SceneDesc) -> Vec<String> {
     // unit than the file's: none stands where the level is.
     let at_origin = mpu < 1.0
         && !placed.is_empty()
-        && placed.iter().all(|x| {
-            (x.fix.is_some() || x.axes_fix.is_some()) && x.p.length() <= ORIGIN_DIAGONALS * diagonal
-        });
+        && placed
+            .iter()
+            .all(|x| x.origin_fix().is_some() && x.p.length() <= ORIGIN_DIAGONALS * diagonal);
     placed
         .iter()
         .filter_map(|x| {
             if far(x) {
                 Some(far_warning(x, bounds, mpu))
             } else {
-                at_origin.then(|| origin_warning(x, diagonal, mpu))
+                let fix = x.origin_fix().filter(|_| at_origin)?;
+                Some(origin_warning(x, fix, diagonal, mpu))
             }
         })
         .collect()
@@ -133,6 +135,18 @@ struct Placed {
     fix: Option<(&'static str, [f64; 3])>,
     /// Where those written were metres with the other axis up: that axis and the numbers.
     axes_fix: Option<(UpAxis, [f64; 3])>,
+}
+
+impl Placed {
+    /// How the numbers were likely written, read for the origin rule, and the numbers to write:
+    /// the unit slip's reading, else the axes'.
+    fn origin_fix(&self) -> Option<(String, [f64; 3])> {
+        let units = self.fix.map(|(unit, f)| (unit.to_string(), f));
+        units.or_else(|| {
+            self.axes_fix
+                .map(|(up, f)| (format!("metres with {} up", axis_name(up)), f))
+        })
+    }
 }
 
 /// The warning for `placed`, outside the box `(lo, hi)` of a level of `mpu` metres per unit.
@@ -171,15 +185,15 @@ fn far_warning(placed: &Placed, (lo, hi): (Vec3, Vec3), mpu: f64) -> String {
 }
 
 /// The warning for `placed`, one of a scene's lights and cameras that all stand near the
-/// origin of a level `diagonal` m across, of `mpu` metres per unit, where each read as metres
-/// would stand inside it.
-fn origin_warning(placed: &Placed, diagonal: f32, mpu: f64) -> String {
+/// origin of a level `diagonal` m across, of `mpu` metres per unit, where each read as `read`
+/// says (`Placed::origin_fix`) would stand inside it, at `fix` in the file's numbers.
+fn origin_warning(
+    placed: &Placed,
+    (read, fix): (String, [f64; 3]),
+    diagonal: f32,
+    mpu: f64,
+) -> String {
     let Placed { what, units, p, .. } = placed;
-    let (read, fix) = match (placed.fix, placed.axes_fix) {
-        (Some((unit, f)), _) => (unit.to_string(), f),
-        (None, Some((up, f))) => (format!("metres with {} up", axis_name(up)), f),
-        (None, None) => ("metres".to_string(), *units),
-    };
     format!(
         "{what} at ({:.3}, {:.3}, {:.3}) m stands {:.2} m from the origin, as every light and \
          camera of the scene does, in a level {diagonal:.1} m across; a scene file's positions \

@@ -475,9 +475,8 @@ fn bake_refuses_bad_arguments_clearly() {
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
     assert!(Path::new(made).is_file());
-    std::fs::write(dir.path().join("a-file"), "x").expect("write");
-    let lost = dir.path().join("a-file").join("x.vgate");
-    let lost = lost.to_str().expect("utf-8");
+    let lost = support::under_a_file(dir.path(), "x.vgate");
+    let lost = lost.as_str();
     for (flag, args) in [
         ("-o", vec!["-o", lost]),
         ("--report", vec!["-o", out, "--report", lost]),

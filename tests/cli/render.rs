@@ -167,9 +167,8 @@ fn render_and_diff_refuse_bad_arguments_clearly() {
     assert!(stderr(&o).contains(".exr"), "{}", stderr(&o));
     // An image whose folder cannot be made (a file stands at its name) is refused before
     // the render, not after it.
-    std::fs::write(dir.path().join("a-file"), "x").expect("write");
-    let lost = dir.path().join("a-file").join("x.png");
-    let lost = lost.to_str().expect("utf-8");
+    let lost = support::under_a_file(dir.path(), "x.png");
+    let lost = lost.as_str();
     let o = visgate(&[
         "render",
         "builtin:cornell-box",

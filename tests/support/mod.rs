@@ -24,6 +24,14 @@ pub fn visgate_warn(args: &[&str]) -> Output {
         .expect("runs visgate")
 }
 
+/// A path `name` in a folder that cannot be made, for outputs that must be refused before
+/// the work: a file stands at the folder's name in `dir`.
+pub fn under_a_file(dir: &Path, name: &str) -> String {
+    std::fs::write(dir.join("a-file"), "x").expect("write a-file");
+    let path = dir.join("a-file").join(name);
+    path.to_str().expect("utf-8").to_string()
+}
+
 /// Its standard output.
 pub fn stdout(o: &Output) -> String {
     String::from_utf8_lossy(&o.stdout).into_owned()
