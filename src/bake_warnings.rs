@@ -1,6 +1,7 @@
 //! What `visgate bake` warns of after a bake that succeeded but that a user would not want:
 //! a bare mesh's inside that reaches the bounds, most of the level's space dropped, a camera
-//! sealed off from every light, a grid too coarse for the level's rooms and doorways. Each warning says why and what to do; the figures also
+//! sealed off from every light, a camera or light inside closed geometry or outside the
+//! level, a grid too coarse for the level's rooms and doorways. Each warning says why and what to do; the figures also
 //! sit in the JSON report.
 
 use serde_json::Value;
@@ -28,6 +29,7 @@ pub fn warnings(report: &BakeReport) -> Vec<String> {
     out.extend(mixed_winding(es, &report.grid));
     out.extend(most_dropped(es, &report.grid));
     out.extend(enclosed_seeds(es, &report.grid));
+    out.extend(outside_seeds(es, &report.grid));
     out.extend(cut_off_cameras(es, &report.grid));
     let radius = report
         .stages
@@ -131,7 +133,12 @@ fn mixed_winding(empty_space: &Value, grid: &GridMeta) -> Option<String> {
     let seeded = |c: &Value| !seeds_of(c).is_empty();
     let inside = |c: &Value| c["reason"].as_str().is_some_and(|r| r.starts_with(INSIDE));
     // A camera or light inside closed geometry is no room (enclosed_seeds says so).
-    let room = |c: &&Value| (seeded(c) || inside(c)) && !enclosed_seed_part(c, grid);
+    // Nor is the void around the level that one holds (outside_seeds says so).
+    let room = |c: &&Value| {
+        (seeded(c) || inside(c))
+            && !enclosed_seed_part(c, grid)
+            && !outside_seed_part(c, comps, grid)
+    };
     let (f, b) = comps.iter().filter(room).fold((0, 0), |(f, b), c| {
         let v = |k: usize| c["faced_by"][k].as_u64().unwrap_or(0);
         (f + v(0), b + v(1))
@@ -239,10 +246,79 @@ fn reaches_bounds(c: &Value, grid: &GridMeta) -> bool {
 /// says so), and a sealed level whose walls were wound at random, 146 backs to 142 fronts
 /// around its rooms, was told that its lamp lit the inside of a bulb.
 fn enclosed_seed_part(c: &Value, grid: &GridMeta) -> bool {
-    let seeded = !seeds_of(c).is_empty();
+    c["kept"] == true && !seeds_of(c).is_empty() && outvoted(c, 1) && !reaches_bounds(c, grid)
+}
+
+/// Whether the triangles around part `c` of the report turn their backs to it (`side` 1) or
+/// face it (`side` 0) [`MIXED_RATIO`] times as often as the other way.
+fn outvoted(c: &Value, side: usize) -> bool {
     let v = |k: usize| c["faced_by"][k].as_u64().unwrap_or(0);
-    let backs = v(1) > v(0) && v(1) as f64 >= MIXED_RATIO * v(0) as f64;
-    c["kept"] == true && seeded && backs && !reaches_bounds(c, grid)
+    let (by, against) = (v(side), v(1 - side));
+    by > against && by as f64 >= MIXED_RATIO * against as f64
+}
+
+/// Whether a kept part holds cameras or lights, reaches the bounds and sees the backs of the
+/// triangles around it while another part with cameras or lights sees their fronts: the void
+/// around the level, behind its walls. A camera written a few centimetres outside a wall of a
+/// cave whose faces look in was there: the bake kept the void for it, its backs made the
+/// level's faces read "wound both ways", and the camera was told to bake at a finer
+/// resolution to reach the light.
+fn outside_seed_part(c: &Value, comps: &[Value], grid: &GridMeta) -> bool {
+    let seeded = |c: &Value| c["kept"] == true && !seeds_of(c).is_empty();
+    let room = |r: &Value| seeded(r) && outvoted(r, 0);
+    seeded(c) && outvoted(c, 1) && reaches_bounds(c, grid) && comps.iter().any(room)
+}
+
+/// A warning for each part that holds cameras or lights outside the level
+/// ([`outside_seed_part`]), naming the rooms' span so that they can be moved in.
+fn outside_seeds(empty_space: &Value, grid: &GridMeta) -> Vec<String> {
+    let Some(comps) = empty_space["components"].as_array() else {
+        return Vec::new();
+    };
+    let rooms: Vec<&Value> = comps
+        .iter()
+        .filter(|c| c["kept"] == true && !seeds_of(c).is_empty() && outvoted(c, 0))
+        .collect();
+    let span = |k: &str, pick: fn(f64, f64) -> f64| {
+        let at = |a: usize| rooms.iter().filter_map(|c| c[k][a].as_f64()).reduce(pick);
+        json_point([at(0), at(1), at(2)].map(|x| x.unwrap_or(0.0)))
+    };
+    let (lo, hi) = (
+        span("bounds_min_m", f64::min),
+        span("bounds_max_m", f64::max),
+    );
+    let in_rooms: Vec<String> = rooms.iter().flat_map(|c| seeds_of(c)).collect();
+    comps
+        .iter()
+        .filter(|c| outside_seed_part(c, comps, grid))
+        .map(|c| {
+            let seeds = seeds_of(c);
+            let lights = !seeds.iter().all(|s| is_camera_seed(s));
+            format!(
+                "{} outside the level: in the void around the level, which reaches the scene's bounds \
+                 and sees the backs of the {} triangles beside it, while the {} triangles beside \
+                 {} face them. {} Move {} inside (the rooms span {} .. {} m), or if the level is \
+                 meant to be seen from outside, ignore this",
+                join_and(&seeds),
+                c["faced_by"][1].as_u64().unwrap_or(0),
+                rooms.iter().map(|r| r["faced_by"][0].as_u64().unwrap_or(0)).sum::<u64>(),
+                join_words(&in_rooms),
+                if lights {
+                    "A light there lights the backs of the walls, not the rooms."
+                } else {
+                    "A camera there sees the level from behind its walls."
+                },
+                if seeds.len() == 1 { "it" } else { "them" },
+                metres(&lo),
+                metres(&hi)
+            )
+        })
+        .collect()
+}
+
+/// A point `[x, y, z]` as the report writes one.
+fn json_point(p: [f64; 3]) -> Value {
+    Value::from(p.to_vec())
 }
 
 /// A warning for each part that holds cameras or lights inside closed geometry
@@ -285,7 +361,10 @@ fn cut_off_cameras(empty_space: &Value, grid: &GridMeta) -> Vec<String> {
     };
     let is_camera = |s: &String| is_camera_seed(s);
     // Parts inside closed geometry are said by enclosed_seeds: no resolution opens them.
-    let open = |c: &&Value| c["kept"] == true && !enclosed_seed_part(c, grid);
+    // Parts outside the level are said by outside_seeds: no resolution joins them either.
+    let open = |c: &&Value| {
+        c["kept"] == true && !enclosed_seed_part(c, grid) && !outside_seed_part(c, comps, grid)
+    };
     let kept: Vec<Vec<String>> = comps.iter().filter(open).map(seeds_of).collect();
     if !kept.iter().any(|s| s.iter().any(|x| !is_camera(x))) {
         return Vec::new(); // no light in any open kept part: nothing is cut off from one
@@ -317,9 +396,17 @@ fn metres(p: &Value) -> String {
 /// `a`, `a and b`, `a, b and c`, with "is"/"are" after.
 fn join_and(items: &[String]) -> String {
     match items {
-        [one] => format!("{one} is"),
-        [rest @ .., last] => format!("{} and {last} are", rest.join(", ")),
         [] => String::new(),
+        [_] => format!("{} is", join_words(items)),
+        _ => format!("{} are", join_words(items)),
+    }
+}
+
+/// `a`, `a and b`, `a, b and c`.
+fn join_words(items: &[String]) -> String {
+    match items {
+        [rest @ .., last] if !rest.is_empty() => format!("{} and {last}", rest.join(", ")),
+        _ => items.concat(),
     }
 }
 
@@ -601,5 +688,72 @@ mod tests {
         let mut window = part(&["point light 0"], [0, 288], 40_000);
         window["bounds_min_m"] = json!([0.0, 0.0, 0.0]);
         assert!(enclosed_seeds(&json!({ "components": [window] }), &g).is_empty());
+    }
+
+    #[test]
+    fn a_camera_or_light_in_the_void_around_the_level_is_said_and_nothing_else() {
+        let g = GridMeta {
+            origin_m: [-4.25, -0.8, -3.94],
+            voxel_size_m: 0.158,
+            dims: [130, 38, 61],
+        };
+        let part = |seeds: &[&str], faced: [u64; 2], min: [f64; 3], max: [f64; 3]| {
+            json!({ "seeds": seeds, "faced_by": faced, "kept": true, "voxels": 1000,
+                    "bounds_min_m": min, "bounds_max_m": max })
+        };
+        let (in_lo, in_hi) = ([-3.94, -0.49, -3.62], [16.02, 4.89, 5.41]);
+        let rooms = part(
+            &["camera 'beyond'", "point light 0"],
+            [37012, 0],
+            in_lo,
+            in_hi,
+        );
+        // The cave with camera 'lit' written a few centimetres outside its wall.
+        let void = part(
+            &["camera 'lit'"],
+            [0, 36855],
+            [-4.09, -0.65, -3.78],
+            [16.2, 5.1, 5.6],
+        );
+        let cave = json!({ "components": [rooms.clone(), void.clone()] });
+        let w = outside_seeds(&cave, &g);
+        assert_eq!(w.len(), 1, "{w:?}");
+        assert!(
+            w[0].starts_with("camera 'lit' is outside the level")
+                && w[0].contains("backs of the 36855 triangles")
+                && w[0].contains("beside camera 'beyond' and point light 0 face them")
+                && w[0].contains("from behind its walls")
+                && w[0].contains("span (-3.94, -0.49, -3.62) .. (16.02, 4.89, 5.41) m"),
+            "{w:?}"
+        );
+        // Its backs are not taken for faces wound both ways, nor its part for a room behind
+        // a doorway closed at this resolution.
+        assert!(mixed_winding(&cave, &g).is_none());
+        assert!(cut_off_cameras(&cave, &g).is_empty());
+        // A lamp under the floor: said as a light.
+        let lamp = part(
+            &["point light 1"],
+            [0, 36855],
+            [-4.09, -0.65, -3.78],
+            [16.2, 5.1, 5.6],
+        );
+        let w = outside_seeds(&json!({ "components": [rooms.clone(), lamp] }), &g);
+        assert!(
+            w.len() == 1 && w[0].contains("lights the backs of the walls"),
+            "{w:?}"
+        );
+        // Alone in the void (a level seen from outside, or lit through a window in one part):
+        // nothing, for there is no room to compare it with.
+        assert!(outside_seeds(&json!({ "components": [void.clone()] }), &g).is_empty());
+        // A pocket that does not reach the bounds is inside closed geometry, not outside.
+        let pocket = part(
+            &["camera 'lit'"],
+            [0, 500],
+            [1.0, 1.0, 1.0],
+            [2.0, 2.0, 2.0],
+        );
+        let es = json!({ "components": [rooms, pocket] });
+        assert!(outside_seeds(&es, &g).is_empty());
+        assert_eq!(enclosed_seeds(&es, &g).len(), 1);
     }
 }
