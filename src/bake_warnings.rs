@@ -270,50 +270,109 @@ fn outside_seed_part(c: &Value, comps: &[Value], grid: &GridMeta) -> bool {
 }
 
 /// A warning for each part that holds cameras or lights outside the level
-/// ([`outside_seed_part`]), naming the rooms' span so that they can be moved in.
+/// ([`outside_seed_part`]), and one for those beyond the grid where the level is sealed (no
+/// room reaches the grid's bounds): the bake keeps no space for them, and a camera 30 cm
+/// behind the ajar door's wall was dropped with nothing said. Each names the rooms' span, so
+/// that they can be moved in.
 fn outside_seeds(empty_space: &Value, grid: &GridMeta) -> Vec<String> {
-    let Some(comps) = empty_space["components"].as_array() else {
-        return Vec::new();
-    };
+    let comps = empty_space["components"].as_array().map_or(&[][..], |c| c);
+    let seeded = |c: &&Value| c["kept"] == true && !seeds_of(c).is_empty();
     let rooms: Vec<&Value> = comps
         .iter()
-        .filter(|c| c["kept"] == true && !seeds_of(c).is_empty() && outvoted(c, 0))
+        .filter(seeded)
+        .filter(|c| outvoted(c, 0))
         .collect();
-    let span = |k: &str, pick: fn(f64, f64) -> f64| {
-        let at = |a: usize| rooms.iter().filter_map(|c| c[k][a].as_f64()).reduce(pick);
-        json_point([at(0), at(1), at(2)].map(|x| x.unwrap_or(0.0)))
-    };
-    let (lo, hi) = (
-        span("bounds_min_m", f64::min),
-        span("bounds_max_m", f64::max),
-    );
     let in_rooms: Vec<String> = rooms.iter().flat_map(|c| seeds_of(c)).collect();
-    comps
+    let mut out: Vec<String> = comps
         .iter()
         .filter(|c| outside_seed_part(c, comps, grid))
         .map(|c| {
             let seeds = seeds_of(c);
-            let lights = !seeds.iter().all(|s| is_camera_seed(s));
             format!(
-                "{} outside the level: in the void around the level, which reaches the scene's bounds \
-                 and sees the backs of the {} triangles beside it, while the {} triangles beside \
-                 {} face them. {} Move {} inside (the rooms span {} .. {} m), or if the level is \
-                 meant to be seen from outside, ignore this",
+                "{} outside the level: in the void around the level, which reaches the scene's \
+                 bounds and sees the backs of the {} triangles beside it, while the {} \
+                 triangles beside {} face them. {} Move {}{}, or if the level is meant to be \
+                 seen from outside, ignore this",
                 join_and(&seeds),
                 c["faced_by"][1].as_u64().unwrap_or(0),
-                rooms.iter().map(|r| r["faced_by"][0].as_u64().unwrap_or(0)).sum::<u64>(),
+                rooms
+                    .iter()
+                    .map(|r| r["faced_by"][0].as_u64().unwrap_or(0))
+                    .sum::<u64>(),
                 join_words(&in_rooms),
-                if lights {
-                    "A light there lights the backs of the walls, not the rooms."
-                } else {
+                if seeds.iter().all(|s| is_camera_seed(s)) {
                     "A camera there sees the level from behind its walls."
+                } else {
+                    "A light there lights the backs of the walls, not the rooms."
                 },
                 if seeds.len() == 1 { "it" } else { "them" },
-                metres(&lo),
-                metres(&hi)
+                rooms_span(&rooms)
             )
         })
-        .collect()
+        .collect();
+    let beyond: Vec<String> = empty_space["seeds_outside_grid"]
+        .as_array()
+        .into_iter()
+        .flatten()
+        .filter_map(|s| s.as_str().map(str::to_string))
+        .collect();
+    let kept: Vec<&Value> = comps.iter().filter(seeded).collect();
+    // A level open to the outside is seen and lit from there (the Cornell box's camera,
+    // `sun-window`'s lamp beyond its window): said only where no room reaches the bounds.
+    let sealed = !kept.is_empty() && !kept.iter().any(|c| reaches_bounds(c, grid));
+    if !beyond.is_empty() && sealed {
+        let lo = grid.origin_m.map(f64::from);
+        let hi = std::array::from_fn(|a| lo[a] + grid.dims[a] as f64 * grid.voxel_size_m as f64);
+        out.push(format!(
+            "{} outside the level: beyond the grid the bake spans around its geometry ({} .. {} \
+             m), and none of the level's rooms reaches that grid's bounds, so the bake kept no \
+             space for {} and {} the backs of its walls alone. Move {}{}, or if {} meant to \
+             be outside, ignore this",
+            join_and(&beyond),
+            metres(&json_point(lo)),
+            metres(&json_point(hi)),
+            if beyond.len() == 1 { "it" } else { "them" },
+            if beyond.iter().all(|s| is_camera_seed(s)) {
+                if beyond.len() == 1 {
+                    "it sees"
+                } else {
+                    "they see"
+                }
+            } else if beyond.len() == 1 {
+                "it lights"
+            } else {
+                "they light"
+            },
+            if beyond.len() == 1 { "it" } else { "them" },
+            rooms_span(&kept),
+            if beyond.len() == 1 {
+                "it is"
+            } else {
+                "they are"
+            },
+        ));
+    }
+    out
+}
+
+/// ` inside (the rooms span A .. B m)`: the box of `rooms`' bounds, or ` inside` where there
+/// are none.
+fn rooms_span(rooms: &[&Value]) -> String {
+    let span = |k: &str, pick: fn(f64, f64) -> f64| {
+        let at = |a: usize| rooms.iter().filter_map(|c| c[k][a].as_f64()).reduce(pick);
+        Some([at(0)?, at(1)?, at(2)?])
+    };
+    match (
+        span("bounds_min_m", f64::min),
+        span("bounds_max_m", f64::max),
+    ) {
+        (Some(lo), Some(hi)) => format!(
+            " inside (the rooms span {} .. {} m)",
+            metres(&json_point(lo)),
+            metres(&json_point(hi))
+        ),
+        _ => " inside".to_string(),
+    }
 }
 
 /// A point `[x, y, z]` as the report writes one.
@@ -752,8 +811,29 @@ mod tests {
             [1.0, 1.0, 1.0],
             [2.0, 2.0, 2.0],
         );
-        let es = json!({ "components": [rooms, pocket] });
+        let es = json!({ "components": [rooms.clone(), pocket] });
         assert!(outside_seeds(&es, &g).is_empty());
         assert_eq!(enclosed_seeds(&es, &g).len(), 1);
+        // Beyond the grid, behind a sealed level's wall: said, with the grid and the rooms.
+        let behind = json!({ "components": [rooms], "seeds_outside_grid": ["camera 'behind'"] });
+        let w = outside_seeds(&behind, &g);
+        assert!(
+            w.len() == 1
+                && w[0].starts_with("camera 'behind' is outside the level: beyond the grid")
+                && w[0].contains("(-4.25, -0.80, -3.94) .. (16.29, 5.20, 5.70) m")
+                && w[0].contains("it sees the backs of its walls alone")
+                && w[0].contains("span (-3.94, -0.49, -3.62)"),
+            "{w:?}"
+        );
+        // Where a room reaches the bounds, the level is seen and lit through its openings
+        // from there (the Cornell box's camera, sun-window's lamp): nothing.
+        let open = part(
+            &["point light 0"],
+            [900, 0],
+            [-4.25, 0.0, 0.0],
+            [1.0, 1.0, 1.0],
+        );
+        let lamp = json!({ "components": [open], "seeds_outside_grid": ["point light 1"] });
+        assert!(outside_seeds(&lamp, &g).is_empty());
     }
 }

@@ -1,6 +1,7 @@
 //! Scenes that rendered black with nothing said: lights and cameras written in metres while the
 //! level is modelled in centimetres (every method matched the black reference to the digit),
-//! and a lamp inside a closed shade (which the bake took for a doorway closed by the voxels).
+//! a lamp inside a closed shade (which the bake took for a doorway closed by the voxels), and a
+//! camera behind a sealed level's wall (dropped by the bake with nothing said).
 //! The command line says so now, with the fix.
 
 mod support;
@@ -136,4 +137,33 @@ fn a_lamp_inside_a_closed_shade_is_named_by_the_bake_and_its_render_says_black()
     let err = stderr(&o);
     assert!(o.status.success(), "{err}");
     assert!(err.contains("the image is black"), "{err}");
+}
+
+#[test]
+fn a_camera_behind_a_sealed_level_s_wall_is_named_by_the_bake() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    let o = visgate_warn(&["scenes", "export", "ajar-door", d.to_str().expect("utf-8")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    // 30 cm behind the wall at z = 0, beyond the grid: the bake dropped it with nothing said.
+    let scene = d.join("ajar-door.toml");
+    let mut toml = std::fs::read_to_string(&scene).expect("toml");
+    toml += "\n[[camera]]\nname = \"behind\"\neye = [4.0, 1.5, -0.3]\n\
+             target = [4.0, 1.5, 2.0]\nfov_deg = 70.0\n";
+    std::fs::write(&scene, toml).expect("toml");
+    let level = d.join("l.vgate");
+    let args = ["bake", scene.to_str().expect("utf-8"), "--resolution", "64"];
+    let o = visgate_warn(&[&args[..], &["-o", level.to_str().expect("utf-8")]].concat());
+    let err = stderr(&o);
+    assert!(o.status.success(), "{err}");
+    assert!(
+        err.contains("camera 'behind' is outside the level: beyond the grid")
+            && err.contains("Move it inside (the rooms span (0.12, 0.12, 0.12) .. (7.88, 2.88"),
+        "{err}"
+    );
+    // The level's own cameras and light: not named.
+    assert!(
+        !err.contains("camera 'main' is") && !err.contains("light 0 is"),
+        "{err}"
+    );
 }
