@@ -189,15 +189,22 @@ pub fn panel(
         let root = BitMapBackend::with_buffer(&mut buf, (pw, ph)).into_drawing_area();
         let style = (FONT, 14).into_font().color(&BLACK);
         root.draw_text(title, &style, (2, 2)).map_err(drawing)?;
-        for (i, label) in [
-            "reference",
-            "method",
-            "FLIP (black 0 … white 1)",
-            "red: black where lit · yellow: mixed",
+        // Each tile's label, shortened where a small image's tile is narrower (at 96 × 72
+        // the long ones ran into each other).
+        for (i, labels) in [
+            ["reference", "ref."],
+            ["method", "method"],
+            ["FLIP (black 0 … white 1)", "FLIP"],
+            ["red: black where lit · yellow: mixed", "red: black"],
         ]
         .iter()
         .enumerate()
         {
+            let fits = |l: &&str| {
+                let size = root.estimate_text_size(l, &style);
+                size.is_ok_and(|(lw, _)| lw + 4 <= w)
+            };
+            let label = labels.iter().copied().find(fits).unwrap_or(labels[1]);
             let x = (i as u32 * (w + gap)) as i32 + 2;
             root.draw_text(label, &style, (x, 22)).map_err(drawing)?;
         }
@@ -213,4 +220,33 @@ pub fn write_jpeg(picture: &RgbImage, path: &std::path::Path) -> Result<(), Rend
     image::codecs::jpeg::JpegEncoder::new_with_quality(std::io::BufWriter::new(file), 90)
         .encode_image(picture)
         .map_err(|e| RenderError::io(path, e))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Whether any pixel of `picture`'s label row in columns `xs` is not white.
+    fn inked(picture: &RgbImage, xs: std::ops::Range<u32>) -> bool {
+        xs.flat_map(|x| (20..40).map(move |y| (x, y)))
+            .any(|(x, y)| picture.get_pixel(x, y).0 != [255, 255, 255])
+    }
+
+    #[test]
+    fn a_small_image_s_panel_keeps_each_label_over_its_own_tile() {
+        for (w, h) in [(96, 72), (320, 240)] {
+            let image = HdrImage::new(w, h);
+            let black = RgbImage::new(w, h);
+            let flip = vec![0.0; (w * h) as usize];
+            let p = panel(&image, &image, (&flip, &black), 0.0, "t").expect("panel");
+            // The label row is inked in each tile, and not in the gaps between them.
+            for i in 0..4 {
+                let x = i * (w + 6);
+                assert!(inked(&p, x..x + w), "{w}: tile {i} has no label");
+                if i < 3 {
+                    assert!(!inked(&p, x + w..x + w + 6), "{w}: label {i} runs on");
+                }
+            }
+        }
+    }
 }
