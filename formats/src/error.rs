@@ -55,6 +55,25 @@ pub enum SceneError {
         /// The gltf crate's message.
         message: String,
     },
+    /// A glTF/GLB file that requires extensions the gltf crate does not read: compressed or
+    /// quantized meshes, as Blender's exporter and gltfpack write when asked.
+    #[error(
+        "{}: needs the glTF extension{} {}, which visgate does not read ({what}). Write the \
+         file out without {}: re-export it from the modelling tool with mesh compression and \
+         quantization off, or decode it with a glTF tool (gltf-transform, gltfpack) first",
+        file.display(),
+        if extensions.len() == 1 { "" } else { "s" },
+        extensions.join(", "),
+        if extensions.len() == 1 { "it" } else { "them" }
+    )]
+    GltfExtensions {
+        /// The glTF file.
+        file: PathBuf,
+        /// The extensions it requires that are not read.
+        extensions: Vec<String>,
+        /// What they are, where known ("Draco-compressed meshes", …).
+        what: String,
+    },
     /// A vertex has a NaN or infinite coordinate.
     #[error(
         "{}: mesh '{mesh}' has a non-finite (NaN or infinite) vertex coordinate at vertex {vertex}",

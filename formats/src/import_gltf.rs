@@ -12,6 +12,33 @@ use crate::import::{
 };
 use crate::scene::{Material, Texture};
 
+/// Where the file at `path` requires extensions that the gltf crate does not read, the
+/// error that names them and what they are; `None` where it requires none such or cannot be
+/// read without validation either (the crate's own error then stands).
+fn unread_extensions(path: &Path) -> Option<SceneError> {
+    let bytes = std::fs::read(path).ok()?;
+    let gltf = gltf::Gltf::from_slice_without_validation(&bytes).ok()?;
+    let read = gltf::json::extensions::ENABLED_EXTENSIONS;
+    let extensions: Vec<String> = gltf
+        .extensions_required()
+        .filter(|e| !read.contains(e))
+        .map(str::to_string)
+        .collect();
+    let what = |e: &String| match e.as_str() {
+        "KHR_draco_mesh_compression" => "Draco-compressed meshes",
+        "EXT_meshopt_compression" => "meshoptimizer-compressed buffers",
+        "KHR_mesh_quantization" => "vertices stored as quantized integers",
+        "KHR_texture_basisu" => "KTX2 / Basis Universal textures",
+        _ => "not read by the gltf crate",
+    };
+    let what: Vec<&str> = extensions.iter().map(what).collect();
+    (!extensions.is_empty()).then(|| SceneError::GltfExtensions {
+        file: path.to_path_buf(),
+        what: what.join("; "),
+        extensions,
+    })
+}
+
 /// Imports a glTF 2.0 file (`.gltf` with external or embedded buffers, or `.glb`), walking
 /// the default scene's node hierarchy and applying node transforms.
 pub fn import_gltf(path: &Path, options: &ImportOptions) -> Result<ImportedModel, SceneError> {
@@ -19,7 +46,9 @@ pub fn import_gltf(path: &Path, options: &ImportOptions) -> Result<ImportedModel
         file: path.to_path_buf(),
         message: e.to_string(),
     };
-    let gltf::Gltf { document, blob } = gltf::Gltf::open(path).map_err(gerr)?;
+    let opened =
+        gltf::Gltf::open(path).map_err(|e| unread_extensions(path).unwrap_or_else(|| gerr(e)));
+    let gltf::Gltf { document, blob } = opened?;
     let base = path.parent().unwrap_or(Path::new("."));
     let buffers = gltf::import_buffers(&document, Some(base), blob).map_err(gerr)?;
     let mut out = ImportedModel::default();

@@ -315,6 +315,42 @@ fn broken_gltf_is_an_error() {
 }
 
 #[test]
+fn a_gltf_with_compressed_or_quantized_meshes_names_the_extensions_not_broken() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    // As gltfpack writes one: meshopt buffers and quantized vertices, both required.
+    let json = r#"{"asset":{"version":"2.0"},
+        "extensionsUsed":["EXT_meshopt_compression","KHR_mesh_quantization","KHR_lights_punctual"],
+        "extensionsRequired":["EXT_meshopt_compression","KHR_mesh_quantization"]}"#;
+    let p = write(dir.path(), "packed.gltf", json.as_bytes());
+    let e = load(&p).expect_err("compressed");
+    let m = e.to_string();
+    assert!(matches!(e, SceneError::GltfExtensions { .. }), "{m}");
+    assert!(
+        m.contains(
+            "packed.gltf: needs the glTF extensions EXT_meshopt_compression, KHR_mesh_quantization"
+        ) && m.contains("meshoptimizer-compressed buffers; vertices stored as quantized integers")
+            && m.contains("Write the file out without them")
+            && !m.contains("broken"),
+        "{m}"
+    );
+    // Draco, as Blender writes it with compression on.
+    let draco = json
+        .replace("EXT_meshopt_compression", "KHR_draco_mesh_compression")
+        .replace(",\"KHR_mesh_quantization\"]}", "]}");
+    let p = write(dir.path(), "draco.gltf", draco.as_bytes());
+    let m = load(&p).expect_err("draco").to_string();
+    assert!(
+        m.contains("extension KHR_draco_mesh_compression, which") && m.contains("Draco"),
+        "{m}"
+    );
+    // An extension required and read (the lights) is no error of this kind.
+    let lights = r#"{"asset":{"version":"2.0"},"extensionsRequired":["KHR_lights_punctual"],
+        "extensionsUsed":["KHR_lights_punctual"]}"#;
+    let p = write(dir.path(), "lights.gltf", lights.as_bytes());
+    assert!(!matches!(load(&p), Err(SceneError::GltfExtensions { .. })));
+}
+
+#[test]
 fn import_file_never_panics_on_random_bytes() {
     let dir = tempfile::tempdir().expect("tempdir");
     let mut x: u64 = 0x9e3779b97f4a7c15;
