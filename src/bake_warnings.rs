@@ -246,7 +246,12 @@ fn reaches_bounds(c: &Value, grid: &GridMeta) -> bool {
 /// says so), and a sealed level whose walls were wound at random, 146 backs to 142 fronts
 /// around its rooms, was told that its lamp lit the inside of a bulb.
 fn enclosed_seed_part(c: &Value, grid: &GridMeta) -> bool {
-    c["kept"] == true && !seeds_of(c).is_empty() && outvoted(c, 1) && !reaches_bounds(c, grid)
+    seeded_part(c) && outvoted(c, 1) && !reaches_bounds(c, grid)
+}
+
+/// Whether part `c` of the report is kept and holds cameras or lights.
+fn seeded_part(c: &Value) -> bool {
+    c["kept"] == true && !seeds_of(c).is_empty()
 }
 
 /// Whether the triangles around part `c` of the report turn their backs to it (`side` 1) or
@@ -257,6 +262,11 @@ fn outvoted(c: &Value, side: usize) -> bool {
     by > against && by as f64 >= MIXED_RATIO * against as f64
 }
 
+/// Whether part `c` holds cameras or lights and is a room: its triangles face it.
+fn seeded_room(c: &Value) -> bool {
+    seeded_part(c) && outvoted(c, 0)
+}
+
 /// Whether a kept part holds cameras or lights, reaches the bounds and sees the backs of the
 /// triangles around it while another part with cameras or lights sees their fronts: the void
 /// around the level, behind its walls. A camera written a few centimetres outside a wall of a
@@ -264,25 +274,25 @@ fn outvoted(c: &Value, side: usize) -> bool {
 /// level's faces read "wound both ways", and the camera was told to bake at a finer
 /// resolution to reach the light.
 fn outside_seed_part(c: &Value, comps: &[Value], grid: &GridMeta) -> bool {
-    let seeded = |c: &Value| c["kept"] == true && !seeds_of(c).is_empty();
-    let room = |r: &Value| seeded(r) && outvoted(r, 0);
-    seeded(c) && outvoted(c, 1) && reaches_bounds(c, grid) && comps.iter().any(room)
+    seeded_part(c) && outvoted(c, 1) && reaches_bounds(c, grid) && comps.iter().any(seeded_room)
+}
+
+/// `one` for a single thing, `many` for several.
+fn by_count<'a>(n: usize, one: &'a str, many: &'a str) -> &'a str {
+    if n == 1 { one } else { many }
 }
 
 /// A warning for each part that holds cameras or lights outside the level
-/// ([`outside_seed_part`]), and one for those beyond the grid where the level is sealed (no
-/// room reaches the grid's bounds): the bake keeps no space for them, and a camera 30 cm
-/// behind the ajar door's wall was dropped with nothing said. Each names the rooms' span, so
-/// that they can be moved in.
+/// ([`outside_seed_part`]), and [`beyond_the_grid`]'s. Each names the rooms' span, so that
+/// they can be moved in.
 fn outside_seeds(empty_space: &Value, grid: &GridMeta) -> Vec<String> {
     let comps = empty_space["components"].as_array().map_or(&[][..], |c| c);
-    let seeded = |c: &&Value| c["kept"] == true && !seeds_of(c).is_empty();
-    let rooms: Vec<&Value> = comps
-        .iter()
-        .filter(seeded)
-        .filter(|c| outvoted(c, 0))
-        .collect();
+    let rooms: Vec<&Value> = comps.iter().filter(|c| seeded_room(c)).collect();
     let in_rooms: Vec<String> = rooms.iter().flat_map(|c| seeds_of(c)).collect();
+    let faced: u64 = rooms
+        .iter()
+        .map(|r| r["faced_by"][0].as_u64().unwrap_or(0))
+        .sum();
     let mut out: Vec<String> = comps
         .iter()
         .filter(|c| outside_seed_part(c, comps, grid))
@@ -290,69 +300,64 @@ fn outside_seeds(empty_space: &Value, grid: &GridMeta) -> Vec<String> {
             let seeds = seeds_of(c);
             format!(
                 "{} outside the level: in the void around the level, which reaches the scene's \
-                 bounds and sees the backs of the {} triangles beside it, while the {} \
+                 bounds and sees the backs of the {} triangles beside it, while the {faced} \
                  triangles beside {} face them. {} Move {}{}, or if the level is meant to be \
                  seen from outside, ignore this",
                 join_and(&seeds),
                 c["faced_by"][1].as_u64().unwrap_or(0),
-                rooms
-                    .iter()
-                    .map(|r| r["faced_by"][0].as_u64().unwrap_or(0))
-                    .sum::<u64>(),
                 join_words(&in_rooms),
                 if seeds.iter().all(|s| is_camera_seed(s)) {
                     "A camera there sees the level from behind its walls."
                 } else {
                     "A light there lights the backs of the walls, not the rooms."
                 },
-                if seeds.len() == 1 { "it" } else { "them" },
+                by_count(seeds.len(), "it", "them"),
                 rooms_span(&rooms)
             )
         })
         .collect();
+    out.extend(beyond_the_grid(empty_space, comps, grid));
+    out
+}
+
+/// A warning for the cameras and lights beyond the grid where the level is sealed (no room
+/// reaches the grid's bounds): the bake keeps no space for them, and a camera 30 cm behind
+/// the ajar door's wall was dropped with nothing said. A level open to the outside is seen
+/// and lit from there (the Cornell box's camera, `sun-window`'s lamp beyond its window), and
+/// nothing is said.
+fn beyond_the_grid(empty_space: &Value, comps: &[Value], grid: &GridMeta) -> Option<String> {
     let beyond: Vec<String> = empty_space["seeds_outside_grid"]
         .as_array()
         .into_iter()
         .flatten()
         .filter_map(|s| s.as_str().map(str::to_string))
         .collect();
-    let kept: Vec<&Value> = comps.iter().filter(seeded).collect();
-    // A level open to the outside is seen and lit from there (the Cornell box's camera,
-    // `sun-window`'s lamp beyond its window): said only where no room reaches the bounds.
+    let kept: Vec<&Value> = comps.iter().filter(|c| seeded_part(c)).collect();
     let sealed = !kept.is_empty() && !kept.iter().any(|c| reaches_bounds(c, grid));
-    if !beyond.is_empty() && sealed {
-        let lo = grid.origin_m.map(f64::from);
-        let hi = std::array::from_fn(|a| lo[a] + grid.dims[a] as f64 * grid.voxel_size_m as f64);
-        out.push(format!(
-            "{} outside the level: beyond the grid the bake spans around its geometry ({} .. {} \
-             m), and none of the level's rooms reaches that grid's bounds, so the bake kept no \
-             space for {} and {} the backs of its walls alone. Move {}{}, or if {} meant to \
-             be outside, ignore this",
-            join_and(&beyond),
-            metres(&json_point(lo)),
-            metres(&json_point(hi)),
-            if beyond.len() == 1 { "it" } else { "them" },
-            if beyond.iter().all(|s| is_camera_seed(s)) {
-                if beyond.len() == 1 {
-                    "it sees"
-                } else {
-                    "they see"
-                }
-            } else if beyond.len() == 1 {
-                "it lights"
-            } else {
-                "they light"
-            },
-            if beyond.len() == 1 { "it" } else { "them" },
-            rooms_span(&kept),
-            if beyond.len() == 1 {
-                "it is"
-            } else {
-                "they are"
-            },
-        ));
+    if beyond.is_empty() || !sealed {
+        return None;
     }
-    out
+    let lo = grid.origin_m.map(f64::from);
+    let hi = std::array::from_fn(|a| lo[a] + grid.dims[a] as f64 * grid.voxel_size_m as f64);
+    let n = beyond.len();
+    let does = if beyond.iter().all(|s| is_camera_seed(s)) {
+        by_count(n, "it sees", "they see")
+    } else {
+        by_count(n, "it lights", "they light")
+    };
+    Some(format!(
+        "{} outside the level: beyond the grid the bake spans around its geometry ({} .. {} m), \
+         and none of the level's rooms reaches that grid's bounds, so the bake kept no space for \
+         {} and {does} the backs of its walls alone. Move {}{}, or if {} meant to be outside, \
+         ignore this",
+        join_and(&beyond),
+        metres(&json_point(lo)),
+        metres(&json_point(hi)),
+        by_count(n, "it", "them"),
+        by_count(n, "it", "them"),
+        rooms_span(&kept),
+        by_count(n, "it is", "they are"),
+    ))
 }
 
 /// ` inside (the rooms span A .. B m)`: the box of `rooms`' bounds, or ` inside` where there
