@@ -124,6 +124,9 @@ fn bake_says_each_import_warning_once() {
         "{}",
         stderr(&o)
     );
+    // Into a pipe or a log file, without the terminal's colour codes (they were written as
+    // `\x1b[33m WARN\x1b[0m` whatever stderr was).
+    assert!(!stderr(&o).contains('\x1b'), "{:?}", stderr(&o));
 }
 
 #[test]
