@@ -82,7 +82,15 @@ pub struct ImportedModel {
     /// Indices of the materials that glow (an OBJ's `Ke`, a glTF's emissive factor above 0):
     /// visgate lights by point and spot lights alone, so they add no light of their own.
     pub emissive: Vec<u32>,
+    /// The materials that let light through, with their opacity under 1 (an MTL's `d`, or 1 −
+    /// its `Tr`; a glTF's base colour alpha where its alpha mode is BLEND): glass.
+    pub see_through: Vec<(u32, f32)>,
 }
+
+/// Opacity under which a see-through material's surfaces are left out of the level (glass):
+/// visgate renders every surface opaque and diffuse, so a window's pane would block all the
+/// light that passes it. [Units: ratio]
+pub const SEE_THROUGH_OPACITY: f32 = 0.5;
 
 /// Imports an OBJ, glTF or GLB file, chosen by its extension.
 pub fn import_file(path: &Path, options: &ImportOptions) -> Result<ImportedModel, SceneError> {
@@ -198,6 +206,15 @@ fn import_obj_reader(
     for m in &materials {
         if m.emissive.is_some_and(|e| e.iter().any(|&c| c > 0.0)) {
             out.emissive.push(out.materials.len() as u32);
+        }
+        let tr = m
+            .unknown_param
+            .get("Tr")
+            .and_then(|t| t.trim().parse::<f32>().ok());
+        let opacity = m.dissolve.or(tr.map(|t| 1.0 - t)).unwrap_or(1.0);
+        if opacity < 1.0 {
+            out.see_through
+                .push((out.materials.len() as u32, opacity.max(0.0)));
         }
         let texture = m
             .diffuse_texture
@@ -364,6 +381,7 @@ pub(crate) fn build_mesh(
 }
 
 pub(crate) fn finish_warnings(path: &Path, out: &mut ImportedModel) {
+    leave_out_see_through(path, out);
     if out.degenerate_dropped > 0 {
         out.warnings.push(format!(
             "{}: dropped {} degenerate (zero-area) triangles of {}",
@@ -374,6 +392,47 @@ pub(crate) fn finish_warnings(path: &Path, out: &mut ImportedModel) {
     }
     for w in &out.warnings {
         tracing::warn!("{w}");
+    }
+}
+
+/// Leaves the meshes of the materials more see-through than [`SEE_THROUGH_OPACITY`] out of
+/// `out` (a window's glass, which would block its light), and says so for each see-through
+/// material, left out or kept opaque.
+fn leave_out_see_through(path: &Path, out: &mut ImportedModel) {
+    for &(material, opacity) in &out.see_through {
+        let name = &out.materials[material as usize].name;
+        let mine = |m: &RawMesh| m.material == material;
+        let triangles: usize = out
+            .meshes
+            .iter()
+            .filter(|m| mine(m))
+            .map(|m| m.triangles.len())
+            .sum();
+        if triangles == 0 {
+            continue;
+        }
+        let (its, block, are) = match triangles {
+            1 => ("its triangle".to_string(), "blocks", "is"),
+            n => (format!("its {n} triangles"), "block", "are"),
+        };
+        let note = if opacity < SEE_THROUGH_OPACITY {
+            out.meshes.retain(|m| !mine(m));
+            format!(
+                "{}: material '{name}' is see-through (opacity {opacity:.2}), and visgate \
+                 renders every surface opaque: {its} (glass?) {are} left out of the level, so \
+                 that light and sight pass there. To keep them as \
+                 walls, make the material opaque (`d 1` in the MTL, alphaMode OPAQUE in a glTF)",
+                path.display()
+            )
+        } else {
+            format!(
+                "{}: material '{name}' is partly see-through (opacity {opacity:.2}); visgate \
+                 renders it opaque, so {its} {block} light as walls do \
+                 (under opacity {SEE_THROUGH_OPACITY} they would be left out)",
+                path.display()
+            )
+        };
+        out.warnings.push(note);
     }
 }
 

@@ -181,6 +181,9 @@ fn materials(document: &gltf::Document, image_texture: &[Option<u32>], out: &mut
         }
         let pbr = m.pbr_metallic_roughness();
         let base_color = pbr.base_color_factor();
+        if m.alpha_mode() == gltf::material::AlphaMode::Blend && base_color[3] < 1.0 {
+            (out.see_through).push((out.materials.len() as u32, base_color[3].max(0.0)));
+        }
         let mut texture = pbr
             .base_color_texture()
             .map(|t| t.texture().source().index());
