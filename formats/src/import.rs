@@ -421,7 +421,8 @@ fn leave_out_see_through(path: &Path, out: &mut ImportedModel) {
                 "{}: material '{name}' is see-through (opacity {opacity:.2}), and visgate \
                  renders every surface opaque: {its} (glass?) {are} left out of the level, so \
                  that light and sight pass there. To keep them as \
-                 walls, make the material opaque (`d 1` in the MTL, alphaMode OPAQUE in a glTF)",
+                 walls, make the material opaque (`d 1` in the MTL; in a glTF alphaMode OPAQUE \
+                 and no transmission)",
                 path.display()
             )
         } else {

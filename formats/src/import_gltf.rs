@@ -181,8 +181,14 @@ fn materials(document: &gltf::Document, image_texture: &[Option<u32>], out: &mut
         }
         let pbr = m.pbr_metallic_roughness();
         let base_color = pbr.base_color_factor();
-        if m.alpha_mode() == gltf::material::AlphaMode::Blend && base_color[3] < 1.0 {
-            (out.see_through).push((out.materials.len() as u32, base_color[3].max(0.0)));
+        // Glass: blended under an alpha below 1, or transmitting (KHR_materials_transmission,
+        // as Blender exports a Principled BSDF's transmission).
+        let blended = m.alpha_mode() == gltf::material::AlphaMode::Blend;
+        let alpha = if blended { base_color[3] } else { 1.0 };
+        let transmits = m.transmission().map_or(0.0, |t| t.transmission_factor());
+        let opacity = alpha.min(1.0 - transmits).max(0.0);
+        if opacity < 1.0 {
+            (out.see_through).push((out.materials.len() as u32, opacity));
         }
         let mut texture = pbr
             .base_color_texture()

@@ -46,7 +46,7 @@ fn an_obj_s_glass_is_left_out_and_tinted_glass_kept_both_said() {
 }
 
 #[test]
-fn a_gltf_s_blended_glass_is_left_out_and_opaque_or_masked_materials_are_not() {
+fn a_gltf_s_blended_or_transmitting_glass_is_left_out_and_opaque_or_masked_materials_are_not() {
     let dir = tempfile::tempdir().expect("tempdir");
     let d = dir.path();
     let mut bin = Vec::new();
@@ -58,27 +58,35 @@ fn a_gltf_s_blended_glass_is_left_out_and_opaque_or_masked_materials_are_not() {
     let json = format!(
         r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],
         "nodes":[{{"mesh":0}}],
-        "meshes":[{{"name":"panes","primitives":[{},{},{},{}]}}],
+        "meshes":[{{"name":"panes","primitives":[{},{},{},{},{}]}}],
         "materials":[
           {{"name":"wall"}},
           {{"name":"window","alphaMode":"BLEND","pbrMetallicRoughness":{{"baseColorFactor":[1,1,1,0.2]}}}},
           {{"name":"leaves","alphaMode":"MASK","pbrMetallicRoughness":{{"baseColorFactor":[1,1,1,0.2]}}}},
-          {{"name":"faded","alphaMode":"BLEND","pbrMetallicRoughness":{{"baseColorFactor":[1,1,1,1]}}}}],
+          {{"name":"faded","alphaMode":"BLEND","pbrMetallicRoughness":{{"baseColorFactor":[1,1,1,1]}}}},
+          {{"name":"pane","extensions":{{"KHR_materials_transmission":{{"transmissionFactor":0.95}}}}}}],
+        "extensionsUsed":["KHR_materials_transmission"],
         "buffers":[{{"uri":"panes.bin","byteLength":36}}],
         "bufferViews":[{{"buffer":0,"byteOffset":0,"byteLength":36}}],
         "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}}]}}"#,
         prim(0),
         prim(1),
         prim(2),
-        prim(3)
+        prim(3),
+        prim(4)
     );
     std::fs::write(d.join("panes.gltf"), json).expect("gltf");
     let scene = load(&d.join("panes.gltf"));
-    assert_eq!(scene.triangle_count(), 3, "all but the window");
+    assert_eq!(scene.triangle_count(), 3, "all but the window and the pane");
     let said = scene.report.warnings.join("\n");
     assert!(
         said.contains("material 'window' is see-through (opacity 0.20)")
             && said.contains("alphaMode OPAQUE"),
+        "{said}"
+    );
+    // Glass as Blender exports a Principled BSDF's transmission.
+    assert!(
+        said.contains("material 'pane' is see-through (opacity 0.05)"),
         "{said}"
     );
     // A cut-out (MASK) is drawn opaque where its texture is, and an alpha of 1 is opaque.
