@@ -83,7 +83,8 @@ pub struct ImportedModel {
     /// visgate lights by point and spot lights alone, so they add no light of their own.
     pub emissive: Vec<u32>,
     /// The materials that let light through, with their opacity under 1 (an MTL's `d`, or 1 −
-    /// its `Tr`; a glTF's base colour alpha where its alpha mode is BLEND): glass.
+    /// its `Tr`; a glTF's base colour alpha where its alpha mode is BLEND, or 1 − its
+    /// `KHR_materials_transmission` factor): glass.
     pub see_through: Vec<(u32, f32)>,
 }
 
@@ -420,9 +421,9 @@ fn leave_out_see_through(path: &Path, out: &mut ImportedModel) {
             format!(
                 "{}: material '{name}' is see-through (opacity {opacity:.2}), and visgate \
                  renders every surface opaque: {its} (glass?) {are} left out of the level, so \
-                 that light and sight pass there. To keep them as \
-                 walls, make the material opaque (`d 1` in the MTL; in a glTF alphaMode OPAQUE \
-                 and no transmission)",
+                 that light and sight pass there. To keep its surfaces as walls, make the \
+                 material opaque (`d 1` in the MTL; in a glTF alphaMode OPAQUE and no \
+                 transmission)",
                 path.display()
             )
         } else {
