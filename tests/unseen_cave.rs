@@ -14,7 +14,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use glam::Vec3;
-use support::{stderr, stdout, visgate, visgate_warn};
+use support::{stderr, stdout, summary_count, visgate, visgate_warn};
 
 /// The marching grid's cell. [Units: m]
 const CELL: f32 = 0.3;
@@ -243,13 +243,7 @@ fn bake(dir: &Path, scene: &str, resolution: &str) -> (f64, String) {
         resolution,
     ]);
     assert!(o.status.success(), "{}", stderr(&o));
-    let report = stdout(&o);
-    let line = report
-        .lines()
-        .find(|l| l.starts_with("clusters "))
-        .unwrap_or_else(|| panic!("no summary line in\n{report}"));
-    let clusters = line.split_whitespace().nth(1).and_then(|n| n.parse().ok());
-    (clusters.expect("a count"), stderr(&o))
+    (summary_count(&stdout(&o), "clusters"), stderr(&o))
 }
 
 #[test]

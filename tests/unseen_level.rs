@@ -12,7 +12,7 @@ mod support;
 use std::fmt::Write as _;
 use std::path::Path;
 
-use support::{stderr, stdout, visgate};
+use support::{stderr, stdout, summary_count, visgate};
 
 /// Rooms along x and y, each `ROOM` cm square and `HEIGHT` cm high.
 const ROOMS: (usize, usize) = (4, 3);
@@ -168,21 +168,6 @@ target = [300, 470, 100]
 fov_deg = 75
 "#;
 
-/// The number after the word `label` on the bake report's summary line (`clusters 44  gates
-/// 70  portals 1263 …`).
-fn count(report: &str, label: &str) -> f64 {
-    let line = report
-        .lines()
-        .find(|l| l.starts_with("clusters "))
-        .unwrap_or_else(|| panic!("no summary line in\n{report}"));
-    let words: Vec<&str> = line.split_whitespace().collect();
-    words
-        .windows(2)
-        .find(|w| w[0] == label)
-        .and_then(|w| w[1].parse().ok())
-        .unwrap_or_else(|| panic!("no number after {label:?}: {line}"))
-}
-
 fn bake(dir: &Path, resolution: &str) -> (f64, f64) {
     let scene = dir.join("office.toml");
     let level = dir.join(format!("office-{resolution}.vgate"));
@@ -201,7 +186,10 @@ fn bake(dir: &Path, resolution: &str) -> (f64, f64) {
         stderr(&o)
     );
     let report = stdout(&o);
-    (count(&report, "clusters"), count(&report, "gates"))
+    (
+        summary_count(&report, "clusters"),
+        summary_count(&report, "gates"),
+    )
 }
 
 /// office.obj (its faces `doubled` or not) and office.toml into `dir`.

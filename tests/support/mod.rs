@@ -32,6 +32,21 @@ pub fn under_a_file(dir: &Path, name: &str) -> String {
     path.to_str().expect("utf-8").to_string()
 }
 
+/// The number after the word `label` on the bake report's summary line (`clusters 44  gates
+/// 70  portals 1263 …`).
+pub fn summary_count(report: &str, label: &str) -> f64 {
+    let line = report
+        .lines()
+        .find(|l| l.starts_with("clusters "))
+        .unwrap_or_else(|| panic!("no summary line in\n{report}"));
+    let words: Vec<&str> = line.split_whitespace().collect();
+    words
+        .windows(2)
+        .find(|w| w[0] == label)
+        .and_then(|w| w[1].parse().ok())
+        .unwrap_or_else(|| panic!("no number after {label:?}: {line}"))
+}
+
 /// Its standard output.
 pub fn stdout(o: &Output) -> String {
     String::from_utf8_lossy(&o.stdout).into_owned()
