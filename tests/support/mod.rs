@@ -47,6 +47,47 @@ pub fn summary_count(report: &str, label: &str) -> f64 {
         .unwrap_or_else(|| panic!("no number after {label:?}: {line}"))
 }
 
+/// `visgate compare SCENE --level LEVEL --modes gates,none --vpls 256 --size SIZE --spp 1`
+/// into `out`, as the tests of levels unlike the built-ins run it: a lookup of each (camera,
+/// mode) row's indirect energy ratio and black-where-lit share.
+pub fn gates_and_none(
+    scene: &Path,
+    level: &Path,
+    size: &str,
+    out: &Path,
+) -> impl Fn(&str, &str) -> (f64, f64) + use<> {
+    let path = |p: &Path| p.to_str().expect("utf8").to_string();
+    let (scene, level, out_s) = (path(scene), path(level), path(out));
+    let o = visgate(&[
+        "compare",
+        &scene,
+        "--level",
+        &level,
+        "--modes",
+        "gates,none",
+        "--vpls",
+        "256",
+        "--size",
+        size,
+        "--spp",
+        "1",
+        "--out",
+        &out_s,
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let json = std::fs::read_to_string(out.join("report.json")).expect("report.json");
+    let report: serde_json::Value = serde_json::from_str(&json).expect("json");
+    let rows = report["rows"].as_array().expect("rows").clone();
+    move |camera: &str, mode: &str| {
+        let row = rows
+            .iter()
+            .find(|r| r["camera"] == camera && r["mode"] == mode)
+            .unwrap_or_else(|| panic!("no row {camera} {mode} in {json}"));
+        let energy = row["energy_ratio"].as_f64().expect("energy");
+        (energy, row["black_where_lit"].as_f64().expect("black"))
+    }
+}
+
 /// Its standard output.
 pub fn stdout(o: &Output) -> String {
     String::from_utf8_lossy(&o.stdout).into_owned()
