@@ -58,6 +58,17 @@ pub enum BakeError {
     /// The scene has no empty space to bake (or none was kept).
     #[error("no empty space: {0}")]
     NoEmptySpace(String),
+    /// The static geometry lies in one plane: it encloses no space to bake.
+    #[error(
+        "the level is flat: its static geometry spans {:.2} x {:.2} x {:.2} m, nothing along {axis}, so it encloses no space — a ground, a wall or a sheet alone, not a level. The bake partitions the space that floors, walls and ceilings close around; bake the whole level (every static mesh in a scene TOML), or render this one without --level (the reference needs no bake)",
+        extent[0], extent[1], extent[2]
+    )]
+    Flat {
+        /// The geometry's bounding box's size. [Units: m]
+        extent: [f64; 3],
+        /// The axis it has no extent along (x, y or z).
+        axis: char,
+    },
     /// The static geometry has no triangle.
     #[error("the scene has no static triangles to bake; mark at least one mesh `static = true`")]
     NoGeometry,

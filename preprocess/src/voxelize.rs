@@ -48,6 +48,12 @@ pub fn grid_for(
 ) -> Result<GridMeta, BakeError> {
     let (lo, hi) = (bounds.0.as_dvec3(), bounds.1.as_dvec3());
     let extent = hi - lo;
+    if let Some(axis) = flat_axis(extent) {
+        return Err(BakeError::Flat {
+            extent: extent.to_array(),
+            axis,
+        });
+    }
     let size = match resolution {
         Resolution::LongestAxisVoxels(n) => {
             if !(8..=2048).contains(&n) {
@@ -96,6 +102,19 @@ pub fn grid_for(
         voxel_size_m: size as f32,
         dims: dims_f.to_array().map(|d| d as u32),
     })
+}
+
+/// How thin a level's bounds may be along one axis, as a share of their longest side, before
+/// it counts as flat: a float's rounding of a plane, not a thin level (a 1 km ground with a
+/// metre of relief is 1e-3, and bakes or says what voxel would).
+const FLAT_SHARE: f64 = 1e-6;
+
+/// The axis along which bounds of this extent are flat ([`FLAT_SHARE`]), where one is; none
+/// for a point (no longest side), which the voxel size's check names.
+fn flat_axis(extent: DVec3) -> Option<char> {
+    let longest = extent.max_element();
+    (longest > 0.0 && extent.min_element() <= longest * FLAT_SHARE)
+        .then(|| ['x', 'y', 'z'][extent.min_position()])
 }
 
 /// Voxels across the level's shortest side that [`all_solid`] suggests. [Units: voxels]

@@ -253,6 +253,14 @@ fn bad_resolutions_are_refused_before_allocating() {
         grid_for(flat, Resolution::LongestAxisVoxels(64), u64::MAX),
         Err(BakeError::Param(_))
     ));
+    // A plane (a single ground quad, one wall) is refused as flat, naming the axis; a thin
+    // level (a 1 km ground with a metre of relief) is not.
+    let plane = (Vec3::new(-5.0, 2.0, 0.0), Vec3::new(5.0, 2.0, 10.0));
+    let e = grid_for(plane, Resolution::LongestAxisVoxels(128), u64::MAX).expect_err("flat");
+    assert!(matches!(e, BakeError::Flat { axis: 'y', .. }), "{e:?}");
+    assert!(e.to_string().contains("10.00 x 0.00 x 10.00 m"), "{e}");
+    let thin = (Vec3::ZERO, Vec3::new(1000.0, 1.0, 1000.0));
+    assert!(grid_for(thin, Resolution::LongestAxisVoxels(128), u64::MAX).is_ok());
     let ok = grid_for(b, Resolution::VoxelSizeM(0.5), u64::MAX).expect("grid");
     assert_eq!(ok.dims, [22, 12, 8]);
 }

@@ -95,9 +95,16 @@ pub fn light_a_bare_scene(
         return None;
     }
     let (lo, hi) = scene.bounds()?;
-    let (at, from) = match ball {
-        Some(p) => (p, "the centre of the level's largest empty ball"),
-        None => {
+    // A plane (a ground alone, one wall) has no inside to stand in: look at it from its
+    // front, lit from the eye (the bake refuses it as flat; the reference renders it).
+    let flat = flat_view(scene, lo, hi);
+    let (at, from) = match (flat, ball) {
+        (Some((eye, _)), _) => (
+            eye,
+            "off the flat level on the side its faces face, looking at its centre",
+        ),
+        (None, Some(p)) => (p, "the centre of the level's largest empty ball"),
+        (None, None) => {
             const N: usize = 7;
             let lattice = (0..N * N * N).map(|i| {
                 let t = Vec3::new((i % N) as f32, ((i / N) % N) as f32, (i / (N * N)) as f32);
@@ -112,8 +119,11 @@ pub fn light_a_bare_scene(
             }
         }
     };
-    // Walls at the mean distance around it get about 2 W/m².
-    let mean = probe(at).map_or(0.1 * (hi - lo).length(), |(_, mean)| mean);
+    // Walls at the mean distance around it get about 2 W/m² (a flat level: its centre).
+    let mean = match flat {
+        Some((eye, centre)) => eye.distance(centre),
+        None => probe(at).map_or(0.1 * (hi - lo).length(), |(_, mean)| mean),
+    };
     // What goes at `at`, and the lamps' lights, which go elsewhere.
     let (mut here, mut lamps_said) = (Vec::new(), None);
     if no_light {
@@ -129,7 +139,7 @@ pub fn light_a_bare_scene(
         }
     }
     if no_camera {
-        let along = deepest_look(at, reach);
+        let along = flat.map_or_else(|| deepest_look(at, reach), |(eye, centre)| centre - eye);
         scene.cameras.push(Camera {
             name: INSIDE_CAMERA.into(),
             eye: at,
@@ -159,6 +169,41 @@ pub fn light_a_bare_scene(
         },
         said.join(" and ")
     ))
+}
+
+/// How thin bounds may be along an axis, as a share of their longest side, to be a plane (as
+/// the bake's voxelizer has it).
+const FLAT_SHARE: f32 = 1e-6;
+
+/// Where bounds `lo`–`hi` are flat along an axis, an eye to see the plane from and its centre:
+/// on the side the most triangle area faces, half the plane's longest side off it; off a
+/// ground (flat along y) also half that back along −z, looking down at 45° (straight down
+/// would leave the camera's up, +y, along its view).
+fn flat_view(scene: &Scene, lo: Vec3, hi: Vec3) -> Option<(Vec3, Vec3)> {
+    let extent = hi - lo;
+    let longest = extent.max_element();
+    if !(longest > 0.0 && extent.min_element() <= longest * FLAT_SHARE) {
+        return None;
+    }
+    let axis = Vec3::AXES[extent.min_position()];
+    let facing: f32 = scene
+        .meshes
+        .iter()
+        .flat_map(|m| {
+            m.triangles.iter().map(|t| {
+                let [a, b, c] = t.map(|i| m.positions[i as usize]);
+                (b - a).cross(c - a).dot(axis)
+            })
+        })
+        .sum();
+    let side = if facing < 0.0 { -axis } else { axis };
+    let centre = 0.5 * (lo + hi);
+    let back = if axis == Vec3::Y {
+        -Vec3::Z
+    } else {
+        Vec3::ZERO
+    };
+    Some((centre + 0.5 * longest * (side + back), centre))
 }
 
 /// Lights `lamps` (a point light in front of each, the walls around it getting its share by
@@ -331,6 +376,59 @@ mod tests {
         let c = (lo + hi) * 0.5;
         assert!((position - c).abs().max_element() < (hi - lo).max_element() / 7.0);
         assert_eq!(scene.cameras[0].eye, position);
+    }
+
+    #[test]
+    fn a_flat_scene_is_seen_from_the_side_its_faces_face() {
+        // A 10 × 6 m ground alone, its two triangles wound to face up (+y): every ray from
+        // it escapes and it has no inside, so the light and the camera sat in its plane and the
+        // render was black. They go 5 m above it and 5 m back along −z, looking at its centre.
+        let mut scene = crate::Builtin::EmptyBox.scene().expect("builtin");
+        scene.lights.clear();
+        scene.cameras.clear();
+        scene.meshes.truncate(1);
+        let ground = &mut scene.meshes[0];
+        ground.positions = vec![
+            Vec3::new(0.0, 1.0, 0.0),
+            Vec3::new(0.0, 1.0, 6.0),
+            Vec3::new(10.0, 1.0, 6.0),
+            Vec3::new(10.0, 1.0, 0.0),
+        ];
+        ground.normals = vec![Vec3::Y; 4];
+        ground.uvs = vec![glam::Vec2::ZERO; 4];
+        ground.triangles = vec![[0, 1, 2], [0, 2, 3]];
+        ground.material = vec![0, 0];
+        let escape = |_: Vec3| None;
+        let said = light_a_bare_scene(&mut scene, None, &escape, &|_, _| None).expect("said");
+        assert!(said.contains("off the flat level"), "{said}");
+        let (eye, centre) = (Vec3::new(5.0, 6.0, -2.0), Vec3::new(5.0, 1.0, 3.0));
+        let cam = &scene.cameras[0];
+        assert!(
+            cam.eye.distance(eye) < 1e-5 && cam.target.distance(centre) < 1e-5,
+            "{cam:?}"
+        );
+        let Light::Point {
+            position,
+            intensity,
+        } = scene.lights[0]
+        else {
+            panic!("{:?}", scene.lights[0]);
+        };
+        // 2 W/m² at the centre, 7.07 m away.
+        assert!(position.distance(eye) < 1e-5, "{position}");
+        assert!((intensity.x - 2.0 * 50.0).abs() < 1e-3, "{intensity}");
+        // Wound the other way, it is seen from below.
+        for t in &mut scene.meshes[0].triangles {
+            t.swap(1, 2);
+        }
+        let (lo, hi) = scene.bounds().expect("bounds");
+        let (below, _) = flat_view(&scene, lo, hi).expect("flat");
+        assert!(
+            (below - Vec3::new(5.0, -4.0, -2.0)).length() < 1e-5,
+            "{below}"
+        );
+        // Bounds with any depth are not flat.
+        assert!(flat_view(&scene, lo, hi + Vec3::Y * 0.01).is_none());
     }
 
     #[test]

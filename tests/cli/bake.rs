@@ -158,6 +158,37 @@ fn a_triangle_far_from_the_level_is_named_before_the_bake() {
     assert!(stderr(&stray).contains(said), "{}", stderr(&stray));
 }
 
+#[test]
+fn a_flat_mesh_is_refused_as_no_level() {
+    // One ground triangle, as a bare file: its grid is a voxel thick, and the bake said that it
+    // was too coarse and to bake at --resolution 768 (a quad on its side: every voxel solid,
+    // and a voxel of 1 mm). A plane encloses no space at any resolution; it says so.
+    let dir = tempfile::tempdir().expect("tempdir");
+    for (name, obj) in [
+        ("ground.obj", "v 0 0 0\nv 10 0 0\nv 0 0 10\nf 1 2 3\n"),
+        (
+            "wall.obj",
+            "v 0 0 0\nv 4 0 0\nv 4 3 0\nv 0 3 0\nf 1 2 3 4\n",
+        ),
+    ] {
+        let mesh = dir.path().join(name);
+        std::fs::write(&mesh, obj).expect("obj");
+        let out = dir.path().join("l.vgate");
+        let (m, o) = (mesh.to_str().expect("utf-8"), out.to_str().expect("utf-8"));
+        let r = visgate(&["bake", m, "-o", o]);
+        assert!(!r.status.success(), "{name}: {}", stdout(&r));
+        let err = stderr(&r);
+        assert!(
+            err.contains("the level is flat") && err.contains("encloses no space"),
+            "{name}: {err}"
+        );
+        assert!(
+            !err.contains("--resolution 7") && !out.exists(),
+            "{name}: {err}"
+        );
+    }
+}
+
 /// `visgate bake SCENE -o DIR/l.vgate --resolution 64 --debug-dir DIR/debug --report
 /// DIR/bake.json`, and those two paths.
 fn bake_at_64_with_debug(
