@@ -74,7 +74,7 @@ pub fn grid_for(
     };
     if !(size.is_finite() && size > 0.0) {
         return Err(BakeError::Param(format!(
-            "the static geometry is flat or a point (extent {extent} m): nothing to voxelize"
+            "the static geometry is a point (extent {extent} m): nothing to voxelize"
         )));
     }
     let inner = (extent / size).ceil().max(DVec3::ONE);
