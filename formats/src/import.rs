@@ -86,6 +86,9 @@ pub struct ImportedModel {
     /// its `Tr`; a glTF's base colour alpha where its alpha mode is BLEND, or 1 − its
     /// `KHR_materials_transmission` factor): glass.
     pub see_through: Vec<(u32, f32)>,
+    /// The materials cut out by an alpha mask (an MTL's `map_d`; a glTF's alphaMode MASK, or
+    /// BLEND with a base colour texture and an opaque factor): drawn whole and opaque.
+    pub alpha_masked: Vec<u32>,
 }
 
 /// Opacity under which a see-through material's surfaces are left out of the level (glass):
@@ -216,6 +219,9 @@ fn import_obj_reader(
         if opacity < 1.0 {
             out.see_through
                 .push((out.materials.len() as u32, opacity.max(0.0)));
+        }
+        if m.dissolve_texture.is_some() {
+            out.alpha_masked.push(out.materials.len() as u32);
         }
         let texture = m
             .diffuse_texture
@@ -383,6 +389,7 @@ pub(crate) fn build_mesh(
 
 pub(crate) fn finish_warnings(path: &Path, out: &mut ImportedModel) {
     leave_out_see_through(path, out);
+    say_alpha_masked(path, out);
     if out.degenerate_dropped > 0 {
         out.warnings.push(format!(
             "{}: dropped {} degenerate (zero-area) triangles of {}",
@@ -436,6 +443,48 @@ fn leave_out_see_through(path: &Path, out: &mut ImportedModel) {
         };
         out.warnings.push(note);
     }
+}
+
+/// Says, once for the file, which materials an alpha mask cuts out (leaves, chains, fences,
+/// grates) that it keeps: visgate reads no mask, so their triangles are drawn whole and block
+/// light and sight as solid quads, in the bake and in every render alike.
+fn say_alpha_masked(path: &Path, out: &mut ImportedModel) {
+    let mut names = Vec::new();
+    let mut triangles = 0;
+    for &material in &out.alpha_masked {
+        let mine: usize = (out.meshes.iter())
+            .filter(|m| m.material == material)
+            .map(|m| m.triangles.len())
+            .sum();
+        if mine > 0 {
+            names.push(format!("'{}'", out.materials[material as usize].name));
+            triangles += mine;
+        }
+    }
+    let Some(first) = names.first() else {
+        return;
+    };
+    let (which, are) = match names.len() {
+        1 => (format!("material {first} is"), "its"),
+        n if n <= 4 => (format!("materials {} are", names.join(", ")), "their"),
+        n => (
+            format!("{n} materials ({}, …) are", names[..3].join(", ")),
+            "their",
+        ),
+    };
+    let (tris, drawn) = match triangles {
+        1 => ("triangle", "is"),
+        _ => ("triangles", "are"),
+    };
+    out.warnings.push(format!(
+        "{}: {which} cut out by an alpha mask (an MTL's map_d, a glTF's alphaMode MASK), which \
+         visgate does not read: {are} {triangles} {tris} {drawn} drawn whole and opaque, so \
+         leaves, chains or grates block light and sight as solid quads, in the bake and every \
+         render alike. To let light through them instead, mark the material see-through (`d \
+         0.4` in the MTL; in a glTF alphaMode BLEND with a base colour alpha under 0.5) and \
+         visgate leaves them out",
+        path.display()
+    ));
 }
 
 /// Decodes each texture file once.

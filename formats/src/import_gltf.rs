@@ -8,7 +8,8 @@ use glam::{Mat4, Vec2, Vec3};
 
 use crate::error::SceneError;
 use crate::import::{
-    DEFAULT_ALBEDO, ImportOptions, ImportedModel, RawMesh, build_mesh, finish_warnings,
+    DEFAULT_ALBEDO, ImportOptions, ImportedModel, RawMesh, SEE_THROUGH_OPACITY, build_mesh,
+    finish_warnings,
 };
 use crate::scene::{Material, Texture};
 
@@ -189,6 +190,18 @@ fn materials(document: &gltf::Document, image_texture: &[Option<u32>], out: &mut
         let opacity = alpha.min(1.0 - transmits).max(0.0);
         if opacity < 1.0 {
             (out.see_through).push((out.materials.len() as u32, opacity));
+        }
+        // Cut out by its texture's alpha: a mask, or a blend whose factor is opaque enough to
+        // be kept (glass is left out above).
+        let masked = match m.alpha_mode() {
+            gltf::material::AlphaMode::Mask => true,
+            gltf::material::AlphaMode::Blend => {
+                opacity >= SEE_THROUGH_OPACITY && pbr.base_color_texture().is_some()
+            }
+            gltf::material::AlphaMode::Opaque => false,
+        };
+        if masked {
+            out.alpha_masked.push(out.materials.len() as u32);
         }
         let mut texture = pbr
             .base_color_texture()

@@ -89,9 +89,44 @@ fn a_gltf_s_blended_or_transmitting_glass_is_left_out_and_opaque_or_masked_mater
         said.contains("material 'pane' is see-through (opacity 0.05)"),
         "{said}"
     );
-    // A cut-out (MASK) is drawn opaque where its texture is, and an alpha of 1 is opaque.
+    // A cut-out (MASK) is kept and drawn whole, and said so; an alpha of 1 is opaque.
     assert!(
-        !said.contains("'leaves'") && !said.contains("'faded'"),
+        said.contains("material 'leaves' is cut out by an alpha mask")
+            && said.contains("its 1 triangle is drawn whole and opaque"),
         "{said}"
     );
+    assert!(!said.contains("'faded'"), "{said}");
+}
+
+#[test]
+fn an_obj_s_alpha_masked_materials_are_kept_and_said_once() {
+    // Crytek Sponza's MTL as McGuire ships it cuts its leaves, plant and chains out with
+    // map_d; visgate draws them whole. One note names them, however many there are; a masked
+    // material that is also glass is left out as glass and not named again.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let d = dir.path();
+    std::fs::write(
+        d.join("court.mtl"),
+        "newmtl wall\nKd 0.5 0.5 0.5\nnewmtl leaf\nKd 0.3 0.5 0.2\nmap_d leaf_mask.tga\n\
+         newmtl chain\nmap_d chain_mask.tga\nnewmtl veil\nd 0.2\nmap_d veil_mask.tga\n",
+    )
+    .expect("mtl");
+    std::fs::write(
+        d.join("court.obj"),
+        "mtllib court.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nv 1 1 0\n\
+         usemtl wall\nf 1 2 3\nusemtl leaf\nf 1 2 4\nf 2 5 4\nusemtl chain\nf 1 3 4\n\
+         usemtl veil\nf 2 3 4\n",
+    )
+    .expect("obj");
+    let scene = load(&d.join("court.obj"));
+    assert_eq!(scene.triangle_count(), 4, "all but the veil");
+    let said = scene.report.warnings.join("\n");
+    assert_eq!(said.matches("alpha mask").count(), 1, "{said}");
+    assert!(
+        said.contains("materials 'leaf', 'chain' are cut out by an alpha mask")
+            && said.contains("their 3 triangles are drawn whole and opaque")
+            && said.contains("`d 0.4` in the MTL"),
+        "{said}"
+    );
+    assert!(said.contains("material 'veil' is see-through"), "{said}");
 }
