@@ -55,12 +55,12 @@ pub enum SceneError {
         /// The gltf crate's message.
         message: String,
     },
-    /// A glTF/GLB file that requires extensions the gltf crate does not read: compressed or
-    /// quantized meshes, as Blender's exporter and gltfpack write when asked.
+    /// A glTF/GLB file that requires extensions visgate does not read: compressed meshes, as
+    /// Blender's exporter and gltfpack write when asked (quantized ones it reads).
     #[error(
         "{}: needs the glTF extension{} {}, which visgate does not read ({what}). Write the \
-         file out without {}: re-export it from the modelling tool with mesh compression and \
-         quantization off, or decode it with a glTF tool (gltf-transform, gltfpack) first",
+         file out without {}: re-export it from the modelling tool with mesh compression off, \
+         or decode it with a glTF tool first (gltf-transform; gltfpack without -c)",
         file.display(),
         if extensions.len() == 1 { "" } else { "s" },
         extensions.join(", "),

@@ -4,9 +4,10 @@
 
 use std::path::Path;
 
-use glam::{Mat4, Vec2, Vec3};
+use glam::{Mat3, Mat4, Vec2, Vec3};
 
 use crate::error::SceneError;
+use crate::gltf_quantized::{self, QUANTIZATION};
 use crate::import::{
     DEFAULT_ALBEDO, ImportOptions, ImportedModel, RawMesh, SEE_THROUGH_OPACITY, build_mesh,
     finish_warnings,
@@ -22,13 +23,12 @@ fn unread_extensions(path: &Path) -> Option<SceneError> {
     let read = gltf::json::extensions::ENABLED_EXTENSIONS;
     let extensions: Vec<String> = gltf
         .extensions_required()
-        .filter(|e| !read.contains(e))
+        .filter(|e| !read.contains(e) && *e != QUANTIZATION)
         .map(str::to_string)
         .collect();
     let what = |e: &String| match e.as_str() {
         "KHR_draco_mesh_compression" => "Draco-compressed meshes",
         "EXT_meshopt_compression" => "meshoptimizer-compressed buffers",
-        "KHR_mesh_quantization" => "vertices stored as quantized integers",
         "KHR_texture_basisu" => "KTX2 / Basis Universal textures",
         _ => "not read by the gltf crate",
     };
@@ -47,8 +47,10 @@ pub fn import_gltf(path: &Path, options: &ImportOptions) -> Result<ImportedModel
         file: path.to_path_buf(),
         message: e.to_string(),
     };
-    let opened =
-        gltf::Gltf::open(path).map_err(|e| unread_extensions(path).unwrap_or_else(|| gerr(e)));
+    // A file that requires KHR_mesh_quantization validates without it (gltf_quantized).
+    let opened = gltf::Gltf::open(path)
+        .or_else(|e| gltf_quantized::open(path).ok_or(e))
+        .map_err(|e| unread_extensions(path).unwrap_or_else(|| gerr(e)));
     let gltf::Gltf { document, blob } = opened?;
     let base = path.parent().unwrap_or(Path::new("."));
     let buffers = gltf::import_buffers(&document, Some(base), blob).map_err(gerr)?;
@@ -58,7 +60,7 @@ pub fn import_gltf(path: &Path, options: &ImportOptions) -> Result<ImportedModel
         buffers: &buffers,
     };
     let image_texture = textures(&document, &file, base, options, &mut out);
-    materials(&document, &image_texture, &mut out);
+    let uv_transforms = materials(&document, &image_texture, &mut out);
     let default_material = out.materials.len() as u32;
     let mut needs_default = false;
 
@@ -91,6 +93,7 @@ pub fn import_gltf(path: &Path, options: &ImportOptions) -> Result<ImportedModel
                 name: &mname,
                 world,
                 material: material.unwrap_or(default_material),
+                uv_transform: material.and_then(|m| uv_transforms.get(m as usize).copied()?),
             };
             // A primitive read (not skipped) without a material takes the default one.
             let Some(raw) = primitive(&file, &prim, &placed, &mut out)? else {
@@ -124,6 +127,8 @@ struct Placed<'a> {
     name: &'a str,
     world: Mat4,
     material: u32,
+    /// Its material's base colour texture transform (KHR_texture_transform), if any.
+    uv_transform: Option<Mat3>,
 }
 
 /// The file's images as textures, each image's texture index (`None` where textures are not
@@ -174,8 +179,15 @@ fn textures(
 }
 
 /// The file's materials: the base colour (or the specular-glossiness diffuse where the base
-/// colour is left white) and its texture; an emissive one is noted as glowing.
-fn materials(document: &gltf::Document, image_texture: &[Option<u32>], out: &mut ImportedModel) {
+/// colour is left white) and its texture; an emissive one is noted as glowing. Returns each
+/// material's base colour texture transform (KHR_texture_transform; gltfpack scales its
+/// quantized texture coordinates back with one).
+fn materials(
+    document: &gltf::Document,
+    image_texture: &[Option<u32>],
+    out: &mut ImportedModel,
+) -> Vec<Option<Mat3>> {
+    let mut uv_transforms = Vec::new();
     for m in document.materials() {
         if m.emissive_factor().iter().any(|&c| c > 0.0) {
             out.emissive.push(out.materials.len() as u32);
@@ -203,6 +215,11 @@ fn materials(document: &gltf::Document, image_texture: &[Option<u32>], out: &mut
         if masked {
             out.alpha_masked.push(out.materials.len() as u32);
         }
+        uv_transforms.push(
+            (pbr.base_color_texture())
+                .and_then(|t| t.texture_transform())
+                .map(|t| gltf_quantized::uv_transform(&t)),
+        );
         let mut texture = pbr
             .base_color_texture()
             .map(|t| t.texture().source().index());
@@ -225,6 +242,7 @@ fn materials(document: &gltf::Document, image_texture: &[Option<u32>], out: &mut
             texture: texture.and_then(|i| image_texture.get(i).copied().flatten()),
         });
     }
+    uv_transforms
 }
 
 /// One primitive as a mesh in the world (strips and fans as lists, turned where the transform
@@ -250,26 +268,56 @@ fn primitive(
         return Ok(None);
     }
     let reader = prim.reader(|b| file.buffers.get(b.index()).map(|d| d.0.as_slice()));
-    let Some(pos) = reader.read_positions() else {
+    let attribute = |semantic: gltf::Semantic| prim.get(&semantic);
+    let Some(pos) = attribute(gltf::Semantic::Positions) else {
         out.warnings.push(format!(
             "{}: mesh '{mname}' has a primitive without positions; skipped",
             path.display()
         ));
         return Ok(None);
     };
+    let quantized = |e: String| SceneError::Gltf {
+        file: path.to_path_buf(),
+        message: format!("mesh '{mname}': {e}"),
+    };
+    // Floats through the crate's readers; quantized integers (KHR_mesh_quantization) read here.
+    let floats = |a: &gltf::Accessor, uv| gltf_quantized::crate_reads(a, uv);
+    let positions: Vec<[f32; 3]> = match reader.read_positions() {
+        Some(it) if floats(&pos, false) => it.collect(),
+        _ => gltf_quantized::read(&pos, file.buffers).map_err(quantized)?,
+    };
     let normal_m = world.inverse().transpose();
-    let positions: Vec<Vec3> = pos.map(|p| world.transform_point3(Vec3::from(p))).collect();
-    let normals = reader.read_normals().map(|it| {
-        it.map(|n| {
-            normal_m
-                .transform_vector3(Vec3::from(n))
-                .normalize_or_zero()
-        })
-        .collect::<Vec<_>>()
+    let positions: Vec<Vec3> = (positions.into_iter())
+        .map(|p| world.transform_point3(Vec3::from(p)))
+        .collect();
+    let normals = match (attribute(gltf::Semantic::Normals), reader.read_normals()) {
+        (Some(a), Some(it)) if floats(&a, false) => Some(it.collect()),
+        (Some(a), _) => Some(gltf_quantized::read::<3>(&a, file.buffers).map_err(quantized)?),
+        (None, _) => None,
+    };
+    let normals = normals.map(|n: Vec<[f32; 3]>| {
+        (n.into_iter())
+            .map(|n| {
+                normal_m
+                    .transform_vector3(Vec3::from(n))
+                    .normalize_or_zero()
+            })
+            .collect::<Vec<_>>()
     });
-    let uvs = reader
-        .read_tex_coords(0)
-        .map(|it| it.into_f32().map(Vec2::from).collect::<Vec<_>>());
+    let uvs = match (
+        attribute(gltf::Semantic::TexCoords(0)),
+        reader.read_tex_coords(0),
+    ) {
+        (Some(a), Some(it)) if floats(&a, true) => Some(it.into_f32().collect()),
+        (Some(a), _) => Some(gltf_quantized::read::<2>(&a, file.buffers).map_err(quantized)?),
+        (None, _) => None,
+    };
+    let uvs = uvs.map(|uv: Vec<[f32; 2]>| {
+        let t = placed.uv_transform.unwrap_or(Mat3::IDENTITY);
+        (uv.into_iter())
+            .map(|uv| t.transform_point2(Vec2::from(uv)))
+            .collect::<Vec<_>>()
+    });
     let list: Vec<u64> = match reader.read_indices() {
         Some(ix) => ix.into_u32().map(u64::from).collect(),
         None => (0..positions.len() as u64).collect(),

@@ -25,6 +25,7 @@ pub mod export;
 pub mod geom;
 pub mod gltf_export;
 pub mod gltf_nodes;
+mod gltf_quantized;
 pub mod import;
 mod import_gltf;
 pub mod load;
