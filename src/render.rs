@@ -244,6 +244,8 @@ pub fn run(args: RenderArgs) -> Result<()> {
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let setup = std::sync::Mutex::new(String::new());
+    // The method the frames run (the job's, or the walk that took its place: JobSetup::mode).
+    let ran = std::sync::Mutex::new(job.mode());
     pool.install(|| {
         job.run(
             &scene,
@@ -254,6 +256,7 @@ pub fn run(args: RenderArgs) -> Result<()> {
                     Some(a) => format!("on {a}, adapter + upload + level {:.3} s", s.seconds),
                     None => String::new(),
                 };
+                *ran.lock().unwrap_or_else(|e| e.into_inner()) = s.mode;
             },
             &|done, _| bar.set_position(done as u64),
             &mut |f| {
@@ -269,7 +272,8 @@ pub fn run(args: RenderArgs) -> Result<()> {
                 }
                 f.image.write(&out, args.exposure)?;
                 let setup = setup.lock().unwrap_or_else(|e| e.into_inner()).clone();
-                let described = job.mode().map(|m| m.describe_for(f.vpl_count as u32));
+                let ran = *ran.lock().unwrap_or_else(|e| e.into_inner());
+                let described = ran.map(|m| m.describe_for(f.vpl_count as u32));
                 let described = described.unwrap_or_default();
                 print_frame(&args, (&scene.name, &described), &f, load_s, &setup);
                 println!("wrote {}", out.display());

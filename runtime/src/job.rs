@@ -126,6 +126,9 @@ pub struct JobSetup {
     pub adapter: Option<String>,
     /// Opening it, uploading the scene and the level. [Units: s]
     pub seconds: f64,
+    /// The method the frames run: the job's, but where its walk's tables did not fit the
+    /// adapter and another walk took their place ([`GpuRenderer::level_for_mode_or_planes`]).
+    pub mode: Option<GpuMode>,
 }
 
 impl RenderJob {
@@ -229,7 +232,7 @@ impl RenderJob {
         on_frame: &mut dyn FnMut(JobFrame) -> Result<(), RenderError>,
     ) -> Result<(), RenderError> {
         self.check(level.is_some())?;
-        let job = self.for_scene(scene)?;
+        let mut job = self.for_scene(scene)?;
         let view = View::new(camera, job.size)?;
         let on_gpu = matches!(job.renderer, Renderer::Gpu(_));
         let t = Instant::now();
@@ -244,15 +247,17 @@ impl RenderJob {
             None => None,
         };
         if let (Some(ctx), Some(g), Some(l), Renderer::Gpu(mode)) =
-            (&ctx, &mut gpu, level, &job.renderer)
+            (&ctx, &mut gpu, level, &mut job.renderer)
+            && let Some(note) = g.level_for_mode_or_planes(ctx, l, mode)?
         {
-            g.level_for_mode(ctx, l, mode)?;
+            tracing::warn!("{note}");
         }
         setup(&JobSetup {
             adapter: ctx
                 .as_ref()
                 .map(|c| format!("{} ({:?})", c.adapter_info.name, c.adapter_info.backend)),
             seconds: t.elapsed().as_secs_f64(),
+            mode: job.mode(),
         });
         for index in 0..job.frames {
             let time = job.time + index as f64 / job.fps;

@@ -143,4 +143,5 @@ fn portal_gates() -> visgate_runtime::gpu::GatesParams {
 
 mod blur_roulette;
 mod gpu;
+mod small_binding;
 mod twin;

@@ -370,13 +370,27 @@ impl Store<'_> {
         let mut frames: Vec<JobFrame> = Vec::new();
         let mut adapter = String::new();
         let progress = |d: u32, t: u32| (self.progress)(Step::Rows(d, t));
+        // A variant measures its own method: where its walk's tables did not fit the adapter
+        // and `run` took another walk (JobSetup::mode), it fails with the reason instead.
+        let swapped = std::cell::Cell::new(false);
         job.run(
             self.scene,
             camera,
             self.level,
-            &mut |s| adapter = s.adapter.clone().unwrap_or_default(),
+            &mut |s| {
+                adapter = s.adapter.clone().unwrap_or_default();
+                swapped.set(s.mode != job.mode());
+            },
             &progress,
             &mut |f| {
+                if swapped.get() {
+                    return Err(RenderError::Param(
+                        "the closed voxels' triangle lists do not fit this adapter's storage \
+                         binding (`visgate render` says by how much, and walks on their planes \
+                         instead: the variant gates-fast's walk)"
+                            .into(),
+                    ));
+                }
                 frames.push(f);
                 Ok(())
             },

@@ -345,6 +345,42 @@ impl GpuRenderer {
         Ok(())
     }
 
+    /// [`GpuRenderer::level_for_mode`], and where `mode` walks the closed voxels' triangles
+    /// and their lists do not go up (over the adapter's storage binding: a level of millions of
+    /// triangles on a 4 cm sight grid, on an adapter that allows 128 MiB a binding), the walk
+    /// on their planes instead (the fast setting's walk; the rest of `mode` kept): `mode`
+    /// changed so, and a note of why and what would keep the triangles. A mode that needs
+    /// neither, or a level whose planes do not go up either, fails as before.
+    pub fn level_for_mode_or_planes(
+        &mut self,
+        ctx: &GpuContext,
+        level: &GateLevel,
+        mode: &mut GpuMode,
+    ) -> Result<Option<String>, RenderError> {
+        let err = match self.level_for_mode(ctx, level, mode) {
+            Ok(()) => return Ok(None),
+            Err(e) => e,
+        };
+        let GpuMode::Gates(p) = mode else {
+            return Err(err);
+        };
+        if !(p.gates.shape == GateShape::Voxels && p.gates.triangles) {
+            return Err(err);
+        }
+        let mut planes = *p;
+        planes.gates.triangles = false;
+        planes.gates.planes = true;
+        let planes = GpuMode::Gates(planes);
+        if self.level_for_mode(ctx, level, &planes).is_err() {
+            return Err(err);
+        }
+        *mode = planes;
+        Ok(Some(format!(
+            "{err}. This render walks on the closed voxels' planes instead (the fast setting's \
+             walk; the rest of the setting kept)"
+        )))
+    }
+
     /// GPU textures, buffers and query sets the renderer's frames have made so far (a frame
     /// with the same sizes and settings as the last makes none).
     pub fn resources_created(&self) -> u64 {

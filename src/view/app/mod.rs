@@ -109,6 +109,9 @@ pub struct ViewerApp {
     /// [`ViewerApp::needs_hdr`]).
     last: Option<(Option<HdrImage>, PassTimes)>,
     error: Option<String>,
+    /// What the viewer changed of the user's settings, and why (the walk on the closed voxels'
+    /// planes where their triangle lists do not fit the adapter).
+    notice: Option<String>,
     /// Recent frame times. [Units: ms]
     history: VecDeque<f32>,
     frames: u32,
@@ -208,6 +211,7 @@ impl ViewerApp {
             texture_key: None,
             last: None,
             error: None,
+            notice: None,
             history: VecDeque::new(),
             frames: 0,
             last_view: None,
@@ -242,7 +246,7 @@ impl ViewerApp {
             return;
         };
         let mode = (m.make)(&self.settings);
-        let params = GpuParams {
+        let mut params = GpuParams {
             mode,
             g_max: self.start.g_max,
             direct: self.direct,
@@ -291,11 +295,20 @@ impl ViewerApp {
         };
         // The closed voxels' triangles go up when the walk first needs them (the box ticked,
         // or a kept view that had it).
-        if let Some(l) = &self.start.level
-            && let Err(e) = self.gpu.level_for_mode(&self.ctx, l, &params.mode)
-        {
-            self.error = Some(e.to_string());
-            return;
+        // Where they do not fit the adapter, the walk on the planes instead, the box unticked.
+        if let Some(l) = &self.start.level {
+            match (self.gpu).level_for_mode_or_planes(&self.ctx, l, &mut params.mode) {
+                Ok(None) => {}
+                Ok(Some(note)) => {
+                    self.settings.gates.gates.triangles = false;
+                    self.settings.gates.gates.planes = true;
+                    self.notice = Some(note);
+                }
+                Err(e) => {
+                    self.error = Some(e.to_string());
+                    return;
+                }
+            }
         }
         match (self.gpu).render_kept(&self.ctx, &view, input, &params, read_hdr) {
             Ok((img, times)) => {

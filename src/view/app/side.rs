@@ -80,6 +80,9 @@ impl ViewerApp {
         if let Some(w) = &self.shaders {
             crate::view::panel::shader_status(ui, w);
         }
+        if let Some(n) = &self.notice {
+            ui.colored_label(egui::Color32::YELLOW, n);
+        }
         if let Some(e) = &self.error {
             ui.colored_label(
                 egui::Color32::LIGHT_RED,
