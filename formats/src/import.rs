@@ -207,6 +207,8 @@ fn import_obj_reader(
         vec![]
     });
     let mut textures = TextureCache::new(options.load_textures);
+    // Each material's diffuse map statement: its scale and offset map the coordinates.
+    let mut maps = Vec::with_capacity(materials.len());
     for m in &materials {
         if m.emissive.is_some_and(|e| e.iter().any(|&c| c > 0.0)) {
             out.emissive.push(out.materials.len() as u32);
@@ -223,10 +225,11 @@ fn import_obj_reader(
         if m.dissolve_texture.is_some() {
             out.alpha_masked.push(out.materials.len() as u32);
         }
-        let texture = m
-            .diffuse_texture
-            .as_deref()
-            .and_then(|t| textures.load(&dir.join(t.replace('\\', "/")), &mut out));
+        // Its options (`-s`, `-o`, …) and quotes off the file (mtl_map).
+        let map = m.diffuse_texture.as_deref().map(crate::mtl_map::parse);
+        let texture = (map.as_ref())
+            .and_then(|t| textures.load(&dir.join(t.file.replace('\\', "/")), &mut out));
+        maps.push(map);
         out.materials.push(Material {
             name: m.name.clone(),
             albedo: Vec3::from(m.diffuse.unwrap_or([DEFAULT_ALBEDO; 3])),
@@ -252,12 +255,14 @@ fn import_obj_reader(
         } else {
             None
         };
+        let map = mesh.material_id.and_then(|id| maps.get(id)?.as_ref());
         let uvs = if mesh.texcoords.len() == n * 2 {
             Some(
                 mesh.texcoords
                     .chunks_exact(2)
+                    .map(|c| map.map_or(Vec2::new(c[0], c[1]), |m| m.map(Vec2::new(c[0], c[1]))))
                     // OBJ's v runs up the image; visgate's texture rows run down.
-                    .map(|c| Vec2::new(c[0], 1.0 - c[1]))
+                    .map(|uv| Vec2::new(uv.x, 1.0 - uv.y))
                     .collect(),
             )
         } else {

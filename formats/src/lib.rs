@@ -30,6 +30,7 @@ pub mod import;
 mod import_gltf;
 pub mod load;
 pub mod mitsuba;
+pub mod mtl_map;
 pub mod placement;
 pub mod scene;
 pub mod stray;

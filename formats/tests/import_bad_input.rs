@@ -162,6 +162,49 @@ fn a_good_texture_is_decoded() {
 }
 
 #[test]
+fn a_texture_written_with_options_or_in_quotes_is_found_and_mapped() {
+    // Blender's OBJ exporter writes a scaled, moved mapping as `-s` and `-o` before the file;
+    // other tools quote a name with spaces. tobj kept the options in the file name, and the
+    // texture was "not loaded".
+    let dir = tempfile::tempdir().expect("tempdir");
+    let img = image::RgbaImage::from_pixel(2, 2, image::Rgba([10, 20, 30, 255]));
+    img.save(dir.path().join("floor tiles.png"))
+        .expect("save png");
+    write(
+        dir.path(),
+        "t.mtl",
+        b"newmtl tiled\nKd 1 1 1\nmap_Kd -o 0.5 0 0 -s 4 2 1 -bm 0.5 floor tiles.png\n\
+          newmtl quoted\nKd 1 1 1\nmap_Kd \"floor tiles.png\"\n",
+    );
+    let p = write(
+        dir.path(),
+        "t.obj",
+        b"mtllib t.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n\
+          usemtl tiled\nf 1/1 2/2 3/3\nusemtl quoted\nf 1/1 3/3 2/2\n",
+    );
+    let scene = load(&p).expect("loads");
+    assert_eq!(
+        scene.report.textures_failed, 0,
+        "{:?}",
+        scene.report.warnings
+    );
+    assert!(scene.materials.iter().all(|m| m.texture == Some(0)));
+    // uv × (4, 2) + (0.5, 0), v then flipped: (1, 0) → (4.5, 1), (0, 1) → (0.5, −1).
+    let tiled = &scene.meshes[0];
+    // The vertex at x = 1, and the other one off the origin (the bare file is read Z up).
+    let uv = |m: &visgate_formats::Mesh, x: f32| {
+        let i = (m.positions.iter())
+            .position(|&q| q.x == x && q.length() > 0.0)
+            .expect("vertex");
+        m.uvs[i]
+    };
+    assert_eq!(uv(tiled, 1.0), glam::Vec2::new(4.5, 1.0));
+    assert_eq!(uv(tiled, 0.0), glam::Vec2::new(0.5, -1.0));
+    // No options: the coordinates as the file has them.
+    assert_eq!(uv(&scene.meshes[1], 1.0), glam::Vec2::new(1.0, 1.0));
+}
+
+#[test]
 fn a_missing_material_library_is_a_warning() {
     let dir = tempfile::tempdir().expect("tempdir");
     let p = write(
