@@ -22,6 +22,11 @@ pub const BARE_LEVEL_MAX_M: f64 = 1000.0;
 /// [Units: m]
 pub const BARE_LEVEL_NOTE_M: f64 = 200.0;
 
+/// A bare mesh read in metres and shorter than this gets a note that it may be modelled in
+/// larger units or scaled down on export (a two-room level of 8 m written as 0.08): no room is
+/// this small. [Units: m]
+pub const BARE_LEVEL_SMALL_M: f64 = 1.0;
+
 /// Metres per unit of a bare mesh (no scene file, so no stated units) whose longest extent is
 /// `longest` of its units: metres, unless that makes a level longer than [`BARE_LEVEL_MAX_M`];
 /// then centimetres (Crytek Sponza's OBJ and GLB, Unreal, Maya and 3ds Max exports), or
@@ -166,6 +171,20 @@ fn metres_note(path: &Path, longest: f64) -> String {
     )
 }
 
+/// What a user reads when a bare mesh read in metres is shorter than [`BARE_LEVEL_SMALL_M`].
+fn small_note(path: &Path, longest: f64) -> String {
+    format!(
+        "{}: a bare mesh states no units; read in metres, its longest side makes a {longest:.3} \
+         m level, smaller than any room. If it was scaled down on export or is modelled in \
+         larger units (× 100: a {:.1} m level; × 10, decimetres: {:.2} m), pass \
+         --metres-per-unit 100 or 10, or name the mesh in a scene TOML with `metres_per_unit` \
+         (README, Scenes)",
+        path.display(),
+        longest * 100.0,
+        longest * 10.0,
+    )
+}
+
 /// What a user reads when the up axis of a bare OBJ is in doubt or Z.
 fn up_warning(path: &Path, why: &str) -> String {
     format!(
@@ -194,6 +213,8 @@ fn read_bare(
                     notes.push(units_warning(path, longest, desc.metres_per_unit));
                 } else if longest > BARE_LEVEL_NOTE_M {
                     notes.push(metres_note(path, longest));
+                } else if longest < BARE_LEVEL_SMALL_M {
+                    notes.push(small_note(path, longest));
                 }
             }
         }

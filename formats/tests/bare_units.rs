@@ -1,7 +1,7 @@
 //! A bare mesh states no units: it is read in metres unless that would make a level longer
 //! than any indoor level, then in centimetres or millimetres, with a warning (and in metres
-//! with a note where that makes it longer than most); a scene TOML's `metres_per_unit`
-//! chooses.
+//! with a note where that makes it longer than most, or smaller than any room); a scene
+//! TOML's `metres_per_unit` chooses.
 
 use std::path::{Path, PathBuf};
 
@@ -66,6 +66,19 @@ fn a_bare_mesh_in_centimetres_is_read_as_such_and_says_so() {
         "{w}"
     );
     assert!(w.contains("--metres-per-unit 0.01"), "{w}");
+    // 0.08 units, read in metres: smaller than any room (a level scaled down on export); a
+    // note says what × 100 and × 10 would make it.
+    let tiny = dir.path().join("small.obj");
+    let text = "v 0 0 0\nv 0.08 0 0\nv 0.08 0.03 0\nv 0 0.03 0.04\nf 1 2 3\nf 1 3 4\n";
+    std::fs::write(&tiny, text).expect("write");
+    let small = Scene::load(&tiny, &options).expect("load");
+    let w = small.report.warnings.join("\n");
+    assert!(
+        w.contains("small.obj")
+            && w.contains("makes a 0.080 m level")
+            && w.contains("× 100: a 8.0 m level"),
+        "{w}"
+    );
     // A scene TOML's units are the user's: never guessed.
     let toml = dir.path().join("s.toml");
     std::fs::write(

@@ -168,7 +168,7 @@ impl BakeReport {
         );
         let v = self.grid.voxel_size_m;
         s += &format!(
-            "partition: {}; gaps under {:.3} m left out of it\n",
+            "partition: {}; gaps under {} m left out of it\n",
             match self.params.separate_partition_voxel(v) {
                 Some(pv) if pv > v => format!(
                     "made on a {pv:.3} m grid (its topology below), each {v:.4} m voxel given \
@@ -180,7 +180,7 @@ impl BakeReport {
                 ),
                 None => "made on the level's grid".to_string(),
             },
-            self.params.min_gap_m.unwrap_or(0.0)
+            three_figures(self.params.min_gap_m.unwrap_or(0.0))
         );
         let (e, k) = (&self.empty_topology, &self.skeleton_topology);
         s += &format!(
@@ -221,4 +221,15 @@ impl BakeReport {
             c.counts["bytes"].as_f64().unwrap_or(0.0) / 1e6
         )
     }
+}
+
+/// `x` with three decimals, or three significant figures where it is under 0.1 (a level
+/// modelled small: gaps under 0.00015 m read "0.000").
+fn three_figures(x: f32) -> String {
+    let decimals = if x > 0.0 && x < 0.1 {
+        (2 - x.log10().floor() as i32).clamp(3, 9) as usize
+    } else {
+        3
+    };
+    format!("{x:.decimals$}")
 }
