@@ -282,18 +282,19 @@ fn primitive(
     };
     // Floats through the crate's readers; quantized integers (KHR_mesh_quantization) read here.
     let floats = |a: &gltf::Accessor, uv| gltf_quantized::crate_reads(a, uv);
-    let positions: Vec<[f32; 3]> = match reader.read_positions() {
-        Some(it) if floats(&pos, false) => it.collect(),
-        _ => gltf_quantized::read(&pos, file.buffers).map_err(quantized)?,
+    // The crate's readers asked only for what they read: a debug build asserts the type.
+    let positions: Vec<[f32; 3]> = match floats(&pos, false) {
+        true => (reader.read_positions().into_iter().flatten()).collect(),
+        false => gltf_quantized::read(&pos, file.buffers).map_err(quantized)?,
     };
     let normal_m = world.inverse().transpose();
     let positions: Vec<Vec3> = (positions.into_iter())
         .map(|p| world.transform_point3(Vec3::from(p)))
         .collect();
-    let normals = match (attribute(gltf::Semantic::Normals), reader.read_normals()) {
-        (Some(a), Some(it)) if floats(&a, false) => Some(it.collect()),
-        (Some(a), _) => Some(gltf_quantized::read::<3>(&a, file.buffers).map_err(quantized)?),
-        (None, _) => None,
+    let normals = match attribute(gltf::Semantic::Normals) {
+        Some(a) if floats(&a, false) => reader.read_normals().map(Iterator::collect),
+        Some(a) => Some(gltf_quantized::read::<3>(&a, file.buffers).map_err(quantized)?),
+        None => None,
     };
     let normals = normals.map(|n: Vec<[f32; 3]>| {
         (n.into_iter())
@@ -304,13 +305,10 @@ fn primitive(
             })
             .collect::<Vec<_>>()
     });
-    let uvs = match (
-        attribute(gltf::Semantic::TexCoords(0)),
-        reader.read_tex_coords(0),
-    ) {
-        (Some(a), Some(it)) if floats(&a, true) => Some(it.into_f32().collect()),
-        (Some(a), _) => Some(gltf_quantized::read::<2>(&a, file.buffers).map_err(quantized)?),
-        (None, _) => None,
+    let uvs = match attribute(gltf::Semantic::TexCoords(0)) {
+        Some(a) if floats(&a, true) => reader.read_tex_coords(0).map(|it| it.into_f32().collect()),
+        Some(a) => Some(gltf_quantized::read::<2>(&a, file.buffers).map_err(quantized)?),
+        None => None,
     };
     let uvs = uvs.map(|uv: Vec<[f32; 2]>| {
         let t = placed.uv_transform.unwrap_or(Mat3::IDENTITY);
