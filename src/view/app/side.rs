@@ -24,6 +24,10 @@ impl ViewerApp {
                 }
             });
         crate::view::panel::method_settings(ui, self.start.mode, &mut self.settings);
+        // What the viewer changed of these settings, under them, where it is seen.
+        if let Some(n) = &self.notice {
+            ui.colored_label(egui::Color32::YELLOW, n);
+        }
         crate::view::panel::direct_settings(ui, &mut self.direct);
         ui.add(
             egui::Slider::new(&mut self.vpl_count, 1..=16384)
@@ -79,9 +83,6 @@ impl ViewerApp {
         ui.separator();
         if let Some(w) = &self.shaders {
             crate::view::panel::shader_status(ui, w);
-        }
-        if let Some(n) = &self.notice {
-            ui.colored_label(egui::Color32::YELLOW, n);
         }
         if let Some(e) = &self.error {
             ui.colored_label(
