@@ -1,8 +1,21 @@
-//! Geometric predicates that the bake and the runtime both decide with, so that they agree:
+//! Geometric predicates that the bake and the runtime (and the scenes) decide with, so that
+//! they agree: whether a level is flat (the bake refuses it, a bare one is seen from off it);
 //! which voxels a triangle touches (the bake closes them; the runtime lists the triangles in
 //! them for the voxel walk).
 
 use glam::DVec3;
+
+/// How thin bounds may be along one axis, as a share of their longest side, before they are
+/// flat: a float's rounding of a plane (one ground, one wall), not a thin level (a 1 km ground
+/// with a metre of relief is 1e-3). [Units: ratio]
+pub const FLAT_SHARE: f64 = 1e-6;
+
+/// The axis (0 x, 1 y, 2 z) along which bounds of size `extent` are flat ([`FLAT_SHARE`]),
+/// where one is; none for a point (no longest side).
+pub fn flat_axis(extent: DVec3) -> Option<usize> {
+    let longest = extent.max_element();
+    (longest > 0.0 && extent.min_element() <= longest * FLAT_SHARE).then(|| extent.min_position())
+}
 
 /// Whether triangle `v` touches the closed axis-aligned box of centre `c` and half-size `h`
 /// (separating axis theorem, Akenine-Möller 2001: 3 box normals, the triangle normal, and the

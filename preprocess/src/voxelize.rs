@@ -104,17 +104,10 @@ pub fn grid_for(
     })
 }
 
-/// How thin a level's bounds may be along one axis, as a share of their longest side, before
-/// it counts as flat: a float's rounding of a plane, not a thin level (a 1 km ground with a
-/// metre of relief is 1e-3, and bakes or says what voxel would).
-const FLAT_SHARE: f64 = 1e-6;
-
-/// The axis along which bounds of this extent are flat ([`FLAT_SHARE`]), where one is; none
-/// for a point (no longest side), which the voxel size's check names.
+/// The axis along which bounds of this extent are flat (`visgate_formats::geom::flat_axis`),
+/// named.
 fn flat_axis(extent: DVec3) -> Option<char> {
-    let longest = extent.max_element();
-    (longest > 0.0 && extent.min_element() <= longest * FLAT_SHARE)
-        .then(|| ['x', 'y', 'z'][extent.min_position()])
+    visgate_formats::geom::flat_axis(extent).map(|a| ['x', 'y', 'z'][a])
 }
 
 /// Voxels across the level's shortest side that [`all_solid`] suggests. [Units: voxels]

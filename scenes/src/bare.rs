@@ -171,21 +171,15 @@ pub fn light_a_bare_scene(
     ))
 }
 
-/// How thin bounds may be along an axis, as a share of their longest side, to be a plane (as
-/// the bake's voxelizer has it).
-const FLAT_SHARE: f32 = 1e-6;
-
-/// Where bounds `lo`–`hi` are flat along an axis, an eye to see the plane from and its centre:
+/// Where bounds `lo`–`hi` are flat along an axis (`visgate_formats::geom::flat_axis`, as the
+/// bake refuses them), an eye to see the plane from and its centre:
 /// on the side the most triangle area faces, half the plane's longest side off it; off a
 /// ground (flat along y) also half that back along −z, looking down at 45° (straight down
 /// would leave the camera's up, +y, along its view).
 fn flat_view(scene: &Scene, lo: Vec3, hi: Vec3) -> Option<(Vec3, Vec3)> {
     let extent = hi - lo;
     let longest = extent.max_element();
-    if !(longest > 0.0 && extent.min_element() <= longest * FLAT_SHARE) {
-        return None;
-    }
-    let axis = Vec3::AXES[extent.min_position()];
+    let axis = Vec3::AXES[visgate_formats::geom::flat_axis(extent.as_dvec3())?];
     let facing: f32 = scene
         .meshes
         .iter()
