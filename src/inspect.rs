@@ -26,6 +26,8 @@ struct SceneSummary {
     textured_materials: usize,
     textures: usize,
     textures_failed: u64,
+    /// Filtered down to `MAX_TEXTURE_TEXELS` on their longest side at load.
+    textures_fitted: u64,
     point_lights: usize,
     spot_lights: usize,
     lights: Vec<Light>,
@@ -106,6 +108,7 @@ fn summarise(scene: &Scene) -> SceneSummary {
             .count(),
         textures: scene.textures.len(),
         textures_failed: scene.report.textures_failed,
+        textures_fitted: scene.report.textures_fitted,
         point_lights: scene
             .lights
             .iter()
@@ -177,8 +180,18 @@ fn print_scene(s: &SceneSummary) {
     );
     println!("vertices    {}", s.vertices);
     println!(
-        "materials   {} ({} textured); textures {} loaded, {} failed",
-        s.materials, s.textured_materials, s.textures, s.textures_failed
+        "materials   {} ({} textured); textures {} loaded, {} failed{}",
+        s.materials,
+        s.textured_materials,
+        s.textures,
+        s.textures_failed,
+        match s.textures_fitted {
+            0 => String::new(),
+            n => format!(
+                ", {n} filtered down to {} texels on their longest side",
+                visgate_formats::scene::MAX_TEXTURE_TEXELS
+            ),
+        }
     );
     println!(
         "lights      {} point, {} spot",

@@ -89,6 +89,8 @@ pub struct ImportedModel {
     /// The materials cut out by an alpha mask (an MTL's `map_d`; a glTF's alphaMode MASK, or
     /// BLEND with a base colour texture and an opaque factor): drawn whole and opaque.
     pub alpha_masked: Vec<u32>,
+    /// Textures filtered down to `scene::MAX_TEXTURE_TEXELS` at import.
+    pub textures_fitted: u64,
 }
 
 /// Opacity under which a see-through material's surfaces are left out of the level (glass):
@@ -516,12 +518,11 @@ impl TextureCache {
         let t = match image::open(path) {
             Ok(img) => {
                 let rgba = img.to_rgba8();
-                out.textures.push(Texture {
-                    name: path.display().to_string(),
-                    width: rgba.width(),
-                    height: rgba.height(),
-                    rgba8: rgba.into_raw(),
-                });
+                let name = path.display().to_string();
+                let (w, h) = (rgba.width(), rgba.height());
+                let (texture, fitted) = Texture::fitted(name, w, h, rgba.into_raw());
+                out.textures_fitted += u64::from(fitted);
+                out.textures.push(texture);
                 Some(out.textures.len() as u32 - 1)
             }
             Err(e) => {

@@ -157,12 +157,9 @@ fn textures(
             .and_then(|d| gltf_image_rgba8(&d).map(|px| (d.width, d.height, px)))
         {
             Ok((width, height, rgba8)) => {
-                out.textures.push(Texture {
-                    name,
-                    width,
-                    height,
-                    rgba8,
-                });
+                let (texture, fitted) = Texture::fitted(name, width, height, rgba8);
+                out.textures_fitted += u64::from(fitted);
+                out.textures.push(texture);
                 image_texture.push(Some(out.textures.len() as u32 - 1));
             }
             Err(e) => {

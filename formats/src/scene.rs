@@ -34,6 +34,46 @@ pub struct Texture {
     pub rgba8: Vec<u8>,
 }
 
+/// The longest side a texture keeps at import: larger ones are filtered down to it, as the GPU
+/// draws them (runtime::gpu::geometry's texture array), so that the CPU reference samples what
+/// the GPU methods do and a level of 4K textures does not hold gigabytes of texels (one 4096²
+/// texture: 64 MiB; at 1024², 4 MiB). [Units: texels]
+pub const MAX_TEXTURE_TEXELS: u32 = 1024;
+
+impl Texture {
+    /// A texture of `rgba8` (`width × height × 4` bytes), filtered (each texel the mean of the
+    /// texels it covers, in their sRGB values: `image`'s thumbnail, where its triangle filter
+    /// took twenty 4K textures' load from 2.9 to 5.6 s) down to [`MAX_TEXTURE_TEXELS`] on its longest side where it is larger, its
+    /// aspect ratio kept; and whether it was.
+    pub fn fitted(name: String, width: u32, height: u32, rgba8: Vec<u8>) -> (Texture, bool) {
+        let longest = width.max(height);
+        let whole = rgba8.len() == width as usize * height as usize * 4;
+        if longest <= MAX_TEXTURE_TEXELS || !whole {
+            let t = Texture {
+                name,
+                width,
+                height,
+                rgba8,
+            };
+            return (t, false);
+        }
+        let image = image::RgbaImage::from_raw(width, height, rgba8)
+            .expect("a buffer of width × height × 4 bytes is an image");
+        let scale = f64::from(MAX_TEXTURE_TEXELS) / f64::from(longest);
+        let fit =
+            |side: u32| ((f64::from(side) * scale).round() as u32).clamp(1, MAX_TEXTURE_TEXELS);
+        let (w, h) = (fit(width), fit(height));
+        let small = image::imageops::thumbnail(&image, w, h);
+        let t = Texture {
+            name,
+            width: w,
+            height: h,
+            rgba8: small.into_raw(),
+        };
+        (t, true)
+    }
+}
+
 /// One triangle mesh in world space.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Mesh {
@@ -115,6 +155,8 @@ pub struct ImportReport {
     pub degenerate_dropped: u64,
     /// Textures that failed to load (their materials fall back to the albedo).
     pub textures_failed: u64,
+    /// Textures larger than [`MAX_TEXTURE_TEXELS`] filtered down to it ([`Texture::fitted`]).
+    pub textures_fitted: u64,
     /// Every warning, in order.
     pub warnings: Vec<String>,
     /// Indices of the materials that glow (an OBJ's `Ke`, a glTF's emissive factor): no light

@@ -162,6 +162,33 @@ fn a_good_texture_is_decoded() {
 }
 
 #[test]
+fn a_texture_larger_than_the_gpu_draws_is_filtered_down_at_load() {
+    // A 2048 × 1024 texture, its left half black and white stripes a texel wide, its right
+    // half white: 1024 × 512 after the load, as the GPU's texture array draws it, the stripes
+    // averaged to grey (filtered, not sampled) and the white kept.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let img = image::RgbaImage::from_fn(2048, 1024, |x, _| {
+        let v = if x < 1024 && x % 2 == 0 { 0 } else { 255 };
+        image::Rgba([v, v, v, 255])
+    });
+    img.save(dir.path().join("big.png")).expect("save png");
+    write(dir.path(), "t.mtl", b"newmtl m\nKd 1 1 1\nmap_Kd big.png\n");
+    let p = write(dir.path(), "t.obj", b"mtllib t.mtl\nusemtl m\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n");
+    let scene = load(&p).expect("loads");
+    let t = &scene.textures[0];
+    assert_eq!(
+        (t.width, t.height, t.rgba8.len()),
+        (1024, 512, 1024 * 512 * 4)
+    );
+    assert_eq!(scene.report.textures_fitted, 1);
+    let at = |x: usize| t.rgba8[4 * (100 * 1024 + x)];
+    for x in [0, 300, 511] {
+        assert!((126..=129).contains(&at(x)), "{x}: {}", at(x));
+    }
+    assert_eq!((at(512), at(1023)), (255, 255));
+}
+
+#[test]
 fn a_texture_written_with_options_or_in_quotes_is_found_and_mapped() {
     // Blender's OBJ exporter writes a scaled, moved mapping as `-s` and `-o` before the file;
     // other tools quote a name with spaces. tobj kept the options in the file name, and the

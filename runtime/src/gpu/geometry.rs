@@ -114,8 +114,9 @@ pub fn positions(stride: u64) -> wgpu::VertexBufferLayout<'static> {
 pub const VERTEX_STRIDE: u64 = 48;
 /// Floats per vertex.
 const VERTEX_FLOATS: usize = 12;
-/// Textures are resized (nearest) to one layer size, at most this. [Units: texels]
-pub const MAX_TEXTURE_SIZE: u32 = 1024;
+/// Textures are resized (nearest) to one layer size, at most this: the size the import filters
+/// larger ones down to. [Units: texels]
+pub const MAX_TEXTURE_SIZE: u32 = visgate_formats::scene::MAX_TEXTURE_TEXELS;
 
 /// A scene's triangles on the GPU: for the G-buffer and shadow maps (position, normal,
 /// albedo, texture coordinates), and subdivided for paraboloid maps.
