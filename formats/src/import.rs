@@ -11,6 +11,7 @@ use std::io::BufRead;
 use std::path::{Path, PathBuf};
 
 use glam::{Vec2, Vec3};
+use rayon::prelude::*;
 
 use crate::error::SceneError;
 pub use crate::import_gltf::import_gltf;
@@ -211,6 +212,10 @@ fn import_obj_reader(
     let mut textures = TextureCache::new(options.load_textures);
     // Each material's diffuse map statement: its scale and offset map the coordinates.
     let mut maps = Vec::with_capacity(materials.len());
+    let files = (materials.iter())
+        .filter_map(|m| m.diffuse_texture.as_deref())
+        .map(|t| dir.join(crate::mtl_map::parse(t).file.replace('\\', "/")));
+    textures.decode(files.collect());
     for m in &materials {
         if m.emissive.is_some_and(|e| e.iter().any(|&c| c > 0.0)) {
             out.emissive.push(out.materials.len() as u32);
@@ -494,9 +499,26 @@ fn say_alpha_masked(path: &Path, out: &mut ImportedModel) {
     ));
 }
 
-/// Decodes each texture file once.
+/// A texture decoded and fitted (`Texture::fitted`: whether it was filtered down), or why not.
+pub(crate) type Decoded = Result<(Texture, bool), String>;
+
+/// The texture file at `path`, decoded and fitted.
+fn decode_file(path: &Path) -> Decoded {
+    let img = image::open(path).map_err(|e| e.to_string())?;
+    let rgba = img.to_rgba8();
+    let (w, h) = (rgba.width(), rgba.height());
+    Ok(Texture::fitted(
+        path.display().to_string(),
+        w,
+        h,
+        rgba.into_raw(),
+    ))
+}
+
+/// Decodes each texture file once, all of them in parallel first ([`TextureCache::decode`]).
 struct TextureCache {
     enabled: bool,
+    decoded: HashMap<PathBuf, Decoded>,
     loaded: HashMap<PathBuf, Option<u32>>,
 }
 
@@ -504,8 +526,25 @@ impl TextureCache {
     fn new(enabled: bool) -> Self {
         TextureCache {
             enabled,
+            decoded: HashMap::new(),
             loaded: HashMap::new(),
         }
+    }
+
+    /// Decodes `paths` (each once) in parallel: a level's textures, which one at a time took
+    /// most of its load (twenty 4K textures: 2.9 s on 2 cores).
+    fn decode(&mut self, mut paths: Vec<PathBuf>) {
+        if !self.enabled {
+            return;
+        }
+        paths.sort();
+        paths.dedup();
+        self.decoded = (paths.into_par_iter())
+            .map(|p| {
+                let decoded = decode_file(&p);
+                (p, decoded)
+            })
+            .collect();
     }
 
     fn load(&mut self, path: &Path, out: &mut ImportedModel) -> Option<u32> {
@@ -515,12 +554,9 @@ impl TextureCache {
         if let Some(&t) = self.loaded.get(path) {
             return t;
         }
-        let t = match image::open(path) {
-            Ok(img) => {
-                let rgba = img.to_rgba8();
-                let name = path.display().to_string();
-                let (w, h) = (rgba.width(), rgba.height());
-                let (texture, fitted) = Texture::fitted(name, w, h, rgba.into_raw());
+        let decoded = (self.decoded.remove(path)).unwrap_or_else(|| decode_file(path));
+        let t = match decoded {
+            Ok((texture, fitted)) => {
                 out.textures_fitted += u64::from(fitted);
                 out.textures.push(texture);
                 Some(out.textures.len() as u32 - 1)

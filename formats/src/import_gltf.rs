@@ -5,12 +5,13 @@
 use std::path::Path;
 
 use glam::{Mat3, Mat4, Vec2, Vec3};
+use rayon::prelude::*;
 
 use crate::error::SceneError;
 use crate::gltf_quantized::{self, QUANTIZATION};
 use crate::import::{
-    DEFAULT_ALBEDO, ImportOptions, ImportedModel, RawMesh, SEE_THROUGH_OPACITY, build_mesh,
-    finish_warnings,
+    DEFAULT_ALBEDO, Decoded, ImportOptions, ImportedModel, RawMesh, SEE_THROUGH_OPACITY,
+    build_mesh, finish_warnings,
 };
 use crate::scene::{Material, Texture};
 
@@ -141,23 +142,29 @@ fn textures(
     out: &mut ImportedModel,
 ) -> Vec<Option<u32>> {
     let mut image_texture: Vec<Option<u32>> = Vec::new();
-    for image in document.images() {
-        if !options.load_textures {
-            image_texture.push(None);
-            continue;
-        }
-        let name = match image.source() {
-            gltf::image::Source::Uri { uri, .. } => uri.to_string(),
-            gltf::image::Source::View { .. } => {
-                format!("image {} (embedded)", image.index())
-            }
-        };
-        match gltf::image::Data::from_source(image.source(), Some(base), file.buffers)
-            .map_err(|e| e.to_string())
-            .and_then(|d| gltf_image_rgba8(&d).map(|px| (d.width, d.height, px)))
-        {
-            Ok((width, height, rgba8)) => {
-                let (texture, fitted) = Texture::fitted(name, width, height, rgba8);
+    if !options.load_textures {
+        return document.images().map(|_| None).collect();
+    }
+    // Decoded and fitted in parallel, as an OBJ's (import.rs's TextureCache::decode).
+    let images: Vec<gltf::Image> = document.images().collect();
+    let decoded: Vec<(String, Decoded)> = (images.par_iter())
+        .map(|image| {
+            let name = match image.source() {
+                gltf::image::Source::Uri { uri, .. } => uri.to_string(),
+                gltf::image::Source::View { .. } => {
+                    format!("image {} (embedded)", image.index())
+                }
+            };
+            let decoded = gltf::image::Data::from_source(image.source(), Some(base), file.buffers)
+                .map_err(|e| e.to_string())
+                .and_then(|d| gltf_image_rgba8(&d).map(|px| (d.width, d.height, px)))
+                .map(|(w, h, px)| Texture::fitted(name.clone(), w, h, px));
+            (name, decoded)
+        })
+        .collect();
+    for (name, decoded) in decoded {
+        match decoded {
+            Ok((texture, fitted)) => {
                 out.textures_fitted += u64::from(fitted);
                 out.textures.push(texture);
                 image_texture.push(Some(out.textures.len() as u32 - 1));
