@@ -632,3 +632,75 @@ fn a_bare_mesh_is_looked_at_from_one_place_with_a_level_or_without() {
     assert_eq!(none_without, none_with);
     assert_eq!(render("gates", true).0, without);
 }
+
+#[test]
+fn where_the_triangle_lists_overflow_the_binding_render_walks_the_planes_and_compare_says_why() {
+    // VISGATE_MAX_BINDING_BYTES: an adapter whose storage binding holds the two rooms' open
+    // voxels (7.0 MB) and planes but not their triangle lists (11.5 MB), as lavapipe's 128 MiB
+    // held none of a 4.2 M-triangle level's 337 MB.
+    let (dir, level, out) = two_rooms_level();
+    let capped = |args: &[&str]| {
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_visgate"))
+            .args(args)
+            .env("RUST_LOG", "warn")
+            .env("VISGATE_MAX_BINDING_BYTES", "9000000")
+            .output()
+            .expect("runs visgate");
+        assert!(o.status.success(), "{}", stderr(&o));
+        o
+    };
+    let o = capped(&gates_render(&level, &out));
+    let (said, report) = (stderr(&o), stdout(&o));
+    assert!(
+        said.contains("the closed voxels' triangle lists")
+            && said.contains("more than the adapter's storage binding limit 9000000")
+            && said.contains("walks on the closed voxels' planes instead"),
+        "{said}"
+    );
+    assert!(
+        report.contains("gates (voxel walk, 8×8") && !report.contains("+ triangles"),
+        "{report}"
+    );
+    // Uncapped, the default walks the triangles, and says nothing of it.
+    let o = succeeded(&gates_render(&level, &out));
+    assert!(
+        stdout(&o).contains("gates (voxel walk + triangles"),
+        "{}",
+        stdout(&o)
+    );
+    assert!(!stderr(&o).contains("planes instead"), "{}", stderr(&o));
+    // `compare` measures the method it names: the default fails with the reason, the fast
+    // setting (the planes' walk) renders.
+    let cmp = dir.path().join("cmp");
+    let cmp = cmp.to_str().expect("utf-8");
+    capped(&[
+        "compare",
+        "builtin:two-rooms",
+        "--level",
+        &level,
+        "--modes",
+        "gates,gates-fast",
+        "--vpls",
+        "64",
+        "--size",
+        "16x12",
+        "--spp",
+        "1",
+        "--out",
+        cmp,
+    ]);
+    let text = std::fs::read_to_string(std::path::Path::new(cmp).join("report.json"));
+    let report: serde_json::Value = serde_json::from_str(&text.expect("report")).expect("json");
+    let failures = report["failures"].as_array().expect("failures");
+    assert!(
+        !failures.is_empty()
+            && failures.iter().all(|f| f["mode"] == "gates"
+                && f["error"]
+                    .as_str()
+                    .is_some_and(|e| e.contains("gates-fast's walk"))),
+        "{failures:?}"
+    );
+    let rows = report["rows"].as_array().expect("rows");
+    assert!(rows.iter().any(|r| r["mode"] == "gates-fast"), "{rows:?}");
+    assert!(!rows.iter().any(|r| r["mode"] == "gates"), "{rows:?}");
+}

@@ -71,7 +71,12 @@ impl GpuContext {
     /// buffer size), timestamp queries where there are. A window that opens its own device
     /// (eframe) asks with this too, so that the viewer renders on the window's device.
     pub fn device_descriptor(adapter: &wgpu::Adapter) -> wgpu::DeviceDescriptor<'static> {
-        let have = adapter.limits();
+        let mut have = adapter.limits();
+        // An adapter's binding as a smaller one has it (an integrated GPU, WebGPU's 128 MiB),
+        // to see how a level fares there: `VISGATE_MAX_BINDING_BYTES`.
+        if let Some(bytes) = binding_cap() {
+            have.max_storage_buffer_binding_size = have.max_storage_buffer_binding_size.min(bytes);
+        }
         let limits = wgpu::Limits {
             max_texture_array_layers: have.max_texture_array_layers,
             // LightCluster's shadow atlas (6 faces a cluster in one texture).
@@ -115,6 +120,19 @@ impl GpuContext {
     pub fn wait(&self) {
         let _ = self.device.poll(wgpu::PollType::wait_indefinitely());
     }
+}
+
+/// `VISGATE_MAX_BINDING_BYTES`: the storage binding visgate asks of any adapter, at most (a
+/// number of bytes, at least 1 MiB); `None` where it is unset or not such a number.
+fn binding_cap() -> Option<u64> {
+    let text = std::env::var("VISGATE_MAX_BINDING_BYTES").ok()?;
+    let bytes = text.trim().parse::<u64>().ok().filter(|&b| b >= 1 << 20);
+    if bytes.is_none() {
+        tracing::warn!(
+            "VISGATE_MAX_BINDING_BYTES={text} is not a number of bytes ≥ 1048576: ignored"
+        );
+    }
+    bytes
 }
 
 /// Runs `f` with the device's validation and out-of-memory errors captured: a GPU error comes
