@@ -32,8 +32,9 @@ pub enum SceneError {
     },
     /// The file's extension names no format visgate imports.
     #[error(
-        "{}: unknown file type; visgate reads scene descriptions (.toml) and meshes (.obj, .gltf, .glb)",
-        file.display()
+        "{}: unknown file type; visgate reads scene descriptions (.toml) and meshes (.obj, .gltf, .glb){}",
+        file.display(),
+        convert_hint(file)
     )]
     UnknownFileType {
         /// The file.
@@ -208,4 +209,29 @@ pub enum VgateError {
         /// Hash of the scene given now.
         scene: String,
     },
+}
+
+/// How to turn a mesh format visgate does not read into one it does, for the formats levels
+/// come in; empty for another extension.
+fn convert_hint(file: &std::path::Path) -> &'static str {
+    let ext = file
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match ext.as_deref() {
+        Some("fbx") => {
+            ". Convert it to glTF: import it into Blender (File > Import > FBX) and export glTF \
+             2.0 (.glb), or run FBX2glTF; Unreal and Unity export glTF with their glTF exporters"
+        }
+        Some("blend") => ". In Blender: File > Export > glTF 2.0 (.glb), or Wavefront (.obj)",
+        Some(
+            "dae" | "3ds" | "max" | "ply" | "stl" | "usd" | "usda" | "usdc" | "usdz" | "x3d"
+            | "abc",
+        ) => ". Import it into Blender and export glTF 2.0 (.glb) or Wavefront (.obj)",
+        Some("bsp" | "map") => {
+            ". A Quake-style map: export its world geometry to OBJ first (TrenchBroom: File > \
+             Export > Wavefront OBJ; a compiled .bsp, with a BSP-to-OBJ converter)"
+        }
+        _ => "",
+    }
 }
