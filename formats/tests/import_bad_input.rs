@@ -47,16 +47,23 @@ fn unknown_extension_is_an_error_listing_what_is_read() {
     let e = load(&p).expect_err("unknown type").to_string();
     assert!(e.contains(".obj") && e.contains(".glb"), "{e}");
     // The formats levels come in are told how to become one visgate reads.
-    assert!(e.contains("Convert it to glTF") && e.contains("FBX2glTF"), "{e}");
+    assert!(
+        e.contains("Convert it to glTF") && e.contains("FBX2glTF"),
+        "{e}"
+    );
     for (name, hint) in [
         ("level.BLEND", "File > Export > glTF 2.0"),
         ("level.dae", "Import it into Blender"),
         ("e1m1.bsp", "BSP-to-OBJ"),
     ] {
-        let e = load(&write(dir.path(), name, b"x")).expect_err(name).to_string();
+        let e = load(&write(dir.path(), name, b"x"))
+            .expect_err(name)
+            .to_string();
         assert!(e.contains(hint), "{name}: {e}");
     }
-    let e = load(&write(dir.path(), "notes.txt", b"x")).expect_err("txt").to_string();
+    let e = load(&write(dir.path(), "notes.txt", b"x"))
+        .expect_err("txt")
+        .to_string();
     assert!(e.ends_with("(.obj, .gltf, .glb)"), "{e}");
 }
 
