@@ -145,7 +145,7 @@ fn textures(
     if !options.load_textures {
         return document.images().map(|_| None).collect();
     }
-    // Decoded and fitted in parallel, as an OBJ's (import.rs's TextureCache::decode).
+    // Decoded and fitted in parallel, as an OBJ's (import.rs's load_textures).
     let images: Vec<gltf::Image> = document.images().collect();
     let decoded: Vec<(String, Decoded)> = (images.par_iter())
         .map(|image| {
@@ -164,11 +164,7 @@ fn textures(
         .collect();
     for (name, decoded) in decoded {
         match decoded {
-            Ok((texture, fitted)) => {
-                out.textures_fitted += u64::from(fitted);
-                out.textures.push(texture);
-                image_texture.push(Some(out.textures.len() as u32 - 1));
-            }
+            Ok(texture) => image_texture.push(Some(out.keep_texture(texture))),
             Err(e) => {
                 out.textures_failed += 1;
                 out.warnings.push(format!(
