@@ -222,20 +222,13 @@ fn succeeded(args: &[&str]) -> std::process::Output {
     o
 }
 
-/// `visgate render builtin:two-rooms --mode gates` at 64 VPLs and 16×12 with `level`, to `out`.
+/// The small renders' settings: 64 VPLs, 16×12, one sample a pixel.
+const SMALL: [&str; 6] = ["--vpls", "64", "--size", "16x12", "--spp", "1"];
+
+/// `visgate render builtin:two-rooms --mode gates` at [`SMALL`] with `level`, to `out`.
 fn gates_render<'a>(level: &'a str, out: &'a str) -> Vec<&'a str> {
-    let mut a = vec![
-        "render",
-        "builtin:two-rooms",
-        "--mode",
-        "gates",
-        "--vpls",
-        "64",
-        "--size",
-        "16x12",
-        "--spp",
-        "1",
-    ];
+    let mut a = vec!["render", "builtin:two-rooms", "--mode", "gates"];
+    a.extend(SMALL);
     a.extend(["--level", level, "--out", out]);
     a
 }
@@ -673,22 +666,15 @@ fn where_the_triangle_lists_overflow_the_binding_render_walks_the_planes_and_com
     // setting (the planes' walk) renders.
     let cmp = dir.path().join("cmp");
     let cmp = cmp.to_str().expect("utf-8");
-    capped(&[
+    let mut compare = vec![
         "compare",
         "builtin:two-rooms",
-        "--level",
-        &level,
         "--modes",
         "gates,gates-fast",
-        "--vpls",
-        "64",
-        "--size",
-        "16x12",
-        "--spp",
-        "1",
-        "--out",
-        cmp,
-    ]);
+    ];
+    compare.extend(SMALL);
+    compare.extend(["--level", &level, "--out", cmp]);
+    capped(&compare);
     let text = std::fs::read_to_string(std::path::Path::new(cmp).join("report.json"));
     let report: serde_json::Value = serde_json::from_str(&text.expect("report")).expect("json");
     let failures = report["failures"].as_array().expect("failures");
