@@ -242,6 +242,9 @@ fn import_obj_reader(
         });
     }
     let mut default_material = None;
+    let library = out.materials.len();
+    // The objects whose material the library lacks (tobj gives them none, without a word).
+    let mut unmatched = Vec::new();
     for model in models {
         let mesh = &model.mesh;
         let n = mesh.positions.len() / 3;
@@ -274,15 +277,14 @@ fn import_obj_reader(
             None
         };
         let material = match mesh.material_id {
-            Some(id) if id < out.materials.len() => id as u32,
-            _ => *default_material.get_or_insert_with(|| {
-                out.materials.push(Material {
-                    name: "default".into(),
-                    albedo: Vec3::splat(DEFAULT_ALBEDO),
-                    texture: None,
-                });
-                out.materials.len() as u32 - 1
-            }),
+            Some(id) if id < library => id as u32,
+            _ => {
+                // tobj splits an object at each `usemtl`: its name once.
+                if unmatched.last() != Some(&model.name) {
+                    unmatched.push(model.name.clone());
+                }
+                default_index(&mut default_material, &mut out)
+            }
         };
         let indices = mesh.indices.iter().map(|&i| i as u64);
         let raw = build_mesh(
@@ -299,8 +301,45 @@ fn import_obj_reader(
             out.meshes.push(raw);
         }
     }
+    if library > 0 && !unmatched.is_empty() {
+        out.warnings.push(unmatched_note(path, &unmatched));
+    }
     finish_warnings(path, &mut out);
     Ok(out)
+}
+
+/// The index of the OBJ's default material (albedo [`DEFAULT_ALBEDO`]), added at its first
+/// use.
+fn default_index(default: &mut Option<u32>, out: &mut ImportedModel) -> u32 {
+    *default.get_or_insert_with(|| {
+        out.materials.push(Material {
+            name: "default".into(),
+            albedo: Vec3::splat(DEFAULT_ALBEDO),
+            texture: None,
+        });
+        out.materials.len() as u32 - 1
+    })
+}
+
+/// The note of the OBJ objects that name no material of their library (a `usemtl` the MTL
+/// lacks, or none before them), with the first few names.
+fn unmatched_note(path: &Path, objects: &[String]) -> String {
+    let shown: Vec<_> = objects.iter().take(3).map(|n| format!("'{n}'")).collect();
+    let more = match objects.len() - shown.len() {
+        0 => String::new(),
+        n => format!(" and {n} more"),
+    };
+    let (count, verb) = match objects.len() {
+        1 => ("1 object".to_string(), "names"),
+        n => (format!("{n} objects"), "name"),
+    };
+    format!(
+        "{}: {count} ({}{more}) {verb} no material of its material library (a `usemtl` the \
+         MTL lacks, or none before them): drawn with albedo {DEFAULT_ALBEDO}; check the \
+         material names in the OBJ and the MTL",
+        path.display(),
+        shown.join(", ")
+    )
 }
 
 /// Whether a triangle has exactly zero area. The cross product is computed in f64, where the

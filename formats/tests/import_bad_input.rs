@@ -270,6 +270,40 @@ fn a_missing_material_library_is_a_warning() {
 }
 
 #[test]
+fn objects_naming_a_material_their_library_lacks_are_named_in_a_note() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    write(dir.path(), "m.mtl", b"newmtl known\nKd 0.2 0.4 0.6\n");
+    let tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+    let text = format!(
+        "mtllib m.mtl\n{tri}o early\nf 1 2 3\no good\nusemtl known\nf 1 2 3\n\
+         o typo\nusemtl knwon\nf 1 2 3\n"
+    );
+    let scene = load(&write(dir.path(), "t.obj", text.as_bytes())).expect("loads");
+    let notes: Vec<_> = (scene.report.warnings.iter())
+        .filter(|w| w.contains("no material of its material library"))
+        .collect();
+    assert_eq!(notes.len(), 1, "{:?}", scene.report.warnings);
+    assert!(
+        notes[0].contains("2 objects ('early', 'typo')"),
+        "{}",
+        notes[0]
+    );
+    assert!(!notes[0].contains("'good'"), "{}", notes[0]);
+    assert_eq!(scene.triangle_count(), 3);
+    // A bare OBJ, without a library, has nothing to name.
+    let bare = load(&write(
+        dir.path(),
+        "bare.obj",
+        format!("{tri}f 1 2 3\n").as_bytes(),
+    ));
+    let warnings = bare.expect("loads").report.warnings;
+    assert!(
+        !warnings.iter().any(|w| w.contains("material library")),
+        "{warnings:?}"
+    );
+}
+
+#[test]
 fn an_obj_without_triangles_is_an_empty_scene() {
     let dir = tempfile::tempdir().expect("tempdir");
     for (i, text) in [
