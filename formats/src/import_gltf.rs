@@ -61,7 +61,7 @@ pub fn import_gltf(path: &Path, options: &ImportOptions) -> Result<ImportedModel
         buffers: &buffers,
     };
     let image_texture = textures(&document, &file, base, options, &mut out);
-    let uv_transforms = materials(&document, &image_texture, &mut out);
+    let uv_maps = materials(&document, &image_texture, &mut out);
     let default_material = out.materials.len() as u32;
     let mut needs_default = false;
 
@@ -94,7 +94,9 @@ pub fn import_gltf(path: &Path, options: &ImportOptions) -> Result<ImportedModel
                 name: &mname,
                 world,
                 material: material.unwrap_or(default_material),
-                uv_transform: material.and_then(|m| uv_transforms.get(m as usize).copied()?),
+                uv_map: material.map_or(UvMap::default(), |m| {
+                    uv_maps.get(m as usize).copied().unwrap_or_default()
+                }),
             };
             // A primitive read (not skipped) without a material takes the default one.
             let Some(raw) = primitive(&file, &prim, &placed, &mut out)? else {
@@ -128,8 +130,16 @@ struct Placed<'a> {
     name: &'a str,
     world: Mat4,
     material: u32,
-    /// Its material's base colour texture transform (KHR_texture_transform), if any.
-    uv_transform: Option<Mat3>,
+    /// How its material's base colour texture maps it.
+    uv_map: UvMap,
+}
+
+/// How a material's base colour texture is mapped: the coordinate set it reads (its
+/// `texCoord`, or KHR_texture_transform's override) and the transform, if any.
+#[derive(Debug, Clone, Copy, Default)]
+struct UvMap {
+    set: u32,
+    transform: Option<Mat3>,
 }
 
 /// The file's images as textures, each image's texture index (`None` where textures are not
@@ -179,15 +189,15 @@ fn textures(
 }
 
 /// The file's materials: the base colour (or the specular-glossiness diffuse where the base
-/// colour is left white) and its texture; an emissive one is noted as glowing. Returns each
-/// material's base colour texture transform (KHR_texture_transform; gltfpack scales its
-/// quantized texture coordinates back with one).
+/// colour is left white) and its texture; an emissive one is noted as glowing. Returns how
+/// each material's base colour texture is mapped (its coordinate set; its
+/// KHR_texture_transform, with which gltfpack scales its quantized coordinates back).
 fn materials(
     document: &gltf::Document,
     image_texture: &[Option<u32>],
     out: &mut ImportedModel,
-) -> Vec<Option<Mat3>> {
-    let mut uv_transforms = Vec::new();
+) -> Vec<UvMap> {
+    let mut uv_maps = Vec::new();
     for m in document.materials() {
         if m.emissive_factor().iter().any(|&c| c > 0.0) {
             out.emissive.push(out.materials.len() as u32);
@@ -215,11 +225,13 @@ fn materials(
         if masked {
             out.alpha_masked.push(out.materials.len() as u32);
         }
-        uv_transforms.push(
-            (pbr.base_color_texture())
-                .and_then(|t| t.texture_transform())
-                .map(|t| gltf_quantized::uv_transform(&t)),
-        );
+        let mut uv_map = pbr.base_color_texture().map_or(UvMap::default(), |t| {
+            let transform = t.texture_transform();
+            UvMap {
+                set: (transform.as_ref().and_then(|t| t.tex_coord())).unwrap_or(t.tex_coord()),
+                transform: transform.map(|t| gltf_quantized::uv_transform(&t)),
+            }
+        });
         let mut texture = pbr
             .base_color_texture()
             .map(|t| t.texture().source().index());
@@ -229,8 +241,9 @@ fn materials(
             if base_color == [1.0; 4] {
                 albedo = Vec3::new(d[0], d[1], d[2]);
             }
-            if texture.is_none() {
-                texture = sg.diffuse_texture().map(|t| t.texture().source().index());
+            if let (None, Some(t)) = (texture, sg.diffuse_texture()) {
+                texture = Some(t.texture().source().index());
+                uv_map.set = t.tex_coord();
             }
         }
         out.materials.push(Material {
@@ -241,8 +254,9 @@ fn materials(
             albedo,
             texture: texture.and_then(|i| image_texture.get(i).copied().flatten()),
         });
+        uv_maps.push(uv_map);
     }
-    uv_transforms
+    uv_maps
 }
 
 /// One primitive as a mesh in the world (strips and fans as lists, turned where the transform
@@ -305,13 +319,16 @@ fn primitive(
             })
             .collect::<Vec<_>>()
     });
-    let uvs = match attribute(gltf::Semantic::TexCoords(0)) {
-        Some(a) if floats(&a, true) => reader.read_tex_coords(0).map(|it| it.into_f32().collect()),
+    let set = placed.uv_map.set;
+    let uvs = match attribute(gltf::Semantic::TexCoords(set)) {
+        Some(a) if floats(&a, true) => {
+            (reader.read_tex_coords(set)).map(|it| it.into_f32().collect())
+        }
         Some(a) => Some(gltf_quantized::read::<2>(&a, file.buffers).map_err(quantized)?),
         None => None,
     };
     let uvs = uvs.map(|uv: Vec<[f32; 2]>| {
-        let t = placed.uv_transform.unwrap_or(Mat3::IDENTITY);
+        let t = placed.uv_map.transform.unwrap_or(Mat3::IDENTITY);
         (uv.into_iter())
             .map(|uv| t.transform_point2(Vec2::from(uv)))
             .collect::<Vec<_>>()

@@ -63,6 +63,18 @@ fn quantized(dir: &Path, pos_type: u32, pos: [[i32; 3]; 3], scale: f32) -> PathB
     path
 }
 
+/// The texture coordinates that [`quantized`]'s transform makes.
+const UVS: [Vec2; 3] = [
+    Vec2::new(0.25, 0.0),
+    Vec2::new(1.25, 0.0),
+    Vec2::new(0.25, 1.0),
+];
+
+/// [`quantized`]'s triangle in centimetres: unsigned shorts under a node scale of 0.01.
+fn centimetre_triangle(dir: &Path) -> PathBuf {
+    quantized(dir, 5123, [[0, 0, 0], [200, 0, 0], [0, 300, 0]], 0.01)
+}
+
 #[test]
 fn a_quantized_gltf_reads_as_its_floats() {
     let dir = tempfile::tempdir().expect("tempdir");
@@ -87,12 +99,7 @@ fn a_quantized_gltf_reads_as_its_floats() {
         for n in &mesh.normals {
             assert!(n.distance(Vec3::Z) < 1e-6, "{kind}: {n}");
         }
-        let uvs = [
-            Vec2::new(0.25, 0.0),
-            Vec2::new(1.25, 0.0),
-            Vec2::new(0.25, 1.0),
-        ];
-        for (got, want) in mesh.uvs.iter().zip(uvs) {
+        for (got, want) in mesh.uvs.iter().zip(UVS) {
             assert!(got.distance(want) < 1e-6, "{kind}: {got} against {want}");
         }
         assert!(scene.materials[0].texture.is_some(), "{kind}");
@@ -104,12 +111,7 @@ fn a_quantized_gltf_reads_as_its_floats() {
 #[test]
 fn a_quantized_accessor_past_its_buffer_is_an_error_not_a_panic() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let path = quantized(
-        dir.path(),
-        5123,
-        [[0, 0, 0], [200, 0, 0], [0, 300, 0]],
-        0.01,
-    );
+    let path = centimetre_triangle(dir.path());
     let json = std::fs::read_to_string(&path).expect("gltf");
     // Ten vertices where the view holds three.
     let json = json.replacen(
@@ -121,5 +123,36 @@ fn a_quantized_accessor_past_its_buffer_is_an_error_not_a_panic() {
     match Scene::load(&path, &ImportOptions::default()) {
         Ok(_) => panic!("loaded an accessor past its buffer"),
         Err(e) => assert!(e.to_string().contains("packed.gltf"), "{e}"),
+    }
+}
+
+/// A base colour texture is read on the coordinate set it names: its `texCoord`, or its
+/// KHR_texture_transform's override (gltfpack and Blender write a second set for lightmaps).
+#[test]
+fn the_base_colour_texture_is_read_on_the_coordinate_set_it_names() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = centimetre_triangle(dir.path());
+    let json = std::fs::read_to_string(&path).expect("gltf");
+    let second = json.replacen(r#""TEXCOORD_0":2"#, r#""TEXCOORD_1":2"#, 1);
+    let named = r#""baseColorTexture":{"index":0,"texCoord":1,"#;
+    let overridden = r#""KHR_texture_transform":{"texCoord":1,"#;
+    for (how, text) in [
+        (
+            "texCoord",
+            second.replacen(r#""baseColorTexture":{"index":0,"#, named, 1),
+        ),
+        (
+            "the transform's texCoord",
+            second.replacen(r#""KHR_texture_transform":{"#, overridden, 1),
+        ),
+    ] {
+        assert_ne!(text, second, "{how}: the fixture changed");
+        std::fs::write(&path, text).expect("gltf");
+        let scene = Scene::load(&path, &ImportOptions::default()).expect("loads");
+        let uvs = &scene.meshes[0].uvs;
+        assert_eq!(uvs.len(), 3, "{how}: the second set was not read");
+        for (got, want) in uvs.iter().zip(UVS) {
+            assert!(got.distance(want) < 1e-6, "{how}: {got} against {want}");
+        }
     }
 }
