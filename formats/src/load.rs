@@ -142,16 +142,21 @@ pub fn bare_mesh_up(models: &[ImportedModel]) -> (UpAxis, Option<String>) {
 
 /// What a user reads when a bare mesh is not read in metres.
 fn units_warning(path: &Path, longest: f64, metres_per_unit: f64) -> String {
-    let unit = if metres_per_unit == 0.01 {
-        "centimetres"
+    let (unit, or_mm) = if metres_per_unit == 0.01 {
+        // A 9 m apartment modelled in millimetres reads as 90 m, as a 90 m Unreal level does.
+        let mm = format!(
+            " (in millimetres it would be a {:.1} m level)",
+            longest * 0.001
+        );
+        ("centimetres", mm)
     } else {
-        "millimetres"
+        ("millimetres", String::new())
     };
     format!(
         "{}: a bare mesh states no units, and in metres its longest side ({longest:.0} units) \
-         would make a {:.1} km level: read in {unit} ({:.1} m). To choose the units, pass \
-         --metres-per-unit (0.01 centimetres, 0.0254 inches, 0.001 millimetres) or name the \
-         mesh in a scene TOML with `metres_per_unit` (README, Scenes)",
+         would make a {:.1} km level: read in {unit} ({:.1} m){or_mm}. To choose the units, \
+         pass --metres-per-unit (0.01 centimetres, 0.0254 inches, 0.001 millimetres) or name \
+         the mesh in a scene TOML with `metres_per_unit` (README, Scenes)",
         path.display(),
         longest / 1000.0,
         longest * metres_per_unit,

@@ -216,16 +216,33 @@ fn axis_name(up: UpAxis) -> &'static str {
     }
 }
 
-/// A point's coordinates, trimmed.
+/// A point's coordinates to a tenth of a millimetre's worth of decimals and six significant
+/// figures (4200, not the 4199.9998 that a scale by 1000 of 4.2 makes in f32).
 fn fmt3(p: DVec3) -> String {
-    p.to_array()
-        .map(|c| format!("{}", (c * 1e4).round() / 1e4))
-        .join(", ")
+    p.to_array().map(fmt_coordinate).join(", ")
+}
+
+fn fmt_coordinate(c: f64) -> String {
+    let rounded = (c * 1e4).round() / 1e4;
+    let six: f64 = format!("{rounded:.5e}").parse().unwrap_or(rounded);
+    // + 0.0: no "-0".
+    format!("{}", six + 0.0)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn coordinates_print_to_six_figures_without_float_noise() {
+        let p = DVec3::new(4199.9998, -0.00001, 0.123_456_789);
+        assert_eq!(fmt3(p), "4200, 0, 0.1235");
+        assert_eq!(
+            fmt3(DVec3::new(-12.5, 1.0e6 + 0.3, 3.0)),
+            "-12.5, 1000000, 3"
+        );
+    }
+
     use crate::import::{ImportedModel, RawMesh};
     use std::path::Path;
 

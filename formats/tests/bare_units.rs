@@ -39,6 +39,11 @@ fn a_bare_mesh_in_centimetres_is_read_as_such_and_says_so() {
     let w = cm.report.warnings.join("\n");
     assert!(w.contains("cm.obj") && w.contains("centimetres"), "{w}");
     assert!(w.contains("metres_per_unit"), "{w}");
+    // Millimetres read in centimetres (a 9 m apartment as 90 m): the note says what they make.
+    assert!(
+        w.contains("in millimetres it would be a 3.7 m level"),
+        "{w}"
+    );
     // 200 m in millimetres: centimetres would still make 2 km.
     let mm = Scene::load(&write_obj(dir.path(), "mm.obj", 2.0e5), &options).expect("load");
     assert!((longest_m(&mm) - 200.0).abs() < 1e-2, "{}", longest_m(&mm));
