@@ -11,8 +11,9 @@
 # LEVEL: e2m3, sponza (default both), pillared (builtin:pillared-hall, camera side-room), ajar
 # (builtin:ajar-door, camera main). Modes: none, direct-only, gates (the default: the balanced
 # setting, the voxel walk with the closed voxels' triangles, the tent blur, the dark pixels'
-# walks, the near field and the ratio estimator; the walks' roulette auto), gates-no-ratio (the
-# default without the ratio estimator), gates-accurate (--accurate), gates-fast (--fast: closed
+# walks, the near field and the ratio estimator; the walks' roulette auto), gates-one-pass (the
+# default with its tent in one pass, as before its two), gates-no-ratio (the default without
+# the ratio estimator), gates-accurate (--accurate), gates-fast (--fast: closed
 # voxels passed on their planes, the box blur; the default before the balanced setting), and on
 # the fast setting, as they were measured before it: gates-blocking (--no-closed-voxel-planes:
 # every closed voxel blocks), gates-rr0, gates-rr05 and gates-rr10 (the roulette off, S = 0.05
@@ -44,6 +45,7 @@ args_of() { # LABEL -> render arguments
     gates-fast) echo "--mode gates --fast" ;;
     gates-accurate) echo "--mode gates --accurate" ;;
     gates-no-ratio) echo "--mode gates --no-ratio" ;;
+    gates-one-pass) echo "--mode gates --blur-tent-one-pass" ;;
     gates-triangles) echo "--mode gates --fast --closed-voxel-triangles" ;;
     gates-blocking) echo "--mode gates --fast --no-closed-voxel-planes" ;;
     gates-portal) echo "--mode gates --fast --gate-shape portal" ;;

@@ -283,9 +283,15 @@ pub struct MethodArgs {
     /// Blur: weight the neighbours by a tent over (2·side − 1)² pixels instead of the box of
     /// side²: every VPL subset still weighs the same, but a bright or dark pixel spreads as a
     /// soft pyramid instead of a square of the block's size; every interleaved mode (gates
-    /// have it in their balanced setting, the default, unless --fast).
+    /// have it in their balanced setting, the default, unless --fast). Summed in two passes,
+    /// rows then columns (2·(2·side − 1) taps a pixel instead of (2·side − 1)²).
     #[arg(long)]
     pub blur_tent: bool,
+    /// Blur: sum the tent in one pass of (2·side − 1)² taps, as before its two passes (for
+    /// comparing them: the two passes take a tap that agrees with its row's pixel, not only
+    /// with the pixel, and read the rows that do not agree tap by tap).
+    #[arg(long)]
+    pub blur_tent_one_pass: bool,
     /// Gates, interleaved: a pixel whose blur block holds fewer pixels than this that agree
     /// with it (a door jamb, a strip along a wall) walks, in a second pass, the VPL subsets of
     /// the pixels that do not agree, so that every VPL counts once there (a pair of pixel and
@@ -456,6 +462,7 @@ impl MethodArgs {
             blur_normal: self.blur_normal,
             fill: self.blur_fill,
             tent: self.blur_tent,
+            tent_rows: !self.blur_tent_one_pass,
             starved_taps: self.starved_taps,
             starved_dark: self.starved_dark,
         }

@@ -45,6 +45,43 @@ fn the_tent_blur_keeps_the_light_of_every_vpl_and_is_nearer_every_vpls_gather_th
     }
 }
 
+/// The tent in two passes (rows, then a column of rows) against the one pass of (2b − 1)²
+/// taps: the same light where every tap agrees with every pixel (a blur whose thresholds take
+/// every surface), and near it with the blur's own thresholds, where a tap can agree with its
+/// row's pixel and not with the pixel.
+#[test]
+fn the_tent_in_two_passes_is_the_one_pass_tent_where_every_tap_agrees() {
+    use visgate_runtime::gpu::{GatesParams, GpuMode, GpuParams, InterleaveParams};
+    use visgate_runtime::metrics::errors;
+    let (ctx, mut gpu, vpls, view) = four_rooms_on_the_gpu([96, 72]);
+    let mut render = |blur_distance: f32, blur_normal: f32, tent_rows: bool| {
+        let interleave = InterleaveParams {
+            tent: true,
+            tent_rows,
+            blur_distance,
+            blur_normal,
+            ..InterleaveParams::default()
+        };
+        let mode = GpuMode::Gates(GatesParams {
+            interleave,
+            ..GatesParams::default()
+        });
+        let (image, times) = gpu
+            .render(&ctx, &view, &vpls, &GpuParams::with_mode(mode))
+            .expect("render");
+        let rows_pass = times.passes.iter().any(|p| p.name == "tent rows");
+        assert_eq!(rows_pass, tent_rows, "the rows' pass ran as asked");
+        image
+    };
+    for (distance, normal, bound) in [(100.0, -1.0, 1e-10), (0.1, 0.8, 2e-4)] {
+        let two = render(distance, normal, true);
+        let one = render(distance, normal, false);
+        let e = errors(&two, &one).expect("size").rel_mse;
+        eprintln!("blur thresholds {distance}, {normal}: rel. MSE of two passes to one {e:.3e}");
+        assert!(e < bound, "thresholds {distance}, {normal}: {e}");
+    }
+}
+
 /// Gates (the default voxel walk) interleaved as `interleave`, the walks' roulette at share
 /// `walk_roulette` with seed `walk_seed`.
 fn with_roulette(

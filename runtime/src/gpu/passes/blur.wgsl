@@ -29,6 +29,93 @@
 // compose 0.97–0.98 → 0.27–0.28 s; the same image, bit for bit).
 override BLUR_FILL: u32 = 1u;
 
+// The tent in two passes (InterleaveParams::tent_rows): cs_tent_rows sums each pixel's row of
+// its window, the 2b − 1 taps that agree with that pixel, each weighed by the tent's factor
+// along x, and the compose sums its column of those rows, each weighed by the factor along y:
+// 2 (2b − 1) taps a pixel where the one pass reads (2b − 1)². A row whose pixel does not agree
+// with the composed pixel (a silhouette, a table's leg, a door's edge) is not taken: the
+// compose reads that row's taps itself against its own surface, as the one pass does, so that
+// what differs from the one pass is only a tap that agrees with its row's pixel and not with
+// the composed one (or the other way round). Fixed with the pipeline, as BLUR_FILL; the fill
+// keeps the one pass (each tap's copies are found against the composed pixel).
+override BLUR_TENT_ROWS: u32 = 0u;
+// The rows (cs_tent_rows): light × weight and the weight, and the unshadowed light × weight;
+// written there, read by the compose.
+@group(0) @binding(16) var rows_out: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(17) var rows_unshadowed_out: texture_storage_2d<r32float, write>;
+@group(0) @binding(18) var rows: texture_2d<f32>;
+@group(0) @binding(19) var rows_unshadowed: texture_2d<f32>;
+
+// Taps summed: light × weight and the weight, and the unshadowed light × weight.
+struct Taps {
+    sum: vec4<f32>,
+    unshadowed: f32,
+}
+
+@compute @workgroup_size(8, 8)
+fn cs_tent_rows(@builtin(global_invocation_id) id: vec3<u32>) {
+    if any(id.xy >= textureDimensions(g_position)) {
+        return;
+    }
+    let px = vec2<i32>(id.xy);
+    let b = i32(gather.block);
+    let size = vec2<i32>(textureDimensions(indirect));
+    let pos = textureLoad(g_position, px, 0);
+    var r = Taps(vec4<f32>(0.0), 0.0);
+    // Where the window does not fit the image the compose takes the box and reads no rows.
+    if pos.w != 0.0 && all(size >= vec2<i32>(2 * b - 1)) {
+        let n = normalize(textureLoad(g_normal, px, 0).xyz);
+        r = tent_row(px.y, clamp(px.x, b - 1, size.x - b), pos.xyz, n);
+    }
+    textureStore(rows_out, px, r.sum);
+    textureStore(rows_unshadowed_out, px, vec4<f32>(r.unshadowed, 0.0, 0.0, 0.0));
+}
+
+// Row y of the tent's window centred on column cx: the taps that agree with surface p (normal
+// n), each weighed b − |x − cx|.
+fn tent_row(y: i32, cx: i32, p: vec3<f32>, n: vec3<f32>) -> Taps {
+    let b = i32(gather.block);
+    let bu = gather.block;
+    let size = vec2<u32>(textureDimensions(indirect));
+    let ay = i32(deinterleave_axis(u32(y), bu, size.y));
+    let lo = cx - (b - 1);
+    var rx = vec2<u32>(u32(lo) % bu, u32(lo) / bu);
+    var r = Taps(vec4<f32>(0.0), 0.0);
+    for (var x = lo; x < cx + b; x++) {
+        let ax = i32(axis_run_place(rx, size.x / bu, size.x % bu));
+        rx = axis_run_next(rx, bu);
+        let tap = vec2<i32>(x, y);
+        if !blur_agrees(tap, p, n) {
+            continue;
+        }
+        let w = f32(b - abs(x - cx));
+        let l = textureLoad(indirect, select(tap, vec2<i32>(ax, ay), gather.deinterleaved == 1u), 0);
+        r.sum += vec4<f32>(w * l.xyz, w);
+        r.unshadowed += w * l.w;
+    }
+    return r;
+}
+
+// The tent's window (rows lo.y..hi.y, centred on `centre`) of the pixel px (surface p, normal
+// n), summed from cs_tent_rows's rows.
+fn tent_by_rows(px: vec2<i32>, centre: vec2<i32>, lo: i32, hi: i32, p: vec3<f32>, n: vec3<f32>) -> Taps {
+    let b = i32(gather.block);
+    var t = Taps(vec4<f32>(0.0), 0.0);
+    for (var y = lo; y < hi; y++) {
+        let at = vec2<i32>(px.x, y);
+        var r: Taps;
+        if blur_agrees(at, p, n) {
+            r = Taps(textureLoad(rows, at, 0), textureLoad(rows_unshadowed, at, 0).x);
+        } else {
+            r = tent_row(y, centre.x, p, n);
+        }
+        let w = f32(b - abs(y - centre.y));
+        t.sum += w * r.sum;
+        t.unshadowed += w * r.unshadowed;
+    }
+    return t;
+}
+
 @compute @workgroup_size(8, 8)
 fn cs_compose(@builtin(global_invocation_id) id: vec3<u32>) {
     if all(id.xy < textureDimensions(previous)) {
@@ -70,7 +157,14 @@ fn compose(px: vec2<i32>) -> vec4<f32> {
     var weight = 0.0;
     // The ratio estimator: the taps' subsets' unshadowed far light (the gather's w).
     var unshadowed_sum = 0.0;
-    for (var y = lo.y; y < hi.y; y++) {
+    let by_rows = BLUR_TENT_ROWS == 1u && tent && !fill;
+    if by_rows {
+        let t = tent_by_rows(px, centre, lo.y, hi.y, pos.xyz, n);
+        sum = t.sum.xyz;
+        weight = t.sum.w;
+        unshadowed_sum = t.unshadowed;
+    }
+    for (var y = select(lo.y, hi.y, by_rows); y < hi.y; y++) {
         let ay = i32(axis_run_place(ry, q.y, m.y));
         ry = axis_run_next(ry, bu);
         var rx = vec2<u32>(u32(lo.x) % bu, u32(lo.x) / bu);

@@ -45,6 +45,11 @@ pub struct InterleaveParams {
     /// twice summing to it along each axis), but one bright tap spreads as a pyramid instead
     /// of a b × b square. Off: Laine et al.'s box. A starved pixel keeps the box.
     pub tent: bool,
+    /// Blur: the tent summed in two passes, each pixel's row of 2b − 1 taps and then its
+    /// column of rows (blur.wgsl's `cs_tent_rows`): 2 (2b − 1) taps a pixel instead of
+    /// (2b − 1)², the same where every tap agrees with its row's pixel as with the pixel. Off:
+    /// one pass. The fill keeps the one pass.
+    pub tent_rows: bool,
 }
 
 impl Default for InterleaveParams {
@@ -57,6 +62,7 @@ impl Default for InterleaveParams {
             starved_dark: false,
             fill: false,
             tent: false,
+            tent_rows: true,
         }
     }
 }
@@ -82,6 +88,12 @@ impl InterleaveParams {
     /// The blur's distance threshold in metres for frame `f` (a fraction of the scene's size).
     pub fn blur_distance_m(&self, f: &Frame) -> f32 {
         self.blur_distance * f.scene.far_m / 4.0
+    }
+
+    /// Whether the blur sums the tent by rows ([`InterleaveParams::tent_rows`]): a tent of an
+    /// interleaved block, without the fill.
+    pub fn by_rows(&self) -> bool {
+        self.tent && self.tent_rows && !self.fill && self.block > 1
     }
 
     /// Checks the limits.
@@ -112,44 +124,59 @@ impl InterleaveParams {
     }
 }
 
-/// The blur-and-compose pipelines: without [`InterleaveParams::fill`] (every mode's default),
-/// and with it, made when a frame first asks for it (blur.wgsl's `BLUR_FILL`: a pipeline
-/// without the fill's code runs the taps 3.5× as fast on llvmpipe).
+/// The blur's passes, each a pipeline of blur.wgsl made when a frame first asks for it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum BlurPass {
+    /// The compose, every tap read by the pixel (the box, the one-pass tent).
+    Compose,
+    /// The compose with [`InterleaveParams::fill`] (blur.wgsl's `BLUR_FILL`: a pipeline without
+    /// the fill's code runs the taps 3.5× as fast on llvmpipe).
+    ComposeFilled,
+    /// The compose of the tent from its rows (`BLUR_TENT_ROWS`).
+    ComposeRows,
+    /// The tent's rows (`cs_tent_rows`).
+    TentRows,
+}
+
+impl BlurPass {
+    fn pipeline(self, d: &wgpu::Device, module: &wgpu::ShaderModule) -> wgpu::ComputePipeline {
+        let compose = |label, fill: bool, rows: bool| {
+            let constants = [
+                ("BLUR_FILL", f64::from(u8::from(fill))),
+                ("BLUR_TENT_ROWS", f64::from(u8::from(rows))),
+            ];
+            compute_pipeline_with(d, label, module, "cs_compose", &constants)
+        };
+        match self {
+            BlurPass::Compose => compose("blur", false, false),
+            BlurPass::ComposeFilled => compose("blur (filled)", true, false),
+            BlurPass::ComposeRows => compose("blur (tent by rows)", false, true),
+            BlurPass::TentRows => {
+                compute_pipeline_with(d, "tent rows", module, "cs_tent_rows", &[])
+            }
+        }
+    }
+}
+
+/// The blur-and-compose pipelines ([`BlurPass`]).
 pub struct InterleaveBlur {
     module: wgpu::ShaderModule,
-    unfilled: wgpu::ComputePipeline,
-    filled: OnceLock<wgpu::ComputePipeline>,
+    pipelines: [OnceLock<wgpu::ComputePipeline>; 4],
 }
 
 impl InterleaveBlur {
-    /// Builds the pipeline without the fill.
+    /// Builds the plain compose's pipeline (the others when first used).
     pub fn new(d: &wgpu::Device, s: &ShaderSources) -> Result<InterleaveBlur, RenderError> {
-        let module = shaders::module(d, s, "blur.wgsl")?;
-        let unfilled = Self::pipeline(d, &module, false);
-        Ok(InterleaveBlur {
-            module,
-            unfilled,
-            filled: OnceLock::new(),
-        })
+        let blur = InterleaveBlur {
+            module: shaders::module(d, s, "blur.wgsl")?,
+            pipelines: Default::default(),
+        };
+        blur.pipeline(d, BlurPass::Compose);
+        Ok(blur)
     }
 
-    fn pipeline(
-        d: &wgpu::Device,
-        module: &wgpu::ShaderModule,
-        fill: bool,
-    ) -> wgpu::ComputePipeline {
-        let label = if fill { "blur (filled)" } else { "blur" };
-        let constants = [("BLUR_FILL", f64::from(u8::from(fill)))];
-        compute_pipeline_with(d, label, module, "cs_compose", &constants)
-    }
-
-    /// The pipeline for a blur with or without the fill.
-    fn pipeline_for(&self, d: &wgpu::Device, fill: bool) -> &wgpu::ComputePipeline {
-        if !fill {
-            return &self.unfilled;
-        }
-        self.filled
-            .get_or_init(|| Self::pipeline(d, &self.module, true))
+    fn pipeline(&self, d: &wgpu::Device, pass: BlurPass) -> &wgpu::ComputePipeline {
+        self.pipelines[pass as usize].get_or_init(|| pass.pipeline(d, &self.module))
     }
 
     /// The blur's constants (a `ValGather` with only the interleaving's fields) for a mode
@@ -202,9 +229,16 @@ impl InterleaveBlur {
         (starved, unshadowed): (Option<&wgpu::Texture>, Option<&wgpu::Texture>),
     ) {
         let d = &f.ctx.device;
-        let pipeline = self.pipeline_for(d, il.fill);
+        let by_rows = il.by_rows();
+        let pass = match (il.fill, by_rows) {
+            (true, _) => BlurPass::ComposeFilled,
+            (false, true) => BlurPass::ComposeRows,
+            (false, false) => BlurPass::Compose,
+        };
+        let pipeline = self.pipeline(d, pass);
         let other = frame_target(f, pool, "hdr (ping-pong)");
         let tex = wgpu::BindingResource::TextureView;
+        let rows = by_rows.then(|| self.tent_rows(f, pool, rec, (g, uniform, indirect)));
         // Modes without them read a texel of zeros (starved: w 0, none starved).
         let mut or_texel = |t: Option<&wgpu::Texture>, label: &'static str| match t {
             Some(t) => t.create_view(&Default::default()),
@@ -221,6 +255,8 @@ impl InterleaveBlur {
         };
         let starved_view = or_texel(starved, "no starved pixels");
         let unshadowed_view = or_texel(unshadowed, "no unshadowed light");
+        let rows_view = or_texel(rows.as_ref().map(|r| &r[0]), "no tent rows");
+        let rows_unshadowed_view = or_texel(rows.as_ref().map(|r| &r[1]), "no tent rows");
         let (out_view, indirect_view, other_view) = (
             out.create_view(&Default::default()),
             indirect.create_view(&Default::default()),
@@ -240,6 +276,8 @@ impl InterleaveBlur {
                 (13, tex(&other_view)),
                 (14, tex(&starved_view)),
                 (15, tex(&unshadowed_view)),
+                (18, tex(&rows_view)),
+                (19, tex(&rows_unshadowed_view)),
             ],
         );
         let span = rec.begin("blur + compose");
@@ -255,5 +293,59 @@ impl InterleaveBlur {
         rec.enc
             .copy_texture_to_texture(other.as_image_copy(), out.as_image_copy(), out.size());
         rec.end();
+    }
+
+    /// Records the tent's rows (blur.wgsl's `cs_tent_rows`) of `indirect`: their light and
+    /// weight (a frame target) and their unshadowed light (R32F), for the compose by rows.
+    fn tent_rows(
+        &self,
+        f: &Frame,
+        pool: &mut Pool,
+        rec: &mut Recorder,
+        (g, uniform, indirect): (&GBufferOutput, &wgpu::Buffer, &wgpu::Texture),
+    ) -> [wgpu::Texture; 2] {
+        let d = &f.ctx.device;
+        let pipeline = self.pipeline(d, BlurPass::TentRows);
+        let [w, h] = f.view.size;
+        let usage = wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING;
+        let rows = [
+            frame_target(f, pool, "tent rows"),
+            pool.texture(
+                d,
+                "tent rows (unshadowed)",
+                [w, h, 1],
+                1,
+                wgpu::TextureFormat::R32Float,
+                usage,
+            ),
+        ];
+        let view = |t: &wgpu::Texture| t.create_view(&Default::default());
+        let (indirect_view, rows_view, unshadowed_view) =
+            (view(indirect), view(&rows[0]), view(&rows[1]));
+        let tex = wgpu::BindingResource::TextureView;
+        let bg = bind_group(
+            d,
+            &pipeline.get_bind_group_layout(0),
+            "tent rows",
+            vec![
+                (0, uniform.as_entire_binding()),
+                (3, tex(&g.views[0])),
+                (4, tex(&g.views[1])),
+                (12, tex(&indirect_view)),
+                (16, tex(&rows_view)),
+                (17, tex(&unshadowed_view)),
+            ],
+        );
+        let span = rec.begin("tent rows");
+        frame_pass(
+            &mut rec.enc,
+            "tent rows",
+            pipeline,
+            &[&bg],
+            span.compute(),
+            f.view.size,
+        );
+        rec.end();
+        rows
     }
 }
