@@ -11,7 +11,8 @@ use crate::hdr::HdrImage;
 pub struct ImageErrors {
     /// Mean over pixels and channels of `(a − r)²`. [Units: radiance²]
     pub mse: f64,
-    /// Mean over pixels and channels of `(a − r)² / (r² + ε)`, `ε = 1e-2 · mean(r)²`.
+    /// Mean over pixels and channels of `(a − r)² / (r² + ε)`, `ε = 1e-2 · mean(r)²` (where
+    /// the reference is black, `1e-2 · mean(a)²`: finite, and 0 where both are black).
     pub rel_mse: f64,
     /// Mean of the reference. [Units: radiance]
     pub reference_mean: f64,
@@ -42,7 +43,9 @@ pub fn errors(a: &HdrImage, r: &HdrImage) -> Result<ImageErrors, RenderError> {
             / n
     };
     let (mean_r, mean_a) = (mean(r), mean(a));
-    let eps = 1e-2 * mean_r * mean_r + f64::MIN_POSITIVE;
+    // A black reference (a view its light does not reach) divided by ε alone gave 1e297.
+    let scale = if mean_r > 0.0 { mean_r } else { mean_a };
+    let eps = 1e-2 * scale * scale + f64::MIN_POSITIVE;
     let (mut mse, mut rel) = (0f64, 0f64);
     for (p, q) in a.pixels.iter().zip(&r.pixels) {
         for k in 0..3 {
@@ -274,6 +277,17 @@ mod tests {
         let mut img = HdrImage::new(px.len() as u32, 1);
         img.pixels = px.iter().map(|&v| Vec3::splat(v)).collect();
         img
+    }
+
+    #[test]
+    fn the_relative_mse_against_a_black_reference_is_finite() {
+        let black = image(&[0.0, 0.0]);
+        let dim = image(&[1e-6, 0.0]);
+        let e = errors(&dim, &black).expect("size");
+        // ε = 1e-2 · (0.5e-6)²: each of the three channels of the lit pixel (1e-6)² / ε = 400,
+        // over six values.
+        assert!((e.rel_mse - 200.0).abs() < 1e-3, "{e:?}");
+        assert_eq!(errors(&black, &black).expect("size").rel_mse, 0.0);
     }
 
     #[test]
