@@ -1,10 +1,10 @@
 //! include: val.wgsl vpl.wgsl face.wgsl ratio.wgsl
 // Interleaving's other half: the interleaved indirect irradiance (val_gather.wgsl) blurred over
-// the b × b block (or, with blur_tent, a tent over (2b − 1)²) where the geometry agrees (Laine
-// et al.: positions closer than a fraction of the scene, normals closer than a cosine), times
-// albedo / π, added onto the image so far
-// (`previous`: ping-pong, 32-bit float targets are not blendable everywhere). A compute pass,
-// as the gathers (shade.wgsl's cs_gates_indirect says why).
+// the b × b block (or, with blur_tent, a tent over (2b − 1)², by rows: cs_tent_rows) where the
+// geometry agrees (Laine et al.: positions closer than a fraction of the scene, normals closer
+// than a cosine), times albedo / π, added onto the image so far (`previous`: ping-pong, 32-bit
+// float targets are not blendable everywhere). A compute pass, as the gathers (shade.wgsl's
+// cs_gates_indirect says why).
 
 @group(0) @binding(0) var<uniform> gather: ValGather;
 @group(0) @binding(3) var g_position: texture_2d<f32>;
