@@ -216,8 +216,8 @@ fn axis_name(up: UpAxis) -> &'static str {
     }
 }
 
-/// A point's coordinates to a tenth of a millimetre's worth of decimals and six significant
-/// figures (4200, not the 4199.9998 that a scale by 1000 of 4.2 makes in f32).
+/// A point's coordinates to four decimals and six significant figures (4200, not the
+/// 4199.9998 that a scale by 1000 of 4.2 makes in f32).
 fn fmt3(p: DVec3) -> String {
     p.to_array().map(fmt_coordinate).join(", ")
 }

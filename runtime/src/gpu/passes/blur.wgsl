@@ -164,6 +164,7 @@ fn compose(px: vec2<i32>) -> vec4<f32> {
         weight = t.sum.w;
         unshadowed_sum = t.unshadowed;
     }
+    // By rows, the taps are summed above: the loop runs no row.
     for (var y = select(lo.y, hi.y, by_rows); y < hi.y; y++) {
         let ay = i32(axis_run_place(ry, q.y, m.y));
         ry = axis_run_next(ry, bu);
