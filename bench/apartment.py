@@ -10,9 +10,10 @@ built-ins: a bare OBJ without an MTL, in millimetres, Z up, with
 
     bench/apartment.py OUT
 
-writes OUT/apartment.obj and three scene files beside it, each one light and the same four
-cameras: apartment-a.toml (a lamp in the living room A), apartment-c.toml (a lamp in room C)
-and apartment-spot.toml (a spot in room B aimed at the door). Run the bare OBJ first to see
+writes OUT/apartment.obj and four scene files beside it, each one light and the same four
+cameras: apartment-a.toml (a lamp in the living room A), apartment-c.toml (a lamp in room C),
+apartment-spot.toml (a spot in room B aimed at the door) and apartment-sun.toml (a lamp
+outside A's window, whose light paths mostly leave the level). Run the bare OBJ first to see
 what visgate makes of it (`visgate bake OUT/apartment.obj`), then the scene files, which say
 `metres_per_unit = 0.001` and `up = "z"` (README, "A third level unlike the built-ins").
 """
@@ -158,6 +159,8 @@ CAMERAS = [
 LIGHTS = {
     "a": '[[light]]\ntype = "point"\nposition = [2500, 2000, 2400]\nintensity = [15, 14.3, 13]\n',
     "c": '[[light]]\ntype = "point"\nposition = [8000, 4800, 2400]\nintensity = [15, 14.3, 13]\n',
+    # Outside the window to the void, above it: most of its paths leave the level.
+    "sun": '[[light]]\ntype = "point"\nposition = [-3000, 3000, 3500]\nintensity = [60, 57, 52]\n',
     "spot": (
         '[[light]]\ntype = "spot"\nposition = [8500, 3000, 2400]\ntarget = [5400, 1900, 0]\n'
         "cutoff_deg = 40\nbeam_deg = 30\nintensity = [40, 40, 40]\n"

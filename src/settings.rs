@@ -266,9 +266,18 @@ pub struct MethodArgs {
     pub cssm_normal_offset: f32,
     /// VAL modes and gates: interleaved sampling in blocks of this side (each pixel lights
     /// itself with one of side² VPL subsets, then a geometry-aware blur over the block); 1:
-    /// every VPL at every pixel (the CPU twins, --cpu, always gather every VPL).
+    /// every VPL at every pixel (the CPU twins, --cpu, always gather every VPL). The most:
+    /// a frame of few VPLs runs smaller blocks (--interleave-min-vpls).
     #[arg(long, default_value_t = 8)]
     pub interleave: u32,
+    /// Interleaved gates: the fewest VPLs a pixel walks. A frame with fewer VPLs than
+    /// --interleave² times this (a lamp outside a window to the void, whose paths mostly leave
+    /// the level) runs smaller blocks, the largest that leave each pixel this many (189 VPLs:
+    /// 3 × 3 instead of 3 VPLs a pixel in 8 × 8); `render` names the block it ran. 0: the
+    /// block whatever the count. The default keeps 8 × 8 from 768 VPLs. The VAL modes keep
+    /// their block (their error is the VALs' more than the interleaving's).
+    #[arg(long, value_name = "N", default_value_t = visgate_runtime::gpu::MIN_VPLS_PER_PIXEL)]
+    pub interleave_min_vpls: u32,
     /// Blur: leave out neighbours farther than this fraction of the scene's size.
     #[arg(long, default_value_t = 0.1)]
     pub blur_distance: f32,
@@ -465,6 +474,7 @@ impl MethodArgs {
             tent_rows: !self.blur_tent_one_pass,
             starved_taps: self.starved_taps,
             starved_dark: self.starved_dark,
+            min_vpls: self.interleave_min_vpls,
         }
     }
 

@@ -223,7 +223,18 @@ fn succeeded(args: &[&str]) -> std::process::Output {
 }
 
 /// The small renders' settings: 64 VPLs, 16×12, one sample a pixel.
-const SMALL: [&str; 6] = ["--vpls", "64", "--size", "16x12", "--spp", "1"];
+/// Small and fast; 64 VPLs in the 8 × 8 blocks the tests name (by default 2 × 2: see
+/// `render_gates_names_its_setting_and_each_flag_that_adds_to_the_fast_one`).
+const SMALL: [&str; 8] = [
+    "--vpls",
+    "64",
+    "--size",
+    "16x12",
+    "--spp",
+    "1",
+    "--interleave-min-vpls",
+    "0",
+];
 
 /// `visgate render builtin:two-rooms --mode gates` at [`SMALL`] with `level`, to `out`.
 fn gates_render<'a>(level: &'a str, out: &'a str) -> Vec<&'a str> {
@@ -256,6 +267,13 @@ fn render_gates_names_its_setting_and_each_flag_that_adds_to_the_fast_one() {
     assert!(stdout(&o).contains("near VPLs"), "{}", stdout(&o));
     assert!(stdout(&o).contains("unshadowed"), "{}", stdout(&o));
     assert!(!stdout(&o).contains("unique clusters"), "{}", stdout(&o));
+    // By default the 64 VPLs run in 2 × 2 blocks, 16 a pixel, named so.
+    let mut shrunk = a.clone();
+    let at = shrunk.iter().position(|x| *x == "--interleave-min-vpls");
+    shrunk[at.expect("in SMALL") + 1] = "12";
+    let out = stdout(&succeeded(&shrunk));
+    let named = "(voxel walk + triangles, 2×2 interleaved (8×8 for 64 VPLs: 1.0 a pixel), tent";
+    assert!(out.contains(named), "{out}");
     // Without the ratio estimator: named so, and its pass not run; with both flags, refused.
     let no_ratio = [&a[..], &["--no-ratio"]].concat();
     let out = stdout(&succeeded(&no_ratio));

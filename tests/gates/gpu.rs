@@ -269,6 +269,7 @@ fn starved_pixels_walk_the_subsets_their_block_lacks_and_count_every_vpl_once() 
                     block,
                     blur_distance,
                     starved_taps,
+                    min_vpls: 0,
                     ..InterleaveParams::default()
                 },
                 walk_roulette: WalkRoulette::Share(0.0),

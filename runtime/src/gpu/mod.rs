@@ -88,6 +88,7 @@ pub use passes::clustered_gates::{
 };
 pub use passes::display::{DISPLAY_FORMAT, read_display};
 pub use passes::gates_params::{NEAR_FIELD_MAX, RATIO_STRIDE, RATIO_STRIDE_MAX};
+pub use passes::interleave_blur::MIN_VPLS_PER_PIXEL;
 pub use passes::light_cluster::{MAX_LC_CLUSTERS, MAX_LC_LIGHTS};
 pub use passes::rsm_vpls::RsmParams;
 pub use passes::unshadowed::RATIO_RUN;

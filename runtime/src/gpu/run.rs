@@ -41,15 +41,16 @@ impl GpuRenderer {
     ) -> Result<(Option<HdrImage>, PassTimes), RenderError> {
         let t0 = Instant::now();
         self.check_frame(view, params)?;
+        let mut rec = Recorder::new(ctx, &mut self.pool);
+        let (vpl_buf, count) = self.frame_vpls(ctx, &vpls, &mut rec)?;
+        // The interleaving block for the frame's VPLs (InterleaveParams::for_vpls).
         let params = &GpuParams {
-            mode: params.mode.as_run(),
+            mode: params.mode.as_run().interleave_for(count),
             ..*params
         };
         let vals = params.mode.vals();
         let val_count = vals.map(|v| v.count);
         let warm = vals.is_some_and(|p| p.warm_start && self.val_warm == Some(p.count));
-        let mut rec = Recorder::new(ctx, &mut self.pool);
-        let (vpl_buf, count) = self.frame_vpls(ctx, &vpls, &mut rec)?;
         let cpu = match vpls {
             VplInput::Given(v) => Some(v),
             VplInput::Rsm(_) => None,

@@ -161,10 +161,14 @@ impl ViewerApp {
         );
         let software = ctx.adapter_info.device_type == wgpu::DeviceType::Cpu;
         let vpl_count = start.vpls.unwrap_or(if software { 64 } else { 1024 });
+        // On a software adapter the gates keep their block at few VPLs too: its cost grows
+        // with the VPLs a pixel walks (64 VPLs would run in 2 × 2 blocks).
+        let mut settings = crate::view::panel::start_settings();
         if software {
+            settings = settings.with_min_vpls(0);
             println!(
-                "{}: a software adapter; {vpl_count} VPLs and a quarter of the resolution while \
-                 moving keep it walkable",
+                "{}: a software adapter; {vpl_count} VPLs, 8 × 8 interleaving blocks whatever \
+                 their count, and a quarter of the resolution while moving keep it walkable",
                 ctx.adapter_info.name
             );
         }
@@ -202,7 +206,7 @@ impl ViewerApp {
             native: None,
             vpls: None,
             camera,
-            settings: crate::view::panel::start_settings(),
+            settings,
             direct: DirectLight::PerLight,
             moving_scale: if software { 0.25 } else { 0.5 },
             vpl_count,

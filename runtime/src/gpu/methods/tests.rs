@@ -294,3 +294,57 @@ fn every_registered_method_makes_its_own_mode() {
         assert!(mode.check().is_ok(), "{}", m.name);
     }
 }
+
+#[test]
+fn the_block_shrinks_where_the_vpls_are_too_few_for_it() {
+    let il = InterleaveParams {
+        starved_taps: 48,
+        ..InterleaveParams::default()
+    };
+    assert_eq!(il.min_vpls, 12);
+    // 8 × 8 from 768 VPLs (12 a pixel); below, the largest side that leaves 12.
+    for (vpls, block) in [(16_384, 8), (928, 8), (768, 8), (767, 7), (189, 3), (64, 2)] {
+        assert_eq!(il.for_vpls(vpls).block, block, "{vpls}");
+    }
+    assert_eq!((il.for_vpls(11).block, il.for_vpls(0).block), (1, 8));
+    // The starved taps in proportion (48 of 64: 12 of 16), at most the block's pixels.
+    let four = il.for_vpls(200);
+    assert_eq!((four.block, four.starved_taps), (4, 12));
+    let all = InterleaveParams {
+        starved_taps: 64,
+        ..il
+    };
+    assert_eq!(all.for_vpls(20).starved_taps, 1);
+    // Off, or a block given smaller: as given.
+    let fixed = InterleaveParams { min_vpls: 0, ..il };
+    assert_eq!(fixed.for_vpls(64), fixed);
+    let small = InterleaveParams { block: 2, ..il };
+    assert_eq!(small.for_vpls(189), small);
+    assert!(
+        InterleaveParams {
+            min_vpls: 4_097,
+            ..il
+        }
+        .check()
+        .is_err()
+    );
+    // The gates run it, and a report names it with the block asked for.
+    let gates = GpuMode::Gates(GatesParams::default());
+    let ran = gates.interleave_for(189).interleave().expect("interleaved");
+    assert_eq!(ran.block, 3);
+    let named = gates.describe_for(189);
+    assert!(
+        named.contains("3×3 interleaved (8×8 for 189 VPLs: 3.0 a pixel)"),
+        "{named}"
+    );
+    assert!(!gates.describe_for(1_024).contains("for 1024 VPLs"));
+    // The VAL modes keep theirs.
+    let val = GpuMode::ValHard(Default::default());
+    assert_eq!(val.interleave_for(189), val);
+    let one = GpuMode::Gates(GatesParams::default()).describe_for(11);
+    assert!(
+        one.contains("every VPL per pixel (8×8 for 11 VPLs: 0.2 a pixel)"),
+        "{one}"
+    );
+    assert_eq!(GpuMode::None.interleave_for(10), GpuMode::None);
+}
