@@ -96,9 +96,11 @@ impl Default for MethodSettings {
 
 impl MethodSettings {
     /// The gates' [`InterleaveParams::min_vpls`] set to `n` (0: their block as given,
-    /// whatever the VPL count).
+    /// whatever the VPL count), and the VAL modes', which a viewer that keeps one interleaving
+    /// for both hands on to the gates (the VAL modes do not read it).
     pub fn with_min_vpls(mut self, n: u32) -> MethodSettings {
         self.gates.interleave.min_vpls = n;
+        self.vals.interleave.min_vpls = n;
         self
     }
 }
@@ -218,8 +220,8 @@ impl GpuMode {
     /// The mode with the interleaving a frame of `vpls` VPLs runs: the gates' block shrunk
     /// where the VPLs are too few for it ([`InterleaveParams::for_vpls`]). The VAL modes keep
     /// theirs: their error is the VALs' more than the interleaving's, and measured in 3 × 3
-    /// and 2 × 2 blocks at 78 and 189 VPLs it was lower on four views of eight and higher on
-    /// the other four (up to 2.8×, the apartment's window under a lamp outside it).
+    /// and 2 × 2 blocks at 189 and 78 VPLs (val-hard and val-cssm, five views) it was lower on
+    /// 4 of 10 and higher on 6 (up to 2.8×, the apartment's window under a lamp outside it).
     pub fn interleave_for(&self, vpls: u32) -> GpuMode {
         match *self {
             GpuMode::Gates(mut p) => {
