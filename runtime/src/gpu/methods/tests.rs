@@ -338,6 +338,23 @@ fn the_block_shrinks_where_the_vpls_are_too_few_for_it() {
         "{named}"
     );
     assert!(!gates.describe_for(1_024).contains("for 1024 VPLs"));
+    // Where the rule keeps the block, the frame is the fixed block's (compare renders it once).
+    let fixed_gates = GpuMode::Gates(GatesParams {
+        interleave: fixed,
+        ..GatesParams::default()
+    });
+    let default_gates = GpuMode::Gates(GatesParams {
+        interleave: il,
+        ..GatesParams::default()
+    });
+    assert_eq!(
+        fixed_gates.resolved_for(1_024),
+        default_gates.resolved_for(1_024)
+    );
+    assert_ne!(
+        fixed_gates.resolved_for(189),
+        default_gates.resolved_for(189)
+    );
     // The VAL modes keep theirs.
     let val = GpuMode::ValHard(Default::default());
     assert_eq!(val.interleave_for(189), val);
