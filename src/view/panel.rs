@@ -7,7 +7,7 @@ use visgate_formats::Scene;
 use visgate_runtime::cpu::gates::GateShape;
 use visgate_runtime::gpu::{
     AUTO_ROULETTE_BLOCK, AUTO_ROULETTE_RATIO_VPLS, AUTO_ROULETTE_SHARE, AUTO_ROULETTE_VPLS,
-    DirectLight, DiskLight, GatesParams, InterleaveParams, IsmParams, LcDisk,
+    DirectLight, DiskLight, GatesParams, GpuMode, InterleaveParams, IsmParams, LcDisk,
     LightClusterGpuParams, MethodSettings, NEAR_FIELD_MAX, PassTimes, RATIO_STRIDE_MAX,
     WalkRoulette,
 };
@@ -86,6 +86,12 @@ fn gates_settings(ui: &mut egui::Ui, mode: &str, s: &mut MethodSettings) {
         let il = &mut s.vals.interleave;
         interleave(ui, il);
         if il.block > 1 {
+            ui.add(egui::Slider::new(&mut il.min_vpls, 0..=64).text("fewest VPLs a pixel"))
+                .on_hover_text(
+                    "where the frame's VPLs are too few for the block (a lamp outside a \
+                     window: most of its paths leave the level), the gates run the largest \
+                     block that leaves each pixel this many; 0: the block whatever the count",
+                );
             let most = il.block * il.block;
             ui.add(egui::Slider::new(&mut il.starved_taps, 0..=most).text("starved taps"))
                 .on_hover_text(
@@ -519,4 +525,13 @@ pub fn shader_status(ui: &mut egui::Ui, w: &super::shader_watch::ShaderWatch) {
             ));
         }
     }
+}
+
+/// The gates' block as a frame of `vpls` VPLs runs it, where that is smaller than the block
+/// set ([`GpuMode::interleave_for`]): "189 VPLs: 3 × 3 blocks (3.0 a pixel in 8 × 8)".
+pub fn block_note(mode: &GpuMode, vpls: u32) -> Option<String> {
+    let (given, ran) = (mode.interleave()?, mode.interleave_for(vpls).interleave()?);
+    let (b, g) = (ran.block, given.block);
+    let each = f64::from(vpls) / f64::from(g * g);
+    (b < g).then(|| format!("{vpls} VPLs: {b} × {b} blocks ({each:.1} a pixel in {g} × {g})"))
 }

@@ -117,6 +117,8 @@ pub struct ViewerApp {
     frames: u32,
     /// The view of the last frame (the layers are drawn with it).
     last_view: Option<View>,
+    /// The gates' block as the last frame ran it, where its VPLs shrank it (panel::block_note).
+    block_note: Option<String>,
     layers: Layers,
     /// The cluster layer and the view it was made for.
     cluster_tex: Option<(View, layers::PixelLayer, egui::TextureHandle)>,
@@ -219,6 +221,7 @@ impl ViewerApp {
             history: VecDeque::new(),
             frames: 0,
             last_view: None,
+            block_note: None,
             layers: start.layers,
             cluster_tex: None,
             portal_lines: start
@@ -275,6 +278,10 @@ impl ViewerApp {
             (false, false, Some((_, v))) => VplInput::Given(v),
             (false, false, None) => VplInput::Given(&[]),
         };
+        let count = match &input {
+            VplInput::Given(v) => v.len() as u32,
+            VplInput::Rsm(p) => p.count,
+        };
         let read_hdr = self.needs_hdr();
         let key = format!(
             "{params:?} {:?} {size:?} {} {} {} {} {read_hdr}",
@@ -317,6 +324,7 @@ impl ViewerApp {
         match (self.gpu).render_kept(&self.ctx, &view, input, &params, read_hdr) {
             Ok((img, times)) => {
                 self.last_view = Some(view);
+                self.block_note = crate::view::panel::block_note(&params.mode, count);
                 self.history.push_back((times.frame_s * 1e3) as f32);
                 if self.history.len() > 120 {
                     self.history.pop_front();

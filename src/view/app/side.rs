@@ -24,6 +24,9 @@ impl ViewerApp {
                 }
             });
         crate::view::panel::method_settings(ui, self.start.mode, &mut self.settings);
+        if let Some(n) = &self.block_note {
+            ui.label(n);
+        }
         // What the viewer changed of these settings, under them, where it is seen.
         if let Some(n) = &self.notice {
             ui.colored_label(egui::Color32::YELLOW, n);

@@ -336,3 +336,21 @@ fn the_viewer_draws_val_isms_vals_as_disks() {
         &SnapshotOptions::new().threshold(2.0),
     );
 }
+
+#[test]
+fn the_viewer_says_when_few_vpls_shrink_the_gates_block() {
+    let mut harness = first_frame(viewer(Layers::default(), false));
+    // On a software adapter the block stays 8 × 8 at the test's 32 VPLs, and nothing is said.
+    assert_eq!(harness.state().settings.vals.interleave.min_vpls, 0);
+    let slider = harness.query_all_by_label("fewest VPLs a pixel").next();
+    assert!(slider.is_some(), "its slider beside the block's");
+    assert!(harness.state().block_note.is_none());
+    // Asked for 4 a pixel: 32 VPLs run in 2 × 2 blocks, said under the settings.
+    let before = harness.state().frames;
+    harness.state_mut().settings.vals.interleave.min_vpls = 4;
+    until_a_frame_after(&mut harness, before);
+    let note = "32 VPLs: 2 × 2 blocks (0.5 a pixel in 8 × 8)";
+    assert_eq!(harness.state().block_note.as_deref(), Some(note));
+    harness.step();
+    harness.get_by_label(note);
+}
