@@ -272,10 +272,11 @@ pub struct MethodArgs {
     pub interleave: u32,
     /// Interleaved gates: the fewest VPLs a pixel walks. A frame with fewer VPLs than
     /// --interleave² times this (a lamp outside a window to the void, whose paths mostly leave
-    /// the level) runs smaller blocks, the largest that leave each pixel this many (189 VPLs:
-    /// 3 × 3 instead of 3 VPLs a pixel in 8 × 8); `render` names the block it ran. 0: the
-    /// block whatever the count. The default keeps 8 × 8 from 768 VPLs. The VAL modes keep
-    /// their block (their error is the VALs' more than the interleaving's).
+    /// the level) runs smaller blocks, the largest power of two that leaves each pixel this
+    /// many (189 VPLs: 2 × 2, 47 a pixel, instead of 3 in 8 × 8); `render` names the block it
+    /// ran. 0: the block whatever the count. The default keeps 8 × 8 from 768 VPLs, 4 × 4 from
+    /// 192. The VAL modes keep their block (their error is the VALs' more than the
+    /// interleaving's).
     #[arg(long, value_name = "N", default_value_t = visgate_runtime::gpu::MIN_VPLS_PER_PIXEL)]
     pub interleave_min_vpls: u32,
     /// Blur: leave out neighbours farther than this fraction of the scene's size.

@@ -6,7 +6,7 @@ use super::{DiskLight, GateParams, GateShape, GpuMode, InterleaveParams, WalkRou
 impl GpuMode {
     /// [`Self::describe`] for a frame of `vpls` VPLs: the gates' automatic roulette as it acts
     /// there ("roulette under 0.05 (auto)", or nothing where it is off), and an interleaving
-    /// block shrunk for few VPLs ([`InterleaveParams::for_vpls`]: "3×3 interleaved (8×8 for
+    /// block shrunk for few VPLs ([`InterleaveParams::for_vpls`]: "2×2 interleaved (8×8 for
     /// 189 VPLs: 3.0 a pixel)").
     pub fn describe_for(&self, vpls: u32) -> String {
         let resolved = self.resolved_for(vpls);

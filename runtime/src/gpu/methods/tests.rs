@@ -302,8 +302,17 @@ fn the_block_shrinks_where_the_vpls_are_too_few_for_it() {
         ..InterleaveParams::default()
     };
     assert_eq!(il.min_vpls, 12);
-    // 8 × 8 from 768 VPLs (12 a pixel); below, the largest side that leaves 12.
-    for (vpls, block) in [(16_384, 8), (928, 8), (768, 8), (767, 7), (189, 3), (64, 2)] {
+    // 8 × 8 from 768 VPLs (12 a pixel); below, the largest power of two that leaves 12.
+    let blocks = [
+        (16_384, 8),
+        (928, 8),
+        (768, 8),
+        (767, 4),
+        (192, 4),
+        (189, 2),
+        (48, 2),
+    ];
+    for (vpls, block) in blocks.into_iter().chain([(47, 1)]) {
         assert_eq!(il.for_vpls(vpls).block, block, "{vpls}");
     }
     assert_eq!((il.for_vpls(11).block, il.for_vpls(0).block), (1, 8));
@@ -320,6 +329,9 @@ fn the_block_shrinks_where_the_vpls_are_too_few_for_it() {
     assert_eq!(fixed.for_vpls(64), fixed);
     let small = InterleaveParams { block: 2, ..il };
     assert_eq!(small.for_vpls(189), small);
+    // A block given that is no power of two shrinks to one.
+    let six = InterleaveParams { block: 6, ..il };
+    assert_eq!(six.for_vpls(300).block, 4);
     assert!(
         InterleaveParams {
             min_vpls: 4_097,
@@ -331,10 +343,10 @@ fn the_block_shrinks_where_the_vpls_are_too_few_for_it() {
     // The gates run it, and a report names it with the block asked for.
     let gates = GpuMode::Gates(GatesParams::default());
     let ran = gates.interleave_for(189).interleave().expect("interleaved");
-    assert_eq!(ran.block, 3);
+    assert_eq!(ran.block, 2);
     let named = gates.describe_for(189);
     assert!(
-        named.contains("3×3 interleaved (8×8 for 189 VPLs: 3.0 a pixel)"),
+        named.contains("2×2 interleaved (8×8 for 189 VPLs: 3.0 a pixel)"),
         "{named}"
     );
     assert!(!gates.describe_for(1_024).contains("for 1024 VPLs"));
