@@ -528,10 +528,10 @@ pub fn shader_status(ui: &mut egui::Ui, w: &super::shader_watch::ShaderWatch) {
 }
 
 /// The gates' block as a frame of `vpls` VPLs runs it, where that is smaller than the block
-/// set ([`GpuMode::interleave_for`]): "189 VPLs: 2 × 2 blocks (3.0 a pixel in 8 × 8)".
+/// set ([`GpuMode::shrunk_block`]): "189 VPLs: 2 × 2 blocks (3.0 a pixel in 8 × 8)".
 pub fn block_note(mode: &GpuMode, vpls: u32) -> Option<String> {
-    let (given, ran) = (mode.interleave()?, mode.interleave_for(vpls).interleave()?);
-    let (b, g) = (ran.block, given.block);
-    let each = f64::from(vpls) / f64::from(g * g);
-    (b < g).then(|| format!("{vpls} VPLs: {b} × {b} blocks ({each:.1} a pixel in {g} × {g})"))
+    let (b, g, each) = mode.shrunk_block(vpls)?;
+    Some(format!(
+        "{vpls} VPLs: {b} × {b} blocks ({each:.1} a pixel in {g} × {g})"
+    ))
 }

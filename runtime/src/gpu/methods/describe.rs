@@ -18,19 +18,24 @@ impl GpuMode {
         {
             s += " (auto)";
         }
-        if let (Some(given), Some(ran)) = (self.interleave(), resolved.interleave())
-            && ran.block < given.block
-        {
-            let (b, g) = (ran.block, given.block);
+        if let Some((b, g, each)) = self.shrunk_block(vpls) {
             let from = match b {
                 1 => "every VPL per pixel".to_string(),
                 b => format!("{b}×{b} interleaved"),
             };
-            let each = f64::from(vpls) / f64::from(g * g);
             let why = format!("{g}×{g} for {vpls} VPLs: {each:.1} a pixel");
             s = s.replacen(&from, &format!("{from} ({why})"), 1);
         }
         s
+    }
+
+    /// Where a frame of `vpls` VPLs shrinks the gates' block ([`Self::interleave_for`]): the
+    /// block it runs, the block set, and the VPLs a pixel the set one would leave; `None` where
+    /// the block is kept (and for the modes that keep theirs).
+    pub fn shrunk_block(&self, vpls: u32) -> Option<(u32, u32, f64)> {
+        let (given, ran) = (self.interleave()?, self.interleave_for(vpls).interleave()?);
+        let (b, g) = (ran.block, given.block);
+        (b < g).then(|| (b, g, f64::from(vpls) / f64::from(g * g)))
     }
 
     /// The method's settings in a few words, for reports ("portals, walk ≤ 64, 8×8
