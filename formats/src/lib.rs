@@ -12,6 +12,8 @@
 //!   into a typed error or a counted warning;
 //! - [`scene`]: the in-memory scene in visgate's space (right-handed, +Y up, metres), and the
 //!   hash of its static geometry;
+//! - [`room_height`]: how high a bare mesh's rooms stand, which its units are read from where
+//!   its extent leaves them in doubt;
 //! - [`stray`]: the static triangles far from the rest of a level (a helper left in the
 //!   export, a sky box), which would size the bake's grid;
 //! - [`vgate`]: the baked `.vgate` file — the runtime layout of a level's skeleton, visibility
@@ -32,6 +34,7 @@ pub mod load;
 pub mod mitsuba;
 pub mod mtl_map;
 pub mod placement;
+pub mod room_height;
 pub mod scene;
 pub mod stray;
 pub mod sun;
@@ -40,6 +43,9 @@ pub mod vgate;
 pub use desc::SceneDesc;
 pub use error::{SceneError, VgateError};
 pub use import::{ImportOptions, ImportedModel};
-pub use load::{BARE_LEVEL_MAX_M, BareMesh, bare_mesh_units, bare_mesh_up};
+pub use load::{
+    BARE_LEVEL_MAX_M, BareMesh, ROOM_PLAUSIBLE_M, ROOM_TYPICAL_M, bare_mesh_units,
+    bare_mesh_units_with_rooms, bare_mesh_up,
+};
 pub use scene::{Camera, GeometryHash, Light, Material, Mesh, Scene, Texture};
 pub use vgate::BakedLevel;

@@ -11,6 +11,7 @@ use glam::DVec3;
 use crate::desc::{SceneDesc, UpAxis};
 use crate::error::SceneError;
 use crate::import::{self, ImportOptions, ImportedModel};
+use crate::room_height::{RoomHeight, room_height};
 use crate::scene::{FileKind, Scene, parent_dir};
 
 /// The longest a bare mesh may be, read in metres, before it is read in smaller units
@@ -18,7 +19,8 @@ use crate::scene::{FileKind, Scene, parent_dir};
 pub const BARE_LEVEL_MAX_M: f64 = 1000.0;
 
 /// A bare mesh read in metres and longer than this gets a note that it may be modelled in
-/// centimetres (a two-room level of 800 cm reads as 800 m): most indoor levels are shorter.
+/// centimetres (a two-room level of 800 cm whose rooms' height is not measured — no ceilings
+/// — reads as 800 m): most indoor levels are shorter.
 /// [Units: m]
 pub const BARE_LEVEL_NOTE_M: f64 = 200.0;
 
@@ -39,6 +41,46 @@ pub fn bare_mesh_units(longest: f64) -> f64 {
         .into_iter()
         .find(|m| longest * m <= BARE_LEVEL_MAX_M)
         .unwrap_or(0.001)
+}
+
+/// Room heights (floor to ceiling, [`crate::room_height`]) a level's units must give before
+/// they replace the units its extent chose ([`bare_mesh_units_with_rooms`]): a house's,
+/// an office's, a Quake corridor's. [Units: m]
+pub const ROOM_TYPICAL_M: (f64, f64) = (2.0, 6.0);
+
+/// Room heights that keep the units a level's extent chose: from a low cellar to a hall
+/// (Crytek Sponza's arcades stand 7 m, a nave 20 m). [Units: m]
+pub const ROOM_PLAUSIBLE_M: (f64, f64) = (1.9, 20.0);
+
+/// Metres per unit of a bare mesh whose longest extent is `longest` of its units and whose
+/// rooms stand `rooms` of them floor to ceiling (`None`: not measured, a level under the open
+/// sky): [`bare_mesh_units`], unless that makes its rooms implausible
+/// ([`ROOM_PLAUSIBLE_M`]) and centimetres or millimetres, the first that does, makes them
+/// typical ([`ROOM_TYPICAL_M`]): a 9 m apartment in millimetres, read in centimetres by its
+/// extent, has rooms 27 m high, and in millimetres 2.7 m; an 8 m level in centimetres, read in
+/// metres, 270 m and 2.7 m. A level whose rooms no unit makes typical keeps its extent's unit
+/// (a sky box 100 m over a level in centimetres: 1,000 m, or 10 m in millimetres).
+pub fn bare_mesh_units_with_rooms(longest: f64, rooms: Option<f64>) -> f64 {
+    let by_extent = bare_mesh_units(longest);
+    let within = |h: f64, (lo, hi): (f64, f64)| (lo..=hi).contains(&h);
+    match rooms {
+        Some(h) if !within(h * by_extent, ROOM_PLAUSIBLE_M) => [0.01, 0.001]
+            .into_iter()
+            .filter(|&m| m < by_extent)
+            .find(|&m| within(h * m, ROOM_TYPICAL_M))
+            .unwrap_or(by_extent),
+        _ => by_extent,
+    }
+}
+
+/// The name of the unit `metres_per_unit` is, where it is one of the three a bare mesh is read
+/// in.
+fn unit_name(metres_per_unit: f64) -> &'static str {
+    match metres_per_unit {
+        1.0 => "metres",
+        0.01 => "centimetres",
+        _ => "millimetres",
+    }
 }
 
 /// The size of the box around every finite vertex of `models`, in their own units and axes
@@ -143,7 +185,8 @@ pub fn bare_mesh_up(models: &[ImportedModel]) -> (UpAxis, Option<String>) {
 /// What a user reads when a bare mesh is not read in metres.
 fn units_warning(path: &Path, longest: f64, metres_per_unit: f64) -> String {
     let (unit, or_mm) = if metres_per_unit == 0.01 {
-        // A 9 m apartment modelled in millimetres reads as 90 m, as a 90 m Unreal level does.
+        // Where its rooms measure none: a 9 m apartment modelled in millimetres then reads as
+        // 90 m, as a 90 m Unreal level does.
         let mm = format!(
             " (in millimetres it would be a {:.1} m level)",
             longest * 0.001
@@ -160,6 +203,31 @@ fn units_warning(path: &Path, longest: f64, metres_per_unit: f64) -> String {
         path.display(),
         longest / 1000.0,
         longest * metres_per_unit,
+    )
+}
+
+/// What a user reads when a bare mesh's rooms chose its units over its extent.
+fn rooms_warning(
+    path: &Path,
+    longest: f64,
+    rooms: &RoomHeight,
+    by_extent: f64,
+    chosen: f64,
+) -> String {
+    format!(
+        "{}: a bare mesh states no units; its rooms stand {:.0} units floor to ceiling (the \
+         median over {} columns of its footprint), which in {} would make them {:.1} m high: \
+         read in {} (rooms {:.2} m high, the level {:.1} m long). To choose the units, pass \
+         --metres-per-unit (0.01 centimetres, 0.0254 inches, 0.001 millimetres) or name the \
+         mesh in a scene TOML with `metres_per_unit` (README, Scenes)",
+        path.display(),
+        rooms.median,
+        rooms.columns,
+        unit_name(by_extent),
+        rooms.median * by_extent,
+        unit_name(chosen),
+        rooms.median * chosen,
+        longest * chosen,
     )
 }
 
@@ -190,6 +258,27 @@ fn small_note(path: &Path, longest: f64) -> String {
     )
 }
 
+/// A bare mesh's units from its extent and its rooms (`desc.up` read already); the note a user
+/// should read of them.
+fn choose_units(
+    desc: &mut SceneDesc,
+    models: &[ImportedModel],
+    path: &Path,
+    longest: f64,
+) -> Option<String> {
+    let rooms = room_height(models, desc.up);
+    let by_extent = bare_mesh_units(longest);
+    desc.metres_per_unit = bare_mesh_units_with_rooms(longest, rooms.map(|r| r.median));
+    let m = desc.metres_per_unit;
+    match rooms {
+        Some(r) if m != by_extent => Some(rooms_warning(path, longest, &r, by_extent, m)),
+        _ if m != 1.0 => Some(units_warning(path, longest, m)),
+        _ if longest > BARE_LEVEL_NOTE_M => Some(metres_note(path, longest)),
+        _ if longest < BARE_LEVEL_SMALL_M => Some(small_note(path, longest)),
+        _ => None,
+    }
+}
+
 /// What a user reads when the up axis of a bare OBJ is in doubt or Z.
 fn up_warning(path: &Path, why: &str) -> String {
     format!(
@@ -209,21 +298,7 @@ fn read_bare(
     said: BareMesh,
 ) -> Vec<String> {
     let mut notes = Vec::new();
-    match said.metres_per_unit {
-        Some(m) => desc.metres_per_unit = m,
-        None => {
-            if let Some(longest) = longest_extent(models) {
-                desc.metres_per_unit = bare_mesh_units(longest);
-                if desc.metres_per_unit != 1.0 {
-                    notes.push(units_warning(path, longest, desc.metres_per_unit));
-                } else if longest > BARE_LEVEL_NOTE_M {
-                    notes.push(metres_note(path, longest));
-                } else if longest < BARE_LEVEL_SMALL_M {
-                    notes.push(small_note(path, longest));
-                }
-            }
-        }
-    }
+    // The up axis first: the rooms' height, which the units may come from, is along it.
     desc.up = match (said.up, kind) {
         (Some(up), _) => up,
         (None, FileKind::Obj) => {
@@ -233,6 +308,14 @@ fn read_bare(
         }
         (None, _) => UpAxis::Y,
     };
+    match said.metres_per_unit {
+        Some(m) => desc.metres_per_unit = m,
+        None => {
+            if let Some(longest) = longest_extent(models) {
+                notes.extend(choose_units(desc, models, path, longest));
+            }
+        }
+    }
     for note in &notes {
         tracing::warn!("{note}");
     }
@@ -290,7 +373,7 @@ fn unread_lights_and_cameras(
 
 impl Scene {
     /// Loads a scene TOML, or a bare OBJ/glTF/GLB file as one static mesh with no lights, in
-    /// the units [`bare_mesh_units`] picks from its size.
+    /// the units [`bare_mesh_units_with_rooms`] picks from its size and its rooms.
     pub fn load(path: &Path, options: &ImportOptions) -> Result<Scene, SceneError> {
         let start = Instant::now();
         let kind = FileKind::of(path);

@@ -1,11 +1,13 @@
 //! A bare mesh states no units: it is read in metres unless that would make a level longer
 //! than any indoor level, then in centimetres or millimetres, with a warning (and in metres
-//! with a note where that makes it longer than most, or smaller than any room); a scene
+//! with a note where that makes it longer than most, or smaller than any room) — unless its
+//! rooms' height, floor to ceiling, is implausible in that unit and typical in a smaller one
+//! (millimetres, or centimetres for a small level), with a warning saying both; a scene
 //! TOML's `metres_per_unit` chooses.
 
 use std::path::{Path, PathBuf};
 
-use visgate_formats::{ImportOptions, Scene, bare_mesh_units};
+use visgate_formats::{ImportOptions, Scene, bare_mesh_units, bare_mesh_units_with_rooms};
 
 /// An OBJ of two triangles spanning `length` units along x (1 unit in y and z).
 fn write_obj(dir: &Path, name: &str, length: f64) -> PathBuf {
@@ -94,4 +96,96 @@ fn a_bare_mesh_in_centimetres_is_read_as_such_and_says_so() {
     let stated = Scene::load(&toml, &options).expect("load");
     assert!((longest_m(&stated) - 3700.0).abs() < 1e-2);
     assert!(stated.report.warnings.is_empty());
+}
+
+/// An OBJ of a room `long` × `wide` units, `high` units floor to ceiling, Z up (as a modeller
+/// in millimetres or centimetres writes it): a floor, a ceiling and four walls, single quads.
+fn write_room(dir: &Path, name: &str, long: f64, wide: f64, high: f64) -> PathBuf {
+    let p = dir.join(name);
+    let corners = [
+        (0.0, 0.0, 0.0),
+        (long, 0.0, 0.0),
+        (long, wide, 0.0),
+        (0.0, wide, 0.0),
+        (0.0, 0.0, high),
+        (long, 0.0, high),
+        (long, wide, high),
+        (0.0, wide, high),
+    ];
+    let mut text: String = corners
+        .iter()
+        .map(|(x, y, z)| format!("v {x} {y} {z}\n"))
+        .collect();
+    for f in [
+        "1 2 3 4", "8 7 6 5", "1 5 6 2", "2 6 7 3", "3 7 8 4", "4 8 5 1",
+    ] {
+        text += &format!("f {f}\n");
+    }
+    std::fs::write(&p, text).expect("write");
+    p
+}
+
+#[test]
+fn the_rooms_height_reads_millimetres_and_small_levels_in_centimetres_where_the_extent_cannot() {
+    assert_eq!(bare_mesh_units_with_rooms(9000.0, Some(2700.0)), 0.001);
+    assert_eq!(bare_mesh_units_with_rooms(800.0, Some(270.0)), 0.01);
+    // Rooms plausible in the extent's unit, or in no unit typical, or not measured: the extent's.
+    assert_eq!(bare_mesh_units_with_rooms(3721.0, Some(1457.5)), 0.01);
+    assert_eq!(bare_mesh_units_with_rooms(60.0, Some(15.4)), 1.0);
+    assert_eq!(bare_mesh_units_with_rooms(3721.0, Some(10_000.0)), 0.01);
+    assert_eq!(bare_mesh_units_with_rooms(9000.0, None), 0.01);
+    let dir = tempfile::tempdir().expect("tempdir");
+    let options = ImportOptions::default();
+    // A 9 m room in millimetres, 2.7 m high: its extent alone read it as 90 m.
+    let mm = Scene::load(
+        &write_room(dir.path(), "mm.obj", 9000.0, 6000.0, 2700.0),
+        &options,
+    )
+    .expect("load");
+    assert!((longest_m(&mm) - 9.0).abs() < 1e-3, "{}", longest_m(&mm));
+    let w = mm.report.warnings.join("\n");
+    assert!(
+        w.contains("mm.obj")
+            && w.contains("its rooms stand 2700 units floor to ceiling")
+            && w.contains("in centimetres would make them 27.0 m high")
+            && w.contains("read in millimetres (rooms 2.70 m high, the level 9.0 m long)")
+            && w.contains("--metres-per-unit"),
+        "{w}"
+    );
+    // An 8 m room in centimetres: its extent alone read it as 800 m.
+    let cm = Scene::load(
+        &write_room(dir.path(), "cm.obj", 800.0, 500.0, 270.0),
+        &options,
+    )
+    .expect("load");
+    assert!((longest_m(&cm) - 8.0).abs() < 1e-4, "{}", longest_m(&cm));
+    let w = cm.report.warnings.join("\n");
+    assert!(
+        w.contains("in metres would make them 270.0 m high") && w.contains("read in centimetres"),
+        "{w}"
+    );
+    // The same room in metres is left alone, and so is a 37 m hall in centimetres 14.6 m high.
+    let m = Scene::load(&write_room(dir.path(), "m.obj", 8.0, 5.0, 2.7), &options).expect("load");
+    assert!((longest_m(&m) - 8.0).abs() < 1e-4);
+    assert!(
+        !m.report.warnings.join("\n").contains("units"),
+        "{:?}",
+        m.report.warnings
+    );
+    let hall = Scene::load(
+        &write_room(dir.path(), "hall.obj", 3700.0, 2000.0, 1460.0),
+        &options,
+    )
+    .expect("load");
+    assert!((longest_m(&hall) - 37.0).abs() < 1e-3);
+    // The user's units are never guessed.
+    let said = ImportOptions {
+        bare: visgate_formats::BareMesh {
+            metres_per_unit: Some(0.01),
+            up: None,
+        },
+        ..ImportOptions::default()
+    };
+    let stated = Scene::load(&dir.path().join("mm.obj"), &said).expect("load");
+    assert!((longest_m(&stated) - 90.0).abs() < 1e-2);
 }

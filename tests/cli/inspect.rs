@@ -172,17 +172,20 @@ fn a_bare_obj_modelled_z_up_in_millimetres_is_read_as_its_flags_say() {
         assert!(o.status.success(), "{}", stderr(&o));
         serde_json::from_slice::<serde_json::Value>(&o.stdout).expect("json")
     };
-    // Unsaid: read Z up (floors face z, the level is low along z) and, 8,000 units long, in
-    // centimetres; both said in its warnings.
+    // Unsaid: read Z up (floors face z, the level is low along z) and, 8,600 units long, in
+    // millimetres: its extent alone would read centimetres (86 m), its rooms' height there
+    // (30 m floor to ceiling) is none a room has; both said in its warnings.
     let v = inspect(&[]);
     let size = size_of(&v);
     assert!(
-        (size[0] - 86.0).abs() < 1e-3 && (size[1] - 34.0).abs() < 1e-3,
+        (size[0] - 8.6).abs() < 1e-4 && (size[1] - 3.4).abs() < 1e-4,
         "{size:?}"
     );
     let warnings = v["warnings"].to_string();
     assert!(
-        warnings.contains("read Z up") && warnings.contains("--metres-per-unit"),
+        warnings.contains("read Z up")
+            && warnings.contains("read in millimetres")
+            && warnings.contains("--metres-per-unit"),
         "{warnings}"
     );
     // Said: millimetres, Y up as written (the rooms then lie on their side), no warning.
