@@ -45,8 +45,8 @@ pub fn bare_mesh_units(longest: f64) -> f64 {
 
 /// Room heights (floor to ceiling, [`crate::room_height`]) a level's units must give before
 /// they replace the units its extent chose ([`bare_mesh_units_with_rooms`]): a house's,
-/// an office's, a Quake corridor's. [Units: m]
-pub const ROOM_TYPICAL_M: (f64, f64) = (2.0, 6.0);
+/// an office's, a Quake corridor's, the Cornell box's 1.99 m. [Units: m]
+pub const ROOM_TYPICAL_M: (f64, f64) = (1.9, 6.0);
 
 /// Room heights that keep the units a level's extent chose: from a low cellar to a hall
 /// (Crytek Sponza's arcades stand 7 m, a nave 20 m). [Units: m]

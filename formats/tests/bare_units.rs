@@ -129,6 +129,8 @@ fn write_room(dir: &Path, name: &str, long: f64, wide: f64, high: f64) -> PathBu
 fn the_rooms_height_reads_millimetres_and_small_levels_in_centimetres_where_the_extent_cannot() {
     assert_eq!(bare_mesh_units_with_rooms(9000.0, Some(2700.0)), 0.001);
     assert_eq!(bare_mesh_units_with_rooms(800.0, Some(270.0)), 0.01);
+    // The Cornell box (1.99 units high in metres) modelled in centimetres.
+    assert_eq!(bare_mesh_units_with_rooms(199.0, Some(199.0)), 0.01);
     // Rooms plausible in the extent's unit, or in no unit typical, or not measured: the extent's.
     assert_eq!(bare_mesh_units_with_rooms(3721.0, Some(1457.5)), 0.01);
     assert_eq!(bare_mesh_units_with_rooms(60.0, Some(15.4)), 1.0);
