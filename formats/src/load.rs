@@ -33,7 +33,8 @@ pub const BARE_LEVEL_SMALL_M: f64 = 1.0;
 /// `longest` of its units: metres, unless that makes a level longer than [`BARE_LEVEL_MAX_M`];
 /// then centimetres (Crytek Sponza's OBJ and GLB, Unreal, Maya and 3ds Max exports), or
 /// millimetres where centimetres still do (a level under 100 m modelled in millimetres is
-/// read in centimetres, 10× too large: the warning says which units were read). glTF states
+/// read in centimetres, 10× too large, unless its rooms' height says millimetres:
+/// [`bare_mesh_units_with_rooms`]; the warning says which units were read). glTF states
 /// metres, but exporters write centimetres there too, so a glTF file is read the same way. A
 /// scene TOML's `metres_per_unit` chooses.
 pub fn bare_mesh_units(longest: f64) -> f64 {
