@@ -1,4 +1,5 @@
-//! What the pair examples share (`portal_agreement`, `closed_voxel_triangles`): from the command
+//! What the pair examples share (`portal_agreement`, `closed_voxel_triangles`, `dominant_vpls`):
+//! from the command
 //! line `SCENE LEVEL.vgate CAMERA [WxH] [PATHS]`, the scene, its gates, the tracer, the VPLs of
 //! one-bounce light paths (seed 1, as `visgate compare`) and the camera's view.
 
@@ -11,6 +12,8 @@ use visgate_runtime::vpl::{PathParams, Vpl, path_vpls};
 
 /// A view of a level and the VPLs that light it.
 pub struct Pairs {
+    /// The level's gates (not read by `dominant_vpls`, hence the allow).
+    #[allow(dead_code)]
     pub gates: GateLevel,
     pub tracer: Tracer,
     pub vpls: Vec<Vpl>,
