@@ -4,6 +4,8 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 use serde::Serialize;
+use visgate_formats::desc::UpAxis;
+use visgate_formats::room_height::room_height_of;
 use visgate_formats::scene::FileKind;
 use visgate_formats::vgate::{BakeParams, BakedLevel, GridMeta, SectionKind};
 use visgate_formats::{Light, Scene};
@@ -34,6 +36,11 @@ struct SceneSummary {
     cameras: Vec<String>,
     bounds_min_m: Option<[f32; 3]>,
     bounds_max_m: Option<[f32; 3]>,
+    /// The rooms' height, floor to ceiling (visgate_formats::room_height: the median over
+    /// columns of the footprint of each one's tallest free span; `None`: no room measured).
+    rooms_m: Option<f64>,
+    /// The columns that hold a room.
+    room_columns: usize,
     closed: bool,
     static_geometry_hash: String,
     load_seconds: f64,
@@ -88,6 +95,10 @@ pub fn run(arg: &str, json: bool, no_textures: bool) -> Result<()> {
 
 fn summarise(scene: &Scene) -> SceneSummary {
     let (lo, hi) = scene.bounds().unzip();
+    let rooms = room_height_of(
+        || scene.static_triangles().map(|t| t.map(|p| p.as_dvec3())),
+        UpAxis::Y,
+    );
     SceneSummary {
         kind: "scene",
         name: scene.name.clone(),
@@ -123,6 +134,8 @@ fn summarise(scene: &Scene) -> SceneSummary {
         cameras: scene.cameras.iter().map(|c| c.name.clone()).collect(),
         bounds_min_m: lo.map(|v| v.to_array()),
         bounds_max_m: hi.map(|v| v.to_array()),
+        rooms_m: rooms.map(|r| r.median),
+        room_columns: rooms.map_or(0, |r| r.columns),
         closed: scene.closed,
         static_geometry_hash: scene.static_geometry_hash().to_string(),
         load_seconds: scene.report.load_seconds,
@@ -222,6 +235,13 @@ fn print_scene(s: &SceneSummary) {
             v3(hi),
             v3(size)
         );
+    }
+    match s.rooms_m {
+        Some(h) => println!(
+            "rooms       {h:.2} m floor to ceiling (the median of {} columns' tallest free span)",
+            s.room_columns
+        ),
+        None => println!("rooms       none measured (too few floors under a ceiling)"),
     }
     println!("closed      {}", if s.closed { "yes" } else { "no" });
     println!("static hash {}", s.static_geometry_hash);

@@ -43,16 +43,27 @@ pub struct RoomHeight {
 /// The rooms' height of `models` read with `up` as the up axis (`None`: fewer than
 /// [`LEAST_ROOM_SHARE`] of the covered columns hold a room, or no floor or ceiling at all).
 pub fn room_height(models: &[ImportedModel], up: UpAxis) -> Option<RoomHeight> {
+    room_height_of(
+        || {
+            models.iter().flat_map(|m| &m.meshes).flat_map(|mesh| {
+                mesh.triangles
+                    .iter()
+                    .map(move |t| t.map(|i| mesh.positions[i as usize].as_dvec3()))
+            })
+        },
+        up,
+    )
+}
+
+/// [`room_height`] of the triangles that `triangles` yields (each call from the first), read
+/// with `up` as the up axis: a loaded scene's in metres, +Y up (`visgate inspect`).
+pub fn room_height_of<I>(triangles: impl Fn() -> I, up: UpAxis) -> Option<RoomHeight>
+where
+    I: Iterator<Item = [DVec3; 3]>,
+{
     let (u, v, w) = match up {
         UpAxis::Y => (0, 2, 1),
         UpAxis::Z => (0, 1, 2),
-    };
-    let triangles = || {
-        models.iter().flat_map(|m| &m.meshes).flat_map(|mesh| {
-            mesh.triangles
-                .iter()
-                .map(move |t| t.map(|i| mesh.positions[i as usize].as_dvec3()))
-        })
     };
     let (lo, hi) = triangles()
         .flatten()

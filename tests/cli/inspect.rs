@@ -39,6 +39,11 @@ fn inspect_a_builtin_as_text_and_json() {
         out.contains("triangles") && out.contains("bounds") && out.contains("closed      yes"),
         "{out}"
     );
+    // How high its rooms stand, which tells a user whether the units are right.
+    assert!(
+        out.contains("rooms       3.00 m floor to ceiling (the median of"),
+        "{out}"
+    );
     // Each light a line: the four rooms' lamp and spot, where they are and how bright.
     let o = visgate(&["inspect", "builtin:four-rooms"]);
     let out = stdout(&o);
@@ -57,6 +62,24 @@ fn inspect_a_builtin_as_text_and_json() {
     assert_eq!(v["spot_lights"], 1);
     assert_eq!(v["closed"], true);
     assert!(v["triangles"].as_u64().expect("count") > 0);
+    let rooms = v["rooms_m"].as_f64().expect("rooms measured");
+    assert!((rooms - 3.0).abs() < 1e-3, "{rooms}");
+    assert!(v["room_columns"].as_u64().expect("columns") > 1000);
+    // A ground alone holds no room.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let ground = dir.path().join("ground.obj");
+    std::fs::write(
+        &ground,
+        "v 0 0 0\nv 40 0 0\nv 40 0 40\nv 0 0 40\nf 1 3 2\nf 1 4 3\n",
+    )
+    .expect("write");
+    let o = visgate(&["inspect", ground.to_str().expect("utf8")]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(
+        stdout(&o).contains("rooms       none measured"),
+        "{}",
+        stdout(&o)
+    );
 }
 
 #[test]
