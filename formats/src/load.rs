@@ -60,7 +60,8 @@ pub const ROOM_PLAUSIBLE_M: (f64, f64) = (1.9, 20.0);
 /// typical ([`ROOM_TYPICAL_M`]): a 9 m apartment in millimetres, read in centimetres by its
 /// extent, has rooms 27 m high, and in millimetres 2.7 m; an 8 m level in centimetres, read in
 /// metres, 270 m and 2.7 m. A level whose rooms no unit makes typical keeps its extent's unit
-/// (a sky box 100 m over a level in centimetres: 1,000 m, or 10 m in millimetres).
+/// (a level in centimetres under a sky box 100 m above its floor: 10 m in millimetres, no
+/// room's height either).
 pub fn bare_mesh_units_with_rooms(longest: f64, rooms: Option<f64>) -> f64 {
     let by_extent = bare_mesh_units(longest);
     let within = |h: f64, (lo, hi): (f64, f64)| (lo..=hi).contains(&h);
