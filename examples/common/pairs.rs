@@ -1,7 +1,7 @@
 //! What the pair examples share (`portal_agreement`, `closed_voxel_triangles`, `dominant_vpls`):
-//! from the command
-//! line `SCENE LEVEL.vgate CAMERA [WxH] [PATHS]`, the scene, its gates, the tracer, the VPLs of
-//! one-bounce light paths (seed 1, as `visgate compare`) and the camera's view.
+//! from the command line `SCENE LEVEL.vgate CAMERA [WxH] [PATHS]`, the scene, its gates, the
+//! tracer, the VPLs of one-bounce light paths (seed 1, as `visgate compare`) and the camera's
+//! view.
 
 use visgate_formats::ImportOptions;
 use visgate_formats::vgate::BakedLevel;

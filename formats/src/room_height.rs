@@ -1,7 +1,7 @@
 //! How high a bare mesh's rooms are, in its own units: the statistic that tells a level
 //! modelled in millimetres from one in centimetres (or a small level in centimetres from one
 //! in metres), which its extent alone cannot (a 9 m apartment in millimetres and a 90 m level
-//! in centimetres are both 9,000 units long; `load::bare_mesh_units_of`).
+//! in centimetres are both 9,000 units long; `load::bare_mesh_units_with_rooms`).
 //!
 //! The footprint is cut into columns (at most [`COLUMNS`] along its longer side); every
 //! triangle that faces up or down (floors, ceilings, table tops, stair treads: its normal within
