@@ -50,8 +50,9 @@ struct Cli {
     /// For a bare mesh file (a SCENE that is an OBJ, glTF or GLB, no scene TOML): metres per
     /// unit of the file (0.01 centimetres, 0.0254 inches, 0.001 millimetres). Default: metres,
     /// or centimetres (then millimetres) where metres would make the level longer than 1 km;
-    /// then centimetres or millimetres where that unit makes its rooms 1.9-6 m floor to ceiling
-    /// and the first makes them no room's height (outside 1.9-20 m). A warning says which.
+    /// then centimetres, inches or millimetres (the first that does) where that unit makes its
+    /// rooms 1.9-6 m floor to ceiling and the first makes them no room's height (outside 1.9-20
+    /// m). A warning says which.
     #[arg(long, global = true, value_name = "M", allow_negative_numbers = true)]
     metres_per_unit: Option<f64>,
     /// For a bare mesh file: the axis that points up. Default: y for glTF (its convention);

@@ -44,7 +44,7 @@ pub use desc::SceneDesc;
 pub use error::{SceneError, VgateError};
 pub use import::{ImportOptions, ImportedModel};
 pub use load::{
-    BARE_LEVEL_MAX_M, BareMesh, ROOM_PLAUSIBLE_M, ROOM_TYPICAL_M, bare_mesh_units,
+    BARE_LEVEL_MAX_M, BareMesh, ROOM_PLAUSIBLE_M, ROOM_TYPICAL_M, ROOM_UNITS, bare_mesh_units,
     bare_mesh_units_with_rooms, bare_mesh_up,
 };
 pub use scene::{Camera, GeometryHash, Light, Material, Mesh, Scene, Texture};

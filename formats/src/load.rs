@@ -53,22 +53,30 @@ pub const ROOM_TYPICAL_M: (f64, f64) = (1.9, 6.0);
 /// (Crytek Sponza's arcades stand 7 m, a nave 20 m). [Units: m]
 pub const ROOM_PLAUSIBLE_M: (f64, f64) = (1.9, 20.0);
 
+/// The units a bare mesh's rooms may choose over its extent ([`bare_mesh_units_with_rooms`]),
+/// in the order tried: centimetres, inches, millimetres. Centimetres before inches: rooms of
+/// 190–236 units are 1.9–2.4 m in centimetres and 4.8–6.0 m in inches, and a low room is
+/// likelier than a tall one; below 190 units only inches make a room (an 8 ft ceiling, 96
+/// units, is 0.96 m in centimetres). [Units: metres per unit]
+pub const ROOM_UNITS: [f64; 3] = [0.01, 0.0254, 0.001];
+
 /// Metres per unit of a bare mesh whose longest extent is `longest` of its units and whose
 /// rooms stand `rooms` of them floor to ceiling (`None`: not measured, a level under the open
 /// sky): [`bare_mesh_units`], unless that makes its rooms implausible
-/// ([`ROOM_PLAUSIBLE_M`]) and centimetres or millimetres, the first that does, makes them
-/// typical ([`ROOM_TYPICAL_M`]): a 9 m apartment in millimetres, read in centimetres by its
-/// extent, has rooms 27 m high, and in millimetres 2.7 m; an 8 m level in centimetres, read in
-/// metres, 270 m and 2.7 m. A level whose rooms no unit makes typical keeps its extent's unit
-/// (a level in centimetres under a sky box 100 m above its floor: 10 m in millimetres, no
-/// room's height either).
+/// ([`ROOM_PLAUSIBLE_M`]) and another of [`ROOM_UNITS`], the first that does and keeps the
+/// level under [`BARE_LEVEL_MAX_M`], makes them typical ([`ROOM_TYPICAL_M`]): a 9 m apartment
+/// in millimetres, read in centimetres by its extent, has rooms 27 m high, and in millimetres
+/// 2.7 m; an 8 m level in centimetres, read in metres, 270 m and 2.7 m; a house in inches
+/// (3ds Max, SketchUp), 96 units floor to ceiling, 96 m in metres and 2.44 m in inches. A
+/// level whose rooms no unit makes typical keeps its extent's unit (a level in centimetres
+/// under a sky box 100 m above its floor: 10 m in millimetres, no room's height either).
 pub fn bare_mesh_units_with_rooms(longest: f64, rooms: Option<f64>) -> f64 {
     let by_extent = bare_mesh_units(longest);
     let within = |h: f64, (lo, hi): (f64, f64)| (lo..=hi).contains(&h);
     match rooms {
-        Some(h) if !within(h * by_extent, ROOM_PLAUSIBLE_M) => [0.01, 0.001]
+        Some(h) if !within(h * by_extent, ROOM_PLAUSIBLE_M) => ROOM_UNITS
             .into_iter()
-            .filter(|&m| m < by_extent)
+            .filter(|&m| m != by_extent && longest * m <= BARE_LEVEL_MAX_M)
             .find(|&m| within(h * m, ROOM_TYPICAL_M))
             .unwrap_or(by_extent),
         _ => by_extent,
@@ -81,6 +89,7 @@ fn unit_name(metres_per_unit: f64) -> &'static str {
     match metres_per_unit {
         1.0 => "metres",
         0.01 => "centimetres",
+        0.0254 => "inches",
         _ => "millimetres",
     }
 }
@@ -218,7 +227,7 @@ fn rooms_warning(
 ) -> String {
     format!(
         "{}: a bare mesh states no units; its rooms stand {:.0} units floor to ceiling (the \
-         median over {} columns of its footprint), which in {} would make them {:.1} m high: \
+         median over {} columns of its footprint), which in {} would make them {:.*} m high: \
          read in {} (rooms {:.2} m high, the level {:.1} m long). To choose the units, pass \
          --metres-per-unit (0.01 centimetres, 0.0254 inches, 0.001 millimetres) or name the \
          mesh in a scene TOML with `metres_per_unit` (README, Scenes)",
@@ -226,6 +235,12 @@ fn rooms_warning(
         rooms.median,
         rooms.columns,
         unit_name(by_extent),
+        // Two decimals under 10 m: 0.96 m in centimetres is no room, where "1.0 m" would hide it.
+        if rooms.median * by_extent < 10.0 {
+            2
+        } else {
+            1
+        },
         rooms.median * by_extent,
         unit_name(chosen),
         rooms.median * chosen,

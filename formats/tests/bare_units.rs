@@ -1,13 +1,15 @@
 //! A bare mesh states no units: it is read in metres unless that would make a level longer
 //! than any indoor level, then in centimetres or millimetres, with a warning (and in metres
 //! with a note where that makes it longer than most, or smaller than any room) — unless its
-//! rooms' height, floor to ceiling, is implausible in that unit and typical in a smaller one
-//! (millimetres, or centimetres for a small level), with a warning saying both; a scene
+//! rooms' height, floor to ceiling, is implausible in that unit and typical in another
+//! (millimetres; centimetres for a small level; inches), with a warning saying both; a scene
 //! TOML's `metres_per_unit` chooses.
 
 use std::path::{Path, PathBuf};
 
-use visgate_formats::{ImportOptions, Scene, bare_mesh_units, bare_mesh_units_with_rooms};
+use visgate_formats::{
+    ImportOptions, ROOM_UNITS, Scene, bare_mesh_units, bare_mesh_units_with_rooms,
+};
 
 /// An OBJ of two triangles spanning `length` units along x (1 unit in y and z).
 fn write_obj(dir: &Path, name: &str, length: f64) -> PathBuf {
@@ -136,6 +138,15 @@ fn the_rooms_height_reads_millimetres_and_small_levels_in_centimetres_where_the_
     assert_eq!(bare_mesh_units_with_rooms(60.0, Some(15.4)), 1.0);
     assert_eq!(bare_mesh_units_with_rooms(3721.0, Some(10_000.0)), 0.01);
     assert_eq!(bare_mesh_units_with_rooms(9000.0, None), 0.01);
+    // Inches where centimetres leave the rooms under 1.9 m and inches make them a room's: an
+    // 8 ft ceiling in a 40 ft house and in a 150 ft hall (centimetres by its extent); a room of
+    // 200 units is 2.0 m in centimetres, tried first, and 5.1 m in inches.
+    assert_eq!(ROOM_UNITS, [0.01, 0.0254, 0.001]);
+    assert_eq!(bare_mesh_units_with_rooms(480.0, Some(96.0)), 0.0254);
+    assert_eq!(bare_mesh_units_with_rooms(1800.0, Some(96.0)), 0.0254);
+    assert_eq!(bare_mesh_units_with_rooms(800.0, Some(200.0)), 0.01);
+    // A level in metres with low rooms (1.2 m crawl spaces) is no level in smaller units.
+    assert_eq!(bare_mesh_units_with_rooms(40.0, Some(1.2)), 1.0);
     let dir = tempfile::tempdir().expect("tempdir");
     let options = ImportOptions::default();
     // A 9 m room in millimetres, 2.7 m high: its extent alone read it as 90 m.
@@ -180,6 +191,41 @@ fn the_rooms_height_reads_millimetres_and_small_levels_in_centimetres_where_the_
     )
     .expect("load");
     assert!((longest_m(&hall) - 37.0).abs() < 1e-3);
+    // A house in inches (3ds Max, SketchUp), 40 × 30 ft, 8 ft floor to ceiling: 96 units,
+    // 96 m in metres and 0.96 m in centimetres; read in inches, the warning saying so.
+    let inches = Scene::load(
+        &write_room(dir.path(), "in.obj", 480.0, 360.0, 96.0),
+        &options,
+    )
+    .expect("load");
+    assert!(
+        (longest_m(&inches) - 12.192).abs() < 1e-3,
+        "{}",
+        longest_m(&inches)
+    );
+    let w = inches.report.warnings.join("\n");
+    assert!(
+        w.contains("in metres would make them 96.0 m high")
+            && w.contains("read in inches (rooms 2.44 m high, the level 12.2 m long)"),
+        "{w}"
+    );
+    // A 150 ft hall in inches (1,800 units: centimetres by its extent, whose rooms of 0.96 m
+    // are no room's height either).
+    let hall_in = Scene::load(
+        &write_room(dir.path(), "hall-in.obj", 1800.0, 600.0, 96.0),
+        &options,
+    )
+    .expect("load");
+    assert!(
+        (longest_m(&hall_in) - 45.72).abs() < 1e-2,
+        "{}",
+        longest_m(&hall_in)
+    );
+    let w = hall_in.report.warnings.join("\n");
+    assert!(
+        w.contains("in centimetres would make them 0.96 m high") && w.contains("read in inches"),
+        "{w}"
+    );
     // The user's units are never guessed.
     let said = ImportOptions {
         bare: visgate_formats::BareMesh {
