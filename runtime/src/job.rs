@@ -349,6 +349,10 @@ impl RenderJob {
             None => Vec::new(),
         };
         let vpl_s = t.elapsed().as_secs_f64();
+        // The BVH only traced the VPLs: freed before the frame, whose buffers a software
+        // adapter holds in host memory beside it (Crytek Sponza subdivided to 4.2 M triangles:
+        // its BVH 0.8 GB of a 4.97 GB peak).
+        drop(tracer);
         let input = match (self.vpl_source, direct_only) {
             (VplSource::Rsm, false) => VplInput::Rsm(rsm),
             _ => VplInput::Given(&vpls),
