@@ -62,9 +62,10 @@ pub struct BakeArgs {
     /// Voxel edge of the grid the skeleton, clusters and gates are made on, metres (0–10; 0 =
     /// the level's grid): a finer --resolution then refines only the voxels' clusters and the
     /// portals, so the partition is the same at 256, 512 or 1024 and the bake much faster.
-    /// Default: the least whole multiple of the level's voxel that reaches 0.125 m (voxels of
-    /// one size at 256, 512 and 1024 where the 256 voxel is over 12.5 cm), or 1/128 of the
-    /// level's longest extent if that is smaller (a small level keeps its doors: the ajar door
+    /// Default: the finest of 1/128, 1/256, 1/512, … of the level's longest extent that reaches
+    /// 0.125 m, so one size at 128, 256, 512 and 1024 voxels (elsewhere the least whole multiple
+    /// of the level's voxel that reaches it), or 1/128 of the level's longest extent if that is
+    /// smaller (a small level keeps its doors: the ajar door
     /// at 256 then agrees with shadow rays on 91–98 % of pairs, 79–98 % partitioned on its own
     /// grid). A coarser --resolution is partitioned on a whole fraction of its voxel, each voxel
     /// taking the cluster most of its share has (at most 25 cm voxels: Dabrovic Sponza at 128 on

@@ -63,12 +63,15 @@ pub(crate) fn level_scaled(
 
 /// The default partition voxel of a level `longest` metres long on voxels of `voxel_m`: 1/128
 /// of its length where that is under [`PARTITION_VOXEL_M`] (a small level; its voxel where
-/// that is coarser), else the least whole multiple of its voxel that reaches
-/// [`PARTITION_VOXEL_M`] (to 1 %): its voxel itself where that reaches it (then the partition
-/// is made on the level's own grid). A whole multiple keeps the
-/// partition's voxels one size at every resolution: Crytek Sponza is partitioned on 14.6 cm
-/// voxels at 256, 512 and 1024 (1, 2 and 4 of its voxels; 73, 84 and 84 clusters), where on
-/// 12.5 cm voxels at 512 it made 89 and baked in 3.8–4.5 s instead of 2.9.
+/// that is coarser), else the finest of 1/128, 1/256, 1/512, … of its length that reaches
+/// [`PARTITION_VOXEL_M`] (to 1 %), where that is a whole multiple of its voxel (as at 128,
+/// 256, 512, … voxels), else the least whole multiple of its voxel that reaches it: its voxel
+/// itself where that reaches it (then the partition is made on the level's own grid). So the
+/// partition's voxels are one size at every such resolution: Crytek Sponza is partitioned on
+/// 14.6 cm voxels at 256, 512 and 1024 (1, 2 and 4 of its voxels; 73, 84 and 84 clusters),
+/// where on 12.5 cm voxels at 512 it made 89 and baked in 3.8–4.5 s instead of 2.9; a 24 m
+/// warehouse of shelving on 18.75 cm voxels at 128, 256 and 512 (201 clusters each), where
+/// the least whole multiple at 512, three of its 4.7 cm voxels, made 58.
 ///
 /// A coarse bake, whose voxels are at least twice that voxel and 1/[`COARSE_PARTS`] of the
 /// level (to 1 %), where the greater of these is at most [`COARSE_MAX_M`], is partitioned on
@@ -89,6 +92,16 @@ pub fn default_partition_voxel(longest: f32, voxel_m: f32) -> f32 {
         // Under twice the level's voxel: its own grid.
         return small.max(voxel_m);
     }
+    // The level's ladder of halvings from 1/128 of it, down to the last that reaches
+    // 12.5 cm (to 1 %): a whole multiple of the voxel at 128, 256, 512, … voxels alike.
+    let mut ladder = small;
+    while ladder / 2.0 * 1.01 >= PARTITION_VOXEL_M {
+        ladder /= 2.0;
+    }
+    let on_ladder = (ladder / voxel_m).round();
+    if on_ladder >= 1.0 && (ladder / voxel_m - on_ladder).abs() <= 0.01 * on_ladder {
+        return on_ladder * voxel_m;
+    }
     let k = (PARTITION_VOXEL_M / voxel_m / 1.01).ceil();
     k.max(1.0) * voxel_m
 }
@@ -107,6 +120,13 @@ mod tests {
         assert_eq!(default_partition_voxel(37.3, v256 / 4.0), v256);
         // 10.5 cm voxels: two of them, not the level's own grid (1.2 of them would be 12.5 cm).
         assert_eq!(default_partition_voxel(107.5, 0.105), 0.21);
+        // A 24 m level: its 128 voxel (18.75 cm) at 256 and 512 too, four of its 512 voxels
+        // where three would reach 12.5 cm; off the ladder (600 voxels, 4 cm), the least whole
+        // multiple that reaches 12.5 cm.
+        assert_eq!(default_partition_voxel(24.0, 24.0 / 256.0), 0.1875);
+        assert_eq!(default_partition_voxel(24.0, 24.0 / 512.0), 0.1875);
+        assert_eq!(default_partition_voxel(24.0, 24.0 / 1024.0), 0.1875);
+        assert_eq!(default_partition_voxel(24.0, 0.04), 0.16);
         // Voxels that reach 12.5 cm (to 1 %) and 1/256 of the level are the partition's own.
         for v in [v256, 0.124, 0.39] {
             assert_eq!(default_partition_voxel(100.0, v), v);

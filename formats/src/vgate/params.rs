@@ -90,8 +90,9 @@ pub struct BakeParams {
     /// from the level's by more than 1 %, and each voxel of the level then takes the cluster of
     /// its space: the partition stays that of this scale at any resolution (a level coarser
     /// than it takes the cluster most of its share of the finer grid has). 0 partitions the
-    /// level's own grid. `None` asks the bake for the least whole multiple of the level's
-    /// voxel that reaches 0.125 m, or 1/128 of the level's longest extent if that is smaller,
+    /// level's own grid. `None` asks the bake for the finest of 1/128, 1/256, … of the level's
+    /// longest extent that reaches 0.125 m (else the least whole multiple of the level's voxel
+    /// that does), or 1/128 of the level's longest extent if that is smaller,
     /// or on a coarser level a whole fraction of its voxel
     /// (`visgate_preprocess::bake::default_partition_voxel`); a baked file stores the value
     /// used ([`BakeParams::separate_partition_voxel`] reads it). [Limit: [0, 10]] [Units: m]
