@@ -1,13 +1,15 @@
 //! What a bare mesh file needs to be looked at. An OBJ or glTF on its own carries no light and
 //! no camera, so every render of it is black (or refused for want of a camera). Such a scene
-//! gets a point light and a camera named `inside` at the same place: the centre of the
+//! gets a point light and a camera named `inside` at one place: the centre of the
 //! level's largest empty ball, inside its largest room, where a level's light belongs (the
 //! caller finds it: `visgate_preprocess::ball`, from the scene alone, so that every render of
 //! it looks from one place, with a baked level or without), else the enclosed point farthest
 //! from the geometry found by rays; the camera looks level, the way whose view holds the most
 //! of the level (of 64 horizontal directions, the one whose rays within its 35° half-field
 //! reach farthest by the mean of their cubes), so that its first picture is neither a wall a
-//! metre away nor a room's corner. The light's intensity gives the walls around it about
+//! metre away nor a room's corner. Where it gets both, the camera then steps back, half-way to
+//! the geometry behind it, and looks past the light: a camera at the light sees every surface
+//! lit and no shadow, as a flash photograph does, and no visibility method differs there. The light's intensity gives the walls around it about
 //! 2 W/m² (`I = 2 d²` W/sr, `d` the mean distance to them). Where the mesh has materials
 //! that glow (a lamp's emissive surface, which lights nothing in visgate), the light goes to
 //! them instead: a point light a hundredth of the level's size in front of each glowing
@@ -138,26 +140,33 @@ pub fn light_a_bare_scene(
             here.push(format!("a point light of {intensity:.3} W/sr"));
         }
     }
+    let mut behind = None;
     if no_camera {
         let along = flat.map_or_else(|| deepest_look(at, reach), |(eye, centre)| centre - eye);
+        // A camera at the light sees no shadow: where the light is ours, it steps back.
+        behind = (flat.is_none() && !here.is_empty())
+            .then(|| step_back(at, along, reach))
+            .flatten();
+        let eye = behind.map_or(at, |step| at - along * step);
         scene.cameras.push(Camera {
             name: INSIDE_CAMERA.into(),
-            eye: at,
-            target: at + along,
+            eye,
+            target: eye + along,
             up: Vec3::Y,
             fov_x_rad: 70f32.to_radians(),
         });
         here.push(format!("a camera '{INSIDE_CAMERA}'"));
     }
-    let here = (!here.is_empty()).then(|| {
-        format!(
-            "{} at ({:.3}, {:.3}, {:.3}) m, {from}",
-            here.join(" and "),
-            at.x,
-            at.y,
-            at.z
-        )
-    });
+    let at_str = |p: Vec3| format!("({:.3}, {:.3}, {:.3}) m", p.x, p.y, p.z);
+    let here = match (behind, here.as_slice()) {
+        (_, []) => None,
+        (Some(step), [light, camera]) => Some(format!(
+            "{light} at {}, {from}, and {camera} at {}, {step:.2} m behind it, looking past it",
+            at_str(at),
+            at_str(scene.cameras.last().map_or(at, |c| c.eye))
+        )),
+        _ => Some(format!("{} at {}, {from}", here.join(" and "), at_str(at))),
+    };
     let said: Vec<String> = lamps_said.into_iter().chain(here).collect();
     Some(format!(
         "the scene has no {}: {} (give [[light]]s and [[camera]]s in a scene TOML that names the \
@@ -169,6 +178,22 @@ pub fn light_a_bare_scene(
         },
         said.join(" and ")
     ))
+}
+
+/// The fraction of the way to the geometry behind a camera at the light that it steps back
+/// ([`step_back`]). [Units: ratio]
+const STEP_BACK_SHARE: f32 = 0.5;
+
+/// The least step back worth taking: nearer, the light is still a headlight. [Units: m]
+const STEP_BACK_MIN_M: f32 = 0.25;
+
+/// How far a camera at the light `at`, looking along `along`, steps back so that it sees the
+/// light's shadows: [`STEP_BACK_SHARE`] of the way to the geometry behind it; `None` where
+/// that is under [`STEP_BACK_MIN_M`] or the ray behind escapes (a window to the void at its
+/// back: it would stand outside the level).
+fn step_back(at: Vec3, along: Vec3, reach: &dyn Fn(Vec3, Vec3) -> Option<f32>) -> Option<f32> {
+    let step = STEP_BACK_SHARE * reach(at, -along)?;
+    (step >= STEP_BACK_MIN_M).then_some(step)
 }
 
 /// Where bounds `lo`–`hi` are flat along an axis (`visgate_formats::geom::flat_axis`, as the
@@ -369,6 +394,15 @@ mod tests {
         // The lattice point nearest the box's centre is the farthest from every face.
         let c = (lo + hi) * 0.5;
         assert!((position - c).abs().max_element() < (hi - lo).max_element() / 7.0);
+        // The camera stands half-way from the light to the wall behind it, looking past it.
+        let cam = &scene.cameras[0];
+        let along = (cam.target - cam.eye).normalize();
+        let behind = reach(position, -along).expect("a wall behind");
+        assert!((cam.eye - (position - along * behind * 0.5)).length() < 1e-4);
+        assert!(said.contains("behind it, looking past it"), "{said}");
+        // With a light of its own, the camera stands where the light would: at the place.
+        scene.cameras.clear();
+        light_a_bare_scene(&mut scene, None, &probe, &reach).expect("a camera");
         assert_eq!(scene.cameras[0].eye, position);
     }
 
