@@ -150,13 +150,15 @@ impl ViewerApp {
             );
             let gates = self.settings.gates.gates;
             let text = layers::probe(&view, p, &self.tracer, level, vpls, &gates);
-            ui.painter().text(
-                rect.left_bottom() + egui::vec2(4.0, -4.0),
-                egui::Align2::LEFT_BOTTOM,
-                text,
-                egui::FontId::monospace(12.0),
-                egui::Color32::WHITE,
-            );
+            // On a dark band: white on a lit wall or a bright floor could not be read. Not
+            // clipped to the frame: a long line runs on past a narrow one.
+            let window = ui.painter();
+            let galley =
+                window.layout_no_wrap(text, egui::FontId::monospace(12.0), egui::Color32::WHITE);
+            let at = rect.left_bottom() + egui::vec2(4.0, -4.0 - galley.size().y);
+            let band = egui::Rect::from_min_size(at, galley.size()).expand(2.0);
+            window.rect_filled(band, 2.0, egui::Color32::from_black_alpha(170));
+            window.galley(at, galley, egui::Color32::WHITE);
         }
     }
 }

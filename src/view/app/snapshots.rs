@@ -178,6 +178,16 @@ fn the_viewer_beside_the_reference() {
 }
 
 #[test]
+fn the_viewer_reads_the_point_under_the_pointer_on_a_dark_band() {
+    // The line under the frame (the point, its normal, the VPLs facing it and those the gates
+    // pass) is drawn on a dark band: white on a lit wall could not be read.
+    let mut harness = first_frame(viewer(Layers::default(), false));
+    harness.hover_at(eframe::egui::pos2(600.0, 280.0));
+    harness.run_steps(2);
+    harness.snapshot_options("viewer_probe", &SnapshotOptions::new().threshold(2.0));
+}
+
+#[test]
 fn the_viewer_starts_balanced_and_its_fast_setting_walks_the_planes() {
     let mut harness = first_frame(viewer(Layers::default(), false));
     // The balanced setting, `visgate render`'s default: the triangles listed for the first
