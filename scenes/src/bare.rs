@@ -9,13 +9,14 @@
 //! reach farthest by the mean of their cubes), so that its first picture is neither a wall a
 //! metre away nor a room's corner. Where it gets both, the camera then steps back, half-way to
 //! the geometry behind it, and looks past the light: a camera at the light sees every surface
-//! lit and no shadow, as a flash photograph does, and no visibility method differs there. The light's intensity gives the walls around it about
-//! 2 W/m² (`I = 2 d²` W/sr, `d` the mean distance to them). Where the mesh has materials
-//! that glow (a lamp's emissive surface, which lights nothing in visgate), the light goes to
-//! them instead: a point light a hundredth of the level's size in front of each glowing
-//! material's surface (its area-weighted centre, off along its area-weighted normal), giving
-//! the walls around it its share by area of about 2 W/m²; a material whose faces point every
-//! way (a closed bulb) gets none.
+//! lit and no shadow, as a flash photograph does, and no visibility method differs there. The
+//! light's intensity gives the walls around it about 2 W/m² (`I = 2 d²` W/sr, `d` the mean
+//! distance to them). Where the mesh has materials that glow (a lamp's emissive surface, which
+//! lights nothing in visgate), the light goes to them instead: a point light a hundredth of the
+//! level's size in front of each glowing material's surface (its area-weighted centre, off
+//! along its area-weighted normal), giving the walls around it its share by area of about
+//! 2 W/m²; a material whose faces point every way (a closed bulb) gets none; the camera then
+//! stays at the place.
 
 use glam::Vec3;
 use visgate_formats::{Camera, Light, Scene};
