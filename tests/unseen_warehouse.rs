@@ -4,8 +4,8 @@
 //! mezzanine slab on columns over an office with zero-thickness walls, a door opening and a
 //! desk on legs; a lamp over the aisles. Baked at 128, 256 and 512 voxels, its partition is
 //! the same (the partition voxel is one size at every resolution: 18.75 cm, where the least
-//! whole multiple of the 512 voxel, 14.1 cm, made 58 clusters against 201), and gates light
-//! its views as the reference does (README, Scenes: a warehouse).
+//! whole multiple of the 512 voxel, 14.1 cm, made 58 clusters against 201), and so is its OBJ
+//! read bare; gates light its views as the reference does (README, Scenes: a warehouse).
 
 #[path = "support/mod.rs"]
 mod support;
@@ -203,6 +203,27 @@ fn a_warehouse_of_shelving_is_partitioned_alike_at_every_resolution_and_gates_li
         assert_eq!((b.0, b.1), (bakes[0].0, bakes[0].1), "128 against {}", b.2);
     }
     assert!(bakes[0].0 > 20.0, "clusters at 128: {}", bakes[0].0);
+
+    // Read bare, as a user drops the OBJ in: its metres and Y up kept, the same partition, and
+    // the skylights named as openings to the outside (no light or camera says where it is).
+    let bare = dir.path().join("bare.vgate");
+    let o = visgate(&[
+        "bake",
+        dir.path().join("warehouse.obj").to_str().expect("utf8"),
+        "-o",
+        bare.to_str().expect("utf8"),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let said = stderr(&o);
+    assert!(
+        !said.contains("read in") && !said.contains("Z up"),
+        "{said}"
+    );
+    assert_eq!(summary_count(&stdout(&o), "clusters"), bakes[0].0);
+    assert!(
+        said.matches("leak:").count() >= 2,
+        "the two skylights: {said}"
+    );
 
     let out = dir.path().join("compare");
     let level = dir.path().join("warehouse-128.vgate");
