@@ -148,15 +148,16 @@ fn the_rooms_height_reads_millimetres_and_small_levels_in_centimetres_where_the_
     // A level in metres with low rooms (1.2 m crawl spaces) is no level in smaller units.
     assert_eq!(bare_mesh_units_with_rooms(40.0, Some(1.2)), 1.0);
     let dir = tempfile::tempdir().expect("tempdir");
-    let options = ImportOptions::default();
+    // A room `long` × `wide` × `high` units read bare: its longest side in metres and its
+    // warnings.
+    let read = |name: &str, long: f64, wide: f64, high: f64| {
+        let path = write_room(dir.path(), name, long, wide, high);
+        let scene = Scene::load(&path, &ImportOptions::default()).expect("load");
+        (longest_m(&scene), scene.report.warnings.join("\n"))
+    };
     // A 9 m room in millimetres, 2.7 m high: its extent alone read it as 90 m.
-    let mm = Scene::load(
-        &write_room(dir.path(), "mm.obj", 9000.0, 6000.0, 2700.0),
-        &options,
-    )
-    .expect("load");
-    assert!((longest_m(&mm) - 9.0).abs() < 1e-3, "{}", longest_m(&mm));
-    let w = mm.report.warnings.join("\n");
+    let (mm, w) = read("mm.obj", 9000.0, 6000.0, 2700.0);
+    assert!((mm - 9.0).abs() < 1e-3, "{mm}");
     assert!(
         w.contains("mm.obj")
             && w.contains("its rooms stand 2700 units floor to ceiling")
@@ -166,44 +167,22 @@ fn the_rooms_height_reads_millimetres_and_small_levels_in_centimetres_where_the_
         "{w}"
     );
     // An 8 m room in centimetres: its extent alone read it as 800 m.
-    let cm = Scene::load(
-        &write_room(dir.path(), "cm.obj", 800.0, 500.0, 270.0),
-        &options,
-    )
-    .expect("load");
-    assert!((longest_m(&cm) - 8.0).abs() < 1e-4, "{}", longest_m(&cm));
-    let w = cm.report.warnings.join("\n");
+    let (cm, w) = read("cm.obj", 800.0, 500.0, 270.0);
+    assert!((cm - 8.0).abs() < 1e-4, "{cm}");
     assert!(
         w.contains("in metres would make them 270.0 m high") && w.contains("read in centimetres"),
         "{w}"
     );
     // The same room in metres is left alone, and so is a 37 m hall in centimetres 14.6 m high.
-    let m = Scene::load(&write_room(dir.path(), "m.obj", 8.0, 5.0, 2.7), &options).expect("load");
-    assert!((longest_m(&m) - 8.0).abs() < 1e-4);
-    assert!(
-        !m.report.warnings.join("\n").contains("units"),
-        "{:?}",
-        m.report.warnings
-    );
-    let hall = Scene::load(
-        &write_room(dir.path(), "hall.obj", 3700.0, 2000.0, 1460.0),
-        &options,
-    )
-    .expect("load");
-    assert!((longest_m(&hall) - 37.0).abs() < 1e-3);
+    let (m, w) = read("m.obj", 8.0, 5.0, 2.7);
+    assert!((m - 8.0).abs() < 1e-4);
+    assert!(!w.contains("units"), "{w}");
+    let (hall, _) = read("hall.obj", 3700.0, 2000.0, 1460.0);
+    assert!((hall - 37.0).abs() < 1e-3);
     // A house in inches (3ds Max, SketchUp), 40 × 30 ft, 8 ft floor to ceiling: 96 units,
     // 96 m in metres and 0.96 m in centimetres; read in inches, the warning saying so.
-    let inches = Scene::load(
-        &write_room(dir.path(), "in.obj", 480.0, 360.0, 96.0),
-        &options,
-    )
-    .expect("load");
-    assert!(
-        (longest_m(&inches) - 12.192).abs() < 1e-3,
-        "{}",
-        longest_m(&inches)
-    );
-    let w = inches.report.warnings.join("\n");
+    let (inches, w) = read("in.obj", 480.0, 360.0, 96.0);
+    assert!((inches - 12.192).abs() < 1e-3, "{inches}");
     assert!(
         w.contains("in metres would make them 96.0 m high")
             && w.contains("read in inches (rooms 2.44 m high, the level 12.2 m long)"),
@@ -211,17 +190,8 @@ fn the_rooms_height_reads_millimetres_and_small_levels_in_centimetres_where_the_
     );
     // A 150 ft hall in inches (1,800 units: centimetres by its extent, whose rooms of 0.96 m
     // are no room's height either).
-    let hall_in = Scene::load(
-        &write_room(dir.path(), "hall-in.obj", 1800.0, 600.0, 96.0),
-        &options,
-    )
-    .expect("load");
-    assert!(
-        (longest_m(&hall_in) - 45.72).abs() < 1e-2,
-        "{}",
-        longest_m(&hall_in)
-    );
-    let w = hall_in.report.warnings.join("\n");
+    let (hall_in, w) = read("hall-in.obj", 1800.0, 600.0, 96.0);
+    assert!((hall_in - 45.72).abs() < 1e-2, "{hall_in}");
     assert!(
         w.contains("in centimetres would make them 0.96 m high") && w.contains("read in inches"),
         "{w}"
