@@ -157,12 +157,22 @@ fn write_warehouse(dir: &Path) {
     std::fs::write(dir.join("warehouse.toml"), SCENE).expect("write warehouse.toml");
 }
 
-/// The level baked at `resolution`: its clusters and gates, and the partition's line.
-fn bake(dir: &Path, resolution: &str) -> (f64, f64, String) {
-    let level = dir.join(format!("warehouse-{resolution}.vgate"));
+/// What a bake of the warehouse printed: its clusters and gates, the partition's line, and
+/// its warnings.
+struct Baked {
+    clusters: f64,
+    gates: f64,
+    partition: String,
+    said: String,
+}
+
+/// `file` (warehouse.toml or the bare warehouse.obj) in `dir` baked at `resolution`, into
+/// `file`-`resolution`.vgate there.
+fn bake(dir: &Path, file: &str, resolution: &str) -> Baked {
+    let level = dir.join(format!("{}-{resolution}.vgate", file.replace('.', "-")));
     let o = visgate(&[
         "bake",
-        dir.join("warehouse.toml").to_str().expect("utf8"),
+        dir.join(file).to_str().expect("utf8"),
         "-o",
         level.to_str().expect("utf8"),
         "--resolution",
@@ -174,11 +184,12 @@ fn bake(dir: &Path, resolution: &str) -> (f64, f64, String) {
         .find(|l| l.starts_with("partition:"))
         .unwrap_or_else(|| panic!("no partition line:\n{report}"))
         .to_string();
-    (
-        summary_count(&report, "clusters"),
-        summary_count(&report, "gates"),
+    Baked {
+        clusters: summary_count(&report, "clusters"),
+        gates: summary_count(&report, "gates"),
         partition,
-    )
+        said: stderr(&o),
+    }
 }
 
 #[test]
@@ -195,38 +206,49 @@ fn a_warehouse_of_shelving_is_partitioned_alike_at_every_resolution_and_gates_li
     // (two and four of theirs), so the same clusters and gates.
     let bakes: Vec<_> = ["128", "256", "512"]
         .iter()
-        .map(|r| bake(dir.path(), r))
+        .map(|r| bake(dir.path(), "warehouse.toml", r))
         .collect();
-    assert!(bakes[0].2.contains("the level's grid"), "{}", bakes[0].2);
+    let coarse = &bakes[0];
+    assert!(
+        coarse.partition.contains("the level's grid"),
+        "{}",
+        coarse.partition
+    );
     for b in &bakes[1..] {
-        assert!(b.2.contains("made on a 0.188 m grid"), "{}", b.2);
-        assert_eq!((b.0, b.1), (bakes[0].0, bakes[0].1), "128 against {}", b.2);
+        assert!(
+            b.partition.contains("made on a 0.188 m grid"),
+            "{}",
+            b.partition
+        );
+        assert_eq!(
+            (b.clusters, b.gates),
+            (coarse.clusters, coarse.gates),
+            "128 against {}",
+            b.partition
+        );
     }
-    assert!(bakes[0].0 > 20.0, "clusters at 128: {}", bakes[0].0);
+    assert!(
+        coarse.clusters > 20.0,
+        "clusters at 128: {}",
+        coarse.clusters
+    );
 
     // Read bare, as a user drops the OBJ in: its metres and Y up kept, the same partition, and
     // the skylights named as openings to the outside (no light or camera says where it is).
-    let bare = dir.path().join("bare.vgate");
-    let o = visgate(&[
-        "bake",
-        dir.path().join("warehouse.obj").to_str().expect("utf8"),
-        "-o",
-        bare.to_str().expect("utf8"),
-    ]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let said = stderr(&o);
+    let bare = bake(dir.path(), "warehouse.obj", "128");
+    let said = &bare.said;
     assert!(
         !said.contains("read in") && !said.contains("Z up"),
         "{said}"
     );
-    assert_eq!(summary_count(&stdout(&o), "clusters"), bakes[0].0);
+    assert_eq!(bare.clusters, coarse.clusters);
     assert!(
         said.matches("leak:").count() >= 2,
         "the two skylights: {said}"
     );
 
     let out = dir.path().join("compare");
-    let level = dir.path().join("warehouse-128.vgate");
+    let level = dir.path().join("warehouse-toml-128.vgate");
     let row = gates_and_none(&dir.path().join("warehouse.toml"), &level, "96x72", &out);
     for camera in ["aisle", "mezzanine"] {
         let (energy, black) = row(camera, "gates");
