@@ -141,11 +141,13 @@ pub fn light_a_bare_scene(
             here.push(format!("a point light of {intensity:.3} W/sr"));
         }
     }
+    // Whether the light just placed stands at `at` (not at the lamps).
+    let light_here = !here.is_empty();
     let mut behind = None;
     if no_camera {
         let along = flat.map_or_else(|| deepest_look(at, reach), |(eye, centre)| centre - eye);
         // A camera at the light sees no shadow: where the light is ours, it steps back.
-        behind = (flat.is_none() && !here.is_empty())
+        behind = (flat.is_none() && light_here)
             .then(|| step_back(at, along, reach))
             .flatten();
         let eye = behind.map_or(at, |step| at - along * step);
