@@ -60,6 +60,13 @@ struct Cli {
     /// along z, else y. The bake, the renders and the viewer must read a mesh the same way.
     #[arg(long, global = true, value_enum)]
     up: Option<UpArg>,
+    /// For a bare mesh file: keep the triangles that lie far from the rest. By default a few
+    /// (at most 1 %) whose leaving out shortens the level more than 4× — a sky box, a helper
+    /// object left in the export, a vertex in the wrong place — are left out, with a warning:
+    /// they would choose the units and size the bake's voxels. A scene TOML keeps every
+    /// triangle (the bake then warns of them).
+    #[arg(long, global = true)]
+    keep_far: bool,
 }
 
 /// An up axis on the command line.
@@ -87,6 +94,7 @@ fn bare_mesh_of(cli: &Cli) -> Result<BareMesh> {
             UpArg::Y => UpAxis::Y,
             UpArg::Z => UpAxis::Z,
         }),
+        keep_far: cli.keep_far,
     })
 }
 

@@ -13,6 +13,7 @@ use crate::error::SceneError;
 use crate::import::{self, ImportOptions, ImportedModel};
 use crate::room_height::{RoomHeight, room_height};
 use crate::scene::{FileKind, Scene, parent_dir};
+use crate::stray::{Stray, leave_out_strays};
 
 /// The longest a bare mesh may be, read in metres, before it is read in smaller units
 /// ([`bare_mesh_units`]): longer than any indoor level. [Units: m]
@@ -121,13 +122,42 @@ pub struct BareMesh {
     pub metres_per_unit: Option<f64>,
     /// The axis that points up; `None`: +Y for glTF (its convention), [`bare_mesh_up`] for OBJ.
     pub up: Option<UpAxis>,
+    /// Keep the triangles far from the rest ([`crate::stray::leave_out_strays`] leaves them
+    /// out otherwise).
+    pub keep_far: bool,
 }
 
 impl BareMesh {
     /// Whether the user said anything.
     pub fn is_set(&self) -> bool {
-        self.metres_per_unit.is_some() || self.up.is_some()
+        self.metres_per_unit.is_some() || self.up.is_some() || self.keep_far
     }
+}
+
+/// What a user reads when a bare mesh's stray triangles `s` (in the file's units, now read as
+/// `metres_per_unit`) were left out of it.
+fn strays_note(path: &Path, s: &Stray, metres_per_unit: f64) -> String {
+    let m = metres_per_unit as f32;
+    let p = s.farthest;
+    format!(
+        "{}: {} of its {} triangles {} far from the rest, the farthest corner at ({:.2}, {:.2}, \
+         {:.2}) in the file, {:.1} m from the rest's bounds: left out of the level. With them it \
+         would be {:.1} m long where the rest is {:.2} m, and the bake's voxels {:.0}× as large \
+         as the rest needs. A sky box, a helper object left in the export, a vertex in the wrong \
+         place? To keep them, pass --keep-far (or name the mesh in a scene TOML, which keeps \
+         every triangle)",
+        path.display(),
+        s.triangles,
+        s.total,
+        if s.triangles == 1 { "lies" } else { "lie" },
+        p.x,
+        p.y,
+        p.z,
+        s.distance_m * m,
+        s.longest_m() * m,
+        s.rest_longest_m() * m,
+        s.longest_m() / s.rest_longest_m().max(f32::MIN_POSITIVE),
+    )
 }
 
 /// How much more of the triangles' area must face ±Z than ±Y, and how much lower the level
@@ -408,20 +438,29 @@ impl Scene {
         if !bare && options.bare.is_set() {
             return Err(SceneError::Invalid {
                 file: path.to_path_buf(),
-                what: "--up and --metres-per-unit read a bare mesh file (OBJ, glTF, GLB); a \
-                       scene TOML states its own `up` and `metres_per_unit`"
+                what: "--up, --metres-per-unit and --keep-far read a bare mesh file (OBJ, glTF, \
+                       GLB); a scene TOML states its own `up` and `metres_per_unit` and keeps \
+                       every triangle"
                     .into(),
             });
         }
-        let models = desc
+        let mut models = desc
             .meshes
             .iter()
             .map(|m| import::import_file(&base.join(&m.path), options))
             .collect::<Result<Vec<_>, _>>()?;
+        let strays = (bare && !options.bare.keep_far)
+            .then(|| leave_out_strays(&mut models))
+            .flatten();
         let mut notes = match kind {
             Some(k) if bare => read_bare(&mut desc, &models, path, k, options.bare),
             _ => Vec::new(),
         };
+        if let Some(s) = strays {
+            let note = strays_note(path, &s, desc.metres_per_unit);
+            tracing::warn!("{note}");
+            notes.insert(0, note);
+        }
         if bare {
             // A bare glTF file brings the lights and cameras it places (gltf_nodes.rs), its suns
             // placed as far spot lights when the scene is assembled (sun.rs).

@@ -6,6 +6,7 @@
 
 use glam::Vec3;
 
+use crate::import::{ImportedModel, RawMesh};
 use crate::scene::{Scene, points_bounds};
 
 /// At most this share of the static triangles (and at least one) may be left out of the bulk
@@ -56,6 +57,11 @@ pub fn stray_geometry(scene: &Scene) -> Option<Stray> {
 
 /// [`stray_geometry`] of a level's static triangles `tris`.
 pub fn stray_triangles(tris: &[[Vec3; 3]]) -> Option<Stray> {
+    stray_split(tris).map(|(s, _)| s)
+}
+
+/// [`stray_triangles`], and which of `tris` are the stray ones (true: far from the rest).
+pub fn stray_split(tris: &[[Vec3; 3]]) -> Option<(Stray, Vec<bool>)> {
     let n = tris.len();
     if n < 8 {
         return None;
@@ -73,9 +79,16 @@ pub fn stray_triangles(tris: &[[Vec3; 3]]) -> Option<Stray> {
         (lo[axis], hi[axis]) = (low, high);
     }
     let reach = (hi - lo).max_element();
-    let (strays, rest): (Vec<&[Vec3; 3]>, Vec<&[Vec3; 3]>) = tris
-        .iter()
-        .partition(|t| t.iter().any(|&p| off_box(p, (lo, hi)) > reach));
+    let far: Vec<bool> = (tris.iter())
+        .map(|t| t.iter().any(|&p| off_box(p, (lo, hi)) > reach))
+        .collect();
+    let of = |stray: bool| -> Vec<&[Vec3; 3]> {
+        (tris.iter().zip(&far))
+            .filter(|&(_, &f)| f == stray)
+            .map(|(t, _)| t)
+            .collect()
+    };
+    let (strays, rest) = (of(true), of(false));
     let corners = |tris: &[&[Vec3; 3]]| points_bounds(tris.iter().flat_map(|t| t.iter().copied()));
     let (Some(rest), Some(bounds)) = (
         corners(&rest),
@@ -92,14 +105,65 @@ pub fn stray_triangles(tris: &[[Vec3; 3]]) -> Option<Stray> {
         .iter()
         .flat_map(|t| t.iter().copied())
         .max_by(|a, b| off_box(*a, rest).total_cmp(&off_box(*b, rest)))?;
-    Some(Stray {
+    let stray = Stray {
         triangles: strays.len(),
         total: n,
         farthest,
         distance_m: off_box(farthest, rest),
         bounds,
         rest,
-    })
+    };
+    Some((stray, far))
+}
+
+/// Leaves the stray triangles ([`stray_triangles`]) of a bare mesh's `models` out of them, in
+/// the file's own units and axes, with the vertices only they used; what was left out, `None`
+/// where nothing was. A bare mesh has no scene TOML to mark them `static = false` in, and they
+/// would choose its units (a house in a sky box 2 km wide reads as centimetres) and size the
+/// bake's grid.
+pub fn leave_out_strays(models: &mut [ImportedModel]) -> Option<Stray> {
+    let tris: Vec<[Vec3; 3]> = (models.iter().flat_map(|m| &m.meshes))
+        .flat_map(|m| {
+            m.triangles
+                .iter()
+                .map(|t| t.map(|i| m.positions[i as usize]))
+        })
+        .collect();
+    let (stray, far) = stray_split(&tris)?;
+    let mut far = far.into_iter();
+    for mesh in models.iter_mut().flat_map(|m| &mut m.meshes) {
+        mesh.triangles.retain(|_| !far.next().unwrap_or(false));
+        keep_used_vertices(mesh);
+    }
+    Some(stray)
+}
+
+/// Drops the vertices of `mesh` that no triangle uses (their normals and texture coordinates
+/// with them), renumbering the triangles' corners.
+fn keep_used_vertices(mesh: &mut RawMesh) {
+    let mut used = vec![false; mesh.positions.len()];
+    for &i in mesh.triangles.iter().flatten() {
+        used[i as usize] = true;
+    }
+    // Each kept vertex's new index: how many kept vertices come before it.
+    let new_index: Vec<u32> = (used.iter())
+        .scan(0u32, |kept, &u| {
+            *kept += u as u32;
+            Some(*kept - 1)
+        })
+        .collect();
+    fn keep<T>(v: &mut Vec<T>, used: &[bool]) {
+        if v.len() == used.len() {
+            let mut flags = used.iter();
+            v.retain(|_| *flags.next().unwrap_or(&false));
+        }
+    }
+    keep(&mut mesh.positions, &used);
+    keep(&mut mesh.normals, &used);
+    keep(&mut mesh.uvs, &used);
+    for t in &mut mesh.triangles {
+        *t = t.map(|i| new_index[i as usize]);
+    }
 }
 
 /// How far point `p` lies outside box `b` (0 inside).
@@ -141,6 +205,45 @@ mod tests {
         assert!((s.distance_m - 497.0).abs() < 1e-3, "{s:?}");
         assert_eq!(s.rest, (Vec3::ZERO, Vec3::new(4.0, 3.0, 4.0)));
         assert!((s.longest_m() - 501.0).abs() < 1e-3 && s.rest_longest_m() == 4.0);
+    }
+
+    #[test]
+    fn a_bare_meshs_far_triangle_is_left_out_with_the_vertices_only_it_used() {
+        // The room as one mesh of three corners a triangle, the far triangle in its middle.
+        let mut tris = room();
+        let far = Vec3::new(500.0, 0.0, 0.0);
+        tris.insert(10, [far, far + Vec3::X, far + Vec3::Y]);
+        let mesh = RawMesh {
+            name: "level".into(),
+            positions: tris.iter().flatten().copied().collect(),
+            normals: vec![Vec3::Y; 3 * tris.len()],
+            uvs: (0..3 * tris.len())
+                .map(|i| glam::Vec2::splat(i as f32))
+                .collect(),
+            triangles: (0..tris.len() as u32)
+                .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+                .collect(),
+            material: 0,
+        };
+        let mut models = vec![ImportedModel {
+            meshes: vec![mesh],
+            ..ImportedModel::default()
+        }];
+        let s = leave_out_strays(&mut models).expect("the far triangle");
+        assert_eq!((s.triangles, s.total), (1, 34));
+        let m = &models[0].meshes[0];
+        tris.remove(10);
+        let kept: Vec<[Vec3; 3]> = (m.triangles.iter())
+            .map(|t| t.map(|i| m.positions[i as usize]))
+            .collect();
+        assert_eq!(kept, tris);
+        assert_eq!((m.positions.len(), m.normals.len()), (99, 99));
+        // The texture coordinates follow their vertices: those after the far triangle's moved
+        // down by its three.
+        assert_eq!(m.uvs[30], glam::Vec2::splat(33.0));
+        // Nothing far: nothing left out.
+        assert_eq!(leave_out_strays(&mut models), None);
+        assert_eq!(models[0].meshes[0].triangles.len(), 33);
     }
 
     #[test]

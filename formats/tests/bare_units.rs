@@ -200,7 +200,7 @@ fn the_rooms_height_reads_millimetres_and_small_levels_in_centimetres_where_the_
     let said = ImportOptions {
         bare: visgate_formats::BareMesh {
             metres_per_unit: Some(0.01),
-            up: None,
+            ..Default::default()
         },
         ..ImportOptions::default()
     };

@@ -129,7 +129,7 @@ fn a_sun_is_placed_for_its_irradiance_in_metres_whatever_the_file_s_units() {
     let options = ImportOptions {
         bare: visgate_formats::load::BareMesh {
             metres_per_unit: Some(0.01),
-            up: None,
+            ..Default::default()
         },
         ..ImportOptions::default()
     };

@@ -130,12 +130,13 @@ fn bake_says_each_import_warning_once() {
 }
 
 #[test]
-fn a_triangle_far_from_the_level_is_named_before_the_bake() {
+fn a_triangle_far_from_the_level_is_left_out_of_a_bare_mesh_and_named_in_a_scene_file() {
     // The leaky room's mesh (8 m long) with one triangle 500 m away, as an exporter leaves a
-    // helper behind: the grid spans it, so the bake says where it is and by how much it grew
-    // the voxels; the room alone says nothing of it.
+    // helper behind. Read bare, it is left out, said so, and the bake is the room's alone; kept
+    // (--keep-far) or named in a scene TOML, the grid spans it, so the bake says where it is
+    // and by how much it grew the voxels. The room alone says nothing of it.
     let dir = tempfile::tempdir().expect("tempdir");
-    leaky_room(dir.path());
+    let toml = leaky_room(dir.path());
     let mesh = dir.path().join("room.obj");
     let out = dir.path().join("l.vgate");
     let (m, o) = (mesh.to_str().expect("utf-8"), out.to_str().expect("utf-8"));
@@ -150,12 +151,31 @@ fn a_triangle_far_from_the_level_is_named_before_the_bake() {
     let mut obj = std::fs::read_to_string(&mesh).expect("obj");
     obj += "v 500 0 0\nv 501 0 0\nv 500 1 0\nf -3 -2 -1\n";
     std::fs::write(&mesh, obj).expect("obj");
-    let stray = visgate(&bake);
-    assert!(stray.status.success(), "{}", stderr(&stray));
+    let left_out = support::visgate_warn(&bake);
+    assert!(left_out.status.success(), "{}", stderr(&left_out));
+    let said = "1 of its 21 triangles lies far from the rest, the farthest corner at (501.00, \
+                0.00, 0.00) in the file, 493.0 m from the rest's bounds: left out of the level. \
+                With them it would be 501.0 m long where the rest is 8.00 m";
+    assert!(stderr(&left_out).contains(said), "{}", stderr(&left_out));
+    // The same grid and partition as the room's alone.
+    let summary = |o: &std::process::Output| -> Vec<String> {
+        (stdout(o).lines())
+            .filter(|l| l.starts_with("grid ") || l.starts_with("clusters "))
+            .map(String::from)
+            .collect()
+    };
+    assert_eq!(summary(&left_out), summary(&clean));
     let said = "1 of the level's 21 static triangles lies far from the rest: the farthest corner \
                 at (501.00, 0.00, 0.00) m, 493 m from the rest's bounds. The grid spans them, a \
                 501.0 m level where the rest is 8.00 m long, so its voxels are 63× as large";
-    assert!(stderr(&stray).contains(said), "{}", stderr(&stray));
+    let keep = visgate(&["bake", m, "--keep-far", "--resolution", "32", "-o", o]);
+    assert!(keep.status.success(), "{}", stderr(&keep));
+    assert!(stderr(&keep).contains(said), "{}", stderr(&keep));
+    let t = toml.to_str().expect("utf-8");
+    // (The leaky room's TOML says it is closed: its window leaks.)
+    let described = visgate(&["bake", t, "--allow-leaks", "--resolution", "32", "-o", o]);
+    assert!(described.status.success(), "{}", stderr(&described));
+    assert!(stderr(&described).contains(said), "{}", stderr(&described));
 }
 
 #[test]

@@ -118,7 +118,7 @@ impl GateLevel {
                 level.info.geometry_hash,
                 scene.static_geometry_hash(),
                 if scene.is_bare_mesh() {
-                    ", or read the mesh as the bake did (the same --up and --metres-per-unit)"
+                    ", or read the mesh as the bake did (the same --up, --metres-per-unit and --keep-far)"
                 } else {
                     ""
                 }

@@ -1,0 +1,105 @@
+//! A bare mesh's few triangles far from the rest — a sky box, a helper object left in the
+//! export — are left out of it, with a warning, before its units are chosen: a house in a sky
+//! box 2,000 units wide read as a 20 m level in centimetres, the house 8 cm long.
+//! `--keep-far` (BareMesh::keep_far) and a scene TOML keep every triangle.
+
+use std::fmt::Write as _;
+use std::path::Path;
+
+use visgate_formats::{BareMesh, ImportOptions, Scene};
+
+/// An 8 × 5 m house 2.7 m high in metres (its floor a grid of 1,280 triangles, its ceiling
+/// and walls single quads), inside a sky box 2,000 units wide (12 triangles facing in).
+fn write_house_in_sky(dir: &Path) -> String {
+    let mut obj = String::new();
+    let mut quad = |c: [[f64; 3]; 4]| {
+        for [x, y, z] in c {
+            writeln!(obj, "v {x} {y} {z}").expect("write");
+        }
+        obj += "f -4 -3 -2 -1\n";
+    };
+    let (l, w, h) = (8.0, 5.0, 2.7);
+    let (nx, nz) = (32, 20);
+    for i in 0..nx {
+        for k in 0..nz {
+            let (x0, x1) = (l * i as f64 / nx as f64, l * (i + 1) as f64 / nx as f64);
+            let (z0, z1) = (w * k as f64 / nz as f64, w * (k + 1) as f64 / nz as f64);
+            quad([[x0, 0.0, z0], [x0, 0.0, z1], [x1, 0.0, z1], [x1, 0.0, z0]]);
+        }
+    }
+    quad([[0.0, h, 0.0], [l, h, 0.0], [l, h, w], [0.0, h, w]]);
+    quad([[0.0, 0.0, 0.0], [l, 0.0, 0.0], [l, h, 0.0], [0.0, h, 0.0]]);
+    quad([[0.0, 0.0, w], [0.0, h, w], [l, h, w], [l, 0.0, w]]);
+    quad([[0.0, 0.0, 0.0], [0.0, h, 0.0], [0.0, h, w], [0.0, 0.0, w]]);
+    quad([[l, 0.0, 0.0], [l, 0.0, w], [l, h, w], [l, h, 0.0]]);
+    let (a, b) = (-1000.0, 1000.0);
+    quad([[a, a, a], [b, a, a], [b, a, b], [a, a, b]]);
+    quad([[a, b, a], [a, b, b], [b, b, b], [b, b, a]]);
+    quad([[a, a, a], [a, b, a], [b, b, a], [b, a, a]]);
+    quad([[a, a, b], [b, a, b], [b, b, b], [a, b, b]]);
+    quad([[a, a, a], [a, a, b], [a, b, b], [a, b, a]]);
+    quad([[b, a, a], [b, b, a], [b, b, b], [b, a, b]]);
+    std::fs::write(dir.join("house.obj"), obj).expect("obj");
+    std::fs::write(
+        dir.join("house.toml"),
+        "[[mesh]]\npath = \"house.obj\"\n[[light]]\ntype = \"point\"\n\
+         position = [4.0, 2.0, 2.5]\nintensity = [5, 5, 5]\n",
+    )
+    .expect("toml");
+    "house.obj".into()
+}
+
+fn longest_m(scene: &Scene) -> f32 {
+    let (lo, hi) = scene.bounds().expect("bounds");
+    (hi - lo).max_element()
+}
+
+#[test]
+fn a_sky_box_round_a_bare_house_is_left_out_before_its_units_are_chosen() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let house = dir.path().join(write_house_in_sky(dir.path()));
+    let scene = Scene::load(&house, &ImportOptions::default()).expect("load");
+    // The house alone, in metres: 1,280 + 10 triangles.
+    assert!(
+        (longest_m(&scene) - 8.0).abs() < 1e-4,
+        "{}",
+        longest_m(&scene)
+    );
+    assert_eq!(scene.static_triangles().count(), 1290);
+    let w = scene.report.warnings.join("\n");
+    assert!(
+        w.contains("12 of its 1302 triangles lie far from the rest")
+            && w.contains("left out of the level")
+            && w.contains("With them it would be 2000.0 m long where the rest is 8.00 m")
+            && w.contains("--keep-far")
+            && !w.contains("centimetres"),
+        "{w}"
+    );
+    // Kept: the sky box chooses centimetres (a 20 m level, the house 8 cm long), as before.
+    let keep = ImportOptions {
+        bare: BareMesh {
+            keep_far: true,
+            ..BareMesh::default()
+        },
+        ..ImportOptions::default()
+    };
+    let kept = Scene::load(&house, &keep).expect("load");
+    assert_eq!(kept.static_triangles().count(), 1302);
+    assert!(
+        (longest_m(&kept) - 20.0).abs() < 1e-3,
+        "{}",
+        longest_m(&kept)
+    );
+    assert!(
+        kept.report
+            .warnings
+            .join("\n")
+            .contains("read in centimetres")
+    );
+    // A scene TOML keeps every triangle (the bake warns of them), and refuses --keep-far.
+    let toml = dir.path().join("house.toml");
+    let described = Scene::load(&toml, &ImportOptions::default()).expect("load");
+    assert_eq!(described.static_triangles().count(), 1302);
+    let refused = Scene::load(&toml, &keep).expect_err("a TOML keeps every triangle");
+    assert!(refused.to_string().contains("--keep-far"), "{refused}");
+}
