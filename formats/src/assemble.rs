@@ -70,7 +70,11 @@ impl Scene {
                 file: file.to_path_buf(),
             });
         }
-        for w in crate::placement::far_placements(&scene, desc) {
+        let far = crate::placement::far_from_origin(&scene);
+        for w in crate::placement::far_placements(&scene, desc)
+            .into_iter()
+            .chain(far)
+        {
             tracing::warn!("{}: {w}", file.display());
             scene.report.warnings.push(w);
         }

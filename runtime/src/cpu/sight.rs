@@ -37,7 +37,7 @@ use visgate_formats::vgate::{GridMeta, VoxelBits};
 use super::sight_clearance::{chessboard, closed_bricks};
 use super::sight_planes::{self, ClosedPlanes, END_PLANES_OFFSET_VOXELS};
 use super::sight_triangles::{
-    ClosedTriangles, TRIANGLE_TESTS_PER_WALK, TRUE_END_OFFSET_VOXELS, WalkTests,
+    ClosedTriangles, TRIANGLE_TESTS_PER_WALK, WalkTests, true_end_offset,
 };
 
 /// What a walk does at a closed voxel.
@@ -68,6 +68,8 @@ pub struct VoxelSight {
     origin_m: Vec3,
     voxel_m: f32,
     dims: IVec3,
+    /// A true end's offset off its surface ([`true_end_offset`]). [Units: voxels]
+    hair: f32,
     /// The open bits, 32 to a word (bit `i % 32` of word `i / 32`).
     words: Vec<u32>,
     /// Bricks per axis.
@@ -106,10 +108,13 @@ impl VoxelSight {
             div_up(dims.z, BRICK),
         );
         let closed = closed_bricks(dims, bricks, &words);
+        let origin_m = Vec3::from(grid.origin_m);
+        let far_corner = origin_m + dims.as_vec3() * grid.voxel_size_m;
         VoxelSight {
-            origin_m: Vec3::from(grid.origin_m),
+            origin_m,
             voxel_m: grid.voxel_size_m,
             dims,
+            hair: true_end_offset(origin_m, far_corner, grid.voxel_size_m),
             words,
             bricks,
             clear: chessboard(bricks, &closed),
@@ -368,7 +373,7 @@ impl VoxelSight {
 
     /// The true segment's end at surface point `p` (normal `n`), in voxel coordinates.
     pub fn true_end(&self, p: Vec3, n: Vec3) -> Vec3 {
-        self.to_voxels(p) + n * TRUE_END_OFFSET_VOXELS
+        self.to_voxels(p) + n * self.hair
     }
 
     /// Whether light passes between surface points `a` (normal `na`) and `b` (normal `nb`):

@@ -74,8 +74,26 @@ pub const LIST_MAX: usize = (1 << (32 - LIST_START_BITS)) - 1;
 const LIST_LENGTH_MASK: u32 = (1 << (32 - LIST_START_BITS)) - 1;
 
 /// The true segment's end is this far along its surface normal, so that its own triangle does
-/// not hit it. [Units: voxels]
+/// not hit it, or farther where the level lies far from the origin ([`true_end_offset`]).
+/// [Units: voxels]
 pub const TRUE_END_OFFSET_VOXELS: f32 = 1e-3;
+
+/// A true end's offset is at least this many float steps (ulps) of the level's farthest
+/// coordinate: positions are rounded to those steps, so a point on a surface may lie that far
+/// behind it. [Units: ulps]
+pub const TRUE_END_OFFSET_ULPS: f32 = 4.0;
+
+/// The true end's offset along the normal in a grid whose corners lie at `origin_m` and
+/// `far_corner_m`, of voxels `voxel_m` across: [`TRUE_END_OFFSET_VOXELS`], or
+/// [`TRUE_END_OFFSET_ULPS`] float steps of the farthest corner's largest coordinate where that
+/// is more. Every level near the origin keeps 1e-3 (LibreQuake e2m3, 88 m from it, needs 3.3e-4
+/// of its 12.8 cm voxels); the ajar door moved 3 km away needs 0.092 of its 1.56 cm voxels
+/// (1.4 mm), where 1e-3 of one (16 µm) is a fifteenth of the 0.24 mm between floats there, so
+/// that walks began behind their own walls (`tests/far_from_origin.rs`). [Units: voxels]
+pub fn true_end_offset(origin_m: Vec3, far_corner_m: Vec3, voxel_m: f32) -> f32 {
+    let far = origin_m.abs().max(far_corner_m.abs()).max_element();
+    TRUE_END_OFFSET_VOXELS.max(TRUE_END_OFFSET_ULPS * f32::EPSILON * far / voxel_m)
+}
 
 /// The triangles touching each closed voxel that any triangle touches, in the layout the GPU
 /// reads (a rank over the grid, list ids, list offsets, indices, corners).
@@ -385,6 +403,29 @@ pub fn sight_too_large(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_true_end_leaves_its_surface_by_float_steps_far_from_the_origin() {
+        // Near the origin 1e-3 of a voxel (e2m3: 88 m out, 12.8 cm voxels, would need 3.3e-4).
+        let e2m3 = true_end_offset(
+            Vec3::new(-25.2, -30.1, -17.1),
+            Vec3::new(82.9, 18.7, 88.6),
+            0.128,
+        );
+        assert_eq!(e2m3, TRUE_END_OFFSET_VOXELS);
+        // The ajar door 3 km out on 1.56 cm voxels: 4 ε × 3008 m, 1.4 mm, 0.092 voxels.
+        let far = true_end_offset(Vec3::new(3000.0, 0.0, 3000.0), Vec3::splat(3008.0), 0.0156);
+        let want = 4.0 * f32::EPSILON * 3008.0 / 0.0156;
+        assert!(
+            (far - want).abs() < 1e-6 && far > 30.0 * TRUE_END_OFFSET_VOXELS,
+            "{far}"
+        );
+        // Either side of the origin alike.
+        assert_eq!(
+            true_end_offset(Vec3::splat(-3008.0), Vec3::splat(-3000.0), 0.0156),
+            far
+        );
+    }
 
     #[test]
     fn lists_hold_the_triangles_touching_each_closed_voxel_and_nothing_else() {

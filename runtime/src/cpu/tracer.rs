@@ -15,8 +15,23 @@ use obvhs::ray::{Ray, RayHit};
 use obvhs::triangle::Triangle;
 use visgate_formats::Scene;
 
-/// Offset of secondary rays from their surface, relative to the scene's size. [Units: ratio]
+/// Offset of secondary rays from their surface, relative to the scene's size, or
+/// [`RAY_EPSILON_ULPS`] float steps of its farthest coordinate where more. [Units: ratio]
 pub const RAY_EPSILON_REL: f32 = 1e-5;
+
+/// Secondary rays leave their surface by at least this many float steps (ulps) of the scene's
+/// farthest coordinate: a hit point is rounded to them, so it may lie that far behind its
+/// surface (the ajar door moved 3 km from the origin, where floats are 0.24 mm apart and its
+/// 8 m × 1e-5 is 80 µm, shadowed itself in dots; now 1.4 mm). Levels near the origin keep
+/// their size's offset. [Units: ulps]
+pub const RAY_EPSILON_ULPS: f32 = 4.0;
+
+/// The offset of secondary rays from their surface in a scene of bounds `lo`..`hi` (m).
+pub fn ray_epsilon(lo: Vec3, hi: Vec3) -> f32 {
+    let size = (hi - lo).max_element().max(f32::MIN_POSITIVE);
+    let far = lo.abs().max(hi.abs()).max_element();
+    (size * RAY_EPSILON_REL).max(RAY_EPSILON_ULPS * f32::EPSILON * far)
+}
 
 /// Barycentric slack of [`intersect`]: a ray through a shared edge hits one of its triangles.
 const EDGE_SLACK: f32 = 1e-6;
@@ -124,11 +139,7 @@ impl Tracer {
             BvhBuildParams::medium_build(),
             &mut Duration::default(),
         );
-        let size = scene
-            .bounds()
-            .map(|(lo, hi)| (hi - lo).max_element())
-            .unwrap_or(1.0)
-            .max(f32::MIN_POSITIVE);
+        let (lo, hi) = scene.bounds().unwrap_or((Vec3::ZERO, Vec3::ONE));
         Tracer {
             tris,
             data,
@@ -136,7 +147,7 @@ impl Tracer {
             albedo: scene.materials.iter().map(|m| m.albedo).collect(),
             textures: scene.materials.iter().map(|m| m.texture).collect(),
             scene_textures: scene.textures.clone(),
-            epsilon_m: size * RAY_EPSILON_REL,
+            epsilon_m: ray_epsilon(lo, hi),
         }
     }
 
@@ -276,5 +287,25 @@ impl Tracer {
             srgb(tex.rgba8[k + 1]),
             srgb(tex.rgba8[k + 2]),
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rays_leave_their_surface_by_the_levels_size_near_the_origin_and_float_steps_far_from_it() {
+        // An 8 m level at the origin: 80 µm; Sponza (37 m, 19 m out): 0.37 mm.
+        assert_eq!(
+            ray_epsilon(Vec3::ZERO, Vec3::splat(8.0)),
+            8.0 * RAY_EPSILON_REL
+        );
+        let sponza = ray_epsilon(Vec3::new(-19.2, -1.3, -11.8), Vec3::new(18.0, 14.3, 11.1));
+        assert!((sponza - 37.2 * RAY_EPSILON_REL).abs() < 1e-9, "{sponza}");
+        // The same 8 m level 3 km out: 4 ε × 3008 m, 1.4 mm.
+        let far = ray_epsilon(Vec3::splat(3000.0), Vec3::splat(3008.0));
+        assert!((far - 4.0 * f32::EPSILON * 3008.0).abs() < 1e-9, "{far}");
+        assert!(far > 10.0 * 8.0 * RAY_EPSILON_REL);
     }
 }

@@ -37,9 +37,15 @@ fn sight_voxels(p: vec3<f32>) -> vec3<f32> {
 }
 
 // The true segment's end at surface point p (normal n), in voxel coordinates
-// (VoxelSight::true_end; TRUE_END_OFFSET_VOXELS is 1e-3).
+// (VoxelSight::true_end): a hair off the surface, TRUE_END_OFFSET_VOXELS or
+// TRUE_END_OFFSET_ULPS float steps of the grid's farthest coordinate, the more
+// (sight_triangles::true_end_offset).
 fn sight_true_end(p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
-    return sight_voxels(p) + n * 1e-3;
+    let origin = bitcast<vec3<f32>>(vec3<u32>(sight_words[8], sight_words[9], sight_words[10]));
+    let voxel = bitcast<f32>(sight_words[11]);
+    let far = max(abs(origin), abs(origin + vec3<f32>(sight_dims()) * voxel));
+    let ulps = TRUE_END_OFFSET_ULPS * 1.1920929e-7 * max(far.x, max(far.y, far.z)) / voxel;
+    return sight_voxels(p) + n * max(TRUE_END_OFFSET_VOXELS, ulps);
 }
 
 // Word w of listed triangle t as a float (runtime::cpu::sight_triangles::TRIANGLE_WORDS a
