@@ -138,25 +138,18 @@ impl BareMesh {
 /// `metres_per_unit`) were left out of it.
 fn strays_note(path: &Path, s: &Stray, metres_per_unit: f64) -> String {
     let m = metres_per_unit as f32;
-    let p = s.farthest;
     format!(
-        "{}: {} of its {} triangles {} far from the rest, the farthest corner at ({:.2}, {:.2}, \
-         {:.2}) in the file, {:.1} m from the rest's bounds: left out of the level. With them it \
+        "{}: {} in the file, {:.1} m from the rest's bounds: left out of the level. With them it \
          would be {:.1} m long where the rest is {:.2} m, and the bake's voxels {:.0}× as large \
          as the rest needs. A sky box, a helper object left in the export, a vertex in the wrong \
          place? To keep them, pass --keep-far (or name the mesh in a scene TOML, which keeps \
          every triangle)",
         path.display(),
-        s.triangles,
-        s.total,
-        if s.triangles == 1 { "lies" } else { "lie" },
-        p.x,
-        p.y,
-        p.z,
+        s.said("its", "triangles"),
         s.distance_m * m,
         s.longest_m() * m,
         s.rest_longest_m() * m,
-        s.longest_m() / s.rest_longest_m().max(f32::MIN_POSITIVE),
+        s.growth(),
     )
 }
 

@@ -44,6 +44,28 @@ impl Stray {
     pub fn rest_longest_m(&self) -> f32 {
         (self.rest.1 - self.rest.0).max_element()
     }
+
+    /// How many times as large the bake's voxels are with the strays as the rest alone needs.
+    /// [Units: ratio]
+    pub fn growth(&self) -> f32 {
+        self.longest_m() / self.rest_longest_m().max(f32::MIN_POSITIVE)
+    }
+
+    /// "N of `whose` M `what` lie far from the rest, the farthest corner at (x, y, z)", as the
+    /// warnings begin.
+    pub fn said(&self, whose: &str, what: &str) -> String {
+        let p = self.farthest;
+        format!(
+            "{} of {whose} {} {what} {} far from the rest, the farthest corner at ({:.2}, {:.2}, \
+             {:.2})",
+            self.triangles,
+            self.total,
+            if self.triangles == 1 { "lies" } else { "lie" },
+            p.x,
+            p.y,
+            p.z
+        )
+    }
 }
 
 /// The static triangles of `scene` that lie far from the rest, where leaving them out would

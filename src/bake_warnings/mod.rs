@@ -64,25 +64,17 @@ pub fn warn_of_strays(scene: &Scene) {
 
 /// The warning for a level's stray triangles `s`.
 fn stray_warning(s: &Stray) -> String {
-    let p = s.farthest;
     format!(
-        "{} of the level's {} static triangles {} far from the rest: the farthest corner at \
-         ({:.2}, {:.2}, {:.2}) m, {:.0} m from the rest's bounds. The grid spans them, a {:.1} m \
-         level where the rest is {:.2} m long, so its voxels are {:.0}× as large as the rest \
-         alone needs and its rooms and doorways fall to a few voxels. A helper object left in \
-         the export, a sky box or a vertex in the wrong place? Delete them in the modelling \
-         tool, or give them a mesh of their own and mark it `static = false` in a scene TOML \
-         (lit, not baked)",
-        s.triangles,
-        s.total,
-        if s.triangles == 1 { "lies" } else { "lie" },
-        p.x,
-        p.y,
-        p.z,
+        "{} m, {:.0} m from the rest's bounds. The grid spans them, a {:.1} m level where the \
+         rest is {:.2} m long, so its voxels are {:.0}× as large as the rest alone needs and its \
+         rooms and doorways fall to a few voxels. A helper object left in the export, a sky box \
+         or a vertex in the wrong place? Delete them in the modelling tool, or give them a mesh \
+         of their own and mark it `static = false` in a scene TOML (lit, not baked)",
+        s.said("the level's", "static triangles"),
         s.distance_m,
         s.longest_m(),
         s.rest_longest_m(),
-        s.longest_m() / s.rest_longest_m().max(1e-9),
+        s.growth(),
     )
 }
 

@@ -165,7 +165,7 @@ fn a_triangle_far_from_the_level_is_left_out_of_a_bare_mesh_and_named_in_a_scene
             .collect()
     };
     assert_eq!(summary(&left_out), summary(&clean));
-    let said = "1 of the level's 21 static triangles lies far from the rest: the farthest corner \
+    let said = "1 of the level's 21 static triangles lies far from the rest, the farthest corner \
                 at (501.00, 0.00, 0.00) m, 493 m from the rest's bounds. The grid spans them, a \
                 501.0 m level where the rest is 8.00 m long, so its voxels are 63× as large";
     let keep = visgate(&["bake", m, "--keep-far", "--resolution", "32", "-o", o]);
