@@ -29,28 +29,30 @@ pub const FAR_DIAGONALS: f32 = 10.0;
 pub const ORIGIN_DIAGONALS: f32 = 0.02;
 
 /// A level whose farthest coordinate is more than this many times its longest side from the
-/// origin is named ([`far_from_origin`]): the ajar door (8 m) renders as at the origin 3 km out
-/// (375×), and 6 km out (750×) the GPU's shadow maps let its lamp's direct light onto the far
-/// room's floor. [Units: ratio]
-pub const FAR_FROM_ORIGIN_RATIO: f32 = 512.0;
+/// origin is named ([`far_from_origin`]): rays and walks leave their surfaces by 4 float
+/// steps of that coordinate, and past this the steps near a tenth of a percent of the level
+/// (the ajar door, 8 m, renders as at the origin 6 km out, 750×; 30 km out, 3,750×, the
+/// reference lights a line along a corner and the GPU's direct light is 0.72 of it on one
+/// view). [Units: ratio]
+pub const FAR_FROM_ORIGIN_RATIO: f32 = 2048.0;
 
 /// A warning where `scene`'s static geometry lies more than [`FAR_FROM_ORIGIN_RATIO`] times its
-/// longest side from the origin: 32-bit positions there are too coarse for its shadow maps.
+/// longest side from the origin: 32-bit positions there are coarse for its walls.
 pub fn far_from_origin(scene: &Scene) -> Option<String> {
     let (lo, hi) = scene.static_bounds().or_else(|| scene.bounds())?;
     let size = (hi - lo).max_element();
     let far = lo.abs().max(hi.abs()).max_element();
+    // One float step at `far`: 2^(exponent − 23).
+    let step_mm = 1e3 * (far.log2().floor() - 23.0).exp2();
     (far > FAR_FROM_ORIGIN_RATIO * size).then(|| {
         format!(
             "the level lies {far:.0} m from the origin, {:.0}× its {size:.1} m length: 32-bit \
-             floats there are {:.2} mm apart, which may be too coarse for the GPU's shadow maps \
-             to tell a surface from the wall beside it (the ajar door, 8 m long, 6 km out: its \
-             lamp's direct light leaked onto the far room's floor; 3 km out it renders as at \
-             the origin). Move the level near the origin: in a scene TOML, `translate` its \
-             meshes and move its lights and cameras with them",
+             floats there are {step_mm:.2} mm apart, and rays and walks leave surfaces by four \
+             of them, so light may pass walls thinner than that and corners (the ajar door, 8 m \
+             long, 30 km out: a line of light along a corner in the reference, the door's lit \
+             edge dotted on the GPU; 6 km out it renders as at the origin). Move the level near the origin: in a \
+             scene TOML, `translate` its meshes and move its lights and cameras with them",
             far / size,
-            // One float step at `far`: 2^(exponent − 23).
-            1e3 * (far.log2().floor() - 23.0).exp2(),
         )
     })
 }
@@ -320,22 +322,22 @@ mod tests {
 
     #[test]
     fn a_level_hundreds_of_its_lengths_from_the_origin_is_named() {
-        // The 8 m room 2.5 km out (312×) says nothing; 6 km out (750×) it is named.
+        // The 8 m room 2.5 km out (312×) says nothing; 30 km out (3,750×) it is named.
         let (near, _) = scene(
             [250_400.0, 1_150.0, -79_800.0],
             [250_100.0, 1_160.0, -79_900.0],
         );
         assert_eq!(far_from_origin(&near), None);
-        let o = DVec3::new(600_000.0, 0.0, 600_000.0);
+        let o = DVec3::new(3_000_000.0, 0.0, 3_000_000.0);
         let (far, _) = room_at(
             o,
-            [600_400.0, 150.0, 600_200.0],
-            [600_100.0, 160.0, 600_100.0],
+            [3_000_400.0, 150.0, 3_000_200.0],
+            [3_000_100.0, 160.0, 3_000_100.0],
         );
         let w = far_from_origin(&far).expect("named");
         assert!(
-            w.starts_with("the level lies 6008 m from the origin, 751× its 8.0 m length")
-                && w.contains("0.49 mm apart")
+            w.starts_with("the level lies 30008 m from the origin, 3751× its 8.0 m length")
+                && w.contains("1.95 mm apart")
                 && w.contains("`translate`"),
             "{w}"
         );

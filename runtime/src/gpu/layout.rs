@@ -228,10 +228,20 @@ gpu_struct! {
 gpu_struct! {
     /// One shadow layer's view (shadow.wgsl), at 256-byte strides in one uniform buffer.
     pub struct ShadowView {
-        /// The layer's view-projection.
+        /// The layer's view-projection of points relative to the light (x − light): a
+        /// level far from the origin keeps its precision, where a world matrix subtracted
+        /// kilometres inside its product (the ajar door 6 km out: direct light through walls).
         pub view_proj: [[f32; 4]; 4],
         /// xyz light position (m).
         pub light: [f32; 4],
+    }
+}
+
+impl ShadowView {
+    /// The layer's view-projection of world points (the RSM's G-buffer pass draws with it).
+    pub fn world_view_proj(&self) -> glam::Mat4 {
+        let light = glam::Vec3::from_slice(&self.light[..3]);
+        glam::Mat4::from_cols_array_2d(&self.view_proj) * glam::Mat4::from_translation(-light)
     }
 }
 

@@ -5,7 +5,7 @@
 //! the frame's VPL buffer: they stay on the GPU unless a caller asks for them
 //! ([`crate::gpu::GpuRenderer::rsm_vpls`]).
 
-use glam::{Mat4, Vec3};
+use glam::Mat4;
 use visgate_formats::Light as SceneLight;
 
 use super::gbuffer::{Depth, FORMATS, GBuffer};
@@ -91,9 +91,10 @@ fn samples(
             let faces = if cube { 6.0 } else { 1.0 };
             // Direction through (x, y) on the layer's image plane at distance 1.
             let view = &views[layer as usize];
+            // The layer's matrix takes points relative to the light.
             let inv = Mat4::from_cols_array_2d(&view.view_proj).inverse();
             let w = inv * glam::Vec4::new(x / half, y / half, 0.5, 1.0);
-            let dir = (w.truncate() / w.w - Vec3::from_slice(&view.light[..3])).normalize_or_zero();
+            let dir = (w.truncate() / w.w).normalize_or_zero();
             let solid = faces * 4.0 * half * half / m as f32 / (1.0 + x * x + y * y).powf(1.5);
             let power = crate::lights::intensity_towards(l, dir) * solid;
             let tx = (((x / half) * 0.5 + 0.5) * s as f32).clamp(0.0, s as f32 - 1.0) as u32;
@@ -171,7 +172,7 @@ impl RsmVpls {
         let globals: Vec<Globals> = views
             .iter()
             .map(|v| Globals {
-                view_proj: v.view_proj,
+                view_proj: v.world_view_proj().to_cols_array_2d(),
                 eye: v.light,
                 ..bytemuck::Zeroable::zeroed()
             })

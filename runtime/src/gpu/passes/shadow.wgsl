@@ -17,7 +17,8 @@ struct VsOut {
 @vertex
 fn vs(@location(0) position: vec3<f32>) -> VsOut {
     var o: VsOut;
-    o.clip = shadow_view.view_proj * vec4<f32>(position, 1.0);
+    // The matrix takes the point relative to the light (ShadowView::view_proj).
+    o.clip = shadow_view.view_proj * vec4<f32>(position - shadow_view.light.xyz, 1.0);
     o.world = position;
     return o;
 }

@@ -52,7 +52,7 @@ pub fn light_views(scene: &SceneGpu) -> (Vec<Light>, Vec<ShadowView>) {
     let cube = |position: Vec3, views: &mut Vec<ShadowView>| {
         let near = near_of(position);
         for (f, up) in CUBE_FACES {
-            let vp = perspective(1.0, 1.0, near, far) * look_to(position, f, up);
+            let vp = perspective(1.0, 1.0, near, far) * look_to(Vec3::ZERO, f, up);
             views.push(ShadowView {
                 view_proj: vp.to_cols_array_2d(),
                 light: position.extend(1.0).to_array(),
@@ -91,7 +91,7 @@ pub fn light_views(scene: &SceneGpu) -> (Vec<Light>, Vec<ShadowView>) {
                     };
                     let t = cutoff_rad.tan();
                     let vp = perspective(t, t, near_of(position), far)
-                        * look_to(position, direction, up);
+                        * look_to(Vec3::ZERO, direction, up);
                     views.push(ShadowView {
                         view_proj: vp.to_cols_array_2d(),
                         light: position.extend(1.0).to_array(),

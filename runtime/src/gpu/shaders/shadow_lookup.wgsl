@@ -21,7 +21,8 @@ const CONTACT_TEXELS: f32 = 4.0;
 // the light has an unbounded one). [Units: texels per texel]
 const MAX_PLANE_SLOPE: f32 = 8.0;
 
-// Point x in layer `layer`'s texels (continuous: texel (i, j) spans [i, i + 1) × [j, j + 1)).
+// Point x, relative to the layer's light (x − light: ShadowView::view_proj), in layer
+// `layer`'s texels (continuous: texel (i, j) spans [i, i + 1) × [j, j + 1)).
 fn shadow_texels(layer: u32, x: vec3<f32>, size: f32) -> vec2<f32> {
     let clip = shadow_mats[layer] * vec4<f32>(x, 1.0);
     let ndc = clip.xyz / clip.w;
@@ -46,7 +47,7 @@ fn receiver_plane(layer: u32, light: vec3<f32>, q: vec3<f32>, f: vec2<f32>, nf: 
     r.t1 = normalize(cross(nf, up)) * texel;
     r.t2 = cross(nf, r.t1);
     // The texel offsets of one step along each tangent.
-    let m = mat2x2<f32>(shadow_texels(layer, q + r.t1, size) - f, shadow_texels(layer, q + r.t2, size) - f);
+    let m = mat2x2<f32>(shadow_texels(layer, q + r.t1 - light, size) - f, shadow_texels(layer, q + r.t2 - light, size) - f);
     let det = determinant(m);
     r.ok = abs(det) > 1e-4;
     if r.ok {
@@ -105,10 +106,12 @@ fn shadow(l: Light, p: vec3<f32>, n: vec3<f32>, nf: vec3<f32>) -> f32 {
         span = 2.0 * dist * tan(l.direction.w);
     }
     let texel = span / size;
-    let light = l.position.xyz;
-    let q = p + n * texel * globals.shadow_normal_offset;
+    // Everything below relative to the light (the light at the origin): a level kilometres
+    // from the world's origin keeps the precision its receiver plane and occluder points need.
+    let light = vec3<f32>(0.0);
+    let q = p - l.position.xyz + n * texel * globals.shadow_normal_offset;
     let f = shadow_texels(layer, q, size);
-    let q_dist = length(q - light);
+    let q_dist = length(q);
     let c = vec2<i32>(floor(f));
     let last = vec2<i32>(i32(size) - 1);
     let ref_dist = q_dist - texel * globals.shadow_bias;
