@@ -17,6 +17,14 @@ pub const STRAY_SHARE: f64 = 0.01;
 /// this many times shorter. [Units: ratio]
 pub const STRAY_SPAN_RATIO: f32 = 4.0;
 
+/// A bare mesh's stray triangles are left out of it ([`leave_out_strays`]) only where leaving
+/// them out shortens the level more than this many times: a sky box 2 km round a 10 m house
+/// (200×), e2m3's 4,000-unit sky box (37×) and a helper left 500 m from an 8 m level (63×)
+/// are; a room of a few dozen triangles round a statue of thousands, which the
+/// [`STRAY_SPAN_RATIO`] rule takes the room for stray around (an 8 m room round a 1 m statue:
+/// 8×), is not, and the bake warns of it instead. [Units: ratio]
+pub const STRAY_LEAVE_OUT_RATIO: f32 = 16.0;
+
 /// The static triangles far from the rest of a level ([`stray_geometry`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Stray {
@@ -139,8 +147,9 @@ pub fn stray_split(tris: &[[Vec3; 3]]) -> Option<(Stray, Vec<bool>)> {
 }
 
 /// Leaves the stray triangles ([`stray_triangles`]) of a bare mesh's `models` out of them, in
-/// the file's own units and axes, with the vertices only they used; what was left out, `None`
-/// where nothing was. A bare mesh has no scene TOML to mark them `static = false` in, and they
+/// the file's own units and axes, with the vertices only they used, where that shortens the
+/// level more than [`STRAY_LEAVE_OUT_RATIO`] times; what was left out, `None` where nothing
+/// was. A bare mesh has no scene TOML to mark them `static = false` in, and they
 /// would choose its units (a house in a sky box 2 km wide reads as centimetres) and size the
 /// bake's grid.
 pub fn leave_out_strays(models: &mut [ImportedModel]) -> Option<Stray> {
@@ -152,6 +161,9 @@ pub fn leave_out_strays(models: &mut [ImportedModel]) -> Option<Stray> {
         })
         .collect();
     let (stray, far) = stray_split(&tris)?;
+    if stray.growth() <= STRAY_LEAVE_OUT_RATIO {
+        return None;
+    }
     let mut far = far.into_iter();
     for mesh in models.iter_mut().flat_map(|m| &mut m.meshes) {
         mesh.triangles.retain(|_| !far.next().unwrap_or(false));
@@ -170,8 +182,9 @@ fn keep_used_vertices(mesh: &mut RawMesh) {
     // Each kept vertex's new index: how many kept vertices come before it.
     let new_index: Vec<u32> = (used.iter())
         .scan(0u32, |kept, &u| {
+            let before = *kept;
             *kept += u as u32;
-            Some(*kept - 1)
+            Some(before)
         })
         .collect();
     fn keep<T>(v: &mut Vec<T>, used: &[bool]) {
@@ -231,41 +244,45 @@ mod tests {
 
     #[test]
     fn a_bare_meshs_far_triangle_is_left_out_with_the_vertices_only_it_used() {
-        // The room as one mesh of three corners a triangle, the far triangle in its middle.
-        let mut tris = room();
-        let far = Vec3::new(500.0, 0.0, 0.0);
-        tris.insert(10, [far, far + Vec3::X, far + Vec3::Y]);
-        let mesh = RawMesh {
-            name: "level".into(),
-            positions: tris.iter().flatten().copied().collect(),
-            normals: vec![Vec3::Y; 3 * tris.len()],
-            uvs: (0..3 * tris.len())
-                .map(|i| glam::Vec2::splat(i as f32))
-                .collect(),
-            triangles: (0..tris.len() as u32)
-                .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
-                .collect(),
-            material: 0,
-        };
-        let mut models = vec![ImportedModel {
-            meshes: vec![mesh],
-            ..ImportedModel::default()
-        }];
-        let s = leave_out_strays(&mut models).expect("the far triangle");
-        assert_eq!((s.triangles, s.total), (1, 34));
-        let m = &models[0].meshes[0];
-        tris.remove(10);
-        let kept: Vec<[Vec3; 3]> = (m.triangles.iter())
-            .map(|t| t.map(|i| m.positions[i as usize]))
-            .collect();
-        assert_eq!(kept, tris);
-        assert_eq!((m.positions.len(), m.normals.len()), (99, 99));
-        // The texture coordinates follow their vertices: those after the far triangle's moved
-        // down by its three.
-        assert_eq!(m.uvs[30], glam::Vec2::splat(33.0));
-        // Nothing far: nothing left out.
-        assert_eq!(leave_out_strays(&mut models), None);
-        assert_eq!(models[0].meshes[0].triangles.len(), 33);
+        // The room as one mesh of three corners a triangle, the far triangle first, in its
+        // middle or last.
+        for at in [0, 10, 33] {
+            let mut tris = room();
+            let far = Vec3::new(500.0, 0.0, 0.0);
+            tris.insert(at, [far, far + Vec3::X, far + Vec3::Y]);
+            let mesh = RawMesh {
+                name: "level".into(),
+                positions: tris.iter().flatten().copied().collect(),
+                normals: vec![Vec3::Y; 3 * tris.len()],
+                uvs: (0..3 * tris.len())
+                    .map(|i| glam::Vec2::splat(i as f32))
+                    .collect(),
+                triangles: (0..tris.len() as u32)
+                    .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+                    .collect(),
+                material: 0,
+            };
+            let mut models = vec![ImportedModel {
+                meshes: vec![mesh],
+                ..ImportedModel::default()
+            }];
+            let s = leave_out_strays(&mut models).expect("the far triangle");
+            assert_eq!((s.triangles, s.total), (1, 34));
+            let m = &models[0].meshes[0];
+            tris.remove(at);
+            let kept: Vec<[Vec3; 3]> = (m.triangles.iter())
+                .map(|t| t.map(|i| m.positions[i as usize]))
+                .collect();
+            assert_eq!(kept, tris, "far triangle at {at}");
+            assert_eq!((m.positions.len(), m.normals.len()), (99, 99));
+            // The texture coordinates follow their vertices: those after the far triangle's
+            // moved down by its three.
+            let uv = |i: usize| glam::Vec2::splat(if i < 3 * at { i } else { i + 3 } as f32);
+            assert!((0..99).all(|i| m.uvs[i] == uv(i)), "far triangle at {at}");
+            // Nothing far: nothing left out.
+            assert_eq!(leave_out_strays(&mut models), None);
+            assert_eq!(models[0].meshes[0].triangles.len(), 33);
+        }
     }
 
     #[test]

@@ -103,3 +103,43 @@ fn a_sky_box_round_a_bare_house_is_left_out_before_its_units_are_chosen() {
     let refused = Scene::load(&toml, &keep).expect_err("a TOML keeps every triangle");
     assert!(refused.to_string().contains("--keep-far"), "{refused}");
 }
+
+#[test]
+fn a_room_round_a_statue_of_many_triangles_keeps_its_walls() {
+    // An 8 × 3 × 8 m room of 12 triangles round a 1 m statue of 1,600 (a "bunny in a box"): the
+    // far-triangle rule takes the room for the strays round the statue (8× the statue's size),
+    // under the 16× a bare mesh's strays must shorten it by to be left out. The bake warns.
+    let dir = tempfile::tempdir().expect("tempdir");
+    let mut obj = String::new();
+    let mut quad = |c: [[f64; 3]; 4]| {
+        for [x, y, z] in c {
+            writeln!(obj, "v {x} {y} {z}").expect("write");
+        }
+        obj += "f -4 -3 -2 -1\n";
+    };
+    let (s, h) = (8.0, 3.0);
+    quad([[0.0, 0.0, 0.0], [0.0, 0.0, s], [s, 0.0, s], [s, 0.0, 0.0]]);
+    quad([[0.0, h, 0.0], [s, h, 0.0], [s, h, s], [0.0, h, s]]);
+    quad([[0.0, 0.0, 0.0], [s, 0.0, 0.0], [s, h, 0.0], [0.0, h, 0.0]]);
+    quad([[0.0, 0.0, s], [0.0, h, s], [s, h, s], [s, 0.0, s]]);
+    quad([[0.0, 0.0, 0.0], [0.0, h, 0.0], [0.0, h, s], [0.0, 0.0, s]]);
+    quad([[s, 0.0, 0.0], [s, 0.0, s], [s, h, s], [s, h, 0.0]]);
+    // The statue: a 1 m column of 800 thin slabs' tops (1,600 triangles) at the room's middle.
+    for i in 0..800 {
+        let y = 1.0 + i as f64 / 800.0;
+        quad([[3.5, y, 3.5], [3.5, y, 4.5], [4.5, y, 4.5], [4.5, y, 3.5]]);
+    }
+    let path = dir.path().join("statue.obj");
+    std::fs::write(&path, obj).expect("obj");
+    let scene = Scene::load(&path, &ImportOptions::default()).expect("load");
+    let stray = visgate_formats::stray::stray_geometry(&scene).expect("the room taken for strays");
+    assert_eq!((stray.triangles, stray.total), (12, 1612));
+    assert_eq!(scene.static_triangles().count(), 1612);
+    assert!(
+        (longest_m(&scene) - 8.0).abs() < 1e-4,
+        "{}",
+        longest_m(&scene)
+    );
+    let w = scene.report.warnings.join("\n");
+    assert!(!w.contains("left out"), "{w}");
+}
