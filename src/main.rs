@@ -61,10 +61,10 @@ struct Cli {
     #[arg(long, global = true, value_enum)]
     up: Option<UpArg>,
     /// For a bare mesh file: keep the triangles that lie far from the rest. By default a few
-    /// (at most 1 %) whose leaving out shortens the level more than 4× — a sky box, a helper
+    /// (at most 1 %) whose leaving out shortens the level more than 16× — a sky box, a helper
     /// object left in the export, a vertex in the wrong place — are left out, with a warning:
     /// they would choose the units and size the bake's voxels. A scene TOML keeps every
-    /// triangle (the bake then warns of them).
+    /// triangle (the bake then warns of them, from 4×).
     #[arg(long, global = true)]
     keep_far: bool,
 }
