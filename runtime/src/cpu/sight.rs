@@ -417,7 +417,7 @@ impl VoxelSight {
     /// clearances, triangle tests a walk, origin x, y, z (m, f32 bits), voxel edge (m, f32
     /// bits), word offsets in [`SightWords::extra`] of the closed voxels' marks, lists,
     /// triangle indices and triangles (0: no lists), of the planes' counts and planes (0:
-    /// none)]`, the open bits (32 a word), the bricks' clearances, four bytes a word
+    /// none), a true end's offset (voxels, f32 bits: [`true_end_offset`])]`, the open bits (32 a word), the bricks' clearances, four bytes a word
     /// (little-endian). [`SightWords::extra`]: a word 0 (so that no table starts at 0), then
     /// the triangle lists ([`ClosedTriangles::words`]) if they are listed
     /// ([`VoxelSight::list_triangles`]) and the planes ([`ClosedPlanes::words`]) if they are
@@ -445,6 +445,7 @@ impl VoxelSight {
         w.push(self.voxel_m.to_bits());
         w.extend(at);
         w.extend(planes_at);
+        w.push(self.hair.to_bits());
         w.extend(&self.words);
         w.extend(self.clear.chunks(4).map(|c| {
             let mut b = [0u8; 4];
@@ -469,7 +470,7 @@ pub struct SightWords {
 }
 
 /// Words before the open bits in [`VoxelSight::words`].
-pub const SIGHT_HEADER_WORDS: usize = 18;
+pub const SIGHT_HEADER_WORDS: usize = 19;
 
 /// Voxel `i` of a grid of `dims` (x fastest).
 pub(super) fn voxel_of(i: usize, dims: IVec3) -> IVec3 {

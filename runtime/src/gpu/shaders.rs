@@ -146,11 +146,6 @@ pub fn constants() -> String {
     s += &format!("const CSSM_EMPTY_DEPTH: f32 = {CSSM_EMPTY_DEPTH:?};\n");
     s += &format!("const SIGHT_BRICK: i32 = {};\n", crate::cpu::sight::BRICK);
     s += &u("SIGHT_BITS", crate::cpu::sight::SIGHT_HEADER_WORDS as u32);
-    s += &format!(
-        "const TRUE_END_OFFSET_VOXELS: f32 = {:?};\nconst TRUE_END_OFFSET_ULPS: f32 = {:?};\n",
-        crate::cpu::sight_triangles::TRUE_END_OFFSET_VOXELS,
-        crate::cpu::sight_triangles::TRUE_END_OFFSET_ULPS,
-    );
     s += &u(
         "PORTAL_RECORD",
         crate::cpu::portal_walk::PORTAL_RECORD_WORDS,

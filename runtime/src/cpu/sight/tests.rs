@@ -230,6 +230,9 @@ fn the_packed_words_hold_the_bits_and_the_clearances() {
     let w = s.words().base;
     assert_eq!(&w[..6], &[9, 5, 6, 5, 3, 3]);
     assert_eq!(&w[8..12], &[0.0f32, 0.0, 0.0, 1.0].map(f32::to_bits));
+    // A true end's offset, at the origin 1e-3 voxels.
+    let hair = crate::cpu::sight_triangles::TRUE_END_OFFSET_VOXELS;
+    assert_eq!(w[18], hair.to_bits());
     let at = w[6] as usize;
     assert_eq!(at, SIGHT_HEADER_WORDS + 270usize.div_ceil(32));
     for i in 0..270 {

@@ -3,7 +3,8 @@
 // `sight_words: array<u32>` (VoxelSight::words' base: [nx, ny, nz, bricks x, y, z, offset of
 // the clearances, triangle tests a walk, origin xyz (m), voxel edge (m), offsets in
 // sight_extra of the closed voxels' marks, list offsets, triangle indices and corners (0: no
-// lists), of the planes' counts and planes (0: none)], the open bits 32 a word, each brick's
+// lists), of the planes' counts and planes (0: none), a true end's offset (voxels)], the open
+// bits 32 a word, each brick's
 // chessboard distance in bricks to the nearest brick holding a closed voxel, a byte each) and
 // `sight_extra: array<u32>` (its extra, a binding of its own so that each fits the storage
 // binding limit: a word 0, the triangle lists (runtime::cpu::sight_triangles::ClosedTriangles)
@@ -37,15 +38,10 @@ fn sight_voxels(p: vec3<f32>) -> vec3<f32> {
 }
 
 // The true segment's end at surface point p (normal n), in voxel coordinates
-// (VoxelSight::true_end): a hair off the surface, TRUE_END_OFFSET_VOXELS or
-// TRUE_END_OFFSET_ULPS float steps of the grid's farthest coordinate, the more
-// (sight_triangles::true_end_offset).
+// (VoxelSight::true_end): a hair off the surface, the header's word 18
+// (sight_triangles::true_end_offset: more than 1e-3 voxels far from the origin).
 fn sight_true_end(p: vec3<f32>, n: vec3<f32>) -> vec3<f32> {
-    let origin = bitcast<vec3<f32>>(vec3<u32>(sight_words[8], sight_words[9], sight_words[10]));
-    let voxel = bitcast<f32>(sight_words[11]);
-    let far = max(abs(origin), abs(origin + vec3<f32>(sight_dims()) * voxel));
-    let ulps = TRUE_END_OFFSET_ULPS * 1.1920929e-7 * max(far.x, max(far.y, far.z)) / voxel;
-    return sight_voxels(p) + n * max(TRUE_END_OFFSET_VOXELS, ulps);
+    return sight_voxels(p) + n * bitcast<f32>(sight_words[18]);
 }
 
 // Word w of listed triangle t as a float (runtime::cpu::sight_triangles::TRIANGLE_WORDS a
