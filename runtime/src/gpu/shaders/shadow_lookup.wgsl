@@ -29,6 +29,10 @@ fn shadow_texels(layer: u32, x: vec3<f32>, size: f32) -> vec2<f32> {
     return vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5) * size;
 }
 
+// Below, every point is relative to the layer's light (the light at the origin: a level
+// kilometres from the world's origin keeps the precision its receiver plane and occluder
+// points need).
+
 // The receiver's plane (through q, normal nf) in layer `layer`'s texels: `to_tangents` takes a
 // texel offset to steps along its tangents `t1`, `t2` (world, a texel `texel` long), and
 // `slope` is how its distance from the light changes per texel. `ok` is false where the plane
@@ -41,20 +45,20 @@ struct ReceiverPlane {
     ok: bool,
 };
 
-fn receiver_plane(layer: u32, light: vec3<f32>, q: vec3<f32>, f: vec2<f32>, nf: vec3<f32>, texel: f32, size: f32) -> ReceiverPlane {
+fn receiver_plane(layer: u32, q: vec3<f32>, f: vec2<f32>, nf: vec3<f32>, texel: f32, size: f32) -> ReceiverPlane {
     var r: ReceiverPlane;
     let up = select(vec3<f32>(0.0, 1.0, 0.0), vec3<f32>(1.0, 0.0, 0.0), abs(nf.y) > 0.9);
     r.t1 = normalize(cross(nf, up)) * texel;
     r.t2 = cross(nf, r.t1);
     // The texel offsets of one step along each tangent.
-    let m = mat2x2<f32>(shadow_texels(layer, q + r.t1 - light, size) - f, shadow_texels(layer, q + r.t2 - light, size) - f);
+    let m = mat2x2<f32>(shadow_texels(layer, q + r.t1, size) - f, shadow_texels(layer, q + r.t2, size) - f);
     let det = determinant(m);
     r.ok = abs(det) > 1e-4;
     if r.ok {
         r.to_tangents = mat2x2<f32>(vec2<f32>(m[1].y, -m[0].y), vec2<f32>(-m[1].x, m[0].x)) * (1.0 / det);
         // slope · m[k] = e[k], the distance's change along tangent k.
-        let d = length(q - light);
-        let e = vec2<f32>(length(q + r.t1 - light), length(q + r.t2 - light)) - d;
+        let d = length(q);
+        let e = vec2<f32>(length(q + r.t1), length(q + r.t2)) - d;
         let s = e * r.to_tangents;
         r.slope = clamp(s, vec2<f32>(-MAX_PLANE_SLOPE * texel), vec2<f32>(MAX_PLANE_SLOPE * texel));
     }
@@ -63,17 +67,17 @@ fn receiver_plane(layer: u32, light: vec3<f32>, q: vec3<f32>, f: vec2<f32>, nf: 
 
 // The surface stored at texel t (texel centre offset `at` from q's point f): its point, on the
 // texel's ray through the receiver's plane.
-fn stored_point(light: vec3<f32>, q: vec3<f32>, r: ReceiverPlane, at: vec2<f32>, stored: f32) -> vec3<f32> {
+fn stored_point(q: vec3<f32>, r: ReceiverPlane, at: vec2<f32>, stored: f32) -> vec3<f32> {
     let ab = r.to_tangents * at;
     let on_plane = q + r.t1 * ab.x + r.t2 * ab.y;
-    return light + normalize(on_plane - light) * stored;
+    return normalize(on_plane) * stored;
 }
 
 // Whether q lies behind the plane through the occluder's points o, ox and oy, seen from the
-// light.
-fn behind(light: vec3<f32>, q: vec3<f32>, o: vec3<f32>, ox: vec3<f32>, oy: vec3<f32>) -> bool {
+// light (at the origin).
+fn behind(q: vec3<f32>, o: vec3<f32>, ox: vec3<f32>, oy: vec3<f32>) -> bool {
     var n_o = cross(ox - o, oy - o);
-    if dot(n_o, light - o) < 0.0 {
+    if dot(n_o, -o) < 0.0 {
         n_o = -n_o;
     }
     return dot(q - o, n_o) < 0.0;
@@ -106,9 +110,7 @@ fn shadow(l: Light, p: vec3<f32>, n: vec3<f32>, nf: vec3<f32>) -> f32 {
         span = 2.0 * dist * tan(l.direction.w);
     }
     let texel = span / size;
-    // Everything below relative to the light (the light at the origin): a level kilometres
-    // from the world's origin keeps the precision its receiver plane and occluder points need.
-    let light = vec3<f32>(0.0);
+    // q relative to the light, as every point below.
     let q = p - l.position.xyz + n * texel * globals.shadow_normal_offset;
     let f = shadow_texels(layer, q, size);
     let q_dist = length(q);
@@ -128,7 +130,7 @@ fn shadow(l: Light, p: vec3<f32>, n: vec3<f32>, nf: vec3<f32>) -> f32 {
     }
     // Some taps lit and some shadowed: the receiver's own texel, against its plane, may be a
     // contact shadow.
-    let r = receiver_plane(layer, light, q, f, nf, texel, size);
+    let r = receiver_plane(layer, q, f, nf, texel, size);
     let at = vec2<f32>(c) + 0.5 - f;
     let own = shadow_stored(layer, c, last);
     let own_plane = q_dist + dot(r.slope, at);
@@ -147,12 +149,12 @@ fn shadow(l: Light, p: vec3<f32>, n: vec3<f32>, nf: vec3<f32>) -> f32 {
         let zyk = select(zy.y, zy.x, sy > 0.0);
         let zx_back = select(zx.x, zx.y, sx > 0.0);
         let zy_back = select(zy.x, zy.y, sy > 0.0);
-        let o = stored_point(light, q, r, at, own);
-        let ox = stored_point(light, q, r, at + vec2<f32>(sx, 0.0), zxk);
-        let oy = stored_point(light, q, r, at + vec2<f32>(0.0, sy), zyk);
-        let ox_back = stored_point(light, q, r, at - vec2<f32>(sx, 0.0), zx_back);
-        let oy_back = stored_point(light, q, r, at - vec2<f32>(0.0, sy), zy_back);
-        if behind(light, q, o, ox, oy) && behind(light, q, o, ox_back, oy_back) {
+        let o = stored_point(q, r, at, own);
+        let ox = stored_point(q, r, at + vec2<f32>(sx, 0.0), zxk);
+        let oy = stored_point(q, r, at + vec2<f32>(0.0, sy), zyk);
+        let ox_back = stored_point(q, r, at - vec2<f32>(sx, 0.0), zx_back);
+        let oy_back = stored_point(q, r, at - vec2<f32>(0.0, sy), zy_back);
+        if behind(q, o, ox, oy) && behind(q, o, ox_back, oy_back) {
             return 0.0;
         }
     }
