@@ -60,11 +60,12 @@ struct Cli {
     /// along z, else y. The bake, the renders and the viewer must read a mesh the same way.
     #[arg(long, global = true, value_enum)]
     up: Option<UpArg>,
-    /// For a bare mesh file: keep the triangles that lie far from the rest. By default a few
-    /// (at most 1 %) whose leaving out shortens the level more than 16× — a sky box, a helper
-    /// object left in the export, a vertex in the wrong place — are left out, with a warning:
-    /// they would choose the units and size the bake's voxels. A scene TOML keeps every
-    /// triangle (the bake then warns of them, from 4×).
+    /// For a bare mesh file: keep the triangles that lie far from the rest. By default, where
+    /// leaving them out shortens the level more than 16×, a few (at most 1 %) far triangles —
+    /// a sky box, a helper object left in the export, a vertex in the wrong place — or whole
+    /// objects round the rest from far away with no more triangles than it — a sky dome — are
+    /// left out, with a warning: they would choose the units and size the bake's voxels. A
+    /// scene TOML keeps every triangle (the bake then warns of them, from 4×).
     #[arg(long, global = true)]
     keep_far: bool,
 }

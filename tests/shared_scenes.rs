@@ -76,6 +76,12 @@ fn every_shared_scene_loads() {
         assert_eq!(scene.report.degenerate_dropped, degenerate, "{file}");
         assert_eq!(scene.triangle_count(), read - degenerate, "{file}");
         assert_eq!(scene.report.textures_failed, 0, "{file}");
+        // Nothing in them is taken for a sky box, a sky dome or a stray helper.
+        assert_eq!(
+            visgate_formats::stray::stray_geometry(&scene),
+            None,
+            "{file}"
+        );
         if degenerate > 0 {
             assert!(
                 scene

@@ -4,6 +4,8 @@
 //! few voxels (the ajar door with one triangle 500 m away baked to 1 cluster on 3.9 m voxels
 //! where it has 6 on 6 cm). [`stray_geometry`] finds them so that the bake can say where.
 
+use std::ops::Range;
+
 use glam::Vec3;
 
 use crate::import::{ImportedModel, RawMesh};
@@ -40,6 +42,9 @@ pub struct Stray {
     pub bounds: (Vec3, Vec3),
     /// The bounds of the rest. [Units: m]
     pub rest: (Vec3, Vec3),
+    /// The names of the objects the far triangles make up whole, where they surround the rest
+    /// (a sky dome); empty where they are a few triangles of any object.
+    pub objects: Vec<String>,
 }
 
 impl Stray {
@@ -60,12 +65,24 @@ impl Stray {
     }
 
     /// "N of `whose` M `what` lie far from the rest, the farthest corner at (x, y, z)", as the
-    /// warnings begin.
+    /// warnings begin; where they are whole objects round the rest, "… lie far from the rest
+    /// (the whole of 'Sky', round it), …".
     pub fn said(&self, whose: &str, what: &str) -> String {
         let p = self.farthest;
+        let objects = match self.objects.len() {
+            0 => String::new(),
+            n => format!(
+                " (the whole of {}, round it)",
+                (self.objects.iter().take(4))
+                    .map(|o| format!("'{o}'"))
+                    .chain((n > 4).then(|| format!("{} more", n - 4)))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ),
+        };
         format!(
-            "{} of {whose} {} {what} {} far from the rest, the farthest corner at ({:.2}, {:.2}, \
-             {:.2})",
+            "{} of {whose} {} {what} {} far from the rest{objects}, the farthest corner at ({:.2}, \
+             {:.2}, {:.2})",
             self.triangles,
             self.total,
             if self.triangles == 1 { "lies" } else { "lie" },
@@ -78,20 +95,48 @@ impl Stray {
 
 /// The static triangles of `scene` that lie far from the rest, where leaving them out would
 /// shorten the level's longest side more than [`STRAY_SPAN_RATIO`] times; `None` where there
-/// are none (or under 8 triangles). The rest is the box of the triangles' centres with the
-/// [`STRAY_SHARE`] (at least one) lowest and highest left out along each axis; a triangle is
-/// far where a corner lies farther from that box than the box's longest side.
+/// are none: a few triangles ([`far_triangles`]), or whole meshes round the rest
+/// ([`far_parts`]).
 pub fn stray_geometry(scene: &Scene) -> Option<Stray> {
-    stray_triangles(&scene.static_triangles().collect::<Vec<_>>())
+    let parts: Vec<Part> = (scene.meshes.iter())
+        .filter(|m| m.is_static)
+        .map(|m| Part {
+            name: &m.name,
+            triangles: m.triangles.len(),
+        })
+        .collect();
+    let tris: Vec<[Vec3; 3]> = scene.static_triangles().collect();
+    stray_split(&tris, &parts).map(|(s, _)| s)
 }
 
 /// [`stray_geometry`] of a level's static triangles `tris`.
 pub fn stray_triangles(tris: &[[Vec3; 3]]) -> Option<Stray> {
-    stray_split(tris).map(|(s, _)| s)
+    stray_split(tris, &[]).map(|(s, _)| s)
 }
 
-/// [`stray_triangles`], and which of `tris` are the stray ones (true: far from the rest).
-pub fn stray_split(tris: &[[Vec3; 3]]) -> Option<(Stray, Vec<bool>)> {
+/// One object of a level for [`stray_split`]: its name, and how many of the level's
+/// triangles, in order, are its.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Part<'a> {
+    /// The object's name (an OBJ's object or group, a glTF mesh).
+    pub name: &'a str,
+    /// How many triangles it has.
+    pub triangles: usize,
+}
+
+/// [`stray_triangles`] of a level made of `parts` (in the order of `tris`; none: one object),
+/// and which of `tris` are the stray ones (true: far from the rest). The
+/// few far triangles first; where there are none, whole objects that surround the rest from
+/// far away ([`far_parts`]): a sky dome of thousands of triangles round a level of a few
+/// thousand more is more than the [`STRAY_SHARE`] the first rule may leave out.
+pub fn stray_split(tris: &[[Vec3; 3]], parts: &[Part]) -> Option<(Stray, Vec<bool>)> {
+    far_triangles(tris).or_else(|| far_parts(tris, parts))
+}
+
+/// The few far triangles: the rest is the box of the triangles' centres with the
+/// [`STRAY_SHARE`] (at least one) lowest and highest left out along each axis; a triangle is
+/// far where a corner lies farther from that box than the box's longest side.
+fn far_triangles(tris: &[[Vec3; 3]]) -> Option<(Stray, Vec<bool>)> {
     let n = tris.len();
     if n < 8 {
         return None;
@@ -108,42 +153,105 @@ pub fn stray_split(tris: &[[Vec3; 3]]) -> Option<(Stray, Vec<bool>)> {
         let (_, &mut high, _) = above.select_nth_unstable_by(n - 2 - 2 * k, f32::total_cmp);
         (lo[axis], hi[axis]) = (low, high);
     }
-    let reach = (hi - lo).max_element();
+    let reach = longest((lo, hi));
     let far: Vec<bool> = (tris.iter())
         .map(|t| t.iter().any(|&p| off_box(p, (lo, hi)) > reach))
         .collect();
-    let of = |stray: bool| -> Vec<&[Vec3; 3]> {
-        (tris.iter().zip(&far))
-            .filter(|&(_, &f)| f == stray)
-            .map(|(t, _)| t)
-            .collect()
-    };
-    let (strays, rest) = (of(true), of(false));
-    let corners = |tris: &[&[Vec3; 3]]| points_bounds(tris.iter().flat_map(|t| t.iter().copied()));
-    let (Some(rest), Some(bounds)) = (
-        corners(&rest),
-        points_bounds(tris.iter().flatten().copied()),
-    ) else {
-        return None;
-    };
-    let longest = |b: (Vec3, Vec3)| (b.1 - b.0).max_element();
-    if strays.is_empty() || strays.len() > k || longest(bounds) <= STRAY_SPAN_RATIO * longest(rest)
-    {
+    let strays = far.iter().filter(|&&f| f).count();
+    if strays == 0 || strays > k {
         return None;
     }
-    let farthest = strays
-        .iter()
-        .flat_map(|t| t.iter().copied())
-        .max_by(|a, b| off_box(*a, rest).total_cmp(&off_box(*b, rest)))?;
-    let stray = Stray {
-        triangles: strays.len(),
-        total: n,
+    Some((stray_of(tris, &far, Vec::new())?, far))
+}
+
+/// At most this many objects, the largest first, are tried as surrounding the rest of a level
+/// from far away ([`far_parts`]): a sky dome, a sky box, a ground plane to the horizon.
+const MOST_SURROUNDING_PARTS: usize = 4;
+
+/// Whole objects that surround the rest of the level from far away: the fewest of the largest
+/// (at most [`MOST_SURROUNDING_PARTS`]) such that every triangle of each lies, box and all,
+/// farther from the rest's bounds than the rest's longest side, each spans the rest's centre
+/// along its own two longest axes, and together they hold no more triangles than the rest. A
+/// room's floor touches what stands on it, and two buildings far apart do not surround each
+/// other, so neither is taken.
+fn far_parts(tris: &[[Vec3; 3]], parts: &[Part]) -> Option<(Stray, Vec<bool>)> {
+    let mut start = 0;
+    // Each object's triangles, their bounds and its name.
+    let mut spans: Vec<(Range<usize>, (Vec3, Vec3), &str)> = (parts.iter())
+        .filter_map(|p| {
+            let range = start..(start + p.triangles).min(tris.len());
+            start = range.end;
+            let b = points_bounds(tris[range.clone()].iter().flatten().copied())?;
+            Some((range, b, p.name))
+        })
+        .collect();
+    spans.sort_by(|a, b| longest(b.1).total_cmp(&longest(a.1)));
+    for j in 1..spans.len().min(MOST_SURROUNDING_PARTS + 1) {
+        let (out, kept) = spans.split_at(j);
+        let count = |s: &[(Range<usize>, _, _)]| s.iter().map(|s| s.0.len()).sum::<usize>();
+        if count(out) > count(kept) {
+            break;
+        }
+        let rest = (kept.iter().map(|s| s.1)).reduce(|a, b| (a.0.min(b.0), a.1.max(b.1)))?;
+        let (reach, centre) = (longest(rest), 0.5 * (rest.0 + rest.1));
+        let surrounds = |b: (Vec3, Vec3)| {
+            let thinnest = (b.1 - b.0).min_position();
+            (0..3).all(|a| a == thinnest || (b.0[a] <= centre[a] && centre[a] <= b.1[a]))
+        };
+        let far_off = |t: &[Vec3; 3]| {
+            let b = points_bounds(t.iter().copied()).unwrap_or((t[0], t[0]));
+            box_gap(b, rest) > reach
+        };
+        if !out
+            .iter()
+            .all(|s| surrounds(s.1) && tris[s.0.clone()].iter().all(far_off))
+        {
+            continue;
+        }
+        let mut far = vec![false; tris.len()];
+        let mut names: Vec<String> = Vec::new();
+        for (range, _, name) in out {
+            far[range.clone()].fill(true);
+            if !names.iter().any(|n| n == name) {
+                names.push(name.to_string());
+            }
+        }
+        if let Some(stray) = stray_of(tris, &far, names) {
+            return Some((stray, far));
+        }
+    }
+    None
+}
+
+/// The [`Stray`] of `tris` whose `far` ones are left out, `objects` the names of those that
+/// are whole objects; `None` where leaving them out shortens the level no more than
+/// [`STRAY_SPAN_RATIO`] times.
+fn stray_of(tris: &[[Vec3; 3]], far: &[bool], objects: Vec<String>) -> Option<Stray> {
+    let corners = |stray: bool| {
+        (tris.iter().zip(far))
+            .filter(move |&(_, &f)| f == stray)
+            .flat_map(|(t, _)| t.iter().copied())
+    };
+    let rest = points_bounds(corners(false))?;
+    let bounds = points_bounds(tris.iter().flatten().copied())?;
+    if longest(bounds) <= STRAY_SPAN_RATIO * longest(rest) {
+        return None;
+    }
+    let farthest = corners(true).max_by(|a, b| off_box(*a, rest).total_cmp(&off_box(*b, rest)))?;
+    Some(Stray {
+        triangles: far.iter().filter(|&&f| f).count(),
+        total: tris.len(),
         farthest,
         distance_m: off_box(farthest, rest),
         bounds,
         rest,
-    };
-    Some((stray, far))
+        objects,
+    })
+}
+
+/// The longest side of box `b`.
+fn longest(b: (Vec3, Vec3)) -> f32 {
+    (b.1 - b.0).max_element()
 }
 
 /// Leaves the stray triangles ([`stray_triangles`]) of a bare mesh's `models` out of them, in
@@ -160,7 +268,13 @@ pub fn leave_out_strays(models: &mut [ImportedModel]) -> Option<Stray> {
                 .map(|t| t.map(|i| m.positions[i as usize]))
         })
         .collect();
-    let (stray, far) = stray_split(&tris)?;
+    let parts: Vec<Part> = (models.iter().flat_map(|m| &m.meshes))
+        .map(|m| Part {
+            name: &m.name,
+            triangles: m.triangles.len(),
+        })
+        .collect();
+    let (stray, far) = stray_split(&tris, &parts)?;
     if stray.growth() <= STRAY_LEAVE_OUT_RATIO {
         return None;
     }
@@ -199,6 +313,11 @@ fn keep_used_vertices(mesh: &mut RawMesh) {
     for t in &mut mesh.triangles {
         *t = t.map(|i| new_index[i as usize]);
     }
+}
+
+/// How far apart boxes `a` and `b` are (0 where they touch or overlap).
+fn box_gap(a: (Vec3, Vec3), b: (Vec3, Vec3)) -> f32 {
+    (b.0 - a.1).max(a.0 - b.1).max(Vec3::ZERO).length()
 }
 
 /// How far point `p` lies outside box `b` (0 inside).
@@ -299,5 +418,110 @@ mod tests {
         let near = Vec3::new(14.0, 0.0, 0.0);
         tris.push([near, near + Vec3::X, near + Vec3::Y]);
         assert_eq!(stray_triangles(&tris), None);
+    }
+
+    /// A UV sphere of `n` × `n / 2` segments (triangles facing in) round `centre`.
+    fn dome(centre: Vec3, radius: f32, n: usize) -> Vec<[Vec3; 3]> {
+        let at = |j: usize, i: usize| {
+            let (th, ph) = (
+                std::f32::consts::PI * j as f32 / (n / 2) as f32,
+                std::f32::consts::TAU * i as f32 / n as f32,
+            );
+            centre + radius * Vec3::new(th.sin() * ph.cos(), th.cos(), th.sin() * ph.sin())
+        };
+        let mut tris = Vec::new();
+        for j in 0..n / 2 {
+            for i in 0..n {
+                let (a, b, c, d) = (at(j, i), at(j, i + 1), at(j + 1, i + 1), at(j + 1, i));
+                if j > 0 {
+                    tris.push([a, c, b]);
+                }
+                if j + 1 < n / 2 {
+                    tris.push([a, d, c]);
+                }
+            }
+        }
+        tris
+    }
+
+    /// `tris` of the parts `a` then `b`, and the parts.
+    fn two_parts<'a>(
+        a: (&'a str, Vec<[Vec3; 3]>),
+        b: (&'a str, Vec<[Vec3; 3]>),
+    ) -> (Vec<[Vec3; 3]>, Vec<Part<'a>>) {
+        let parts = vec![
+            Part {
+                name: a.0,
+                triangles: a.1.len(),
+            },
+            Part {
+                name: b.0,
+                triangles: b.1.len(),
+            },
+        ];
+        ([a.1, b.1].concat(), parts)
+    }
+
+    #[test]
+    fn a_sky_dome_of_many_triangles_round_the_room_is_found_whole() {
+        // The room's floor in 10 cm squares (3,200 triangles and the tall one) in a dome of 48 ×
+        // 24 segments, 2,208 triangles: far more than the 1 % the few-far-triangles rule takes.
+        let mut dense = Vec::new();
+        for (x, z) in (0..40).flat_map(|x| (0..40).map(move |z| (x, z))) {
+            let p = |dx: i32, dz: i32| Vec3::new((x + dx) as f32, 0.0, (z + dz) as f32) / 10.0;
+            dense.extend([[p(0, 0), p(1, 0), p(1, 1)], [p(0, 0), p(1, 1), p(0, 1)]]);
+        }
+        dense.push(room()[32]);
+        let sky = dome(Vec3::new(2.0, 0.0, 2.0), 500.0, 48);
+        let (tris, parts) = two_parts(("room", dense.clone()), ("sky", sky.clone()));
+        assert_eq!(stray_triangles(&tris), None, "one object: not found");
+        let (s, far) = stray_split(&tris, &parts).expect("the dome");
+        assert_eq!((s.triangles, s.total), (2208, 3201 + 2208));
+        assert_eq!(s.objects, ["sky"]);
+        assert_eq!(s.rest, (Vec3::ZERO, Vec3::new(4.0, 3.0, 4.0)));
+        assert!(far[3201..].iter().all(|&f| f) && !far[..3201].iter().any(|&f| f));
+        assert!(
+            s.said("its", "triangles")
+                .contains("(the whole of 'sky', round it)")
+        );
+        // More triangles than the rest (9,024): not taken for its surroundings.
+        let finer = dome(Vec3::new(2.0, 0.0, 2.0), 500.0, 96);
+        let (tris, parts) = two_parts(("room", dense), ("sky", finer));
+        assert_eq!(stray_split(&tris, &parts), None);
+    }
+
+    #[test]
+    fn a_hall_round_its_furniture_and_two_far_buildings_are_not_strays() {
+        // A 40 m hall of 12 triangles round a 2 m table of 160 in its middle: its walls are
+        // far from the table, its floor is not (the table stands on it).
+        let (l, h) = (40.0, 5.0);
+        let mut hall = Vec::new();
+        let mut quad = |q: [Vec3; 4]| hall.extend([[q[0], q[1], q[2]], [q[0], q[2], q[3]]]);
+        let p = Vec3::new;
+        quad([p(0., 0., 0.), p(0., 0., l), p(l, 0., l), p(l, 0., 0.)]);
+        quad([p(0., h, 0.), p(l, h, 0.), p(l, h, l), p(0., h, l)]);
+        quad([p(0., 0., 0.), p(l, 0., 0.), p(l, h, 0.), p(0., h, 0.)]);
+        quad([p(0., 0., l), p(0., h, l), p(l, h, l), p(l, 0., l)]);
+        quad([p(0., 0., 0.), p(0., h, 0.), p(0., h, l), p(0., 0., l)]);
+        quad([p(l, 0., 0.), p(l, 0., l), p(l, h, l), p(l, h, 0.)]);
+        let table: Vec<[Vec3; 3]> = (0..80)
+            .flat_map(|i| {
+                let y = i as f32 / 80.0;
+                let c = |x: f32, z: f32| p(19.0 + 2.0 * x, y, 19.0 + 2.0 * z);
+                [
+                    [c(0., 0.), c(0., 1.), c(1., 1.)],
+                    [c(0., 0.), c(1., 1.), c(1., 0.)],
+                ]
+            })
+            .collect();
+        let (tris, parts) = two_parts(("table", table), ("hall", hall));
+        assert_eq!(stray_split(&tris, &parts), None);
+        // Two rooms 1 km apart: neither surrounds the other.
+        let far_room = room()
+            .iter()
+            .map(|t| t.map(|v| v + p(1000., 0., 0.)))
+            .collect();
+        let (tris, parts) = two_parts(("near", room()), ("far", far_room));
+        assert_eq!(stray_split(&tris, &parts), None);
     }
 }

@@ -16,6 +16,13 @@ fn every_builtin_loads_with_a_camera_and_a_light_inside_its_empty_space() {
         let scene = b.scene().unwrap_or_else(|e| panic!("{}: {e}", b.name()));
         assert!(scene.triangle_count() > 0, "{}", b.name());
         assert_eq!(scene.report.degenerate_dropped, 0, "{}", b.name());
+        // Nothing in them is taken for a sky box or a stray helper (the bake would warn).
+        assert_eq!(
+            visgate_formats::stray::stray_geometry(&scene),
+            None,
+            "{}",
+            b.name()
+        );
         assert!(
             !scene.lights.is_empty() && !scene.cameras.is_empty(),
             "{}",
