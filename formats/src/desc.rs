@@ -164,6 +164,11 @@ pub struct MeshDesc {
     /// A dynamic mesh's translation moves on a circle about the up axis.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub orbit: Option<Orbit>,
+    /// Objects of the file left out of the scene by name — an OBJ's object or group, a glTF
+    /// mesh (or its node, where the mesh has no name): a sky dome, a helper left in the
+    /// export, which would size the bake's grid. [Limit: each names an object of the file]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub leave_out: Vec<String>,
 }
 
 /// A keyframe of a dynamic mesh.
@@ -359,6 +364,7 @@ impl SceneDesc {
                 scale: Scale::Uniform(1.0),
                 animate: vec![],
                 orbit: None,
+                leave_out: vec![],
             }],
             materials: vec![],
             lights: vec![],

@@ -136,6 +136,42 @@ impl BareMesh {
 
 /// What a user reads when a bare mesh's stray triangles `s` (in the file's units, now read as
 /// `metres_per_unit`) were left out of it.
+/// Leaves the objects that mesh entry `m` names in `leave_out` out of its import `model`; an
+/// error that lists the file's objects where a name is none of them.
+fn leave_out_objects(
+    file: &Path,
+    m: &crate::desc::MeshDesc,
+    model: &mut ImportedModel,
+) -> Result<(), SceneError> {
+    let named = |n: &String| model.meshes.iter().any(|r| &r.name == n);
+    if let Some(missing) = m.leave_out.iter().find(|n| !named(n)) {
+        let mut names: Vec<String> = Vec::new();
+        for r in &model.meshes {
+            if !names.contains(&r.name) {
+                names.push(r.name.clone());
+            }
+        }
+        let shown: Vec<String> = names.iter().take(12).map(|n| format!("'{n}'")).collect();
+        let more = names.len().saturating_sub(shown.len());
+        return Err(SceneError::Invalid {
+            file: file.to_path_buf(),
+            what: format!(
+                "mesh '{}': leave_out names '{missing}', which is no object of the file; its \
+                 objects are {}{}",
+                m.path.display(),
+                shown.join(", "),
+                if more > 0 {
+                    format!(" and {more} more")
+                } else {
+                    String::new()
+                }
+            ),
+        });
+    }
+    model.meshes.retain(|r| !m.leave_out.contains(&r.name));
+    Ok(())
+}
+
 fn strays_note(path: &Path, s: &Stray, metres_per_unit: f64) -> String {
     let m = metres_per_unit as f32;
     format!(
@@ -442,6 +478,9 @@ impl Scene {
             .iter()
             .map(|m| import::import_file(&base.join(&m.path), options))
             .collect::<Result<Vec<_>, _>>()?;
+        for (m, model) in desc.meshes.iter().zip(&mut models) {
+            leave_out_objects(path, m, model)?;
+        }
         let strays = (bare && !options.bare.keep_far)
             .then(|| leave_out_strays(&mut models))
             .flatten();

@@ -180,6 +180,24 @@ fn a_sky_dome_round_a_bare_house_is_left_out_whole() {
         (stray.triangles, &stray.objects[..]),
         (528, &["Sky".to_string()][..])
     );
+    // A scene TOML keeps it, unless it leaves the object out by name; a name that is no
+    // object of the file is refused with the file's objects.
+    let toml = |leave_out: &str| {
+        let path = dir.path().join("leave-out.toml");
+        let text = format!("[[mesh]]\npath = \"house.obj\"\nleave_out = [{leave_out}]\n");
+        std::fs::write(&path, text).expect("toml");
+        Scene::load(&path, &ImportOptions::default())
+    };
+    let described = toml("").expect("load");
+    assert_eq!(described.static_triangles().count(), 1818);
+    let left = toml("\"Sky\"").expect("load");
+    assert_eq!(left.static_triangles().count(), 1290);
+    assert_eq!(visgate_formats::stray::stray_geometry(&left), None);
+    let e = toml("\"Skye\"").expect_err("no such object").to_string();
+    assert!(
+        e.contains("leave_out names 'Skye', which is no object of the file") && e.contains("'Sky'"),
+        "{e}"
+    );
 }
 
 #[test]

@@ -64,12 +64,23 @@ pub fn warn_of_strays(scene: &Scene) {
 
 /// The warning for a level's stray triangles `s`.
 fn stray_warning(s: &Stray) -> String {
+    let fix = if s.objects.is_empty() {
+        "A helper object left in the export, a sky box or a vertex in the wrong place? Delete \
+         them in the modelling tool, or give them a mesh of their own and mark it `static = \
+         false` in a scene TOML (lit, not baked)"
+            .to_string()
+    } else {
+        let names: Vec<String> = s.objects.iter().map(|o| format!("\"{o}\"")).collect();
+        format!(
+            "A sky dome or a sky box? Leave them out in a scene TOML, `leave_out = [{}]` in \
+             their file's [[mesh]], or delete them in the modelling tool",
+            names.join(", ")
+        )
+    };
     format!(
         "{} m, {:.0} m from the rest's bounds. The grid spans them, a {:.1} m level where the \
          rest is {:.2} m long, so its voxels are {:.0}× as large as the rest alone needs and its \
-         rooms and doorways fall to a few voxels. A helper object left in the export, a sky box \
-         or a vertex in the wrong place? Delete them in the modelling tool, or give them a mesh \
-         of their own and mark it `static = false` in a scene TOML (lit, not baked)",
+         rooms and doorways fall to a few voxels. {fix}",
         s.said("the level's", "static triangles"),
         s.distance_m,
         s.longest_m(),
