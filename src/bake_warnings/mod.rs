@@ -271,6 +271,7 @@ fn most_dropped(empty_space: &Value, grid: &GridMeta) -> Option<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::Vec3;
     use serde_json::json;
 
     #[test]
@@ -417,5 +418,33 @@ mod tests {
         // Too few votes: nothing.
         let few = json!({ "components": [comp(&["camera 'a'"], "holds", [40, 45], true)] });
         assert!(mixed_winding(&few, &g).is_none());
+    }
+
+    #[test]
+    fn a_surrounding_object_is_told_the_toml_line_that_leaves_it_out() {
+        let (lo, hi) = (Vec3::splat(-2000.0), Vec3::splat(2000.0));
+        let mut s = Stray {
+            triangles: 2208,
+            total: 24070,
+            farthest: Vec3::new(30.0, 2000.0, 40.0),
+            distance_m: 1981.3,
+            bounds: (lo, hi),
+            rest: (Vec3::ZERO, Vec3::new(108.1, 48.8, 105.7)),
+            objects: vec!["SkyDome".into()],
+        };
+        let w = stray_warning(&s);
+        assert!(
+            w.contains("(the whole of 'SkyDome', round it)")
+                && w.contains("`leave_out = [\"SkyDome\"]` in their file's [[mesh]]")
+                && !w.contains("static = false"),
+            "{w}"
+        );
+        // A few far triangles of any object: their own mesh, marked dynamic.
+        s.objects.clear();
+        let w = stray_warning(&s);
+        assert!(
+            w.contains("static = false") && !w.contains("leave_out"),
+            "{w}"
+        );
     }
 }
