@@ -484,6 +484,14 @@ mod tests {
             s.said("its", "triangles")
                 .contains("(the whole of 'sky', round it)")
         );
+        // A hemisphere, its rim level with the floor, as sky domes often are.
+        let upper: Vec<[Vec3; 3]> = (sky.iter())
+            .filter(|t| t.iter().all(|p| p.y >= -1e-3))
+            .copied()
+            .collect();
+        let (tris, parts) = two_parts(("room", dense.clone()), ("sky", upper.clone()));
+        let (s, _) = stray_split(&tris, &parts).expect("the hemisphere");
+        assert_eq!((s.triangles, &s.objects[..]), (upper.len(), &["sky".to_string()][..]));
         // More triangles than the rest (9,024): not taken for its surroundings.
         let finer = dome(Vec3::new(2.0, 0.0, 2.0), 500.0, 96);
         let (tris, parts) = two_parts(("room", dense), ("sky", finer));
