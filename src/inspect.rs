@@ -23,6 +23,8 @@ struct SceneSummary {
     static_triangles: u64,
     triangles_read: u64,
     degenerate_dropped: u64,
+    /// An OBJ's concave polygons, ear-clipped (visgate_formats::polygons).
+    concave_polygons: u64,
     vertices: u64,
     materials: usize,
     textured_materials: usize,
@@ -110,6 +112,7 @@ fn summarise(scene: &Scene) -> SceneSummary {
         static_triangles: scene.static_triangle_count(),
         triangles_read: scene.report.triangles_read,
         degenerate_dropped: scene.report.degenerate_dropped,
+        concave_polygons: scene.report.concave_polygons,
         vertices: scene.meshes.iter().map(|m| m.positions.len() as u64).sum(),
         materials: scene.materials.len(),
         textured_materials: scene
@@ -188,8 +191,15 @@ fn print_scene(s: &SceneSummary) {
         s.meshes, s.static_meshes, s.dynamic_meshes
     );
     println!(
-        "triangles   {} ({} static); {} read, {} degenerate dropped",
-        s.triangles, s.static_triangles, s.triangles_read, s.degenerate_dropped
+        "triangles   {} ({} static); {} read, {} degenerate dropped{}",
+        s.triangles,
+        s.static_triangles,
+        s.triangles_read,
+        s.degenerate_dropped,
+        match s.concave_polygons {
+            0 => String::new(),
+            n => format!("; {n} concave polygons ear-clipped"),
+        }
     );
     println!("vertices    {}", s.vertices);
     println!(

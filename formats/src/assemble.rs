@@ -124,6 +124,7 @@ impl Scene {
         report.degenerate_dropped += model.degenerate_dropped;
         report.textures_failed += model.textures_failed;
         report.textures_fitted += model.textures_fitted;
+        report.concave_polygons += model.concave_polygons as u64;
         (report.glowing_materials).extend(model.emissive.iter().map(|m| m + mat_base));
         report.warnings.extend(model.warnings);
         self.textures.extend(model.textures);

@@ -92,6 +92,8 @@ pub struct ImportedModel {
     pub alpha_masked: Vec<u32>,
     /// Textures filtered down to `scene::MAX_TEXTURE_TEXELS` at import.
     pub textures_fitted: u64,
+    /// An OBJ's concave polygons, ear-clipped where tobj would have fanned them (polygons.rs).
+    pub concave_polygons: usize,
 }
 
 /// Opacity under which a see-through material's surfaces are left out of the level (glass):
@@ -150,7 +152,8 @@ pub fn import_file(path: &Path, options: &ImportOptions) -> Result<ImportedModel
 
 fn tobj_options() -> tobj::LoadOptions {
     tobj::LoadOptions {
-        triangulate: true,
+        // Polygons are triangulated in polygons.rs: tobj fans them, wrong where concave.
+        triangulate: false,
         single_index: true,
         ignore_points: true,
         ignore_lines: true,
@@ -286,7 +289,10 @@ fn import_obj_reader(
                 default_index(&mut default_material, &mut out)
             }
         };
-        let indices = mesh.indices.iter().map(|&i| i as u64);
+        let (triangles, concave) =
+            crate::polygons::triangulate(&positions, &mesh.indices, &mesh.face_arities);
+        out.concave_polygons += concave;
+        let indices = triangles.iter().map(|&i| i as u64);
         let raw = build_mesh(
             path,
             model.name.clone(),

@@ -34,6 +34,7 @@ pub mod load;
 pub mod mitsuba;
 pub mod mtl_map;
 pub mod placement;
+pub mod polygons;
 pub mod room_height;
 pub mod scene;
 pub mod stray;

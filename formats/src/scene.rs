@@ -149,8 +149,11 @@ pub struct Camera {
 /// What the import saw and did, for reports.
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
 pub struct ImportReport {
-    /// Triangles in the files after fan triangulation of polygons.
+    /// Triangles in the files after triangulation of polygons (convex ones fanned, concave
+    /// ones ear-clipped: `crate::polygons`).
     pub triangles_read: u64,
+    /// An OBJ's concave polygons, ear-clipped (a fan from a corner would cover their notches).
+    pub concave_polygons: u64,
     /// Zero-area triangles dropped.
     pub degenerate_dropped: u64,
     /// Textures that failed to load (their materials fall back to the albedo).

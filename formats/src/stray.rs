@@ -491,7 +491,10 @@ mod tests {
             .collect();
         let (tris, parts) = two_parts(("room", dense.clone()), ("sky", upper.clone()));
         let (s, _) = stray_split(&tris, &parts).expect("the hemisphere");
-        assert_eq!((s.triangles, &s.objects[..]), (upper.len(), &["sky".to_string()][..]));
+        assert_eq!(
+            (s.triangles, &s.objects[..]),
+            (upper.len(), &["sky".to_string()][..])
+        );
         // More triangles than the rest (9,024): not taken for its surroundings.
         let finer = dome(Vec3::new(2.0, 0.0, 2.0), 500.0, 96);
         let (tris, parts) = two_parts(("room", dense), ("sky", finer));
