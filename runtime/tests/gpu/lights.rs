@@ -203,13 +203,39 @@ fn gpu_the_dark_side_of_a_zero_thickness_walls_joins_stays_dark() {
     // the floor and the outer walls, which run on under and past it into the lit room. A
     // shadow map's bias and its PCF taps past the wall's edge lit a line along each join on the
     // dark side: 131 of the 69,975 pixels dark in the reference and away from its lit ones
-    // (0.19 %); the receiver's own texel tested against its plane leaves 17 (0.02 %).
+    // (0.19 %); the receiver's own texel tested against its plane left 17 (0.02 %), and from
+    // `main` 55 of 71,833 (0.08 %), dots along the joins of the walls and ceiling with the
+    // dividing wall, on receivers millimetres behind it (all nine taps lit by the bias); with
+    // the own texel tested wherever it is nearer than the receiver too, 10 and 5.
     let ctx = context();
     let scene = Builtin::AjarDoor.scene().expect("scene");
-    let cam = scene.camera("door").expect("camera");
+    for camera in ["door", "main"] {
+        let (leaks, dark) = leaks_on_the_dark_side(&ctx, &scene, camera);
+        let share = leaks as f64 / dark as f64;
+        eprintln!(
+            "{camera}: {leaks} of {dark} dark pixels lit on the GPU ({:.3} %)",
+            100.0 * share
+        );
+        assert!(dark > 30_000, "{dark}");
+        assert!(
+            share < 2.5e-4,
+            "{camera}: {leaks} of {dark} dark pixels lit"
+        );
+    }
+}
+
+/// Of the pixels dark in the reference's direct light from `camera` at 320 × 240, with every
+/// neighbour within two pixels dark too (not a shadow's edge), how many the GPU lights, and
+/// how many there are.
+fn leaks_on_the_dark_side(
+    ctx: &GpuContext,
+    scene: &visgate_formats::Scene,
+    camera: &str,
+) -> (usize, usize) {
+    let cam = scene.camera(camera).expect("camera");
     let [w, h] = [320u32, 240];
     let view = View::new(cam, [w, h]).expect("view");
-    let (gpu, cpu) = direct_on_gpu_and_cpu(&ctx, &scene, &view);
+    let (gpu, cpu) = direct_on_gpu_and_cpu(ctx, scene, &view);
     let lit = |img: &visgate_runtime::hdr::HdrImage, x: i64, y: i64| {
         x >= 0
             && y >= 0
@@ -229,13 +255,7 @@ fn gpu_the_dark_side_of_a_zero_thickness_walls_joins_stays_dark() {
             leaks += usize::from(lit(&gpu, x, y));
         }
     }
-    let share = leaks as f64 / dark as f64;
-    eprintln!(
-        "{leaks} of {dark} dark pixels lit on the GPU ({:.3} %)",
-        100.0 * share
-    );
-    assert!(dark > 30_000, "{dark}");
-    assert!(share < 1e-3, "{leaks} of {dark} dark pixels lit");
+    (leaks, dark)
 }
 
 #[test]

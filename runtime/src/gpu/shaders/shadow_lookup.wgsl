@@ -6,8 +6,10 @@
 // That bias lit every receiver within about a texel behind a zero-thickness wall, and the taps
 // past a thin wall's edge see the surface that runs on past it (a floor under a wall, an outer
 // wall that a dividing wall meets) lit on the far side at the receiver's own distance: a
-// dotted line of light along every such join, on the dark side. So where the taps disagree,
-// the receiver's own texel is tested against the receiver's plane along that texel's ray
+// dotted line of light along every such join, on the dark side. So where the taps disagree, or
+// all are lit but the own texel holds a surface nearer than the receiver (a receiver
+// millimetres behind a wall it meets, which the bias lit), the receiver's own texel is tested
+// against the receiver's plane along that texel's ray
 // (receiver-plane depth: the plane through q with the face's normal, its distance per texel
 // solved from two tangent steps), with no bias but the plane's own change over half a texel:
 // shadowed there by a surface within CONTACT_TEXELS of the receiver, and behind that surface's
@@ -125,17 +127,22 @@ fn shadow(l: Light, p: vec3<f32>, n: vec3<f32>, nf: vec3<f32>) -> f32 {
             lit += select(0.0, 1.0, stored >= ref_dist);
         }
     }
-    if lit == 9.0 || lit == 0.0 {
-        return lit / 9.0;
+    if lit == 0.0 {
+        return 0.0;
     }
-    // Some taps lit and some shadowed: the receiver's own texel, against its plane, may be a
-    // contact shadow.
+    // Some taps lit, or all of them: the receiver's own texel, against its plane, may be a
+    // contact shadow (all taps lit: a receiver within the bias behind a zero-thickness wall,
+    // where a side wall or the ceiling meets it).
     let r = receiver_plane(layer, q, f, nf, texel, size);
     let at = vec2<f32>(c) + 0.5 - f;
     let own = shadow_stored(layer, c, last);
     let own_plane = q_dist + dot(r.slope, at);
     let rounding = 0.5 * (abs(r.slope.x) + abs(r.slope.y));
-    if r.ok && own < own_plane - rounding && own > own_plane - CONTACT_TEXELS * texel {
+    // Nearer than the receiver's plane there, or than the receiver itself: a receiver
+    // millimetres behind a zero-thickness wall that meets it (under a texel, the bias's reach)
+    // sees the wall at its own texel nearer than itself but not than its plane's rounding.
+    let nearer = own < own_plane - rounding || own < q_dist;
+    if r.ok && nearer && own > own_plane - CONTACT_TEXELS * texel {
         // Only behind the occluder's own plane, from its texel and the nearer-valued neighbour
         // along each axis, and from the opposite ones too: a surface meeting the receiver on
         // the lit side of a crease hides the receiver's plane past the crease, not the
