@@ -91,6 +91,24 @@ fn write_dome(obj: &mut String, radius: f64, n: usize) {
     }
 }
 
+/// Options that keep a bare mesh's far triangles (`--keep-far`).
+fn keep_far() -> ImportOptions {
+    ImportOptions {
+        bare: BareMesh {
+            keep_far: true,
+            ..BareMesh::default()
+        },
+        ..ImportOptions::default()
+    }
+}
+
+/// Asserts that `scene` is the house alone, in metres: 1,280 + 10 triangles, 8 m long.
+fn assert_the_house_alone(scene: &Scene) {
+    assert_eq!(scene.static_triangles().count(), 1290);
+    let longest = longest_m(scene);
+    assert!((longest - 8.0).abs() < 1e-4, "{longest}");
+}
+
 fn longest_m(scene: &Scene) -> f32 {
     let (lo, hi) = scene.bounds().expect("bounds");
     (hi - lo).max_element()
@@ -101,13 +119,7 @@ fn a_sky_box_round_a_bare_house_is_left_out_before_its_units_are_chosen() {
     let dir = tempfile::tempdir().expect("tempdir");
     let house = dir.path().join(write_house_in_sky(dir.path(), Sky::Box));
     let scene = Scene::load(&house, &ImportOptions::default()).expect("load");
-    // The house alone, in metres: 1,280 + 10 triangles.
-    assert!(
-        (longest_m(&scene) - 8.0).abs() < 1e-4,
-        "{}",
-        longest_m(&scene)
-    );
-    assert_eq!(scene.static_triangles().count(), 1290);
+    assert_the_house_alone(&scene);
     let w = scene.report.warnings.join("\n");
     assert!(
         w.contains("12 of its 1302 triangles lie far from the rest")
@@ -118,13 +130,7 @@ fn a_sky_box_round_a_bare_house_is_left_out_before_its_units_are_chosen() {
         "{w}"
     );
     // Kept: the sky box chooses centimetres (a 20 m level, the house 8 cm long), as before.
-    let keep = ImportOptions {
-        bare: BareMesh {
-            keep_far: true,
-            ..BareMesh::default()
-        },
-        ..ImportOptions::default()
-    };
+    let keep = keep_far();
     let kept = Scene::load(&house, &keep).expect("load");
     assert_eq!(kept.static_triangles().count(), 1302);
     assert!(
@@ -151,12 +157,7 @@ fn a_sky_dome_round_a_bare_house_is_left_out_whole() {
     let dir = tempfile::tempdir().expect("tempdir");
     let house = dir.path().join(write_house_in_sky(dir.path(), Sky::Dome));
     let scene = Scene::load(&house, &ImportOptions::default()).expect("load");
-    assert_eq!(scene.static_triangles().count(), 1290);
-    assert!(
-        (longest_m(&scene) - 8.0).abs() < 1e-4,
-        "{}",
-        longest_m(&scene)
-    );
+    assert_the_house_alone(&scene);
     let w = scene.report.warnings.join("\n");
     assert!(
         w.contains(
@@ -166,15 +167,14 @@ fn a_sky_dome_round_a_bare_house_is_left_out_whole() {
         "{w}"
     );
     // Kept, the dome chooses centimetres, and the bake warns of it as a whole.
-    let keep = ImportOptions {
-        bare: BareMesh {
-            keep_far: true,
-            ..BareMesh::default()
-        },
-        ..ImportOptions::default()
-    };
-    let kept = Scene::load(&house, &keep).expect("load");
+    let kept = Scene::load(&house, &keep_far()).expect("load");
     assert_eq!(kept.static_triangles().count(), 1818);
+    assert!(
+        kept.report
+            .warnings
+            .join("\n")
+            .contains("read in centimetres")
+    );
     let stray = visgate_formats::stray::stray_geometry(&kept).expect("the dome");
     assert_eq!(
         (stray.triangles, &stray.objects[..]),
