@@ -134,8 +134,6 @@ impl BareMesh {
     }
 }
 
-/// What a user reads when a bare mesh's stray triangles `s` (in the file's units, now read as
-/// `metres_per_unit`) were left out of it.
 /// Leaves the objects that mesh entry `m` names in `leave_out` out of its import `model`; an
 /// error that lists the file's objects where a name is none of them.
 fn leave_out_objects(
@@ -172,6 +170,8 @@ fn leave_out_objects(
     Ok(())
 }
 
+/// What a user reads when a bare mesh's stray triangles `s` (in the file's units, now read as
+/// `metres_per_unit`) were left out of it.
 fn strays_note(path: &Path, s: &Stray, metres_per_unit: f64) -> String {
     let m = metres_per_unit as f32;
     format!(
