@@ -165,8 +165,9 @@ pub struct MeshDesc {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub orbit: Option<Orbit>,
     /// Objects of the file left out of the scene by name — an OBJ's object or group, a glTF
-    /// mesh (or its node, where the mesh has no name): a sky dome, a helper left in the
-    /// export, which would size the bake's grid. [Limit: each names an object of the file]
+    /// node (the object as Blender names it; its mesh's name where the node has none): a sky
+    /// dome, a helper left in the export, which would size the bake's grid. [Limit: each
+    /// names an object of the file]
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub leave_out: Vec<String>,
 }

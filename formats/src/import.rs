@@ -41,7 +41,7 @@ impl Default for ImportOptions {
 /// One mesh as read from a file, in the file's own units and axes.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RawMesh {
-    /// Object/group or glTF mesh name.
+    /// An OBJ's object or group name, a glTF node's (its mesh's where the node has none).
     pub name: String,
     /// Positions.
     pub positions: Vec<Vec3>,

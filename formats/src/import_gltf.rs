@@ -88,10 +88,14 @@ pub fn import_gltf(path: &Path, options: &ImportOptions) -> Result<ImportedModel
             .or(node.name())
             .map(str::to_string)
             .unwrap_or_else(|| format!("mesh {}", mesh.index()));
+        // The object as a modelling tool names it (Blender's object, a game engine's actor):
+        // the node, or its mesh where the node has no name.
+        let object = node.name().unwrap_or(&mname);
         for prim in mesh.primitives() {
             let material = prim.material().index().map(|i| i as u32);
             let placed = Placed {
                 name: &mname,
+                object,
                 world,
                 material: material.unwrap_or(default_material),
                 uv_map: material.map_or(UvMap::default(), |m| {
@@ -127,7 +131,10 @@ struct File<'a> {
 
 /// Where a primitive goes: its mesh's name, its node's world transform, its material.
 struct Placed<'a> {
+    /// The mesh's name (its node's where it has none), as the warnings name it.
     name: &'a str,
+    /// The object's: the node's name, or the mesh's ([`RawMesh::name`]).
+    object: &'a str,
     world: Mat4,
     material: u32,
     /// How its material's base colour texture maps it.
@@ -359,7 +366,11 @@ fn primitive(
         placed.material,
         out,
     )?;
-    Ok(Some(raw))
+    // Errors above name the mesh; the level knows it as its object.
+    Ok(Some(RawMesh {
+        name: placed.object.to_string(),
+        ..raw
+    }))
 }
 
 /// An image's pixels as RGBA8 (grey and grey-alpha spread, RGB made opaque).

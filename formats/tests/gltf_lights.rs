@@ -248,3 +248,28 @@ fn glowing_materials_in_a_scene_without_lights_are_told_to_need_a_light() {
     let p = gltf(d, nodes, &format!("{LIGHTS}{glow}"), "[0,1]");
     assert!(!said(&p).contains("glows"), "{}", said(&p));
 }
+
+#[test]
+fn a_scene_toml_leaves_a_gltf_object_out_by_its_node_name() {
+    // The wall's triangle placed twice: as the node "wall" and, 500 m off, as "SkyDome" (the
+    // object's name in Blender; its mesh is still "wall").
+    let dir = tempfile::tempdir().expect("tempdir");
+    let nodes = r#"{"mesh":0,"name":"SkyDome","translation":[500,0,0]}"#;
+    gltf(dir.path(), nodes, "", "[0,1]");
+    let toml = |leave_out: &str| {
+        let path = dir.path().join("s.toml");
+        let text = format!("[[mesh]]\npath = \"t.gltf\"\nleave_out = [{leave_out}]\n");
+        std::fs::write(&path, text).expect("toml");
+        Scene::load(&path, &ImportOptions::default())
+    };
+    assert_eq!(toml("").expect("load").static_triangles().count(), 2);
+    let left = toml("\"SkyDome\"").expect("load");
+    let tris: Vec<[Vec3; 3]> = left.static_triangles().collect();
+    assert_eq!(tris.len(), 1);
+    assert!(tris[0].iter().all(|p| p.x <= 4.0), "{tris:?}");
+    let e = toml("\"Sphere\"").expect_err("no such object").to_string();
+    assert!(
+        e.contains("its objects are") && e.contains("'SkyDome'"),
+        "{e}"
+    );
+}
