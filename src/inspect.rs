@@ -19,6 +19,9 @@ struct SceneSummary {
     meshes: usize,
     static_meshes: usize,
     dynamic_meshes: usize,
+    /// The objects (meshes of one name: an OBJ's object or group, a glTF node) and their
+    /// triangles, the most first: the names a scene TOML's `leave_out` takes.
+    objects: Vec<(String, usize)>,
     triangles: u64,
     static_triangles: u64,
     triangles_read: u64,
@@ -108,6 +111,7 @@ fn summarise(scene: &Scene) -> SceneSummary {
         meshes: scene.meshes.len(),
         static_meshes: scene.meshes.iter().filter(|m| m.is_static).count(),
         dynamic_meshes: scene.meshes.iter().filter(|m| !m.is_static).count(),
+        objects: objects(scene),
         triangles: scene.triangle_count(),
         static_triangles: scene.static_triangle_count(),
         triangles_read: scene.report.triangles_read,
@@ -145,6 +149,23 @@ fn summarise(scene: &Scene) -> SceneSummary {
         warnings: scene.report.warnings.clone(),
     }
 }
+
+/// `scene`'s objects: its meshes' names, each with the triangles of the meshes of that name,
+/// the most first.
+fn objects(scene: &Scene) -> Vec<(String, usize)> {
+    let mut out: Vec<(String, usize)> = Vec::new();
+    for m in &scene.meshes {
+        match out.iter_mut().find(|(name, _)| *name == m.name) {
+            Some((_, n)) => *n += m.triangles.len(),
+            None => out.push((m.name.clone(), m.triangles.len())),
+        }
+    }
+    out.sort_by_key(|o| std::cmp::Reverse(o.1));
+    out
+}
+
+/// Objects the text summary names.
+const OBJECTS_LISTED: usize = 6;
 
 /// Lights the text summary lists one a line.
 const LIGHTS_LISTED: usize = 8;
@@ -189,6 +210,20 @@ fn print_scene(s: &SceneSummary) {
     println!(
         "meshes      {} ({} static, {} dynamic)",
         s.meshes, s.static_meshes, s.dynamic_meshes
+    );
+    let named: Vec<String> = (s.objects.iter().take(OBJECTS_LISTED))
+        .map(|(name, n)| format!("'{name}' {n}"))
+        .collect();
+    let more = s.objects.len().saturating_sub(OBJECTS_LISTED);
+    println!(
+        "objects     {}: {}{} (triangles; a scene TOML's leave_out takes these names)",
+        s.objects.len(),
+        named.join(", "),
+        if more > 0 {
+            format!(", and {more} more")
+        } else {
+            String::new()
+        }
     );
     println!(
         "triangles   {} ({} static); {} read, {} degenerate dropped{}",

@@ -44,6 +44,13 @@ fn inspect_a_builtin_as_text_and_json() {
         out.contains("rooms       3.00 m floor to ceiling (the median of"),
         "{out}"
     );
+    // Its objects by name, the most triangles first: what a scene TOML's leave_out takes.
+    let o = visgate(&["inspect", "builtin:ajar-door"]);
+    let out = stdout(&o);
+    assert!(
+        out.contains("objects     5: 'wood' 72, 'wall' 14, 'floor' 2, 'ceiling' 2, 'red' 2"),
+        "{out}"
+    );
     // Each light a line: the four rooms' lamp and spot, where they are and how bright.
     let o = visgate(&["inspect", "builtin:four-rooms"]);
     let out = stdout(&o);
